@@ -1,0 +1,1 @@
+"""The ``hexdem`` command line: one small module per subcommand (see :mod:`.main`)."""

@@ -1,0 +1,54 @@
+"""``hexdem`` entry point: subcommands as modules with ``add_arguments`` and ``run``.
+
+Subcommand modules are imported lazily (only the one asked for), following ASE's CLI.
+Every :class:`~hexdem.errors.HexdemError` is printed as one line, ``hexdem: error: ...``,
+with exit status 2; ``--traceback`` shows the full traceback instead.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from hexdem.errors import HexdemError
+
+#: name → (module, one-line help)
+COMMANDS = {
+    "run": ("hexdem.cli.run", "simulate one impact (default: the paper's 11-per-edge experiment)"),
+}
+
+
+def build_parser(argv) -> argparse.ArgumentParser:
+    """The parser, with full options only for the subcommand named in ``argv``."""
+    wanted = next((token for token in argv if token in COMMANDS), None)
+    parser = argparse.ArgumentParser(prog="hexdem", description="Impulses in 2D hexagonal granular crystals.")
+    parser.add_argument("--traceback", action="store_true", help="show full tracebacks on errors")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for name, (module_name, help_text) in COMMANDS.items():
+        module = importlib.import_module(module_name) if name == wanted else None
+        command = sub.add_parser(name, help=help_text, description=help_text)
+        if module is not None:
+            module.add_arguments(command)
+            command.set_defaults(_module=module)
+    return parser
+
+
+def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = build_parser(argv).parse_args(argv)
+    try:
+        args._module.run(args)
+    except HexdemError as exc:
+        if args.traceback:
+            raise
+        print(f"hexdem: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("hexdem: interrupted", file=sys.stderr)
+        return 130
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,26 @@
+"""``hexdem run``: one impact simulation, written to an output directory."""
+
+from __future__ import annotations
+
+from hexdem.config import ENGINES, RunConfig
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("--config", metavar="FILE.toml", help="parameters (keys: RunConfig fields); "
+                        "default: the paper's 11-per-edge steel experiment")
+    parser.add_argument("--out", metavar="DIR", default="results", help="output directory (default: results/)")
+    parser.add_argument("--ranks", type=int, metavar="N", help="MPI ranks for LAMMPS (default 1, in-process)")
+    parser.add_argument("--engine", choices=ENGINES, help="integrator (default: lammps)")
+
+
+def config_from_args(args) -> RunConfig:
+    """The config file (or the defaults) with command-line overrides applied."""
+    config = RunConfig.from_toml(args.config) if args.config else RunConfig()
+    overrides = {key: value for key, value in (("ranks", args.ranks), ("engine", args.engine)) if value is not None}
+    return config.replace(**overrides)
+
+
+def run(args) -> None:
+    from hexdem.experiment import run_experiment
+
+    run_experiment(config_from_args(args), args.out)

@@ -1,0 +1,115 @@
+"""Render a :class:`~hexdem.model.GranularModel` into a standalone LAMMPS run directory.
+
+The directory holds ``data.hexdem`` (atoms: id type diameter density x y z) and
+``in.hexdem`` (from ``lammps_inputs/impact.in``); ``cd DIR && lmp -in in.hexdem`` reruns it
+by hand. Quantities are written in the chosen :class:`~hexdem.units.UnitSystem`: SI
+(``units si``) or the paper's A = d = M = 1 (``units lj``). Contacts use the ``hertz k_n``
+model, F = k_n sqrt(R_eff δ) δ, for bead pairs and for the walls alike, so the walls carry
+their own modulus (the wall fix's ``hertz/material`` cannot mix materials, LAMMPS issue 4141).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from string import Template
+
+import numpy as np
+
+from hexdem.model import GranularModel, RunSettings
+
+DECK_NAME = "in.hexdem"
+DATA_NAME = "data.hexdem"
+DUMP_NAME = "dump.lammpstrj"
+#: Atom types: lattice beads and the striker.
+BEAD_TYPE, STRIKER_TYPE = 1, 2
+
+
+@dataclass(frozen=True)
+class Deck:
+    """A rendered run directory: where its input, data and dump files are."""
+
+    directory: Path
+    settings: RunSettings
+    n_atoms: int
+
+    @property
+    def input_path(self) -> Path:
+        return self.directory / DECK_NAME
+
+    @property
+    def dump_path(self) -> Path:
+        return self.directory / DUMP_NAME
+
+    @property
+    def log_path(self) -> Path:
+        return self.directory / "log.lammps"
+
+
+def _fmt(value: float) -> str:
+    return repr(float(value))
+
+
+def _data_file(model: GranularModel, units: UnitSystem) -> str:
+    pos = model.initial_positions_m() / units.length_m
+    diam = model.diameters_m / units.length_m
+    density = model.bead.density_kg_m3 / units.density_kg_m3
+    margin = 2.0 * diam.max()
+    lo, hi = pos.min(axis=0) - margin, pos.max(axis=0) + margin
+    types = np.full(model.n_bodies, BEAD_TYPE)
+    if model.has_striker:
+        types[-1] = STRIKER_TYPE
+    lines = [f"hexdem data file: {model.lattice.shape}", "",
+             f"{model.n_bodies} atoms", "2 atom types", "",
+             f"{_fmt(lo[0])} {_fmt(hi[0])} xlo xhi", f"{_fmt(lo[1])} {_fmt(hi[1])} ylo yhi",
+             f"{_fmt(-diam.max())} {_fmt(diam.max())} zlo zhi", "", "Atoms # sphere", ""]
+    lines += [f"{i + 1} {t} {_fmt(d)} {_fmt(density)} {_fmt(x)} {_fmt(y)} 0.0"
+              for i, (t, d, (x, y)) in enumerate(zip(types, diam, pos))]
+    return "\n".join(lines) + "\n"
+
+
+def _walls_block(model: GranularModel, units: UnitSystem) -> str:
+    if not model.walls:
+        return "# (no walls)\n"
+    stiffness = _fmt(model.wall_stiffness_pa / units.stress_pa)
+    block = []
+    for wall in model.walls:
+        point = np.asarray(wall.normal) * wall.offset_m / units.length_m
+        ids = " ".join(str(i + 1) for i in wall.members)
+        block += [f"group           {wall.name} id {ids}",
+                  f"region          {wall.name} plane {_fmt(point[0])} {_fmt(point[1])} 0.0 "
+                  f"{_fmt(wall.normal[0])} {_fmt(wall.normal[1])} 0.0 side in",
+                  f"fix             {wall.name} {wall.name} wall/gran/region granular hertz {stiffness} 0.0 "
+                  f"damping viscoelastic tangential linear_nohistory 0.0 0.0 region {wall.name}"]
+    return "\n".join(block) + "\n"
+
+
+def render_input(model: GranularModel, settings: RunSettings) -> str:
+    """The text of ``in.hexdem`` for ``model`` run with ``settings``."""
+    units = settings.units
+    impactor = model.n_bodies if model.has_striker else model.lattice.struck + 1
+    velocity = model.impact.speed_m_s * model.impact.direction / units.velocity_m_s
+    note = ("SI (m, kg, s)" if units.name == "si" else
+            f"nondimensional A = d = M = 1 (d = {units.length_m} m, M = {units.mass_kg} kg, "
+            f"T = {units.time_s} s)")
+    template = Template(resources.files("hexdem.lammps_inputs").joinpath("impact.in").read_text())
+    return template.substitute(
+        title=f"{model.lattice.shape}, V0 = {model.impact.speed_m_s} m/s at {model.impact.angle_deg} deg"
+              + (" by a striker" if model.has_striker else " on the struck bead"),
+        units_note=note, lammps_units=units.lammps_units,
+        pair_stiffness=_fmt(model.pair_stiffness_pa / units.stress_pa),
+        skin=_fmt(0.1 * model.lattice.diameter_m / units.length_m),
+        walls=_walls_block(model, units), impactor_id=impactor,
+        vx=_fmt(velocity[0]), vy=_fmt(velocity[1]), dt=_fmt(settings.dt_s / units.time_s),
+        thermo_every=max(1, settings.n_steps // 20), dump_every=settings.dump_every,
+        nsteps=settings.n_steps)
+
+
+def write_deck(model: GranularModel, settings: RunSettings, directory) -> Deck:
+    """Write ``data.hexdem`` and ``in.hexdem`` into ``directory`` (created if needed)."""
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    (directory / DATA_NAME).write_text(_data_file(model, settings.units))
+    (directory / DECK_NAME).write_text(render_input(model, settings))
+    return Deck(directory, settings, model.n_bodies)

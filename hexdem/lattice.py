@@ -1,0 +1,178 @@
+"""Geometry of 2D hexagonal (triangular) packings of touching beads, indexed as in the paper.
+
+Bead {m, n} (m + n even) of an ideal packing with diameter d sits at
+    x = (√3/2) d n,   y = (d/2) m,
+so its six touching neighbours are {m ± 2, n} and {m ± 1, n ± 1} (the paper's e₁, e₂, e₃,
+Sec. III, rotated so that the struck edge is vertical). The struck bead is the centre bead
+{0, 0} of the left edge n = 0; the wave runs towards +x.
+
+Strike angles are measured from +x: 0° is perpendicular to the struck edge and pushes the
+two neighbours at ±30°; 30° points along a line of touching beads. Observation lines
+start at the struck bead (n = 0 on every line):
+
+* ``"0"``   beads {0, 2k}: exactly on the x axis, spacing √3 d;
+* ``"+30"`` beads {k, k}: touching beads at +30°, spacing d;
+* ``"-30"`` beads {−k, k}: touching beads at −30°, spacing d.
+
+Shapes: :func:`hexagon` (N beads per edge, 3N(N−1)+1 beads; N = 11 is the experiment) and
+:func:`half_hexagon` (Fig. 4: a hexagon cut along its long diagonal, which becomes the
+struck edge). Each shape carries its flat confining walls, placed touching the outermost
+beads without compressing them, with the hole at the impact site.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from hexdem.errors import HexdemError
+
+#: Observation lines and the step in (m, n) between consecutive beads on each.
+LINE_STEPS = {"0": (0, 2), "+30": (1, 1), "-30": (-1, 1)}
+#: Index offsets of the three neighbours counted once per bond (paper's e₁, e₂, e₃).
+BOND_STEPS = ((2, 0), (1, 1), (-1, 1))
+#: A bead belongs to a wall's contact group when its gap to the wall is below this many d.
+WALL_GROUP_GAP = 0.25
+
+
+@dataclass(frozen=True)
+class Wall:
+    """A flat wall {x : normal·x = offset_m} that pushes beads along ``normal`` (inward).
+
+    ``members`` are the indices of the beads that can touch it: the beads of that edge,
+    minus the struck bead for the wall with the impact hole.
+    """
+
+    name: str
+    normal: tuple[float, float]
+    offset_m: float
+    members: np.ndarray
+
+    def gaps_m(self, positions_m, radii_m):
+        """Signed gap between each bead surface and the wall (negative = overlap) [m]."""
+        return np.asarray(positions_m) @ np.asarray(self.normal) - radii_m - self.offset_m
+
+
+@dataclass(frozen=True)
+class Lattice:
+    """A finite hexagonal packing: indices, positions, diameters, walls and lines.
+
+    ``indices`` (N, 2) int paper labels {m, n}; ``positions_m`` (N, 2) bead centres [m];
+    ``diameters_m`` (N,) per-bead diameters [m] (all equal for the ideal lattice);
+    ``diameter_m`` the nominal diameter d; ``struck`` index of the struck bead;
+    ``walls`` the confining walls; ``shape`` a readable description.
+    """
+
+    indices: np.ndarray
+    positions_m: np.ndarray
+    diameters_m: np.ndarray
+    diameter_m: float
+    struck: int
+    walls: tuple[Wall, ...]
+    shape: str
+    _lookup: dict = field(default=None, repr=False, compare=False)
+
+    def __post_init__(self):
+        object.__setattr__(self, "_lookup", {tuple(mn): i for i, mn in enumerate(self.indices.tolist())})
+
+    def __len__(self) -> int:
+        return len(self.indices)
+
+    @property
+    def radii_m(self) -> np.ndarray:
+        return self.diameters_m / 2.0
+
+    def index_of(self, m: int, n: int) -> int | None:
+        """The bead index of label {m, n}, or None when it is not in the packing."""
+        return self._lookup.get((m, n))
+
+    def bonds(self) -> np.ndarray:
+        """(B, 2) index pairs of touching neighbours, each bond once (the paper's fixed bonds)."""
+        pairs = [(i, j) for i, (m, n) in enumerate(self.indices.tolist())
+                 for dm, dn in BOND_STEPS if (j := self.index_of(m + dm, n + dn)) is not None]
+        return np.array(pairs, dtype=int).reshape(-1, 2)
+
+    def line(self, name: str) -> np.ndarray:
+        """Bead indices on observation line ``name`` ("0", "+30", "-30"), from the struck bead."""
+        if name not in LINE_STEPS:
+            raise HexdemError(f"unknown observation line {name!r}; known: {', '.join(LINE_STEPS)}")
+        (m0, n0), (dm, dn) = self.indices[self.struck], LINE_STEPS[name]
+        beads, k = [], 0
+        while (i := self.index_of(m0 + k * dm, n0 + k * dn)) is not None:
+            beads.append(i)
+            k += 1
+        return np.array(beads, dtype=int)
+
+    def lines(self) -> dict[str, np.ndarray]:
+        return {name: self.line(name) for name in LINE_STEPS}
+
+    def with_geometry(self, positions_m, diameters_m) -> "Lattice":
+        """The same labels with new positions and diameters, walls re-placed to touch them."""
+        moved = replace(self, positions_m=np.asarray(positions_m, float),
+                        diameters_m=np.asarray(diameters_m, float), walls=())
+        return replace(moved, walls=touching_walls(moved, [w.normal for w in self.walls]))
+
+
+def strike_direction(angle_deg: float) -> np.ndarray:
+    """Unit vector of a strike at ``angle_deg`` from +x; it must point into the packing."""
+    angle = float(angle_deg)
+    if not np.isfinite(angle) or abs(angle) >= 90.0:
+        raise HexdemError(f"strike angle {angle_deg}° does not point into the packing; "
+                          "use an angle in (-90°, 90°), e.g. 0 or 30")
+    return np.array([np.cos(np.radians(angle)), np.sin(np.radians(angle))])
+
+
+def _from_layers(half_heights, diameter_m: float, wall_angles_deg, shape: str) -> Lattice:
+    """Packing whose layer n (x = (√3/2) d n) holds the beads |m| ≤ half_heights[n]."""
+    if not diameter_m > 0:
+        raise HexdemError(f"bead diameter must be > 0 m, got {diameter_m}")
+    labels = np.array([(m, n) for n, h in enumerate(half_heights)
+                       for m in range(-h, h + 1) if (m + n) % 2 == 0], dtype=int)
+    positions = np.column_stack([np.sqrt(3) / 2 * labels[:, 1], labels[:, 0] / 2.0]) * diameter_m
+    lattice = Lattice(indices=labels, positions_m=positions,
+                      diameters_m=np.full(len(labels), float(diameter_m)), diameter_m=float(diameter_m),
+                      struck=int(np.flatnonzero((labels[:, 0] == 0) & (labels[:, 1] == 0))[0]),
+                      walls=(), shape=shape)
+    normals = [(np.cos(np.radians(a)), np.sin(np.radians(a))) for a in wall_angles_deg]
+    return replace(lattice, walls=touching_walls(lattice, normals))
+
+
+def touching_walls(lattice: Lattice, normals) -> tuple[Wall, ...]:
+    """Flat walls with the given inward normals, each touching the packing without overlap.
+
+    The wall whose normal is +x (the struck edge) has a hole: the struck bead is not a member.
+    """
+    walls = []
+    for normal in normals:
+        normal = (float(normal[0]), float(normal[1]))
+        reach = lattice.positions_m @ np.asarray(normal) - lattice.radii_m
+        offset = float(reach.min())
+        members = np.flatnonzero(reach - offset < WALL_GROUP_GAP * lattice.diameter_m)
+        if np.isclose(normal[0], 1.0):
+            members = members[members != lattice.struck]
+        angle = int(round(np.degrees(np.arctan2(normal[1], normal[0]))))
+        walls.append(Wall(f"wall_{angle:03d}".replace("-", "m"), normal, offset, members))
+    return tuple(walls)
+
+
+def hexagon(edge_beads: int, diameter_m: float = 1.0) -> Lattice:
+    """Regular hexagon with ``edge_beads`` beads per edge, struck edge vertical (N = 11: 331 beads)."""
+    if int(edge_beads) != edge_beads or edge_beads < 2:
+        raise HexdemError(f"a hexagon needs at least 2 beads per edge, got {edge_beads}")
+    k = int(edge_beads) - 1
+    heights = [k + min(n, 2 * k - n) for n in range(2 * k + 1)]
+    return _from_layers(heights, diameter_m, (0, 180, 60, -60, 120, -120), f"hexagon, {k + 1} per edge")
+
+
+def half_hexagon(long_edge: int = 91, short_edge: int = 46, diameter_m: float = 1.0) -> Lattice:
+    """Half of a hexagon cut along its long diagonal (Fig. 4): that diagonal is the struck edge.
+
+    ``long_edge`` = 2·``short_edge`` − 1 beads (91 and 46 → 3151 beads).
+    """
+    if int(short_edge) != short_edge or short_edge < 2 or long_edge != 2 * short_edge - 1:
+        raise HexdemError(f"a half-hexagon needs long_edge = 2*short_edge - 1 >= 3, "
+                          f"got long {long_edge}, short {short_edge}")
+    heights = [long_edge - 1 - n for n in range(int(short_edge))]
+    return _from_layers(heights, diameter_m, (0, 180, 120, -120),
+                        f"half-hexagon, long edge {long_edge}, short edges {short_edge}")
