@@ -16,6 +16,11 @@ from hexdem.errors import HexdemError
 #: name → (module, one-line help)
 COMMANDS = {
     "run": ("hexdem.cli.run", "simulate one impact (default: the paper's 11-per-edge experiment)"),
+    "compare": ("hexdem.cli.compare", "run one configuration through LAMMPS and the reference integrator"),
+    "tca": ("hexdem.cli.tca", "ternary collision approximation: omega, c, pulse speeds (Sec. IV)"),
+    "scaling": ("hexdem.cli.scaling", "velocity-decay scaling laws over a V0 sweep (Sec. V)"),
+    "ensemble": ("hexdem.cli.ensemble", "weakly disordered ensembles with striker impacts (Sec. VI)"),
+    "snapshots": ("hexdem.cli.snapshots", "wavefront speed maps at chosen times (Figs. 3 and 4)"),
 }
 
 
