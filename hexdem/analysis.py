@@ -81,9 +81,16 @@ class BeadRecord(_analysis_base()):
         return pulse_times(self.results.times, self.results.speeds[:, atoms])
 
 
-def read_dump(path, dt: float) -> BeadRecord:
-    """Open and walk a hexdem dump: the finished :class:`BeadRecord`."""
+def read_dump(path, dt: float, expected_frames: int | None = None) -> BeadRecord:
+    """Open and walk a hexdem dump: the finished :class:`BeadRecord`.
+
+    MDAnalysis silently drops an incomplete last frame, so a dump cut short (a killed or
+    crashed run) is only recognised by its frame count: pass ``expected_frames``.
+    """
     universe = open_dump(path, dt)
+    if expected_frames is not None and len(universe.trajectory) != expected_frames:
+        raise HexdemError(f"dump {path} is corrupt or truncated: {len(universe.trajectory)} "
+                          f"of {expected_frames} frames")
     try:
         return BeadRecord(universe).run()
     except HexdemError:

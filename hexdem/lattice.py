@@ -123,12 +123,12 @@ def strike_direction(angle_deg: float) -> np.ndarray:
     return np.array([np.cos(np.radians(angle)), np.sin(np.radians(angle))])
 
 
-def _from_layers(half_heights, diameter_m: float, wall_angles_deg, shape: str) -> Lattice:
-    """Packing whose layer n (x = (√3/2) d n) holds the beads |m| ≤ half_heights[n]."""
+def _from_layers(half_heights, diameter_m: float, wall_angles_deg, shape: str, shift: int = 0) -> Lattice:
+    """Packing whose layer n (x = (√3/2) d n) holds the beads |m − shift| ≤ half_heights[n]."""
     if not diameter_m > 0:
         raise HexdemError(f"bead diameter must be > 0 m, got {diameter_m}")
     labels = np.array([(m, n) for n, h in enumerate(half_heights)
-                       for m in range(-h, h + 1) if (m + n) % 2 == 0], dtype=int)
+                       for m in range(shift - h, shift + h + 1) if (m + n) % 2 == 0], dtype=int)
     positions = np.column_stack([np.sqrt(3) / 2 * labels[:, 1], labels[:, 0] / 2.0]) * diameter_m
     lattice = Lattice(indices=labels, positions_m=positions,
                       diameters_m=np.full(len(labels), float(diameter_m)), diameter_m=float(diameter_m),
@@ -157,12 +157,17 @@ def touching_walls(lattice: Lattice, normals) -> tuple[Wall, ...]:
 
 
 def hexagon(edge_beads: int, diameter_m: float = 1.0) -> Lattice:
-    """Regular hexagon with ``edge_beads`` beads per edge, struck edge vertical (N = 11: 331 beads)."""
+    """Regular hexagon with ``edge_beads`` beads per edge, struck edge vertical (N = 11: 331 beads).
+
+    With an even count the struck edge has two middle beads; the struck bead {0, 0} is the
+    lower one (the packing is shifted up by half a bead).
+    """
     if int(edge_beads) != edge_beads or edge_beads < 2:
         raise HexdemError(f"a hexagon needs at least 2 beads per edge, got {edge_beads}")
     k = int(edge_beads) - 1
     heights = [k + min(n, 2 * k - n) for n in range(2 * k + 1)]
-    return _from_layers(heights, diameter_m, (0, 180, 60, -60, 120, -120), f"hexagon, {k + 1} per edge")
+    return _from_layers(heights, diameter_m, (0, 180, 60, -60, 120, -120), f"hexagon, {k + 1} per edge",
+                        shift=k % 2)
 
 
 def half_hexagon(long_edge: int = 91, short_edge: int = 46, diameter_m: float = 1.0) -> Lattice:

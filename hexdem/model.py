@@ -117,3 +117,8 @@ class RunSettings:
     @property
     def duration_s(self) -> float:
         return self.dt_s * self.n_steps
+
+    @property
+    def n_samples(self) -> int:
+        """Samples taken, t = 0 included (LAMMPS dumps every ``dump_every`` steps and at step 0)."""
+        return self.n_steps // self.dump_every + 1

@@ -29,9 +29,8 @@ def save(fig, path) -> None:
 def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=None):
     """Beads as true-size circles coloured by ``values`` (NaN drawn grey); returns the mappable."""
     circles = PatchCollection([Circle(p, d / 2) for p, d in zip(positions, diameters)],
-                              cmap=cmap, edgecolor="k", linewidth=0.2)
+                              cmap=plt.get_cmap(cmap).with_extremes(bad="lightgrey"), edgecolor="k", linewidth=0.2)
     circles.set_array(np.ma.masked_invalid(values))
-    circles.get_cmap().set_bad("lightgrey")
     if clim is not None:
         circles.set_clim(*clim)
     ax.add_collection(circles)

@@ -23,7 +23,7 @@ class LammpsEngine:
         deck = write_deck(model, settings, directory)
         info = run_deck(deck, self.ranks)
         units = settings.units
-        record = read_dump(deck.dump_path, settings.dt_s / units.time_s).results
+        record = read_dump(deck.dump_path, settings.dt_s / units.time_s, settings.n_samples).results
         return Trajectory(times_s=record.times * units.time_s,
                           velocities_m_s=record.velocities * units.velocity_m_s,
                           displacements_m=record.displacements * units.length_m,

@@ -1,0 +1,110 @@
+"""Bad input gets one clear line from the CLI, exit status 2, and no partial result files."""
+
+import numpy as np
+import pytest
+
+from hexdem.analysis import read_dump
+from hexdem.cli.main import main
+from hexdem.config import RunConfig
+from hexdem.errors import HexdemError
+from hexdem.experiment import RESULT_FILES
+from hexdem.lammps import library
+from hexdem.lammps.deck import write_deck
+from hexdem.lammps.runner import run_deck
+
+
+def run_cli(tmp_path, capsys, config_text=None, out=None):
+    args = ["run", "--out", str(out or tmp_path / "out")]
+    if config_text is not None:
+        (tmp_path / "bad.toml").write_text(config_text)
+        args += ["--config", str(tmp_path / "bad.toml")]
+    code = main(args)
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert not any("Traceback" in line for line in lines)
+    return code, [line for line in lines if not line.startswith("hexdem: running")]
+
+
+def assert_no_results(directory):
+    if directory.exists():
+        assert not [name for name in RESULT_FILES if (directory / name).exists()]
+        assert not (directory / "deck").exists()
+        assert not list(directory.glob("*.part"))
+
+
+@pytest.mark.parametrize("config_text, message", [
+    ("edge_beads = 1", "at least 2 beads per edge"),
+    ("v0 = 0.0", "v0 must be > 0"),
+    ("v0 = -0.4", "v0 must be > 0"),
+    ("strike_angle_deg = 95", "strike angle 95"),
+    ('shape = "square"', "unknown shape 'square'"),
+    ("diameter_m = -0.01", "bead diameter must be > 0"),
+    ("ranks = 0", "ranks must be a positive integer"),
+    ("velocity = 0.4", "unknown parameter(s) velocity"),
+    ("v0 = [", "not valid TOML"),
+])
+def test_bad_config_is_one_line_and_writes_nothing(tmp_path, capsys, config_text, message):
+    code, err = run_cli(tmp_path, capsys, config_text)
+    assert code == 2
+    assert len(err) == 1 and err[0].startswith("hexdem: error:") and message in err[0]
+    assert_no_results(tmp_path / "out")
+
+
+def test_unwritable_output_directory(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a directory")
+    code, err = run_cli(tmp_path, capsys, out=blocker / "out")
+    assert code == 2 and len(err) == 1 and "is not writable" in err[0]
+
+
+def test_lammps_failure_names_lammps_message_and_the_kept_deck(tmp_path, capsys):
+    code, err = run_cli(tmp_path, capsys, "dt = 1e-3\nduration = 0.05")
+    out = tmp_path / "out"
+    assert code == 2 and len(err) == 1
+    assert "LAMMPS failed on" in err[0] and "ERROR" in err[0] and str(out / "deck.failed" / "in.hexdem") in err[0]
+    assert (out / "deck.failed" / "log.lammps").exists()
+    assert_no_results(out)
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_deck_error_is_reported_with_lammps_message(tmp_path, ranks):
+    config = RunConfig(edge_beads=3)
+    deck = write_deck(config.model(), config.settings(), tmp_path)
+    deck.input_path.write_text(deck.input_path.read_text().replace("pair_style      granular", "pair_style nonsense"))
+    with pytest.raises(HexdemError, match=r"LAMMPS failed on .*in\.hexdem: ERROR: .*nonsense") as info:
+        run_deck(deck, ranks)
+    assert "\n" not in str(info.value)
+
+
+def test_corrupt_dump_is_a_clear_error(tmp_path):
+    dump = tmp_path / "dump.lammpstrj"
+    dump.write_text("ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n3\nthis is not a dump\n")
+    with pytest.raises(HexdemError, match="corrupt"):
+        read_dump(dump, 1e-7)
+    with pytest.raises(HexdemError, match="does not exist"):
+        read_dump(tmp_path / "missing", 1e-7)
+
+
+def test_truncated_dump_is_a_clear_error(default_run, tmp_path):
+    text = (default_run[0] / "deck" / "dump.lammpstrj").read_text()
+    dump = tmp_path / "dump.lammpstrj"
+    dump.write_text(text[: len(text) // 2])
+    settings = default_run[1].settings
+    with pytest.raises(HexdemError, match=f"truncated: .* of {settings.n_samples} frames"):
+        read_dump(dump, settings.dt_s, settings.n_samples)
+
+
+def test_missing_lammps_module(monkeypatch):
+    monkeypatch.setitem(__import__("sys").modules, "lammps", None)
+    with pytest.raises(HexdemError, match="LAMMPS Python module is not installed"):
+        library.load_lammps.__wrapped__()
+
+
+def test_lammps_loads_without_ld_library_path():
+    lammps = library.load_lammps()
+    instance = lammps.lammps(cmdargs=["-screen", "none", "-log", "none", "-nocite"])
+    try:
+        assert instance.has_package("GRANULAR")
+    finally:
+        instance.close()
+    assert library.mpi_library_path().name == "libmpi.so.12"
+    assert np.isfinite(float(instance.version()))

@@ -1,0 +1,84 @@
+"""The default experiment (``hexdem run``) on real LAMMPS: files, energy, symmetry, ranks, units."""
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+from hexdem.config import RunConfig
+from hexdem.experiment import RESULT_FILES, simulate
+from hexdem.impact import PEAK_COLUMNS
+
+
+def read_peaks(path):
+    with open(path, newline="") as fh:
+        reader = csv.DictReader(fh)
+        return reader.fieldnames, list(reader)
+
+
+def test_default_run_writes_the_contracted_files(default_run):
+    out, analysis = default_run
+    for name in RESULT_FILES:
+        assert (out / name).stat().st_size > 0
+    assert (out / "deck" / "in.hexdem").exists() and (out / "deck" / "dump.lammpstrj").exists()
+    header, rows = read_peaks(out / "peaks.csv")
+    assert tuple(header) == PEAK_COLUMNS
+    assert {row["line"] for row in rows} == {"0", "+30", "-30"}
+    assert [int(r["n"]) for r in rows if r["line"] == "0"] == list(range(11))
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["lattice"]["n_beads"] == 331
+    assert summary["lammps_version"].startswith("LAMMPS")
+    assert summary["far_wall_reached"] is True
+
+
+def test_default_run_conserves_energy(default_run):
+    _, analysis = default_run
+    assert analysis.results.energy_drift < 1e-5
+
+
+def test_zero_degree_strike_is_mirror_symmetric(default_run):
+    r = default_run[1].results
+    upper, lower = r.lines["+30"], r.lines["-30"]
+    np.testing.assert_allclose(r.peak_speed[upper], r.peak_speed[lower], rtol=1e-9)
+    np.testing.assert_allclose(r.arrival_time[upper], r.arrival_time[lower], rtol=0, atol=1e-12)
+
+
+def test_struck_bead_starts_at_v0_and_the_wave_decays_along_every_line(default_run):
+    r = default_run[1].results
+    for beads in r.lines.values():
+        assert r.peak_speed[beads[0]] == pytest.approx(0.4, rel=1e-12)
+        assert np.all(np.diff(r.peak_speed[beads][:8]) < 0)
+        assert np.all(np.diff(r.arrival_time[beads]) > 0)
+
+
+def test_one_and_two_ranks_give_the_same_peaks(default_run, tmp_path):
+    one = default_run[1].results
+    two = simulate(RunConfig(ranks=2), tmp_path).results
+    assert default_run[1].trajectory.engine["ranks"] == 1
+    np.testing.assert_allclose(two.peak_speed, one.peak_speed, rtol=1e-9)
+    np.testing.assert_allclose(two.t_peak, one.t_peak, rtol=1e-9)
+
+
+def test_nondimensional_deck_reproduces_the_si_run(default_run, tmp_path):
+    si = default_run[1]
+    nondim_config = RunConfig(units="nondimensional")
+    units = nondim_config.unit_system
+    config = nondim_config.replace(v0=0.4 / units.velocity_m_s, dt=si.settings.dt_s / units.time_s,
+                                   duration=si.settings.duration_s / units.time_s)
+    nd = simulate(config, tmp_path)
+    assert "units           lj" in (tmp_path / "in.hexdem").read_text()
+    np.testing.assert_allclose(nd.results.peak_speed * units.velocity_m_s, si.results.peak_speed, rtol=1e-7)
+    np.testing.assert_allclose(nd.results.t_peak * units.time_s, si.results.t_peak, rtol=1e-7, atol=1e-12)
+
+
+def test_peaks_are_sampled_finely_enough(default_run, tmp_path):
+    """Default sampling vs every-step sampling: peaks within 0.5 %, times of peak within 1 µs."""
+    config = RunConfig(edge_beads=7, duration=6e-4)
+    coarse = simulate(config, tmp_path / "coarse").results
+    fine = simulate(config.replace(dump_every=1), tmp_path / "fine").results
+    seen = np.isfinite(fine.peak_speed) & (fine.peak_speed > 0.01 * 0.4)
+    assert seen.sum() > 50
+    np.testing.assert_allclose(coarse.peak_speed[seen], fine.peak_speed[seen], rtol=5e-3)
+    np.testing.assert_allclose(coarse.t_peak[seen], fine.t_peak[seen], rtol=0, atol=1e-6)
+    np.testing.assert_allclose(coarse.arrival_time[seen], fine.arrival_time[seen], rtol=0, atol=1e-6)
