@@ -1,0 +1,107 @@
+"""LAMMPS against the reference integrator: per-bead agreement of peaks and arrival times, and the CLI."""
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+from hexdem.cli.main import main
+from hexdem.compare import COMPARE_COLUMNS, Tolerances, compare_analyses, run_comparison
+from hexdem.config import RunConfig
+from hexdem.errors import HexdemError
+from hexdem.experiment import RESULT_FILES, simulate
+from hexdem.impact import ImpactAnalysis
+from hexdem.lammps.engine import LammpsEngine
+from hexdem.model import RunSettings
+from hexdem.reference import PARAMETERS_NAME, ReferenceEngine
+from test_reference import V0, disordered_model
+
+SMALL = RunConfig(edge_beads=4)
+
+
+def test_reference_agrees_with_lammps_on_the_default_experiment(default_run, tmp_path):
+    """Issue 3's criterion on the paper's experiment (0.5 % in peak, 2 µs in arrival, beads above 1 % V0)."""
+    lammps = default_run[1]
+    reference = simulate(RunConfig(engine="reference"), tmp_path)
+    np.testing.assert_allclose(reference.trajectory.times_s, lammps.trajectory.times_s, rtol=1e-12)
+    comparison = compare_analyses(lammps, reference, RunConfig().v0)
+    assert comparison.n_checked == sum(len(beads) for beads in lammps.results.lines.values())
+    assert comparison.agree, comparison.verdict()
+    assert reference.results.energy_drift < 1e-6
+
+
+@pytest.mark.parametrize("changes", [{"impact": "striker", "strike_angle_deg": 30.0},
+                                     {"units": "nondimensional", "v0": 0.05, "strike_angle_deg": -30.0}],
+                         ids=["striker-30deg", "nondimensional"])
+def test_engines_agree_on_small_lattices(tmp_path, changes):
+    comparison = run_comparison(SMALL.replace(**changes), tmp_path, log=lambda message: None)
+    assert comparison.agree, comparison.verdict()
+    assert comparison.n_checked > 10
+    with open(tmp_path / "compare.csv", newline="") as fh:
+        rows = list(csv.reader(fh))
+    assert tuple(rows[0]) == COMPARE_COLUMNS and len(rows) == len(comparison.rows) + 1
+    assert json.loads((tmp_path / "compare.json").read_text())["agree"] is True
+    assert (tmp_path / "compare.png").stat().st_size > 0
+
+
+def test_engines_agree_with_per_bead_diameters(tmp_path):
+    """Fixed bonds with per-pair contact distances (reference) vs every overlap (LAMMPS), on every bead."""
+    model = disordered_model(seed=3, edge_beads=5)
+    settings = RunSettings(dt_s=1e-7, n_steps=8000, dump_every=20)
+    lammps, reference = (ImpactAnalysis(model, settings, engine.run(model, settings, tmp_path / engine.name))
+                         .run().results for engine in (LammpsEngine(), ReferenceEngine()))
+    np.testing.assert_array_equal(np.isnan(reference.peak_speed), np.isnan(lammps.peak_speed))
+    moving = np.nan_to_num(lammps.peak_speed) > Tolerances().min_peak_fraction * V0
+    assert moving.sum() > 20
+    np.testing.assert_allclose(reference.peak_speed[moving], lammps.peak_speed[moving], rtol=Tolerances().peak_rel)
+    np.testing.assert_allclose(reference.arrival_time[moving], lammps.arrival_time[moving],
+                               rtol=0, atol=Tolerances().arrival_s)
+
+
+def test_a_difference_beyond_tolerance_is_detected(tmp_path):
+    analysis = simulate(SMALL.replace(engine="reference"), tmp_path)
+    assert compare_analyses(analysis, analysis, SMALL.v0).agree
+    bead = analysis.results.lines["+30"][2]
+    analysis.results.peak_speed[bead] *= 1.01
+    comparison = compare_analyses(simulate(SMALL.replace(engine="reference"), tmp_path), analysis, SMALL.v0)
+    assert comparison.max_peak_rel_diff == pytest.approx(0.01)
+    assert not comparison.agree and "DISAGREE" in comparison.verdict()
+    analysis.results.arrival_time[bead] = np.nan
+    assert compare_analyses(simulate(SMALL.replace(engine="reference"), tmp_path), analysis,
+                            SMALL.v0).max_arrival_diff == np.inf
+
+
+@pytest.fixture
+def small_toml(tmp_path):
+    path = tmp_path / "small.toml"
+    path.write_text("edge_beads = 4\nstrike_angle_deg = 30.0\n")
+    return path
+
+
+def test_run_with_the_reference_engine_writes_the_same_files(tmp_path, small_toml):
+    assert main(["run", "--engine", "reference", "--config", str(small_toml), "--out", str(tmp_path / "out")]) == 0
+    out = tmp_path / "out"
+    for name in RESULT_FILES:
+        assert (out / name).stat().st_size > 0
+    assert json.loads((out / "deck" / PARAMETERS_NAME).read_text())["integrator"] == "classical RK4"
+    assert json.loads((out / "summary.json").read_text())["engine"] == "reference"
+
+
+def test_compare_cli_reports_agreement_and_fails_on_disagreement(tmp_path, small_toml, capsys):
+    assert main(["compare", "--config", str(small_toml), "--out", str(tmp_path / "ok")]) == 0
+    assert "engines agree" in capsys.readouterr().out
+    assert {p.name for p in (tmp_path / "ok").iterdir()} == {"compare.csv", "compare.json", "compare.png",
+                                                           "lammps", "reference"}
+    assert main(["compare", "--config", str(small_toml), "--out", str(tmp_path / "strict"),
+                 "--peak-tol", "1e-15"]) == 2
+    error = capsys.readouterr().err.strip().splitlines()[-1]
+    assert error.startswith("hexdem: error: ") and "DISAGREE" in error and "compare.csv" in error
+
+
+def test_bad_tolerance_is_a_one_line_error(tmp_path, small_toml, capsys):
+    with pytest.raises(HexdemError, match="peak_rel"):
+        Tolerances(peak_rel=float("nan"))
+    assert main(["compare", "--config", str(small_toml), "--out", str(tmp_path), "--arrival-tol", "-1"]) == 2
+    assert capsys.readouterr().err.strip() == "hexdem: error: tolerance arrival_s must be a number >= 0, got -1.0"
+    assert not any(tmp_path.glob("compare*"))
