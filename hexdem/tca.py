@@ -290,3 +290,39 @@ def lattice_pulses(analysis, line: str) -> LatticePulses:
     speeds = analysis.trajectory.speeds_m_s[:, beads] / units.velocity_m_s
     crossing = crossing_times(times, speeds, analysis.results.arrival_time[beads])
     return LatticePulses(np.arange(len(crossing)), crossing, np.diff(np.concatenate([[0.0], crossing])))
+
+
+def _nondimensional_units(analysis):
+    from hexdem.units import nondimensional
+
+    return nondimensional(analysis.model.lattice.diameter_m, analysis.model.bead)
+
+
+def pulse_speed_table(analysis, line: str = "+30") -> dict:
+    """Fig. 5a: c_n = 1/T_n along ``line`` of a 30°-strike run against the TCA started with the
+    run's V₀ at n = 0. Arrays ``n``, ``lattice``, ``tca``, ``hyperg`` (nondimensional), NaN-free."""
+    units = _nondimensional_units(analysis)
+    measured = lattice_pulses(analysis, line)
+    keep = np.isfinite(measured.residence_time)
+    n = measured.n[keep]
+    v0 = analysis.model.impact.speed_m_s / units.velocity_m_s
+    prediction = predict_pulses(v0, 0, int(n.max()))
+    speed = measured.pulse_speed[keep] * units.time_s / analysis.settings.units.time_s
+    return {"n": n, "lattice": speed, "tca": prediction.pulse_speed[n], "hyperg": prediction.pulse_speed_hyperg[n]}
+
+
+def arrival_time_table(analysis, line: str = "+30") -> dict:
+    """Fig. 5b: arrival time of the pulse at beads n ≥ 1 of ``line`` after a 0° strike, in the
+    run's time unit. The lattice's arrival at n is when beads n − 1 and n move equally fast;
+    the TCA's is the lattice's arrival at bead 1 (the anchor, as the paper anchors the
+    experiment at its first sensor) plus the TCA residence times from V₁ = V₀/2 on."""
+    units = _nondimensional_units(analysis)
+    scale = analysis.settings.units.time_s / units.time_s
+    lattice = lattice_pulses(analysis, line).crossing_time
+    lattice = lattice[:np.flatnonzero(np.isfinite(lattice))[-1] + 1]
+    v1 = 0.5 * analysis.model.impact.speed_m_s / units.velocity_m_s
+    prediction = predict_pulses(v1, 1, len(lattice) - 1)
+    tca, hyperg = prediction.arrival_times(t_first=lattice[0] * scale)
+    return {"n": np.arange(1, len(lattice) + 1), "lattice": lattice,
+            "tca": np.concatenate([[lattice[0]], tca / scale]),
+            "hyperg": np.concatenate([[lattice[0]], hyperg / scale])}
