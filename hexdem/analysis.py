@@ -11,6 +11,7 @@ as additional columns, at full double precision.
 
 from __future__ import annotations
 
+import sys
 import warnings
 from pathlib import Path
 
@@ -92,7 +93,7 @@ def read_dump(path, dt: float, expected_frames: int | None = None) -> BeadRecord
         raise HexdemError(f"dump {path} is corrupt or truncated: {len(universe.trajectory)} "
                           f"of {expected_frames} frames")
     try:
-        return BeadRecord(universe).run()
+        return BeadRecord(universe).run(verbose=sys.stderr.isatty())
     except HexdemError:
         raise
     except Exception as exc:

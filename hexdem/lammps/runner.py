@@ -18,6 +18,7 @@ from pathlib import Path
 from hexdem.errors import HexdemError
 from hexdem.lammps.deck import DECK_NAME, Deck
 from hexdem.lammps.library import environment_command, load_lammps
+from hexdem.progress import lammps_log_progress
 
 
 @dataclass(frozen=True)
@@ -62,7 +63,8 @@ def run_in_process(deck: Deck) -> RunInfo:
     with _working_directory(deck.directory):
         lmp = lammps.lammps(cmdargs=["-screen", "none", "-log", "log.lammps", "-nocite"])
         try:
-            lmp.file(DECK_NAME)
+            with lammps_log_progress(deck.log_path, deck.settings.n_steps):
+                lmp.file(DECK_NAME)
         except Exception as exc:
             raise _fail(deck, str(exc)) from None
         finally:
@@ -75,7 +77,8 @@ def run_mpiexec(deck: Deck, ranks: int) -> RunInfo:
     command = [environment_command("mpiexec"), "-n", str(ranks), environment_command("lmp"),
                "-in", DECK_NAME, "-screen", "none", "-log", "log.lammps", "-nocite"]
     start = time.perf_counter()
-    done = subprocess.run(command, cwd=deck.directory, capture_output=True, text=True)
+    with lammps_log_progress(deck.log_path, deck.settings.n_steps, f"LAMMPS x{ranks}"):
+        done = subprocess.run(command, cwd=deck.directory, capture_output=True, text=True)
     if done.returncode != 0:
         log = deck.log_path.read_text() if deck.log_path.exists() else ""
         raise _fail(deck, log if "ERROR" in log else done.stderr + done.stdout)
