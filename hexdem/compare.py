@@ -11,8 +11,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from pathlib import Path
-
 import numpy as np
 
 from hexdem.config import RunConfig
@@ -27,6 +25,7 @@ ENGINE_NAMES = ("lammps", "reference")
 #: Columns of ``compare.csv``; differences are reference − LAMMPS (relative to LAMMPS for peaks).
 COMPARE_COLUMNS = ("line", "n", "bead_id", "peak_lammps", "peak_reference", "peak_rel_diff",
                    "arrival_lammps", "arrival_reference", "arrival_diff", "checked")
+PEAK_DIFF, ARRIVAL_DIFF, CHECKED = (COMPARE_COLUMNS.index(key) for key in ("peak_rel_diff", "arrival_diff", "checked"))
 
 
 @dataclass(frozen=True)
@@ -63,7 +62,7 @@ class EngineComparison:
 
     @property
     def n_checked(self) -> int:
-        return sum(1 for row in self.rows if row[-1])
+        return sum(1 for row in self.rows if row[CHECKED])
 
     @property
     def agree(self) -> bool:
@@ -101,11 +100,11 @@ def compare_analyses(lammps: ImpactAnalysis, reference: ImpactAnalysis, v0: floa
             checked = bool(np.nanmax([pa, pb, -np.inf]) > tolerances.min_peak_fraction * v0)
             rows.append((name, n, int(bead) + 1, pa, pb, _difference(pa, pb, True),
                          ta, tb, _difference(ta, tb, False), checked))
-    checked = [row for row in rows if row[-1]]
+    checked = [row for row in rows if row[CHECKED]]
     return EngineComparison(
         rows=rows,
-        max_peak_rel_diff=max((abs(row[5]) for row in checked), default=0.0),
-        max_arrival_diff=max((abs(row[8]) for row in checked), default=0.0),
+        max_peak_rel_diff=max((abs(row[PEAK_DIFF]) for row in checked), default=0.0),
+        max_arrival_diff=max((abs(row[ARRIVAL_DIFF]) for row in checked), default=0.0),
         arrival_tolerance=tolerances.arrival_s / lammps.settings.units.time_s,
         tolerances=tolerances, units=a.units)
 
@@ -149,11 +148,12 @@ def comparison_plot(comparison: EngineComparison, v0: float, path) -> None:
 def run_comparison(config: RunConfig, out, log=None, tolerances: Tolerances = Tolerances()) -> EngineComparison:
     """Run ``config`` with both engines into ``out`` and write the comparison files."""
     out = ensure_writable_dir(out)
-    analyses = {name: run_experiment(config.replace(engine=name), Path(out) / name, log) for name in ENGINE_NAMES}
+    analyses = {name: run_experiment(config.replace(engine=name), out / name, log) for name in ENGINE_NAMES}
     comparison = compare_analyses(analyses["lammps"], analyses["reference"], config.v0, tolerances)
     write_csv(out / "compare.csv", COMPARE_COLUMNS, comparison.rows)
     write_json(out / "compare.json", {
-        "config": config.as_dict(), "units": comparison.units,
+        "config": {key: value for key, value in config.as_dict().items() if key != "engine"},
+        "units": comparison.units,
         "tolerances": {"peak_rel": tolerances.peak_rel, "arrival": comparison.arrival_tolerance,
                        "arrival_s": tolerances.arrival_s, "min_peak_fraction": tolerances.min_peak_fraction},
         "beads_checked": comparison.n_checked, "max_peak_rel_diff": comparison.max_peak_rel_diff,
