@@ -30,9 +30,11 @@ V_n = V₀ (V_s/V₀)(V₀) (m V₀ + b)^{n − s}, eqs. (v30), (v0), (veq0).
 **Why c depends on V₀ at all.** The Hertz lattice with linearised bond directions is scale
 invariant (x → λx, t → λ^{−1/4}t): c would be a constant. V₀ enters only through the
 geometric nonlinearity of the bond lengths |d e + q_j − q_i|, whose relative size grows with
-the overlaps δ ∝ V₀^{4/5} (δ ≈ 0.3 d at V₀ = 0.3). So b is the small-amplitude decay rate
-and m measures geometric nonlinearity. The sweep's V₀ = 0.01 … 0.30 are 41 … 1230 m/s for
-the paper's steel beads; the experiment's 0.4 m/s is V₀ ≈ 1e−4, where c = b to 4 digits.
+the overlaps δ ∝ V₀^{4/5} (δ ≈ 0.3 d at V₀ = 0.3). So m measures geometric nonlinearity
+and b is the law's small-amplitude intercept (c(V₀) is slightly convex over the sweep, so b
+lies a little below the measured c at the smallest V₀). The sweep's V₀ = 0.01 … 0.30 are
+41 … 1230 m/s for the paper's steel beads; the experiment's 0.4 m/s is V₀ ≈ 1e−4, where the
+law gives c = b to 4 digits.
 
 **Physical units** (:meth:`ScalingLaw.physical`): replace every V by V/U, U = d^{5/4}
 sqrt(A/M) (end of Sec. V), so m and the V₀-powers of the polynomial pick up powers of 1/U.

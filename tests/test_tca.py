@@ -133,3 +133,30 @@ def test_bad_velocity_is_a_hexdem_error():
         tca.equal_velocity(-1.0)
     with pytest.raises(HexdemError):
         tca.predict_pulses(0.1, 3, 1)
+
+
+def test_tca_command_prints_omega_and_c(capsys):
+    import json
+
+    from hexdem.cli.main import main
+
+    assert main(["tca", "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert tca.compatibility_residual(result["omega"]) == pytest.approx(0.0, abs=1e-12)
+    assert result["c"] == pytest.approx(tca.decay_factor(), rel=1e-12)
+
+
+def test_tca_figures_compare_favourably_with_the_lattice(tmp_path):
+    """Fig. 5: the TCA's pulse speeds and arrival times stay within 15 % of the lattice's
+    (the paper: it "favorably compares with the full numerical results")."""
+    import json
+
+    from hexdem.cli.main import main
+
+    assert main(["tca", "--out", str(tmp_path)]) == 0
+    result = json.loads((tmp_path / "tca.json").read_text())["lattice"]
+    assert result["fig5a"]["beads"] == [0, 15] and result["fig5b"]["beads"][0] == 1
+    for figure in ("fig5a", "fig5b"):
+        assert result[figure]["max_relative_deviation_tca"] < 0.15
+    for name in ("fig5a_pulse_speed", "fig5b_arrival_time"):
+        assert (tmp_path / f"{name}.png").stat().st_size > 0 and (tmp_path / f"{name}.csv").stat().st_size > 0
