@@ -400,7 +400,7 @@ class SweepSettings:
 
     @property
     def v0(self) -> np.ndarray:
-        return np.linspace(self.v0_min, self.v0_max, self.n_v0)
+        return np.round(np.linspace(self.v0_min, self.v0_max, self.n_v0), 12)
 
     @property
     def hexagon_edge(self) -> int:
