@@ -274,7 +274,8 @@ def fit_combination(combination: Combination, v0, peaks, last: int = DEFAULT_LAS
 
 
 def sensitivity(combination: Combination, v0, peaks, lasts=None) -> list[dict]:
-    """(m, b) and their standard errors for every window end in ``lasts`` and both fit types."""
+    """(m, b) and their standard errors for every window end in ``lasts`` (default: all the
+    beads of ``peaks``) and both fit types."""
     peaks = np.asarray(peaks, float)
     lasts = range(combination.start + 2, peaks.shape[1]) if lasts is None else lasts
     rows = []
@@ -528,6 +529,12 @@ def _trace(sweep: Sweep, combination: Combination):
     return times, speeds, run.peaks[combination.line], run.t_peak[combination.line], run.v0
 
 
+def _complete_beads(sweep: Sweep, combination: Combination) -> int:
+    """Number of leading beads of the line whose peaks were seen at every V₀."""
+    complete = np.all(np.isfinite(sweep.peaks(combination)), axis=0)
+    return int(np.argmin(complete)) if not complete.all() else len(complete)
+
+
 def write_outputs(sweep: Sweep, out, last: int | None = None, kind: str = "loglinear") -> dict:
     """Fit all four combinations and publish :data:`OUTPUT_FILES` in ``out``; returns the
     contents of ``scaling.json``."""
@@ -557,7 +564,8 @@ def write_outputs(sweep: Sweep, out, last: int | None = None, kind: str = "logli
               ("combination", "v0", "c", "c_stderr", "v_start", "v_start_over_v0", "c_law", "v_start_over_v0_law"),
               [(name, v, c, e, vs, vs / v, float(f.law.decay_rate(v)), float(f.law.start_ratio(v)))
                for name, f in fits.items() for v, c, e, vs in zip(f.v0, f.c, f.c_stderr, f.v_start)])
-    sensitivity_rows = [row for c in COMBINATIONS.values() for row in sensitivity(c, sweep.v0, sweep.peaks(c))]
+    sensitivity_rows = [row for c in COMBINATIONS.values()
+                        for row in sensitivity(c, sweep.v0, sweep.peaks(c), range(c.start + 2, _complete_beads(sweep, c)))]
     write_csv(out / "sensitivity.csv", tuple(sensitivity_rows[0]), [tuple(r.values()) for r in sensitivity_rows])
     write_csv(out / "decay_form.csv",
               ("combination", "v0", "rss_geometric", "rss_power", "q", "p", "ratio_slope", "ratio_slope_stderr",

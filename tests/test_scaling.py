@@ -36,6 +36,14 @@ def test_sweep_fits_recover_known_m_b_and_amplitude(name, kind):
     assert fit.rate.error("m") < 1e-9
 
 
+def test_sensitivity_table_covers_every_window_and_fit_type():
+    combination = scaling.COMBINATIONS["0/0"]
+    rows = scaling.sensitivity(combination, V0, synthetic_peaks(combination))
+    assert [(r["last"], r["fit"]) for r in rows] == [(last, kind) for last in range(4, 14) for kind in scaling.FIT_KINDS]
+    np.testing.assert_allclose([r["m"] for r in rows], TRUE["m"], rtol=1e-8)
+    np.testing.assert_allclose([r["b"] for r in rows], TRUE["b"], rtol=1e-9)
+
+
 def test_standard_errors_match_the_scatter_of_repeated_noisy_sweeps():
     combination, rng = scaling.COMBINATIONS["30/30"], np.random.default_rng(7)
     fits = [scaling.fit_combination(combination, V0, synthetic_peaks(combination, noise=0.01, rng=rng), last=12)
