@@ -155,14 +155,15 @@ class ReferenceSystem:
     @classmethod
     def from_model(cls, model: GranularModel, units: UnitSystem) -> "ReferenceSystem":
         grid = Grid.of(model.lattice)
-        cells = np.concatenate([grid.cells, np.arange(model.n_bodies - len(model.lattice)) + grid.n_cells])
-        n_cells = grid.n_cells + model.n_bodies - len(model.lattice)
+        off_grid = model.n_bodies - len(model.lattice)
+        cells = np.concatenate([grid.cells, grid.n_cells + np.arange(off_grid)]).astype(np.int64)
+        n_cells = grid.n_cells + off_grid
         inv_mass = np.zeros(n_cells)
         inv_mass[cells] = units.mass_kg / model.masses_kg
         kernel = KernelArrays(np.array([grid.offset(step) for step in BOND_STEPS], dtype=np.int64),
                               grid.lo, grid.hi, *_lattice_bonds(model, grid, units), inv_mass,
                               *_striker_pairs(model, cells, units), *_wall_contacts(model, cells, units))
-        return cls(kernel, cells.astype(np.int64), n_cells, units)
+        return cls(kernel, cells, n_cells, units)
 
     @property
     def n_bonds(self) -> int:
@@ -204,7 +205,7 @@ def _check_settings(settings: RunSettings) -> None:
         raise HexdemError(f"time step must be a positive number of seconds, got {settings.dt_s!r}")
     for name in ("n_steps", "dump_every"):
         value = getattr(settings, name)
-        if isinstance(value, bool) or int(value) != value or value < 1:
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
             raise HexdemError(f"{name} must be a positive integer, got {value!r}")
 
 
@@ -233,7 +234,6 @@ class ReferenceEngine:
                                      settings.dt_s / units.time_s, settings.n_steps, settings.dump_every)
         wall_time = time.perf_counter() - start
         times_s = np.arange(len(disp)) * settings.dump_every * settings.dt_s
-        _check_finite(times_s, vel)
         engine = {"name": self.name, "version": version("hexdem"), "ranks": 1, "integrator": "classical RK4",
                   "units": units.name, "wall_time_s": wall_time, "n_bonds": system.n_bonds,
                   "n_wall_contacts": system.n_wall_contacts}
@@ -243,5 +243,6 @@ class ReferenceEngine:
                                                  "unit_scales_si": {"length_m": units.length_m,
                                                                     "mass_kg": units.mass_kg,
                                                                     "time_s": units.time_s}})
+        _check_finite(times_s, vel)
         return Trajectory(times_s=times_s, velocities_m_s=vel * units.velocity_m_s,
                           displacements_m=disp * units.length_m, engine=engine)
