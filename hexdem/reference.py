@@ -184,7 +184,7 @@ class ReferenceSystem:
         x, y = self._cell_arrays(displacements)
         fx, fy = np.zeros(self.n_cells), np.zeros(self.n_cells)
         scratch = np.zeros((2, 3, self.kernel.hi))
-        forces(self.kernel, x, y, scratch[0], scratch[1], fx, fy)
+        forces(self.kernel, x, y, np.ones(self.n_cells), scratch[0], scratch[1], fx, fy)
         return np.column_stack([fx[self.cells], fy[self.cells]])
 
     def integrate(self, velocities, dt: float, n_steps: int, every: int):

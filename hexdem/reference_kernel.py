@@ -76,14 +76,14 @@ def _hertz_bonds(xi, yi, xj, yj, rest_x, rest_y, contact, stiffness, fx, fy):
 
 
 @_jit
-def _net_bond_force(in0, in1, in2, out0, out1, out2, net):
-    """Net force on each cell: its bonds as partner j (+) minus its bonds as origin i (−)."""
+def _net_bond_force(in0, in1, in2, out0, out1, out2, scale, net):
+    """Net force on each cell, times ``scale``: its bonds as partner j (+) minus as origin i (−)."""
     for p in range(net.shape[0]):
-        net[p] = in0[p] + in1[p] + in2[p] - out0[p] - out1[p] - out2[p]
+        net[p] = (in0[p] + in1[p] + in2[p] - out0[p] - out1[p] - out2[p]) * scale[p]
 
 
 @_jit
-def _pair_forces(k, x, y, fx, fy):
+def _pair_forces(k, x, y, scale, fx, fy):
     for b in range(k.pair_i.shape[0]):
         i, j = k.pair_i[b], k.pair_j[b]
         dx = k.pair_rest_x[b] + x[j] - x[i]
@@ -92,47 +92,40 @@ def _pair_forces(k, x, y, fx, fy):
         overlap = k.pair_contact[b] - r
         if overlap > 0.0:
             f = k.pair_stiffness[b] * overlap * np.sqrt(overlap) / r
-            fx[i] -= f * dx
-            fy[i] -= f * dy
-            fx[j] += f * dx
-            fy[j] += f * dy
+            fx[i] -= f * dx * scale[i]
+            fy[i] -= f * dy * scale[i]
+            fx[j] += f * dx * scale[j]
+            fy[j] += f * dy * scale[j]
 
 
 @_jit
-def _wall_forces(k, x, y, fx, fy):
+def _wall_forces(k, x, y, scale, fx, fy):
     for w in range(k.wall_cell.shape[0]):
         c = k.wall_cell[w]
         depth = -(k.wall_gap[w] + x[c] * k.wall_nx[w] + y[c] * k.wall_ny[w])
         if depth > 0.0:
-            f = k.wall_stiffness[w] * depth * np.sqrt(depth)
+            f = k.wall_stiffness[w] * depth * np.sqrt(depth) * scale[c]
             fx[c] += f * k.wall_nx[w]
             fy[c] += f * k.wall_ny[w]
 
 
 @_jit
-def forces(k, x, y, bond_fx, bond_fy, fx, fy):
-    """Net force (fx, fy) on every cell at displacements (x, y); ``bond_*`` are (3, hi) scratch."""
+def forces(k, x, y, scale, bond_fx, bond_fy, fx, fy):
+    """Net force on every cell at displacements (x, y), times ``scale`` (1: forces; 1/M:
+    accelerations), into (fx, fy); ``bond_fx``, ``bond_fy`` are (3, hi) scratch."""
     lo, hi = k.lo, k.hi
     for d in range(3):
         o = k.offsets[d]
         _hertz_bonds(x[:hi], y[:hi], x[o:o + hi], y[o:o + hi], k.rest_x[d], k.rest_y[d],
                      k.contact[d], k.stiffness[d], bond_fx[d], bond_fy[d])
-    fx[:] = 0.0
-    fy[:] = 0.0
     o0, o1, o2 = k.offsets[0], k.offsets[1], k.offsets[2]
     for bond, net in ((bond_fx, fx), (bond_fy, fy)):
+        net[:lo] = 0.0
+        net[hi:] = 0.0
         _net_bond_force(bond[0, lo - o0:hi - o0], bond[1, lo - o1:hi - o1], bond[2, lo - o2:hi - o2],
-                        bond[0, lo:hi], bond[1, lo:hi], bond[2, lo:hi], net[lo:hi])
-    _pair_forces(k, x, y, fx, fy)
-    _wall_forces(k, x, y, fx, fy)
-
-
-@_jit
-def _accelerations(k, x, y, bond_fx, bond_fy, ax, ay):
-    forces(k, x, y, bond_fx, bond_fy, ax, ay)
-    for c in range(ax.shape[0]):
-        ax[c] *= k.inv_mass[c]
-        ay[c] *= k.inv_mass[c]
+                        bond[0, lo:hi], bond[1, lo:hi], bond[2, lo:hi], scale[lo:hi], net[lo:hi])
+    _pair_forces(k, x, y, scale, fx, fy)
+    _wall_forces(k, x, y, scale, fx, fy)
 
 
 @_jit
@@ -174,16 +167,16 @@ def integrate(k, x, y, u, w, h, n_steps, every, cells, disp, vel):
     half, sq = 0.5 * h, h * h
     _sample(x, y, u, w, cells, disp, vel, 0)
     for step in range(1, n_steps + 1):
-        _accelerations(k, x, y, bond_fx, bond_fy, a[0], a[1])
+        forces(k, x, y, k.inv_mass, bond_fx, bond_fy, a[0], a[1])
         _shifted(tx, x, half, u, 0.0, a[0])
         _shifted(ty, y, half, w, 0.0, a[1])
-        _accelerations(k, tx, ty, bond_fx, bond_fy, a[2], a[3])
+        forces(k, tx, ty, k.inv_mass, bond_fx, bond_fy, a[2], a[3])
         _shifted(tx, x, half, u, 0.25 * sq, a[0])
         _shifted(ty, y, half, w, 0.25 * sq, a[1])
-        _accelerations(k, tx, ty, bond_fx, bond_fy, a[4], a[5])
+        forces(k, tx, ty, k.inv_mass, bond_fx, bond_fy, a[4], a[5])
         _shifted(tx, x, h, u, 0.5 * sq, a[2])
         _shifted(ty, y, h, w, 0.5 * sq, a[3])
-        _accelerations(k, tx, ty, bond_fx, bond_fy, a[6], a[7])
+        forces(k, tx, ty, k.inv_mass, bond_fx, bond_fy, a[6], a[7])
         _advance(x, u, h, a[0], a[2], a[4], a[6])
         _advance(y, w, h, a[1], a[3], a[5], a[7])
         if step % every == 0:
