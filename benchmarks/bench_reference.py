@@ -15,6 +15,7 @@ Target: reference >= 20 M bead-steps/s on 3151 beads.
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import tempfile
 from pathlib import Path
@@ -51,7 +52,8 @@ def main() -> None:
                "LAMMPS, 2 ranks": (LammpsEngine(ranks=2), lammps_seconds)}
     work = Path(tempfile.mkdtemp(prefix="hexdem-bench-reference-"))
     print(f"machine: {describe()}")
-    print(f"median of {args.repeats} alternating runs, a sample every {args.dump_every} steps")
+    print(f"median of {args.repeats} alternating runs, a sample every {args.dump_every} steps; "
+          f"1-min load average before: {os.getloadavg()[0]:.2f} (other processes slow every engine down)")
     print(f"{'lattice':<42} {'beads':>6} {'engine':<26} {'steps':>6} {'time [s]':>9} {'M (bead|atom)-steps/s':>22}")
     verdict = []
     for config, steps in LATTICES:
