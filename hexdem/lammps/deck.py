@@ -6,6 +6,7 @@ by hand. Quantities are written in the chosen :class:`~hexdem.units.UnitSystem`:
 (``units si``) or the paper's A = d = M = 1 (``units lj``). Contacts use the ``hertz k_n``
 model, F = k_n sqrt(R_eff δ) δ, for bead pairs and for the walls alike, so the walls carry
 their own modulus (the wall fix's ``hertz/material`` cannot mix materials, LAMMPS issue 4141).
+An optional uniform in-plane gravity (the tilted set-up of Sec. VI-A) adds ``fix gravity``.
 """
 
 from __future__ import annotations
@@ -51,7 +52,8 @@ def _fmt(value: float) -> str:
     return repr(float(value))
 
 
-def _data_file(model: GranularModel, units: UnitSystem) -> str:
+def data_file(model: GranularModel, units: UnitSystem) -> str:
+    """The text of ``data.hexdem``: every body of ``model`` at its initial position."""
     pos = model.initial_positions_m() / units.length_m
     diam = model.diameters_m / units.length_m
     density = model.bead.density_kg_m3 / units.density_kg_m3
@@ -69,7 +71,8 @@ def _data_file(model: GranularModel, units: UnitSystem) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _walls_block(model: GranularModel, units: UnitSystem) -> str:
+def walls_block(model: GranularModel, units: UnitSystem) -> str:
+    """Deck commands for the walls of ``model``: member group, plane region and wall fix each."""
     if not model.walls:
         return "# (no walls)\n"
     stiffness = _fmt(model.wall_stiffness_pa / units.stress_pa)
@@ -85,8 +88,22 @@ def _walls_block(model: GranularModel, units: UnitSystem) -> str:
     return "\n".join(block) + "\n"
 
 
-def render_input(model: GranularModel, settings: RunSettings) -> str:
-    """The text of ``in.hexdem`` for ``model`` run with ``settings``."""
+def gravity_block(gravity_m_s2, units: UnitSystem) -> str:
+    """``fix gravity`` for a uniform in-plane acceleration ``gravity_m_s2`` (gx, gy) [m/s²], if any.
+
+    In 2D the vector must lie in the plane (a z component gives NaN coordinates).
+    """
+    g = np.zeros(2) if gravity_m_s2 is None else np.asarray(gravity_m_s2, float) * units.time_s**2 / units.length_m
+    magnitude = float(np.hypot(*g))
+    if magnitude == 0.0:
+        return "# (no gravity)\n"
+    return (f"fix             gravity all gravity {_fmt(magnitude)} vector "
+            f"{_fmt(g[0] / magnitude)} {_fmt(g[1] / magnitude)} 0.0\n")
+
+
+def render_input(model: GranularModel, settings: RunSettings, gravity_m_s2=None) -> str:
+    """The text of ``in.hexdem`` for ``model`` run with ``settings``, under uniform gravity
+    ``gravity_m_s2`` (gx, gy) [m/s²] if given (the tilted set-up of Sec. VI-A)."""
     units = settings.units
     impactor = model.n_bodies if model.has_striker else model.lattice.struck + 1
     velocity = model.impact.speed_m_s * model.impact.direction / units.velocity_m_s
@@ -100,16 +117,16 @@ def render_input(model: GranularModel, settings: RunSettings) -> str:
         units_note=note, lammps_units=units.lammps_units,
         pair_stiffness=_fmt(model.pair_stiffness_pa / units.stress_pa),
         skin=_fmt(0.1 * model.lattice.diameter_m / units.length_m),
-        walls=_walls_block(model, units), impactor_id=impactor,
+        walls=walls_block(model, units), body_force=gravity_block(gravity_m_s2, units), impactor_id=impactor,
         vx=_fmt(velocity[0]), vy=_fmt(velocity[1]), dt=_fmt(settings.dt_s / units.time_s),
         thermo_every=max(1, settings.n_steps // 20), dump_every=settings.dump_every,
         nsteps=settings.n_steps)
 
 
-def write_deck(model: GranularModel, settings: RunSettings, directory) -> Deck:
+def write_deck(model: GranularModel, settings: RunSettings, directory, gravity_m_s2=None) -> Deck:
     """Write ``data.hexdem`` and ``in.hexdem`` into ``directory`` (created if needed)."""
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
-    (directory / DATA_NAME).write_text(_data_file(model, settings.units))
-    (directory / DECK_NAME).write_text(render_input(model, settings))
+    (directory / DATA_NAME).write_text(data_file(model, settings.units))
+    (directory / DECK_NAME).write_text(render_input(model, settings, gravity_m_s2))
     return Deck(directory, settings, model.n_bodies)
