@@ -5,8 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from hexdem.analysis import read_dump
-from hexdem.lammps.deck import write_deck
-from hexdem.lammps.runner import run_deck
+from hexdem.lammps.deck import Deck, write_deck
+from hexdem.lammps.runner import RunInfo, run_deck
 from hexdem.model import GranularModel, RunSettings
 from hexdem.trajectory import Trajectory
 
@@ -21,11 +21,16 @@ class LammpsEngine:
     def run(self, model: GranularModel, settings: RunSettings, directory) -> Trajectory:
         """Render the deck into ``directory``, run it, and read its dump back in SI."""
         deck = write_deck(model, settings, directory)
-        info = run_deck(deck, self.ranks)
-        units = settings.units
-        record = read_dump(deck.dump_path, settings.dt_s / units.time_s, settings.n_samples).results
-        return Trajectory(times_s=record.times * units.time_s,
-                          velocities_m_s=record.velocities * units.velocity_m_s,
-                          displacements_m=record.displacements * units.length_m,
-                          engine={"name": self.name, "version": info.lammps_version, "ranks": info.ranks,
-                                  "wall_time_s": info.wall_time_s, "deck": str(deck.input_path)})
+        return read_trajectory(deck, run_deck(deck, self.ranks))
+
+
+def read_trajectory(deck: Deck, info: RunInfo) -> Trajectory:
+    """The finished run of ``deck`` (however it was run, see ``info``) as a SI :class:`Trajectory`."""
+    settings = deck.settings
+    units = settings.units
+    record = read_dump(deck.dump_path, settings.dt_s / units.time_s, settings.n_samples).results
+    return Trajectory(times_s=record.times * units.time_s,
+                      velocities_m_s=record.velocities * units.velocity_m_s,
+                      displacements_m=record.displacements * units.length_m,
+                      engine={"name": LammpsEngine.name, "version": info.lammps_version, "ranks": info.ranks,
+                              "wall_time_s": info.wall_time_s, "deck": str(deck.input_path)})
