@@ -1,11 +1,17 @@
-"""Shared fixtures: one real LAMMPS run of the paper's default experiment per test session."""
+"""Shared fixtures and helpers: one real LAMMPS run of the paper's default experiment per
+session, tiny packings for two-body collisions, and a weakly disordered model."""
 
 import numpy as np
 import pytest
 
 from hexdem.config import RunConfig
 from hexdem.experiment import run_experiment
-from hexdem.lattice import Lattice
+from hexdem.lattice import Lattice, hexagon
+from hexdem.materials import DELRIN, STEEL_316
+from hexdem.model import GranularModel, Impact
+from hexdem.peaks import refine_peak
+
+D, V0 = 0.01905, 0.4
 
 
 @pytest.fixture(scope="session")
@@ -21,3 +27,18 @@ def single_bead(diameter_m=0.01905) -> Lattice:
     return Lattice(indices=np.array([[0, 0]]), positions_m=np.zeros((1, 2)),
                    diameters_m=np.array([diameter_m]), diameter_m=diameter_m,
                    struck=0, walls=(), shape="single bead")
+
+
+def disordered_model(seed=1, edge_beads=3) -> GranularModel:
+    """Beads of diameters in [0.999, 1] d on a lattice spaced for d, walls re-placed, a 20° striker."""
+    lattice = hexagon(edge_beads, D)
+    rng = np.random.default_rng(seed)
+    lattice = lattice.with_geometry(lattice.positions_m, D * rng.uniform(0.999, 1.0, len(lattice)))
+    return GranularModel(lattice, Impact(V0, angle_deg=20.0, striker=True), STEEL_316, DELRIN)
+
+
+def contact_history(times, overlap):
+    """(contact duration, peak overlap) of an overlap series that starts at 0 and ends negative."""
+    k = int(np.flatnonzero(overlap[1:] < 0)[0]) + 1
+    end = np.interp(0.0, overlap[[k, k - 1]], times[[k, k - 1]])
+    return end, refine_peak(times, overlap)[1]

@@ -6,6 +6,7 @@ import json
 import numpy as np
 import pytest
 
+from conftest import V0, disordered_model
 from hexdem.cli.main import main
 from hexdem.compare import COMPARE_COLUMNS, Tolerances, compare_analyses, run_comparison
 from hexdem.config import RunConfig
@@ -15,7 +16,6 @@ from hexdem.impact import ImpactAnalysis
 from hexdem.lammps.engine import LammpsEngine
 from hexdem.model import RunSettings
 from hexdem.reference import PARAMETERS_NAME, ReferenceEngine
-from test_reference import V0, disordered_model
 
 SMALL = RunConfig(edge_beads=4)
 

@@ -5,23 +5,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from conftest import single_bead
+from conftest import D, V0, contact_history, single_bead
 from hexdem.hertz import contact_time, max_overlap
 from hexdem.lammps.engine import LammpsEngine
 from hexdem.lattice import Wall
 from hexdem.materials import DELRIN, STEEL_316, hertz_stiffness, sphere_mass
 from hexdem.model import GranularModel, Impact, RunSettings
-from hexdem.peaks import refine_peak
-
-D, V0 = 0.01905, 0.4
-
-
-def contact_history(trajectory, overlap):
-    """(contact time, peak overlap) from an overlap series that starts at 0 and ends negative."""
-    times = trajectory.times_s
-    k = int(np.flatnonzero(overlap[1:] < 0)[0]) + 1
-    end = np.interp(0.0, [overlap[k], overlap[k - 1]], [times[k], times[k - 1]])
-    return end, refine_peak(times, overlap)[1]
 
 
 def test_two_sphere_collision_matches_hertz(tmp_path):
@@ -34,7 +23,7 @@ def test_two_sphere_collision_matches_hertz(tmp_path):
     start = model.initial_positions_m()
     gap = np.linalg.norm((start[1] + trajectory.displacements_m[:, 1]) - (start[0] + trajectory.displacements_m[:, 0]),
                          axis=1)
-    duration, peak = contact_history(trajectory, D - gap)
+    duration, peak = contact_history(trajectory.times_s, D - gap)
     assert duration == pytest.approx(expected_time, rel=1e-3)
     assert peak == pytest.approx(max_overlap(mass / 2, a, V0), rel=1e-3)
     final = trajectory.velocities_m_s[-1]
@@ -51,7 +40,7 @@ def test_sphere_on_delrin_wall_uses_the_walls_own_modulus(tmp_path):
     dt = 2e-7
     trajectory = LammpsEngine().run(model, RunSettings(dt, int(1.1 * expected_time / dt), 1), tmp_path)
     depth = trajectory.displacements_m[:, 0, 0]
-    duration, peak = contact_history(trajectory, depth)
+    duration, peak = contact_history(trajectory.times_s, depth)
     assert duration == pytest.approx(expected_time, rel=1e-3)
     assert peak == pytest.approx(max_overlap(mass, a, V0), rel=1e-3)
     np.testing.assert_allclose(trajectory.velocities_m_s[-1, 0], [-V0, 0.0], atol=1e-6 * V0)

@@ -5,29 +5,20 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from conftest import single_bead
+from conftest import D, V0, contact_history, disordered_model, single_bead
 from hexdem.config import RunConfig
 from hexdem.energy import contact_energy_j
 from hexdem.errors import HexdemError
 from hexdem.experiment import simulate
 from hexdem.hertz import contact_time, max_overlap
-from hexdem.lattice import Wall, hexagon
+from hexdem.lattice import Wall
 from hexdem.materials import DELRIN, STEEL_316, hertz_stiffness, sphere_mass
 from hexdem.model import GranularModel, Impact, RunSettings
 from hexdem.reference import PARAMETERS_NAME, ReferenceEngine, ReferenceSystem
 from hexdem.units import SI, nondimensional
 
-D, V0 = 0.01905, 0.4
 #: A small experiment: 5 beads per edge (61 beads), everything else the paper's defaults.
 SMALL = RunConfig(edge_beads=5, engine="reference")
-
-
-def disordered_model(seed=1, edge_beads=3) -> GranularModel:
-    """Beads of diameters in [0.999, 1] d on a lattice spaced for d, walls re-placed, a 20° striker."""
-    lattice = hexagon(edge_beads, D)
-    rng = np.random.default_rng(seed)
-    lattice = lattice.with_geometry(lattice.positions_m, D * rng.uniform(0.999, 1.0, len(lattice)))
-    return GranularModel(lattice, Impact(V0, angle_deg=20.0, striker=True), STEEL_316, DELRIN)
 
 
 @pytest.mark.parametrize("units", [SI, nondimensional(D)], ids=["si", "nondimensional"])
@@ -50,12 +41,6 @@ def test_forces_are_minus_the_gradient_of_the_hertz_energy(units):
     np.testing.assert_allclose(force, -gradient, rtol=1e-6, atol=1e-6 * np.abs(gradient).max())
 
 
-def contact_record(times, overlap):
-    """(contact duration, peak overlap) of an overlap series that starts at 0 and ends negative."""
-    k = int(np.flatnonzero(overlap[1:] < 0)[0]) + 1
-    return np.interp(0.0, overlap[[k, k - 1]], times[[k, k - 1]]), overlap.max()
-
-
 def run_until(model, duration_s, tmp_path, steps=4000):
     """A reference run sampled at every step of ``duration_s / steps``."""
     return ReferenceEngine().run(model, RunSettings(duration_s / steps, steps, 1), tmp_path)
@@ -72,7 +57,7 @@ def test_two_bead_collision_matches_analytic_hertz(tmp_path, ratio):
     trajectory = run_until(model, 1.1 * expected, tmp_path)
     centres = model.initial_positions_m() + trajectory.displacements_m
     overlap = (1 + ratio) * D / 2 - np.linalg.norm(centres[:, 0] - centres[:, 1], axis=1)
-    duration, peak = contact_record(trajectory.times_s, overlap)
+    duration, peak = contact_history(trajectory.times_s, overlap)
     assert duration == pytest.approx(expected, rel=1e-4)
     assert peak == pytest.approx(max_overlap(mu, a, V0), rel=1e-5)
     total = striker_mass + bead_mass  # elastic head-on collision: momentum and energy conserved
@@ -87,7 +72,7 @@ def test_sphere_on_a_delrin_wall_uses_the_walls_own_modulus(tmp_path):
     a = hertz_stiffness(STEEL_316, DELRIN) * np.sqrt(D / 2)
     expected = contact_time(mass, a, V0)
     trajectory = run_until(model, 1.1 * expected, tmp_path)
-    duration, peak = contact_record(trajectory.times_s, trajectory.displacements_m[:, 0, 0])
+    duration, peak = contact_history(trajectory.times_s, trajectory.displacements_m[:, 0, 0])
     assert duration == pytest.approx(expected, rel=1e-4)
     assert peak == pytest.approx(max_overlap(mass, a, V0), rel=1e-5)
     np.testing.assert_allclose(trajectory.velocities_m_s[-1, 0], [-V0, 0.0], atol=1e-7 * V0)

@@ -19,6 +19,7 @@ from string import Template
 import numpy as np
 
 from hexdem.model import GranularModel, RunSettings
+from hexdem.units import UnitSystem
 
 DECK_NAME = "in.hexdem"
 DATA_NAME = "data.hexdem"
