@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 import os
 import tempfile
 from contextlib import contextmanager
@@ -34,8 +35,22 @@ def write_text(path, text: str) -> None:
         tmp.write_text(text)
 
 
+def _strict_json(value):
+    """``value`` with NaN and ±inf as null and NumPy scalars and arrays as Python values."""
+    if isinstance(value, dict):
+        return {key: _strict_json(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_strict_json(item) for item in value]
+    if hasattr(value, "tolist"):
+        return _strict_json(value.tolist())
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
 def write_json(path, data) -> None:
-    write_text(path, json.dumps(data, indent=2, sort_keys=False) + "\n")
+    """Write strict JSON (no NaN/Infinity tokens, which many readers reject): non-finite → null."""
+    write_text(path, json.dumps(_strict_json(data), indent=2, allow_nan=False) + "\n")
 
 
 def write_csv(path, header, rows) -> None:
