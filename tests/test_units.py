@@ -36,17 +36,3 @@ def test_bad_material_values():
     with pytest.raises(HexdemError, match="Poisson"):
         Material("rubberish", 1e6, 0.6, 1000.0)
 
-
-def test_json_results_are_strict_and_atomic(tmp_path):
-    import json
-
-    from hexdem.io import write_json
-
-    path = tmp_path / "r.json"
-    write_json(path, {"a": float("nan"), "b": np.array([1.0, np.inf]), "c": np.float64(2.5)})
-    assert json.loads(path.read_text(), parse_constant=lambda token: pytest.fail(token)) == {
-        "a": None, "b": [1.0, None], "c": 2.5}
-    with pytest.raises(TypeError):
-        write_json(path, {"a": object()})
-    assert json.loads(path.read_text())["c"] == 2.5
-    assert [p.name for p in tmp_path.iterdir()] == ["r.json"]
