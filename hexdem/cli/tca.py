@@ -42,7 +42,8 @@ def theory() -> dict:
 
 def _rows(table):
     keys = list(table)
-    return keys, [tuple(float(table[k][i]) for k in keys) for i in range(len(table["n"]))]
+    return keys, [tuple(int(table[k][i]) if k == "n" else float(table[k][i]) for k in keys)
+                  for i in range(len(table["n"]))]
 
 
 def figures(out, engine: str, log) -> dict:
