@@ -24,6 +24,8 @@ from hexdem.impact import PEAK_COLUMNS, ImpactAnalysis
 from hexdem.io import ensure_writable_dir, write_csv, write_json
 
 RESULT_FILES = ("peaks.csv", "summary.json", "arrival_map.png", "peak_decay.png")
+#: A conservative model whose energy wanders more than this was integrated too coarsely.
+MAX_ENERGY_DRIFT = 1e-3
 
 
 def make_engine(config: RunConfig):
@@ -52,7 +54,12 @@ def simulate(config: RunConfig, workdir, log=None) -> ImpactAnalysis:
         f"{settings.n_steps} steps of {settings.dt_s:.4g} s ({settings.duration_s * 1e3:.4g} ms)")
     trajectory = engine.run(model, settings, workdir)
     log(f"analysing {len(trajectory.times_s)} samples")
-    return ImpactAnalysis(model, settings, trajectory).run()
+    analysis = ImpactAnalysis(model, settings, trajectory).run()
+    drift = analysis.results.energy_drift
+    if not drift <= MAX_ENERGY_DRIFT:
+        raise HexdemError(f"energy drift {drift:.1e} exceeds {MAX_ENERGY_DRIFT:g} in {workdir}: the time step "
+                          f"{settings.dt_s:.3g} s is too large for V0; leave dt at its default or reduce it")
+    return analysis
 
 
 def summary(config: RunConfig, analysis: ImpactAnalysis, wall_time_s: float) -> dict:

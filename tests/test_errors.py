@@ -8,7 +8,7 @@ from hexdem.cli.main import main
 from hexdem.config import RunConfig
 from hexdem.errors import HexdemError
 from hexdem.experiment import RESULT_FILES
-from hexdem.lammps import library
+from hexdem.lammps import deck, library
 from hexdem.lammps.deck import write_deck
 from hexdem.lammps.runner import run_deck
 
@@ -21,7 +21,8 @@ def run_cli(tmp_path, capsys, config_text=None, out=None):
     code = main(args)
     lines = capsys.readouterr().err.strip().splitlines()
     assert not any("Traceback" in line for line in lines)
-    return code, [line for line in lines if not line.startswith("hexdem: running")]
+    progress = [line for line in lines if line.startswith("hexdem: ") and not line.startswith("hexdem: error:")]
+    return code, [line for line in lines if line not in progress]
 
 
 def assert_no_results(directory):
@@ -56,22 +57,32 @@ def test_unwritable_output_directory(tmp_path, capsys):
     assert code == 2 and len(err) == 1 and "is not writable" in err[0]
 
 
-def test_lammps_failure_names_lammps_message_and_the_kept_deck(tmp_path, capsys):
-    code, err = run_cli(tmp_path, capsys, "dt = 1e-3\nduration = 0.05")
+def test_lammps_failure_names_lammps_message_and_the_kept_deck(tmp_path, capsys, monkeypatch):
+    render = deck.render_input
+    monkeypatch.setattr(deck, "render_input", lambda *args: render(*args).replace("run ", "rnu "))
+    code, err = run_cli(tmp_path, capsys, "edge_beads = 3")
     out = tmp_path / "out"
     assert code == 2 and len(err) == 1
-    assert "LAMMPS failed on" in err[0] and "ERROR" in err[0] and str(out / "deck.failed" / "in.hexdem") in err[0]
+    assert "LAMMPS failed on" in err[0] and "ERROR: Unknown command: rnu" in err[0]
+    assert str(out / "deck.failed" / "in.hexdem") in err[0]
     assert (out / "deck.failed" / "log.lammps").exists()
     assert_no_results(out)
+
+
+def test_too_coarse_time_step_is_refused(tmp_path, capsys):
+    code, err = run_cli(tmp_path, capsys, "edge_beads = 5\ndt = 2e-5\nduration = 1e-3")
+    assert code == 2 and len(err) == 1 and "energy drift" in err[0] and "time step" in err[0]
+    assert str(tmp_path / "out" / "deck.failed") in err[0]
+    assert_no_results(tmp_path / "out")
 
 
 @pytest.mark.parametrize("ranks", [1, 2])
 def test_deck_error_is_reported_with_lammps_message(tmp_path, ranks):
     config = RunConfig(edge_beads=3)
-    deck = write_deck(config.model(), config.settings(), tmp_path)
-    deck.input_path.write_text(deck.input_path.read_text().replace("pair_style      granular", "pair_style nonsense"))
+    rendered = write_deck(config.model(), config.settings(), tmp_path)
+    rendered.input_path.write_text(rendered.input_path.read_text().replace("pair_style      granular", "pair_style nonsense"))
     with pytest.raises(HexdemError, match=r"LAMMPS failed on .*in\.hexdem: ERROR: .*nonsense") as info:
-        run_deck(deck, ranks)
+        run_deck(rendered, ranks)
     assert "\n" not in str(info.value)
 
 
