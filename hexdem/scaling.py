@@ -1,11 +1,11 @@
-"""Velocity-decay scaling laws of Sec. V, from a sweep of impact velocities V₀.
+"""Velocity-decay scaling laws of Sec. V: per-V₀ decay fits and the laws c(V₀), V_s/V₀.
 
-Everything is nondimensional (A = d = M = 1, eq. scaling) unless it says otherwise.
+Everything is nondimensional (A = d = M = 1, eq. scaling) unless it says otherwise. The
+peak speeds come from a sweep of impact velocities V₀ (:mod:`hexdem.sweep`); the files and
+figures from :mod:`hexdem.scaling_outputs`.
 
-**Sweep.** For each strike angle (0°, 30°) and each V₀ of the sweep, one ideal lattice
-without walls is struck (V₀ given to bead 0) and the peak speed V_n of every bead of the
-0° and +30° observation lines is measured (:mod:`hexdem.peaks`). One run per strike serves
-both of its observation lines. The four strike/observation combinations:
+**Combinations.** Each strike angle (0°, 30°) is observed along the 0° and +30° lines of
+the struck lattice. The four strike/observation combinations:
 
 =========  ============  ========  ==========  ================================
 name       strike, line  start s   law         V_s / V₀
@@ -39,13 +39,6 @@ law gives c = b to 4 digits.
 **Physical units** (:meth:`ScalingLaw.physical`): replace every V by V/U, U = d^{5/4}
 sqrt(A/M) (end of Sec. V), so m and the V₀-powers of the polynomial pick up powers of 1/U.
 
-**Run design** (:class:`SweepSettings`). The time step is the two-bead Hertz contact time
-τ(V₀) over ``steps_per_contact`` and every run lasts ``duration_contacts`` τ(V₀): in units of
-τ(V₀) the pulse needs nearly the same time at every V₀ (14.6 τ to peak at bead 12 of the 0°
-line). Without walls, the free edges of an uncompressed packing send nothing back (there is
-no tension); the hexagon is ``last + 4`` beads per edge so that the line ends stay ahead of
-the fitted beads (a larger hexagon gives identical peaks).
-
 **Beyond the paper** (:func:`decay_form_test`). The paper calls the decay a power law but
 fits a geometric law in n. Both are two-parameter straight lines, log V_n against n or
 against log n, so their residual sums of squares compare directly; the residual curvature
@@ -56,12 +49,7 @@ as (n/(n+1))^p for a power law) say which one the data follow.
 from __future__ import annotations
 
 import math
-import sys
-import tempfile
-import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
-from dataclasses import asdict, dataclass, field
-from multiprocessing import get_context
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import curve_fit
@@ -88,7 +76,6 @@ COMBINATIONS = {c.name: c for c in (
     Combination("0/0", 0.0, "0", 2, "v0", 2),
     Combination("0/30", 0.0, "+30", 1, "veq0", 2),
 )}
-STRIKES_DEG = (0.0, 30.0)
 FIT_KINDS = ("loglinear", "nonlinear")
 #: Default last bead of the fit windows (the paper's Figs. 6a and 7a show beads 0–12).
 DEFAULT_LAST = 12
@@ -362,225 +349,3 @@ def decay_form_summary(tests, v0) -> dict:
                                  "v0_min": float(v0[0]), "v0_max": float(v0[-1])},
         "median_rss_power_over_geometric": float(np.median([t.rss_power / t.rss_geometric for t in tests])),
     }
-
-
-# --------------------------------------------------------------------------- the sweep
-
-
-@dataclass(frozen=True)
-class SweepSettings:
-    """How the V₀ sweep is simulated (nondimensional V₀).
-
-    ``v0_min``, ``v0_max``, ``n_v0``: evenly spaced V₀; ``last``: the last bead any fit may
-    use; ``edge_beads``: hexagon size (None: ``last`` + 4); ``steps_per_contact``: time step
-    τ(V₀)/this; ``samples_per_contact``: output samples per τ(V₀); ``duration_contacts``: run
-    length in τ(V₀); ``engine``: "reference" or "lammps"; ``workers``: parallel runs.
-    """
-
-    v0_min: float = 0.01
-    v0_max: float = 0.30
-    n_v0: int = 30
-    last: int = DEFAULT_LAST
-    edge_beads: int | None = None
-    steps_per_contact: int = 140
-    samples_per_contact: int = 35
-    duration_contacts: float = 16.0
-    engine: str = "reference"
-    workers: int = 2
-
-    def __post_init__(self):
-        if not (0 < self.v0_min < self.v0_max and self.n_v0 >= 4):
-            raise HexdemError(f"need 0 < v0_min < v0_max and at least 4 values of V0 (the quadratic laws have "
-                              f"3 parameters), got {self.v0_min}..{self.v0_max} with {self.n_v0} values")
-        if self.steps_per_contact < self.samples_per_contact or self.samples_per_contact < 5:
-            raise HexdemError("need steps_per_contact >= samples_per_contact >= 5")
-        if self.workers < 1:
-            raise HexdemError(f"workers must be >= 1, got {self.workers}")
-        if self.last < 3:
-            raise HexdemError(f"the last bead of the windows must be >= 3, got {self.last}")
-
-    @property
-    def v0(self) -> np.ndarray:
-        return np.round(np.linspace(self.v0_min, self.v0_max, self.n_v0), 12)
-
-    @property
-    def hexagon_edge(self) -> int:
-        return self.edge_beads if self.edge_beads is not None else self.last + 4
-
-    def config(self, v0: float, strike_deg: float):
-        """The :class:`~hexdem.config.RunConfig` of one run of the sweep."""
-        from hexdem.config import RunConfig
-
-        base = RunConfig(shape="hexagon", edge_beads=self.hexagon_edge, wall_material="none",
-                         units="nondimensional", v0=float(v0), strike_angle_deg=float(strike_deg),
-                         engine=self.engine, dump_every=self.steps_per_contact // self.samples_per_contact)
-        tau = base.contact_time_s() / base.unit_system.time_s
-        return base.replace(dt=tau / self.steps_per_contact, duration=self.duration_contacts * tau)
-
-
-@dataclass(frozen=True)
-class RunPeaks:
-    """What one run of the sweep keeps: per observation line (``"0"``, ``"+30"``) the beads'
-    ``peaks`` V_n and ``t_peak``, and ``traces`` (times, speeds of the line's beads)."""
-
-    v0: float
-    strike_deg: float
-    peaks: dict
-    t_peak: dict
-    traces: dict
-    energy_drift: float
-    wall_time_s: float
-
-
-def run_one(settings: SweepSettings, v0: float, strike_deg: float) -> RunPeaks:
-    """Simulate one V₀ and strike of the sweep in a scratch directory."""
-    from hexdem.experiment import simulate
-
-    start = time.perf_counter()
-    config = settings.config(v0, strike_deg)
-    with tempfile.TemporaryDirectory(prefix="hexdem-scaling-") as scratch:
-        analysis = simulate(config, scratch)
-    r, units = analysis.results, analysis.settings.units
-    times = analysis.trajectory.times_s / units.time_s
-    speeds = analysis.trajectory.speeds_m_s / units.velocity_m_s
-    lines = {name: r.lines[name][:settings.last + 2] for name in ("0", "+30")}
-    return RunPeaks(float(v0), float(strike_deg),
-                    {name: r.peak_speed[beads] for name, beads in lines.items()},
-                    {name: r.t_peak[beads] for name, beads in lines.items()},
-                    {name: (times, speeds[:, beads]) for name, beads in lines.items()},
-                    float(r.energy_drift), time.perf_counter() - start)
-
-
-@dataclass
-class Sweep:
-    """Peak speeds of a V₀ sweep: ``runs[(strike_deg, i)]`` the :class:`RunPeaks` of V₀ = v0[i]."""
-
-    settings: SweepSettings
-    runs: dict = field(default_factory=dict)
-    wall_time_s: float = 0.0
-
-    @property
-    def v0(self) -> np.ndarray:
-        return self.settings.v0
-
-    def peaks(self, combination: Combination) -> np.ndarray:
-        """(K, L) peak speeds V_n along the combination's line for every V₀."""
-        rows = [self.runs[(combination.strike_deg, i)].peaks[combination.line] for i in range(len(self.v0))]
-        return np.array(rows)
-
-    def fit(self, combination: Combination, last: int | None = None, kind: str = "loglinear") -> CombinationFit:
-        peaks = self.peaks(combination)
-        last = self.settings.last if last is None else last
-        missing = ~np.isfinite(peaks[:, :last + 1])
-        if missing.any():
-            i, n = np.argwhere(missing)[0]
-            raise HexdemError(f"{combination.name}: bead {n} had not peaked at V0 = {self.v0[i]:.4g} within "
-                              f"{self.settings.duration_contacts} contact times; raise duration_contacts or "
-                              "lower the window's last bead")
-        return fit_combination(combination, self.v0, peaks, last, kind)
-
-
-def run_sweep(settings: SweepSettings, log=None) -> Sweep:
-    """All runs of the sweep (both strike angles), ``settings.workers`` at a time, with
-    progress on ``log`` (default: stderr)."""
-    log = log or (lambda message: print(f"hexdem scaling: {message}", file=sys.stderr, flush=True))
-    jobs = [(strike, i, v0) for strike in STRIKES_DEG for i, v0 in enumerate(settings.v0)]
-    sweep, start = Sweep(settings), time.perf_counter()
-    log(f"{len(jobs)} runs ({settings.engine}, hexagon {settings.hexagon_edge} per edge, no walls, "
-        f"{settings.workers} workers)")
-    for done, (key, result) in enumerate(_results(settings, jobs), 1):
-        sweep.runs[key] = result
-        log(f"[{done}/{len(jobs)}] strike {result.strike_deg:g} deg, V0 = {result.v0:.4g}: "
-            f"{result.wall_time_s:.1f} s, energy drift {result.energy_drift:.1e}")
-    sweep.wall_time_s = time.perf_counter() - start
-    return sweep
-
-
-def _results(settings: SweepSettings, jobs):
-    """Yield ((strike, i), RunPeaks) as runs finish: in this process for one worker, else in
-    spawned processes (callers' scripts need an ``if __name__ == "__main__":`` guard)."""
-    if settings.workers == 1:
-        for strike, i, v0 in jobs:
-            yield (strike, i), run_one(settings, v0, strike)
-        return
-    with ProcessPoolExecutor(max_workers=settings.workers, mp_context=get_context("spawn")) as pool:
-        futures = {pool.submit(run_one, settings, v0, strike): (strike, i) for strike, i, v0 in jobs}
-        for future in as_completed(futures):
-            yield futures[future], future.result()
-
-
-def settings_dict(settings: SweepSettings) -> dict:
-    return {**asdict(settings), "hexagon_edge": settings.hexagon_edge}
-
-
-# --------------------------------------------------------------------------- outputs
-
-#: Files ``write_outputs`` publishes.
-OUTPUT_FILES = ("scaling.json", "peaks.csv", "decay_fits.csv", "sensitivity.csv", "decay_form.csv",
-                "fig6_vodecay30.png", "fig7_vodecay0.png", "decay_rates.png", "decay_form.png")
-#: V₀ of the example traces in Figs. 6a and 7a (the paper's Fig. 6a uses 0.05).
-TRACE_V0 = 0.05
-
-
-def _trace(sweep: Sweep, combination: Combination):
-    i = int(np.argmin(abs(sweep.v0 - TRACE_V0)))
-    run = sweep.runs[(combination.strike_deg, i)]
-    times, speeds = run.traces[combination.line]
-    return times, speeds, run.peaks[combination.line], run.t_peak[combination.line], run.v0
-
-
-def _complete_beads(sweep: Sweep, combination: Combination) -> int:
-    """Number of leading beads of the line whose peaks were seen at every V₀."""
-    complete = np.all(np.isfinite(sweep.peaks(combination)), axis=0)
-    return int(np.argmin(complete)) if not complete.all() else len(complete)
-
-
-def write_outputs(sweep: Sweep, out, last: int | None = None, kind: str = "loglinear") -> dict:
-    """Fit all four combinations and publish :data:`OUTPUT_FILES` in ``out``; returns the
-    contents of ``scaling.json``."""
-    from hexdem import theory_plots
-    from hexdem.config import RunConfig
-    from hexdem.io import ensure_writable_dir, write_csv, write_json
-
-    out = ensure_writable_dir(out)
-    last = sweep.settings.last if last is None else last
-    unit = RunConfig(units="nondimensional").unit_system.velocity_m_s
-    fits = {name: sweep.fit(combination, last, kind) for name, combination in COMBINATIONS.items()}
-    forms = {name: [decay_form_test(row, c.start, last) for row in sweep.peaks(c)]
-             for name, c in COMBINATIONS.items()}
-    summary = {name: fit.summary(unit) for name, fit in fits.items()}
-    for name, tests in forms.items():
-        summary[name]["decay_form"] = decay_form_summary(tests, sweep.v0)
-    summary["sweep"] = {**settings_dict(sweep.settings), "v0": sweep.v0.tolist(), "wall_time_s": sweep.wall_time_s,
-                        "max_energy_drift": max(run.energy_drift for run in sweep.runs.values()),
-                        "velocity_unit_m_s": unit}
-    write_json(out / "scaling.json", summary)
-
-    peak_rows = [(run.strike_deg, line, run.v0, n, float(v), float(t))
-                 for run in sorted(sweep.runs.values(), key=lambda r: (r.strike_deg, r.v0))
-                 for line in ("0", "+30") for n, (v, t) in enumerate(zip(run.peaks[line], run.t_peak[line]))]
-    write_csv(out / "peaks.csv", ("strike_deg", "line", "v0", "n", "peak_speed", "t_peak"), peak_rows)
-    write_csv(out / "decay_fits.csv",
-              ("combination", "v0", "c", "c_stderr", "v_start", "v_start_over_v0", "c_law", "v_start_over_v0_law"),
-              [(name, v, c, e, vs, vs / v, float(f.law.decay_rate(v)), float(f.law.start_ratio(v)))
-               for name, f in fits.items() for v, c, e, vs in zip(f.v0, f.c, f.c_stderr, f.v_start)])
-    sensitivity_rows = [row for c in COMBINATIONS.values()
-                        for row in sensitivity(c, sweep.v0, sweep.peaks(c), range(c.start + 2, _complete_beads(sweep, c)))]
-    write_csv(out / "sensitivity.csv", tuple(sensitivity_rows[0]), [tuple(r.values()) for r in sensitivity_rows])
-    write_csv(out / "decay_form.csv",
-              ("combination", "v0", "rss_geometric", "rss_power", "q", "p", "ratio_slope", "ratio_slope_stderr",
-               "power_ratio_slope", "drift_fraction", "verdict"),
-              [(name, v, t.rss_geometric, t.rss_power, t.q, t.p, t.ratio_slope, t.ratio_slope_stderr,
-                t.power_ratio_slope, t.drift_fraction, t.verdict)
-               for name, tests in forms.items() for v, t in zip(sweep.v0, tests)])
-
-    theory_plots.vodecay30(_trace(sweep, COMBINATIONS["30/30"]), fits["30/30"], fits["30/0"],
-                           out / "fig6_vodecay30.png")
-    theory_plots.vodecay0(_trace(sweep, COMBINATIONS["0/0"]), fits["0/0"], fits["0/30"], out / "fig7_vodecay0.png")
-    theory_plots.decay_rates(list(fits.values()), out / "decay_rates.png")
-    picks = sorted({0, len(sweep.v0) // 2, len(sweep.v0) - 1})
-    theory_plots.decay_form(
-        {name: [(sweep.v0[i], np.arange(c.start, last), sweep.peaks(c)[i, c.start + 1:last + 1]
-                 / sweep.peaks(c)[i, c.start:last]) for i in picks] for name, c in COMBINATIONS.items()},
-        out / "decay_form.png")
-    return summary

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.optimize import curve_fit
 
-from hexdem import scaling
+from hexdem import scaling, scaling_outputs, sweep
 from hexdem.cli.main import main
 from hexdem.errors import HexdemError
 
@@ -125,14 +125,14 @@ def test_fit_windows_are_validated():
     with pytest.raises(HexdemError):
         scaling.fit_decay(np.arange(14), peaks[0], 2, 10, kind="cubic")
     with pytest.raises(HexdemError):
-        scaling.SweepSettings(n_v0=3)
+        sweep.SweepSettings(n_v0=3)
 
 
 def test_larger_hexagon_gives_identical_peaks():
     """No walls, no tension: the packing's far edges cannot reach the fitted beads in time."""
-    settings = scaling.SweepSettings(last=6, duration_contacts=9.0, workers=1)
-    small = scaling.run_one(settings, 0.3, 0.0)
-    large = scaling.run_one(scaling.SweepSettings(last=6, duration_contacts=9.0, edge_beads=14, workers=1), 0.3, 0.0)
+    settings = sweep.SweepSettings(last=6, duration_contacts=9.0, workers=1)
+    small = sweep.run_one(settings, 0.3, 0.0)
+    large = sweep.run_one(sweep.SweepSettings(last=6, duration_contacts=9.0, edge_beads=14, workers=1), 0.3, 0.0)
     for line in ("0", "+30"):
         assert np.all(np.isfinite(small.peaks[line][:7]))
         np.testing.assert_allclose(small.peaks[line][:7], large.peaks[line][:7], rtol=1e-9)  # summation order
@@ -151,5 +151,5 @@ def test_scaling_command_writes_the_four_laws(tmp_path, capsys):
         assert (entry["gamma"] is None) == (combination.degree == 1)
         assert set(entry["stderr"]) == {"m", "b", "alpha", "beta", "gamma"}
         assert 0.7 < entry["b"] < 1.0, "peaks decay along the line"
-    for name in scaling.OUTPUT_FILES:
+    for name in scaling_outputs.OUTPUT_FILES:
         assert (out / name).stat().st_size > 0

@@ -2,7 +2,8 @@
 
 Writes ``OUT/scaling.json`` (keys "30/30", "30/0", "0/0", "0/30": m, b, alpha, beta, gamma,
 standard errors, start bead, window, V₀ range, the laws in m/s and the geometric-or-power
-verdict), CSV tables and the PNGs of Figs. 6 and 7 (see :mod:`hexdem.scaling`).
+verdict), CSV tables and the PNGs of Figs. 6 and 7 (see :mod:`hexdem.scaling`, :mod:`hexdem.sweep`
+and :mod:`hexdem.scaling_outputs`).
 """
 
 from __future__ import annotations
@@ -13,14 +14,11 @@ import sys
 from hexdem.config import ENGINES
 
 
-def _defaults():
-    from hexdem.scaling import SweepSettings
-
-    return SweepSettings()
-
-
 def add_arguments(parser) -> None:
-    d = _defaults()
+    from hexdem.scaling import FIT_KINDS
+    from hexdem.sweep import SweepSettings
+
+    d = SweepSettings()
     parser.add_argument("--out", metavar="DIR", default="scaling", help="output directory (default: scaling/)")
     parser.add_argument("--engine", choices=ENGINES, default=d.engine,
                         help=f"integrator (default: {d.engine}; lammps runs nondimensional decks)")
@@ -29,7 +27,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--n-v0", type=int, default=d.n_v0, help=f"number of V0 values, evenly spaced (default {d.n_v0})")
     parser.add_argument("--last", type=int, default=d.last,
                         help=f"last bead of every fit window (default {d.last}, as in the paper's Figs. 6a and 7a)")
-    parser.add_argument("--fit", choices=("loglinear", "nonlinear"), default="loglinear",
+    parser.add_argument("--fit", choices=FIT_KINDS, default="loglinear",
                         help="per-V0 fit of V_n = V_start c^(n - start): least squares on log V (default) "
                              "or on V itself")
     parser.add_argument("--steps-per-contact", type=int, default=d.steps_per_contact,
@@ -42,7 +40,8 @@ def add_arguments(parser) -> None:
 
 def run(args) -> None:
     from hexdem.io import ensure_writable_dir
-    from hexdem.scaling import SweepSettings, run_sweep, write_outputs
+    from hexdem.scaling_outputs import write_outputs
+    from hexdem.sweep import SweepSettings, run_sweep
 
     settings = SweepSettings(v0_min=args.v0_min, v0_max=args.v0_max, n_v0=args.n_v0, last=args.last,
                              steps_per_contact=args.steps_per_contact, duration_contacts=args.duration,

@@ -54,7 +54,7 @@ def figures(out, engine: str, log) -> dict:
     from hexdem.config import RunConfig
     from hexdem.experiment import simulate
     from hexdem.io import write_csv
-    from hexdem.scaling import SweepSettings
+    from hexdem.sweep import SweepSettings
 
     config_a = SweepSettings(engine=engine, last=FIG5A_LAST).config(FIG5A_V0, 30.0)
     config_b = RunConfig(engine=engine, v0=FIG5B_V0_M_S, strike_angle_deg=0.0)
