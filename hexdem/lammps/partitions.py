@@ -114,7 +114,7 @@ def run_partitioned(directories, workers: int, run_dir, description: str = "LAMM
     partitions = min(int(workers), len(directories))
     prefix = shlex.split(launcher) if launcher else [environment_command("mpiexec")]
     command = [*prefix, "-n", str(partitions), environment_command("lmp"), "-partition", f"{partitions}x1",
-               "-in", DRIVER_NAME, "-screen", "none", "-nocite"]
+               "-in", driver.name, "-screen", "none", "-nocite"]
     output = run_dir / "launcher.out"
     pending, bar = list(directories), progress_bar(len(directories), f"{description} x{partitions}", unit="deck")
     with open(output, "w") as out:
