@@ -54,7 +54,7 @@ from hexdem.impact import ImpactAnalysis
 from hexdem.io import atomic_path, ensure_writable_dir, write_csv, write_json
 from hexdem.lammps.deck import DUMP_NAME, Deck, write_deck
 from hexdem.lammps.engine import read_trajectory
-from hexdem.lammps.partitions import is_done, lammps_version, run_info, run_partitioned
+from hexdem.lammps.partitions import die_with_parent, is_done, lammps_version, run_info, run_partitioned
 from hexdem.lattice import Lattice
 from hexdem.model import GranularModel, RunSettings
 from hexdem.progress import progress_bar
@@ -348,6 +348,8 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
     ensemble = Ensemble(config, out)
     with _locked(out) as lock:
         manifest = _check_manifest(out, config)
+        for leftover in out.rglob(".*.part"):  # atomic writes cut short by a killed run
+            leftover.unlink()
         todo = [k for k in range(config.realizations) if not ensemble.result_path(k).exists()]
         ideal_todo = not ensemble.result_path(None).exists()
         log(f"{config.realizations} realizations x {len(config.velocities_m_s)} striker velocities, "
@@ -372,7 +374,8 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
         impacts = _pending_impacts(ensemble, todo, ideal_todo)
         groups = [*todo, *([None] if ideal_todo else [])]
         log(f"impacts: {len(impacts)} decks")
-        with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn")) as pool:
+        with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"),
+                                 initializer=die_with_parent) as pool:
             analyses = {}
 
             def analyse_if_complete(k: int | None) -> None:

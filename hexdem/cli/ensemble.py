@@ -47,7 +47,7 @@ def add_arguments(parser) -> None:
                         help='MPI launcher to which "-n N lmp -partition Nx1 -in run.in" is appended '
                              '(default: this environment\'s mpiexec), e.g. "mpiexec -f hosts" or "srun"')
     parser.add_argument("--edge-beads", type=int, default=11, help="beads per hexagon edge (default 11)")
-    parser.add_argument("--tol-mm", type=float, default=0.0127, help="diameter tolerance tol in mm (default 0.0127)")
+    parser.add_argument("--tol-mm", type=float, help="diameter tolerance tol in mm (default 0.0127)")
     parser.add_argument("--sigma-mm", type=float, help="standard deviation of the diameters in mm (default 6 tol)")
     parser.add_argument("--tilt-deg", type=float, default=5.0,
                         help="tilt of the set-up: gravity g sin(tilt) along the strike (default 5)")
@@ -68,8 +68,9 @@ def config_from_args(args):
     from hexdem.ensemble import EnsembleConfig
     from hexdem.materials import PAPER_DIAMETER_M
 
-    disorder = Disorder(PAPER_DIAMETER_M, tol_m=args.tol_mm * 1e-3,
-                        sigma_m=None if args.sigma_mm is None else args.sigma_mm * 1e-3)
+    sizes = {name: value * 1e-3 for name, value in (("tol_m", args.tol_mm), ("sigma_m", args.sigma_mm))
+             if value is not None}
+    disorder = Disorder(PAPER_DIAMETER_M, **sizes)
     preparation = Preparation(push_force_n=args.push_force, tilt_deg=args.tilt_deg, max_steps=args.max_settle_steps)
     return EnsembleConfig(realizations=args.realizations, velocities_m_s=parse_numbers(args.velocities),
                           seed=args.seed, edge_beads=args.edge_beads, disorder=disorder, preparation=preparation,

@@ -80,9 +80,11 @@ def write_driver(directories, run_dir: Path) -> Path:
     return driver
 
 
-def _die_with_parent() -> None:
-    """In the launcher's child process: receive SIGTERM when hexdem dies (Linux prctl)."""
-    ctypes.CDLL(None).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+def die_with_parent() -> None:
+    """Ask for SIGTERM when the parent process dies (Linux prctl; elsewhere nothing): for
+    child processes that must not outlive hexdem and keep writing into its directories."""
+    if sys.platform.startswith("linux"):
+        ctypes.CDLL(None).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
 
 
 def _failure(directories, run_dir: Path, output: str) -> HexdemError:
@@ -119,7 +121,7 @@ def run_partitioned(directories, workers: int, run_dir, description: str = "LAMM
     pending, bar = list(directories), progress_bar(len(directories), f"{description} x{partitions}", unit="deck")
     with open(output, "w") as out:
         process = subprocess.Popen(command, cwd=run_dir, stdout=out, stderr=subprocess.STDOUT, pass_fds=pass_fds,
-                                   preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None)
+                                   preexec_fn=die_with_parent)
     try:
         while pending:
             finished = process.poll() is not None
