@@ -1,0 +1,193 @@
+"""Disorder ensembles (hexdem.ensemble) on real LAMMPS partitions: contract, statistics,
+determinism per seed and across workers, resuming after a kill, bad input.
+
+The ensembles are small (4 beads per edge, 37 beads, 3 realizations, 2 striker speeds) so
+that each runs in seconds.
+"""
+
+import csv
+import fcntl
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from hexdem.cli.main import main
+from hexdem.ensemble import STATS_COLUMNS, Ensemble, EnsembleConfig, run_ensemble
+from hexdem.errors import HexdemError
+from hexdem.lammps.partitions import DONE_MARKER, run_partitioned
+
+VELOCITIES = (0.4, 0.7)
+SMALL = {"edge_beads": 4, "velocities_m_s": VELOCITIES, "realizations": 3}
+CLI_SMALL = ["--edge-beads", "4", "--velocities", "0.4,0.7"]
+RESULT_ARRAYS = ("diameters_m", "positions_m", "peak_speed", "t_peak", "arrival_time")
+
+
+def quiet(message):
+    pass
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    """The small ensemble on two partitions."""
+    out = tmp_path_factory.mktemp("reference")
+    config = EnsembleConfig(**SMALL)
+    summary = run_ensemble(config, out, workers=2, log=quiet)
+    return Ensemble(config, out), summary
+
+
+def results(ensemble, k):
+    with np.load(ensemble.result_path(k)) as data:
+        return {name: data[name] for name in data.files}
+
+
+def read_csv(path):
+    with open(path, newline="") as fh:
+        reader = csv.DictReader(fh)
+        return reader.fieldnames, list(reader)
+
+
+def test_the_ensemble_writes_its_tables_and_figures(reference):
+    ensemble, summary = reference
+    header, rows = read_csv(ensemble.out / "peaks_stats.csv")
+    assert tuple(header) == STATS_COLUMNS
+    assert len(rows) == len(VELOCITIES) * sum(len(beads) for beads in ensemble.ideal.lines().values())
+    assert {int(row["count"]) for row in rows} <= {0, 1, 2, 3}
+    for name in ("ideal_peaks.csv", "arrival_map.csv", "disorder_effect.csv", "fig9_all_directions.png",
+                 "fig8_expnumsim_v0.400.png", "fig8_expnumsim_v0.700.png", "ensemble.json"):
+        assert (ensemble.out / name).stat().st_size > 0
+    assert {row["line"] for row in summary["disorder_effect"]} == {"0", "+30", "-30", "±30"}
+    assert summary["lammps_time_s"]["settle_per_realization"] > 0 < summary["lammps_time_s"]["impact_per_run"]
+
+
+def test_statistics_are_the_mean_and_sample_deviation_of_the_realizations(reference):
+    ensemble, _ = reference
+    peaks = np.array([results(ensemble, k)["peak_speed"] for k in range(3)])
+    lines = ensemble.ideal.lines()
+    _, rows = read_csv(ensemble.out / "peaks_stats.csv")
+    for row in rows:
+        values = peaks[:, VELOCITIES.index(float(row["v_striker"])), lines[row["line"]][int(row["n"])]]
+        values = values[np.isfinite(values)]
+        assert int(row["count"]) == len(values)
+        if len(values) > 1:
+            assert float(row["mean_peak_speed"]) == pytest.approx(values.mean(), rel=1e-12)
+            assert float(row["std_peak_speed"]) == pytest.approx(values.std(ddof=1), rel=1e-9)
+
+
+def test_every_impact_is_prepared_settled_and_conserves_energy(reference):
+    ensemble, _ = reference
+    for k in range(3):
+        r = results(ensemble, k)
+        assert np.all(r["energy_drift"] < 1e-5)
+        assert r["compact_kinetic_energy_j"] > 0 and r["settle_max_force_n"] < 1e-4
+        assert np.all(r["peak_speed"][:, ensemble.ideal.struck] > 0.5 * np.array(VELOCITIES))
+
+
+def test_the_same_seed_gives_identical_results_on_one_worker(reference, tmp_path):
+    ensemble, _ = reference
+    run_ensemble(EnsembleConfig(**SMALL), tmp_path, workers=1, log=quiet)
+    again = Ensemble(EnsembleConfig(**SMALL), tmp_path)
+    for k in range(3):
+        first, second = results(ensemble, k), results(again, k)
+        for name in RESULT_ARRAYS:
+            np.testing.assert_array_equal(first[name], second[name])
+
+
+def test_another_seed_draws_other_diameters(reference):
+    ensemble, _ = reference
+    other = Ensemble(EnsembleConfig(**SMALL, seed=1), ensemble.out)
+    assert np.all(other.diameters_m(0) != ensemble.diameters_m(0))
+    np.testing.assert_allclose(results(ensemble, 2)["diameters_m"], ensemble.diameters_m(2), rtol=1e-15)
+
+
+def wait_for_unlock(out, timeout_s=60):
+    deadline = time.time() + timeout_s
+    fd = os.open(out / ".lock", os.O_RDWR)
+    try:
+        while True:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                return
+            except BlockingIOError:
+                assert time.time() < deadline, "the killed ensemble's processes kept the lock"
+                time.sleep(0.1)
+    finally:
+        os.close(fd)
+
+
+def test_an_ensemble_killed_midway_resumes_with_every_realization_intact(reference, tmp_path):
+    ensemble, _ = reference
+    out = tmp_path / "killed"
+    args = ["ensemble", "--out", str(out), *CLI_SMALL, "--realizations", "5", "--workers", "2"]
+    process = subprocess.Popen([sys.executable, "-m", "hexdem.cli.main", *args], stderr=subprocess.DEVNULL)
+    deadline = time.time() + 120
+    while not list(out.glob("realizations/*/result.npz")):
+        assert process.poll() is None and time.time() < deadline, "the ensemble ended before it could be killed"
+        time.sleep(0.05)
+    process.kill()
+    process.wait()
+    finished = {path: path.stat().st_mtime_ns for path in out.glob("realizations/*/result.npz")}
+    assert 0 < len(finished) < 5
+    wait_for_unlock(out)
+    assert main(args) == 0
+    for path, mtime in finished.items():
+        assert path.stat().st_mtime_ns == mtime
+    resumed = Ensemble(EnsembleConfig(**{**SMALL, "realizations": 5}), out)
+    for k in range(3):
+        first, second = results(ensemble, k), results(resumed, k)
+        for name in RESULT_ARRAYS:
+            np.testing.assert_array_equal(first[name], second[name])
+    for k in range(5):
+        peaks = results(resumed, k)["peak_speed"]
+        assert peaks.shape == (len(VELOCITIES), len(resumed.ideal)) and np.all(peaks[:, resumed.ideal.struck] > 0)
+    assert not list(out.rglob("*.part"))
+    _, rows = read_csv(out / "peaks_stats.csv")
+    assert max(int(row["count"]) for row in rows) == 5
+
+
+def test_other_parameters_in_the_same_directory_are_refused(reference):
+    ensemble, _ = reference
+    with pytest.raises(HexdemError, match="other parameters \\(seed\\)"):
+        run_ensemble(EnsembleConfig(**SMALL, seed=5), ensemble.out, log=quiet)
+
+
+def test_a_directory_in_use_is_refused(reference):
+    ensemble, _ = reference
+    fd = os.open(ensemble.out / ".lock", os.O_RDWR)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        with pytest.raises(HexdemError, match="in use by another hexdem ensemble"):
+            run_ensemble(EnsembleConfig(**SMALL), ensemble.out, log=quiet)
+    finally:
+        os.close(fd)
+
+
+@pytest.mark.parametrize("options, message", [
+    (["--sigma-mm", "-0.01"], "standard deviation sigma must be >= 0"),
+    (["--realizations", "0"], "number of realizations must be a positive integer"),
+    (["--velocities", "0.25;0.40"], "--velocities must be comma-separated numbers in m/s"),
+    (["--velocities", "fast"], "--velocities must be comma-separated numbers in m/s"),
+    (["--velocities", "0.4,-0.7"], "distinct positive speeds"),
+    (["--workers", "0"], "--workers must be a positive integer"),
+    (["--reference-bead", "0,1"], "reference bead {0, 1} is not in the hexagon"),
+    (["--scaling", "missing.json"], "cannot read scaling laws missing.json"),
+])
+def test_bad_input_is_one_clear_line(tmp_path, capsys, options, message):
+    out = tmp_path / "out"
+    assert main(["ensemble", "--out", str(out), *CLI_SMALL, *options]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("hexdem: error: ") and message in lines[0]
+    assert not out.exists()
+
+
+def test_a_failing_deck_is_named_with_lammps_error(tmp_path):
+    good, bad = tmp_path / "good", tmp_path / "bad"
+    for directory, text in ((good, 'print "fine"\n'), (bad, "units si\nbogus_command 1\n")):
+        directory.mkdir()
+        (directory / "in.hexdem").write_text(text)
+    with pytest.raises(HexdemError, match=r"LAMMPS failed on .*bad/in.hexdem: ERROR: Unknown command: bogus_command"):
+        run_partitioned([good, bad], 2, tmp_path / "run")
+    assert not (bad / DONE_MARKER).exists()
