@@ -59,6 +59,7 @@ def all_directions(stats_rows, ideal_rows, laws: dict, path) -> None:
     the ideal lattice struck by the same striker; red: the fitted law, if any.
     """
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
     stats = _by_velocity_line(stats_rows, slice(3, 5))
     ideal = _by_velocity_line(ideal_rows, slice(3, 4))
@@ -78,12 +79,14 @@ def all_directions(stats_rows, ideal_rows, laws: dict, path) -> None:
                 n_law = n_ideal[n_ideal >= law.start]
                 ax.plot(n_law, law(v, n_law), "r-", label=f"fitted law ({law.combination})")
             ax.set_ylim(bottom=0)
+            ax.xaxis.set_major_locator(MaxNLocator(integer=True))
             ax.grid(True, alpha=0.3)
             ax.set_title(f"0° strike, {line}° line, $V_{{striker}}$ = {v:g} m/s", fontsize=10)
             ax.set_ylabel("peak speed [m/s]")
             if row == len(velocities) - 1:
                 ax.set_xlabel("bead n along the line")
-    axes[0, 0].legend(fontsize=8)
+    for ax in axes[0]:
+        ax.legend(fontsize=8)
     fig.suptitle("Peak speed along the lines, weak disorder vs ideal (Fig. 9)")
     plots.save(fig, path)
 
