@@ -54,7 +54,8 @@ def test_the_spaced_lattice_has_no_overlap(seed):
     disorder = Disorder(D)
     lattice = spaced_lattice(hexagon(11, D), disorder.diameters_m(331, seed, 0), disorder)
     i, j = lattice.bonds().T
-    gaps = np.linalg.norm(lattice.positions_m[i] - lattice.positions_m[j], axis=1) - lattice.radii_m[i] - lattice.radii_m[j]
+    distances = np.linalg.norm(lattice.positions_m[i] - lattice.positions_m[j], axis=1)
+    gaps = distances - lattice.radii_m[i] - lattice.radii_m[j]
     assert gaps.min() >= -1e-15
     assert len(contact_overlaps_m(lattice.positions_m, lattice.diameters_m)) == 0
     assert disorder.spacing_m(lattice.diameters_m) >= D + TOLERANCE_M

@@ -7,6 +7,7 @@ that each runs in seconds.
 
 import csv
 import fcntl
+import json
 import os
 import subprocess
 import sys
@@ -191,3 +192,25 @@ def test_a_failing_deck_is_named_with_lammps_error(tmp_path):
     with pytest.raises(HexdemError, match=r"LAMMPS failed on .*bad/in.hexdem: ERROR: Unknown command: bogus_command"):
         run_partitioned([good, bad], 2, tmp_path / "run")
     assert not (bad / DONE_MARKER).exists()
+
+
+def test_fitted_laws_follow_the_papers_rule_for_physical_units(tmp_path):
+    """eq. (v0) with nondimensional coefficients, evaluated in m/s: every V becomes V/U."""
+    from hexdem.ensemble_plots import fitted_laws
+    from hexdem.materials import PAPER_DIAMETER_M
+    from hexdem.units import nondimensional
+
+    entry = {"m": 0.13, "b": 0.91, "alpha": -0.26, "beta": -0.097, "gamma": 0.215}
+    path = tmp_path / "scaling.json"
+    path.write_text(json.dumps({"0/0": {**entry, "start_bead": 2}, "0/30": {**entry, "start_bead": 1}}))
+    laws = fitted_laws(path, PAPER_DIAMETER_M)
+    unit = nondimensional(PAPER_DIAMETER_M).velocity_m_s
+    v, n = 0.4, np.arange(2, 11)
+    u = v / unit
+    amplitude = entry["alpha"] * u**2 + entry["beta"] * u + entry["gamma"]
+    expected = unit * u * amplitude * (entry["m"] * u + entry["b"]) ** (n - 2)
+    np.testing.assert_allclose(laws["0"](v, n), expected, rtol=1e-12)
+    np.testing.assert_allclose(laws["-30"](v, n), expected * (entry["m"] * u + entry["b"]), rtol=1e-12)
+    path.write_text(json.dumps({"0/0": entry}))
+    with pytest.raises(HexdemError, match="is not a scaling.json of hexdem scaling"):
+        fitted_laws(path, PAPER_DIAMETER_M)
