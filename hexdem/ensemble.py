@@ -284,6 +284,13 @@ def analyse(ensemble: Ensemble, k: int | None, version: str, keep_dumps: bool = 
 # --------------------------------------------------------------------------- running
 
 
+def _analysis_worker() -> None:
+    """Set-up of an analysis process: it dies with hexdem, and shows no per-dump progress
+    bars (errors reach hexdem through the futures; hexdem shows one bar for all)."""
+    die_with_parent()
+    sys.stderr = open(os.devnull, "w")
+
+
 @contextmanager
 def _locked(out: Path):
     """Hold ``OUT/.lock`` (also inherited by the MPI launcher) so two runs never share OUT."""
@@ -375,7 +382,7 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
         groups = [*todo, *([None] if ideal_todo else [])]
         log(f"impacts: {len(impacts)} decks")
         with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"),
-                                 initializer=die_with_parent) as pool:
+                                 initializer=_analysis_worker) as pool:
             analyses = {}
 
             def analyse_if_complete(k: int | None) -> None:
