@@ -284,10 +284,10 @@ def analyse(ensemble: Ensemble, k: int | None, version: str, keep_dumps: bool = 
 # --------------------------------------------------------------------------- running
 
 
-def _analysis_worker() -> None:
+def _analysis_worker(parent_pid: int) -> None:
     """Set-up of an analysis process: it dies with hexdem, and shows no per-dump progress
     bars (errors reach hexdem through the futures; hexdem shows one bar for all)."""
-    die_with_parent()
+    die_with_parent(parent_pid)
     sys.stderr = open(os.devnull, "w")
 
 
@@ -382,11 +382,12 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
         groups = [*todo, *([None] if ideal_todo else [])]
         log(f"impacts: {len(impacts)} decks")
         with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"),
-                                 initializer=_analysis_worker) as pool:
+                                 initializer=_analysis_worker, initargs=(os.getpid(),)) as pool:
             analyses = {}
 
             def analyse_if_complete(k: int | None) -> None:
-                if k not in analyses and all(is_done(d) for d in ensemble.impact_dirs(k)):
+                if k not in analyses and not ensemble.result_path(k).exists() and all(
+                        is_done(d) for d in ensemble.impact_dirs(k)):
                     version = lammps_version(out / "lammps" / "impacts")
                     analyses[k] = pool.submit(analyse, ensemble, k, version, keep_dumps)
 

@@ -16,6 +16,8 @@ On Linux the launcher gets SIGTERM if hexdem dies, so that no orphaned LAMMPS ke
 from __future__ import annotations
 
 import ctypes
+import functools
+import os
 import re
 import shlex
 import signal
@@ -80,11 +82,14 @@ def write_driver(directories, run_dir: Path) -> Path:
     return driver
 
 
-def die_with_parent() -> None:
-    """Ask for SIGTERM when the parent process dies (Linux prctl; elsewhere nothing): for
-    child processes that must not outlive hexdem and keep writing into its directories."""
+def die_with_parent(parent_pid: int) -> None:
+    """In a child of process ``parent_pid``: get SIGTERM when it dies (Linux prctl;
+    elsewhere nothing), or exit at once if it already has. For child processes that must not
+    outlive hexdem and keep writing into its directories."""
     if sys.platform.startswith("linux"):
         ctypes.CDLL(None).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+        if os.getppid() != parent_pid:
+            os._exit(1)
 
 
 def _failure(directories, run_dir: Path, output: str) -> HexdemError:
@@ -121,7 +126,7 @@ def run_partitioned(directories, workers: int, run_dir, description: str = "LAMM
     pending, bar = list(directories), progress_bar(len(directories), f"{description} x{partitions}", unit="deck")
     with open(output, "w") as out:
         process = subprocess.Popen(command, cwd=run_dir, stdout=out, stderr=subprocess.STDOUT, pass_fds=pass_fds,
-                                   preexec_fn=die_with_parent)
+                                   preexec_fn=functools.partial(die_with_parent, os.getpid()))
     try:
         while pending:
             finished = process.poll() is not None
