@@ -9,8 +9,8 @@ entering through the hole in the wall.
 
 **Running.** Three phases, compact → settle → impacts, each running all its pending decks
 on LAMMPS partitions (:mod:`hexdem.lammps.partitions`): ``workers`` one-rank LAMMPS
-instances here, or as many as an MPI launcher reaches across machines. Impacts are analysed
-in this process as their decks finish.
+instances here, or as many as an MPI launcher reaches across machines. A realization's
+impacts are analysed (in ``workers`` spawned processes) as soon as its last deck finishes.
 
 **Resuming.** A deck is finished when it has its done marker; a realization when its
 ``result.npz`` exists (written atomically once all its impacts are analysed; the dumps are
@@ -330,8 +330,7 @@ def _pending_impacts(ensemble: Ensemble, todo: list[int], ideal_todo: bool) -> d
     """Render every impact deck not yet done: {deck directory: realization (None: ideal)}."""
     pending = {}
     for k in [*todo, *([None] if ideal_todo else [])]:
-        for v in ensemble.config.velocities_m_s:
-            directory = ensemble.ideal_dir(v) if k is None else ensemble.impact_dir(k, v)
+        for v, directory in zip(ensemble.config.velocities_m_s, ensemble.impact_dirs(k)):
             if not is_done(directory):
                 write_deck(ensemble.impact_model(k, v), ensemble.settings(v), directory,
                            gravity_m_s2=None if k is None else ensemble.gravity_m_s2)
@@ -413,8 +412,9 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
 
 @dataclass(frozen=True)
 class EnsembleResults:
-    """Stacked results: per-realization arrays have shape (R, V, N) (R realizations, V
-    velocities, N beads); ``ideal`` holds the ideal lattice's (V, N) arrays."""
+    """Stacked results: ``peak_speed`` and ``arrival_time`` (R, V, N) for R realizations, V
+    striker velocities [m/s] and N beads [m/s, s]; ``ideal_*`` the ideal lattice's (V, N);
+    ``per_realization`` every other array of the realizations' ``result.npz``, stacked."""
 
     velocities_m_s: np.ndarray
     peak_speed: np.ndarray
@@ -424,6 +424,11 @@ class EnsembleResults:
     per_realization: dict
 
 
+def _load(path: Path) -> dict:
+    with np.load(path) as data:
+        return {name: data[name] for name in data.files}
+
+
 def load_results(ensemble: Ensemble) -> EnsembleResults:
     """Read every realization's ``result.npz`` and the ideal one (all must exist)."""
     config = ensemble.config
@@ -431,8 +436,8 @@ def load_results(ensemble: Ensemble) -> EnsembleResults:
     if missing or not ensemble.result_path(None).exists():
         raise HexdemError(f"{ensemble.out}: {len(missing)} realization(s) unfinished; "
                           "rerun hexdem ensemble to complete it")
-    runs = [dict(np.load(ensemble.result_path(k))) for k in range(config.realizations)]
-    ideal = dict(np.load(ensemble.result_path(None)))
+    runs = [_load(ensemble.result_path(k)) for k in range(config.realizations)]
+    ideal = _load(ensemble.result_path(None))
     return EnsembleResults(velocities_m_s=ideal["velocities_m_s"],
                            peak_speed=np.array([r["peak_speed"] for r in runs]),
                            arrival_time=np.array([r["arrival_time"] for r in runs]),
@@ -500,7 +505,8 @@ def disorder_effect(results: EnsembleResults, lattice: Lattice) -> list[tuple]:
             beads = beads[np.isfinite(results.ideal_peak_speed[iv, beads])]
             with np.errstate(invalid="ignore"):
                 ratios[line] = (results.peak_speed[:, iv, beads] / results.ideal_peak_speed[iv, beads], beads)
-        ratios["±30"] = (np.concatenate([ratios["+30"][0], ratios["-30"][0]], axis=1), ratios["-30"][1])
+        longer = max(ratios["+30"][1], ratios["-30"][1], key=len)
+        ratios["±30"] = (np.concatenate([ratios["+30"][0], ratios["-30"][0]], axis=1), longer)
         for line, (ratio, beads) in ratios.items():
             per_realization = np.nanmean(ratio, axis=1)
             mean, std, count = _mean_std_count(per_realization)
