@@ -141,16 +141,18 @@ def _from_layers(half_heights, diameter_m: float, wall_angles_deg, shape: str, s
 def touching_walls(lattice: Lattice, normals) -> tuple[Wall, ...]:
     """Flat walls with the given inward normals, each touching the packing without overlap.
 
-    The wall whose normal is +x (the struck edge) has a hole: the struck bead is not a member.
+    The wall whose normal is +x (the struck edge) has a hole: the struck bead is not a member
+    and, sitting in the hole, does not decide where that wall is (it may protrude when the
+    diameters vary).
     """
     walls = []
     for normal in normals:
         normal = (float(normal[0]), float(normal[1]))
         reach = lattice.positions_m @ np.asarray(normal) - lattice.radii_m
+        if np.isclose(normal[0], 1.0):
+            reach[lattice.struck] = np.inf
         offset = float(reach.min())
         members = np.flatnonzero(reach - offset < WALL_GROUP_GAP * lattice.diameter_m)
-        if np.isclose(normal[0], 1.0):
-            members = members[members != lattice.struck]
         angle = int(round(np.degrees(np.arctan2(normal[1], normal[0]))))
         walls.append(Wall(f"wall_{angle:03d}".replace("-", "m"), normal, offset, members))
     return tuple(walls)

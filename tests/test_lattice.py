@@ -77,3 +77,13 @@ def test_too_few_edge_beads_is_an_error(bad):
 def test_half_hexagon_edges_must_match():
     with pytest.raises(HexdemError, match="long_edge"):
         half_hexagon(90, 46, D)
+
+
+def test_a_protruding_struck_bead_sits_in_the_hole_and_does_not_move_its_wall():
+    lattice = hexagon(5, D)
+    diameters = lattice.diameters_m.copy()
+    diameters[lattice.struck] *= 1.01
+    grown = lattice.with_geometry(lattice.positions_m, diameters)
+    struck_wall = next(w for w in grown.walls if w.name == "wall_000")
+    assert struck_wall.offset_m == pytest.approx(-D / 2)
+    assert struck_wall.gaps_m(grown.positions_m[lattice.struck], grown.radii_m[lattice.struck]) < 0

@@ -29,7 +29,7 @@ from pathlib import Path
 from hexdem.errors import HexdemError
 from hexdem.lammps.deck import DECK_NAME
 from hexdem.lammps.library import environment_command
-from hexdem.lammps.runner import RunInfo, _error_line, _log_version
+from hexdem.lammps.runner import RunInfo, error_line, log_version
 from hexdem.progress import progress_bar
 
 #: Written into a deck directory once its run has finished and closed its files.
@@ -50,7 +50,7 @@ def loop_time_s(log) -> float:
 
 def lammps_version(run_dir) -> str:
     """The LAMMPS version line of a partitioned run in ``run_dir``."""
-    return _log_version(Path(run_dir) / "log.lammps.0")
+    return log_version(Path(run_dir) / "log.lammps.0")
 
 
 def run_info(directory, version: str) -> RunInfo:
@@ -96,8 +96,8 @@ def _failure(directories, run_dir: Path, output: str) -> HexdemError:
     for directory in directories:
         log = Path(directory) / "log.lammps"
         if not is_done(directory) and log.exists() and "ERROR" in (text := log.read_text()):
-            return HexdemError(f"LAMMPS failed on {Path(directory) / DECK_NAME}: {_error_line(text)}")
-    return HexdemError(f"LAMMPS partitions failed in {run_dir}: {_error_line(output)}")
+            return HexdemError(f"LAMMPS failed on {Path(directory) / DECK_NAME}: {error_line(text)}")
+    return HexdemError(f"LAMMPS partitions failed in {run_dir}: {error_line(output)}")
 
 
 def run_partitioned(directories, workers: int, run_dir, description: str = "LAMMPS", launcher: str | None = None,

@@ -40,12 +40,13 @@ def _working_directory(path: Path):
         os.chdir(previous)
 
 
-def _log_version(log: Path) -> str:
+def log_version(log: Path) -> str:
+    """The LAMMPS version line a log starts with ("LAMMPS (22 Jul 2025 - Update 4)")."""
     first = log.read_text().splitlines()[0] if log.exists() else ""
     return first.strip() or "unknown"
 
 
-def _error_line(text: str) -> str:
+def error_line(text: str) -> str:
     """LAMMPS's ``ERROR...`` line from its output, without the source-file reference."""
     match = re.search(r"ERROR[^\n]*", text)
     line = match.group(0) if match else (text.strip().splitlines() or ["unknown error"])[-1]
@@ -53,7 +54,7 @@ def _error_line(text: str) -> str:
 
 
 def _fail(deck: Deck, message: str) -> HexdemError:
-    return HexdemError(f"LAMMPS failed on {deck.input_path}: {_error_line(message)}")
+    return HexdemError(f"LAMMPS failed on {deck.input_path}: {error_line(message)}")
 
 
 def run_in_process(deck: Deck) -> RunInfo:
@@ -69,7 +70,7 @@ def run_in_process(deck: Deck) -> RunInfo:
             raise _fail(deck, str(exc)) from None
         finally:
             lmp.close()
-    return RunInfo(_log_version(deck.log_path), 1, time.perf_counter() - start)
+    return RunInfo(log_version(deck.log_path), 1, time.perf_counter() - start)
 
 
 def run_mpiexec(deck: Deck, ranks: int) -> RunInfo:
@@ -82,7 +83,7 @@ def run_mpiexec(deck: Deck, ranks: int) -> RunInfo:
     if done.returncode != 0:
         log = deck.log_path.read_text() if deck.log_path.exists() else ""
         raise _fail(deck, log if "ERROR" in log else done.stderr + done.stdout)
-    return RunInfo(_log_version(deck.log_path), ranks, time.perf_counter() - start)
+    return RunInfo(log_version(deck.log_path), ranks, time.perf_counter() - start)
 
 
 def run_deck(deck: Deck, ranks: int = 1) -> RunInfo:
