@@ -2,8 +2,11 @@
 
 Reproduces and extends Leonard, Chong, Kevrekidis & Daraio, "Traveling Waves in 2D
 Hexagonal Granular Crystal Lattices". Data flow: geometry (:mod:`hexdem.lattice`) →
-model (:mod:`hexdem.model`) → engine (:mod:`hexdem.lammps`) → trajectory → analysis
-(:mod:`hexdem.impact`, :mod:`hexdem.peaks`) → figures (:mod:`hexdem.plots`).
+model (:mod:`hexdem.model`) → engine (LAMMPS, :mod:`hexdem.lammps`, or the RK4 reference
+integrator, :mod:`hexdem.reference`) → :class:`~hexdem.trajectory.Trajectory` → analysis
+(:mod:`hexdem.impact`, :mod:`hexdem.peaks`) → figures (:mod:`hexdem.plots`). Theory lives in
+:mod:`hexdem.tca` and :mod:`hexdem.scaling`; weak disorder in :mod:`hexdem.disorder` and
+:mod:`hexdem.ensemble`.
 """
 
 from hexdem.errors import HexdemError
