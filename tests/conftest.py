@@ -1,6 +1,8 @@
 """Shared fixtures and helpers: one real LAMMPS run of the paper's default experiment per
 session, tiny packings for two-body collisions, and a weakly disordered model."""
 
+import csv
+
 import numpy as np
 import pytest
 
@@ -42,3 +44,10 @@ def contact_history(times, overlap):
     k = int(np.flatnonzero(overlap[1:] < 0)[0]) + 1
     end = np.interp(0.0, overlap[[k, k - 1]], times[[k, k - 1]])
     return end, refine_peak(times, overlap)[1]
+
+
+def read_csv(path):
+    """(header, rows as dicts) of a result table."""
+    with open(path, newline="") as fh:
+        reader = csv.DictReader(fh)
+        return tuple(reader.fieldnames), list(reader)

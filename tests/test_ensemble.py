@@ -5,7 +5,6 @@ The ensembles are small (4 beads per edge, 37 beads, 3 realizations, 2 striker s
 that each runs in seconds.
 """
 
-import csv
 import fcntl
 import json
 import os
@@ -16,6 +15,7 @@ import time
 import numpy as np
 import pytest
 
+from conftest import read_csv
 from hexdem.cli.main import main
 from hexdem.ensemble import STATS_COLUMNS, Ensemble, EnsembleConfig, run_ensemble
 from hexdem.errors import HexdemError
@@ -45,16 +45,10 @@ def results(ensemble, k):
         return {name: data[name] for name in data.files}
 
 
-def read_csv(path):
-    with open(path, newline="") as fh:
-        reader = csv.DictReader(fh)
-        return reader.fieldnames, list(reader)
-
-
 def test_the_ensemble_writes_its_tables_and_figures(reference):
     ensemble, summary = reference
     header, rows = read_csv(ensemble.out / "peaks_stats.csv")
-    assert tuple(header) == STATS_COLUMNS
+    assert header == STATS_COLUMNS
     assert len(rows) == len(VELOCITIES) * sum(len(beads) for beads in ensemble.ideal.lines().values())
     assert {int(row["count"]) for row in rows} <= {0, 1, 2, 3}
     for name in ("ideal_peaks.csv", "arrival_map.csv", "disorder_effect.csv", "fig9_all_directions.png",

@@ -1,20 +1,14 @@
 """The default experiment (``hexdem run``) on real LAMMPS: files, energy, symmetry, ranks, units."""
 
-import csv
 import json
 
 import numpy as np
 import pytest
 
+from conftest import read_csv
 from hexdem.config import RunConfig
 from hexdem.experiment import RESULT_FILES, simulate
 from hexdem.impact import PEAK_COLUMNS
-
-
-def read_peaks(path):
-    with open(path, newline="") as fh:
-        reader = csv.DictReader(fh)
-        return reader.fieldnames, list(reader)
 
 
 def test_default_run_writes_the_contracted_files(default_run):
@@ -22,8 +16,8 @@ def test_default_run_writes_the_contracted_files(default_run):
     for name in RESULT_FILES:
         assert (out / name).stat().st_size > 0
     assert (out / "deck" / "in.hexdem").exists() and (out / "deck" / "dump.lammpstrj").exists()
-    header, rows = read_peaks(out / "peaks.csv")
-    assert tuple(header) == PEAK_COLUMNS
+    header, rows = read_csv(out / "peaks.csv")
+    assert header == PEAK_COLUMNS
     assert {row["line"] for row in rows} == {"0", "+30", "-30"}
     assert [int(r["n"]) for r in rows if r["line"] == "0"] == list(range(11))
     summary = json.loads((out / "summary.json").read_text())

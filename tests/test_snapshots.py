@@ -1,11 +1,11 @@
 """Wavefront snapshots (hexdem.snapshots, Figs. 3 and 4) on real LAMMPS, one and two ranks."""
 
-import csv
 import json
 
 import numpy as np
 import pytest
 
+from conftest import read_csv
 from hexdem.cli.main import main
 from hexdem.config import RunConfig
 from hexdem.errors import HexdemError
@@ -64,8 +64,7 @@ def test_the_front_moves_outward_and_nothing_moves_ahead_of_it(one_and_two_ranks
 def test_the_command_writes_the_figure_and_its_table(tmp_path):
     out = tmp_path / "fig3"
     assert main(["snapshots", "--out", str(out), "--edge-beads", "5", "--times", "0.1,0.2", "--outline-edge", "3"]) == 0
-    with open(out / "fig3_smallsim.csv", newline="") as fh:
-        rows = list(csv.DictReader(fh))
+    _, rows = read_csv(out / "fig3_smallsim.csv")
     assert len(rows) == 2 * 61
     assert sorted({float(row["time"]) for row in rows}) == pytest.approx([1e-4, 2e-4], rel=1e-12)
     assert (out / "fig3_smallsim.png").stat().st_size > 0
