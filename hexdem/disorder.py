@@ -55,7 +55,7 @@ from scipy.spatial import cKDTree
 
 from hexdem.errors import HexdemError
 from hexdem.lammps.deck import DATA_NAME, DECK_NAME, data_file, gravity_block, walls_block
-from hexdem.lattice import Lattice
+from hexdem.lattice import BOND_STEPS, Lattice
 from hexdem.model import GranularModel
 from hexdem.trajectory import Trajectory
 from hexdem.units import SI
@@ -72,8 +72,8 @@ STAGES = ("compact", "settle")
 STATS_NAME = "settle.txt"
 #: LAMMPS data file with the settled state of a stage.
 SETTLED_NAME = "settled.data"
-#: Neighbour offsets {Δm, Δn} of a bead in the paper's labels.
-NEIGHBOURS = ((2, 0), (1, 1), (-1, 1), (-2, 0), (-1, -1), (1, -1))
+#: Neighbour offsets {Δm, Δn} of a bead in the paper's labels: the bond steps and their opposites.
+NEIGHBOURS = BOND_STEPS + tuple((-dm, -dn) for dm, dn in BOND_STEPS)
 
 
 def _finite(value) -> bool:

@@ -17,7 +17,8 @@ import pytest
 
 from conftest import read_csv
 from hexdem.cli.main import main
-from hexdem.ensemble import STATS_COLUMNS, Ensemble, EnsembleConfig, run_ensemble
+from hexdem.ensemble import Ensemble, EnsembleConfig, run_ensemble
+from hexdem.ensemble_stats import STATS_COLUMNS
 from hexdem.errors import HexdemError
 from hexdem.lammps.partitions import DONE_MARKER, run_partitioned
 

@@ -3,7 +3,8 @@
 Runs (or resumes) the ensemble in ``--out`` on ``--workers`` LAMMPS partitions (``mpiexec -n
 N lmp -partition Nx1``; ``--launcher`` replaces ``mpiexec`` to reach other machines) and
 writes ``peaks_stats.csv``, ``ideal_peaks.csv``, ``arrival_map.csv``, ``disorder_effect.csv``,
-``ensemble.json`` and the PNGs of Figs. 8 and 9 (see :mod:`hexdem.ensemble`).
+``ensemble.json`` and the PNGs of Figs. 8 and 9 (see :mod:`hexdem.ensemble`,
+:mod:`hexdem.ensemble_stats`).
 """
 
 from __future__ import annotations
