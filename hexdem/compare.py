@@ -9,11 +9,11 @@ verdict) and ``compare.png``. Values are in the run's units (SI or A = d = M = 1
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 import numpy as np
 
 from hexdem.config import RunConfig
+from hexdem.checks import is_number
 from hexdem.errors import HexdemError
 from hexdem.experiment import run_experiment
 from hexdem.impact import ImpactAnalysis
@@ -40,7 +40,7 @@ class Tolerances:
     def __post_init__(self):
         for name in ("peak_rel", "arrival_s", "min_peak_fraction"):
             value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+            if not (is_number(value) and value >= 0):
                 raise HexdemError(f"tolerance {name} must be a number >= 0, got {value!r}")
 
 

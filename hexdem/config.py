@@ -15,6 +15,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
+from hexdem.checks import is_number, positive_int
 from hexdem.errors import HexdemError
 from hexdem.hertz import contact_time
 from hexdem.lattice import Lattice, half_hexagon, hexagon
@@ -62,12 +63,10 @@ class RunConfig:
             if getattr(self, name) not in allowed:
                 raise HexdemError(f"unknown {name} {getattr(self, name)!r}; use one of: {', '.join(allowed)}")
         for name in ("dump_every", "ranks"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise HexdemError(f"{name} must be a positive integer, got {value!r}")
+            positive_int(name, getattr(self, name))
         for name in ("dt", "duration"):
             value = getattr(self, name)
-            if value is not None and not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            if value is not None and not (is_number(value) and value > 0):
                 raise HexdemError(f"{name} must be a positive number of {self.units} time units, got {value!r}")
         self.model()
 
@@ -109,7 +108,7 @@ class RunConfig:
 
     def model(self) -> GranularModel:
         """The SI :class:`GranularModel` this configuration describes."""
-        if not (isinstance(self.v0, (int, float)) and math.isfinite(self.v0) and self.v0 > 0):
+        if not (is_number(self.v0) and self.v0 > 0):
             raise HexdemError(f"v0 must be > 0 (the impact moves into the packing), got {self.v0!r}")
         wall = None if self.wall_material == "none" else material(self.wall_material)
         impact = Impact(self.v0 * self.unit_system.velocity_m_s, self.strike_angle_deg, self.impact == "striker")

@@ -53,6 +53,7 @@ from string import Template
 import numpy as np
 from scipy.spatial import cKDTree
 
+from hexdem.checks import is_number
 from hexdem.errors import HexdemError
 from hexdem.lammps.deck import DATA_NAME, DECK_NAME, data_file, gravity_block, walls_block
 from hexdem.lattice import BOND_STEPS, Lattice
@@ -76,10 +77,6 @@ SETTLED_NAME = "settled.data"
 NEIGHBOURS = BOND_STEPS + tuple((-dm, -dn) for dm, dn in BOND_STEPS)
 
 
-def _finite(value) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-
-
 @dataclass(frozen=True)
 class Disorder:
     """Per-bead diameters ~ N(``diameter_m``, ``sigma_m``) [m] (Sec. VI-A).
@@ -93,11 +90,11 @@ class Disorder:
     sigma_m: float | None = None
 
     def __post_init__(self):
-        if not (_finite(self.diameter_m) and self.diameter_m > 0):
+        if not (is_number(self.diameter_m) and self.diameter_m > 0):
             raise HexdemError(f"bead diameter must be > 0 m, got {self.diameter_m!r}")
-        if not (_finite(self.tol_m) and self.tol_m >= 0):
+        if not (is_number(self.tol_m) and self.tol_m >= 0):
             raise HexdemError(f"diameter tolerance tol must be >= 0, got {self.tol_m!r} m")
-        if self.sigma_m is not None and not (_finite(self.sigma_m) and self.sigma_m >= 0):
+        if self.sigma_m is not None and not (is_number(self.sigma_m) and self.sigma_m >= 0):
             raise HexdemError(f"diameter standard deviation sigma must be >= 0, got {self.sigma_m!r} m")
 
     @property
@@ -144,7 +141,7 @@ class Preparation:
     def __post_init__(self):
         for f in fields(self):
             value = getattr(self, f.name)
-            if not _finite(value) or value < 0 or (value == 0 and f.name != "tilt_deg"):
+            if not is_number(value) or value < 0 or (value == 0 and f.name != "tilt_deg"):
                 raise HexdemError(f"preparation parameter {f.name} must be a positive number, got {value!r}")
             if f.type == "int" and int(value) != value:
                 raise HexdemError(f"preparation parameter {f.name} must be an integer, got {value!r}")

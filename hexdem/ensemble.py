@@ -32,7 +32,6 @@ from __future__ import annotations
 import dataclasses
 import fcntl
 import json
-import math
 import os
 import shutil
 import sys
@@ -48,6 +47,7 @@ import numpy as np
 from hexdem.config import RunConfig
 from hexdem.disorder import (SETTLED_NAME, STAGES, Disorder, Preparation, TiltedTrajectory, contact_overlaps_m,
                              read_data_file, read_stage, spaced_lattice, write_stage_deck)
+from hexdem.checks import is_number, positive_int
 from hexdem.errors import HexdemError
 from hexdem.experiment import MAX_ENERGY_DRIFT
 from hexdem.impact import ImpactAnalysis
@@ -63,12 +63,6 @@ RESULT_NAME = "result.npz"
 MANIFEST_NAME = "ensemble.json"
 #: Progress-bar labels of the phases.
 PHASE_LABELS = {"compact": "compacting", "settle": "settling", "impacts": "impacts"}
-
-
-def _positive_int(name: str, value) -> int:
-    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-        raise HexdemError(f"{name} must be a positive integer, got {value!r}")
-    return value
 
 
 @dataclass(frozen=True)
@@ -98,18 +92,18 @@ class EnsembleConfig:
     reference_bead: tuple[int, int] = (0, 2)
 
     def __post_init__(self):
-        _positive_int("the number of realizations", self.realizations)
-        _positive_int("dump_every", self.dump_every)
+        positive_int("the number of realizations", self.realizations)
+        positive_int("dump_every", self.dump_every)
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
             raise HexdemError(f"the seed must be a non-negative integer, got {self.seed!r}")
         speeds = tuple(self.velocities_m_s)
         if not speeds or len(set(speeds)) != len(speeds) or not all(
-                isinstance(v, (int, float)) and math.isfinite(v) and v > 0 for v in speeds):
+                is_number(v) and v > 0 for v in speeds):
             raise HexdemError(f"striker velocities must be distinct positive speeds in m/s, got {speeds!r}")
         object.__setattr__(self, "velocities_m_s", tuple(float(v) for v in speeds))
-        if self.duration_s is not None and not (math.isfinite(self.duration_s) and self.duration_s > 0):
+        if self.duration_s is not None and not (is_number(self.duration_s) and self.duration_s > 0):
             raise HexdemError(f"duration must be a positive time in s, got {self.duration_s!r}")
-        if not (math.isfinite(self.duration_factor) and self.duration_factor >= 1):
+        if not (is_number(self.duration_factor) and self.duration_factor >= 1):
             raise HexdemError(f"duration_factor must be >= 1, got {self.duration_factor!r}")
         ideal = self.ideal_lattice()
         if ideal.index_of(*self.reference_bead) is None:
@@ -341,7 +335,7 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
     from hexdem.ensemble_stats import write_statistics
 
     log = log or (lambda message: print(f"hexdem ensemble: {message}", file=sys.stderr, flush=True))
-    _positive_int("--workers", workers)
+    positive_int("--workers", workers)
     laws = fitted_laws(scaling_json, config.disorder.diameter_m) if scaling_json else {}
     out = ensure_writable_dir(out)
     ensemble = Ensemble(config, out)

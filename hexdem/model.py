@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hexdem.checks import is_number
 from hexdem.errors import HexdemError
 from hexdem.lattice import Lattice, strike_direction
 from hexdem.materials import DELRIN, STEEL_316, Material, hertz_stiffness, sphere_mass
@@ -33,7 +34,7 @@ class Impact:
     striker: bool = False
 
     def __post_init__(self):
-        if not (np.isfinite(self.speed_m_s) and self.speed_m_s > 0):
+        if not (is_number(self.speed_m_s) and self.speed_m_s > 0):
             raise HexdemError(f"impact velocity V0 must be > 0 (towards the packing), got {self.speed_m_s}")
         strike_direction(self.angle_deg)
 

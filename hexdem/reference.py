@@ -31,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from hexdem.checks import is_number, positive_int
 from hexdem.errors import HexdemError
 from hexdem.io import write_json
 from hexdem.lattice import BOND_STEPS, Lattice
@@ -201,12 +202,10 @@ class ReferenceSystem:
 
 
 def _check_settings(settings: RunSettings) -> None:
-    if not (math.isfinite(settings.dt_s) and settings.dt_s > 0):
+    if not (is_number(settings.dt_s) and settings.dt_s > 0):
         raise HexdemError(f"time step must be a positive number of seconds, got {settings.dt_s!r}")
     for name in ("n_steps", "dump_every"):
-        value = getattr(settings, name)
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-            raise HexdemError(f"{name} must be a positive integer, got {value!r}")
+        positive_int(name, getattr(settings, name))
 
 
 def _check_finite(times_s, velocities) -> None:

@@ -49,6 +49,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 from scipy.special import hyp2f1
 
+from hexdem.checks import is_number
 from hexdem.errors import HexdemError
 from hexdem.peaks import rising_crossing
 
@@ -137,7 +138,7 @@ def _until_rate_vanishes(rhs, state0, rate, theta: float, v: float):
 
 
 def _positive(v, what: str = "V") -> float:
-    if not (np.isfinite(v) and v > 0):
+    if not (is_number(v) and v > 0):
         raise HexdemError(f"the TCA needs a velocity > 0, got {what} = {v}")
     return float(v)
 

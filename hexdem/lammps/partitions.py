@@ -26,6 +26,7 @@ import sys
 import time
 from pathlib import Path
 
+from hexdem.checks import positive_int
 from hexdem.errors import HexdemError
 from hexdem.lammps.deck import DECK_NAME
 from hexdem.lammps.library import environment_command
@@ -110,15 +111,14 @@ def run_partitioned(directories, workers: int, run_dir, description: str = "LAMM
     Returns the :class:`RunInfo` of every deck.
     """
     directories = [Path(d) for d in directories]
-    if int(workers) != workers or workers < 1:
-        raise HexdemError(f"--workers must be a positive integer, got {workers}")
+    workers = positive_int("--workers", workers)
     if not directories:
         return {}
     run_dir = Path(run_dir)
     for directory in directories:
         (directory / DONE_MARKER).unlink(missing_ok=True)
     driver = write_driver(directories, run_dir)
-    partitions = min(int(workers), len(directories))
+    partitions = min(workers, len(directories))
     prefix = shlex.split(launcher) if launcher else [environment_command("mpiexec")]
     command = [*prefix, "-n", str(partitions), environment_command("lmp"), "-partition", f"{partitions}x1",
                "-in", driver.name, "-screen", "none", "-nocite"]

@@ -15,6 +15,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
+from hexdem.checks import positive_int
 from hexdem.errors import HexdemError
 from hexdem.lammps.deck import DECK_NAME, Deck
 from hexdem.lammps.library import environment_command, load_lammps
@@ -88,6 +89,5 @@ def run_mpiexec(deck: Deck, ranks: int) -> RunInfo:
 
 def run_deck(deck: Deck, ranks: int = 1) -> RunInfo:
     """Run on ``ranks`` MPI ranks: in-process for one, through ``mpiexec`` for more."""
-    if int(ranks) != ranks or ranks < 1:
-        raise HexdemError(f"--ranks must be a positive integer, got {ranks}")
-    return run_in_process(deck) if ranks == 1 else run_mpiexec(deck, int(ranks))
+    ranks = positive_int("--ranks", ranks)
+    return run_in_process(deck) if ranks == 1 else run_mpiexec(deck, ranks)
