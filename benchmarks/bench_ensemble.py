@@ -48,7 +48,8 @@ def bench_ensemble(work: Path, workers: int) -> None:
 def bench_ranks(work: Path, repeats: int) -> None:
     config = snapshot_config(RunConfig(shape="half-hexagon", impact="striker", v0=0.4),
                              [t * 1e-3 for t in DEFAULT_TIMES_MS["half-hexagon"]])
-    model, settings = config.model(), config.settings()
+    model = config.model()
+    settings = config.settings(model)
     decks = {ranks: write_deck(model, settings, work / f"ranks{ranks}") for ranks in (1, 2)}
     atom_steps = model.n_bodies * settings.n_steps
     times = {ranks: {"wall": [], "loop": []} for ranks in decks}

@@ -48,7 +48,8 @@ def _replace_dir(source: Path, target: Path) -> None:
 def simulate(config: RunConfig, workdir, log=None) -> ImpactAnalysis:
     """Run ``config`` with its engine in ``workdir`` and analyse it (no result files)."""
     log = log or (lambda message: None)
-    model, settings = config.model(), config.settings()
+    model = config.model()
+    settings = config.settings(model)
     engine = make_engine(config)
     log(f"running {engine.name}: {model.lattice.shape}, {model.n_bodies} bodies, "
         f"{settings.n_steps} steps of {settings.dt_s:.4g} s ({settings.duration_s * 1e3:.4g} ms)")
@@ -100,7 +101,6 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
 def run_experiment(config: RunConfig, out, log=None) -> ImpactAnalysis:
     """Run ``config`` and publish its result files in ``out`` (see module docstring)."""
     log = log or (lambda message: print(f"hexdem: {message}", file=sys.stderr))
-    config.settings()
     out = ensure_writable_dir(out)
     start = time.perf_counter()
     workdir = out / "deck.inprogress"

@@ -63,7 +63,8 @@ def take_snapshots(config: RunConfig, times_s, directory) -> Snapshots:
     """Run ``config`` (striker impact, ideal lattice) in LAMMPS on ``config.ranks`` ranks
     and keep the bead speeds at ``times_s``."""
     config = snapshot_config(config, sorted(times_s))
-    model, settings = config.model(), config.settings()
+    model = config.model()
+    settings = config.settings(model)
     trajectory = LammpsEngine(ranks=config.ranks).run(model, settings, directory)
     wanted = np.array([round(t * 1e6) * 1e-6 for t in sorted(times_s)])
     index = np.rint(wanted / (settings.dump_every * settings.dt_s)).astype(int)
