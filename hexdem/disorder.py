@@ -46,16 +46,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, fields, replace
-from importlib import resources
 from pathlib import Path
-from string import Template
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from hexdem.checks import is_number
 from hexdem.errors import HexdemError
-from hexdem.lammps.deck import DATA_NAME, DECK_NAME, data_file, gravity_block, walls_block
+from hexdem.lammps.deck import DATA_NAME, DECK_NAME, data_file, granular_block, gravity_block, template, walls_block
 from hexdem.lattice import BOND_STEPS, Lattice
 from hexdem.model import GranularModel
 from hexdem.trajectory import Trajectory
@@ -232,10 +230,9 @@ def write_stage_deck(model: GranularModel, stage: str, preparation: Preparation,
     if force is not None:
         condition = f"({condition})&&(fmax<{force!r})"
         note += f"\n# and no net force component above {force!r} N"
-    template = Template(resources.files("hexdem.lammps_inputs").joinpath("settle.in").read_text())
-    text = template.substitute(
+    text = template("settle.in").substitute(
         stage=stage, title=f"{lattice.shape}, {len(lattice)} beads", loads_note=blocks["loads_note"],
-        pair_stiffness=repr(float(model.pair_stiffness_pa)), skin=repr(0.1 * lattice.diameter_m),
+        granular=granular_block(model, SI),
         walls=blocks["walls"], loads=blocks["loads"], damping_time=repr(blocks["damping_s"]),
         gamma=repr(float(masses.mean()) / blocks["damping_s"]), max_step=repr(preparation.max_step_m),
         max_dt=repr(preparation.max_dt_s), first_dt=repr(preparation.max_dt_s / 100),

@@ -89,6 +89,19 @@ def walls_block(model: GranularModel, units: UnitSystem) -> str:
     return "\n".join(block) + "\n"
 
 
+def template(name: str) -> Template:
+    """The deck template ``lammps_inputs/<name>`` shipped with hexdem."""
+    return Template(resources.files("hexdem.lammps_inputs").joinpath(name).read_text())
+
+
+def granular_block(model: GranularModel, units: UnitSystem) -> str:
+    """Deck commands shared by every hexdem deck: 2D sphere atoms from ``data.hexdem`` and
+    the undamped Hertz pair potential of ``model`` without tangential force."""
+    return template("granular.in").substitute(
+        lammps_units=units.lammps_units, pair_stiffness=_fmt(model.pair_stiffness_pa / units.stress_pa),
+        skin=_fmt(0.1 * model.lattice.diameter_m / units.length_m))
+
+
 def gravity_block(gravity_m_s2, units: UnitSystem) -> str:
     """``fix gravity`` for a uniform in-plane acceleration ``gravity_m_s2`` (gx, gy) [m/s²], if any.
 
@@ -111,14 +124,10 @@ def render_input(model: GranularModel, settings: RunSettings, gravity_m_s2=None)
     note = ("SI (m, kg, s)" if units.name == "si" else
             f"nondimensional A = d = M = 1 (d = {units.length_m} m, M = {units.mass_kg} kg, "
             f"T = {units.time_s} s)")
-    template = Template(resources.files("hexdem.lammps_inputs").joinpath("impact.in").read_text())
-    return template.substitute(
+    return template("impact.in").substitute(
         title=f"{model.lattice.shape}, V0 = {model.impact.speed_m_s} m/s at {model.impact.angle_deg} deg"
               + (" by a striker" if model.has_striker else " on the struck bead"),
-        units_note=note, lammps_units=units.lammps_units,
-        pair_stiffness=_fmt(model.pair_stiffness_pa / units.stress_pa),
-        skin=_fmt(0.1 * model.lattice.diameter_m / units.length_m),
-        walls=walls_block(model, units), body_force=gravity_block(gravity_m_s2, units), impactor_id=impactor,
+        units_note=note, granular=granular_block(model, units), walls=walls_block(model, units), body_force=gravity_block(gravity_m_s2, units), impactor_id=impactor,
         vx=_fmt(velocity[0]), vy=_fmt(velocity[1]), dt=_fmt(settings.dt_s / units.time_s),
         thermo_every=max(1, settings.n_steps // 20), dump_every=settings.dump_every,
         nsteps=settings.n_steps)
