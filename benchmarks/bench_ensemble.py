@@ -23,12 +23,13 @@ from pathlib import Path
 
 from machine import describe
 
-from hexdem.config import RunConfig
-from hexdem.ensemble import EnsembleConfig, run_ensemble
-from hexdem.lammps.deck import write_deck
-from hexdem.lammps.partitions import loop_time_s
-from hexdem.lammps.runner import run_deck
-from hexdem.snapshots import DEFAULT_TIMES_MS, snapshot_config
+from hexdem.disorder.ensemble import EnsembleConfig
+from hexdem.disorder.runner import run_ensemble
+from hexdem.engines.lammps.deck import write_deck
+from hexdem.engines.lammps.partitions import loop_time_s
+from hexdem.engines.lammps.runner import run_deck
+from hexdem.experiments.snapshots import DEFAULT_TIMES_MS, snapshot_config
+from hexdem.model.config import RunConfig
 
 
 def bench_ensemble(work: Path, workers: int) -> None:

@@ -23,10 +23,10 @@ from pathlib import Path
 from bench_run import loop_time
 from machine import describe
 
-from hexdem.config import RunConfig
-from hexdem.lammps.engine import LammpsEngine
-from hexdem.model import RunSettings
-from hexdem.reference import ReferenceEngine
+from hexdem.engines.lammps.engine import LammpsEngine
+from hexdem.engines.reference.engine import ReferenceEngine
+from hexdem.model.config import RunConfig
+from hexdem.model.granular import RunSettings
 
 #: (config, steps per timed run) of each benchmarked lattice.
 LATTICES = ((RunConfig(shape="hexagon"), 20000), (RunConfig(shape="half-hexagon"), 4000))

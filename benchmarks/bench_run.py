@@ -22,10 +22,10 @@ from pathlib import Path
 
 from machine import describe
 
-from hexdem.config import RunConfig
-from hexdem.lammps.deck import DECK_NAME, write_deck
-from hexdem.lammps.library import environment_command
-from hexdem.lammps.runner import run_in_process
+from hexdem.engines.lammps.deck import DECK_NAME, write_deck
+from hexdem.engines.lammps.library import environment_command
+from hexdem.engines.lammps.runner import run_in_process
+from hexdem.model.config import RunConfig
 
 
 def loop_times(log: Path) -> tuple[float, float]:

@@ -6,12 +6,12 @@ import csv
 import numpy as np
 import pytest
 
-from hexdem.config import RunConfig
-from hexdem.experiment import run_experiment
-from hexdem.lattice import Lattice, hexagon
-from hexdem.materials import DELRIN, STEEL_316
-from hexdem.model import GranularModel, Impact
-from hexdem.peaks import refine_peak
+from hexdem.analysis.peaks import refine_peak
+from hexdem.experiments.run import run_experiment
+from hexdem.model.config import RunConfig
+from hexdem.model.granular import GranularModel, Impact
+from hexdem.model.lattice import Lattice, hexagon
+from hexdem.model.materials import DELRIN, STEEL_316
 
 D, V0 = 0.01905, 0.4
 

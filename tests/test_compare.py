@@ -4,17 +4,17 @@ import json
 
 import numpy as np
 import pytest
-
 from conftest import V0, disordered_model, read_csv
+
+from hexdem.analysis.impact import ImpactAnalysis
 from hexdem.cli.main import main
-from hexdem.compare import COMPARE_COLUMNS, Tolerances, compare_analyses, run_comparison
-from hexdem.config import RunConfig
+from hexdem.engines.lammps.engine import LammpsEngine
+from hexdem.engines.reference.engine import PARAMETERS_NAME, ReferenceEngine
 from hexdem.errors import HexdemError
-from hexdem.experiment import RESULT_FILES, simulate
-from hexdem.impact import ImpactAnalysis
-from hexdem.lammps.engine import LammpsEngine
-from hexdem.model import RunSettings
-from hexdem.reference import PARAMETERS_NAME, ReferenceEngine
+from hexdem.experiments.compare import COMPARE_COLUMNS, Tolerances, compare_analyses, run_comparison
+from hexdem.experiments.run import RESULT_FILES, simulate
+from hexdem.model.config import RunConfig
+from hexdem.model.granular import RunSettings
 
 SMALL = RunConfig(edge_beads=4)
 

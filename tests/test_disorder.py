@@ -1,4 +1,4 @@
-"""Weak disorder and the preparation scheme of Sec. VI-A on real LAMMPS (hexdem.disorder).
+"""Weak disorder and the preparation scheme of Sec. VI-A on real LAMMPS (hexdem.disorder.preparation).
 
 Small packings (4 beads per edge, 37 beads) keep the settling runs to about a second.
 """
@@ -11,15 +11,26 @@ import pytest
 from scipy import stats
 from scipy.spatial import cKDTree
 
-from hexdem.config import RunConfig
-from hexdem.disorder import (SETTLED_NAME, TOLERANCE_M, Disorder, Preparation, TiltedTrajectory, contact_overlaps_m,
-                             edge_directions, read_data_file, read_stage, spaced_lattice, write_stage_deck)
+from hexdem.disorder.preparation import (
+    SETTLED_NAME,
+    TOLERANCE_M,
+    Disorder,
+    Preparation,
+    TiltedTrajectory,
+    contact_overlaps_m,
+    edge_directions,
+    read_data_file,
+    read_stage,
+    spaced_lattice,
+    write_stage_deck,
+)
+from hexdem.engines.lammps.deck import write_deck
+from hexdem.engines.lammps.engine import read_trajectory
+from hexdem.engines.lammps.partitions import run_info, run_partitioned
 from hexdem.errors import HexdemError
-from hexdem.lammps.deck import write_deck
-from hexdem.lammps.engine import read_trajectory
-from hexdem.lammps.partitions import run_info, run_partitioned
-from hexdem.lattice import hexagon
-from hexdem.materials import PAPER_DIAMETER_M, sphere_mass
+from hexdem.model.config import RunConfig
+from hexdem.model.lattice import hexagon
+from hexdem.model.materials import PAPER_DIAMETER_M, sphere_mass
 
 D = PAPER_DIAMETER_M
 EDGE = 4

@@ -1,4 +1,4 @@
-"""Disorder ensembles (hexdem.ensemble) on real LAMMPS partitions: contract, statistics,
+"""Disorder ensembles (hexdem.disorder.ensemble) on real LAMMPS partitions: contract, statistics,
 determinism per seed and across workers, resuming after a kill, bad input.
 
 The ensembles are small (4 beads per edge, 37 beads, 3 realizations, 2 striker speeds) so
@@ -14,13 +14,14 @@ import time
 
 import numpy as np
 import pytest
-
 from conftest import read_csv
+
 from hexdem.cli.main import main
-from hexdem.ensemble import Ensemble, EnsembleConfig, run_ensemble
-from hexdem.ensemble_stats import STATS_COLUMNS
+from hexdem.disorder.ensemble import Ensemble, EnsembleConfig
+from hexdem.disorder.runner import run_ensemble
+from hexdem.disorder.stats import STATS_COLUMNS
+from hexdem.engines.lammps.partitions import DONE_MARKER, run_partitioned
 from hexdem.errors import HexdemError
-from hexdem.lammps.partitions import DONE_MARKER, run_partitioned
 
 VELOCITIES = (0.4, 0.7)
 SMALL = {"edge_beads": 4, "velocities_m_s": VELOCITIES, "realizations": 3}
@@ -191,9 +192,9 @@ def test_a_failing_deck_is_named_with_lammps_error(tmp_path):
 
 def test_fitted_laws_follow_the_papers_rule_for_physical_units(tmp_path):
     """eq. (v0) with nondimensional coefficients, evaluated in m/s: every V becomes V/U."""
-    from hexdem.ensemble_plots import fitted_laws
-    from hexdem.materials import PAPER_DIAMETER_M
-    from hexdem.units import nondimensional
+    from hexdem.disorder.figures import fitted_laws
+    from hexdem.model.materials import PAPER_DIAMETER_M
+    from hexdem.model.units import nondimensional
 
     entry = {"m": 0.13, "b": 0.91, "alpha": -0.26, "beta": -0.097, "gamma": 0.215}
     path = tmp_path / "scaling.json"

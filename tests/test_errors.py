@@ -3,14 +3,14 @@
 import numpy as np
 import pytest
 
-from hexdem.analysis import read_dump
+from hexdem.analysis.dump import read_dump
 from hexdem.cli.main import main
-from hexdem.config import RunConfig
+from hexdem.engines.lammps import deck, library
+from hexdem.engines.lammps.deck import write_deck
+from hexdem.engines.lammps.runner import run_deck
 from hexdem.errors import HexdemError
-from hexdem.experiment import RESULT_FILES
-from hexdem.lammps import deck, library
-from hexdem.lammps.deck import write_deck
-from hexdem.lammps.runner import run_deck
+from hexdem.experiments.run import RESULT_FILES
+from hexdem.model.config import RunConfig
 
 
 def run_cli(tmp_path, capsys, config_text=None, out=None):

@@ -1,11 +1,11 @@
-"""Result files are strict JSON and written atomically (hexdem.io)."""
+"""Result files are strict JSON and written atomically (hexdem.common.io)."""
 
 import json
 
 import numpy as np
 import pytest
 
-from hexdem.io import write_json
+from hexdem.common.io import write_json
 
 
 def test_json_results_are_strict_and_atomic(tmp_path):

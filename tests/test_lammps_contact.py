@@ -1,16 +1,16 @@
-"""LAMMPS, through hexdem's decks, against the analytic Hertz collision (hexdem.hertz)."""
+"""LAMMPS, through hexdem's decks, against the analytic Hertz collision (hexdem.model.hertz)."""
 
 from dataclasses import replace
 
 import numpy as np
 import pytest
+from conftest import V0, D, contact_history, single_bead
 
-from conftest import D, V0, contact_history, single_bead
-from hexdem.hertz import contact_time, max_overlap
-from hexdem.lammps.engine import LammpsEngine
-from hexdem.lattice import Wall
-from hexdem.materials import DELRIN, STEEL_316, hertz_stiffness, sphere_mass
-from hexdem.model import GranularModel, Impact, RunSettings
+from hexdem.engines.lammps.engine import LammpsEngine
+from hexdem.model.granular import GranularModel, Impact, RunSettings
+from hexdem.model.hertz import contact_time, max_overlap
+from hexdem.model.lattice import Wall
+from hexdem.model.materials import DELRIN, STEEL_316, hertz_stiffness, sphere_mass
 
 
 def test_two_sphere_collision_matches_hertz(tmp_path):

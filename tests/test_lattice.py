@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from hexdem.errors import HexdemError
-from hexdem.lattice import half_hexagon, hexagon, strike_direction
+from hexdem.model.lattice import half_hexagon, hexagon, strike_direction
 
 D = 0.01905
 

@@ -1,9 +1,9 @@
-"""Pulse definitions (hexdem.peaks) on pulses whose peak and half-maximum are known exactly."""
+"""Pulse definitions (hexdem.analysis.peaks) on pulses whose peak and half-maximum are known exactly."""
 
 import numpy as np
 import pytest
 
-from hexdem.peaks import pulse_times, refine_peak
+from hexdem.analysis.peaks import pulse_times, refine_peak
 
 
 def hertz_like_pulse(t, centre, width, height):

@@ -1,21 +1,21 @@
-"""The reference integrator (hexdem.reference) against physics: Hertz law, energy, symmetry, scaling."""
+"""The reference integrator (hexdem.engines.reference.engine) against physics: Hertz law, energy, symmetry, scaling."""
 
 from dataclasses import replace
 
 import numpy as np
 import pytest
+from conftest import V0, D, contact_history, disordered_model, single_bead
 
-from conftest import D, V0, contact_history, disordered_model, single_bead
-from hexdem.config import RunConfig
-from hexdem.energy import contact_energy_j
+from hexdem.analysis.energy import contact_energy_j
+from hexdem.engines.reference.engine import PARAMETERS_NAME, ReferenceEngine, ReferenceSystem
 from hexdem.errors import HexdemError
-from hexdem.experiment import simulate
-from hexdem.hertz import contact_time, max_overlap
-from hexdem.lattice import Wall
-from hexdem.materials import DELRIN, STEEL_316, hertz_stiffness, sphere_mass
-from hexdem.model import GranularModel, Impact, RunSettings
-from hexdem.reference import PARAMETERS_NAME, ReferenceEngine, ReferenceSystem
-from hexdem.units import SI, nondimensional
+from hexdem.experiments.run import simulate
+from hexdem.model.config import RunConfig
+from hexdem.model.granular import GranularModel, Impact, RunSettings
+from hexdem.model.hertz import contact_time, max_overlap
+from hexdem.model.lattice import Wall
+from hexdem.model.materials import DELRIN, STEEL_316, hertz_stiffness, sphere_mass
+from hexdem.model.units import SI, nondimensional
 
 #: A small experiment: 5 beads per edge (61 beads), everything else the paper's defaults.
 SMALL = RunConfig(edge_beads=5, engine="reference")
@@ -24,7 +24,7 @@ SMALL = RunConfig(edge_beads=5, engine="reference")
 @pytest.mark.parametrize("units", [SI, nondimensional(D)], ids=["si", "nondimensional"])
 def test_forces_are_minus_the_gradient_of_the_hertz_energy(units):
     """Bonds with per-pair contact distance and R_eff, the striker bond and the walls, checked
-    against hexdem.energy (all overlapping pairs, V = (2/5) k_n sqrt(R_eff) δ^{5/2})."""
+    against hexdem.analysis.energy (all overlapping pairs, V = (2/5) k_n sqrt(R_eff) δ^{5/2})."""
     model = disordered_model()
     start = model.initial_positions_m()
     q = np.random.default_rng(2).normal(scale=3e-4, size=start.shape)

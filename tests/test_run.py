@@ -4,11 +4,11 @@ import json
 
 import numpy as np
 import pytest
-
 from conftest import read_csv
-from hexdem.config import RunConfig
-from hexdem.experiment import RESULT_FILES, simulate
-from hexdem.impact import PEAK_COLUMNS
+
+from hexdem.analysis.impact import PEAK_COLUMNS
+from hexdem.experiments.run import RESULT_FILES, simulate
+from hexdem.model.config import RunConfig
 
 
 def test_default_run_writes_the_contracted_files(default_run):

@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 from scipy.optimize import curve_fit
 
-from hexdem import scaling, scaling_outputs, sweep
 from hexdem.cli.main import main
 from hexdem.errors import HexdemError
+from hexdem.theory import outputs as scaling_outputs
+from hexdem.theory import scaling, sweep
 
 V0 = np.linspace(0.01, 0.30, 30)
 TRUE = {"m": 0.21, "b": 0.84, "amplitude": {1: (0.2, 0.63), 2: (-0.4, 0.05, 0.2)}}

@@ -1,15 +1,15 @@
-"""Wavefront snapshots (hexdem.snapshots, Figs. 3 and 4) on real LAMMPS, one and two ranks."""
+"""Wavefront snapshots (hexdem.experiments.snapshots, Figs. 3 and 4) on real LAMMPS, one and two ranks."""
 
 import json
 
 import numpy as np
 import pytest
-
 from conftest import read_csv
+
 from hexdem.cli.main import main
-from hexdem.config import RunConfig
 from hexdem.errors import HexdemError
-from hexdem.snapshots import snapshot_config, take_snapshots
+from hexdem.experiments.snapshots import snapshot_config, take_snapshots
+from hexdem.model.config import RunConfig
 
 TIMES_S = (1e-4, 2e-4, 3e-4)
 #: A half-hexagon small enough for seconds, large enough to split between two ranks.

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from hexdem import tca
 from hexdem.errors import HexdemError
+from hexdem.theory import tca
 
 
 def test_omega_solves_the_compatibility_condition():
@@ -78,7 +78,7 @@ def test_c_does_not_depend_on_v0_and_t_scales_as_v_to_the_minus_one_fifth():
 
 def test_without_side_beads_the_tca_is_the_bca():
     """θ = π/2 decouples beads a and b: a head-on two-bead collision, c = 1 and T = τ/2."""
-    from hexdem.hertz import contact_time
+    from hexdem.model.hertz import contact_time
 
     assert tca.decay_factor(theta=np.pi / 2) == pytest.approx(1.0, abs=1e-9)
     # reduced mass 1/2, A = 1: the velocities meet at maximum compression, half the contact time

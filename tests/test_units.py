@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from hexdem.errors import HexdemError
-from hexdem.materials import DELRIN, STEEL_316, Material, effective_modulus, hertz_coefficient, sphere_mass
-from hexdem.units import nondimensional, to_nondimensional_velocity, to_physical_velocity
+from hexdem.model.materials import DELRIN, STEEL_316, Material, effective_modulus, hertz_coefficient, sphere_mass
+from hexdem.model.units import nondimensional, to_nondimensional_velocity, to_physical_velocity
 
 D = 0.01905
 

@@ -21,7 +21,7 @@ import time
 from pathlib import Path
 
 from hexdem.cli.main import main as hexdem
-from hexdem.io import write_csv, write_json
+from hexdem.common.io import write_csv, write_json
 
 COLUMNS = ("v_striker", "line", "disordered_over_ideal", "sem", "control_over_ideal", "disordered_over_control")
 

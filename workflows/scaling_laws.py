@@ -22,7 +22,7 @@ import time
 from pathlib import Path
 
 from hexdem.cli.main import main as hexdem
-from hexdem.io import write_csv, write_json
+from hexdem.common.io import write_csv, write_json
 
 COEFFICIENTS = ("m", "b", "alpha", "beta", "gamma")
 

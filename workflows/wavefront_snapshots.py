@@ -18,7 +18,7 @@ import time
 from pathlib import Path
 
 from hexdem.cli.main import main as hexdem
-from hexdem.io import write_json
+from hexdem.common.io import write_json
 
 
 def run(argv=None) -> int:

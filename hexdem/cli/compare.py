@@ -21,7 +21,7 @@ def add_arguments(parser) -> None:
 
 
 def run(args) -> None:
-    from hexdem.compare import Tolerances, run_comparison
+    from hexdem.experiments.compare import Tolerances, run_comparison
 
     overrides = {key: value for key, value in (("peak_rel", args.peak_tol), ("arrival_s", args.arrival_tol))
                  if value is not None}

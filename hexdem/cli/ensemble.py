@@ -3,8 +3,8 @@
 Runs (or resumes) the ensemble in ``--out`` on ``--workers`` LAMMPS partitions (``mpiexec -n
 N lmp -partition Nx1``; ``--launcher`` replaces ``mpiexec`` to reach other machines) and
 writes ``peaks_stats.csv``, ``ideal_peaks.csv``, ``arrival_map.csv``, ``disorder_effect.csv``,
-``ensemble.json`` and the PNGs of Figs. 8 and 9 (see :mod:`hexdem.ensemble`,
-:mod:`hexdem.ensemble_stats`).
+``ensemble.json`` and the PNGs of Figs. 8 and 9 (see :mod:`hexdem.disorder.ensemble`,
+:mod:`hexdem.disorder.stats`).
 """
 
 from __future__ import annotations
@@ -65,9 +65,9 @@ def add_arguments(parser) -> None:
 
 
 def config_from_args(args):
-    from hexdem.disorder import Disorder, Preparation
-    from hexdem.ensemble import EnsembleConfig
-    from hexdem.materials import PAPER_DIAMETER_M
+    from hexdem.disorder.ensemble import EnsembleConfig
+    from hexdem.disorder.preparation import Disorder, Preparation
+    from hexdem.model.materials import PAPER_DIAMETER_M
 
     sizes = {name: value * 1e-3 for name, value in (("tol_m", args.tol_mm), ("sigma_m", args.sigma_mm))
              if value is not None}
@@ -80,7 +80,7 @@ def config_from_args(args):
 
 
 def run(args) -> None:
-    from hexdem.ensemble import run_ensemble
+    from hexdem.disorder.runner import run_ensemble
 
     run_ensemble(config_from_args(args), args.out, workers=args.workers, launcher=args.launcher,
                  keep_dumps=args.keep_dumps, scaling_json=args.scaling)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from hexdem.config import ENGINES, RunConfig
+from hexdem.model.config import ENGINES, RunConfig
 
 
 def add_arguments(parser) -> None:
@@ -21,6 +21,6 @@ def config_from_args(args) -> RunConfig:
 
 
 def run(args) -> None:
-    from hexdem.experiment import run_experiment
+    from hexdem.experiments.run import run_experiment
 
     run_experiment(config_from_args(args), args.out)

@@ -2,8 +2,8 @@
 
 Writes ``OUT/scaling.json`` (keys "30/30", "30/0", "0/0", "0/30": m, b, alpha, beta, gamma,
 standard errors, start bead, window, V₀ range, the laws in m/s and the geometric-or-power
-verdict), CSV tables and the PNGs of Figs. 6 and 7 (see :mod:`hexdem.scaling`, :mod:`hexdem.sweep`
-and :mod:`hexdem.scaling_outputs`).
+verdict), CSV tables and the PNGs of Figs. 6 and 7 (see :mod:`hexdem.theory.scaling`, :mod:`hexdem.theory.sweep`
+and :mod:`hexdem.theory.outputs`).
 """
 
 from __future__ import annotations
@@ -11,12 +11,12 @@ from __future__ import annotations
 import json
 import sys
 
-from hexdem.config import ENGINES
+from hexdem.model.config import ENGINES
 
 
 def add_arguments(parser) -> None:
-    from hexdem.scaling import FIT_KINDS
-    from hexdem.sweep import SweepSettings
+    from hexdem.theory.scaling import FIT_KINDS
+    from hexdem.theory.sweep import SweepSettings
 
     d = SweepSettings()
     parser.add_argument("--out", metavar="DIR", default="scaling", help="output directory (default: scaling/)")
@@ -39,9 +39,9 @@ def add_arguments(parser) -> None:
 
 
 def run(args) -> None:
-    from hexdem.io import ensure_writable_dir
-    from hexdem.scaling_outputs import write_outputs
-    from hexdem.sweep import SweepSettings, run_sweep
+    from hexdem.common.io import ensure_writable_dir
+    from hexdem.theory.outputs import write_outputs
+    from hexdem.theory.sweep import SweepSettings, run_sweep
 
     settings = SweepSettings(v0_min=args.v0_min, v0_max=args.v0_max, n_v0=args.n_v0, last=args.last,
                              steps_per_contact=args.steps_per_contact, duration_contacts=args.duration,

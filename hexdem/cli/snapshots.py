@@ -2,12 +2,12 @@
 
 Writes ``fig3_smallsim.png/.csv`` (hexagon) or ``fig4_largesim.png/.csv`` (half-hexagon,
 with the walls of the 11-per-edge hexagon outlined), ``snapshots.json`` and the LAMMPS run
-in ``deck/`` (see :mod:`hexdem.snapshots`).
+in ``deck/`` (see :mod:`hexdem.experiments.snapshots`).
 """
 
 from __future__ import annotations
 
-from hexdem.config import SHAPES
+from hexdem.model.config import SHAPES
 
 
 def add_arguments(parser) -> None:
@@ -30,8 +30,8 @@ def add_arguments(parser) -> None:
 
 def run(args) -> None:
     from hexdem.cli.ensemble import parse_numbers
-    from hexdem.config import RunConfig
-    from hexdem.snapshots import DEFAULT_TIMES_MS, run_snapshots
+    from hexdem.experiments.snapshots import DEFAULT_TIMES_MS, run_snapshots
+    from hexdem.model.config import RunConfig
 
     config = RunConfig(shape=args.shape, edge_beads=args.edge_beads, long_edge=args.long_edge,
                        short_edge=args.short_edge, impact="striker", v0=args.v_striker, ranks=args.ranks)

@@ -12,7 +12,7 @@ import json
 import sys
 import tempfile
 
-from hexdem.config import ENGINES
+from hexdem.model.config import ENGINES
 
 #: Fig. 5a: V₀ (nondimensional) and the last bead shown.
 FIG5A_V0, FIG5A_LAST = 0.1, 15
@@ -28,7 +28,7 @@ def add_arguments(parser) -> None:
 
 def theory() -> dict:
     """ω, c and the TCA's timing at V₀ = 1 (T scales as V₀^{-1/5})."""
-    from hexdem import tca
+    from hexdem.theory import tca
 
     event = tca.equal_velocity(1.0)
     omega = tca.solve_omega()
@@ -50,11 +50,12 @@ def figures(out, engine: str, log) -> dict:
     """Simulate both lattices of Fig. 5, write its tables and figures, return their summary."""
     import numpy as np
 
-    from hexdem import tca, theory_plots
-    from hexdem.config import RunConfig
-    from hexdem.experiment import simulate
-    from hexdem.io import write_csv
-    from hexdem.sweep import SweepSettings
+    from hexdem.common.io import write_csv
+    from hexdem.experiments.run import simulate
+    from hexdem.model.config import RunConfig
+    from hexdem.theory import figures as theory_plots
+    from hexdem.theory import tca
+    from hexdem.theory.sweep import SweepSettings
 
     config_a = SweepSettings(engine=engine, last=FIG5A_LAST).config(FIG5A_V0, 30.0)
     config_b = RunConfig(engine=engine, v0=FIG5B_V0_M_S, strike_angle_deg=0.0)
@@ -86,7 +87,7 @@ def figures(out, engine: str, log) -> dict:
 
 
 def run(args) -> None:
-    from hexdem.io import ensure_writable_dir, write_json
+    from hexdem.common.io import ensure_writable_dir, write_json
 
     def log(message):
         print(f"hexdem tca: {message}", file=sys.stderr, flush=True)

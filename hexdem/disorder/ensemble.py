@@ -1,0 +1,203 @@
+"""Ensembles of weakly disordered packings struck by a striker sphere (Sec. VI; Figs. 8, 9).
+
+Every realization k is prepared as in Sec. VI-A (:mod:`hexdem.disorder.preparation`: diameters from
+(seed, k), compaction by 5 N edge forces, walls, gravity settle) once, and its settled
+packing is struck at every velocity of the ensemble. The ideal lattice (equal diameters,
+no gravity, as in the paper's ideal simulations) is struck by the same striker for
+reference. Striker: steel, nominal diameter, touching the edge-centre bead at t = 0 and
+entering through the hole in the wall.
+
+**Running.** Three phases, compact → settle → impacts, each running all its pending decks
+on LAMMPS partitions (:mod:`hexdem.engines.lammps.partitions`): ``workers`` one-rank LAMMPS
+instances here, or as many as an MPI launcher reaches across machines. A realization's
+impacts are analysed (in ``workers`` spawned processes) as soon as its last deck finishes.
+
+**Resuming.** A deck is finished when it has its done marker; a realization when its
+``result.npz`` exists (written atomically once all its impacts are analysed; the dumps are
+then deleted unless ``keep_dumps``). A rerun with the same parameters skips both and redoes
+only what is missing; nothing half-written is ever read. More realizations can be added
+later: realization k does not depend on how many there are.
+
+**Determinism.** The same seed gives the same diameters and, LAMMPS being deterministic
+on one rank, bit-identical results, however many workers share the work.
+
+**Layout of OUT**: ``ensemble.json`` (parameters, timings, disorder effect),
+``realizations/r0007/{compact,settle,v0.400,...}/`` decks and ``result.npz``,
+``ideal/v0.400/`` decks and ``ideal/result.npz``, ``lammps/<phase>/`` partition drivers,
+and the tables and figures of :func:`hexdem.disorder.stats.write_statistics`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from hexdem.common.checks import is_number, positive_int
+from hexdem.disorder.preparation import (
+    SETTLED_NAME,
+    Disorder,
+    Preparation,
+    read_data_file,
+    read_stage,
+    spaced_lattice,
+)
+from hexdem.errors import HexdemError
+from hexdem.model.config import RunConfig
+from hexdem.model.granular import GranularModel, RunSettings
+from hexdem.model.lattice import Lattice
+
+RESULT_NAME = "result.npz"
+MANIFEST_NAME = "ensemble.json"
+#: Progress-bar labels of the phases.
+PHASE_LABELS = {"compact": "compacting", "settle": "settling", "impacts": "impacts"}
+
+
+@dataclass(frozen=True)
+class EnsembleConfig:
+    """An ensemble: ``realizations`` packings of a hexagon with ``edge_beads`` per edge,
+    each struck at every striker speed of ``velocities_m_s`` [m/s].
+
+    ``seed`` seeds every realization's diameters; ``disorder`` and ``preparation`` are Sec.
+    VI-A; ``dump_every`` steps between samples (50 steps of 0.1 µs: peaks within 1e-4 and
+    arrival times within 3 ns of every-other-step sampling); ``duration_s`` run length [s]
+    (None: the ideal crossing estimate of :class:`~hexdem.model.config.RunConfig` times
+    ``duration_factor``: 1.5 lets the slower disordered wave reach the lines' far beads,
+    while the far wall's reflection has not yet changed the ideal lattice's peaks, which it
+    does at 1.75); ``reference_bead`` {m, n} the bead whose arrival is t = 0 in the maps
+    (Fig. 8's white x; default: bead 1 of the 0° line, the sensor nearest the impact).
+    """
+
+    realizations: int = 20
+    velocities_m_s: tuple[float, ...] = (0.25, 0.40, 0.70)
+    seed: int = 0
+    edge_beads: int = 11
+    disorder: Disorder = field(default_factory=lambda: Disorder(RunConfig().diameter_m))
+    preparation: Preparation = field(default_factory=Preparation)
+    dump_every: int = 50
+    duration_s: float | None = None
+    duration_factor: float = 1.5
+    reference_bead: tuple[int, int] = (0, 2)
+
+    def __post_init__(self):
+        positive_int("the number of realizations", self.realizations)
+        positive_int("dump_every", self.dump_every)
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
+            raise HexdemError(f"the seed must be a non-negative integer, got {self.seed!r}")
+        speeds = tuple(self.velocities_m_s)
+        if not speeds or len(set(speeds)) != len(speeds) or not all(
+                is_number(v) and v > 0 for v in speeds):
+            raise HexdemError(f"striker velocities must be distinct positive speeds in m/s, got {speeds!r}")
+        object.__setattr__(self, "velocities_m_s", tuple(float(v) for v in speeds))
+        if self.duration_s is not None and not (is_number(self.duration_s) and self.duration_s > 0):
+            raise HexdemError(f"duration must be a positive time in s, got {self.duration_s!r}")
+        if not (is_number(self.duration_factor) and self.duration_factor >= 1):
+            raise HexdemError(f"duration_factor must be >= 1, got {self.duration_factor!r}")
+        ideal = self.ideal_lattice()
+        if ideal.index_of(*self.reference_bead) is None:
+            raise HexdemError(f"reference bead {{{self.reference_bead[0]}, {self.reference_bead[1]}}} "
+                              f"is not in the {ideal.shape}")
+
+    def run_config(self, v_striker: float) -> RunConfig:
+        """The ideal-lattice striker run at ``v_striker`` (also sets every run's dt and length)."""
+        base = RunConfig(shape="hexagon", edge_beads=self.edge_beads, diameter_m=self.disorder.diameter_m,
+                         impact="striker", v0=float(v_striker), dump_every=self.dump_every)
+        if self.duration_s is not None:
+            return base.replace(duration=self.duration_s)
+        return base.replace(duration=self.duration_factor * base.settings().duration_s)
+
+    def ideal_lattice(self) -> Lattice:
+        return self.run_config(self.velocities_m_s[0]).lattice()
+
+    def as_dict(self) -> dict:
+        return dataclasses.asdict(self)
+
+    def identity(self) -> dict:
+        """Everything that determines a realization's results: all but the number of
+        realizations and the preparation's step limit (which only decides whether a stage
+        that has not settled yet goes on)."""
+        return self.identity_of(self.as_dict())
+
+    @staticmethod
+    def identity_of(config: dict) -> dict:
+        identity = json.loads(json.dumps(config))
+        del identity["realizations"], identity["preparation"]["max_steps"]
+        return identity
+
+
+def velocity_name(v: float) -> str:
+    """Directory and figure suffix of striker speed ``v`` [m/s], e.g. ``v0.400``."""
+    return f"v{v:.3f}"
+
+
+class Ensemble:
+    """An ensemble directory: where each deck and result lives, and the models behind them."""
+
+    def __init__(self, config: EnsembleConfig, out):
+        self.config, self.out = config, Path(out)
+        self.ideal = config.ideal_lattice()
+        self._base_model = config.run_config(config.velocities_m_s[0]).model()
+
+    # ---- layout
+    def realization_dir(self, k: int) -> Path:
+        return self.out / "realizations" / f"r{k:04d}"
+
+    def stage_dir(self, k: int, stage: str) -> Path:
+        return self.realization_dir(k) / stage
+
+    def impact_dir(self, k: int, v: float) -> Path:
+        return self.realization_dir(k) / velocity_name(v)
+
+    def ideal_dir(self, v: float) -> Path:
+        return self.out / "ideal" / velocity_name(v)
+
+    def result_path(self, k: int | None) -> Path:
+        """``result.npz`` of realization k (None: the ideal lattice)."""
+        return self.out / "ideal" / RESULT_NAME if k is None else self.realization_dir(k) / RESULT_NAME
+
+    def impact_dirs(self, k: int | None) -> list[Path]:
+        """The impact decks of realization k (None: the ideal lattice), one per velocity."""
+        return [self.ideal_dir(v) if k is None else self.impact_dir(k, v) for v in self.config.velocities_m_s]
+
+    # ---- models
+    def settings(self, v: float) -> RunSettings:
+        return self.config.run_config(v).settings()
+
+    def diameters_m(self, k: int) -> np.ndarray:
+        return self.config.disorder.diameters_m(len(self.ideal), self.config.seed, k)
+
+    def stage_model(self, k: int, stage: str) -> GranularModel:
+        """The packing a preparation stage starts from: spaced (compact) or compacted with walls (settle)."""
+        if stage == "compact":
+            spaced = spaced_lattice(self.ideal, self.diameters_m(k), self.config.disorder)
+            return replace(self._base_model, lattice=spaced)
+        compacted = self._stage_state(k, "compact")
+        return replace(self._base_model, lattice=self.ideal.with_geometry(compacted.positions_m, compacted.diameters_m))
+
+    def _stage_state(self, k: int, stage: str):
+        directory = self.stage_dir(k, stage)
+        result = read_stage(directory)
+        if not result.settled:
+            raise HexdemError(f"realization {k}: stage {stage!r} did not settle in {result.steps} steps "
+                              f"(kinetic energy {result.kinetic_energy_j:.3g} J, tolerance {result.tolerance_j:.3g} J; "
+                              f"largest force {result.max_force_n:.3g} N, tolerance {result.force_tolerance_n:.3g} N); "
+                              "rerun with a larger --max-settle-steps")
+        return read_data_file(directory / SETTLED_NAME)
+
+    def settled_lattice(self, k: int) -> Lattice:
+        """The settled packing of realization k, with the walls placed after compaction."""
+        walled = self.stage_model(k, "settle").lattice
+        settled = self._stage_state(k, "settle")
+        return replace(walled, positions_m=settled.positions_m, diameters_m=settled.diameters_m)
+
+    def impact_model(self, k: int | None, v: float) -> GranularModel:
+        """Realization k (None: the ideal lattice) struck at ``v``."""
+        model = self.config.run_config(v).model()
+        return model if k is None else replace(model, lattice=self.settled_lattice(k))
+
+    @property
+    def gravity_m_s2(self) -> np.ndarray:
+        return self.config.preparation.gravity_vector_m_s2(self._base_model.impact.direction)

@@ -1,0 +1,348 @@
+"""Weak disorder and the preparation scheme of Sec. VI-A, as LAMMPS decks.
+
+**Diameters.** Every bead of realization k gets a diameter drawn from the normal distribution
+N(d, σ), σ = 6 tol by default (tol = 0.0127 mm, the manufacturer's diameter tolerance), by
+NumPy's default generator seeded with (seed, k). A realization's diameters therefore depend
+on nothing else: not on the number of realizations, workers or MPI ranks (LAMMPS's own
+random numbers would depend on the rank count).
+
+**Preparation**, two damped LAMMPS runs rendered from ``lammps_inputs/settle.in``:
+
+1. ``compact``: the lattice is spaced for its largest diameter (at least d + tol), so that
+   nothing overlaps. A constant force of 5 N pushes every edge bead (a bead with fewer than
+   six neighbours) inward, perpendicular to its edge (along the bisector at a corner). There
+   are no walls yet, so nothing resists a rigid drift or spin of the whole packing:
+   ``fix momentum`` removes both (fixed-direction forces on a rotated hexagon would drive
+   the spin further). Artificial viscous drag F = −γ v settles the packing.
+2. ``settle``: the walls are placed touching the compacted packing
+   (:meth:`~hexdem.model.lattice.Lattice.with_geometry`), the 5 N forces are removed, gravity
+   g sin(tilt) acts along the strike direction (the set-up's tilt, 5° by default:
+   0.855 m/s²), and a ten times weaker drag settles the packing again.
+
+Damping times M/γ: 1.5 ms, then 15 ms. The settled packing (``settle/settled.data``, with
+its contact overlaps) is the starting state of every striker velocity; the walls stay where
+step 2 put them. Walls placed around the compressed packing keep part of its compression
+once the 5 N are gone (overlaps of a few 0.1 µm, forces of order 1 N): even equal beads
+(σ = 0) prepared this way transmit 5-17 % less than the uncompressed ideal lattice.
+
+**Settled** means, at a check every 100 steps after at least 1000 steps: the total kinetic
+energy Σ ½ m v² is below ½ (Σ m) v_rms², v_rms = 10 µm/s (4.8e-10 J for the 331 beads of
+the experiment), and, for the final stage, no component of the net force on any bead
+exceeds 1e-4 N (0.4 % of a bead's weight along the 5° tilt). Kinetic energy alone can be
+caught near the turning point of a slow oscillation, with residual forces of a third of a
+bead's weight left that would set beads moving during the impact. (The compacted packing
+is held against spinning by ``fix momentum``, which leaves the pushes' small net torque as
+residual forces: stage 1 uses the kinetic-energy test only.) A stage not settled after
+``max_steps`` is an error. The time step is reset every 10 steps so that no bead moves more
+than 0.1 µm per step, up to 20 µs: the equilibrium reached does not depend on it.
+
+**Impact under gravity.** Gravity stays on during the impact (it holds the packing in the
+state it settled in). The energy audit of such a run must include the gravitational
+potential −Σ m g·u; :class:`TiltedTrajectory` adds it, so that
+:class:`~hexdem.analysis.impact.ImpactAnalysis` reports the drift of the conserved total.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields, replace
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from hexdem.analysis.trajectory import Trajectory
+from hexdem.common.checks import is_number
+from hexdem.engines.lammps.deck import (
+    DATA_NAME,
+    DECK_NAME,
+    data_file,
+    granular_block,
+    gravity_block,
+    template,
+    walls_block,
+)
+from hexdem.errors import HexdemError
+from hexdem.model.granular import GranularModel
+from hexdem.model.lattice import BOND_STEPS, Lattice
+from hexdem.model.units import SI
+
+#: The manufacturer's diameter tolerance of the experiment's beads, tol = 0.0127 mm.
+TOLERANCE_M = 0.0127e-3
+#: σ / tol of the paper's diameter distribution.
+SIGMA_PER_TOLERANCE = 6.0
+#: Standard gravity [m/s²].
+STANDARD_GRAVITY_M_S2 = 9.80665
+#: The two preparation stages, in order.
+STAGES = ("compact", "settle")
+#: File in which a stage deck writes its final step, time and kinetic energy.
+STATS_NAME = "settle.txt"
+#: LAMMPS data file with the settled state of a stage.
+SETTLED_NAME = "settled.data"
+#: Neighbour offsets {Δm, Δn} of a bead in the paper's labels: the bond steps and their opposites.
+NEIGHBOURS = BOND_STEPS + tuple((-dm, -dn) for dm, dn in BOND_STEPS)
+
+
+@dataclass(frozen=True)
+class Disorder:
+    """Per-bead diameters ~ N(``diameter_m``, ``sigma_m``) [m] (Sec. VI-A).
+
+    ``tol_m`` is the diameter tolerance [m]; ``sigma_m`` defaults to 6 tol. σ = 0 gives the
+    ideal lattice, prepared the same way.
+    """
+
+    diameter_m: float
+    tol_m: float = TOLERANCE_M
+    sigma_m: float | None = None
+
+    def __post_init__(self):
+        if not (is_number(self.diameter_m) and self.diameter_m > 0):
+            raise HexdemError(f"bead diameter must be > 0 m, got {self.diameter_m!r}")
+        if not (is_number(self.tol_m) and self.tol_m >= 0):
+            raise HexdemError(f"diameter tolerance tol must be >= 0, got {self.tol_m!r} m")
+        if self.sigma_m is not None and not (is_number(self.sigma_m) and self.sigma_m >= 0):
+            raise HexdemError(f"diameter standard deviation sigma must be >= 0, got {self.sigma_m!r} m")
+
+    @property
+    def sigma(self) -> float:
+        """σ [m]: ``sigma_m``, or 6 tol."""
+        return SIGMA_PER_TOLERANCE * self.tol_m if self.sigma_m is None else float(self.sigma_m)
+
+    def diameters_m(self, n_beads: int, seed: int, realization: int) -> np.ndarray:
+        """The (n_beads,) diameters of realization ``realization`` of ensemble ``seed`` [m]."""
+        rng = np.random.default_rng([int(seed), int(realization)])
+        return rng.normal(self.diameter_m, self.sigma, int(n_beads))
+
+    def spacing_m(self, diameters_m) -> float:
+        """Lattice spacing at which no two beads overlap: max(d + tol, largest diameter) [m]."""
+        return max(self.diameter_m + self.tol_m, float(np.max(diameters_m)))
+
+
+@dataclass(frozen=True)
+class Preparation:
+    """The damped settling of Sec. VI-A (see the module docstring), in SI units.
+
+    ``push_force_n`` inward force on edge beads in stage 1 [N]; ``tilt_deg`` tilt of the set-up,
+    gravity g sin(tilt) along the strike [deg]; ``gravity_m_s2`` g; ``compact_damping_s`` and
+    ``settle_damping_s`` damping times M/γ of the two stages [s]; ``settled_rms_speed_m_s`` and
+    ``settled_max_force_n`` the rms bead speed [m/s] and the net force component [N] below which
+    a stage is settled; ``max_dt_s`` and ``max_step_m`` bound the
+    time step and the distance a bead moves per step; ``check_every``, ``min_steps`` and
+    ``max_steps`` schedule the kinetic-energy check.
+    """
+
+    push_force_n: float = 5.0
+    tilt_deg: float = 5.0
+    gravity_m_s2: float = STANDARD_GRAVITY_M_S2
+    compact_damping_s: float = 1.5e-3
+    settle_damping_s: float = 15e-3
+    settled_rms_speed_m_s: float = 1e-5
+    settled_max_force_n: float = 1e-4
+    max_dt_s: float = 2e-5
+    max_step_m: float = 1e-7
+    check_every: int = 100
+    min_steps: int = 1000
+    max_steps: int = 1_000_000
+
+    def __post_init__(self):
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if not is_number(value) or value < 0 or (value == 0 and f.name != "tilt_deg"):
+                raise HexdemError(f"preparation parameter {f.name} must be a positive number, got {value!r}")
+            if f.type == "int" and int(value) != value:
+                raise HexdemError(f"preparation parameter {f.name} must be an integer, got {value!r}")
+        if self.tilt_deg >= 90:
+            raise HexdemError(f"tilt must be below 90 degrees, got {self.tilt_deg!r}")
+
+    def gravity_vector_m_s2(self, direction) -> np.ndarray:
+        """In-plane gravity of the tilted set-up: g sin(tilt) along the strike ``direction``."""
+        return self.gravity_m_s2 * math.sin(math.radians(self.tilt_deg)) * np.asarray(direction, float)
+
+    def kinetic_tolerance_j(self, masses_kg) -> float:
+        """The settling criterion: Σ ½ m v² below ½ (Σ m) v_rms² [J]."""
+        return 0.5 * float(np.sum(masses_kg)) * self.settled_rms_speed_m_s**2
+
+
+def edge_directions(lattice: Lattice) -> np.ndarray:
+    """(N, 2) inward unit vectors of the edge beads (zero for interior beads).
+
+    An edge bead misses some of its six neighbours; it is pushed away from the missing
+    ones: perpendicular to a straight edge, along the bisector at a corner.
+    """
+    unit = {step: np.array([np.sqrt(3) / 2 * step[1], step[0] / 2]) for step in NEIGHBOURS}
+    directions = np.zeros((len(lattice), 2))
+    for i, (m, n) in enumerate(lattice.indices.tolist()):
+        for dm, dn in NEIGHBOURS:
+            if lattice.index_of(m + dm, n + dn) is None:
+                directions[i] -= unit[(dm, dn)]
+    norms = np.linalg.norm(directions, axis=1)
+    edge = norms > 1e-12
+    directions[edge] /= norms[edge, None]
+    directions[~edge] = 0.0
+    return directions
+
+
+def spaced_lattice(lattice: Lattice, diameters_m, disorder: Disorder) -> Lattice:
+    """``lattice`` with the given diameters, spaced by :meth:`Disorder.spacing_m` (no overlap)."""
+    scale = disorder.spacing_m(diameters_m) / lattice.diameter_m
+    return lattice.with_geometry(lattice.positions_m * scale, diameters_m)
+
+
+def _push_block(model: GranularModel, preparation: Preparation) -> str:
+    """Constant inward forces on the edge beads, grouped by direction, and fix momentum."""
+    directions = edge_directions(model.lattice)
+    groups: dict[tuple[float, float], list[int]] = {}
+    for i in np.flatnonzero(np.any(directions != 0, axis=1)):
+        groups.setdefault(tuple(np.round(directions[i], 9)), []).append(int(i))
+    lines = []
+    for k, members in enumerate(groups[key] for key in sorted(groups)):
+        force = preparation.push_force_n * directions[members[0]]
+        ids = [i + 1 for i in members]
+        lines += [f"group           push_{k} id {' '.join(map(str, ids))}",
+                  f"fix             push_{k} push_{k} addforce {float(force[0])!r} {float(force[1])!r} 0.0"]
+    lines.append("fix             rigid_modes all momentum 10 linear 1 1 0 angular")
+    return "\n".join(lines) + "\n"
+
+
+def _stage_blocks(model: GranularModel, stage: str, preparation: Preparation) -> dict:
+    """What differs between the stages: walls, loads, damping time, force criterion (None: none)."""
+    if stage == "compact":
+        return {"walls": "# (none yet: they are placed touching the compacted packing)\n",
+                "loads": _push_block(model, preparation), "damping_s": preparation.compact_damping_s,
+                "loads_note": f"{preparation.push_force_n:g} N inward on every edge bead; rigid drift and spin removed",
+                "force_tolerance": None}
+    return {"walls": walls_block(model, SI),
+            "loads": gravity_block(preparation.gravity_vector_m_s2(model.impact.direction), SI),
+            "damping_s": preparation.settle_damping_s,
+            "loads_note": f"gravity of the {preparation.tilt_deg:g} deg tilt along the strike, no push",
+            "force_tolerance": preparation.settled_max_force_n}
+
+
+def write_stage_deck(model: GranularModel, stage: str, preparation: Preparation, directory) -> Path:
+    """Render the deck of preparation ``stage`` ("compact" or "settle") for ``model``'s lattice.
+
+    ``model`` supplies the packing (positions, diameters, walls) and the materials; its
+    impact is not part of the deck. Returns the deck directory.
+    """
+    if stage not in STAGES:
+        raise HexdemError(f"unknown preparation stage {stage!r}; known: {', '.join(STAGES)}")
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    lattice = model.lattice
+    masses = model.masses_kg[:len(lattice)]
+    blocks = _stage_blocks(model, stage, preparation)
+    kinetic = repr(preparation.kinetic_tolerance_j(masses))
+    condition = f"c_kinetic<{kinetic}"
+    note = f"kinetic energy below {kinetic} J (rms bead speed {preparation.settled_rms_speed_m_s!r} m/s)"
+    force = blocks["force_tolerance"]
+    if force is not None:
+        condition = f"({condition})&&(fmax<{force!r})"
+        note += f"\n# and no net force component above {force!r} N"
+    text = template("settle.in").substitute(
+        stage=stage, title=f"{lattice.shape}, {len(lattice)} beads", loads_note=blocks["loads_note"],
+        granular=granular_block(model, SI),
+        walls=blocks["walls"], loads=blocks["loads"], damping_time=repr(blocks["damping_s"]),
+        gamma=repr(float(masses.mean()) / blocks["damping_s"]), max_step=repr(preparation.max_step_m),
+        max_dt=repr(preparation.max_dt_s), first_dt=repr(preparation.max_dt_s / 100),
+        thermo_every=10 * preparation.check_every, min_steps=preparation.min_steps,
+        check_every=preparation.check_every, max_steps=preparation.max_steps, settled_condition=condition,
+        settled_note=note, kinetic_tolerance=kinetic, force_tolerance="inf" if force is None else repr(force),
+        stats=STATS_NAME, output=SETTLED_NAME)
+    (directory / DATA_NAME).write_text(data_file(replace(model, impact=replace(model.impact, striker=False)), SI))
+    (directory / DECK_NAME).write_text(text)
+    return directory
+
+
+@dataclass(frozen=True)
+class StageResult:
+    """How a preparation stage ended: ``steps`` taken, simulated ``time_s`` [s], final
+    ``kinetic_energy_j`` [J] and largest net force component ``max_force_n`` [N], against
+    the criteria ``tolerance_j`` and ``force_tolerance_n``."""
+
+    steps: int
+    time_s: float
+    kinetic_energy_j: float
+    tolerance_j: float
+    max_force_n: float
+    force_tolerance_n: float
+
+    @property
+    def settled(self) -> bool:
+        return self.kinetic_energy_j < self.tolerance_j and self.max_force_n < self.force_tolerance_n
+
+
+def read_stage(directory) -> StageResult:
+    """The :class:`StageResult` a finished stage deck wrote into ``directory``."""
+    path = Path(directory) / STATS_NAME
+    try:
+        words = path.read_text().split()
+        values = dict(zip(words[::2], words[1::2]))
+        return StageResult(int(values["steps"]), float(values["time_s"]), float(values["kinetic_energy_j"]),
+                           float(values["tolerance_j"]), float(values["max_force_n"]),
+                           float(values["force_tolerance_n"]))
+    except (OSError, KeyError, ValueError):
+        raise HexdemError(f"{path} is missing or unreadable: the preparation stage did not finish") from None
+
+
+@dataclass(frozen=True)
+class DataFileState:
+    """Bodies of a LAMMPS data file, ordered by atom id: ``diameters_m`` (N,),
+    ``positions_m`` (N, 2), ``velocities_m_s`` (N, 2) (zero when the file has none)."""
+
+    diameters_m: np.ndarray
+    positions_m: np.ndarray
+    velocities_m_s: np.ndarray
+
+
+def _section(lines: list[str], name: str, count: int) -> np.ndarray | None:
+    starts = [i for i, line in enumerate(lines) if line.split("#")[0].strip() == name]
+    if not starts:
+        return None
+    rows = [line.split() for line in lines[starts[0] + 1:] if line.strip()][:count]
+    table = np.array(rows, dtype=float)
+    return table[np.argsort(table[:, 0])]
+
+
+def read_data_file(path) -> DataFileState:
+    """Read an ``atom_style sphere`` data file (as written by ``write_data``), SI units."""
+    path = Path(path)
+    try:
+        lines = path.read_text().splitlines()
+        count = next(int(line.split()[0]) for line in lines if line.strip().endswith(" atoms"))
+        atoms = _section(lines, "Atoms", count)
+        velocities = _section(lines, "Velocities", count)
+        if atoms is None or len(atoms) != count or (velocities is not None and len(velocities) != count):
+            raise ValueError
+    except (OSError, StopIteration, ValueError):
+        raise HexdemError(f"{path} is not a complete LAMMPS data file") from None
+    return DataFileState(diameters_m=atoms[:, 2], positions_m=atoms[:, 4:6],
+                         velocities_m_s=np.zeros((count, 2)) if velocities is None else velocities[:, 1:3])
+
+
+def contact_overlaps_m(positions_m, diameters_m) -> np.ndarray:
+    """Overlaps δ > 0 of every touching pair of beads [m]."""
+    positions_m, radii = np.asarray(positions_m, float), np.asarray(diameters_m, float) / 2
+    pairs = cKDTree(positions_m).query_pairs(2 * radii.max(), output_type="ndarray")
+    i, j = pairs.T
+    overlap = radii[i] + radii[j] - np.linalg.norm(positions_m[i] - positions_m[j], axis=1)
+    return overlap[overlap > 0]
+
+
+@dataclass(frozen=True)
+class TiltedTrajectory(Trajectory):
+    """A :class:`~hexdem.analysis.trajectory.Trajectory` under uniform gravity ``gravity_m_s2`` (gx, gy).
+
+    Its energy adds the gravitational potential −Σ m g·u (u: displacement from t = 0), so
+    that the energy audit checks the conserved total of a tilted set-up.
+    """
+
+    gravity_m_s2: tuple[float, float] = field(default=(0.0, 0.0))
+
+    @classmethod
+    def tilt(cls, trajectory: Trajectory, gravity_m_s2) -> "TiltedTrajectory":
+        values = {f.name: getattr(trajectory, f.name) for f in fields(Trajectory)}
+        return cls(**values, gravity_m_s2=tuple(float(g) for g in gravity_m_s2))
+
+    def energies_j(self, model: GranularModel) -> np.ndarray:
+        work = np.einsum("fbk,b,k->f", self.displacements_m, model.masses_kg, np.asarray(self.gravity_m_s2))
+        return super().energies_j(model) - work

@@ -1,0 +1,142 @@
+"""Render a :class:`~hexdem.model.granular.GranularModel` into a standalone LAMMPS run directory.
+
+The directory holds ``data.hexdem`` (atoms: id type diameter density x y z) and
+``in.hexdem`` (from ``lammps_inputs/impact.in``); ``cd DIR && lmp -in in.hexdem`` reruns it
+by hand. Quantities are written in the chosen :class:`~hexdem.model.units.UnitSystem`: SI
+(``units si``) or the paper's A = d = M = 1 (``units lj``). Contacts use the ``hertz k_n``
+model, F = k_n sqrt(R_eff δ) δ, for bead pairs and for the walls alike, so the walls carry
+their own modulus (the wall fix's ``hertz/material`` cannot mix materials, LAMMPS issue 4141).
+An optional uniform in-plane gravity (the tilted set-up of Sec. VI-A) adds ``fix gravity``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from string import Template
+
+import numpy as np
+
+from hexdem.model.granular import GranularModel, RunSettings
+from hexdem.model.units import UnitSystem
+
+DECK_NAME = "in.hexdem"
+DATA_NAME = "data.hexdem"
+DUMP_NAME = "dump.lammpstrj"
+#: Atom types: lattice beads and the striker.
+BEAD_TYPE, STRIKER_TYPE = 1, 2
+
+
+@dataclass(frozen=True)
+class Deck:
+    """A rendered run directory: where its input, data and dump files are."""
+
+    directory: Path
+    settings: RunSettings
+    n_atoms: int
+
+    @property
+    def input_path(self) -> Path:
+        return self.directory / DECK_NAME
+
+    @property
+    def dump_path(self) -> Path:
+        return self.directory / DUMP_NAME
+
+    @property
+    def log_path(self) -> Path:
+        return self.directory / "log.lammps"
+
+
+def _fmt(value: float) -> str:
+    return repr(float(value))
+
+
+def data_file(model: GranularModel, units: UnitSystem) -> str:
+    """The text of ``data.hexdem``: every body of ``model`` at its initial position."""
+    pos = model.initial_positions_m() / units.length_m
+    diam = model.diameters_m / units.length_m
+    density = model.bead.density_kg_m3 / units.density_kg_m3
+    margin = 2.0 * diam.max()
+    lo, hi = pos.min(axis=0) - margin, pos.max(axis=0) + margin
+    types = np.full(model.n_bodies, BEAD_TYPE)
+    if model.has_striker:
+        types[-1] = STRIKER_TYPE
+    lines = [f"hexdem data file: {model.lattice.shape}", "",
+             f"{model.n_bodies} atoms", "2 atom types", "",
+             f"{_fmt(lo[0])} {_fmt(hi[0])} xlo xhi", f"{_fmt(lo[1])} {_fmt(hi[1])} ylo yhi",
+             f"{_fmt(-diam.max())} {_fmt(diam.max())} zlo zhi", "", "Atoms # sphere", ""]
+    lines += [f"{i + 1} {t} {_fmt(d)} {_fmt(density)} {_fmt(x)} {_fmt(y)} 0.0"
+              for i, (t, d, (x, y)) in enumerate(zip(types, diam, pos))]
+    return "\n".join(lines) + "\n"
+
+
+def walls_block(model: GranularModel, units: UnitSystem) -> str:
+    """Deck commands for the walls of ``model``: member group, plane region and wall fix each."""
+    if not model.walls:
+        return "# (no walls)\n"
+    stiffness = _fmt(model.wall_stiffness_pa / units.stress_pa)
+    block = []
+    for wall in model.walls:
+        point = np.asarray(wall.normal) * wall.offset_m / units.length_m
+        ids = " ".join(str(i + 1) for i in wall.members)
+        block += [f"group           {wall.name} id {ids}",
+                  f"region          {wall.name} plane {_fmt(point[0])} {_fmt(point[1])} 0.0 "
+                  f"{_fmt(wall.normal[0])} {_fmt(wall.normal[1])} 0.0 side in",
+                  f"fix             {wall.name} {wall.name} wall/gran/region granular hertz {stiffness} 0.0 "
+                  f"damping viscoelastic tangential linear_nohistory 0.0 0.0 region {wall.name}"]
+    return "\n".join(block) + "\n"
+
+
+def template(name: str) -> Template:
+    """The deck template ``lammps_inputs/<name>`` shipped with hexdem."""
+    return Template(resources.files("hexdem.lammps_inputs").joinpath(name).read_text())
+
+
+def granular_block(model: GranularModel, units: UnitSystem) -> str:
+    """Deck commands shared by every hexdem deck: 2D sphere atoms from ``data.hexdem`` and
+    the undamped Hertz pair potential of ``model`` without tangential force."""
+    return template("granular.in").substitute(
+        lammps_units=units.lammps_units, pair_stiffness=_fmt(model.pair_stiffness_pa / units.stress_pa),
+        skin=_fmt(0.1 * model.lattice.diameter_m / units.length_m))
+
+
+def gravity_block(gravity_m_s2, units: UnitSystem) -> str:
+    """``fix gravity`` for a uniform in-plane acceleration ``gravity_m_s2`` (gx, gy) [m/s²], if any.
+
+    In 2D the vector must lie in the plane (a z component gives NaN coordinates).
+    """
+    g = np.zeros(2) if gravity_m_s2 is None else np.asarray(gravity_m_s2, float) * units.time_s**2 / units.length_m
+    magnitude = float(np.hypot(*g))
+    if magnitude == 0.0:
+        return "# (no gravity)\n"
+    return (f"fix             gravity all gravity {_fmt(magnitude)} vector "
+            f"{_fmt(g[0] / magnitude)} {_fmt(g[1] / magnitude)} 0.0\n")
+
+
+def render_input(model: GranularModel, settings: RunSettings, gravity_m_s2=None) -> str:
+    """The text of ``in.hexdem`` for ``model`` run with ``settings``, under uniform gravity
+    ``gravity_m_s2`` (gx, gy) [m/s²] if given (the tilted set-up of Sec. VI-A)."""
+    units = settings.units
+    impactor = model.n_bodies if model.has_striker else model.lattice.struck + 1
+    velocity = model.impact.speed_m_s * model.impact.direction / units.velocity_m_s
+    note = ("SI (m, kg, s)" if units.name == "si" else
+            f"nondimensional A = d = M = 1 (d = {units.length_m} m, M = {units.mass_kg} kg, "
+            f"T = {units.time_s} s)")
+    return template("impact.in").substitute(
+        title=f"{model.lattice.shape}, V0 = {model.impact.speed_m_s} m/s at {model.impact.angle_deg} deg"
+              + (" by a striker" if model.has_striker else " on the struck bead"),
+        units_note=note, granular=granular_block(model, units), walls=walls_block(model, units), body_force=gravity_block(gravity_m_s2, units), impactor_id=impactor,
+        vx=_fmt(velocity[0]), vy=_fmt(velocity[1]), dt=_fmt(settings.dt_s / units.time_s),
+        thermo_every=max(1, settings.n_steps // 20), dump_every=settings.dump_every,
+        nsteps=settings.n_steps)
+
+
+def write_deck(model: GranularModel, settings: RunSettings, directory, gravity_m_s2=None) -> Deck:
+    """Write ``data.hexdem`` and ``in.hexdem`` into ``directory`` (created if needed)."""
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    (directory / DATA_NAME).write_text(data_file(model, settings.units))
+    (directory / DECK_NAME).write_text(render_input(model, settings, gravity_m_s2))
+    return Deck(directory, settings, model.n_bodies)

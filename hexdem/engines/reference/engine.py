@@ -1,0 +1,247 @@
+"""Reference integrator of the paper's Hamiltonian (Sec. III): an engine independent of LAMMPS.
+
+It integrates eq. (model) as the paper does, with classical 4th-order Runge–Kutta:
+
+* fixed bonds between the six touching neighbours of the lattice (``Lattice.bonds()``,
+  the paper's e₁, e₂, e₃), each with V(r) = (2/5) A [c − r]_+^{5/2}: no tension, and a
+  per-pair contact distance c = R_i + R_j and A = k_n sqrt(R_eff), so per-bead diameters
+  work (for equal beads c = d and A is the paper's A);
+* the Hertz force along the *current* line of centres, r = |rest + q_j − q_i|;
+* flat walls as sphere–half-plane Hertz contacts with the wall's own modulus
+  (F = k_n,wall sqrt(R) δ^{3/2}, the paper's "spheres with an infinite radius"), acting on
+  the wall's member beads only, so the struck bead sits in the impact hole as in the decks;
+* V0 on the struck bead, or on a striker sphere bonded to it (``Impact.striker``).
+
+It works in the run's unit system (SI, or the paper's A = d = M = 1 of eq. (scaling)) and
+hands back a :class:`~hexdem.analysis.trajectory.Trajectory` in SI sampled like a LAMMPS dump, so the
+same :class:`~hexdem.analysis.impact.ImpactAnalysis` judges both engines. Unlike LAMMPS, which
+treats every overlapping pair as a contact, bonds are fixed; in a lattice whose
+next-nearest neighbours never touch (all hexdem packings) the two coincide.
+
+The force and RK4 loops are compiled (:mod:`hexdem.engines.reference.kernel`, numba).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from importlib.metadata import version
+from pathlib import Path
+
+import numpy as np
+
+from hexdem.analysis.trajectory import Trajectory
+from hexdem.common.checks import is_number, positive_int
+from hexdem.common.io import write_json
+from hexdem.engines.reference.kernel import KernelArrays, forces, integrate
+from hexdem.errors import HexdemError
+from hexdem.model.granular import GranularModel, RunSettings
+from hexdem.model.lattice import BOND_STEPS, Lattice
+from hexdem.model.units import UnitSystem
+
+#: Description of the run written into the engine's directory.
+PARAMETERS_NAME = "reference.json"
+#: The striker is bonded to every bead closer than this many d to touching it at t = 0.
+STRIKER_REACH = 0.5
+
+
+@dataclass(frozen=True)
+class Grid:
+    """Padded (rows × cols) cell grid of a lattice: bead {m, n} → row n + 1, col (m + n)/2 + 1.
+
+    ``cells`` (n_beads,) flat cell of each bead; ``cols`` C; ``n_cells`` rows · cols.
+    """
+
+    cells: np.ndarray
+    cols: int
+    n_cells: int
+
+    @classmethod
+    def of(cls, lattice: Lattice) -> "Grid":
+        m, n = lattice.indices.T
+        if np.any((m + n) % 2):
+            raise HexdemError("lattice labels {m, n} must have m + n even (hexagonal packing indices)")
+        row, col = n - n.min() + 1, (m + n) // 2
+        col = col - col.min() + 1
+        cols = int(col.max()) + 2
+        return cls(cells=row * cols + col, cols=cols, n_cells=(int(row.max()) + 2) * cols)
+
+    def offset(self, step) -> int:
+        """Cell offset of the bond step (dm, dn) of :data:`~hexdem.model.lattice.BOND_STEPS`."""
+        dm, dn = step
+        return dn * self.cols + (dm + dn) // 2
+
+    @property
+    def lo(self) -> int:
+        """First cell that can hold a bead (after the padding row and column)."""
+        return self.cols + 1
+
+    @property
+    def hi(self) -> int:
+        """One past the last cell that can start a bond (before the padding row)."""
+        return self.n_cells - self.cols - 1
+
+
+def _coefficient(stiffness_pa: float, r_eff_m, units: UnitSystem):
+    """Hertz coefficient A = k_n sqrt(R_eff) [N/m^1.5] of a contact, in ``units``."""
+    return stiffness_pa * np.sqrt(r_eff_m) * units.length_m**1.5 / units.force_n
+
+
+def _reduced_radius(radius_i, radius_j):
+    return radius_i * radius_j / (radius_i + radius_j)
+
+
+def _lattice_bonds(model: GranularModel, grid: Grid, units: UnitSystem):
+    """(rest_x, rest_y, contact, stiffness), each (3, hi), of the lattice's fixed bonds."""
+    lattice = model.lattice
+    shape = (len(BOND_STEPS), grid.hi)
+    # Empty slots keep a rest vector of bond length, so r > 0 and their force is exactly 0.
+    ideal = np.array([[math.sqrt(3) / 2 * dn, dm / 2] for dm, dn in BOND_STEPS]) * lattice.diameter_m / units.length_m
+    rest_x, rest_y = np.repeat(ideal[:, :1], grid.hi, axis=1), np.repeat(ideal[:, 1:], grid.hi, axis=1)
+    contact, stiffness = np.zeros(shape), np.zeros(shape)
+    i, j = lattice.bonds().T
+    direction = {grid.offset(step): d for d, step in enumerate(BOND_STEPS)}
+    d = np.array([direction[o] for o in grid.cells[j] - grid.cells[i]], dtype=int)
+    cell, radii = grid.cells[i], lattice.radii_m
+    rest_x[d, cell], rest_y[d, cell] = (lattice.positions_m[j] - lattice.positions_m[i]).T / units.length_m
+    contact[d, cell] = (radii[i] + radii[j]) / units.length_m
+    stiffness[d, cell] = _coefficient(model.pair_stiffness_pa, _reduced_radius(radii[i], radii[j]), units)
+    return rest_x, rest_y, contact, stiffness
+
+
+def _striker_pairs(model: GranularModel, cells: np.ndarray, units: UnitSystem):
+    """Bonds of the striker to every bead it touches or nearly touches at t = 0 (none without one).
+
+    Besides the struck bead, an oblique striker touches a neighbour of it (at 30° the bead
+    {−2, 0}); LAMMPS, which counts every overlap, feels both. Bonds are repulsive only, so a
+    bond to a bead that the striker never reaches costs nothing.
+    """
+    pos, radii = model.initial_positions_m(), model.diameters_m / 2
+    striker, n_beads = model.n_bodies - 1, len(model.lattice)
+    gap = np.linalg.norm(pos[:n_beads] - pos[striker], axis=1) - radii[:n_beads] - radii[striker]
+    beads = np.flatnonzero((gap < STRIKER_REACH * model.lattice.diameter_m) & model.has_striker)
+    rest = (pos[beads] - pos[striker]) / units.length_m
+    r_eff = _reduced_radius(radii[beads], radii[striker])
+    return (np.full(len(beads), cells[striker], dtype=np.int64), cells[beads].astype(np.int64),
+            rest[:, 0].copy(), rest[:, 1].copy(), (radii[beads] + radii[striker]) / units.length_m,
+            _coefficient(model.pair_stiffness_pa, r_eff, units))
+
+
+def _wall_contacts(model: GranularModel, cells: np.ndarray, units: UnitSystem):
+    """(cell, n_x, n_y, rest gap, A_w) of every wall member: sphere–half-plane Hertz."""
+    lattice, walls = model.lattice, model.walls
+    beads = np.concatenate([np.zeros(0, dtype=np.int64)] + [wall.members for wall in walls]).astype(np.int64)
+    normals = np.concatenate([np.zeros((0, 2))] + [np.tile(wall.normal, (len(wall.members), 1)) for wall in walls])
+    radii = lattice.radii_m[beads]
+    gaps = np.concatenate([np.zeros(0)] + [wall.gaps_m(lattice.positions_m[wall.members], lattice.radii_m[wall.members])
+                                           for wall in walls])
+    stiffness = _coefficient(model.wall_stiffness_pa if walls else 0.0, radii, units)
+    return cells[beads], normals[:, 0].copy(), normals[:, 1].copy(), gaps / units.length_m, stiffness
+
+
+@dataclass(frozen=True)
+class ReferenceSystem:
+    """A :class:`GranularModel` in ``units``, laid out for :mod:`hexdem.engines.reference.kernel`.
+
+    ``kernel`` the arrays of eq. (model); ``cells`` (n_bodies,) the cell of each body
+    (beads, then the striker); ``n_cells`` grid cells plus off-grid bodies.
+    """
+
+    kernel: KernelArrays
+    cells: np.ndarray
+    n_cells: int
+    units: UnitSystem
+
+    @classmethod
+    def from_model(cls, model: GranularModel, units: UnitSystem) -> "ReferenceSystem":
+        grid = Grid.of(model.lattice)
+        off_grid = model.n_bodies - len(model.lattice)
+        cells = np.concatenate([grid.cells, grid.n_cells + np.arange(off_grid)]).astype(np.int64)
+        n_cells = grid.n_cells + off_grid
+        inv_mass = np.zeros(n_cells)
+        inv_mass[cells] = units.mass_kg / model.masses_kg
+        kernel = KernelArrays(np.array([grid.offset(step) for step in BOND_STEPS], dtype=np.int64),
+                              grid.lo, grid.hi, *_lattice_bonds(model, grid, units), inv_mass,
+                              *_striker_pairs(model, cells, units), *_wall_contacts(model, cells, units))
+        return cls(kernel, cells, n_cells, units)
+
+    @property
+    def n_bonds(self) -> int:
+        return int(np.count_nonzero(self.kernel.stiffness)) + len(self.kernel.pair_i)
+
+    @property
+    def n_wall_contacts(self) -> int:
+        return len(self.kernel.wall_cell)
+
+    def _cell_arrays(self, values):
+        """(n_bodies, 2) body values → x and y arrays over all cells."""
+        grid = np.zeros((2, self.n_cells))
+        grid[:, self.cells] = np.asarray(values, float).T
+        return grid[0], grid[1]
+
+    def forces(self, displacements) -> np.ndarray:
+        """(n_bodies, 2) net Hertz force on every body at ``displacements`` (both in ``units``)."""
+        x, y = self._cell_arrays(displacements)
+        fx, fy = np.zeros(self.n_cells), np.zeros(self.n_cells)
+        scratch = np.zeros((2, 3, self.kernel.hi))
+        forces(self.kernel, x, y, np.ones(self.n_cells), scratch[0], scratch[1], fx, fy)
+        return np.column_stack([fx[self.cells], fy[self.cells]])
+
+    def integrate(self, velocities, dt: float, n_steps: int, every: int):
+        """RK4 from rest positions with ``velocities``; (displacements, velocities) samples.
+
+        Both are (n_steps // every + 1, n_bodies, 2) in ``units``, at steps 0, every, 2·every, ….
+        """
+        x, y = self._cell_arrays(np.zeros_like(velocities))
+        u, w = self._cell_arrays(velocities)
+        shape = (n_steps // every + 1, len(self.cells), 2)
+        disp, vel = np.empty(shape), np.empty(shape)
+        integrate(self.kernel, x, y, u, w, float(dt), int(n_steps), int(every), self.cells, disp, vel)
+        return disp, vel
+
+
+def _check_settings(settings: RunSettings) -> None:
+    if not (is_number(settings.dt_s) and settings.dt_s > 0):
+        raise HexdemError(f"time step must be a positive number of seconds, got {settings.dt_s!r}")
+    for name in ("n_steps", "dump_every"):
+        positive_int(name, getattr(settings, name))
+
+
+def _check_finite(times_s, velocities) -> None:
+    bad = ~np.isfinite(velocities).all(axis=(1, 2))
+    if bad.any():
+        raise HexdemError(f"reference integration diverged (non-finite velocities at t = "
+                          f"{times_s[np.argmax(bad)]:.4g} s): reduce the time step")
+
+
+@dataclass(frozen=True)
+class ReferenceEngine:
+    """The reference integrator as a hexdem engine (same protocol as ``LammpsEngine``)."""
+
+    name = "reference"
+
+    def run(self, model: GranularModel, settings: RunSettings, directory) -> Trajectory:
+        """Integrate ``model`` with ``settings``; write ``reference.json`` into ``directory``."""
+        _check_settings(settings)
+        units = settings.units
+        directory = Path(directory)
+        directory.mkdir(parents=True, exist_ok=True)
+        system = ReferenceSystem.from_model(model, units)
+        start = time.perf_counter()
+        disp, vel = system.integrate(model.initial_velocities_m_s() / units.velocity_m_s,
+                                     settings.dt_s / units.time_s, settings.n_steps, settings.dump_every)
+        wall_time = time.perf_counter() - start
+        times_s = np.arange(len(disp)) * settings.dump_every * settings.dt_s
+        engine = {"name": self.name, "version": version("hexdem"), "ranks": 1, "integrator": "classical RK4",
+                  "units": units.name, "wall_time_s": wall_time, "n_bonds": system.n_bonds,
+                  "n_wall_contacts": system.n_wall_contacts}
+        write_json(directory / PARAMETERS_NAME, {**engine, "model": model.lattice.shape, "n_bodies": model.n_bodies,
+                                                 "time_step": settings.dt_s / units.time_s,
+                                                 "n_steps": settings.n_steps, "dump_every": settings.dump_every,
+                                                 "unit_scales_si": {"length_m": units.length_m,
+                                                                    "mass_kg": units.mass_kg,
+                                                                    "time_s": units.time_s}})
+        _check_finite(times_s, vel)
+        return Trajectory(times_s=times_s, velocities_m_s=vel * units.velocity_m_s,
+                          displacements_m=disp * units.length_m, engine=engine)

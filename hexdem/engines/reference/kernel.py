@@ -1,0 +1,183 @@
+"""Compiled kernel of the reference integrator: the forces of eq. (model) and classical RK4.
+
+The paper's equations of motion (Sec. III, eq. (model)) with V(r) = (2/5) A [c − r]_+^{5/2}
+give each fixed bond a repulsive force A [c − r]_+^{3/2} along the current line of centres,
+where r = |rest + q_j − q_i| is the current distance of the bond's beads (rest vector
+``rest`` plus displacements q) and c their contact distance. A bead touching a flat wall
+with normal n feels A_w [−(g₀ + q·n)]_+^{3/2} along n (g₀ its gap at rest).
+
+Layout (built by :mod:`hexdem.engines.reference.engine`): every body owns a *cell* of flat arrays. Lattice
+bead {m, n} sits in the padded grid cell (n + 1)·C + (m + n)/2 + 1, so the paper's three
+bond directions e₁, e₂, e₃ become three constant cell offsets and a bond's partner is a
+shifted slice: the bond loop is a straight, branch-free pass over contiguous arrays that
+the compiler vectorises. Cells without a bead (padding) carry bonds of stiffness 0 and
+zero inverse mass. Bodies off the grid (the striker) follow the grid and are bonded
+through a short explicit pair list.
+
+Compiled with numba (``error_model="numpy"`` lets divisions vectorise) and without
+fast-math, so results are IEEE-exact and reproducible.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+_jit = njit(cache=True, error_model="numpy")
+
+
+class KernelArrays(NamedTuple):
+    """One model laid out for the kernel, in the run's unit system.
+
+    ``offsets`` (3,) cell offsets of the bond directions; lattice bonds start at cells
+    [0, ``hi``) and beads lie in [``lo``, ``hi``). Per bond direction, (3, hi):
+    ``rest_x``, ``rest_y`` rest vector from a cell to its partner, ``contact`` contact
+    distance c = R_i + R_j, ``stiffness`` A = k_n sqrt(R_eff) (0: no bond). Per cell:
+    ``inv_mass`` 1/M (0 for padding). Explicit pairs (i → j): ``pair_i``, ``pair_j``,
+    ``pair_rest_x``, ``pair_rest_y``, ``pair_contact``, ``pair_stiffness``. Wall contacts:
+    ``wall_cell``, inward normal ``wall_nx``, ``wall_ny``, rest gap ``wall_gap``,
+    ``wall_stiffness`` A_w = k_n,wall sqrt(R).
+    """
+
+    offsets: np.ndarray
+    lo: int
+    hi: int
+    rest_x: np.ndarray
+    rest_y: np.ndarray
+    contact: np.ndarray
+    stiffness: np.ndarray
+    inv_mass: np.ndarray
+    pair_i: np.ndarray
+    pair_j: np.ndarray
+    pair_rest_x: np.ndarray
+    pair_rest_y: np.ndarray
+    pair_contact: np.ndarray
+    pair_stiffness: np.ndarray
+    wall_cell: np.ndarray
+    wall_nx: np.ndarray
+    wall_ny: np.ndarray
+    wall_gap: np.ndarray
+    wall_stiffness: np.ndarray
+
+
+@_jit
+def _hertz_bonds(xi, yi, xj, yj, rest_x, rest_y, contact, stiffness, fx, fy):
+    """Force on bead j of each bond (i, j): A [c − r]_+^{3/2} along the line of centres."""
+    for p in range(fx.shape[0]):
+        dx = rest_x[p] + xj[p] - xi[p]
+        dy = rest_y[p] + yj[p] - yi[p]
+        r = np.sqrt(dx * dx + dy * dy)
+        overlap = max(contact[p] - r, 0.0)
+        f = stiffness[p] * overlap * np.sqrt(overlap) / r
+        fx[p] = f * dx
+        fy[p] = f * dy
+
+
+@_jit
+def _net_bond_force(in0, in1, in2, out0, out1, out2, scale, net):
+    """Net force on each cell, times ``scale``: its bonds as partner j (+) minus as origin i (−)."""
+    for p in range(net.shape[0]):
+        net[p] = (in0[p] + in1[p] + in2[p] - out0[p] - out1[p] - out2[p]) * scale[p]
+
+
+@_jit
+def _pair_forces(k, x, y, scale, fx, fy):
+    for b in range(k.pair_i.shape[0]):
+        i, j = k.pair_i[b], k.pair_j[b]
+        dx = k.pair_rest_x[b] + x[j] - x[i]
+        dy = k.pair_rest_y[b] + y[j] - y[i]
+        r = np.sqrt(dx * dx + dy * dy)
+        overlap = k.pair_contact[b] - r
+        if overlap > 0.0:
+            f = k.pair_stiffness[b] * overlap * np.sqrt(overlap) / r
+            fx[i] -= f * dx * scale[i]
+            fy[i] -= f * dy * scale[i]
+            fx[j] += f * dx * scale[j]
+            fy[j] += f * dy * scale[j]
+
+
+@_jit
+def _wall_forces(k, x, y, scale, fx, fy):
+    for w in range(k.wall_cell.shape[0]):
+        c = k.wall_cell[w]
+        depth = -(k.wall_gap[w] + x[c] * k.wall_nx[w] + y[c] * k.wall_ny[w])
+        if depth > 0.0:
+            f = k.wall_stiffness[w] * depth * np.sqrt(depth) * scale[c]
+            fx[c] += f * k.wall_nx[w]
+            fy[c] += f * k.wall_ny[w]
+
+
+@_jit
+def forces(k, x, y, scale, bond_fx, bond_fy, fx, fy):
+    """Net force on every cell at displacements (x, y), times ``scale`` (1: forces; 1/M:
+    accelerations), into (fx, fy); ``bond_fx``, ``bond_fy`` are (3, hi) scratch."""
+    lo, hi = k.lo, k.hi
+    for d in range(3):
+        o = k.offsets[d]
+        _hertz_bonds(x[:hi], y[:hi], x[o:o + hi], y[o:o + hi], k.rest_x[d], k.rest_y[d],
+                     k.contact[d], k.stiffness[d], bond_fx[d], bond_fy[d])
+    o0, o1, o2 = k.offsets[0], k.offsets[1], k.offsets[2]
+    for bond, net in ((bond_fx, fx), (bond_fy, fy)):
+        net[:lo] = 0.0
+        net[hi:] = 0.0
+        _net_bond_force(bond[0, lo - o0:hi - o0], bond[1, lo - o1:hi - o1], bond[2, lo - o2:hi - o2],
+                        bond[0, lo:hi], bond[1, lo:hi], bond[2, lo:hi], scale[lo:hi], net[lo:hi])
+    _pair_forces(k, x, y, scale, fx, fy)
+    _wall_forces(k, x, y, scale, fx, fy)
+
+
+@_jit
+def _shifted(out, q, cv, v, ca, a):
+    """out = q + cv·v + ca·a: the position at which an RK4 stage evaluates the force."""
+    for c in range(out.shape[0]):
+        out[c] = q[c] + cv * v[c] + ca * a[c]
+
+
+@_jit
+def _advance(q, v, h, a1, a2, a3, a4):
+    """Classical RK4 update of q'' = a(q): q += h v + h²/6 (a1+a2+a3), v += h/6 (a1+2a2+2a3+a4)."""
+    for c in range(q.shape[0]):
+        q[c] += h * v[c] + h * h / 6.0 * (a1[c] + a2[c] + a3[c])
+        v[c] += h / 6.0 * (a1[c] + 2.0 * a2[c] + 2.0 * a3[c] + a4[c])
+
+
+@_jit
+def _sample(x, y, u, w, cells, disp, vel, s):
+    for b in range(cells.shape[0]):
+        c = cells[b]
+        disp[s, b, 0] = x[c]
+        disp[s, b, 1] = y[c]
+        vel[s, b, 0] = u[c]
+        vel[s, b, 1] = w[c]
+
+
+@_jit
+def integrate(k, x, y, u, w, h, n_steps, every, cells, disp, vel):
+    """Advance displacements (x, y) and velocities (u, w) by ``n_steps`` RK4 steps of ``h``.
+
+    Samples the bodies' ``cells`` into ``disp`` and ``vel`` (n_samples, n_bodies, 2) at
+    step 0 and every ``every`` steps, as a LAMMPS dump does.
+    """
+    n = x.shape[0]
+    a = np.zeros((8, n))
+    tx, ty = np.zeros(n), np.zeros(n)
+    bond_fx, bond_fy = np.zeros((3, k.hi)), np.zeros((3, k.hi))
+    half, sq = 0.5 * h, h * h
+    _sample(x, y, u, w, cells, disp, vel, 0)
+    for step in range(1, n_steps + 1):
+        forces(k, x, y, k.inv_mass, bond_fx, bond_fy, a[0], a[1])
+        _shifted(tx, x, half, u, 0.0, a[0])
+        _shifted(ty, y, half, w, 0.0, a[1])
+        forces(k, tx, ty, k.inv_mass, bond_fx, bond_fy, a[2], a[3])
+        _shifted(tx, x, half, u, 0.25 * sq, a[0])
+        _shifted(ty, y, half, w, 0.25 * sq, a[1])
+        forces(k, tx, ty, k.inv_mass, bond_fx, bond_fy, a[4], a[5])
+        _shifted(tx, x, h, u, 0.5 * sq, a[2])
+        _shifted(ty, y, h, w, 0.5 * sq, a[3])
+        forces(k, tx, ty, k.inv_mass, bond_fx, bond_fy, a[6], a[7])
+        _advance(x, u, h, a[0], a[2], a[4], a[6])
+        _advance(y, w, h, a[1], a[3], a[5], a[7])
+        if step % every == 0:
+            _sample(x, y, u, w, cells, disp, vel, step // every)

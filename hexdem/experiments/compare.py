@@ -1,0 +1,167 @@
+"""LAMMPS against the reference integrator: one configuration through both engines.
+
+:func:`run_comparison` runs ``config`` once with each engine (each run published as by
+``hexdem run``, in ``OUT/lammps`` and ``OUT/reference``), then compares peak speed and
+arrival time bead by bead along the three observation lines and writes
+``compare.csv`` (one row per bead), ``compare.json`` (largest differences, tolerances,
+verdict) and ``compare.png``. Values are in the run's units (SI or A = d = M = 1).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from hexdem.analysis.figures import UNIT_LABELS, plt, save
+from hexdem.analysis.impact import ImpactAnalysis
+from hexdem.common.checks import is_number
+from hexdem.common.io import ensure_writable_dir, write_csv, write_json
+from hexdem.errors import HexdemError
+from hexdem.experiments.run import run_experiment
+from hexdem.model.config import RunConfig
+from hexdem.model.lattice import LINE_STEPS
+
+ENGINE_NAMES = ("lammps", "reference")
+#: Columns of ``compare.csv``; differences are reference − LAMMPS (relative to LAMMPS for peaks).
+COMPARE_COLUMNS = ("line", "n", "bead_id", "peak_lammps", "peak_reference", "peak_rel_diff",
+                   "arrival_lammps", "arrival_reference", "arrival_diff", "checked")
+PEAK_DIFF, ARRIVAL_DIFF, CHECKED = (COMPARE_COLUMNS.index(key) for key in ("peak_rel_diff", "arrival_diff", "checked"))
+
+
+@dataclass(frozen=True)
+class Tolerances:
+    """Required agreement (issue 3): ``peak_rel`` relative peak speed [-], ``arrival_s``
+    arrival time [s], on the beads whose peak exceeds ``min_peak_fraction`` of V0."""
+
+    peak_rel: float = 5e-3
+    arrival_s: float = 2e-6
+    min_peak_fraction: float = 0.01
+
+    def __post_init__(self):
+        for name in ("peak_rel", "arrival_s", "min_peak_fraction"):
+            value = getattr(self, name)
+            if not (is_number(value) and value >= 0):
+                raise HexdemError(f"tolerance {name} must be a number >= 0, got {value!r}")
+
+
+@dataclass(frozen=True)
+class EngineComparison:
+    """Per-bead differences of two analyses of one configuration, in the run's units.
+
+    ``rows`` follow :data:`COMPARE_COLUMNS`; ``max_peak_rel_diff`` and ``max_arrival_diff``
+    are over the checked beads (inf when one engine saw a pulse the other did not);
+    ``arrival_tolerance`` is ``tolerances.arrival_s`` in the run's time unit.
+    """
+
+    rows: list
+    max_peak_rel_diff: float
+    max_arrival_diff: float
+    arrival_tolerance: float
+    tolerances: Tolerances
+    units: str
+
+    @property
+    def n_checked(self) -> int:
+        return sum(1 for row in self.rows if row[CHECKED])
+
+    @property
+    def agree(self) -> bool:
+        return (self.max_peak_rel_diff <= self.tolerances.peak_rel
+                and self.max_arrival_diff <= self.arrival_tolerance)
+
+    def verdict(self) -> str:
+        """One line: the largest differences against their tolerances."""
+        time_label = "µs" if self.units == "si" else "T"
+        scale = 1e6 if self.units == "si" else 1.0
+        return (f"max relative peak difference {self.max_peak_rel_diff:.2g} (tolerance {self.tolerances.peak_rel:g}), "
+                f"max arrival difference {self.max_arrival_diff * scale:.2g} {time_label} (tolerance "
+                f"{self.arrival_tolerance * scale:.3g} {time_label}) over {self.n_checked} beads: "
+                + ("engines agree" if self.agree else "engines DISAGREE"))
+
+
+def _difference(lammps: float, reference: float, relative: bool) -> float:
+    """reference − lammps (relative to lammps); inf when exactly one of them is NaN."""
+    if np.isnan(lammps) and np.isnan(reference):
+        return float("nan")
+    if np.isnan(lammps) or np.isnan(reference):
+        return float("inf")
+    return (reference - lammps) / lammps if relative else reference - lammps
+
+
+def compare_analyses(lammps: ImpactAnalysis, reference: ImpactAnalysis, v0: float,
+                     tolerances: Tolerances = Tolerances()) -> EngineComparison:
+    """Compare two analyses of the same model; ``v0`` is the impact speed in the run's units."""
+    a, b = lammps.results, reference.results
+    rows = []
+    for name in LINE_STEPS:
+        for n, bead in enumerate(a.lines[name]):
+            pa, pb, ta, tb = (float(v) for v in (a.peak_speed[bead], b.peak_speed[bead],
+                                                  a.arrival_time[bead], b.arrival_time[bead]))
+            checked = bool(np.nanmax([pa, pb, -np.inf]) > tolerances.min_peak_fraction * v0)
+            rows.append((name, n, int(bead) + 1, pa, pb, _difference(pa, pb, True),
+                         ta, tb, _difference(ta, tb, False), checked))
+    checked = [row for row in rows if row[CHECKED]]
+    return EngineComparison(
+        rows=rows,
+        max_peak_rel_diff=max((abs(row[PEAK_DIFF]) for row in checked), default=0.0),
+        max_arrival_diff=max((abs(row[ARRIVAL_DIFF]) for row in checked), default=0.0),
+        arrival_tolerance=tolerances.arrival_s / lammps.settings.units.time_s,
+        tolerances=tolerances, units=a.units)
+
+
+def comparison_plot(comparison: EngineComparison, v0: float, path) -> None:
+    """Peak speed and arrival time per line from both engines (top), |differences| (bottom, log)."""
+    units = UNIT_LABELS[comparison.units]
+    scale = units["time_scale"]
+    fig, axes = plt.subplots(2, 2, figsize=(11, 7.5), sharex=True)
+    for k, (name, marker) in enumerate(zip(LINE_STEPS, "o^v")):
+        rows = [row for row in comparison.rows if row[0] == name]
+        n = np.array([row[1] for row in rows])
+        column = {key: np.array([row[COMPARE_COLUMNS.index(key)] for row in rows], float)
+                  for key in COMPARE_COLUMNS[3:9]}
+        colour = f"C{k}"
+        for engine, style in zip(ENGINE_NAMES, ({"marker": marker, "linestyle": "none", "mfc": "none"},
+                                               {"linestyle": "-"})):
+            label = f"{name}°, {engine}"
+            axes[0, 0].semilogy(n, column[f"peak_{engine}"] / v0, color=colour, label=label, **style)
+            axes[0, 1].plot(n, column[f"arrival_{engine}"] * scale, color=colour, label=label, **style)
+        for ax, key, factor in ((axes[1, 0], "peak_rel_diff", 1.0), (axes[1, 1], "arrival_diff", scale)):
+            size = np.abs(column[key]) * factor
+            ax.semilogy(n, np.where(size > 0, size, np.nan), color=colour, marker=marker, label=f"{name}°")
+    tolerance_style = {"color": "grey", "linestyle": "--", "linewidth": 1, "label": "tolerance"}
+    axes[1, 0].axhline(comparison.tolerances.peak_rel, **tolerance_style)
+    axes[1, 1].axhline(comparison.arrival_tolerance * scale, **tolerance_style)
+    axes[0, 0].set_ylabel("$V_n / V_0$")
+    axes[0, 1].set_ylabel(f"arrival time [{units['time']}]")
+    axes[1, 0].set_ylabel("|peak difference| / peak (LAMMPS)")
+    axes[1, 1].set_ylabel(f"|arrival difference| [{units['time']}]")
+    for ax in axes.flat:
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    for ax in axes[1]:
+        ax.set_xlabel("bead n along the line")
+    fig.suptitle(comparison.verdict(), fontsize=9)
+    fig.tight_layout()
+    save(fig, path)
+
+
+def run_comparison(config: RunConfig, out, log=None, tolerances: Tolerances = Tolerances()) -> EngineComparison:
+    """Run ``config`` with both engines into ``out`` and write the comparison files."""
+    out = ensure_writable_dir(out)
+    analyses = {name: run_experiment(config.replace(engine=name), out / name, log) for name in ENGINE_NAMES}
+    comparison = compare_analyses(analyses["lammps"], analyses["reference"], config.v0, tolerances)
+    write_csv(out / "compare.csv", COMPARE_COLUMNS, comparison.rows)
+    write_json(out / "compare.json", {
+        "config": {key: value for key, value in config.as_dict().items() if key != "engine"},
+        "units": comparison.units,
+        "tolerances": {"peak_rel": tolerances.peak_rel, "arrival": comparison.arrival_tolerance,
+                       "arrival_s": tolerances.arrival_s, "min_peak_fraction": tolerances.min_peak_fraction},
+        "beads_checked": comparison.n_checked, "max_peak_rel_diff": comparison.max_peak_rel_diff,
+        "max_arrival_diff": comparison.max_arrival_diff, "agree": comparison.agree,
+        "energy_drift": {name: analysis.results.energy_drift for name, analysis in analyses.items()},
+        "engine_wall_time_s": {name: analysis.trajectory.engine.get("wall_time_s")
+                               for name, analysis in analyses.items()},
+    })
+    comparison_plot(comparison, config.v0, out / "compare.png")
+    return comparison

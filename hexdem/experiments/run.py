@@ -1,0 +1,123 @@
+"""One impact simulation end to end: config → engine → analysis → result files.
+
+:func:`run_experiment` validates everything before it touches the disk, runs the engine in
+``OUT/deck.inprogress`` and, only when the run and its analysis succeeded, publishes
+``OUT/deck`` (inputs, log, dump), ``peaks.csv``, ``summary.json``, ``arrival_map.png`` and
+``peak_decay.png``, each written atomically. A failed run leaves its inputs and log in
+``OUT/deck.failed`` for inspection and no result files.
+"""
+
+from __future__ import annotations
+
+import shutil
+import sys
+import time
+from importlib.metadata import version
+from pathlib import Path
+
+import numpy as np
+
+from hexdem.analysis import figures as plots
+from hexdem.analysis.impact import PEAK_COLUMNS, ImpactAnalysis
+from hexdem.common.io import ensure_writable_dir, write_csv, write_json
+from hexdem.errors import HexdemError
+from hexdem.model.config import RunConfig
+
+RESULT_FILES = ("peaks.csv", "summary.json", "arrival_map.png", "peak_decay.png")
+#: A conservative model whose energy wanders more than this was integrated too coarsely.
+MAX_ENERGY_DRIFT = 1e-3
+
+
+def make_engine(config: RunConfig):
+    """The engine named by ``config.engine``, on ``config.ranks`` ranks where that applies."""
+    if config.engine == "reference":
+        from hexdem.engines.reference.engine import ReferenceEngine
+
+        return ReferenceEngine()
+    from hexdem.engines.lammps.engine import LammpsEngine
+
+    return LammpsEngine(ranks=config.ranks)
+
+
+def _replace_dir(source: Path, target: Path) -> None:
+    if target.exists():
+        shutil.rmtree(target)
+    source.rename(target)
+
+
+def simulate(config: RunConfig, workdir, log=None) -> ImpactAnalysis:
+    """Run ``config`` with its engine in ``workdir`` and analyse it (no result files)."""
+    log = log or (lambda message: None)
+    model = config.model()
+    settings = config.settings(model)
+    engine = make_engine(config)
+    log(f"running {engine.name}: {model.lattice.shape}, {model.n_bodies} bodies, "
+        f"{settings.n_steps} steps of {settings.dt_s:.4g} s ({settings.duration_s * 1e3:.4g} ms)")
+    trajectory = engine.run(model, settings, workdir)
+    log(f"analysing {len(trajectory.times_s)} samples")
+    analysis = ImpactAnalysis(model, settings, trajectory).run()
+    drift = analysis.results.energy_drift
+    if not drift <= MAX_ENERGY_DRIFT:
+        raise HexdemError(f"energy drift {drift:.1e} exceeds {MAX_ENERGY_DRIFT:g} in {workdir}: the time step "
+                          f"{settings.dt_s:.3g} s is too large for V0; leave dt at its default or reduce it")
+    return analysis
+
+
+def summary(config: RunConfig, analysis: ImpactAnalysis, wall_time_s: float) -> dict:
+    """The contents of ``summary.json``: inputs, engine, energy drift, timings."""
+    r, settings, engine = analysis.results, analysis.settings, analysis.trajectory.engine
+    return {
+        "hexdem_version": version("hexdem"),
+        "config": config.as_dict(),
+        "units": r.units,
+        "lattice": {"shape": analysis.model.lattice.shape, "n_beads": len(analysis.model.lattice),
+                    "struck_bead_id": analysis.model.lattice.struck + 1},
+        "time_step": settings.dt_s / settings.units.time_s,
+        "n_steps": settings.n_steps,
+        "duration": settings.duration_s / settings.units.time_s,
+        "dump_every": settings.dump_every,
+        "engine": engine.get("name"),
+        "lammps_version": engine.get("version") if engine.get("name") == "lammps" else None,
+        "ranks": engine.get("ranks"),
+        "engine_wall_time_s": engine.get("wall_time_s"),
+        "wall_time_s": wall_time_s,
+        "energy_drift": r.energy_drift,
+        "far_wall_reached": r.far_wall_reached,
+        "beads_per_line": {name: len(beads) for name, beads in r.lines.items()},
+    }
+
+
+def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_time_s: float) -> None:
+    rows = analysis.line_rows()
+    write_csv(out / "peaks.csv", PEAK_COLUMNS, rows)
+    write_json(out / "summary.json", summary(config, analysis, wall_time_s))
+    r = analysis.results
+    plots.arrival_map(r, analysis.model, out / "arrival_map.png",
+                      title=f"Arrival time, {analysis.model.lattice.shape}, V0 = {config.v0:g}")
+    by_line = {name: (np.arange(len(beads)), r.peak_speed[beads]) for name, beads in r.lines.items()}
+    plots.peak_decay(by_line, out / "peak_decay.png", r.units, config.v0)
+
+
+def run_experiment(config: RunConfig, out, log=None) -> ImpactAnalysis:
+    """Run ``config`` and publish its result files in ``out`` (see module docstring)."""
+    log = log or (lambda message: print(f"hexdem: {message}", file=sys.stderr))
+    out = ensure_writable_dir(out)
+    start = time.perf_counter()
+    workdir = out / "deck.inprogress"
+    if workdir.exists():
+        shutil.rmtree(workdir)
+    try:
+        analysis = simulate(config, workdir, log)
+    except HexdemError as exc:
+        if workdir.exists():
+            _replace_dir(workdir, out / "deck.failed")
+        raise HexdemError(str(exc).replace(str(workdir), str(out / "deck.failed"))) from None
+    except BaseException:
+        shutil.rmtree(workdir, ignore_errors=True)
+        raise
+    _replace_dir(workdir, out / "deck")
+    write_results(config, analysis, out, time.perf_counter() - start)
+    log(f"energy drift {analysis.results.energy_drift:.2e}; results in {out}")
+    if not analysis.results.far_wall_reached:
+        log("warning: the leading wave did not pass the far wall within the run; increase 'duration'")
+    return analysis

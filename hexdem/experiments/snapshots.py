@@ -1,0 +1,137 @@
+"""Wavefront snapshots (Figs. 3 and 4): every bead's speed at chosen times after the impact.
+
+The ideal lattice is struck at the centre of an edge by a striker sphere (V_striker =
+0.40 m/s in both figures): Fig. 3 (fig:smallsim) is the 11-per-edge hexagon of the
+experiment, Fig. 4 (fig:largesim) the half-hexagon with a long edge of 91 beads and short
+edges of 46, on which the walls of the small hexagon are outlined (both packings put the
+struck bead {0, 0} at the origin, so the outline needs no shift).
+
+Frames fall exactly on the requested times: the times are rounded to whole microseconds,
+and the time step is the default one (contact time / 700) shortened just enough that their
+greatest common divisor is a whole number of steps, which becomes the dump interval.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from dataclasses import dataclass
+from importlib.metadata import version
+
+import numpy as np
+
+from hexdem.analysis import figures as plots
+from hexdem.common.io import ensure_writable_dir, write_csv, write_json
+from hexdem.engines.lammps.engine import LammpsEngine
+from hexdem.errors import HexdemError
+from hexdem.model.config import RunConfig
+from hexdem.model.lattice import Lattice, hexagon
+
+#: Default snapshot times [ms]: at V_striker = 0.4 m/s the leading wave reaches the far wall
+#: of the hexagon after about 0.95 ms, that of the half-hexagon after about 2.5 ms.
+DEFAULT_TIMES_MS = {"hexagon": (0.15, 0.3, 0.45, 0.6, 0.75, 0.9), "half-hexagon": (0.4, 0.8, 1.2, 1.6, 2.0, 2.4)}
+#: Output names (PNG and CSV) per shape, after the paper's figure labels.
+FIGURE_NAMES = {"hexagon": "fig3_smallsim", "half-hexagon": "fig4_largesim"}
+SNAPSHOT_COLUMNS = ("time", "bead_id", "m", "n", "x", "y", "speed")
+
+
+def snapshot_config(config: RunConfig, times_s) -> RunConfig:
+    """``config`` with the time step, dump interval and length that put a frame on every time."""
+    if config.units != "si":
+        raise HexdemError("snapshots need an SI configuration (times are in seconds)")
+    micro = [round(float(t) * 1e6) for t in times_s]
+    if not micro or min(micro) < 1 or len(set(micro)) != len(micro):
+        raise HexdemError(f"snapshot times must be distinct and at least 1 µs, got {list(times_s)}")
+    unit_s = math.gcd(*micro) * 1e-6
+    every = math.ceil(unit_s / config.settings().dt_s)
+    return config.replace(dt=unit_s / every, duration=max(micro) * 1e-6, dump_every=every)
+
+
+@dataclass(frozen=True)
+class Snapshots:
+    """Bead speeds [m/s] ``speeds`` (T, N) at ``times_s`` (T,) of the run of ``config``."""
+
+    config: RunConfig
+    lattice: Lattice
+    times_s: np.ndarray
+    speeds: np.ndarray
+    engine: dict
+
+
+def take_snapshots(config: RunConfig, times_s, directory) -> Snapshots:
+    """Run ``config`` (striker impact, ideal lattice) in LAMMPS on ``config.ranks`` ranks
+    and keep the bead speeds at ``times_s``."""
+    config = snapshot_config(config, sorted(times_s))
+    model = config.model()
+    settings = config.settings(model)
+    trajectory = LammpsEngine(ranks=config.ranks).run(model, settings, directory)
+    wanted = np.array([round(t * 1e6) * 1e-6 for t in sorted(times_s)])
+    index = np.rint(wanted / (settings.dump_every * settings.dt_s)).astype(int)
+    n_beads = len(model.lattice)
+    return Snapshots(config, model.lattice, trajectory.times_s[index],
+                     trajectory.speeds_m_s[index][:, :n_beads], trajectory.engine)
+
+
+def snapshot_rows(snapshots: Snapshots) -> list[tuple]:
+    lattice = snapshots.lattice
+    return [(float(t), bead + 1, int(m), int(n), float(x), float(y), float(speed))
+            for t, speeds in zip(snapshots.times_s, snapshots.speeds)
+            for bead, ((m, n), (x, y), speed) in enumerate(zip(lattice.indices, lattice.positions_m, speeds))]
+
+
+def snapshot_figure(snapshots: Snapshots, walls, path, outline: Lattice | None = None) -> None:
+    """Bead-speed maps, one panel per time (own colour scale), walls drawn; ``outline``: a
+    smaller packing whose walls are drawn dashed (Fig. 4)."""
+    import matplotlib.pyplot as plt
+
+    lattice, config = snapshots.lattice, snapshots.config
+    count = len(snapshots.times_s)
+    aspect = np.ptp(lattice.positions_m[:, 1]) / max(np.ptp(lattice.positions_m[:, 0]), lattice.diameter_m)
+    tall = aspect > 1.5
+    columns = count if tall else min(3, count)
+    rows = math.ceil(count / columns)
+    width = 3.2 if tall else 5.2
+    fig, axes = plt.subplots(rows, columns, figsize=(width * columns, 0.8 * width * aspect * rows + 0.8),
+                             squeeze=False, layout="constrained")
+    for ax, t, speeds in zip(axes.flat, snapshots.times_s, snapshots.speeds):
+        plots.bead_map(ax, lattice.positions_m, lattice.diameters_m, speeds, cmap="hot_r", label="speed [m/s]")
+        plots.draw_walls(ax, walls, lattice.positions_m, lattice.radii_m, linewidth=1)
+        if outline is not None:
+            plots.draw_walls(ax, outline.walls, outline.positions_m, outline.radii_m, linestyle="--", linewidth=1.2)
+        ax.set_title(f"t = {t * 1e3:.3g} ms")
+        ax.set_xticks([])
+        ax.set_yticks([])
+    for ax in list(axes.flat)[count:]:
+        ax.set_visible(False)
+    fig.suptitle(f"Wavefront, {lattice.shape}, striker at {config.v0:g} m/s"
+                 + (f"; dashed: walls of the {outline.shape}" if outline is not None else ""))
+    plots.save(fig, path)
+
+
+def run_snapshots(config: RunConfig, times_s, out, outline_edge: int | None = None, log=None) -> Snapshots:
+    """Simulate, then write ``<figure>.png``, ``<figure>.csv`` and ``snapshots.json`` into ``out``.
+
+    ``outline_edge``: draw the walls of a hexagon with this many beads per edge (Fig. 4: 11).
+    """
+    log = log or (lambda message: print(f"hexdem snapshots: {message}", file=sys.stderr, flush=True))
+    snapshot_config(config, times_s)
+    outline = hexagon(outline_edge, config.diameter_m) if outline_edge else None
+    out = ensure_writable_dir(out)
+    start = time.perf_counter()
+    log(f"{config.lattice().shape}, striker at {config.v0:g} m/s, {config.ranks} rank(s), "
+        f"{len(times_s)} snapshots up to {max(times_s) * 1e3:g} ms")
+    snapshots = take_snapshots(config, times_s, out / "deck")
+    name = FIGURE_NAMES.get(config.shape, "snapshots")
+    write_csv(out / f"{name}.csv", SNAPSHOT_COLUMNS, snapshot_rows(snapshots))
+    snapshot_figure(snapshots, snapshots.config.model().walls, out / f"{name}.png", outline)
+    settings = snapshots.config.settings()
+    engine = snapshots.engine
+    write_json(out / "snapshots.json", {
+        "hexdem_version": version("hexdem"), "config": snapshots.config.as_dict(),
+        "times_s": snapshots.times_s.tolist(), "n_beads": len(snapshots.lattice),
+        "lammps_version": engine["version"], "ranks": engine["ranks"], "lammps_wall_time_s": engine["wall_time_s"],
+        "atom_steps_per_s": (len(snapshots.lattice) + 1) * settings.n_steps / engine["wall_time_s"],
+        "wall_time_s": time.perf_counter() - start})
+    log(f"LAMMPS {engine['wall_time_s']:.1f} s on {engine['ranks']} rank(s); results in {out}")
+    return snapshots

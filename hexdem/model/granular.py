@@ -1,0 +1,125 @@
+"""The physical model shared by every engine: packing + materials + impact, in SI units.
+
+A :class:`GranularModel` says everything an engine needs to integrate the paper's
+Hamiltonian (Sec. III): bead masses, Hertz stiffnesses of bead–bead and bead–wall
+contacts, the walls, and the initial state. The optional striker is an extra body (the
+last one), a sphere of the bead material and nominal diameter that touches the struck
+bead at t = 0 and moves towards it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from hexdem.common.checks import is_number
+from hexdem.errors import HexdemError
+from hexdem.model.lattice import Lattice, strike_direction
+from hexdem.model.materials import DELRIN, STEEL_316, Material, hertz_stiffness, sphere_mass
+from hexdem.model.units import SI, UnitSystem
+
+
+@dataclass(frozen=True)
+class Impact:
+    """How the packing is struck.
+
+    ``speed_m_s`` V0 > 0 [m/s]; ``angle_deg`` strike angle from +x; ``striker`` False:
+    V0 is given to the struck bead (the paper's numerics); True: a striker sphere moving
+    at V0 hits it (the experiment).
+    """
+
+    speed_m_s: float
+    angle_deg: float = 0.0
+    striker: bool = False
+
+    def __post_init__(self):
+        if not (is_number(self.speed_m_s) and self.speed_m_s > 0):
+            raise HexdemError(f"impact velocity V0 must be > 0 (towards the packing), got {self.speed_m_s}")
+        strike_direction(self.angle_deg)
+
+    @property
+    def direction(self) -> np.ndarray:
+        return strike_direction(self.angle_deg)
+
+
+@dataclass(frozen=True)
+class GranularModel:
+    """Lattice, materials and impact of one simulation (SI units).
+
+    ``wall`` is the wall-lining material, or None for a packing without walls.
+    """
+
+    lattice: Lattice
+    impact: Impact
+    bead: Material = STEEL_316
+    wall: Material | None = DELRIN
+
+    @property
+    def has_striker(self) -> bool:
+        return self.impact.striker
+
+    @property
+    def n_bodies(self) -> int:
+        """Beads plus the striker, if any (the striker is the last body)."""
+        return len(self.lattice) + int(self.has_striker)
+
+    @property
+    def diameters_m(self) -> np.ndarray:
+        extra = [self.lattice.diameter_m] if self.has_striker else []
+        return np.concatenate([self.lattice.diameters_m, extra])
+
+    @property
+    def masses_kg(self) -> np.ndarray:
+        return sphere_mass(self.diameters_m, self.bead)
+
+    @property
+    def pair_stiffness_pa(self) -> float:
+        """k_n = (4/3) E* of a bead–bead contact: F = k_n sqrt(R_eff) δ^{3/2}."""
+        return hertz_stiffness(self.bead, self.bead)
+
+    @property
+    def wall_stiffness_pa(self) -> float:
+        """k_n = (4/3) E* of a bead–wall contact with the wall's own E, ν (R_eff = bead radius)."""
+        if self.wall is None:
+            raise HexdemError("this model has no walls")
+        return hertz_stiffness(self.bead, self.wall)
+
+    @property
+    def walls(self):
+        return self.lattice.walls if self.wall is not None else ()
+
+    def initial_positions_m(self) -> np.ndarray:
+        """(n_bodies, 2) positions at t = 0; a striker touches the struck bead from outside."""
+        pos = self.lattice.positions_m
+        if not self.has_striker:
+            return pos.copy()
+        struck = self.lattice.struck
+        gap = (self.lattice.diameters_m[struck] + self.lattice.diameter_m) / 2
+        return np.vstack([pos, pos[struck] - gap * self.impact.direction])
+
+    def initial_velocities_m_s(self) -> np.ndarray:
+        """(n_bodies, 2) velocities at t = 0: V0 on the striker, or on the struck bead."""
+        vel = np.zeros((self.n_bodies, 2))
+        vel[-1 if self.has_striker else self.lattice.struck] = self.impact.speed_m_s * self.impact.direction
+        return vel
+
+
+@dataclass(frozen=True)
+class RunSettings:
+    """Time integration of one run: ``dt_s`` step [s], ``n_steps``, a sample every ``dump_every``
+    steps; ``units`` is the system the engine works in and the results are reported in."""
+
+    dt_s: float
+    n_steps: int
+    dump_every: int
+    units: UnitSystem = SI
+
+    @property
+    def duration_s(self) -> float:
+        return self.dt_s * self.n_steps
+
+    @property
+    def n_samples(self) -> int:
+        """Samples taken, t = 0 included (LAMMPS dumps every ``dump_every`` steps and at step 0)."""
+        return self.n_steps // self.dump_every + 1
