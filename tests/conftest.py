@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from hexdem.analysis.peaks import refine_peak
+from hexdem.analysis.trajectory import TrajectoryRecorder
 from hexdem.experiments.run import run_experiment
 from hexdem.model.config import RunConfig
 from hexdem.model.granular import GranularModel, Impact
@@ -22,6 +23,20 @@ def default_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("default")
     analysis = run_experiment(RunConfig(), out, log=lambda message: None)
     return out, analysis
+
+
+@pytest.fixture(scope="session")
+def dumped_run(tmp_path_factory):
+    """The default experiment with ``--dump``: analysed in the run and its full dump on disk."""
+    out = tmp_path_factory.mktemp("dumped")
+    analysis = run_experiment(RunConfig(dump=True), out, log=lambda message: None)
+    return out, analysis
+
+
+def record(engine, model, settings, directory, **options):
+    """Run ``model`` with ``engine`` on one rank, keeping every sample: the whole trajectory (SI)."""
+    recorder = TrajectoryRecorder(model, settings)
+    return recorder.trajectory(engine.run(model, settings, directory, recorder, **options))
 
 
 def single_bead(diameter_m=0.01905) -> Lattice:

@@ -4,10 +4,12 @@ Small packings (4 beads per edge, 37 beads) keep the settling runs to about a se
 """
 
 import dataclasses
+from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from conftest import record
 from scipy import stats
 from scipy.spatial import cKDTree
 
@@ -16,7 +18,6 @@ from hexdem.disorder.preparation import (
     TOLERANCE_M,
     Disorder,
     Preparation,
-    TiltedTrajectory,
     contact_overlaps_m,
     edge_directions,
     read_data_file,
@@ -24,9 +25,8 @@ from hexdem.disorder.preparation import (
     spaced_lattice,
     write_stage_deck,
 )
-from hexdem.engines.lammps.deck import write_deck
-from hexdem.engines.lammps.engine import read_trajectory
-from hexdem.engines.lammps.partitions import run_info, run_partitioned
+from hexdem.engines.lammps.engine import LammpsEngine
+from hexdem.engines.lammps.partitions import run_partitioned
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
 from hexdem.model.lattice import hexagon
@@ -202,10 +202,8 @@ def test_gravity_acts_during_the_impact_and_the_tilted_audit_conserves_energy(pr
     gravitational potential included the total is conserved to the integrator's accuracy."""
     config = RunConfig(edge_beads=EDGE, impact="striker", v0=0.4, duration=3e-4, dump_every=20)
     settings = config.settings(prepared.model)
-    deck = write_deck(prepared.model, settings, tmp_path / "impact", gravity_m_s2=prepared.gravity)
-    run_partitioned([deck.directory], 1, tmp_path / "run")
-    plain = read_trajectory(deck, run_info(deck.directory, "LAMMPS"))
-    tilted = TiltedTrajectory.tilt(plain, prepared.gravity)
+    plain = record(LammpsEngine(gravity_m_s2=tuple(prepared.gravity)), prepared.model, settings, tmp_path / "impact")
+    tilted = replace(plain, gravity_m_s2=tuple(prepared.gravity))
     assert tilted.energy_drift(prepared.model) < 1e-5
     energy = plain.energies_j(prepared.model)
     work = np.einsum("bk,b,k->", plain.displacements_m[-1], prepared.model.masses_kg, prepared.gravity)

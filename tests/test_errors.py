@@ -1,5 +1,7 @@
 """Bad input gets one clear line from the CLI, exit status 2, and no partial result files."""
 
+import functools
+
 import numpy as np
 import pytest
 
@@ -7,8 +9,10 @@ from hexdem.analysis.dump import read_dump
 from hexdem.cli.main import main
 from hexdem.engines.lammps import deck, library
 from hexdem.engines.lammps.deck import write_deck
-from hexdem.engines.lammps.runner import run_deck
+from hexdem.engines.lammps.driver import run_streaming
+from hexdem.engines.lammps.runner import run_bare
 from hexdem.errors import HexdemError
+from hexdem.experiments.parallel import run_on_ranks
 from hexdem.experiments.run import RESULT_FILES
 from hexdem.model.config import RunConfig
 
@@ -59,31 +63,56 @@ def test_unwritable_output_directory(tmp_path, capsys):
 
 def test_lammps_failure_names_lammps_message_and_the_kept_deck(tmp_path, capsys, monkeypatch):
     render = deck.render_input
-    monkeypatch.setattr(deck, "render_input", lambda *args: render(*args).replace("run ", "rnu "))
+    monkeypatch.setattr(deck, "render_input", lambda *args: render(*args).replace("timestep ", "timestpe "))
     code, err = run_cli(tmp_path, capsys, "edge_beads = 3")
     out = tmp_path / "out"
     assert code == 2 and len(err) == 1
-    assert "LAMMPS failed on" in err[0] and "ERROR: Unknown command: rnu" in err[0]
+    assert "LAMMPS failed on" in err[0] and "ERROR: Unknown command: timestpe" in err[0]
     assert str(out / "deck.failed" / "in.hexdem") in err[0]
     assert (out / "deck.failed" / "log.lammps").exists()
     assert_no_results(out)
 
 
-def test_too_coarse_time_step_is_refused(tmp_path, capsys):
+def test_time_step_not_small_against_the_contact_is_refused_before_running(tmp_path, capsys):
+    """dt = 2e-5 s against the 71.7 µs two-bead contact at 0.4 m/s: fewer than 20 steps per contact."""
     code, err = run_cli(tmp_path, capsys, "edge_beads = 5\ndt = 2e-5\nduration = 1e-3")
+    assert code == 2 and len(err) == 1 and "not small against the Hertz contact time 7.17e-05" in err[0]
+    assert not (tmp_path / "out" / "deck.failed").exists()
+    assert_no_results(tmp_path / "out")
+
+
+def test_run_whose_energy_drifts_is_refused(tmp_path, capsys):
+    """dt = τ/24 passes the step check, but its energy drift (≈ 2e-6 · (700/24)² ≈ 2e-3) does not."""
+    code, err = run_cli(tmp_path, capsys, "edge_beads = 5\ndt = 3e-6\nduration = 1e-3\ndump_every = 2")
     assert code == 2 and len(err) == 1 and "energy drift" in err[0] and "time step" in err[0]
     assert str(tmp_path / "out" / "deck.failed") in err[0]
     assert_no_results(tmp_path / "out")
 
 
+@pytest.mark.parametrize("config_text, message", [
+    ("dt = 1e-3", "not small against the Hertz contact time"),
+    ("dump_every = 2000", "too few samples to analyse"),
+    ("duration = 1e-6", "too few samples to analyse"),
+    ("edge_beads = 100000", "needs about"),
+    ('shape = "half-hexagon"\nshort_edge = 40000\nlong_edge = 79999', "needs about"),
+])
+def test_runs_that_cannot_be_analysed_or_cannot_fit_are_refused(tmp_path, capsys, config_text, message):
+    code, err = run_cli(tmp_path, capsys, config_text)
+    assert code == 2 and len(err) == 1 and message in err[0]
+    assert_no_results(tmp_path / "out")
+
+
 @pytest.mark.parametrize("ranks", [1, 2])
 def test_deck_error_is_reported_with_lammps_message(tmp_path, ranks):
+    """By hand (``lmp -in``) and through the streaming driver on 1 and 2 MPI ranks."""
     config = RunConfig(edge_beads=3)
-    rendered = write_deck(config.model(), config.settings(), tmp_path)
+    rendered = write_deck(config.model(), config.settings(), tmp_path / "deck")
     rendered.input_path.write_text(rendered.input_path.read_text().replace("pair_style      granular", "pair_style nonsense"))
-    with pytest.raises(HexdemError, match=r"LAMMPS failed on .*in\.hexdem: ERROR: .*nonsense") as info:
-        run_deck(rendered, ranks)
-    assert "\n" not in str(info.value)
+    for attempt in (lambda: run_bare(rendered, ranks),
+                    lambda: run_on_ranks(functools.partial(run_streaming, rendered, repr), ranks, tmp_path / "job")):
+        with pytest.raises(HexdemError, match=r"LAMMPS failed on .*in\.hexdem: ERROR: .*nonsense") as info:
+            attempt()
+        assert "\n" not in str(info.value)
 
 
 def test_corrupt_dump_is_a_clear_error(tmp_path):
@@ -95,11 +124,11 @@ def test_corrupt_dump_is_a_clear_error(tmp_path):
         read_dump(tmp_path / "missing", 1e-7)
 
 
-def test_truncated_dump_is_a_clear_error(default_run, tmp_path):
-    text = (default_run[0] / "deck" / "dump.lammpstrj").read_text()
+def test_truncated_dump_is_a_clear_error(dumped_run, tmp_path):
+    text = (dumped_run[0] / "deck" / "dump.lammpstrj").read_text()
     dump = tmp_path / "dump.lammpstrj"
     dump.write_text(text[: len(text) // 2])
-    settings = default_run[1].settings
+    settings = dumped_run[1].settings
     with pytest.raises(HexdemError, match=f"truncated: .* of {settings.n_samples} frames"):
         read_dump(dump, settings.dt_s, settings.n_samples)
 

@@ -4,7 +4,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from conftest import V0, D, contact_history, single_bead
+from conftest import V0, D, contact_history, record, single_bead
 
 from hexdem.engines.lammps.engine import LammpsEngine
 from hexdem.model.granular import GranularModel, Impact, RunSettings
@@ -19,7 +19,7 @@ def test_two_sphere_collision_matches_hertz(tmp_path):
     a = hertz_stiffness(STEEL_316, STEEL_316) * np.sqrt(D / 4)
     expected_time = contact_time(mass / 2, a, V0)
     dt = 5e-8
-    trajectory = LammpsEngine().run(model, RunSettings(dt, int(1.1 * expected_time / dt), 1), tmp_path)
+    trajectory = record(LammpsEngine(), model, RunSettings(dt, int(1.1 * expected_time / dt), 1), tmp_path)
     start = model.initial_positions_m()
     gap = np.linalg.norm((start[1] + trajectory.displacements_m[:, 1]) - (start[0] + trajectory.displacements_m[:, 0]),
                          axis=1)
@@ -38,7 +38,7 @@ def test_sphere_on_delrin_wall_uses_the_walls_own_modulus(tmp_path):
     a = hertz_stiffness(STEEL_316, DELRIN) * np.sqrt(D / 2)
     expected_time = contact_time(mass, a, V0)
     dt = 2e-7
-    trajectory = LammpsEngine().run(model, RunSettings(dt, int(1.1 * expected_time / dt), 1), tmp_path)
+    trajectory = record(LammpsEngine(), model, RunSettings(dt, int(1.1 * expected_time / dt), 1), tmp_path)
     depth = trajectory.displacements_m[:, 0, 0]
     duration, peak = contact_history(trajectory.times_s, depth)
     assert duration == pytest.approx(expected_time, rel=1e-3)

@@ -4,7 +4,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from conftest import V0, D, contact_history, disordered_model, single_bead
+from conftest import V0, D, contact_history, disordered_model, record, single_bead
 
 from hexdem.analysis.energy import contact_energy_j
 from hexdem.engines.reference.engine import PARAMETERS_NAME, ReferenceEngine, ReferenceSystem
@@ -43,7 +43,7 @@ def test_forces_are_minus_the_gradient_of_the_hertz_energy(units):
 
 def run_until(model, duration_s, tmp_path, steps=4000):
     """A reference run sampled at every step of ``duration_s / steps``."""
-    return ReferenceEngine().run(model, RunSettings(duration_s / steps, steps, 1), tmp_path)
+    return record(ReferenceEngine(), model, RunSettings(duration_s / steps, steps, 1), tmp_path)
 
 
 @pytest.mark.parametrize("ratio", [1.0, 0.6], ids=["equal", "smaller-struck-bead"])
@@ -121,14 +121,14 @@ def test_nondimensional_run_is_the_scaled_si_run(tmp_path):
     nd = si.replace(units="nondimensional", v0=si.v0 / scale.velocity_m_s, dt=settings.dt_s / scale.time_s,
                     duration=settings.duration_s / scale.time_s)
     a, b = simulate(si, tmp_path / "si"), simulate(nd, tmp_path / "nd")
-    assert b.trajectory.engine["units"] == "nondimensional"
+    assert b.engine["units"] == "nondimensional"
     np.testing.assert_allclose(b.results.peak_speed / nd.v0, a.results.peak_speed / si.v0, rtol=1e-9)
     np.testing.assert_allclose(b.results.arrival_time * scale.time_s, a.results.arrival_time, rtol=1e-9)
 
 
 def test_samples_start_at_zero_every_dump_interval_and_the_run_is_described(tmp_path):
     model = SMALL.model()
-    trajectory = ReferenceEngine().run(model, RunSettings(1e-7, 105, 10), tmp_path / "deck")
+    trajectory = record(ReferenceEngine(), model, RunSettings(1e-7, 105, 10), tmp_path / "deck")
     np.testing.assert_allclose(trajectory.times_s, np.arange(11) * 1e-6)
     assert trajectory.velocities_m_s.shape == (11, model.n_bodies, 2)
     np.testing.assert_array_equal(trajectory.velocities_m_s[0], model.initial_velocities_m_s())
@@ -141,7 +141,7 @@ def test_samples_start_at_zero_every_dump_interval_and_the_run_is_described(tmp_
     (RunSettings(1e-7, 0, 1), "n_steps"), (RunSettings(1e-7, 10, 0), "dump_every")])
 def test_bad_settings_are_one_line_errors(tmp_path, settings, message):
     with pytest.raises(HexdemError, match=message):
-        ReferenceEngine().run(SMALL.model(), settings, tmp_path)
+        ReferenceEngine().run(SMALL.model(), settings, tmp_path, lambda sample: None)
 
 
 def test_divergence_is_reported(tmp_path):
@@ -149,4 +149,4 @@ def test_divergence_is_reported(tmp_path):
     d, v0 = 2.0**-6, 0.5
     model = GranularModel(single_bead(d), Impact(v0, striker=True), STEEL_316, wall=None)
     with pytest.raises(HexdemError, match="diverged"):
-        ReferenceEngine().run(model, RunSettings(2 * d / v0, 3, 1), tmp_path)
+        record(ReferenceEngine(), model, RunSettings(2 * d / v0, 3, 1), tmp_path)

@@ -15,7 +15,8 @@ def test_default_run_writes_the_contracted_files(default_run):
     out, analysis = default_run
     for name in RESULT_FILES:
         assert (out / name).stat().st_size > 0
-    assert (out / "deck" / "in.hexdem").exists() and (out / "deck" / "dump.lammpstrj").exists()
+    assert (out / "deck" / "in.hexdem").exists() and (out / "deck" / "hexdem.json").exists()
+    assert not (out / "deck" / "dump.lammpstrj").exists(), "no dump unless asked for"
     header, rows = read_csv(out / "peaks.csv")
     assert header == PEAK_COLUMNS
     assert {row["line"] for row in rows} == {"0", "+30", "-30"}
@@ -49,7 +50,7 @@ def test_struck_bead_starts_at_v0_and_the_wave_decays_along_every_line(default_r
 def test_one_and_two_ranks_give_the_same_peaks(default_run, tmp_path):
     one = default_run[1].results
     two = simulate(RunConfig(ranks=2), tmp_path).results
-    assert default_run[1].trajectory.engine["ranks"] == 1
+    assert default_run[1].engine["ranks"] == 1
     np.testing.assert_allclose(two.peak_speed, one.peak_speed, rtol=1e-9)
     np.testing.assert_allclose(two.t_peak, one.t_peak, rtol=1e-9)
 

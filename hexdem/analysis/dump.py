@@ -18,7 +18,9 @@ from pathlib import Path
 import numpy as np
 
 from hexdem.analysis.peaks import PulseTimes, pulse_times
+from hexdem.analysis.trajectory import Trajectory
 from hexdem.errors import HexdemError
+from hexdem.model.granular import RunSettings
 
 #: Columns read at full precision (MDAnalysis's own positions and velocities are float32).
 FULL_PRECISION_COLUMNS = ("vx", "vy", "dx", "dy")
@@ -98,3 +100,12 @@ def read_dump(path, dt: float, expected_frames: int | None = None) -> BeadRecord
         raise
     except Exception as exc:
         raise HexdemError(f"cannot read dump {path}: it is corrupt or truncated ({type(exc).__name__})") from None
+
+
+def read_trajectory(path, settings: RunSettings, engine: dict | None = None) -> Trajectory:
+    """The hexdem dump at ``path`` of a run with ``settings`` (all its frames required) as a SI
+    :class:`~hexdem.analysis.trajectory.Trajectory`; ``engine`` describes the run."""
+    units = settings.units
+    record = read_dump(path, settings.dt_s / units.time_s, settings.n_samples).results
+    return Trajectory(times_s=record.times * units.time_s, velocities_m_s=record.velocities * units.velocity_m_s,
+                      displacements_m=record.displacements * units.length_m, engine=engine or {})

@@ -83,3 +83,25 @@ def peak_decay(rows_by_line: dict, path, units_name: str, v0: float, title="Peak
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(title="observation line")
     save(fig, path)
+
+
+def front_shape_figure(curves: dict, path, title="Roundness of the wavefront") -> None:
+    """Relative sixfold amplitude of the front vs its mean radius, one curve per labelled packing.
+
+    ``curves`` maps a label to a :class:`~hexdem.analysis.front_shape.FrontShape` (or anything
+    with ``mean_radius`` in bead diameters and ``sixfold_amplitude``). A regular hexagon's value
+    is drawn dashed and a circle's, 0, solid.
+    """
+    from hexdem.analysis.front_shape import HEXAGON_SIXFOLD
+
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    for label, shape in curves.items():
+        ax.plot(shape.mean_radius, shape.sixfold_amplitude, marker="o", linestyle="-", label=label)
+    ax.axhline(HEXAGON_SIXFOLD, color="k", linestyle="--", linewidth=1, label=f"regular hexagon ({HEXAGON_SIXFOLD:.4f})")
+    ax.axhline(0.0, color="grey", linestyle="-", linewidth=1, label="circle (0)")
+    ax.set_xlabel("mean front radius $a_0$ [d]")
+    ax.set_ylabel("sixfold amplitude $\\sqrt{a_6^2 + b_6^2}\\,/\\,a_0$  [–]")
+    ax.set_title(title)
+    ax.grid(True, alpha=0.3)
+    ax.legend()
+    save(fig, path)

@@ -1,8 +1,10 @@
-"""From a trajectory to the paper's observables: per-bead pulses, lines, energy audit.
+"""The paper's observables of one impact: per-bead pulses, observation lines, energy audit.
 
-:class:`ImpactAnalysis` follows MDAnalysis's run → results shape: construct it with the
-model and the trajectory, call :meth:`run`, read ``results``. Values are reported in the
-run's unit system (SI by default, or the paper's A = d = M = 1).
+An :class:`ImpactAnalysis` holds one run's ``model``, ``settings``, ``engine`` description
+and ``results`` (in the run's unit system, SI or the paper's A = d = M = 1). It is made
+either from the tracker that followed the run (:meth:`ImpactAnalysis.from_tracker`,
+hexdem's own runs) or from a whole trajectory (:meth:`ImpactAnalysis.from_trajectory`, a
+dump read back from disk), with the same definitions (:mod:`hexdem.analysis.peaks`).
 """
 
 from __future__ import annotations
@@ -12,7 +14,9 @@ from types import SimpleNamespace
 import numpy as np
 
 from hexdem.analysis.peaks import pulse_times
+from hexdem.analysis.tracker import TrackedPulses
 from hexdem.analysis.trajectory import Trajectory
+from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel, RunSettings
 from hexdem.model.lattice import LINE_STEPS
 
@@ -21,33 +25,57 @@ PEAK_COLUMNS = ("line", "n", "bead_id", "x", "y", "peak_speed", "t_peak", "arriv
 
 
 class ImpactAnalysis:
-    """Peaks, times of peak and arrival times of every bead, and the energy drift."""
+    """Peaks, times of peak and arrival times of every bead, and the energy drift.
 
-    def __init__(self, model: GranularModel, settings: RunSettings, trajectory: Trajectory):
-        self.model, self.settings, self.trajectory = model, settings, trajectory
-        self.results = SimpleNamespace()
+    ``results``: ``units``, ``length_unit_m``, ``positions`` (N, 2), ``peak_speed``, ``t_peak``,
+    ``arrival_time`` (N,), ``lines`` {name: bead indices}, ``energy_drift``,
+    ``far_wall_reached``. ``tracked``: the :class:`TrackedPulses` (traces, fields) of a
+    tracked run, else None.
+    """
 
-    def run(self) -> "ImpactAnalysis":
-        units = self.settings.units
-        n_beads = len(self.model.lattice)
-        pulses = pulse_times(self.trajectory.times_s / units.time_s,
-                             self.trajectory.speeds_m_s[:, :n_beads] / units.velocity_m_s)
-        r = self.results
+    def __init__(self, model: GranularModel, settings: RunSettings, engine: dict, peak_speed, t_peak, arrival_time,
+                 energy_drift: float, tracked: TrackedPulses | None = None):
+        self.model, self.settings, self.engine, self.tracked = model, settings, engine, tracked
+        units = settings.units
+        self.results = r = SimpleNamespace()
         r.units = units.name
         r.length_unit_m = units.length_m
-        r.positions = self.model.lattice.positions_m / units.length_m
-        r.peak_speed, r.t_peak, r.arrival_time = pulses.peak_speed, pulses.t_peak, pulses.arrival_time
-        r.lines = self.model.lattice.lines()
-        r.energy_drift = self.trajectory.energy_drift(self.model)
+        r.positions = model.lattice.positions_m / units.length_m
+        r.peak_speed, r.t_peak, r.arrival_time = peak_speed, t_peak, arrival_time
+        r.lines = model.lattice.lines()
+        r.energy_drift = energy_drift
         r.far_wall_reached = self._far_wall_reached()
-        return self
+
+    @classmethod
+    def from_tracker(cls, model: GranularModel, settings: RunSettings, tracked: TrackedPulses,
+                     engine: dict) -> "ImpactAnalysis":
+        return cls(model, settings, engine, tracked.peak_speed, tracked.t_peak, tracked.arrival_time,
+                   tracked.energy_drift, tracked)
+
+    @classmethod
+    def from_trajectory(cls, model: GranularModel, settings: RunSettings, trajectory: Trajectory) -> "ImpactAnalysis":
+        units = settings.units
+        pulses = pulse_times(trajectory.times_s / units.time_s,
+                             trajectory.speeds_m_s[:, :len(model.lattice)] / units.velocity_m_s)
+        return cls(model, settings, trajectory.engine, pulses.peak_speed, pulses.t_peak, pulses.arrival_time,
+                   trajectory.energy_drift(model))
 
     def _far_wall_reached(self) -> bool:
         """Did the leading wave reach (and pass) every bead at the wall facing the strike?"""
+        arrival = self.results.arrival_time
         if not self.model.walls:
-            return bool(np.all(np.isfinite(self.results.arrival_time)))
+            return bool(np.all(np.isfinite(arrival)))
         far = min(self.model.walls, key=lambda wall: float(np.dot(wall.normal, self.model.impact.direction)))
-        return bool(np.all(np.isfinite(self.results.arrival_time[far.members])))
+        return bool(np.all(np.isfinite(arrival[far.members])))
+
+    def line_trace(self, line: str) -> tuple[np.ndarray, np.ndarray]:
+        """(times (S,), speeds (S, L)) of the beads of observation ``line`` at every sample, in
+        the run's units; the run must have traced them (``trace_lines`` of ``simulate``)."""
+        beads = self.results.lines[line]
+        traced = {} if self.tracked is None else {int(b): k for k, b in enumerate(self.tracked.trace_beads)}
+        if not all(int(b) in traced for b in beads):
+            raise HexdemError(f"line {line} was not traced in this run; pass trace_lines=[{line!r}]")
+        return self.tracked.trace_times, self.tracked.trace_speeds[:, [traced[int(b)] for b in beads]]
 
     def line_rows(self) -> list[tuple]:
         """Rows of ``peaks.csv``: one per bead on each observation line, n from 0."""

@@ -1,7 +1,9 @@
-"""What an engine hands to the analysis: the sampled motion of every body, in SI.
+"""A whole sampled trajectory in memory, for small runs and for dumps read back from disk.
 
-Engines (LAMMPS, the reference integrator) differ in how they integrate; the analysis
-only sees a :class:`Trajectory`, so both are judged by the same definitions.
+hexdem's own runs stream their samples into a tracker (:mod:`hexdem.analysis.tracker`) and
+keep no trajectory. A :class:`Trajectory` is what the dump path hands to the analysis (a
+deck run by hand, read through MDAnalysis), and what :class:`TrajectoryRecorder` builds
+from the samples of a small run when every sample is wanted (contact tests, one-off studies).
 """
 
 from __future__ import annotations
@@ -10,23 +12,26 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from hexdem.analysis.energy import total_energy_j
-from hexdem.model.granular import GranularModel
+from hexdem.analysis.energy import EnergyAudit, relative_drift
+from hexdem.engines.sampling import Sample
+from hexdem.model.granular import GranularModel, RunSettings
 
 
 @dataclass(frozen=True)
 class Trajectory:
-    """Samples of all bodies (beads, then the striker if any).
+    """Samples of all bodies (beads, then the striker if any), in SI.
 
     ``times_s`` (F,) [s]; ``velocities_m_s`` and ``displacements_m`` (F, n_bodies, 2) [m/s, m],
     displacements from the initial positions; ``engine`` a dict describing the run
-    (name, version, ranks, wall_time_s, ...).
+    (name, version, ranks, wall_time_s, ...); ``gravity_m_s2`` the uniform in-plane gravity
+    (gx, gy) [m/s²] the run was under, if any (its work enters the energy audit).
     """
 
     times_s: np.ndarray
     velocities_m_s: np.ndarray
     displacements_m: np.ndarray
     engine: dict = field(default_factory=dict)
+    gravity_m_s2: tuple[float, float] | None = None
 
     @property
     def speeds_m_s(self) -> np.ndarray:
@@ -34,12 +39,35 @@ class Trajectory:
         return np.linalg.norm(self.velocities_m_s, axis=2)
 
     def energies_j(self, model: GranularModel) -> np.ndarray:
-        """Total energy (kinetic + Hertz) at every sample [J]."""
+        """Total conserved energy (kinetic + Hertz − work of gravity) at every sample [J]."""
+        audit = EnergyAudit(model, self.gravity_m_s2)
         start = model.initial_positions_m()
-        return np.array([total_energy_j(start + u, v, model)
-                         for u, v in zip(self.displacements_m, self.velocities_m_s)])
+        return np.array([audit(start + u, v) for u, v in zip(self.displacements_m, self.velocities_m_s)])
 
     def energy_drift(self, model: GranularModel) -> float:
         """max_t |E(t) − E(0)| / E(0): 0 for an exact integrator of this conservative model."""
-        energy = self.energies_j(model)
-        return float(np.max(np.abs(energy - energy[0])) / energy[0])
+        return relative_drift(self.energies_j(model))
+
+
+class TrajectoryRecorder:
+    """An observer that keeps every sample of a one-rank run, then :meth:`trajectory` in SI.
+
+    Memory grows with the run's length: for small runs only.
+    """
+
+    def __init__(self, model: GranularModel, settings: RunSettings):
+        self.start = model.initial_positions_m() / settings.units.length_m
+        self.units = settings.units
+        self.samples: list[Sample] = []
+
+    def __call__(self, sample: Sample) -> None:
+        self.samples.append(sample)
+
+    def trajectory(self, engine: dict) -> Trajectory:
+        order = [np.argsort(s.ids) for s in self.samples]
+        positions = np.array([s.positions[o] for s, o in zip(self.samples, order)])
+        velocities = np.array([s.velocities[o] for s, o in zip(self.samples, order)])
+        units = self.units
+        return Trajectory(times_s=np.array([s.time for s in self.samples]) * units.time_s,
+                          velocities_m_s=velocities * units.velocity_m_s,
+                          displacements_m=(positions - self.start) * units.length_m, engine=engine)

@@ -16,6 +16,7 @@ from hexdem.errors import HexdemError
 #: name → (module, one-line help)
 COMMANDS = {
     "run": ("hexdem.cli.run", "simulate one impact (default: the paper's 11-per-edge experiment)"),
+    "analyse": ("hexdem.cli.analyse", "result files from the dump of a deck run by hand (lmp -in in.hexdem)"),
     "compare": ("hexdem.cli.compare", "run one configuration through LAMMPS and the reference integrator"),
     "tca": ("hexdem.cli.tca", "ternary collision approximation: omega, c, pulse speeds (Sec. IV)"),
     "scaling": ("hexdem.cli.scaling", "velocity-decay scaling laws over a V0 sweep (Sec. V)"),

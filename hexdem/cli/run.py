@@ -11,12 +11,15 @@ def add_arguments(parser) -> None:
     parser.add_argument("--out", metavar="DIR", default="results", help="output directory (default: results/)")
     parser.add_argument("--ranks", type=int, metavar="N", help="MPI ranks for LAMMPS (default 1, in-process)")
     parser.add_argument("--engine", choices=ENGINES, help="integrator (default: lammps)")
+    parser.add_argument("--dump", action="store_true", default=None,
+                        help="also write LAMMPS's full trajectory dump into DIR/deck (config key dump = true)")
 
 
 def config_from_args(args) -> RunConfig:
     """The config file (or the defaults) with command-line overrides applied."""
     config = RunConfig.from_toml(args.config) if args.config else RunConfig()
-    overrides = {key: value for key, value in (("ranks", args.ranks), ("engine", args.engine)) if value is not None}
+    overrides = {key: value for key, value in (("ranks", args.ranks), ("engine", args.engine),
+                                                                  ("dump", args.dump)) if value is not None}
     return config.replace(**overrides)
 
 

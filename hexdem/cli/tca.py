@@ -61,9 +61,9 @@ def figures(out, engine: str, log) -> dict:
     config_b = RunConfig(engine=engine, v0=FIG5B_V0_M_S, strike_angle_deg=0.0)
     with tempfile.TemporaryDirectory(prefix="hexdem-tca-") as scratch:
         log(f"Fig. 5a: 30 deg strike, V0 = {FIG5A_V0} (nondimensional), {engine}")
-        speeds = tca.pulse_speed_table(simulate(config_a, f"{scratch}/a"))
+        speeds = tca.pulse_speed_table(simulate(config_a, f"{scratch}/a", trace_lines=["+30"]))
         log(f"Fig. 5b: 0 deg strike, V0 = {FIG5B_V0_M_S} m/s, the experiment's hexagon, {engine}")
-        arrivals = tca.arrival_time_table(simulate(config_b, f"{scratch}/b"))
+        arrivals = tca.arrival_time_table(simulate(config_b, f"{scratch}/b", trace_lines=["+30"]))
     speeds = {k: v[speeds["n"] <= FIG5A_LAST] for k, v in speeds.items()}
     header, rows = _rows(speeds)
     write_csv(out / "fig5a_pulse_speed.csv", header, rows)

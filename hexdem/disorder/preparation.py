@@ -38,20 +38,20 @@ than 0.1 µm per step, up to 20 µs: the equilibrium reached does not depend on 
 
 **Impact under gravity.** Gravity stays on during the impact (it holds the packing in the
 state it settled in). The energy audit of such a run must include the gravitational
-potential −Σ m g·u; :class:`TiltedTrajectory` adds it, so that
+potential −Σ m g·u; the impact's tracker is given the gravity and adds it
+(:class:`~hexdem.analysis.energy.EnergyAudit`), so that
 :class:`~hexdem.analysis.impact.ImpactAnalysis` reports the drift of the conserved total.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 import numpy as np
 from scipy.spatial import cKDTree
 
-from hexdem.analysis.trajectory import Trajectory
 from hexdem.common.checks import is_number
 from hexdem.engines.lammps.deck import (
     DATA_NAME,
@@ -326,23 +326,3 @@ def contact_overlaps_m(positions_m, diameters_m) -> np.ndarray:
     i, j = pairs.T
     overlap = radii[i] + radii[j] - np.linalg.norm(positions_m[i] - positions_m[j], axis=1)
     return overlap[overlap > 0]
-
-
-@dataclass(frozen=True)
-class TiltedTrajectory(Trajectory):
-    """A :class:`~hexdem.analysis.trajectory.Trajectory` under uniform gravity ``gravity_m_s2`` (gx, gy).
-
-    Its energy adds the gravitational potential −Σ m g·u (u: displacement from t = 0), so
-    that the energy audit checks the conserved total of a tilted set-up.
-    """
-
-    gravity_m_s2: tuple[float, float] = field(default=(0.0, 0.0))
-
-    @classmethod
-    def tilt(cls, trajectory: Trajectory, gravity_m_s2) -> "TiltedTrajectory":
-        values = {f.name: getattr(trajectory, f.name) for f in fields(Trajectory)}
-        return cls(**values, gravity_m_s2=tuple(float(g) for g in gravity_m_s2))
-
-    def energies_j(self, model: GranularModel) -> np.ndarray:
-        work = np.einsum("fbk,b,k->f", self.displacements_m, model.masses_kg, np.asarray(self.gravity_m_s2))
-        return super().energies_j(model) - work

@@ -160,7 +160,7 @@ def run_comparison(config: RunConfig, out, log=None, tolerances: Tolerances = To
         "beads_checked": comparison.n_checked, "max_peak_rel_diff": comparison.max_peak_rel_diff,
         "max_arrival_diff": comparison.max_arrival_diff, "agree": comparison.agree,
         "energy_drift": {name: analysis.results.energy_drift for name, analysis in analyses.items()},
-        "engine_wall_time_s": {name: analysis.trajectory.engine.get("wall_time_s")
+        "engine_wall_time_s": {name: analysis.engine.get("wall_time_s")
                                for name, analysis in analyses.items()},
     })
     comparison_plot(comparison, config.v0, out / "compare.png")

@@ -20,23 +20,18 @@ import numpy as np
 from hexdem.analysis import figures as plots
 from hexdem.analysis.impact import PEAK_COLUMNS, ImpactAnalysis
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json
+from hexdem.common.machine import free_disk_bytes
 from hexdem.errors import HexdemError
+from hexdem.experiments.tracked_run import ImpactJob, track_impact
 from hexdem.model.config import RunConfig
 
+#: The configuration of a LAMMPS deck, in its directory (read by ``hexdem analyse``).
+CONFIG_NAME = "hexdem.json"
 RESULT_FILES = ("peaks.csv", "summary.json", "arrival_map.png", "peak_decay.png")
+#: Bytes per atom and frame of a full-precision dump (measured: 30 MB for 331 atoms x 701 frames).
+DUMP_BYTES_PER_ATOM_FRAME = 150
 #: A conservative model whose energy wanders more than this was integrated too coarsely.
 MAX_ENERGY_DRIFT = 1e-3
-
-
-def make_engine(config: RunConfig):
-    """The engine named by ``config.engine``, on ``config.ranks`` ranks where that applies."""
-    if config.engine == "reference":
-        from hexdem.engines.reference.engine import ReferenceEngine
-
-        return ReferenceEngine()
-    from hexdem.engines.lammps.engine import LammpsEngine
-
-    return LammpsEngine(ranks=config.ranks)
 
 
 def _replace_dir(source: Path, target: Path) -> None:
@@ -45,27 +40,55 @@ def _replace_dir(source: Path, target: Path) -> None:
     source.rename(target)
 
 
-def simulate(config: RunConfig, workdir, log=None) -> ImpactAnalysis:
-    """Run ``config`` with its engine in ``workdir`` and analyse it (no result files)."""
+def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples=()) -> ImpactAnalysis:
+    """Run ``config`` with its engine in ``workdir``, analysed while it runs (no result files).
+
+    ``trace_lines`` (observation line names) keep the speeds of those lines' beads at every
+    sample, ``field_samples`` every bead's speed at those samples (see
+    :class:`~hexdem.analysis.tracker.PulseTracker`). A LAMMPS deck directory also gets
+    ``hexdem.json`` (the configuration), which ``hexdem analyse`` reads.
+    """
     log = log or (lambda message: None)
     model = config.model()
     settings = config.settings(model)
-    engine = make_engine(config)
-    log(f"running {engine.name}: {model.lattice.shape}, {model.n_bodies} bodies, "
-        f"{settings.n_steps} steps of {settings.dt_s:.4g} s ({settings.duration_s * 1e3:.4g} ms)")
-    trajectory = engine.run(model, settings, workdir)
-    log(f"analysing {len(trajectory.times_s)} samples")
-    analysis = ImpactAnalysis(model, settings, trajectory).run()
+    workdir = Path(workdir)
+    workdir.mkdir(parents=True, exist_ok=True)
+    if config.engine == "lammps":
+        write_json(workdir / CONFIG_NAME, config.as_dict())
+    log(f"running {config.engine}: {model.lattice.shape}, {model.n_bodies} bodies, "
+        f"{settings.n_steps} steps of {settings.dt_s:.4g} s ({settings.duration_s * 1e3:.4g} ms), "
+        f"{config.ranks if config.engine == 'lammps' else 1} rank(s), {settings.n_samples} samples analysed in the run")
+    job = ImpactJob(model, settings, config.engine, workdir, dump=config.dump, trace_beads=tuple(int(b) for line in trace_lines
+                                                             for b in model.lattice.line(line)),
+                    field_samples=tuple(field_samples))
+    analysis = track_impact(job, config.ranks)
+    check_energy(analysis, workdir)
+    return analysis
+
+
+def check_dump_space(config: RunConfig, out: Path) -> None:
+    """Refuse a run whose requested dump would not fit on the disk of ``out``."""
+    if not (config.dump and config.engine == "lammps"):
+        return
+    settings = config.settings()
+    needed = DUMP_BYTES_PER_ATOM_FRAME * settings.n_samples * (config.n_beads() + (config.impact == "striker"))
+    free = free_disk_bytes(out)
+    if needed > free:
+        raise HexdemError(f"the dump would take about {needed / 1e9:.3g} GB and {out} has {free / 1e9:.3g} GB free; "
+                          "drop dump, raise dump_every or free some space")
+
+
+def check_energy(analysis: ImpactAnalysis, where) -> None:
+    """Refuse a run whose energy drift shows a time step too coarse for its impact."""
     drift = analysis.results.energy_drift
     if not drift <= MAX_ENERGY_DRIFT:
-        raise HexdemError(f"energy drift {drift:.1e} exceeds {MAX_ENERGY_DRIFT:g} in {workdir}: the time step "
-                          f"{settings.dt_s:.3g} s is too large for V0; leave dt at its default or reduce it")
-    return analysis
+        raise HexdemError(f"energy drift {drift:.1e} exceeds {MAX_ENERGY_DRIFT:g} in {where}: the time step "
+                          f"{analysis.settings.dt_s:.3g} s is too large for V0; leave dt at its default or reduce it")
 
 
 def summary(config: RunConfig, analysis: ImpactAnalysis, wall_time_s: float) -> dict:
     """The contents of ``summary.json``: inputs, engine, energy drift, timings."""
-    r, settings, engine = analysis.results, analysis.settings, analysis.trajectory.engine
+    r, settings, engine = analysis.results, analysis.settings, analysis.engine
     return {
         "hexdem_version": version("hexdem"),
         "config": config.as_dict(),
@@ -102,6 +125,7 @@ def run_experiment(config: RunConfig, out, log=None) -> ImpactAnalysis:
     """Run ``config`` and publish its result files in ``out`` (see module docstring)."""
     log = log or (lambda message: print(f"hexdem: {message}", file=sys.stderr))
     out = ensure_writable_dir(out)
+    check_dump_space(config, out)
     start = time.perf_counter()
     workdir = out / "deck.inprogress"
     if workdir.exists():

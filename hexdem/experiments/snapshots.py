@@ -6,9 +6,10 @@ experiment, Fig. 4 (fig:largesim) the half-hexagon with a long edge of 91 beads 
 edges of 46, on which the walls of the small hexagon are outlined (both packings put the
 struck bead {0, 0} at the origin, so the outline needs no shift).
 
-Frames fall exactly on the requested times: the times are rounded to whole microseconds,
-and the time step is the default one (contact time / 700) shortened just enough that their
-greatest common divisor is a whole number of steps, which becomes the dump interval.
+Samples fall exactly on the requested times: the times are rounded to whole microseconds,
+and the time step and sampling interval are the default ones shortened just enough that
+the times' greatest common divisor is a whole number of samples of whole numbers of steps.
+The fields are taken inside the run (no dump), on one or several ranks.
 """
 
 from __future__ import annotations
@@ -18,13 +19,14 @@ import sys
 import time
 from dataclasses import dataclass
 from importlib.metadata import version
+from pathlib import Path
 
 import numpy as np
 
 from hexdem.analysis import figures as plots
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json
-from hexdem.engines.lammps.engine import LammpsEngine
 from hexdem.errors import HexdemError
+from hexdem.experiments.tracked_run import ImpactJob, track_impact
 from hexdem.model.config import RunConfig
 from hexdem.model.lattice import Lattice, hexagon
 
@@ -37,15 +39,22 @@ SNAPSHOT_COLUMNS = ("time", "bead_id", "m", "n", "x", "y", "speed")
 
 
 def snapshot_config(config: RunConfig, times_s) -> RunConfig:
-    """``config`` with the time step, dump interval and length that put a frame on every time."""
+    """``config`` with the time step, sampling interval and length that put a sample on every time.
+
+    The times' greatest common divisor (whole µs) is split into a whole number of samples no
+    longer than the default sampling interval, each a whole number of steps no longer than
+    the default time step.
+    """
     if config.units != "si":
         raise HexdemError("snapshots need an SI configuration (times are in seconds)")
     micro = [round(float(t) * 1e6) for t in times_s]
     if not micro or min(micro) < 1 or len(set(micro)) != len(micro):
         raise HexdemError(f"snapshot times must be distinct and at least 1 µs, got {list(times_s)}")
     unit_s = math.gcd(*micro) * 1e-6
-    every = math.ceil(unit_s / config.settings().dt_s)
-    return config.replace(dt=unit_s / every, duration=max(micro) * 1e-6, dump_every=every)
+    default = config.settings()
+    samples = math.ceil(unit_s / (default.dt_s * default.dump_every))
+    every = math.ceil(unit_s / samples / default.dt_s)
+    return config.replace(dt=unit_s / (samples * every), duration=max(micro) * 1e-6, dump_every=every)
 
 
 @dataclass(frozen=True)
@@ -61,16 +70,17 @@ class Snapshots:
 
 def take_snapshots(config: RunConfig, times_s, directory) -> Snapshots:
     """Run ``config`` (striker impact, ideal lattice) in LAMMPS on ``config.ranks`` ranks
-    and keep the bead speeds at ``times_s``."""
+    and keep every bead's speed at ``times_s``, taken inside the run (no dump)."""
     config = snapshot_config(config, sorted(times_s))
     model = config.model()
     settings = config.settings(model)
-    trajectory = LammpsEngine(ranks=config.ranks).run(model, settings, directory)
     wanted = np.array([round(t * 1e6) * 1e-6 for t in sorted(times_s)])
-    index = np.rint(wanted / (settings.dump_every * settings.dt_s)).astype(int)
-    n_beads = len(model.lattice)
-    return Snapshots(config, model.lattice, trajectory.times_s[index],
-                     trajectory.speeds_m_s[index][:, :n_beads], trajectory.engine)
+    samples = np.rint(wanted / (settings.dump_every * settings.dt_s)).astype(int)
+    job = ImpactJob(model, settings, "lammps", Path(directory), dump=config.dump, field_samples=tuple(samples))
+    analysis = track_impact(job, config.ranks)
+    tracked = analysis.tracked
+    return Snapshots(config, model.lattice, tracked.field_times * settings.units.time_s, tracked.field_speeds,
+                     analysis.engine)
 
 
 def snapshot_rows(snapshots: Snapshots) -> list[tuple]:

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from hexdem.common.checks import is_number, positive_int
+from hexdem.common.machine import available_memory_bytes
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time
@@ -29,12 +30,26 @@ UNITS = ("si", "nondimensional")
 ENGINES = ("lammps", "reference")
 #: Default time step: this many steps per two-bead Hertz contact at V0 (1.02e-7 s at 0.4 m/s).
 STEPS_PER_CONTACT = 700
+#: A time step must resolve the Hertz contact at V0 with at least this many steps (energy drift
+#: grows as dt²: about 2e-6 at 700 steps, 1e-3 at about 30).
+MIN_STEPS_PER_CONTACT = 20
+#: The analysis needs at least this many samples per contact time at V0, and this many in all.
+MIN_SAMPLES_PER_CONTACT = 4
+MIN_SAMPLES = 10
+#: Memory a run needs on each process: a fixed part (Python, NumPy, SciPy, numba, LAMMPS and
+#: the plotting libraries loaded) and a part per bead (LAMMPS's atoms and neighbour lists, the
+#: lattice, the tracker's state); measured by benchmarks/bench_scale.py.
+MEMORY_BASE_BYTES = 400e6
+MEMORY_PER_BEAD_BYTES = 8e3
 
 
 @dataclass(frozen=True)
 class RunConfig:
     """One simulation. Lengths in m; ``v0``, ``dt``, ``duration`` in ``units``.
 
+    ``dump_every`` steps between samples: the analysis inside the run takes one every
+    ``dump_every`` steps, and so does the full LAMMPS dump, written only with ``dump = true``
+    (the deck's ``in.hexdem`` always writes it when rerun by hand).
     ``dt = None`` takes the Hertz contact time at V0 / 700; ``duration = None`` runs until
     the leading wave has crossed the packing: one two-bead contact time at V0 per layer
     between the struck bead and the far wall (the pulse resides less than that on each
@@ -57,6 +72,7 @@ class RunConfig:
     dump_every: int = 20
     ranks: int = 1
     engine: str = "lammps"
+    dump: bool = False
 
     def __post_init__(self):
         for name, allowed in (("shape", SHAPES), ("impact", IMPACTS), ("units", UNITS), ("engine", ENGINES)):
@@ -64,11 +80,51 @@ class RunConfig:
                 raise HexdemError(f"unknown {name} {getattr(self, name)!r}; use one of: {', '.join(allowed)}")
         for name in ("dump_every", "ranks"):
             positive_int(name, getattr(self, name))
+        if not isinstance(self.dump, bool):
+            raise HexdemError(f"dump must be true or false, got {self.dump!r}")
         for name in ("dt", "duration"):
             value = getattr(self, name)
             if value is not None and not (is_number(value) and value > 0):
                 raise HexdemError(f"{name} must be a positive number of {self.units} time units, got {value!r}")
-        self.model()
+        self._check_size()
+        self._check_sampling(self.settings(self.model()))
+
+    def n_beads(self) -> int:
+        """Beads of the packing, counted without building it: 3N(N − 1) + 1 for a hexagon with N
+        per edge, S(3S − 1)/2 for a half-hexagon with short edges of S."""
+        if self.shape == "hexagon":
+            return 3 * self.edge_beads * (self.edge_beads - 1) + 1
+        return self.short_edge * (3 * self.short_edge - 1) // 2
+
+    def memory_estimate_bytes(self) -> float:
+        """Peak memory of the run on each of its processes [bytes] (see MEMORY_PER_BEAD_BYTES)."""
+        return MEMORY_BASE_BYTES + MEMORY_PER_BEAD_BYTES * self.n_beads()
+
+    def _check_size(self) -> None:
+        sizes = (self.edge_beads,) if self.shape == "hexagon" else (self.short_edge, self.long_edge)
+        if not all(isinstance(n, int) and not isinstance(n, bool) and n >= 2 for n in sizes):
+            return  # the lattice builder words the error
+        needed = self.memory_estimate_bytes() * (self.ranks if self.engine == "lammps" else 1)
+        available = available_memory_bytes()
+        if needed > available:
+            raise HexdemError(f"{self.shape} of {self.n_beads():,} beads needs about {needed / 1e9:.3g} GB of memory "
+                              f"({self.ranks if self.engine == 'lammps' else 1} process(es)); this machine has "
+                              f"{available / 1e9:.3g} GB available")
+
+    def _check_sampling(self, settings: RunSettings) -> None:
+        """Refuse a time step that does not resolve the Hertz contact, or too few samples."""
+        contact_s = self.contact_time_s()
+        scale = self.unit_system.time_s
+        if settings.dt_s > contact_s / MIN_STEPS_PER_CONTACT:
+            raise HexdemError(f"time step {settings.dt_s / scale:.3g} is not small against the Hertz contact time "
+                              f"{contact_s / scale:.3g} at V0 (in {self.units} units): use dt <= "
+                              f"{contact_s / scale / MIN_STEPS_PER_CONTACT:.3g}, or leave dt at its default")
+        interval_s = settings.dt_s * settings.dump_every
+        if settings.n_samples < MIN_SAMPLES or interval_s > contact_s / MIN_SAMPLES_PER_CONTACT:
+            raise HexdemError(f"too few samples to analyse: {settings.n_samples} samples, one every "
+                              f"{interval_s / scale:.3g} (contact time {contact_s / scale:.3g}); need at least "
+                              f"{MIN_SAMPLES} and {MIN_SAMPLES_PER_CONTACT} per contact time: lower dump_every "
+                              "or lengthen duration")
 
     @classmethod
     def from_toml(cls, path) -> "RunConfig":

@@ -108,15 +108,17 @@ def run_one(settings: SweepSettings, v0: float, strike_deg: float) -> RunPeaks:
     start = time.perf_counter()
     config = settings.config(v0, strike_deg)
     with tempfile.TemporaryDirectory(prefix="hexdem-scaling-") as scratch:
-        analysis = simulate(config, scratch)
-    r, units = analysis.results, analysis.settings.units
-    times = analysis.trajectory.times_s / units.time_s
-    speeds = analysis.trajectory.speeds_m_s / units.velocity_m_s
+        analysis = simulate(config, scratch, trace_lines=("0", "+30"))
+    r = analysis.results
     lines = {name: r.lines[name][:settings.last + 2] for name in ("0", "+30")}
+    traces = {}
+    for name, beads in lines.items():
+        times, speeds = analysis.line_trace(name)
+        traces[name] = (times, speeds[:, :len(beads)])
     return RunPeaks(float(v0), float(strike_deg),
                     {name: r.peak_speed[beads] for name, beads in lines.items()},
                     {name: r.t_peak[beads] for name, beads in lines.items()},
-                    {name: (times, speeds[:, beads]) for name, beads in lines.items()},
+                    traces,
                     float(r.energy_drift), time.perf_counter() - start)
 
 

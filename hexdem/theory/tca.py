@@ -284,12 +284,9 @@ def crossing_times(times, speeds, arrival) -> np.ndarray:
 
 def lattice_pulses(analysis, line: str) -> LatticePulses:
     """Crossing and residence times along ``line`` of a finished
-    :class:`~hexdem.analysis.impact.ImpactAnalysis`, in the run's units."""
-    units = analysis.settings.units
-    beads = analysis.results.lines[line]
-    times = analysis.trajectory.times_s / units.time_s
-    speeds = analysis.trajectory.speeds_m_s[:, beads] / units.velocity_m_s
-    crossing = crossing_times(times, speeds, analysis.results.arrival_time[beads])
+    :class:`~hexdem.analysis.impact.ImpactAnalysis` that traced ``line``, in the run's units."""
+    times, speeds = analysis.line_trace(line)
+    crossing = crossing_times(times, speeds, analysis.results.arrival_time[analysis.results.lines[line]])
     return LatticePulses(np.arange(len(crossing)), crossing, np.diff(np.concatenate([[0.0], crossing])))
 
 

@@ -1,36 +1,36 @@
-"""LAMMPS as a hexdem engine (an ASE-style calculator): model in, :class:`Trajectory` out."""
+"""LAMMPS as a hexdem engine (an ASE-style calculator): model in, samples out to an observer."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from hexdem.analysis.dump import read_dump
-from hexdem.analysis.trajectory import Trajectory
 from hexdem.engines.lammps.deck import Deck, write_deck
-from hexdem.engines.lammps.runner import RunInfo, run_deck
+from hexdem.engines.lammps.driver import run_streaming
 from hexdem.model.granular import GranularModel, RunSettings
 
 
 @dataclass(frozen=True)
 class LammpsEngine:
-    """Run a model in LAMMPS on ``ranks`` MPI ranks (1: in-process; more: ``mpiexec``)."""
+    """Run a model in LAMMPS through the ``lammps`` module, streaming its samples.
 
-    ranks: int = 1
+    ``dump``: also write the deck's full trajectory dump; ``gravity_m_s2``: uniform in-plane
+    gravity (gx, gy) [m/s²] in the deck (the tilted set-up of Sec. VI-A), or None.
+    """
+
+    dump: bool = False
+    gravity_m_s2: tuple[float, float] | None = None
     name = "lammps"
 
-    def run(self, model: GranularModel, settings: RunSettings, directory) -> Trajectory:
-        """Render the deck into ``directory``, run it, and read its dump back in SI."""
-        deck = write_deck(model, settings, directory)
-        return read_trajectory(deck, run_deck(deck, self.ranks))
-
-
-def read_trajectory(deck: Deck, info: RunInfo) -> Trajectory:
-    """The finished run of ``deck`` (however it was run, see ``info``) as a SI :class:`Trajectory`."""
-    settings = deck.settings
-    units = settings.units
-    record = read_dump(deck.dump_path, settings.dt_s / units.time_s, settings.n_samples).results
-    return Trajectory(times_s=record.times * units.time_s,
-                      velocities_m_s=record.velocities * units.velocity_m_s,
-                      displacements_m=record.displacements * units.length_m,
-                      engine={"name": LammpsEngine.name, "version": info.lammps_version, "ranks": info.ranks,
-                              "wall_time_s": info.wall_time_s, "deck": str(deck.input_path)})
+    def run(self, model: GranularModel, settings: RunSettings, directory, on_sample, comm=None,
+            show_progress: bool = True) -> dict:
+        """Render the deck into ``directory`` (on rank 0 of ``comm``) and run it on every rank of
+        ``comm`` (None: this process alone), calling ``on_sample`` with each rank's samples.
+        Returns a description of the run (name, version, ranks, wall_time_s, deck)."""
+        if comm is None or comm.Get_rank() == 0:
+            deck = write_deck(model, settings, directory, self.gravity_m_s2)
+        if comm is not None:
+            comm.Barrier()
+        deck = Deck(directory, settings, model.n_bodies)
+        info = run_streaming(deck, on_sample, comm, self.dump, show_progress)
+        return {"name": self.name, "version": info.lammps_version, "ranks": info.ranks,
+                "wall_time_s": info.wall_time_s, "deck": str(deck.input_path)}

@@ -1,24 +1,22 @@
-"""Run a rendered deck: in-process through the ``lammps`` module, or with ``mpiexec -n N lmp``.
+"""What every way of running a deck shares: its :class:`RunInfo`, LAMMPS's version and error
+line from its log, and the bare run ``mpiexec -n N lmp -in in.hexdem`` of a deck by hand.
 
-Either way LAMMPS runs inside the deck's directory (the deck uses relative paths, so that
-it can be rerun by hand) and writes ``log.lammps`` there. A LAMMPS error becomes a
-one-line :class:`~hexdem.errors.HexdemError` with LAMMPS's own message and the deck path.
+LAMMPS runs inside the deck's directory (the deck uses relative paths, so that it can be
+rerun by hand) and writes ``log.lammps`` there. A LAMMPS error becomes a one-line
+:class:`~hexdem.errors.HexdemError` with LAMMPS's own message and the deck path.
 """
 
 from __future__ import annotations
 
-import os
 import re
 import subprocess
 import time
-from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
 from hexdem.common.checks import positive_int
-from hexdem.common.progress import lammps_log_progress
 from hexdem.engines.lammps.deck import DECK_NAME, Deck
-from hexdem.engines.lammps.library import environment_command, load_lammps
+from hexdem.engines.lammps.library import environment_command
 from hexdem.errors import HexdemError
 
 
@@ -29,16 +27,6 @@ class RunInfo:
     lammps_version: str
     ranks: int
     wall_time_s: float
-
-
-@contextmanager
-def _working_directory(path: Path):
-    previous = os.getcwd()
-    os.chdir(path)
-    try:
-        yield
-    finally:
-        os.chdir(previous)
 
 
 def log_version(log: Path) -> str:
@@ -58,36 +46,15 @@ def _fail(deck: Deck, message: str) -> HexdemError:
     return HexdemError(f"LAMMPS failed on {deck.input_path}: {error_line(message)}")
 
 
-def run_in_process(deck: Deck) -> RunInfo:
-    """Run ``deck`` in this process on one rank."""
-    lammps = load_lammps()
-    start = time.perf_counter()
-    with _working_directory(deck.directory):
-        lmp = lammps.lammps(cmdargs=["-screen", "none", "-log", "log.lammps", "-nocite"])
-        try:
-            with lammps_log_progress(deck.log_path, deck.settings.n_steps):
-                lmp.file(DECK_NAME)
-        except Exception as exc:
-            raise _fail(deck, str(exc)) from None
-        finally:
-            lmp.close()
-    return RunInfo(log_version(deck.log_path), 1, time.perf_counter() - start)
-
-
-def run_mpiexec(deck: Deck, ranks: int) -> RunInfo:
-    """Run ``deck`` with ``mpiexec -n ranks lmp -in in.hexdem`` (both from this environment)."""
+def run_bare(deck: Deck, ranks: int = 1, input_name: str = DECK_NAME) -> RunInfo:
+    """Run a deck as a user would by hand, ``mpiexec -n ranks lmp -in input_name`` (both from
+    this environment), with no Python in the loop: the yardstick of hexdem's own runs."""
+    ranks = positive_int("--ranks", ranks)
     command = [environment_command("mpiexec"), "-n", str(ranks), environment_command("lmp"),
-               "-in", DECK_NAME, "-screen", "none", "-log", "log.lammps", "-nocite"]
+               "-in", input_name, "-screen", "none", "-log", "log.lammps", "-nocite"]
     start = time.perf_counter()
-    with lammps_log_progress(deck.log_path, deck.settings.n_steps, f"LAMMPS x{ranks}"):
-        done = subprocess.run(command, cwd=deck.directory, capture_output=True, text=True)
+    done = subprocess.run(command, cwd=deck.directory, capture_output=True, text=True)
     if done.returncode != 0:
         log = deck.log_path.read_text() if deck.log_path.exists() else ""
         raise _fail(deck, log if "ERROR" in log else done.stderr + done.stdout)
     return RunInfo(log_version(deck.log_path), ranks, time.perf_counter() - start)
-
-
-def run_deck(deck: Deck, ranks: int = 1) -> RunInfo:
-    """Run on ``ranks`` MPI ranks: in-process for one, through ``mpiexec`` for more."""
-    ranks = positive_int("--ranks", ranks)
-    return run_in_process(deck) if ranks == 1 else run_mpiexec(deck, ranks)

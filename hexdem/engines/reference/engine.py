@@ -13,8 +13,8 @@ It integrates eq. (model) as the paper does, with classical 4th-order Runge–Ku
 * V0 on the struck bead, or on a striker sphere bonded to it (``Impact.striker``).
 
 It works in the run's unit system (SI, or the paper's A = d = M = 1 of eq. (scaling)) and
-hands back a :class:`~hexdem.analysis.trajectory.Trajectory` in SI sampled like a LAMMPS dump, so the
-same :class:`~hexdem.analysis.impact.ImpactAnalysis` judges both engines. Unlike LAMMPS, which
+hands its samples, taken like a LAMMPS dump's, to the same observer as LAMMPS, so the same
+analysis judges both engines. Unlike LAMMPS, which
 treats every overlapping pair as a contact, bonds are fixed; in a lattice whose
 next-nearest neighbours never touch (all hexdem packings) the two coincide.
 
@@ -31,10 +31,11 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.analysis.trajectory import Trajectory
 from hexdem.common.checks import is_number, positive_int
 from hexdem.common.io import write_json
+from hexdem.common.progress import progress_bar
 from hexdem.engines.reference.kernel import KernelArrays, forces, integrate
+from hexdem.engines.sampling import Sample
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel, RunSettings
 from hexdem.model.lattice import BOND_STEPS, Lattice
@@ -188,17 +189,17 @@ class ReferenceSystem:
         forces(self.kernel, x, y, np.ones(self.n_cells), scratch[0], scratch[1], fx, fy)
         return np.column_stack([fx[self.cells], fy[self.cells]])
 
-    def integrate(self, velocities, dt: float, n_steps: int, every: int):
-        """RK4 from rest positions with ``velocities``; (displacements, velocities) samples.
-
-        Both are (n_steps // every + 1, n_bodies, 2) in ``units``, at steps 0, every, 2·every, ….
-        """
+    def integrate(self, velocities, dt: float, settings: RunSettings, emit):
+        """RK4 from rest positions with ``velocities`` (in ``units``); ``emit(index, step, x, y, u, w)``
+        at step 0 and every ``settings.dump_every`` steps, with the cell arrays of
+        displacements (x, y) and velocities (u, w)."""
         x, y = self._cell_arrays(np.zeros_like(velocities))
         u, w = self._cell_arrays(velocities)
-        shape = (n_steps // every + 1, len(self.cells), 2)
-        disp, vel = np.empty(shape), np.empty(shape)
-        integrate(self.kernel, x, y, u, w, float(dt), int(n_steps), int(every), self.cells, disp, vel)
-        return disp, vel
+        every = settings.dump_every
+        emit(0, 0, x, y, u, w)
+        for index in range(1, settings.n_samples):
+            integrate(self.kernel, x, y, u, w, float(dt), every)
+            emit(index, index * every, x, y, u, w)
 
 
 def _check_settings(settings: RunSettings) -> None:
@@ -208,40 +209,52 @@ def _check_settings(settings: RunSettings) -> None:
         positive_int(name, getattr(settings, name))
 
 
-def _check_finite(times_s, velocities) -> None:
-    bad = ~np.isfinite(velocities).all(axis=(1, 2))
-    if bad.any():
-        raise HexdemError(f"reference integration diverged (non-finite velocities at t = "
-                          f"{times_s[np.argmax(bad)]:.4g} s): reduce the time step")
-
-
 @dataclass(frozen=True)
 class ReferenceEngine:
-    """The reference integrator as a hexdem engine (same protocol as ``LammpsEngine``)."""
+    """The reference integrator as a hexdem engine (same protocol as ``LammpsEngine``; one rank)."""
 
     name = "reference"
 
-    def run(self, model: GranularModel, settings: RunSettings, directory) -> Trajectory:
-        """Integrate ``model`` with ``settings``; write ``reference.json`` into ``directory``."""
+    def run(self, model: GranularModel, settings: RunSettings, directory, on_sample, comm=None,
+            show_progress: bool = True) -> dict:
+        """Integrate ``model`` with ``settings``, calling ``on_sample`` with every sample; write
+        ``reference.json`` into ``directory``. Returns a description of the run."""
         _check_settings(settings)
+        if comm is not None and comm.Get_size() > 1:
+            raise HexdemError("the reference integrator runs on one rank; use ranks = 1 with it")
         units = settings.units
         directory = Path(directory)
         directory.mkdir(parents=True, exist_ok=True)
         system = ReferenceSystem.from_model(model, units)
-        start = time.perf_counter()
-        disp, vel = system.integrate(model.initial_velocities_m_s() / units.velocity_m_s,
-                                     settings.dt_s / units.time_s, settings.n_steps, settings.dump_every)
-        wall_time = time.perf_counter() - start
-        times_s = np.arange(len(disp)) * settings.dump_every * settings.dt_s
+        start_positions = model.initial_positions_m() / units.length_m
+        ids = np.arange(1, model.n_bodies + 1)
+        dt = settings.dt_s / units.time_s
+        bar = progress_bar(settings.n_steps, "reference", unit="step") if show_progress else None
+
+        def emit(index, step, x, y, u, w):
+            cells = system.cells
+            velocities = np.column_stack([u[cells], w[cells]])
+            if not np.isfinite(velocities).all():
+                raise HexdemError(f"reference integration diverged (non-finite velocities at t = "
+                                  f"{step * settings.dt_s:.4g} s): reduce the time step")
+            on_sample(Sample(index, step, step * dt, ids, start_positions + np.column_stack([x[cells], y[cells]]),
+                             velocities))
+            if bar is not None:
+                bar.update(step - bar.n)
+
+        begin = time.perf_counter()
+        try:
+            system.integrate(model.initial_velocities_m_s() / units.velocity_m_s, dt, settings, emit)
+        finally:
+            if bar is not None:
+                bar.close()
         engine = {"name": self.name, "version": version("hexdem"), "ranks": 1, "integrator": "classical RK4",
-                  "units": units.name, "wall_time_s": wall_time, "n_bonds": system.n_bonds,
+                  "units": units.name, "wall_time_s": time.perf_counter() - begin, "n_bonds": system.n_bonds,
                   "n_wall_contacts": system.n_wall_contacts}
         write_json(directory / PARAMETERS_NAME, {**engine, "model": model.lattice.shape, "n_bodies": model.n_bodies,
-                                                 "time_step": settings.dt_s / units.time_s,
-                                                 "n_steps": settings.n_steps, "dump_every": settings.dump_every,
+                                                 "time_step": dt, "n_steps": settings.n_steps,
+                                                 "dump_every": settings.dump_every,
                                                  "unit_scales_si": {"length_m": units.length_m,
                                                                     "mass_kg": units.mass_kg,
                                                                     "time_s": units.time_s}})
-        _check_finite(times_s, vel)
-        return Trajectory(times_s=times_s, velocities_m_s=vel * units.velocity_m_s,
-                          displacements_m=disp * units.length_m, engine=engine)
+        return engine

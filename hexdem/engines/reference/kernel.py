@@ -144,29 +144,14 @@ def _advance(q, v, h, a1, a2, a3, a4):
 
 
 @_jit
-def _sample(x, y, u, w, cells, disp, vel, s):
-    for b in range(cells.shape[0]):
-        c = cells[b]
-        disp[s, b, 0] = x[c]
-        disp[s, b, 1] = y[c]
-        vel[s, b, 0] = u[c]
-        vel[s, b, 1] = w[c]
-
-
-@_jit
-def integrate(k, x, y, u, w, h, n_steps, every, cells, disp, vel):
-    """Advance displacements (x, y) and velocities (u, w) by ``n_steps`` RK4 steps of ``h``.
-
-    Samples the bodies' ``cells`` into ``disp`` and ``vel`` (n_samples, n_bodies, 2) at
-    step 0 and every ``every`` steps, as a LAMMPS dump does.
-    """
+def integrate(k, x, y, u, w, h, n_steps):
+    """Advance displacements (x, y) and velocities (u, w) in place by ``n_steps`` RK4 steps of ``h``."""
     n = x.shape[0]
     a = np.zeros((8, n))
     tx, ty = np.zeros(n), np.zeros(n)
     bond_fx, bond_fy = np.zeros((3, k.hi)), np.zeros((3, k.hi))
     half, sq = 0.5 * h, h * h
-    _sample(x, y, u, w, cells, disp, vel, 0)
-    for step in range(1, n_steps + 1):
+    for _ in range(n_steps):
         forces(k, x, y, k.inv_mass, bond_fx, bond_fy, a[0], a[1])
         _shifted(tx, x, half, u, 0.0, a[0])
         _shifted(ty, y, half, w, 0.0, a[1])
@@ -179,5 +164,3 @@ def integrate(k, x, y, u, w, h, n_steps, every, cells, disp, vel):
         forces(k, tx, ty, k.inv_mass, bond_fx, bond_fy, a[6], a[7])
         _advance(x, u, h, a[0], a[2], a[4], a[6])
         _advance(y, w, h, a[1], a[3], a[5], a[7])
-        if step % every == 0:
-            _sample(x, y, u, w, cells, disp, vel, step // every)

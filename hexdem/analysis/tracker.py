@@ -1,0 +1,203 @@
+"""Pulse analysis inside the run: an observer of an engine's samples that keeps only what
+the outputs need, so that memory grows with the number of beads, never with the run's length.
+
+:class:`PulseTracker` is called with every :class:`~hexdem.engines.sampling.Sample` of a
+run (every ``dump_every`` steps, step 0 included) and, at the end, :meth:`PulseTracker.finish`
+gives each bead's peak speed, time of peak and half-maximum arrival time with the
+definitions of :mod:`hexdem.analysis.peaks`:
+
+* **peak speed** and **time of peak**: the same local cubic spline through the 7 samples
+  around the largest one as the dump analysis, so that equal samples give equal peaks;
+* **arrival time**: the first time |v| reaches half of the (spline) peak, interpolated
+  linearly between the sample before the crossing and the crossing sample (the dump analysis
+  uses its spline there; the two differ by a few ns at the default sampling);
+* beads whose largest sample is among the last two, or that never moved, get NaN.
+
+It also audits the energy (kinetic + Hertz, minus the work of gravity if any) at about
+:data:`ENERGY_SAMPLES` evenly spaced samples, records the speed of a few ``trace_beads`` at
+every sample (pulse shapes for the theory), and the speed of every bead at the samples
+``field_samples`` (wavefront snapshots).
+
+**Several ranks.** Under MPI every rank owns some atoms and sees only those. Each rank keeps
+state arrays for all beads but updates only its own; the state of a bead is exact on the
+rank that owns it. When atoms change ranks (LAMMPS migrates them when it rebuilds its
+neighbour lists) the states are merged, each bead's from its previous owner, before the
+new sample is taken; :meth:`finish` merges them once more onto rank 0, which alone returns
+the results. The energy audit and the snapshot fields gather whole states onto rank 0.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from hexdem.analysis.energy import EnergyAudit, relative_drift
+from hexdem.analysis.peaks import refine_peak
+from hexdem.analysis.tracker_kernel import first_crossing, rung, update
+from hexdem.engines.sampling import Sample
+from hexdem.model.granular import GranularModel, RunSettings
+
+#: About this many evenly spaced samples enter the energy audit (the first and last always).
+ENERGY_SAMPLES = 100
+#: Records of the running maximum kept per bead for the arrival time (see tracker_kernel).
+RECORD_CAPACITY = 64
+
+
+@dataclass(frozen=True)
+class TrackedPulses:
+    """What a :class:`PulseTracker` found, in the run's unit system.
+
+    Per bead (N,): ``peak_speed``, ``t_peak``, ``arrival_time``.
+    ``energy_drift`` max |E − E0|/E0 over ``energy_times``; ``n_samples``;
+    ``trace_times`` (S,) and ``trace_speeds`` (S, len(trace_beads)); ``field_times`` (F,) and
+    ``field_speeds`` (F, N) at the requested snapshot samples.
+    """
+
+    peak_speed: np.ndarray
+    t_peak: np.ndarray
+    arrival_time: np.ndarray
+    energy_drift: float
+    energy_times: np.ndarray
+    n_samples: int
+    trace_beads: np.ndarray
+    trace_times: np.ndarray
+    trace_speeds: np.ndarray
+    field_times: np.ndarray
+    field_speeds: np.ndarray
+
+
+class PulseTracker:
+    """Observer of one run's samples (see the module docstring).
+
+    ``model`` and ``settings`` are the run's (SI model, run units from ``settings.units``);
+    ``comm`` the mpi4py communicator of the ranks that share the run (None: one rank);
+    ``trace_beads`` bead indices whose every sample is kept; ``field_samples`` sample
+    indices at which every bead's speed is kept; ``gravity_m_s2`` the run's uniform gravity.
+    """
+
+    def __init__(self, model: GranularModel, settings: RunSettings, comm=None, trace_beads=(),
+                 field_samples=(), gravity_m_s2=None):
+        self.model, self.settings, self.comm = model, settings, comm
+        self.root = comm is None or comm.Get_rank() == 0
+        n, total = len(model.lattice), settings.n_samples
+        self.n_beads, self.n_bodies, self.n_samples_expected = n, model.n_bodies, total
+        self.ring = np.zeros((n, 3))
+        self.peak = np.full(n, -1.0)
+        self.peak_index = np.full(n, -1, dtype=np.int64)
+        self.window = np.full((n, 7), np.nan)
+        self.after = np.zeros(n, dtype=np.int64)
+        self.rung = rung(RECORD_CAPACITY)
+        self.rec_index = np.zeros((n, RECORD_CAPACITY), dtype=np.int64)
+        self.rec_value = np.zeros((n, RECORD_CAPACITY))
+        self.rec_prev = np.zeros((n, RECORD_CAPACITY))
+        self.rec_len = np.zeros(n, dtype=np.int64)
+        self.owned = np.zeros(n, dtype=np.bool_)
+        self.trace_beads = np.asarray(trace_beads, dtype=np.int64)
+        self.traces = np.full((total, len(self.trace_beads)), np.nan)
+        self.field_samples = np.asarray(sorted(field_samples), dtype=np.int64)
+        self.fields = np.full((len(self.field_samples), n), np.nan)
+        self.energy_every = max(1, (total - 1) // ENERGY_SAMPLES)
+        self.audit = EnergyAudit(model, gravity_m_s2) if self.root else None
+        self.energies, self.energy_times = [], []
+        self.count = 0
+
+    # ---- state shared across ranks
+    def _state(self) -> list[np.ndarray]:
+        return [self.ring, self.peak, self.peak_index, self.window, self.after, self.rec_index, self.rec_value,
+                self.rec_prev, self.rec_len]
+
+    def _merge(self) -> None:
+        """Give every rank each bead's state from the rank that owned it until now."""
+        from mpi4py import MPI
+
+        for array in self._state():
+            mask = self.owned.reshape((-1,) + (1,) * (array.ndim - 1))
+            local = np.where(mask, array, np.zeros((), array.dtype))
+            self.comm.Allreduce(local, array, op=MPI.SUM)
+
+    def _collect(self) -> None:
+        """Merge the states onto rank 0 for the results; each sample of a trace or field was
+        taken by exactly one rank (NaN elsewhere)."""
+        from mpi4py import MPI
+
+        for array in self._state():
+            mask = self.owned.reshape((-1,) + (1,) * (array.ndim - 1))
+            local = np.where(mask, array, np.zeros((), array.dtype))
+            self.comm.Reduce(local, array if self.root else None, op=MPI.SUM, root=0)
+        for array in (self.traces, self.fields):
+            local = np.nan_to_num(array, nan=0.0)
+            self.comm.Reduce(local, array if self.root else None, op=MPI.SUM, root=0)
+
+    def _gather(self, sample: Sample, ids, values):
+        """(n_bodies, k) ``values`` of all bodies on rank 0 (None elsewhere)."""
+        if self.comm is None:
+            whole = np.empty((self.n_bodies,) + values.shape[1:])
+            whole[ids - 1] = values
+            return whole
+        parts = self.comm.gather((ids, values), root=0)
+        if not self.root:
+            return None
+        whole = np.empty((self.n_bodies,) + values.shape[1:])
+        for part_ids, part_values in parts:
+            whole[part_ids - 1] = part_values
+        return whole
+
+    # ---- observing
+    def __call__(self, sample: Sample) -> None:
+        s = sample.index
+        beads = sample.ids <= self.n_beads
+        index = sample.ids[beads] - 1
+        speeds = np.hypot(sample.velocities[beads, 0], sample.velocities[beads, 1])
+        if self.comm is not None and self.comm.Get_size() > 1:
+            owned = np.zeros(self.n_beads, dtype=np.bool_)
+            owned[index] = True
+            moved = s > 0 and not np.array_equal(owned, self.owned)
+            if self.comm.allreduce(moved):
+                self._merge()
+            self.owned = owned
+        else:
+            self.owned[index] = True
+        update(index, speeds, s, self.rung, *self._state())
+        if len(self.trace_beads):
+            mine = np.flatnonzero(self.owned[self.trace_beads])
+            lookup = np.full(self.n_beads, -1, dtype=np.int64)
+            lookup[index] = np.arange(len(index))
+            self.traces[s, mine] = speeds[lookup[self.trace_beads[mine]]]
+        if s in self.field_samples:
+            self.fields[np.searchsorted(self.field_samples, s), index] = speeds
+        if s % self.energy_every == 0 or s == self.n_samples_expected - 1:
+            self._audit(sample)
+        self.count = s + 1
+
+    def _audit(self, sample: Sample) -> None:
+        state = self._gather(sample, sample.ids, np.hstack([sample.positions, sample.velocities]))
+        if state is not None:
+            units = self.settings.units
+            self.energies.append(self.audit(state[:, :2] * units.length_m, state[:, 2:] * units.velocity_m_s))
+            self.energy_times.append(sample.time)
+
+    # ---- results
+    def finish(self) -> TrackedPulses | None:
+        """The results on rank 0 (None on the other ranks); see :class:`TrackedPulses`."""
+        if self.comm is not None and self.comm.Get_size() > 1:
+            self._collect()
+        if not self.root:
+            return None
+        interval = self.settings.dump_every * self.settings.dt_s / self.settings.units.time_s
+        peak, t_peak, arrival = (np.full(self.n_beads, np.nan) for _ in range(3))
+        for b in range(self.n_beads):
+            k = int(self.peak_index[b])
+            if self.peak[b] <= 0.0 or k > self.count - 3:
+                continue
+            index = np.arange(k - 3, k + 4)
+            valid = (index >= 0) & (index < self.count) & np.isfinite(self.window[b])
+            t_peak[b], peak[b] = refine_peak(index[valid] * interval, self.window[b, valid])
+            n = int(self.rec_len[b])
+            arrival[b] = interval * first_crossing(0.5 * peak[b], self.rung, self.rec_index[b, :n],
+                                                   self.rec_value[b, :n], self.rec_prev[b, :n], n)
+        return TrackedPulses(peak_speed=peak, t_peak=t_peak, arrival_time=arrival, 
+                             energy_drift=relative_drift(self.energies), energy_times=np.array(self.energy_times),
+                             n_samples=self.count, trace_beads=self.trace_beads,
+                             trace_times=np.arange(self.count) * interval, trace_speeds=self.traces[:self.count],
+                             field_times=self.field_samples * interval, field_speeds=self.fields)

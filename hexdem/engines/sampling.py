@@ -1,0 +1,31 @@
+"""What an engine hands to the analysis while it runs: samples of the bodies' state.
+
+Engines do not keep trajectories. Every ``settings.dump_every`` steps (step 0 included, as
+a LAMMPS dump would) they hand a :class:`Sample` of the bodies each MPI rank owns to an
+observer, a callable ``on_sample(sample)``. The analysis (a tracker) keeps only what its
+outputs need, so memory grows with the number of beads, never with the run's length.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Sample:
+    """The bodies one rank owns at one sampled step, in the run's unit system.
+
+    ``index`` sample number (step // dump_every); ``step`` the time step; ``time`` the
+    simulated time; ``ids`` (n,) body ids, 1-based (beads 1..N as in the data file, then
+    the striker); ``positions`` and ``velocities`` (n, 2) full-step values at ``step``.
+    """
+
+    index: int
+    step: int
+    time: float
+    ids: np.ndarray
+    positions: np.ndarray
+    velocities: np.ndarray
+

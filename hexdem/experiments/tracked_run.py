@@ -1,0 +1,62 @@
+"""One impact run with its analysis inside: engine → samples → tracker → :class:`ImpactAnalysis`.
+
+Every study that simulates (``hexdem run``, ``compare``, ``snapshots``, the V0 sweep, the
+disorder ensembles) runs its impacts through :func:`track_impact`, on one rank in-process or
+on several under MPI (:mod:`hexdem.experiments.parallel`), with the same tracker.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from hexdem.analysis.impact import ImpactAnalysis
+from hexdem.analysis.tracker import PulseTracker
+from hexdem.engines.lammps.engine import LammpsEngine
+from hexdem.engines.reference.engine import ReferenceEngine
+from hexdem.experiments.parallel import run_on_ranks
+from hexdem.model.granular import GranularModel, RunSettings
+
+
+@dataclass(frozen=True)
+class ImpactJob:
+    """What every rank of one impact run does (picklable, see :mod:`hexdem.experiments.parallel`).
+
+    ``engine``: "lammps" or "reference"; ``dump``: LAMMPS also writes its full dump;
+    ``gravity_m_s2``: uniform in-plane gravity (gx, gy) [m/s²] or None; ``trace_beads`` and
+    ``field_samples``: what the tracker keeps besides the pulses; ``show_progress``: a bar on
+    a terminal.
+    """
+
+    model: GranularModel
+    settings: RunSettings
+    engine: str
+    directory: Path
+    dump: bool = False
+    gravity_m_s2: tuple[float, float] | None = None
+    trace_beads: tuple[int, ...] = ()
+    field_samples: tuple[int, ...] = ()
+    show_progress: bool = True
+
+    def __call__(self, comm):
+        tracker = PulseTracker(self.model, self.settings, comm, self.trace_beads, self.field_samples,
+                               self.gravity_m_s2)
+        engine = (ReferenceEngine() if self.engine == "reference"
+                  else LammpsEngine(dump=self.dump, gravity_m_s2=self.gravity_m_s2))
+        description = engine.run(self.model, self.settings, self.directory, tracker, comm, self.show_progress)
+        tracked = tracker.finish()
+        return None if tracked is None else (tracked, description)
+
+
+def track_impact(job: ImpactJob, ranks: int = 1, comm=None) -> ImpactAnalysis | None:
+    """Run ``job`` on ``ranks`` MPI ranks (LAMMPS only; 1: in this process) and analyse it.
+    Given ``comm``, every rank of that communicator calls this instead; rank 0 gets the
+    analysis, the others None."""
+    if comm is not None:
+        result = job(comm)
+    else:
+        result = run_on_ranks(job, ranks if job.engine == "lammps" else 1, job.directory)
+    if result is None:
+        return None
+    tracked, description = result
+    return ImpactAnalysis.from_tracker(job.model, job.settings, tracked, description)
