@@ -1,81 +1,131 @@
-"""hexdem-driven LAMMPS vs bare ``lmp -in`` on the same deck (the default experiment).
+"""hexdem end to end vs bare ``lmp -in`` of the same deck without output (the default experiment).
 
-Usage: python benchmarks/bench_run.py [--repeats 3]
+Usage: python benchmarks/bench_run.py [--repeats 5] [--quick]
 
-Renders the default ``hexdem run`` deck once, then alternates the two ways of running it,
-so that both see the same machine load, and prints atom-steps/s for each: from wall-clock
-time (hexdem: the in-process run; bare: the whole ``lmp`` process), from LAMMPS's own
-"Loop time", and from the loop without its Output section (the 30 MB full-precision dump,
-whose write time varies with the disk cache from run to run). Target: hexdem >= 0.9 x bare.
+Renders the default ``hexdem run`` deck once, with ``in.nooutput`` beside it (the deck's
+set-up and its ``run``, no dump: LAMMPS's bare work, no Python in the loop). Then, after a
+discarded in-process warm-up, it alternates, so that all see the same machine load:
+
+* ``hexdem run`` (CLI): the command in a subprocess, Python start-up and imports included;
+* ``run_experiment`` (in-process): the same run and result files from an imported hexdem;
+* ``python -c "import hexdem.experiments.run"``: the import cost alone;
+* bare ``lmp``: ``mpiexec -n 1 lmp -in in.nooutput``.
+
+It prints median wall times, LAMMPS's "Loop time" (hexdem's includes the sampling callback
+that feeds the analysis every ``dump_every`` steps), the ratio of each wall time to the bare
+loop, where the CLI's time goes, and the target: end to end <= 1.3 x bare loop + 2 s.
+``--quick``: a 5-per-edge hexagon for 0.2 ms, one repeat (the same code path, seconds).
 """
 
 from __future__ import annotations
 
 import argparse
-import re
+import json
+import math
+import os
 import shutil
 import statistics
 import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
 
+from harness import NOOUTPUT_NAME, nooutput_deck, write_config
 from machine import describe
 
-from hexdem.engines.lammps.deck import DECK_NAME, write_deck
 from hexdem.engines.lammps.library import environment_command
-from hexdem.engines.lammps.runner import run_in_process
+from hexdem.engines.lammps.partitions import loop_time_s
+from hexdem.engines.lammps.runner import run_bare
+from hexdem.experiments.run import run_experiment
 from hexdem.model.config import RunConfig
 
-
-def loop_times(log: Path) -> tuple[float, float]:
-    """(loop time, loop time without the Output section) from a LAMMPS log [s]."""
-    text = log.read_text()
-    loop = float(re.search(r"Loop time of ([0-9.eE+-]+)", text).group(1))
-    output = float(re.search(r"^Output\s+\|\s+[0-9.eE+-]+\s+\|\s+([0-9.eE+-]+)", text, re.MULTILINE).group(1))
-    return loop, loop - output
+QUICK = RunConfig(edge_beads=5, duration=2e-4)
+TARGET_FACTOR, TARGET_OFFSET_S = 1.3, 2.0
 
 
-def bare_lmp(directory: Path) -> float:
+def quiet(message: str) -> None:
+    pass
+
+
+def timed_cli(config_path: Path, out: Path) -> tuple[float, dict]:
+    """Wall time of ``hexdem run --config FILE --out DIR`` and its summary.json."""
     start = time.perf_counter()
-    subprocess.run([environment_command("lmp"), "-in", DECK_NAME, "-screen", "none", "-log", "log.lammps"],
-                   cwd=directory, check=True)
+    done = subprocess.run([environment_command("hexdem"), "run", "--config", str(config_path), "--out", str(out)],
+                          check=False, capture_output=True, text=True)
+    wall = time.perf_counter() - start
+    if done.returncode != 0:
+        raise SystemExit(f"hexdem run failed:\n{done.stderr}")
+    return wall, json.loads((out / "summary.json").read_text())
+
+
+def timed_import() -> float:
+    start = time.perf_counter()
+    subprocess.run([sys.executable, "-c", "import hexdem.experiments.run"], check=True)
     return time.perf_counter() - start
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--quick", action="store_true", help="a small deck, one repeat (seconds)")
     args = parser.parse_args()
-    config = RunConfig()
+    repeats = 1 if args.quick else args.repeats
+    config = QUICK if args.quick else RunConfig()
     model = config.model()
     settings = config.settings(model)
-    work = Path(tempfile.mkdtemp(prefix="hexdem-bench-"))
-    deck = write_deck(model, settings, work / "hexdem")
-    shutil.copytree(work / "hexdem", work / "bare")
+    work = Path(tempfile.mkdtemp(prefix="hexdem-bench-run-"))
+    print(f"machine: {describe()}; load average {os.getloadavg()[0]:.2f}", flush=True)
+    try:
+        deck = nooutput_deck(model, settings, work / "bare")
+        config_path = write_config(config, work / "run.toml")
+        run_experiment(config, work / "warm-up", log=quiet)
+        t = {key: [] for key in ("cli", "cli loop", "cli summary", "cli engine", "inproc", "inproc loop",
+                                 "import", "bare", "bare loop")}
+        for repeat in range(repeats):
+            out = work / f"cli-{repeat}"
+            wall, summary = timed_cli(config_path, out)
+            t["cli"].append(wall)
+            t["cli loop"].append(loop_time_s(out / "deck" / "log.lammps"))
+            t["cli summary"].append(summary.get("wall_time_s", math.nan))
+            t["cli engine"].append(summary.get("engine_wall_time_s", math.nan))
+            out = work / f"inproc-{repeat}"
+            start = time.perf_counter()
+            run_experiment(config, out, log=quiet)
+            t["inproc"].append(time.perf_counter() - start)
+            t["inproc loop"].append(loop_time_s(out / "deck" / "log.lammps"))
+            t["import"].append(timed_import())
+            t["bare"].append(run_bare(deck, 1, NOOUTPUT_NAME).wall_time_s)
+            t["bare loop"].append(loop_time_s(deck.log_path))
+            shutil.rmtree(work / f"cli-{repeat}")
+            shutil.rmtree(out)
+    finally:
+        shutil.rmtree(work)
+    m = {key: statistics.median(values) for key, values in t.items()}
+    bare_loop = m["bare loop"]
     atom_steps = model.n_bodies * settings.n_steps
-    timings = {name: {"wall": [], "loop": [], "no output": []} for name in ("hexdem", "bare lmp")}
-
-    def record(name, wall, log):
-        loop, compute = loop_times(log)
-        for key, value in (("wall", wall), ("loop", loop), ("no output", compute)):
-            timings[name][key].append(value)
-
-    for _ in range(args.repeats):
-        record("hexdem", run_in_process(deck).wall_time_s, deck.log_path)
-        record("bare lmp", bare_lmp(work / "bare"), work / "bare" / "log.lammps")
-    shutil.rmtree(work)
-    print(f"machine: {describe()}")
-    print(f"deck: default experiment, {model.n_bodies} atoms x {settings.n_steps} steps, "
-          f"dump every {settings.dump_every} steps; median of {args.repeats} alternating runs")
-    print(f"{'runner':<10} {'wall [s]':>9}   M atom-steps/s: {'wall':>7} {'loop':>7} {'no output':>10}")
-    rates = {name: {key: atom_steps / statistics.median(values) / 1e6 for key, values in t.items()}
-             for name, t in timings.items()}
-    for name, rate in rates.items():
-        print(f"{name:<10} {statistics.median(timings[name]['wall']):>9.3f}   {'':>15} "
-              f"{rate['wall']:>7.2f} {rate['loop']:>7.2f} {rate['no output']:>10.2f}")
-    ratios = ", ".join(f"{rates['hexdem'][key] / rates['bare lmp'][key]:.3f} ({key})" for key in ("wall", "loop", "no output"))
-    print(f"hexdem / bare: {ratios}; target >= 0.9")
+    print(f"deck: {'quick: ' if args.quick else 'default experiment, '}{model.lattice.shape}, {model.n_bodies} atoms x "
+          f"{settings.n_steps} steps, a sample every {settings.dump_every} steps; median of {repeats} alternating "
+          "run(s), after an in-process warm-up")
+    print(f"{'runner':<34} {'wall [s]':>9} {'loop [s]':>9} {'wall / bare loop':>17} {'M atom-steps/s (loop)':>22}")
+    rows = (("hexdem run (CLI, subprocess)", m["cli"], m["cli loop"]),
+            ("run_experiment (in-process)", m["inproc"], m["inproc loop"]),
+            (f"bare lmp -in {NOOUTPUT_NAME}", m["bare"], bare_loop))
+    for name, wall, loop in rows:
+        print(f"{name:<34} {wall:>9.3f} {loop:>9.3f} {wall / bare_loop:>17.2f} {atom_steps / loop / 1e6:>22.2f}")
+    target = TARGET_FACTOR * bare_loop + TARGET_OFFSET_S
+    for name, wall in (("CLI", m["cli"]), ("in-process", m["inproc"])):
+        margin = target - wall
+        print(f"target end to end ({name}) <= {TARGET_FACTOR:g} x bare loop + {TARGET_OFFSET_S:g} s = {target:.2f} s: "
+              f"{wall:.2f} s, {'met' if margin >= 0 else 'NOT met'} ({'+' if margin >= 0 else '-'}"
+              f"{abs(margin):.2f} s)")
+    parts = (("python start-up + imports (alone)", m["import"]),
+             ("result files, exit (rest)", m["cli"] - m["cli summary"] - m["import"]),
+             ("model, deck, tracker, analysis", m["cli summary"] - m["cli engine"]),
+             ("LAMMPS start-up + set-up", m["cli engine"] - m["cli loop"]),
+             ("sampling callbacks in the loop", m["cli loop"] - bare_loop),
+             ("bare loop", bare_loop))
+    print("where the CLI's time goes [s]: " + ", ".join(f"{name} {value:.2f}" for name, value in parts))
 
 
 if __name__ == "__main__":

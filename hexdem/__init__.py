@@ -1,14 +1,28 @@
 """hexdem: impulses in 2D hexagonal granular crystals, driven through LAMMPS.
 
 Reproduces and extends Leonard, Chong, Kevrekidis & Daraio, "Traveling Waves in 2D
-Hexagonal Granular Crystal Lattices". Data flow: geometry (:mod:`hexdem.model.lattice`) →
-model (:mod:`hexdem.model.granular`) → engine (LAMMPS, :mod:`hexdem.engines.lammps`, or the RK4 reference
-integrator, :mod:`hexdem.engines.reference.engine`) → :class:`~hexdem.analysis.trajectory.Trajectory` → analysis
-(:mod:`hexdem.analysis.impact`, :mod:`hexdem.analysis.peaks`) → figures (:mod:`hexdem.analysis.figures`). Theory lives in
-:mod:`hexdem.theory.tca` and :mod:`hexdem.theory.scaling`; weak disorder in :mod:`hexdem.disorder.preparation`,
-:mod:`hexdem.disorder.ensemble` and :mod:`hexdem.disorder.stats`.
+Hexagonal Granular Crystal Lattices". The subpackages follow the data flow:
+:mod:`hexdem.model` (lattice, materials, units, Hertz law, configuration) →
+:mod:`hexdem.engines` (LAMMPS and the RK4 reference integrator, streaming samples) →
+:mod:`hexdem.analysis` (the tracker inside the run, peaks, arrival, energy, dumps, figures) →
+:mod:`hexdem.experiments` (one run, the engine cross-check, snapshots) →
+:mod:`hexdem.theory` (TCA, scaling laws) and :mod:`hexdem.disorder` (Sec. VI ensembles) →
+:mod:`hexdem.cli`. :mod:`hexdem.common` holds helpers every layer uses.
+
+The Python API (:mod:`hexdem.api`) is available here and imported on first use, so that
+``import hexdem`` stays light: ``hexdem.RunConfig``, ``hexdem.simulate_impact``,
+``hexdem.tca``, ``hexdem.SweepSettings``, ``hexdem.scaling_laws``.
 """
 
 from hexdem.errors import HexdemError
 
-__all__ = ["HexdemError"]
+_API = ("RunConfig", "ImpactResult", "LineResult", "simulate_impact", "tca", "SweepSettings", "scaling_laws")
+__all__ = ["HexdemError", *_API]
+
+
+def __getattr__(name):
+    if name in _API:
+        from hexdem import api
+
+        return getattr(api, name)
+    raise AttributeError(f"module 'hexdem' has no attribute {name!r}")

@@ -82,6 +82,12 @@ def test_every_package_is_a_known_layer():
     assert packages <= set(LAYERS)
 
 
+def test_imports_point_down_the_data_flow():
+    upward = [f"{name} -> {target}" for name, targets in import_graph().items() for target in targets
+              if name != "hexdem" and layer(target) > layer(name)]
+    assert upward == []
+
+
 def test_modules_stay_small():
     large = {name: n for name, path in modules().items() if (n := len(path.read_text().splitlines())) > MAX_LINES}
     assert large == {}

@@ -14,6 +14,7 @@ import numpy as np  # noqa: E402
 from matplotlib.collections import PatchCollection  # noqa: E402
 from matplotlib.patches import Circle  # noqa: E402
 
+from hexdem.analysis.front_shape import HEXAGON_SIXFOLD  # noqa: E402
 from hexdem.common.io import atomic_path  # noqa: E402
 
 UNIT_LABELS = {"si": {"length": "m", "speed": "m/s", "time": "ms", "time_scale": 1e3},
@@ -92,8 +93,6 @@ def front_shape_figure(curves: dict, path, title="Roundness of the wavefront") -
     with ``mean_radius`` in bead diameters and ``sixfold_amplitude``). A regular hexagon's value
     is drawn dashed and a circle's, 0, solid.
     """
-    from hexdem.analysis.front_shape import HEXAGON_SIXFOLD
-
     fig, ax = plt.subplots(figsize=(6, 4.5))
     for label, shape in curves.items():
         ax.plot(shape.mean_radius, shape.sixfold_amplitude, marker="o", linestyle="-", label=label)

@@ -26,20 +26,6 @@ def add_arguments(parser) -> None:
     parser.add_argument("--json", action="store_true", help="print the results as JSON")
 
 
-def theory() -> dict:
-    """ω, c and the TCA's timing at V₀ = 1 (T scales as V₀^{-1/5})."""
-    from hexdem.theory import tca
-
-    event = tca.equal_velocity(1.0)
-    omega = tca.solve_omega()
-    return {"omega": omega, "c": event.decay_factor,
-            "compatibility_residual": float(tca.compatibility_residual(omega)),
-            "equal_velocity_fraction": event.velocity, "bca_equal_velocity_fraction": tca.BCA_EQUAL_VELOCITY_FRACTION,
-            "residence_time_at_v0_1": event.time,
-            "residence_time_hyperg_at_v0_1": tca.hypergeometric_residence_time(1.0, omega),
-            "units": "nondimensional, A = d = M = 1"}
-
-
 def _rows(table):
     keys = list(table)
     return keys, [tuple(int(table[k][i]) if k == "n" else float(table[k][i]) for k in keys)
@@ -92,7 +78,9 @@ def run(args) -> None:
     def log(message):
         print(f"hexdem tca: {message}", file=sys.stderr, flush=True)
 
-    result = theory()
+    from hexdem.theory import tca
+
+    result = tca.summary()
     if args.out:
         out = ensure_writable_dir(args.out)
         result["lattice"] = figures(out, args.engine, log)

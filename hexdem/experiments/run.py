@@ -2,8 +2,9 @@
 
 :func:`run_experiment` validates everything before it touches the disk, runs the engine in
 ``OUT/deck.inprogress`` and, only when the run and its analysis succeeded, publishes
-``OUT/deck`` (inputs, log, dump), ``peaks.csv``, ``summary.json``, ``arrival_map.png`` and
-``peak_decay.png``, each written atomically. A failed run leaves its inputs and log in
+``OUT/deck`` (inputs, log, the dump if asked for), ``peaks.csv``, ``summary.json``,
+``arrival_map.png``, ``peak_decay.png``, ``front_shape.csv`` and ``front_shape.png``, each
+written atomically. A failed run leaves its inputs and log in
 ``OUT/deck.failed`` for inspection and no result files.
 """
 
@@ -18,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from hexdem.analysis import figures as plots
+from hexdem.analysis.front_shape import FRONT_SHAPE_COLUMNS, FrontShape, default_front_times, front_shape
 from hexdem.analysis.impact import PEAK_COLUMNS, ImpactAnalysis
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.common.machine import free_disk_bytes
@@ -27,7 +29,8 @@ from hexdem.model.config import RunConfig
 
 #: The configuration of a LAMMPS deck, in its directory (read by ``hexdem analyse``).
 CONFIG_NAME = "hexdem.json"
-RESULT_FILES = ("peaks.csv", "summary.json", "arrival_map.png", "peak_decay.png")
+RESULT_FILES = ("peaks.csv", "summary.json", "arrival_map.png", "peak_decay.png", "front_shape.csv",
+                "front_shape.png")
 #: Bytes per atom and frame of a full-precision dump (measured: 30 MB for 331 atoms x 701 frames).
 DUMP_BYTES_PER_ATOM_FRAME = 150
 #: A conservative model whose energy wanders more than this was integrated too coarsely.
@@ -99,6 +102,8 @@ def summary(config: RunConfig, analysis: ImpactAnalysis, wall_time_s: float) -> 
         "n_steps": settings.n_steps,
         "duration": settings.duration_s / settings.units.time_s,
         "dump_every": settings.dump_every,
+        "n_samples": settings.n_samples,
+        "analysis": "in the run" if analysis.tracked is not None else "from the dump",
         "engine": engine.get("name"),
         "lammps_version": engine.get("version") if engine.get("name") == "lammps" else None,
         "ranks": engine.get("ranks"),
@@ -119,6 +124,23 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
                       title=f"Arrival time, {analysis.model.lattice.shape}, V0 = {config.v0:g}")
     by_line = {name: (np.arange(len(beads)), r.peak_speed[beads]) for name, beads in r.lines.items()}
     plots.peak_decay(by_line, out / "peak_decay.png", r.units, config.v0)
+    shape = measure_front_shape(analysis)
+    write_csv(out / "front_shape.csv", FRONT_SHAPE_COLUMNS, shape.rows())
+    plots.front_shape_figure({analysis.model.lattice.shape: shape}, out / "front_shape.png")
+
+
+def measure_front_shape(analysis: ImpactAnalysis) -> FrontShape:
+    """Roundness of the half-maximum arrival front about the struck bead against its mean radius
+    in bead diameters, from a little after the impact until the front first meets a wall; no
+    rows when the packing is too small for the front to grow before it meets one."""
+    model, r = analysis.model, analysis.results
+    positions = model.lattice.positions_m / model.lattice.diameter_m
+    origin = positions[model.lattice.struck]
+    try:
+        times = default_front_times(positions, r.arrival_time, origin)
+    except HexdemError:
+        times = []
+    return front_shape(positions, r.arrival_time, origin, times)
 
 
 def run_experiment(config: RunConfig, out, log=None) -> ImpactAnalysis:

@@ -324,3 +324,15 @@ def arrival_time_table(analysis, line: str = "+30") -> dict:
     return {"n": np.arange(1, len(lattice) + 1), "lattice": lattice,
             "tca": np.concatenate([[lattice[0]], tca / scale]),
             "hyperg": np.concatenate([[lattice[0]], hyperg / scale])}
+
+
+def summary() -> dict:
+    """ω, c and the TCA's timing at V₀ = 1 (T scales as V₀^{-1/5}), nondimensional (``hexdem tca``)."""
+    event = equal_velocity(1.0)
+    omega = solve_omega()
+    return {"omega": omega, "c": event.decay_factor,
+            "compatibility_residual": float(compatibility_residual(omega)),
+            "equal_velocity_fraction": event.velocity, "bca_equal_velocity_fraction": BCA_EQUAL_VELOCITY_FRACTION,
+            "residence_time_at_v0_1": event.time,
+            "residence_time_hyperg_at_v0_1": hypergeometric_residence_time(1.0, omega),
+            "units": "nondimensional, A = d = M = 1"}

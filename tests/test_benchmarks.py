@@ -1,0 +1,42 @@
+"""Every benchmark runs: ``benchmarks/bench_*.py --quick`` exits 0 and prints its table under a machine line.
+
+The quick modes take the full modes' code paths on small packings and few steps (seconds
+each), so that an API change that breaks a benchmark is caught here rather than when
+someone next measures.
+"""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+BENCHMARKS = ROOT / "benchmarks"
+#: Words each benchmark's printed table must contain (headers, row names, the target line).
+EXPECTED = {
+    "bench_run.py": ("runner", "wall [s]", "loop [s]", "wall / bare loop", "hexdem run (CLI, subprocess)",
+                     "run_experiment (in-process)", "bare lmp -in in.nooutput", "target end to end",
+                     "where the CLI's time goes"),
+    "bench_reference.py": ("lattice", "beads", "engine", "steps", "M (bead|atom)-steps/s", "reference (RK4, 1 thread)",
+                           "LAMMPS in hexdem, 1 rank", "LAMMPS bare, 2 ranks", "target >= 20"),
+    "bench_ensemble.py": ("runner", "LAMMPS [s]", "hexdem, 1 rank", "hexdem, 2 ranks", "bare lmp, 2 ranks",
+                          "phase", "compact", "settle", "impacts", "target <= 120 s"),
+    "bench_scale.py": ("beads", "ranks", "bare loop [s]", "end-to-end [s]", "ratio", "peak RSS per process [MB]",
+                       "hexdem bytes", "bare bytes", "target"),
+}
+
+
+def test_every_benchmark_is_checked():
+    assert sorted(path.name for path in BENCHMARKS.glob("bench_*.py")) == sorted(EXPECTED)
+
+
+@pytest.mark.parametrize("script", sorted(EXPECTED))
+def test_quick_benchmark_runs(script):
+    done = subprocess.run([sys.executable, str(BENCHMARKS / script), "--quick"], cwd=ROOT, check=False,
+                          capture_output=True, text=True, timeout=180)
+    assert done.returncode == 0, f"{script} --quick failed:\n{done.stdout}\n{done.stderr[-3000:]}"
+    lines = done.stdout.splitlines()
+    assert lines and lines[0].startswith("machine: ") and "cores" in lines[0], done.stdout
+    missing = [word for word in EXPECTED[script] if word not in done.stdout]
+    assert not missing, f"{script} --quick printed no {missing}:\n{done.stdout}"

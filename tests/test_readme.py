@@ -1,0 +1,26 @@
+"""README.md's Python example runs verbatim, so the documentation cannot rot."""
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+README = Path(__file__).resolve().parents[1] / "README.md"
+
+
+def python_api_example() -> str:
+    section = README.read_text().split("## Python API", 1)[1].split("\n## ", 1)[0]
+    blocks = re.findall(r"```python\n(.*?)```", section, flags=re.DOTALL)
+    assert len(blocks) == 1, "the Python API section holds one example"
+    return blocks[0]
+
+
+def test_the_python_api_example_runs(tmp_path):
+    script = tmp_path / "example.py"
+    script.write_text(python_api_example())
+    done = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert lines[-2] == "omega = 0.381966, c = 0.845276"
+    assert lines[-1].startswith("30/30: c = ")
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["example.py"], "no files unless asked for"
