@@ -23,7 +23,7 @@ UNIT_LABELS = {"si": {"length": "m", "speed": "m/s", "time": "ms", "time_scale":
 
 def save(fig, path) -> None:
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=150, bbox_inches="tight")
+        fig.savefig(tmp, format="png", dpi=150)
     plt.close(fig)
 
 
@@ -59,7 +59,7 @@ def arrival_map(results, model, path, title="Wavefront arrival time") -> None:
     scale = 1.0 / results.length_unit_m
     positions = results.positions
     diameters = model.lattice.diameters_m * scale
-    fig, ax = plt.subplots(figsize=(7, 6))
+    fig, ax = plt.subplots(figsize=(7, 6), layout="constrained")
     bead_map(ax, positions, diameters, results.arrival_time * units["time_scale"],
              cmap="viridis_r", label=f"arrival time [{units['time']}]")
     draw_walls(ax, model.walls, positions, diameters / 2, scale=scale)
@@ -74,7 +74,7 @@ def arrival_map(results, model, path, title="Wavefront arrival time") -> None:
 def peak_decay(rows_by_line: dict, path, units_name: str, v0: float, title="Peak speed along the observation lines"):
     """Peak speed V_n / V0 vs n for each observation line, logarithmic axis."""
     units = UNIT_LABELS[units_name]
-    fig, ax = plt.subplots(figsize=(6, 4.5))
+    fig, ax = plt.subplots(figsize=(6, 4.5), layout="constrained")
     markers = {"0": "o", "+30": "^", "-30": "v"}
     for line, (n, peak) in rows_by_line.items():
         ax.semilogy(n, np.asarray(peak) / v0, marker=markers.get(line, "o"), linestyle="-", label=f"{line}°")
@@ -93,7 +93,7 @@ def front_shape_figure(curves: dict, path, title="Roundness of the wavefront") -
     with ``mean_radius`` in bead diameters and ``sixfold_amplitude``). A regular hexagon's value
     is drawn dashed and a circle's, 0, solid.
     """
-    fig, ax = plt.subplots(figsize=(6, 4.5))
+    fig, ax = plt.subplots(figsize=(6, 4.5), layout="constrained")
     for label, shape in curves.items():
         ax.plot(shape.mean_radius, shape.sixfold_amplitude, marker="o", linestyle="-", label=label)
     ax.axhline(HEXAGON_SIXFOLD, color="k", linestyle="--", linewidth=1, label=f"regular hexagon ({HEXAGON_SIXFOLD:.4f})")
