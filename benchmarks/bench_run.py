@@ -34,6 +34,7 @@ from pathlib import Path
 from harness import NOOUTPUT_NAME, nooutput_deck, write_config
 from machine import describe
 
+from hexdem.engines.lammps.deck import DECK_NAME
 from hexdem.engines.lammps.library import environment_command
 from hexdem.engines.lammps.partitions import loop_time_s
 from hexdem.engines.lammps.runner import run_bare
@@ -85,6 +86,8 @@ def main() -> None:
         for repeat in range(repeats):
             out = work / f"cli-{repeat}"
             wall, summary = timed_cli(config_path, out)
+            if (out / "deck" / DECK_NAME).read_text() != deck.input_path.read_text():
+                raise SystemExit(f"hexdem run wrote another deck than {deck.input_path}: the comparison would be unfair")
             t["cli"].append(wall)
             t["cli loop"].append(loop_time_s(out / "deck" / "log.lammps"))
             t["cli summary"].append(summary.get("wall_time_s", math.nan))

@@ -38,6 +38,7 @@ from pathlib import Path
 from harness import MB, NOOUTPUT_NAME, nooutput_deck, run_watched, tree_bytes, write_config
 from machine import describe
 
+from hexdem.engines.lammps.deck import DECK_NAME
 from hexdem.engines.lammps.library import environment_command
 from hexdem.engines.lammps.partitions import loop_time_s
 from hexdem.engines.lammps.runner import run_bare
@@ -64,13 +65,15 @@ def measure(config: RunConfig, ranks: int, work: Path, repeat: int) -> dict:
     settings = config.settings(model)
     tag = f"{config.n_beads()}-{ranks}-{repeat}"
     config_path = write_config(config, work / f"{tag}.toml")
+    deck = nooutput_deck(model, settings, work / f"bare-{tag}")
     out = work / f"hexdem-{tag}"
     watched = run_watched([environment_command("hexdem"), "run", "--config", str(config_path), "--out", str(out),
                            "--ranks", str(ranks)]).check(f"hexdem run ({tag})")
+    if (out / "deck" / DECK_NAME).read_text() != deck.input_path.read_text():
+        raise SystemExit(f"hexdem run wrote another deck than {deck.input_path}: the comparison would be unfair")
     hexdem_loop = loop_time_s(out / "deck" / "log.lammps")
     hexdem_bytes = tree_bytes(out)
     shutil.rmtree(out)
-    deck = nooutput_deck(model, settings, work / f"bare-{tag}")
     bare = run_bare(deck, ranks, NOOUTPUT_NAME)
     row = {"wall": watched.wall_s, "hexdem loop": hexdem_loop, "bare wall": bare.wall_time_s,
            "bare loop": loop_time_s(deck.log_path), "rss": watched.peak_per_process,
