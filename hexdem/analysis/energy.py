@@ -95,7 +95,14 @@ class EnergyAudit:
         return energy
 
 
-def relative_drift(energies_j) -> float:
-    """max_t |E(t) − E(0)| / E(0): 0 for an exact integrator of a conservative model."""
+def energy_error(energies_j, dissipative: bool = False) -> float:
+    """The energy audit's figure of merit, 0 for an exact integrator.
+
+    Conservative model: max_t |E(t) − E(0)| / E(0). Dissipative model (restitution < 1): the
+    energy may only fall, so the largest rise above the lowest energy reached before,
+    max_t [E(t) − min_{s ≤ t} E(s)] / E(0).
+    """
     energies_j = np.asarray(energies_j, float)
+    if dissipative:
+        return float(np.max(energies_j - np.minimum.accumulate(energies_j)) / energies_j[0])
     return float(np.max(np.abs(energies_j - energies_j[0])) / energies_j[0])

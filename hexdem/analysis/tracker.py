@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hexdem.analysis.energy import EnergyAudit, relative_drift
+from hexdem.analysis.energy import EnergyAudit, energy_error
 from hexdem.analysis.peaks import refine_peak
 from hexdem.analysis.tracker_kernel import first_crossing, rung, update
 from hexdem.engines.sampling import Sample
@@ -49,7 +49,8 @@ class TrackedPulses:
     """What a :class:`PulseTracker` found, in the run's unit system.
 
     Per bead (N,): ``peak_speed``, ``t_peak``, ``arrival_time``.
-    ``energy_drift`` max |E − E0|/E0 over ``energy_times``; ``n_samples``;
+    ``energy_drift`` the audit's error over ``energy_times`` (see
+    :func:`~hexdem.analysis.energy.energy_error`); ``energy_lost`` 1 − E_end/E0; ``n_samples``;
     ``trace_times`` (S,) and ``trace_speeds`` (S, len(trace_beads)); ``field_times`` (F,) and
     ``field_speeds`` (F, N) at the requested snapshot samples.
     """
@@ -58,6 +59,7 @@ class TrackedPulses:
     t_peak: np.ndarray
     arrival_time: np.ndarray
     energy_drift: float
+    energy_lost: float
     energy_times: np.ndarray
     n_samples: int
     trace_beads: np.ndarray
@@ -107,14 +109,17 @@ class PulseTracker:
         return [self.ring, self.peak, self.peak_index, self.window, self.after, self.rec_index, self.rec_value,
                 self.rec_prev, self.rec_len]
 
+    def _owned(self, array: np.ndarray) -> np.ndarray:
+        """``array`` with the rows of the beads this rank does not own zeroed (for a sum over ranks)."""
+        mask = self.owned.reshape((-1,) + (1,) * (array.ndim - 1))
+        return np.where(mask, array, np.zeros((), array.dtype))
+
     def _merge(self) -> None:
         """Give every rank each bead's state from the rank that owned it until now."""
         from mpi4py import MPI
 
         for array in self._state():
-            mask = self.owned.reshape((-1,) + (1,) * (array.ndim - 1))
-            local = np.where(mask, array, np.zeros((), array.dtype))
-            self.comm.Allreduce(local, array, op=MPI.SUM)
+            self.comm.Allreduce(self._owned(array), array, op=MPI.SUM)
 
     def _collect(self) -> None:
         """Merge the states onto rank 0 for the results; each sample of a trace or field was
@@ -122,12 +127,9 @@ class PulseTracker:
         from mpi4py import MPI
 
         for array in self._state():
-            mask = self.owned.reshape((-1,) + (1,) * (array.ndim - 1))
-            local = np.where(mask, array, np.zeros((), array.dtype))
-            self.comm.Reduce(local, array if self.root else None, op=MPI.SUM, root=0)
+            self.comm.Reduce(self._owned(array), array if self.root else None, op=MPI.SUM, root=0)
         for array in (self.traces, self.fields):
-            local = np.nan_to_num(array, nan=0.0)
-            self.comm.Reduce(local, array if self.root else None, op=MPI.SUM, root=0)
+            self.comm.Reduce(np.nan_to_num(array, nan=0.0), array if self.root else None, op=MPI.SUM, root=0)
 
     def _gather(self, sample: Sample, ids, values):
         """(n_bodies, k) ``values`` of all bodies on rank 0 (None elsewhere)."""
@@ -197,7 +199,8 @@ class PulseTracker:
             arrival[b] = interval * first_crossing(0.5 * peak[b], self.rung, self.rec_index[b, :n],
                                                    self.rec_value[b, :n], self.rec_prev[b, :n], n)
         return TrackedPulses(peak_speed=peak, t_peak=t_peak, arrival_time=arrival, 
-                             energy_drift=relative_drift(self.energies), energy_times=np.array(self.energy_times),
+                             energy_drift=energy_error(self.energies, self.model.dissipative),
+                             energy_lost=1.0 - self.energies[-1] / self.energies[0], energy_times=np.array(self.energy_times),
                              n_samples=self.count, trace_beads=self.trace_beads,
                              trace_times=np.arange(self.count) * interval, trace_speeds=self.traces[:self.count],
                              field_times=self.field_samples * interval, field_speeds=self.fields)

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from hexdem.analysis.energy import EnergyAudit, relative_drift
+from hexdem.analysis.energy import EnergyAudit, energy_error
 from hexdem.engines.sampling import Sample
 from hexdem.model.granular import GranularModel, RunSettings
 
@@ -45,8 +45,8 @@ class Trajectory:
         return np.array([audit(start + u, v) for u, v in zip(self.displacements_m, self.velocities_m_s)])
 
     def energy_drift(self, model: GranularModel) -> float:
-        """max_t |E(t) − E(0)| / E(0): 0 for an exact integrator of this conservative model."""
-        return relative_drift(self.energies_j(model))
+        """The energy audit's error (:func:`~hexdem.analysis.energy.energy_error`)."""
+        return energy_error(self.energies_j(model), model.dissipative)
 
 
 class TrajectoryRecorder:

@@ -110,6 +110,7 @@ def summary(config: RunConfig, analysis: ImpactAnalysis, wall_time_s: float) -> 
         "engine_wall_time_s": engine.get("wall_time_s"),
         "wall_time_s": wall_time_s,
         "energy_drift": r.energy_drift,
+        "energy_lost": analysis.tracked.energy_lost if analysis.tracked is not None else None,
         "far_wall_reached": r.far_wall_reached,
         "beads_per_line": {name: len(beads) for name, beads in r.lines.items()},
     }

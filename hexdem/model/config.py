@@ -50,6 +50,8 @@ class RunConfig:
     ``dump_every`` steps between samples: the analysis inside the run takes one every
     ``dump_every`` steps, and so does the full LAMMPS dump, written only with ``dump = true``
     (the deck's ``in.hexdem`` always writes it when rerun by hand).
+    ``restitution``: bead–bead coefficient of restitution (1.0: the paper's ideal model);
+    ``wall_restitution``: bead–wall (None: the same as ``restitution``).
     ``dt = None`` takes the Hertz contact time at V0 / 700; ``duration = None`` runs until
     the leading wave has crossed the packing: one two-bead contact time at V0 per layer
     between the struck bead and the far wall (the pulse resides less than that on each
@@ -73,6 +75,8 @@ class RunConfig:
     ranks: int = 1
     engine: str = "lammps"
     dump: bool = False
+    restitution: float = 1.0
+    wall_restitution: float | None = None
 
     def __post_init__(self):
         for name, allowed in (("shape", SHAPES), ("impact", IMPACTS), ("units", UNITS), ("engine", ENGINES)):
@@ -168,7 +172,9 @@ class RunConfig:
             raise HexdemError(f"v0 must be > 0 (the impact moves into the packing), got {self.v0!r}")
         wall = None if self.wall_material == "none" else material(self.wall_material)
         impact = Impact(self.v0 * self.unit_system.velocity_m_s, self.strike_angle_deg, self.impact == "striker")
-        return GranularModel(self.lattice(), impact, material(self.bead_material), wall)
+        wall_restitution = self.restitution if self.wall_restitution is None else self.wall_restitution
+        return GranularModel(self.lattice(), impact, material(self.bead_material), wall, self.restitution,
+                             wall_restitution)
 
     def contact_time_s(self) -> float:
         """Two-bead Hertz contact time at V0 [s], the natural time scale of the impact."""

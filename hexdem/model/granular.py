@@ -15,6 +15,7 @@ import numpy as np
 
 from hexdem.common.checks import is_number
 from hexdem.errors import HexdemError
+from hexdem.model.dissipation import check_restitution, damping_coefficient
 from hexdem.model.lattice import Lattice, strike_direction
 from hexdem.model.materials import DELRIN, STEEL_316, Material, hertz_stiffness, sphere_mass
 from hexdem.model.units import SI, UnitSystem
@@ -47,13 +48,36 @@ class Impact:
 class GranularModel:
     """Lattice, materials and impact of one simulation (SI units).
 
-    ``wall`` is the wall-lining material, or None for a packing without walls.
+    ``wall`` is the wall-lining material, or None for a packing without walls;
+    ``restitution`` and ``wall_restitution`` the coefficients of restitution of bead–bead and
+    bead–wall contacts (1: the paper's conservative model; below 1: Tsuji damping, see
+    :mod:`hexdem.model.dissipation`).
     """
 
     lattice: Lattice
     impact: Impact
     bead: Material = STEEL_316
     wall: Material | None = DELRIN
+    restitution: float = 1.0
+    wall_restitution: float = 1.0
+
+    def __post_init__(self):
+        check_restitution("restitution", self.restitution)
+        check_restitution("wall_restitution", self.wall_restitution)
+
+    @property
+    def dissipative(self) -> bool:
+        return self.restitution < 1.0 or (bool(self.walls) and self.wall_restitution < 1.0)
+
+    @property
+    def pair_damping(self) -> float:
+        """Tsuji's α of bead–bead contacts (0: undamped)."""
+        return damping_coefficient(self.restitution)
+
+    @property
+    def wall_damping(self) -> float:
+        """Tsuji's α of bead–wall contacts (0: undamped)."""
+        return damping_coefficient(self.wall_restitution)
 
     @property
     def has_striker(self) -> bool:

@@ -18,6 +18,7 @@ from string import Template
 
 import numpy as np
 
+from hexdem.model.dissipation import lammps_tsuji_coefficient
 from hexdem.model.granular import GranularModel, RunSettings
 from hexdem.model.units import UnitSystem
 
@@ -84,8 +85,8 @@ def walls_block(model: GranularModel, units: UnitSystem) -> str:
         block += [f"group           {wall.name} id {ids}",
                   f"region          {wall.name} plane {_fmt(point[0])} {_fmt(point[1])} 0.0 "
                   f"{_fmt(wall.normal[0])} {_fmt(wall.normal[1])} 0.0 side in",
-                  f"fix             {wall.name} {wall.name} wall/gran/region granular hertz {stiffness} 0.0 "
-                  f"damping viscoelastic tangential linear_nohistory 0.0 0.0 region {wall.name}"]
+                  f"fix             {wall.name} {wall.name} wall/gran/region granular hertz {stiffness} "
+                  f"{damping_model(model.wall_damping)} tangential linear_nohistory 0.0 0.0 region {wall.name}"]
     return "\n".join(block) + "\n"
 
 
@@ -94,11 +95,21 @@ def template(name: str) -> Template:
     return Template(resources.files("hexdem.lammps_inputs").joinpath(name).read_text())
 
 
+def damping_model(alpha: float) -> str:
+    """The damping of a ``hertz`` contact: none (α = 0), or Tsuji's with damping α
+    (:mod:`hexdem.model.dissipation`), as LAMMPS's ``damp`` value and model name."""
+    if alpha == 0.0:
+        return "0.0 damping viscoelastic"
+    return f"{_fmt(lammps_tsuji_coefficient(alpha))} damping tsuji"
+
+
 def granular_block(model: GranularModel, units: UnitSystem) -> str:
     """Deck commands shared by every hexdem deck: 2D sphere atoms from ``data.hexdem`` and
     the undamped Hertz pair potential of ``model`` without tangential force."""
     return template("granular.in").substitute(
         lammps_units=units.lammps_units, pair_stiffness=_fmt(model.pair_stiffness_pa / units.stress_pa),
+        pair_damping=damping_model(model.pair_damping),
+        damping_note="undamped" if model.restitution == 1.0 else f"Tsuji damping, restitution {model.restitution}",
         skin=_fmt(0.1 * model.lattice.diameter_m / units.length_m))
 
 

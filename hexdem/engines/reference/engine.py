@@ -94,13 +94,13 @@ def _reduced_radius(radius_i, radius_j):
 
 
 def _lattice_bonds(model: GranularModel, grid: Grid, units: UnitSystem):
-    """(rest_x, rest_y, contact, stiffness), each (3, hi), of the lattice's fixed bonds."""
+    """(rest_x, rest_y, contact, stiffness, damping), each (3, hi), of the lattice's fixed bonds."""
     lattice = model.lattice
     shape = (len(BOND_STEPS), grid.hi)
     # Empty slots keep a rest vector of bond length, so r > 0 and their force is exactly 0.
     ideal = np.array([[math.sqrt(3) / 2 * dn, dm / 2] for dm, dn in BOND_STEPS]) * lattice.diameter_m / units.length_m
     rest_x, rest_y = np.repeat(ideal[:, :1], grid.hi, axis=1), np.repeat(ideal[:, 1:], grid.hi, axis=1)
-    contact, stiffness = np.zeros(shape), np.zeros(shape)
+    contact, stiffness, damping = np.zeros(shape), np.zeros(shape), np.zeros(shape)
     i, j = lattice.bonds().T
     direction = {grid.offset(step): d for d, step in enumerate(BOND_STEPS)}
     d = np.array([direction[o] for o in grid.cells[j] - grid.cells[i]], dtype=int)
@@ -108,7 +108,9 @@ def _lattice_bonds(model: GranularModel, grid: Grid, units: UnitSystem):
     rest_x[d, cell], rest_y[d, cell] = (lattice.positions_m[j] - lattice.positions_m[i]).T / units.length_m
     contact[d, cell] = (radii[i] + radii[j]) / units.length_m
     stiffness[d, cell] = _coefficient(model.pair_stiffness_pa, _reduced_radius(radii[i], radii[j]), units)
-    return rest_x, rest_y, contact, stiffness
+    masses = model.masses_kg / units.mass_kg
+    damping[d, cell] = model.pair_damping * np.sqrt(_reduced_radius(masses[i], masses[j]) * stiffness[d, cell])
+    return rest_x, rest_y, contact, stiffness, damping
 
 
 def _striker_pairs(model: GranularModel, cells: np.ndarray, units: UnitSystem):
@@ -124,13 +126,16 @@ def _striker_pairs(model: GranularModel, cells: np.ndarray, units: UnitSystem):
     beads = np.flatnonzero((gap < STRIKER_REACH * model.lattice.diameter_m) & model.has_striker)
     rest = (pos[beads] - pos[striker]) / units.length_m
     r_eff = _reduced_radius(radii[beads], radii[striker])
+    stiffness = _coefficient(model.pair_stiffness_pa, r_eff, units)
+    masses = model.masses_kg / units.mass_kg
+    damping = model.pair_damping * np.sqrt(_reduced_radius(masses[beads], masses[striker]) * stiffness)
     return (np.full(len(beads), cells[striker], dtype=np.int64), cells[beads].astype(np.int64),
             rest[:, 0].copy(), rest[:, 1].copy(), (radii[beads] + radii[striker]) / units.length_m,
-            _coefficient(model.pair_stiffness_pa, r_eff, units))
+            stiffness, damping)
 
 
 def _wall_contacts(model: GranularModel, cells: np.ndarray, units: UnitSystem):
-    """(cell, n_x, n_y, rest gap, A_w) of every wall member: sphere–half-plane Hertz."""
+    """(cell, n_x, n_y, rest gap, A_w, η_w) of every wall member: sphere–half-plane Hertz."""
     lattice, walls = model.lattice, model.walls
     beads = np.concatenate([np.zeros(0, dtype=np.int64)] + [wall.members for wall in walls]).astype(np.int64)
     normals = np.concatenate([np.zeros((0, 2))] + [np.tile(wall.normal, (len(wall.members), 1)) for wall in walls])
@@ -138,7 +143,8 @@ def _wall_contacts(model: GranularModel, cells: np.ndarray, units: UnitSystem):
     gaps = np.concatenate([np.zeros(0)] + [wall.gaps_m(lattice.positions_m[wall.members], lattice.radii_m[wall.members])
                                            for wall in walls])
     stiffness = _coefficient(model.wall_stiffness_pa if walls else 0.0, radii, units)
-    return cells[beads], normals[:, 0].copy(), normals[:, 1].copy(), gaps / units.length_m, stiffness
+    damping = model.wall_damping * np.sqrt(model.masses_kg[beads] / units.mass_kg * stiffness)
+    return cells[beads], normals[:, 0].copy(), normals[:, 1].copy(), gaps / units.length_m, stiffness, damping
 
 
 @dataclass(frozen=True)
@@ -162,9 +168,12 @@ class ReferenceSystem:
         n_cells = grid.n_cells + off_grid
         inv_mass = np.zeros(n_cells)
         inv_mass[cells] = units.mass_kg / model.masses_kg
+        rest_x, rest_y, contact, stiffness, damping = _lattice_bonds(model, grid, units)
+        *pairs, pair_damping = _striker_pairs(model, cells, units)
+        *walls, wall_damping = _wall_contacts(model, cells, units)
         kernel = KernelArrays(np.array([grid.offset(step) for step in BOND_STEPS], dtype=np.int64),
-                              grid.lo, grid.hi, *_lattice_bonds(model, grid, units), inv_mass,
-                              *_striker_pairs(model, cells, units), *_wall_contacts(model, cells, units))
+                              grid.lo, grid.hi, rest_x, rest_y, contact, stiffness, inv_mass, *pairs, *walls,
+                              damping, pair_damping, wall_damping, model.dissipative)
         return cls(kernel, cells, n_cells, units)
 
     @property
@@ -182,11 +191,12 @@ class ReferenceSystem:
         return grid[0], grid[1]
 
     def forces(self, displacements) -> np.ndarray:
-        """(n_bodies, 2) net Hertz force on every body at ``displacements`` (both in ``units``)."""
+        """(n_bodies, 2) net Hertz force on every body at ``displacements``, at rest (both in ``units``)."""
         x, y = self._cell_arrays(displacements)
         fx, fy = np.zeros(self.n_cells), np.zeros(self.n_cells)
         scratch = np.zeros((2, 3, self.kernel.hi))
-        forces(self.kernel, x, y, np.ones(self.n_cells), scratch[0], scratch[1], fx, fy)
+        still = np.zeros(self.n_cells)
+        forces(self.kernel, x, y, still, still, np.ones(self.n_cells), scratch[0], scratch[1], fx, fy)
         return np.column_stack([fx[self.cells], fy[self.cells]])
 
     def integrate(self, velocities, dt: float, settings: RunSettings, emit):

@@ -38,7 +38,9 @@ class KernelArrays(NamedTuple):
     ``inv_mass`` 1/M (0 for padding). Explicit pairs (i → j): ``pair_i``, ``pair_j``,
     ``pair_rest_x``, ``pair_rest_y``, ``pair_contact``, ``pair_stiffness``. Wall contacts:
     ``wall_cell``, inward normal ``wall_nx``, ``wall_ny``, rest gap ``wall_gap``,
-    ``wall_stiffness`` A_w = k_n,wall sqrt(R).
+    ``wall_stiffness`` A_w = k_n,wall sqrt(R). Tsuji damping (:mod:`hexdem.model.dissipation`)
+    η = α sqrt(m_eff A) of each lattice bond (3, hi), explicit pair and wall contact:
+    ``damping``, ``pair_damping``, ``wall_damping``; ``damped`` whether any is non-zero.
     """
 
     offsets: np.ndarray
@@ -60,6 +62,10 @@ class KernelArrays(NamedTuple):
     wall_ny: np.ndarray
     wall_gap: np.ndarray
     wall_stiffness: np.ndarray
+    damping: np.ndarray
+    pair_damping: np.ndarray
+    wall_damping: np.ndarray
+    damped: bool
 
 
 @_jit
@@ -76,6 +82,21 @@ def _hertz_bonds(xi, yi, xj, yj, rest_x, rest_y, contact, stiffness, fx, fy):
 
 
 @_jit
+def _damped_bonds(xi, yi, xj, yj, ui, wi, uj, wj, rest_x, rest_y, contact, stiffness, damping, fx, fy):
+    """As :func:`_hertz_bonds` plus Tsuji's damping η δ^{1/4} δ̇ (δ̇ > 0 while compressing)."""
+    for p in range(fx.shape[0]):
+        dx = rest_x[p] + xj[p] - xi[p]
+        dy = rest_y[p] + yj[p] - yi[p]
+        r = np.sqrt(dx * dx + dy * dy)
+        overlap = max(contact[p] - r, 0.0)
+        rate = -(dx * (uj[p] - ui[p]) + dy * (wj[p] - wi[p])) / r
+        root = np.sqrt(overlap)
+        f = (stiffness[p] * overlap * root + damping[p] * np.sqrt(root) * rate) / r
+        fx[p] = f * dx
+        fy[p] = f * dy
+
+
+@_jit
 def _net_bond_force(in0, in1, in2, out0, out1, out2, scale, net):
     """Net force on each cell, times ``scale``: its bonds as partner j (+) minus as origin i (−)."""
     for p in range(net.shape[0]):
@@ -83,7 +104,7 @@ def _net_bond_force(in0, in1, in2, out0, out1, out2, scale, net):
 
 
 @_jit
-def _pair_forces(k, x, y, scale, fx, fy):
+def _pair_forces(k, x, y, u, w, scale, fx, fy):
     for b in range(k.pair_i.shape[0]):
         i, j = k.pair_i[b], k.pair_j[b]
         dx = k.pair_rest_x[b] + x[j] - x[i]
@@ -91,7 +112,9 @@ def _pair_forces(k, x, y, scale, fx, fy):
         r = np.sqrt(dx * dx + dy * dy)
         overlap = k.pair_contact[b] - r
         if overlap > 0.0:
-            f = k.pair_stiffness[b] * overlap * np.sqrt(overlap) / r
+            rate = -(dx * (u[j] - u[i]) + dy * (w[j] - w[i])) / r
+            root = np.sqrt(overlap)
+            f = (k.pair_stiffness[b] * overlap * root + k.pair_damping[b] * np.sqrt(root) * rate) / r
             fx[i] -= f * dx * scale[i]
             fy[i] -= f * dy * scale[i]
             fx[j] += f * dx * scale[j]
@@ -99,38 +122,45 @@ def _pair_forces(k, x, y, scale, fx, fy):
 
 
 @_jit
-def _wall_forces(k, x, y, scale, fx, fy):
+def _wall_forces(k, x, y, u, v, scale, fx, fy):
     for w in range(k.wall_cell.shape[0]):
         c = k.wall_cell[w]
         depth = -(k.wall_gap[w] + x[c] * k.wall_nx[w] + y[c] * k.wall_ny[w])
         if depth > 0.0:
-            f = k.wall_stiffness[w] * depth * np.sqrt(depth) * scale[c]
+            rate = -(u[c] * k.wall_nx[w] + v[c] * k.wall_ny[w])
+            root = np.sqrt(depth)
+            f = (k.wall_stiffness[w] * depth * root + k.wall_damping[w] * np.sqrt(root) * rate) * scale[c]
             fx[c] += f * k.wall_nx[w]
             fy[c] += f * k.wall_ny[w]
 
 
 @_jit
-def forces(k, x, y, scale, bond_fx, bond_fy, fx, fy):
-    """Net force on every cell at displacements (x, y), times ``scale`` (1: forces; 1/M:
-    accelerations), into (fx, fy); ``bond_fx``, ``bond_fy`` are (3, hi) scratch."""
+def forces(k, x, y, u, w, scale, bond_fx, bond_fy, fx, fy):
+    """Net force on every cell at displacements (x, y) and velocities (u, w), times ``scale``
+    (1: forces; 1/M: accelerations), into (fx, fy); ``bond_fx``, ``bond_fy`` are (3, hi) scratch."""
     lo, hi = k.lo, k.hi
     for d in range(3):
         o = k.offsets[d]
-        _hertz_bonds(x[:hi], y[:hi], x[o:o + hi], y[o:o + hi], k.rest_x[d], k.rest_y[d],
-                     k.contact[d], k.stiffness[d], bond_fx[d], bond_fy[d])
+        if k.damped:
+            _damped_bonds(x[:hi], y[:hi], x[o:o + hi], y[o:o + hi], u[:hi], w[:hi], u[o:o + hi], w[o:o + hi],
+                          k.rest_x[d], k.rest_y[d], k.contact[d], k.stiffness[d], k.damping[d],
+                          bond_fx[d], bond_fy[d])
+        else:
+            _hertz_bonds(x[:hi], y[:hi], x[o:o + hi], y[o:o + hi], k.rest_x[d], k.rest_y[d],
+                         k.contact[d], k.stiffness[d], bond_fx[d], bond_fy[d])
     o0, o1, o2 = k.offsets[0], k.offsets[1], k.offsets[2]
     for bond, net in ((bond_fx, fx), (bond_fy, fy)):
         net[:lo] = 0.0
         net[hi:] = 0.0
         _net_bond_force(bond[0, lo - o0:hi - o0], bond[1, lo - o1:hi - o1], bond[2, lo - o2:hi - o2],
                         bond[0, lo:hi], bond[1, lo:hi], bond[2, lo:hi], scale[lo:hi], net[lo:hi])
-    _pair_forces(k, x, y, scale, fx, fy)
-    _wall_forces(k, x, y, scale, fx, fy)
+    _pair_forces(k, x, y, u, w, scale, fx, fy)
+    _wall_forces(k, x, y, u, w, scale, fx, fy)
 
 
 @_jit
 def _shifted(out, q, cv, v, ca, a):
-    """out = q + cv·v + ca·a: the position at which an RK4 stage evaluates the force."""
+    """out = q + cv·v + ca·a: a position (or velocity) at which an RK4 stage evaluates the force."""
     for c in range(out.shape[0]):
         out[c] = q[c] + cv * v[c] + ca * a[c]
 
@@ -145,22 +175,36 @@ def _advance(q, v, h, a1, a2, a3, a4):
 
 @_jit
 def integrate(k, x, y, u, w, h, n_steps):
-    """Advance displacements (x, y) and velocities (u, w) in place by ``n_steps`` RK4 steps of ``h``."""
+    """Advance displacements (x, y) and velocities (u, w) in place by ``n_steps`` RK4 steps of ``h``.
+
+    Stage velocities (v + h/2 a₁, v + h/2 a₂, v + h a₃ of classical RK4) are formed only for a
+    damped model; without damping the forces depend on positions alone.
+    """
     n = x.shape[0]
     a = np.zeros((8, n))
     tx, ty = np.zeros(n), np.zeros(n)
+    tu, tw = (np.zeros(n), np.zeros(n)) if k.damped else (u, w)
     bond_fx, bond_fy = np.zeros((3, k.hi)), np.zeros((3, k.hi))
     half, sq = 0.5 * h, h * h
     for _ in range(n_steps):
-        forces(k, x, y, k.inv_mass, bond_fx, bond_fy, a[0], a[1])
+        forces(k, x, y, u, w, k.inv_mass, bond_fx, bond_fy, a[0], a[1])
         _shifted(tx, x, half, u, 0.0, a[0])
         _shifted(ty, y, half, w, 0.0, a[1])
-        forces(k, tx, ty, k.inv_mass, bond_fx, bond_fy, a[2], a[3])
+        if k.damped:
+            _shifted(tu, u, half, a[0], 0.0, a[0])
+            _shifted(tw, w, half, a[1], 0.0, a[1])
+        forces(k, tx, ty, tu, tw, k.inv_mass, bond_fx, bond_fy, a[2], a[3])
         _shifted(tx, x, half, u, 0.25 * sq, a[0])
         _shifted(ty, y, half, w, 0.25 * sq, a[1])
-        forces(k, tx, ty, k.inv_mass, bond_fx, bond_fy, a[4], a[5])
+        if k.damped:
+            _shifted(tu, u, half, a[2], 0.0, a[2])
+            _shifted(tw, w, half, a[3], 0.0, a[3])
+        forces(k, tx, ty, tu, tw, k.inv_mass, bond_fx, bond_fy, a[4], a[5])
         _shifted(tx, x, h, u, 0.5 * sq, a[2])
         _shifted(ty, y, h, w, 0.5 * sq, a[3])
-        forces(k, tx, ty, k.inv_mass, bond_fx, bond_fy, a[6], a[7])
+        if k.damped:
+            _shifted(tu, u, h, a[4], 0.0, a[4])
+            _shifted(tw, w, h, a[5], 0.0, a[5])
+        forces(k, tx, ty, tu, tw, k.inv_mass, bond_fx, bond_fy, a[6], a[7])
         _advance(x, u, h, a[0], a[2], a[4], a[6])
         _advance(y, w, h, a[1], a[3], a[5], a[7])
