@@ -4,8 +4,9 @@ LAMMPS reports no potential energy for granular pairs, so hexdem computes it its
 positions: a contact of overlap δ stores U = (2/5) k_n sqrt(R_eff) δ^{5/2} (the integral of
 F = k_n sqrt(R_eff) δ^{3/2}; with equal spheres this is the paper's V = (2/5) A δ^{5/2}).
 Every pair closer than the sum of radii counts, as in LAMMPS, not only lattice bonds.
-Under uniform gravity g (the tilted set-up of Sec. VI-A) the conserved total also holds the
-potential −Σ m g·u of the displacements u from t = 0.
+Under constant forces F (gravity m g in the tilted set-up of Sec. VI-A; the force holding a
+precompressed packing's struck bead) the conserved total also holds their potential −Σ F·u
+of the displacements u from t = 0.
 """
 
 from __future__ import annotations
@@ -64,7 +65,8 @@ def total_energy_j(positions_m, velocities_m_s, model: GranularModel) -> float:
 class EnergyAudit:
     """Total energy [J] of successive states of one run, for the drift of a conservative model.
 
-    Equal to :func:`total_energy_j` (minus the work of ``gravity_m_s2``, if given), but the
+    Equal to :func:`total_energy_j` minus the work of the constant forces (``gravity_m_s2``, if
+    given, and the model's held force on a precompressed packing's struck bead), but the
     candidate contact pairs are kept between calls and searched again only after some body
     has moved half of :data:`PAIR_SKIN_D` bead diameters, so a large packing costs a few
     vector operations per state instead of a tree search.
@@ -75,7 +77,8 @@ class EnergyAudit:
         self.start_m = model.initial_positions_m()
         self.radii_m = model.diameters_m / 2
         self.skin_m = PAIR_SKIN_D * model.lattice.diameter_m
-        self.gravity = None if gravity_m_s2 is None else np.asarray(gravity_m_s2, float)
+        gravity = np.zeros(2) if gravity_m_s2 is None else np.asarray(gravity_m_s2, float)
+        self.external_n = model.external_forces_n() + model.masses_kg[:, None] * gravity
         self._listed_at, self._pairs = None, None
 
     def _candidate_pairs(self, positions_m):
@@ -90,9 +93,7 @@ class EnergyAudit:
         energy = (kinetic_energy_j(velocities_m_s, self.model)
                   + _pair_energy_j(positions_m, i, j, self.radii_m, self.model.pair_stiffness_pa)
                   + wall_energy_j(positions_m, self.model))
-        if self.gravity is not None:
-            energy -= float(np.einsum("bk,b,k->", positions_m - self.start_m, self.model.masses_kg, self.gravity))
-        return energy
+        return energy - float(np.sum((positions_m - self.start_m) * self.external_n))
 
 
 def energy_error(energies_j, dissipative: bool = False) -> float:

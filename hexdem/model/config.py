@@ -21,7 +21,8 @@ from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time
 from hexdem.model.lattice import Lattice, half_hexagon, hexagon
-from hexdem.model.materials import PAPER_DIAMETER_M, hertz_coefficient, material, sphere_mass
+from hexdem.model.materials import PAPER_DIAMETER_M, hertz_coefficient, hertz_stiffness, material, sphere_mass
+from hexdem.model.precompression import hole_force, precompressed_lattice, spring_stiffness
 from hexdem.model.units import SI, UnitSystem, nondimensional
 
 SHAPES = ("hexagon", "half-hexagon")
@@ -52,6 +53,8 @@ class RunConfig:
     (the deck's ``in.hexdem`` always writes it when rerun by hand).
     ``restitution``: bead–bead coefficient of restitution (1.0: the paper's ideal model);
     ``wall_restitution``: bead–wall (None: the same as ``restitution``).
+    ``precompression_n``: static force per bead–bead contact [N] (0: uncompressed; see
+    :mod:`hexdem.model.precompression`).
     ``dt = None`` takes the Hertz contact time at V0 / 700; ``duration = None`` runs until
     the leading wave has crossed the packing: one two-bead contact time at V0 per layer
     between the struck bead and the far wall (the pulse resides less than that on each
@@ -77,6 +80,7 @@ class RunConfig:
     dump: bool = False
     restitution: float = 1.0
     wall_restitution: float | None = None
+    precompression_n: float = 0.0
 
     def __post_init__(self):
         for name, allowed in (("shape", SHAPES), ("impact", IMPACTS), ("units", UNITS), ("engine", ENGINES)):
@@ -84,6 +88,8 @@ class RunConfig:
                 raise HexdemError(f"unknown {name} {getattr(self, name)!r}; use one of: {', '.join(allowed)}")
         for name in ("dump_every", "ranks"):
             positive_int(name, getattr(self, name))
+        if not (is_number(self.precompression_n) and self.precompression_n >= 0):
+            raise HexdemError(f"precompression_n must be a force >= 0 N, got {self.precompression_n!r}")
         if not isinstance(self.dump, bool):
             raise HexdemError(f"dump must be true or false, got {self.dump!r}")
         for name in ("dt", "duration"):
@@ -173,15 +179,25 @@ class RunConfig:
         wall = None if self.wall_material == "none" else material(self.wall_material)
         impact = Impact(self.v0 * self.unit_system.velocity_m_s, self.strike_angle_deg, self.impact == "striker")
         wall_restitution = self.restitution if self.wall_restitution is None else self.wall_restitution
-        return GranularModel(self.lattice(), impact, material(self.bead_material), wall, self.restitution,
-                             wall_restitution)
+        bead, lattice, held = material(self.bead_material), self.lattice(), (0.0, 0.0)
+        if self.precompression_n > 0:
+            if wall is None:
+                raise HexdemError("a precompressed packing needs walls to hold it (wall_material = \"none\")")
+            coefficient = float(hertz_coefficient(self.diameter_m, bead))
+            lattice = precompressed_lattice(lattice, self.precompression_n, coefficient, hertz_stiffness(bead, wall))
+            held = tuple(float(f) for f in hole_force(lattice, self.precompression_n))
+        return GranularModel(lattice, impact, bead, wall, self.restitution, wall_restitution, held)
 
     def contact_time_s(self) -> float:
-        """Two-bead Hertz contact time at V0 [s], the natural time scale of the impact."""
+        """The natural time scale of the impact [s]: the two-bead Hertz contact time at V0, or, if
+        shorter, half the period of two beads on the linearized precompressed contact, π sqrt(m/2k)."""
         bead = material(self.bead_material)
         mass = float(sphere_mass(self.diameter_m, bead))
-        return float(contact_time(mass / 2, hertz_coefficient(self.diameter_m, bead),
-                                  self.v0 * self.unit_system.velocity_m_s))
+        coefficient = float(hertz_coefficient(self.diameter_m, bead))
+        hertz = float(contact_time(mass / 2, coefficient, self.v0 * self.unit_system.velocity_m_s))
+        if self.precompression_n <= 0:
+            return hertz
+        return min(hertz, math.pi * math.sqrt(mass / 2 / spring_stiffness(self.precompression_n, coefficient)))
 
     def settings(self, model: GranularModel | None = None) -> RunSettings:
         """Time step, step count and dump interval in SI, with the defaults resolved."""

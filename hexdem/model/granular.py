@@ -51,7 +51,9 @@ class GranularModel:
     ``wall`` is the wall-lining material, or None for a packing without walls;
     ``restitution`` and ``wall_restitution`` the coefficients of restitution of bead–bead and
     bead–wall contacts (1: the paper's conservative model; below 1: Tsuji damping, see
-    :mod:`hexdem.model.dissipation`).
+    :mod:`hexdem.model.dissipation`); ``held_force_n`` a constant force (fx, fy) [N] on the
+    struck bead, the force its missing wall would exert on a precompressed packing
+    (:mod:`hexdem.model.precompression`).
     """
 
     lattice: Lattice
@@ -60,6 +62,7 @@ class GranularModel:
     wall: Material | None = DELRIN
     restitution: float = 1.0
     wall_restitution: float = 1.0
+    held_force_n: tuple[float, float] = (0.0, 0.0)
 
     def __post_init__(self):
         check_restitution("restitution", self.restitution)
@@ -68,6 +71,12 @@ class GranularModel:
     @property
     def dissipative(self) -> bool:
         return self.restitution < 1.0 or (bool(self.walls) and self.wall_restitution < 1.0)
+
+    def external_forces_n(self) -> np.ndarray:
+        """(n_bodies, 2) constant forces [N] on the bodies: the held force on the struck bead."""
+        forces = np.zeros((self.n_bodies, 2))
+        forces[self.lattice.struck] = self.held_force_n
+        return forces
 
     @property
     def pair_damping(self) -> float:

@@ -126,6 +126,16 @@ def gravity_block(gravity_m_s2, units: UnitSystem) -> str:
             f"{_fmt(g[0] / magnitude)} {_fmt(g[1] / magnitude)} 0.0\n")
 
 
+def held_force_block(model: GranularModel, units: UnitSystem) -> str:
+    """``fix addforce`` holding the struck bead of a precompressed packing with the force of its
+    missing wall (:mod:`hexdem.model.precompression`), if any."""
+    force = np.asarray(model.held_force_n) / units.force_n
+    if not force.any():
+        return ""
+    return (f"group           hole id {model.lattice.struck + 1}\n"
+            f"fix             hole hole addforce {_fmt(force[0])} {_fmt(force[1])} 0.0\n")
+
+
 def render_input(model: GranularModel, settings: RunSettings, gravity_m_s2=None) -> str:
     """The text of ``in.hexdem`` for ``model`` run with ``settings``, under uniform gravity
     ``gravity_m_s2`` (gx, gy) [m/s²] if given (the tilted set-up of Sec. VI-A)."""
@@ -138,7 +148,8 @@ def render_input(model: GranularModel, settings: RunSettings, gravity_m_s2=None)
     return template("impact.in").substitute(
         title=f"{model.lattice.shape}, V0 = {model.impact.speed_m_s} m/s at {model.impact.angle_deg} deg"
               + (" by a striker" if model.has_striker else " on the struck bead"),
-        units_note=note, granular=granular_block(model, units), walls=walls_block(model, units), body_force=gravity_block(gravity_m_s2, units), impactor_id=impactor,
+        units_note=note, granular=granular_block(model, units), walls=walls_block(model, units),
+        body_force=gravity_block(gravity_m_s2, units) + held_force_block(model, units), impactor_id=impactor,
         vx=_fmt(velocity[0]), vy=_fmt(velocity[1]), dt=_fmt(settings.dt_s / units.time_s),
         thermo_every=max(1, settings.n_steps // 20), dump_every=settings.dump_every,
         nsteps=settings.n_steps)

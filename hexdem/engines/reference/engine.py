@@ -147,6 +147,13 @@ def _wall_contacts(model: GranularModel, cells: np.ndarray, units: UnitSystem):
     return cells[beads], normals[:, 0].copy(), normals[:, 1].copy(), gaps / units.length_m, stiffness, damping
 
 
+def _cell_forces(forces, cells: np.ndarray, n_cells: int):
+    """(fx, fy) over all cells of per-body ``forces`` (n_bodies, 2)."""
+    grid = np.zeros((2, n_cells))
+    grid[:, cells] = np.asarray(forces, float).T
+    return grid[0], grid[1]
+
+
 @dataclass(frozen=True)
 class ReferenceSystem:
     """A :class:`GranularModel` in ``units``, laid out for :mod:`hexdem.engines.reference.kernel`.
@@ -173,7 +180,8 @@ class ReferenceSystem:
         *walls, wall_damping = _wall_contacts(model, cells, units)
         kernel = KernelArrays(np.array([grid.offset(step) for step in BOND_STEPS], dtype=np.int64),
                               grid.lo, grid.hi, rest_x, rest_y, contact, stiffness, inv_mass, *pairs, *walls,
-                              damping, pair_damping, wall_damping, model.dissipative)
+                              damping, pair_damping, wall_damping, model.dissipative,
+                              *_cell_forces(model.external_forces_n() / units.force_n, cells, n_cells))
         return cls(kernel, cells, n_cells, units)
 
     @property
@@ -186,9 +194,7 @@ class ReferenceSystem:
 
     def _cell_arrays(self, values):
         """(n_bodies, 2) body values → x and y arrays over all cells."""
-        grid = np.zeros((2, self.n_cells))
-        grid[:, self.cells] = np.asarray(values, float).T
-        return grid[0], grid[1]
+        return _cell_forces(values, self.cells, self.n_cells)
 
     def forces(self, displacements) -> np.ndarray:
         """(n_bodies, 2) net Hertz force on every body at ``displacements``, at rest (both in ``units``)."""

@@ -40,7 +40,8 @@ class KernelArrays(NamedTuple):
     ``wall_cell``, inward normal ``wall_nx``, ``wall_ny``, rest gap ``wall_gap``,
     ``wall_stiffness`` A_w = k_n,wall sqrt(R). Tsuji damping (:mod:`hexdem.model.dissipation`)
     η = α sqrt(m_eff A) of each lattice bond (3, hi), explicit pair and wall contact:
-    ``damping``, ``pair_damping``, ``wall_damping``; ``damped`` whether any is non-zero.
+    ``damping``, ``pair_damping``, ``wall_damping``; ``damped`` whether any is non-zero. Per cell: ``external_x``, ``external_y`` constant
+    forces (the held force of a precompressed packing's struck bead).
     """
 
     offsets: np.ndarray
@@ -66,6 +67,8 @@ class KernelArrays(NamedTuple):
     pair_damping: np.ndarray
     wall_damping: np.ndarray
     damped: bool
+    external_x: np.ndarray
+    external_y: np.ndarray
 
 
 @_jit
@@ -156,6 +159,9 @@ def forces(k, x, y, u, w, scale, bond_fx, bond_fy, fx, fy):
                         bond[0, lo:hi], bond[1, lo:hi], bond[2, lo:hi], scale[lo:hi], net[lo:hi])
     _pair_forces(k, x, y, u, w, scale, fx, fy)
     _wall_forces(k, x, y, u, w, scale, fx, fy)
+    for c in range(fx.shape[0]):
+        fx[c] += k.external_x[c] * scale[c]
+        fy[c] += k.external_y[c] * scale[c]
 
 
 @_jit
