@@ -52,7 +52,9 @@ class TrackedPulses:
     ``energy_drift`` the audit's error over ``energy_times`` (see
     :func:`~hexdem.analysis.energy.energy_error`); ``energy_lost`` 1 − E_end/E0; ``n_samples``;
     ``trace_times`` (S,) and ``trace_speeds`` (S, len(trace_beads)); ``field_times`` (F,) and
-    ``field_speeds`` (F, N) at the requested snapshot samples.
+    ``field_speeds`` (F, N) at the requested snapshot samples; ``sensor_times`` (K,) and
+    ``sensor_states`` (K, n_sensors, 4): vx, vy, ax, ay of the model's sensor beads every
+    ``settings.sensor_every`` steps.
     """
 
     peak_speed: np.ndarray
@@ -67,6 +69,8 @@ class TrackedPulses:
     trace_speeds: np.ndarray
     field_times: np.ndarray
     field_speeds: np.ndarray
+    sensor_times: np.ndarray
+    sensor_states: np.ndarray
 
 
 class PulseTracker:
@@ -97,6 +101,10 @@ class PulseTracker:
         self.owned = np.zeros(n, dtype=np.bool_)
         self.trace_beads = np.asarray(trace_beads, dtype=np.int64)
         self.traces = np.full((total, len(self.trace_beads)), np.nan)
+        self.sensor_beads = np.asarray(model.sensor_beads, dtype=np.int64)
+        self.sensor_every = settings.sensor_every
+        n_sensed = settings.n_steps // settings.sensor_every + 1 if settings.sensor_every else 0
+        self.sensors = np.full((n_sensed, len(self.sensor_beads), 4), np.nan)
         self.field_samples = np.asarray(sorted(field_samples), dtype=np.int64)
         self.fields = np.full((len(self.field_samples), n), np.nan)
         self.energy_every = max(1, (total - 1) // ENERGY_SAMPLES)
@@ -128,7 +136,7 @@ class PulseTracker:
 
         for array in self._state():
             self.comm.Reduce(self._owned(array), array if self.root else None, op=MPI.SUM, root=0)
-        for array in (self.traces, self.fields):
+        for array in (self.traces, self.fields, self.sensors):
             self.comm.Reduce(np.nan_to_num(array, nan=0.0), array if self.root else None, op=MPI.SUM, root=0)
 
     def _gather(self, sample: Sample, ids, values):
@@ -166,11 +174,21 @@ class PulseTracker:
             lookup = np.full(self.n_beads, -1, dtype=np.int64)
             lookup[index] = np.arange(len(index))
             self.traces[s, mine] = speeds[lookup[self.trace_beads[mine]]]
+        if self.sensor_every and sample.step % self.sensor_every == 0 and len(self.sensor_beads):
+            self._sense(sample)
         if s in self.field_samples:
             self.fields[np.searchsorted(self.field_samples, s), index] = speeds
         if s % self.energy_every == 0 or s == self.n_samples_expected - 1:
             self._audit(sample)
         self.count = s + 1
+
+    def _sense(self, sample: Sample) -> None:
+        """Velocity and acceleration of the sensor beads this rank owns, at a sensor sample."""
+        row = {int(b): k for k, b in enumerate(sample.ids - 1)}
+        for k, bead in enumerate(self.sensor_beads.tolist()):
+            if bead in row:
+                j = row[bead]
+                self.sensors[sample.step // self.sensor_every, k] = (*sample.velocities[j], *sample.accelerations[j])
 
     def _audit(self, sample: Sample) -> None:
         state = self._gather(sample, sample.ids, np.hstack([sample.positions, sample.velocities]))
@@ -203,4 +221,6 @@ class PulseTracker:
                              energy_lost=1.0 - self.energies[-1] / self.energies[0], energy_times=np.array(self.energy_times),
                              n_samples=self.count, trace_beads=self.trace_beads,
                              trace_times=np.arange(self.count) * interval, trace_speeds=self.traces[:self.count],
-                             field_times=self.field_samples * interval, field_speeds=self.fields)
+                             field_times=self.field_samples * interval, field_speeds=self.fields,
+                             sensor_times=np.arange(len(self.sensors)) * self.sensor_every * self.settings.dt_s
+                             / self.settings.units.time_s, sensor_states=self.sensors)

@@ -18,6 +18,7 @@ COMMANDS = {
     "run": ("hexdem.cli.run", "simulate one impact (default: the paper's 11-per-edge experiment)"),
     "analyse": ("hexdem.cli.analyse", "result files from the dump of a deck run by hand (lmp -in in.hexdem)"),
     "compare": ("hexdem.cli.compare", "run one configuration through LAMMPS and the reference integrator"),
+    "signals": ("hexdem.cli.signals", "measured accelerometer signals beside a run's sensor particles"),
     "tca": ("hexdem.cli.tca", "ternary collision approximation: omega, c, pulse speeds (Sec. IV)"),
     "scaling": ("hexdem.cli.scaling", "velocity-decay scaling laws over a V0 sweep (Sec. V)"),
     "ensemble": ("hexdem.cli.ensemble", "weakly disordered ensembles with striker impacts (Sec. VI)"),

@@ -19,7 +19,9 @@ class Sample:
 
     ``index`` sample number (step // dump_every); ``step`` the time step; ``time`` the
     simulated time; ``ids`` (n,) body ids, 1-based (beads 1..N as in the data file, then
-    the striker); ``positions`` and ``velocities`` (n, 2) full-step values at ``step``.
+    the striker); ``positions`` and ``velocities`` (n, 2) full-step values at ``step``;
+    ``accelerations`` (n, 2), total force / mass, only at the sensor samples (every
+    ``settings.sensor_every`` steps), else None.
     """
 
     index: int
@@ -28,4 +30,5 @@ class Sample:
     ids: np.ndarray
     positions: np.ndarray
     velocities: np.ndarray
+    accelerations: np.ndarray | None = None
 

@@ -24,6 +24,7 @@ from hexdem.analysis.impact import PEAK_COLUMNS, ImpactAnalysis
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.common.machine import free_disk_bytes
 from hexdem.errors import HexdemError
+from hexdem.experiments.sensors import write_sensor_files
 from hexdem.experiments.tracked_run import ImpactJob, track_impact
 from hexdem.model.config import RunConfig
 
@@ -125,6 +126,8 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
                       title=f"Arrival time, {analysis.model.lattice.shape}, V0 = {config.v0:g}")
     by_line = {name: (np.arange(len(beads)), r.peak_speed[beads]) for name, beads in r.lines.items()}
     plots.peak_decay(by_line, out / "peak_decay.png", r.units, config.v0)
+    if config.sensors:
+        write_sensor_files(analysis, list(config.sensor_beads(analysis.model.lattice)), out)
     shape = measure_front_shape(analysis)
     write_csv(out / "front_shape.csv", FRONT_SHAPE_COLUMNS, shape.rows())
     plots.front_shape_figure({analysis.model.lattice.shape: shape}, out / "front_shape.png")

@@ -20,7 +20,7 @@ from hexdem.common.machine import available_memory_bytes
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time
-from hexdem.model.lattice import Lattice, half_hexagon, hexagon
+from hexdem.model.lattice import LINE_STEPS, Lattice, half_hexagon, hexagon
 from hexdem.model.materials import PAPER_DIAMETER_M, hertz_coefficient, hertz_stiffness, material, sphere_mass
 from hexdem.model.precompression import hole_force, precompressed_lattice, spring_stiffness
 from hexdem.model.units import SI, UnitSystem, nondimensional
@@ -55,6 +55,9 @@ class RunConfig:
     ``wall_restitution``: bead–wall (None: the same as ``restitution``).
     ``precompression_n``: static force per bead–bead contact [N] (0: uncompressed; see
     :mod:`hexdem.model.precompression`).
+    ``sensors``: sensor particles, each ``"line:n"`` (e.g. ``"0:1"``, ``"+30:6"``) or a bead id;
+    sampled at ``sensor_rate_hz`` (the paper's 500 kS/s); ``sensor_mass_factor``: a sensor
+    bead's mass relative to a plain bead's.
     ``dt = None`` takes the Hertz contact time at V0 / 700; ``duration = None`` runs until
     the leading wave has crossed the packing: one two-bead contact time at V0 per layer
     between the struck bead and the far wall (the pulse resides less than that on each
@@ -81,6 +84,9 @@ class RunConfig:
     restitution: float = 1.0
     wall_restitution: float | None = None
     precompression_n: float = 0.0
+    sensors: tuple = ()
+    sensor_rate_hz: float = 500e3
+    sensor_mass_factor: float = 1.0
 
     def __post_init__(self):
         for name, allowed in (("shape", SHAPES), ("impact", IMPACTS), ("units", UNITS), ("engine", ENGINES)):
@@ -88,6 +94,9 @@ class RunConfig:
                 raise HexdemError(f"unknown {name} {getattr(self, name)!r}; use one of: {', '.join(allowed)}")
         for name in ("dump_every", "ranks"):
             positive_int(name, getattr(self, name))
+        object.__setattr__(self, "sensors", tuple(self.sensors))
+        if not (is_number(self.sensor_rate_hz) and self.sensor_rate_hz > 0):
+            raise HexdemError(f"sensor_rate_hz must be > 0, got {self.sensor_rate_hz!r}")
         if not (is_number(self.precompression_n) and self.precompression_n >= 0):
             raise HexdemError(f"precompression_n must be a force >= 0 N, got {self.precompression_n!r}")
         if not isinstance(self.dump, bool):
@@ -186,7 +195,29 @@ class RunConfig:
             coefficient = float(hertz_coefficient(self.diameter_m, bead))
             lattice = precompressed_lattice(lattice, self.precompression_n, coefficient, hertz_stiffness(bead, wall))
             held = tuple(float(f) for f in hole_force(lattice, self.precompression_n))
-        return GranularModel(lattice, impact, bead, wall, self.restitution, wall_restitution, held)
+        return GranularModel(lattice, impact, bead, wall, self.restitution, wall_restitution, held,
+                             tuple(self.sensor_beads(lattice).values()), self.sensor_mass_factor)
+
+    def sensor_beads(self, lattice: Lattice) -> dict[str, int]:
+        """{label: bead index} of the ``sensors``, in the order given ("line:n" or a bead id)."""
+        beads = {}
+        for sensor in self.sensors:
+            if isinstance(sensor, int) and not isinstance(sensor, bool):
+                if not 1 <= sensor <= len(lattice):
+                    raise HexdemError(f"sensor bead id {sensor} is not in the packing (ids 1 to {len(lattice)})")
+                beads[str(sensor)] = sensor - 1
+                continue
+            name, _, n = str(sensor).partition(":")
+            if name not in LINE_STEPS or not n.isdigit():
+                raise HexdemError(f"sensor {sensor!r} is neither a bead id nor 'line:n' with line one of "
+                                  f"{', '.join(LINE_STEPS)}")
+            line = lattice.line(name)
+            if int(n) >= len(line):
+                raise HexdemError(f"sensor {sensor!r}: line {name} has beads 0 to {len(line) - 1}")
+            beads[str(sensor)] = int(line[int(n)])
+        if len(set(beads.values())) != len(self.sensors):
+            raise HexdemError(f"sensors {list(self.sensors)} name the same bead twice")
+        return beads
 
     def contact_time_s(self) -> float:
         """The natural time scale of the impact [s]: the two-bead Hertz contact time at V0, or, if
@@ -200,7 +231,9 @@ class RunConfig:
         return min(hertz, math.pi * math.sqrt(mass / 2 / spring_stiffness(self.precompression_n, coefficient)))
 
     def settings(self, model: GranularModel | None = None) -> RunSettings:
-        """Time step, step count and dump interval in SI, with the defaults resolved."""
+        """Time step, step count and dump interval in SI, with the defaults resolved. With sensors,
+        the time step is shortened so that a sensor sample is a whole number of steps, and the
+        samples of the analysis fall on every sensor sample."""
         model = model or self.model()
         scale = self.unit_system.time_s
         dt_s = self.dt * scale if self.dt is not None else self.contact_time_s() / STEPS_PER_CONTACT
@@ -211,5 +244,11 @@ class RunConfig:
             reach = (lattice.positions_m - lattice.positions_m[lattice.struck]) @ model.impact.direction
             layers = math.ceil(reach.max() / (math.sqrt(3) / 2 * lattice.diameter_m))
             duration_s = layers * self.contact_time_s()
+        every, sensor_every = self.dump_every, 0
+        if self.sensors:
+            sensor_every = math.ceil(1.0 / self.sensor_rate_hz / dt_s)
+            dt_s = 1.0 / self.sensor_rate_hz / sensor_every
+            every = max(k for k in range(1, min(every, sensor_every) + 1) if sensor_every % k == 0)
         n_steps = max(1, round(duration_s / dt_s))
-        return RunSettings(dt_s=dt_s, n_steps=n_steps, dump_every=self.dump_every, units=self.unit_system)
+        return RunSettings(dt_s=dt_s, n_steps=n_steps, dump_every=every, units=self.unit_system,
+                           sensor_every=sensor_every)

@@ -53,7 +53,8 @@ class GranularModel:
     bead–wall contacts (1: the paper's conservative model; below 1: Tsuji damping, see
     :mod:`hexdem.model.dissipation`); ``held_force_n`` a constant force (fx, fy) [N] on the
     struck bead, the force its missing wall would exert on a precompressed packing
-    (:mod:`hexdem.model.precompression`).
+    (:mod:`hexdem.model.precompression`); ``sensor_beads`` bead indices of the sensor particles,
+    whose mass is ``sensor_mass_factor`` times a plain bead's (the accelerometer inside).
     """
 
     lattice: Lattice
@@ -63,10 +64,14 @@ class GranularModel:
     restitution: float = 1.0
     wall_restitution: float = 1.0
     held_force_n: tuple[float, float] = (0.0, 0.0)
+    sensor_beads: tuple[int, ...] = ()
+    sensor_mass_factor: float = 1.0
 
     def __post_init__(self):
         check_restitution("restitution", self.restitution)
         check_restitution("wall_restitution", self.wall_restitution)
+        if not (is_number(self.sensor_mass_factor) and self.sensor_mass_factor > 0):
+            raise HexdemError(f"sensor_mass_factor must be > 0, got {self.sensor_mass_factor!r}")
 
     @property
     def dissipative(self) -> bool:
@@ -104,7 +109,15 @@ class GranularModel:
 
     @property
     def masses_kg(self) -> np.ndarray:
-        return sphere_mass(self.diameters_m, self.bead)
+        """(n_bodies,) masses [kg]: 3D spheres of the bead material, sensor beads scaled."""
+        return sphere_mass(self.diameters_m, self.bead) * self.mass_factors
+
+    @property
+    def mass_factors(self) -> np.ndarray:
+        """(n_bodies,) mass of each body relative to a plain sphere of its size."""
+        factors = np.ones(self.n_bodies)
+        factors[list(self.sensor_beads)] = self.sensor_mass_factor
+        return factors
 
     @property
     def pair_stiffness_pa(self) -> float:
@@ -141,12 +154,15 @@ class GranularModel:
 @dataclass(frozen=True)
 class RunSettings:
     """Time integration of one run: ``dt_s`` step [s], ``n_steps``, a sample every ``dump_every``
-    steps; ``units`` is the system the engine works in and the results are reported in."""
+    steps; ``units`` is the system the engine works in and the results are reported in;
+    ``sensor_every`` steps between two samples of the sensor particles (0: no sensors), a
+    multiple of ``dump_every``."""
 
     dt_s: float
     n_steps: int
     dump_every: int
     units: UnitSystem = SI
+    sensor_every: int = 0
 
     @property
     def duration_s(self) -> float:

@@ -58,7 +58,7 @@ def data_file(model: GranularModel, units: UnitSystem) -> str:
     """The text of ``data.hexdem``: every body of ``model`` at its initial position."""
     pos = model.initial_positions_m() / units.length_m
     diam = model.diameters_m / units.length_m
-    density = model.bead.density_kg_m3 / units.density_kg_m3
+    densities = model.bead.density_kg_m3 * model.mass_factors / units.density_kg_m3
     margin = 2.0 * diam.max()
     lo, hi = pos.min(axis=0) - margin, pos.max(axis=0) + margin
     types = np.full(model.n_bodies, BEAD_TYPE)
@@ -68,8 +68,8 @@ def data_file(model: GranularModel, units: UnitSystem) -> str:
              f"{model.n_bodies} atoms", "2 atom types", "",
              f"{_fmt(lo[0])} {_fmt(hi[0])} xlo xhi", f"{_fmt(lo[1])} {_fmt(hi[1])} ylo yhi",
              f"{_fmt(-diam.max())} {_fmt(diam.max())} zlo zhi", "", "Atoms # sphere", ""]
-    lines += [f"{i + 1} {t} {_fmt(d)} {_fmt(density)} {_fmt(x)} {_fmt(y)} 0.0"
-              for i, (t, d, (x, y)) in enumerate(zip(types, diam, pos))]
+    lines += [f"{i + 1} {t} {_fmt(d)} {_fmt(rho)} {_fmt(x)} {_fmt(y)} 0.0"
+              for i, (t, d, rho, (x, y)) in enumerate(zip(types, diam, densities, pos))]
     return "\n".join(lines) + "\n"
 
 

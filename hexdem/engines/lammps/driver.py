@@ -65,6 +65,7 @@ class _Stream:
     def __init__(self, lmp, deck: Deck, on_sample, show_progress: bool):
         self.lmp, self.on_sample = lmp, on_sample
         self.every, self.dt = deck.settings.dump_every, float(lmp.extract_global("dt"))
+        self.sensor_every = deck.settings.sensor_every
         self.bar = progress_bar(deck.settings.n_steps, "LAMMPS", unit="step") if show_progress else None
         self.error: BaseException | None = None
 
@@ -78,7 +79,8 @@ class _Stream:
 
     def initial(self) -> None:
         ids, positions, velocities = self.local_state()
-        self.on_sample(Sample(0, 0, 0.0, ids, positions, velocities))
+        accelerations = np.zeros_like(velocities) if self.sensor_every else None  # no force computed yet
+        self.on_sample(Sample(0, 0, 0.0, ids, positions, velocities, accelerations))
 
     def __call__(self, caller, step, nlocal, tag, x, fexternal) -> None:
         if step == 0 or self.error is not None:
@@ -88,7 +90,10 @@ class _Stream:
             force = self.lmp.numpy.extract_atom("f")[:nlocal, :2]
             mass = self.lmp.numpy.extract_atom("rmass")[:nlocal]
             velocities += (0.5 * self.dt / mass)[:, None] * force
-            self.on_sample(Sample(step // self.every, int(step), step * self.dt, ids, positions, velocities))
+            sensed = self.sensor_every and step % self.sensor_every == 0
+            accelerations = force / mass[:, None] if sensed else None
+            self.on_sample(Sample(step // self.every, int(step), step * self.dt, ids, positions, velocities,
+                                  accelerations))
             if self.bar is not None:
                 self.bar.update(int(step) - self.bar.n)
         except BaseException as exc:  # a ctypes callback cannot raise: keep it for after the run

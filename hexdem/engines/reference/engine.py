@@ -205,6 +205,13 @@ class ReferenceSystem:
         forces(self.kernel, x, y, still, still, np.ones(self.n_cells), scratch[0], scratch[1], fx, fy)
         return np.column_stack([fx[self.cells], fy[self.cells]])
 
+    def accelerations(self, x, y, u, w) -> np.ndarray:
+        """(n_bodies, 2) accelerations at the cell displacements (x, y) and velocities (u, w)."""
+        ax, ay = np.zeros(self.n_cells), np.zeros(self.n_cells)
+        scratch = np.zeros((2, 3, self.kernel.hi))
+        forces(self.kernel, x, y, u, w, self.kernel.inv_mass, scratch[0], scratch[1], ax, ay)
+        return np.column_stack([ax[self.cells], ay[self.cells]])
+
     def integrate(self, velocities, dt: float, settings: RunSettings, emit):
         """RK4 from rest positions with ``velocities`` (in ``units``); ``emit(index, step, x, y, u, w)``
         at step 0 and every ``settings.dump_every`` steps, with the cell arrays of
@@ -250,11 +257,13 @@ class ReferenceEngine:
         def emit(index, step, x, y, u, w):
             cells = system.cells
             velocities = np.column_stack([u[cells], w[cells]])
+            sensed = settings.sensor_every and step % settings.sensor_every == 0
+            accelerations = system.accelerations(x, y, u, w) if sensed else None
             if not np.isfinite(velocities).all():
                 raise HexdemError(f"reference integration diverged (non-finite velocities at t = "
                                   f"{step * settings.dt_s:.4g} s): reduce the time step")
             on_sample(Sample(index, step, step * dt, ids, start_positions + np.column_stack([x[cells], y[cells]]),
-                             velocities))
+                             velocities, accelerations))
             if bar is not None:
                 bar.update(step - bar.n)
 
