@@ -20,14 +20,13 @@ from __future__ import annotations
 import argparse
 import csv
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
+from record import WorkflowRecord
 
 from hexdem.analysis.figures import plt, save
-from hexdem.cli.main import main as hexdem
-from hexdem.common.io import write_csv, write_json
+from hexdem.common.io import write_csv
 from hexdem.theory.scaling import fit_decay
 
 RESTITUTIONS = (1.0, 0.95, 0.9, 0.8)
@@ -81,24 +80,19 @@ def run(argv=None) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     cases = sorted({(e, 0.0) for e in RESTITUTIONS} | {(1.0, f0) for f0 in PRECOMPRESSIONS_N}, reverse=True)
-    record = {"command": "python workflows/dissipation_precompression.py " + " ".join(sys.argv[1:] if argv is None
-                                                                                      else argv)}
+    record = WorkflowRecord(__file__, argv)
     rows = []
     for e, f0 in cases:
         name = f"e{e:.2f}_f{f0:g}N"
         (out / f"{name}.toml").write_text(f"restitution = {e!r}\nprecompression_n = {f0!r}\n")
         command = ["run", "--config", str(out / f"{name}.toml"), "--out", str(out / name)]
-        start = time.perf_counter()
-        status = hexdem(command)
+        status = record.run(name, command)
         if status:
             return status
-        record[name] = {"hexdem_command": "hexdem " + " ".join(command), "wall_time_s": time.perf_counter() - start}
         rows += measure(out / name, e, f0)
     write_csv(out / "dissipation_precompression.csv", COLUMNS, rows)
     figure(rows, out / "decay_and_speed.png")
-    write_json(out / "workflow.json", record)
-    print(f"dissipation_precompression: {sum(r['wall_time_s'] for r in record.values() if isinstance(r, dict)):.1f} s "
-          f"wall time, results in {out}", file=sys.stderr)
+    record.finish(out)
     return 0
 
 

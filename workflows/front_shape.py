@@ -17,16 +17,15 @@ from __future__ import annotations
 import argparse
 import csv
 import sys
-import time
 from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
+from record import WorkflowRecord
 
 from hexdem.analysis import figures
 from hexdem.analysis.front_shape import FRONT_SHAPE_COLUMNS
-from hexdem.cli.main import main as hexdem
-from hexdem.common.io import write_csv, write_json
+from hexdem.common.io import write_csv
 
 
 def read_shape(path: Path) -> tuple[SimpleNamespace, list[dict]]:
@@ -47,25 +46,21 @@ def run(argv=None) -> int:
     out.mkdir(parents=True, exist_ok=True)
     configs = {"hexagon": f"shape = \"hexagon\"\nedge_beads = {args.edge_beads}\n",
                "half-hexagon": "shape = \"half-hexagon\"\nlong_edge = 91\nshort_edge = 46\n"}
-    record = {"command": "python workflows/front_shape.py " + " ".join(sys.argv[1:] if argv is None else argv)}
+    record = WorkflowRecord(__file__, argv)
     shapes, rows = {}, []
     for name, text in configs.items():
         (out / f"{name}.toml").write_text(text)
         command = ["run", "--config", str(out / f"{name}.toml"), "--ranks", str(args.ranks), "--out", str(out / name)]
-        start = time.perf_counter()
-        status = hexdem(command)
+        status = record.run(name, command)
         if status:
             return status
-        record[name] = {"hexdem_command": "hexdem " + " ".join(command), "wall_time_s": time.perf_counter() - start}
         shape, table = read_shape(out / name / "front_shape.csv")
         label = f"{name}, {'%d per edge' % args.edge_beads if name == 'hexagon' else 'long edge 91, short edges 46'}"
         shapes[label] = shape
         rows += [(name, *(row[key] for key in FRONT_SHAPE_COLUMNS)) for row in table]
     write_csv(out / "front_shape.csv", ("packing", *FRONT_SHAPE_COLUMNS), rows)
     figures.front_shape_figure(shapes, out / "front_shape.png", title="Roundness of the wavefront as it grows")
-    write_json(out / "workflow.json", record)
-    print(f"front_shape: {sum(r['wall_time_s'] for r in record.values() if isinstance(r, dict)):.1f} s wall time, "
-          f"results in {out}", file=sys.stderr)
+    record.finish(out)
     return 0
 
 

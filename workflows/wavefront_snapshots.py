@@ -14,11 +14,9 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-import time
 from pathlib import Path
 
-from hexdem.cli.main import main as hexdem
-from hexdem.common.io import write_json
+from record import WorkflowRecord
 
 
 def run(argv=None) -> int:
@@ -30,18 +28,14 @@ def run(argv=None) -> int:
     commands = {"fig3": ["snapshots", "--shape", "hexagon", "--out", str(out / "fig3")],
                 "fig4": ["snapshots", "--shape", "half-hexagon", "--ranks", str(args.ranks),
                          "--out", str(out / "fig4")]}
-    record = {"command": "python workflows/wavefront_snapshots.py " + " ".join(sys.argv[1:] if argv is None else argv)}
+    record = WorkflowRecord(__file__, argv)
     for name, command in commands.items():
-        start = time.perf_counter()
-        status = hexdem(command)
+        status = record.run(name, command)
         if status:
             return status
         summary = json.loads((out / name / "snapshots.json").read_text())
-        record[name] = {"hexdem_command": "hexdem " + " ".join(command), "wall_time_s": time.perf_counter() - start,
-                        "ranks": summary["ranks"], "atom_steps_per_s": summary["atom_steps_per_s"]}
-    write_json(out / "workflow.json", record)
-    print(f"wavefront_snapshots: {sum(r['wall_time_s'] for r in record.values() if isinstance(r, dict)):.1f} s "
-          f"wall time, results in {out}", file=sys.stderr)
+        record.steps[name].update(ranks=summary["ranks"], atom_steps_per_s=summary["atom_steps_per_s"])
+    record.finish(out)
     return 0
 
 
