@@ -112,15 +112,21 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
         tasks = _pending_impacts(ensemble, groups)
         log(f"impacts: {len(tasks)} runs, analysed as they run")
         start = time.perf_counter()
-        if tasks:
-            def count_done() -> int:
-                return sum(impact_done(ensemble, k, v) for k, v in tasks)
+        published: set = set()
 
+        def publish_finished() -> int:
+            """Publish every realization whose impacts are all done; the impacts done so far."""
+            for k in groups:
+                if k not in published and all(impact_done(ensemble, k, v) for v in config.velocities_m_s):
+                    publish_result(ensemble, k)
+                    published.add(k)
+            return sum(impact_done(ensemble, k, v) for k, v in tasks)
+
+        if tasks:
             run_on_ranks(ImpactTasks(config, out, tuple(tasks), keep_dumps), min(workers, len(tasks)),
-                         out / "lammps" / "impacts", launcher, progress=(len(tasks), PHASE_LABELS["impacts"],
-                                                                         count_done))
-        for k in groups:
-            publish_result(ensemble, k)
+                         out / "lammps" / "impacts", launcher,
+                         progress=(len(tasks), PHASE_LABELS["impacts"], publish_finished))
+        publish_finished()
         wall["impacts"] = time.perf_counter() - start
         summary = write_statistics(ensemble, laws)
         summary["this_run"] = {"realizations_run": len(todo), "workers": workers,

@@ -35,7 +35,8 @@ POLL_S = 0.5
 
 @contextmanager
 def _progress(progress):
-    """Poll ``progress = (total, description, count_done)`` into a bar while the job runs."""
+    """Poll ``progress = (total, description, count_done)`` while the job runs, into a bar on a
+    terminal; ``count_done`` is called every :data:`POLL_S` seconds either way (and once at the end)."""
     if progress is None:
         yield
         return
@@ -47,14 +48,13 @@ def _progress(progress):
             bar.update(count_done() - bar.n)
 
     watcher = threading.Thread(target=follow, daemon=True)
-    if not bar.disable:
-        watcher.start()
+    watcher.start()
     try:
         yield
     finally:
         stop.set()
-        if watcher.is_alive():
-            watcher.join()
+        watcher.join()
+        bar.update(count_done() - bar.n)
         bar.close()
 
 
@@ -63,8 +63,9 @@ def run_on_ranks(job, ranks: int, directory, launcher: str | None = None, progre
 
     ``directory`` holds the job's hand-over files (kept only on failure); ``launcher`` the MPI
     launcher command (default: this environment's ``mpiexec``; e.g. ``"mpiexec -f hosts"`` to
-    reach other machines); ``progress`` an optional (total, description, count_done) whose
-    count is shown in a bar while the job runs.
+    reach other machines); ``progress`` an optional (total, description, count_done):
+    ``count_done()`` is polled while the job runs (it may publish what is finished) and its
+    count shown in a bar on a terminal.
     """
     ranks = positive_int("--ranks", ranks)
     if ranks == 1 and launcher is None:

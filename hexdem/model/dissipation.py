@@ -26,10 +26,11 @@ from __future__ import annotations
 from functools import cache
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
 
 from hexdem.errors import HexdemError
+
+# scipy's ODE solver and root finder are imported inside the functions that need them: only
+# a damped run does, and importing them costs an undamped run half a second of start-up.
 
 #: Marshall's polynomial P(c) = Σ p_k c^k by which LAMMPS's ``damping tsuji`` sets α = P(c).
 TSUJI_POLYNOMIAL = (1.2728, -4.2783, 11.087, -22.348, 27.467, -18.022, 4.8218)
@@ -37,6 +38,7 @@ TSUJI_POLYNOMIAL = (1.2728, -4.2783, 11.087, -22.348, 27.467, -18.022, 4.8218)
 
 def restitution_of(alpha: float) -> float:
     """The coefficient of restitution of a head-on Tsuji-damped Hertz collision with damping α."""
+    from scipy.integrate import solve_ivp
 
     def rhs(t, state):
         x, v = state
@@ -60,11 +62,14 @@ def damping_coefficient(restitution: float) -> float:
     check_restitution("restitution", restitution)
     if restitution == 1.0:
         return 0.0
+    from scipy.optimize import brentq
+
     return float(brentq(lambda alpha: restitution_of(alpha) - restitution, 0.0, 20.0, xtol=1e-13))
 
 
 def lammps_tsuji_coefficient(alpha: float) -> float:
     """The coefficient c to give LAMMPS's ``damping tsuji`` so that it applies damping ``alpha``."""
+    from scipy.optimize import brentq
 
     def applied(c: float) -> float:
         return float(np.polynomial.polynomial.polyval(c, TSUJI_POLYNOMIAL))
