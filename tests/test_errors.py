@@ -148,3 +148,13 @@ def test_lammps_loads_without_ld_library_path():
         instance.close()
     assert library.mpi_library_path().name == "libmpi.so.12"
     assert np.isfinite(float(instance.version()))
+
+
+def test_an_observer_failing_on_two_ranks_is_one_line(tmp_path):
+    """The failing rank aborts the MPI job (the others would wait in a collective call) and its
+    message reaches the user through job.error."""
+    config = RunConfig(edge_beads=3)
+    rendered = write_deck(config.model(), config.settings(), tmp_path / "deck")
+    with pytest.raises(HexdemError, match="TypeError: object of type 'Sample' has no len") as info:
+        run_on_ranks(functools.partial(run_streaming, rendered, len), 2, tmp_path / "job")
+    assert "\n" not in str(info.value)

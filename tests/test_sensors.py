@@ -110,3 +110,13 @@ def test_measured_file_without_accelerations_is_a_one_line_error(sensor_run, tmp
     bad.write_text("sensor,time,vx\n0:1,0.0,1.0\n")
     assert main(["signals", "--measured", str(bad), "--run", str(sensor_run[0])]) == 2
     assert "lacks the column(s) ax, ay" in capsys.readouterr().err
+
+
+def test_both_engines_record_the_same_sensor_signals(tmp_path):
+    """Velocities and accelerations of every sensor sample, t = 0 included, within 0.5 % of each
+    signal's largest value."""
+    lammps, reference = (simulate(CONFIG.replace(engine=name), tmp_path / name).tracked
+                         for name in ("lammps", "reference"))
+    np.testing.assert_allclose(lammps.sensor_times, reference.sensor_times, rtol=1e-12)
+    scale = np.max(np.abs(reference.sensor_states), axis=0)
+    assert np.all(np.abs(lammps.sensor_states - reference.sensor_states) <= 5e-3 * scale + 1e-12)

@@ -90,3 +90,24 @@ def test_one_and_two_ranks_agree_on_arrival_and_energy(default_run, tmp_path):
     assert two.engine["ranks"] == 2
     np.testing.assert_allclose(two.results.arrival_time, one.results.arrival_time, rtol=1e-9)
     assert two.results.energy_drift == pytest.approx(one.results.energy_drift, rel=1e-6)
+
+
+def test_an_earlier_small_pulse_just_above_half_the_peak_is_the_arrival():
+    """A bead first rises to 0.5005, dips, and later peaks at 1.0: its half-maximum arrival is
+    on the first rise (sample 7.96), although that record lies within a rung of the next; the
+    tracker interpolates linearly at the rounded top of the small pulse (7.80), not 20 samples
+    later on the main pulse."""
+    model = RunConfig(edge_beads=2).model()
+    n = len(model.lattice)
+    series = np.zeros(60)
+    series[5:12] = (0.3, 0.45, 0.498, 0.5005, 0.49, 0.3, 0.1)
+    series[20:49] = np.sin(np.linspace(0.0, np.pi, 29))
+    series[34] = 1.0
+    tracker = PulseTracker(model, RunSettings(dt_s=1.0, n_steps=59, dump_every=1))
+    tracker.audit = lambda positions, velocities: 1.0  # synthetic speeds: no mechanics to audit
+    for s, v in enumerate(series):
+        tracker(Sample(s, s, float(s), np.arange(1, n + 1), np.zeros((n, 2)),
+                       np.column_stack([np.full(n, v), np.zeros(n)])))
+    whole = pulse_times(np.arange(60.0), series[:, None])
+    assert whole.arrival_time[0] == pytest.approx(7.96, abs=0.01)
+    assert tracker.finish().arrival_time[0] == pytest.approx(whole.arrival_time[0], abs=0.2)

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hexdem.analysis.energy import EnergyAudit, energy_error
+from hexdem.analysis.energy import ROUND_OFF, EnergyAudit, energy_error, kinetic_energy_j
 from hexdem.analysis.peaks import refine_peak
 from hexdem.analysis.tracker_kernel import first_crossing, rung, update
 from hexdem.engines.sampling import Sample
@@ -50,7 +50,8 @@ class TrackedPulses:
 
     Per bead (N,): ``peak_speed``, ``t_peak``, ``arrival_time``.
     ``energy_drift`` the audit's error over ``energy_times`` (see
-    :func:`~hexdem.analysis.energy.energy_error`); ``energy_lost`` 1 − E_end/E0; ``n_samples``;
+    :func:`~hexdem.analysis.energy.energy_error`); ``energy_lost`` (E0 − E_end) relative to the
+    impact's kinetic energy; ``n_samples``;
     ``trace_times`` (S,) and ``trace_speeds`` (S, len(trace_beads)); ``field_times`` (F,) and
     ``field_speeds`` (F, N) at the requested snapshot samples; ``sensor_times`` (K,) and
     ``sensor_states`` (K, n_sensors, 4): vx, vy, ax, ay of the model's sensor beads every
@@ -98,6 +99,9 @@ class PulseTracker:
         self.rec_value = np.zeros((n, RECORD_CAPACITY))
         self.rec_prev = np.zeros((n, RECORD_CAPACITY))
         self.rec_len = np.zeros(n, dtype=np.int64)
+        self.first_index = np.zeros((n, RECORD_CAPACITY), dtype=np.int64)
+        self.first_value = np.zeros((n, RECORD_CAPACITY))
+        self.first_prev = np.zeros((n, RECORD_CAPACITY))
         self.owned = np.zeros(n, dtype=np.bool_)
         self.trace_beads = np.asarray(trace_beads, dtype=np.int64)
         self.traces = np.full((total, len(self.trace_beads)), np.nan)
@@ -109,13 +113,13 @@ class PulseTracker:
         self.fields = np.full((len(self.field_samples), n), np.nan)
         self.energy_every = max(1, (total - 1) // ENERGY_SAMPLES)
         self.audit = EnergyAudit(model, gravity_m_s2) if self.root else None
-        self.energies, self.energy_times = [], []
+        self.energies, self.energy_times, self.impact_energy = [], [], None
         self.count = 0
 
     # ---- state shared across ranks
     def _state(self) -> list[np.ndarray]:
         return [self.ring, self.peak, self.peak_index, self.window, self.after, self.rec_index, self.rec_value,
-                self.rec_prev, self.rec_len]
+                self.rec_prev, self.rec_len, self.first_index, self.first_value, self.first_prev]
 
     def _owned(self, array: np.ndarray) -> np.ndarray:
         """``array`` with the rows of the beads this rank does not own zeroed (for a sum over ranks)."""
@@ -137,7 +141,12 @@ class PulseTracker:
         for array in self._state():
             self.comm.Reduce(self._owned(array), array if self.root else None, op=MPI.SUM, root=0)
         for array in (self.traces, self.fields, self.sensors):
+            taken = np.isfinite(array).astype(np.int64)
+            counts = np.empty_like(taken) if self.root else None
+            self.comm.Reduce(taken, counts, op=MPI.SUM, root=0)
             self.comm.Reduce(np.nan_to_num(array, nan=0.0), array if self.root else None, op=MPI.SUM, root=0)
+            if self.root:
+                array[counts == 0] = np.nan
 
     def _gather(self, sample: Sample, ids, values):
         """(n_bodies, k) ``values`` of all bodies on rank 0 (None elsewhere)."""
@@ -194,7 +203,10 @@ class PulseTracker:
         state = self._gather(sample, sample.ids, np.hstack([sample.positions, sample.velocities]))
         if state is not None:
             units = self.settings.units
-            self.energies.append(self.audit(state[:, :2] * units.length_m, state[:, 2:] * units.velocity_m_s))
+            velocities = state[:, 2:] * units.velocity_m_s
+            if self.impact_energy is None:
+                self.impact_energy = kinetic_energy_j(velocities, self.model)
+            self.energies.append(self.audit(state[:, :2] * units.length_m, velocities))
             self.energy_times.append(sample.time)
 
     # ---- results
@@ -214,11 +226,13 @@ class PulseTracker:
             valid = (index >= 0) & (index < self.count) & np.isfinite(self.window[b])
             t_peak[b], peak[b] = refine_peak(index[valid] * interval, self.window[b, valid])
             n = int(self.rec_len[b])
-            arrival[b] = interval * first_crossing(0.5 * peak[b], self.rung, self.rec_index[b, :n],
-                                                   self.rec_value[b, :n], self.rec_prev[b, :n], n)
+            arrival[b] = interval * first_crossing(0.5 * peak[b], self.rec_index[b, :n], self.rec_value[b, :n],
+                                                   self.rec_prev[b, :n], self.first_index[b, :n],
+                                                   self.first_value[b, :n], self.first_prev[b, :n], n)
         return TrackedPulses(peak_speed=peak, t_peak=t_peak, arrival_time=arrival, 
-                             energy_drift=energy_error(self.energies, self.model.dissipative),
-                             energy_lost=1.0 - self.energies[-1] / self.energies[0], energy_times=np.array(self.energy_times),
+                             energy_drift=energy_error(self.energies, self.impact_energy, self.model.dissipative),
+                             energy_lost=(self.energies[0] - self.energies[-1])
+                             / max(self.impact_energy, ROUND_OFF * abs(self.energies[0])), energy_times=np.array(self.energy_times),
                              n_samples=self.count, trace_beads=self.trace_beads,
                              trace_times=np.arange(self.count) * interval, trace_speeds=self.traces[:self.count],
                              field_times=self.field_samples * interval, field_speeds=self.fields,

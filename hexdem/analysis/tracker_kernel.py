@@ -14,12 +14,15 @@ For every bead it keeps, in fixed-size arrays, exactly what the definitions of
   climbed a rung). With q = 2^(1/(C − 4)) at most C − 2 records lie in [M/2, M], so with the
   one below the C slots never overflow, whatever the sampling or the run's length.
 
-  For a level L = P/2 the crossing is then found exactly when L lies more than a rung above
-  the record below it (no skipped record can reach L): it is the first ladder record ≥ L,
-  interpolated linearly from the sample just before it. Otherwise it lies between two
-  ladder records a rung apart (on a rising edge, a few samples) and is interpolated
-  between them. At the default sampling consecutive samples on a rising edge differ by more
-  than a rung, so every record is kept and the crossing is exact.
+  Each slot also remembers the first record that entered it (later ones in the same rung
+  replace only the newest). For a level L = P/2 take the first slot whose record reaches L:
+  if the first record that entered it reaches L, that record is the crossing, exactly (every
+  earlier sample was below L), interpolated linearly from the sample before it; otherwise
+  the crossing is among the slot's later records, within one rung of each other (on a rising
+  edge, a few samples), and is interpolated between them. At the default sampling
+  consecutive samples on a rising edge differ by more than a rung, so every record keeps its
+  own slot and the crossing is exact. The one inexact case is a separate earlier pulse whose
+  peak lies within a rung above both L and the slot's first record.
 
 Sample s of a bead is its s-th sample; ``ring`` holds its last three samples.
 """
@@ -37,7 +40,7 @@ def rung(capacity: int) -> float:
 
 @njit(cache=True)
 def update(beads, speeds, s, q, ring, peak, peak_index, window, after, rec_index, rec_value, rec_prev,
-           rec_len) -> None:
+           rec_len, first_index, first_value, first_prev) -> None:
     """Take sample ``s`` (speeds of ``beads``) into the per-bead state arrays, in place."""
     for k in range(beads.shape[0]):
         b, v = beads[k], speeds[k]
@@ -59,8 +62,15 @@ def update(beads, speeds, s, q, ring, peak, peak_index, window, after, rec_index
                 rec_index[b, j] = rec_index[b, j + drop]
                 rec_value[b, j] = rec_value[b, j + drop]
                 rec_prev[b, j] = rec_prev[b, j + drop]
+                first_index[b, j] = first_index[b, j + drop]
+                first_value[b, j] = first_value[b, j + drop]
+                first_prev[b, j] = first_prev[b, j + drop]
             if n >= 2 and rec_value[b, n - 1] < q * rec_value[b, n - 2]:
                 n -= 1
+            else:
+                first_index[b, n] = s
+                first_value[b, n] = v
+                first_prev[b, n] = prev
             rec_index[b, n] = s
             rec_value[b, n] = v
             rec_prev[b, n] = prev
@@ -72,15 +82,17 @@ def update(beads, speeds, s, q, ring, peak, peak_index, window, after, rec_index
 
 
 @njit(cache=True)
-def first_crossing(level, q, rec_index, rec_value, rec_prev, n_records) -> float:
+def first_crossing(level, rec_index, rec_value, rec_prev, first_index, first_value, first_prev, n_records) -> float:
     """Fractional sample index at which the samples first reached ``level`` (NaN if never)."""
     for j in range(n_records):
         if rec_value[j] >= level:
+            s0, v0, before0 = first_index[j], first_value[j], first_prev[j]
+            if v0 >= level:
+                if s0 == 0 or not before0 < level:
+                    return float(s0)
+                return s0 - 1 + (level - before0) / (v0 - before0)
             s, before = rec_index[j], rec_prev[j]
-            if s == 0:
-                return 0.0
-            if before < level or j == 0:
+            if before < level:
                 return s - 1 + (level - before) / (rec_value[j] - before)
-            low, t_low = rec_value[j - 1], rec_index[j - 1]
-            return t_low + (level - low) / (before - low) * (s - 1 - t_low)
+            return s0 + (level - v0) / (before - v0) * (s - 1 - s0)
     return np.nan

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from hexdem.analysis.energy import EnergyAudit, energy_error
+from hexdem.analysis.energy import EnergyAudit, energy_error, kinetic_energy_j
 from hexdem.engines.sampling import Sample
 from hexdem.model.granular import GranularModel, RunSettings
 
@@ -46,7 +46,7 @@ class Trajectory:
 
     def energy_drift(self, model: GranularModel) -> float:
         """The energy audit's error (:func:`~hexdem.analysis.energy.energy_error`)."""
-        return energy_error(self.energies_j(model), model.dissipative)
+        return energy_error(self.energies_j(model), kinetic_energy_j(self.velocities_m_s[0], model), model.dissipative)
 
 
 class TrajectoryRecorder:

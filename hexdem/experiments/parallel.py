@@ -6,7 +6,8 @@ None. For N > 1 ranks hexdem pickles the job into its directory and starts
 ``mpiexec -n N python -m hexdem.experiments.parallel job.pickle`` (both from this
 environment: the ``mpich`` wheel's launcher and this Python), which writes rank 0's result
 atomically beside the job. A failure on any rank is written to ``job.error`` in one line and
-aborts the whole MPI job, so that no rank waits forever in a collective call.
+aborts the whole MPI job, so that no rank waits forever in a collective call (a failure inside
+a LAMMPS sampling callback is written there too, through ``HEXDEM_JOB_ERROR``).
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from pathlib import Path
 from hexdem.common.checks import positive_int
 from hexdem.common.io import atomic_path
 from hexdem.common.progress import progress_bar
+from hexdem.engines.lammps.driver import ERROR_FILE_VARIABLE
 from hexdem.engines.lammps.library import environment_command, load_lammps
 from hexdem.engines.lammps.partitions import die_with_parent
 from hexdem.errors import HexdemError
@@ -81,6 +83,7 @@ def run_on_ranks(job, ranks: int, directory, launcher: str | None = None, progre
     command = [*prefix, "-n", str(ranks), sys.executable, "-m", __name__, str(paths[JOB_NAME].resolve())]
     with _progress(progress):
         done = subprocess.run(command, stdout=subprocess.PIPE, stderr=None, text=True,
+                              env={**os.environ, ERROR_FILE_VARIABLE: str(paths[ERROR_NAME].resolve())},
                               preexec_fn=functools.partial(die_with_parent, os.getpid()))
     if done.returncode != 0 or not paths[RESULT_NAME].exists():
         if paths[ERROR_NAME].exists():

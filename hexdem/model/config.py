@@ -18,6 +18,7 @@ from pathlib import Path
 from hexdem.common.checks import is_number, positive_int
 from hexdem.common.machine import available_memory_bytes
 from hexdem.errors import HexdemError
+from hexdem.model.dissipation import damping_coefficient, lammps_tsuji_coefficient
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time
 from hexdem.model.lattice import LINE_STEPS, Lattice, half_hexagon, hexagon
@@ -188,6 +189,8 @@ class RunConfig:
         wall = None if self.wall_material == "none" else material(self.wall_material)
         impact = Impact(self.v0 * self.unit_system.velocity_m_s, self.strike_angle_deg, self.impact == "striker")
         wall_restitution = self.restitution if self.wall_restitution is None else self.wall_restitution
+        for alpha in {damping_coefficient(self.restitution), damping_coefficient(wall_restitution)} - {0.0}:
+            lammps_tsuji_coefficient(alpha)
         bead, lattice, held = material(self.bead_material), self.lattice(), (0.0, 0.0)
         if self.precompression_n > 0:
             if wall is None:
@@ -232,8 +235,8 @@ class RunConfig:
 
     def settings(self, model: GranularModel | None = None) -> RunSettings:
         """Time step, step count and dump interval in SI, with the defaults resolved. With sensors,
-        the time step is shortened so that a sensor sample is a whole number of steps, and the
-        samples of the analysis fall on every sensor sample."""
+        the time step is shortened (at most by one sample's worth) so that a sensor sample is a
+        whole number of analysis samples of ``dump_every`` steps."""
         model = model or self.model()
         scale = self.unit_system.time_s
         dt_s = self.dt * scale if self.dt is not None else self.contact_time_s() / STEPS_PER_CONTACT
@@ -246,9 +249,9 @@ class RunConfig:
             duration_s = layers * self.contact_time_s()
         every, sensor_every = self.dump_every, 0
         if self.sensors:
-            sensor_every = math.ceil(1.0 / self.sensor_rate_hz / dt_s)
+            samples = math.ceil(1.0 / self.sensor_rate_hz / (dt_s * every) - 1e-9)
+            sensor_every = samples * every
             dt_s = 1.0 / self.sensor_rate_hz / sensor_every
-            every = max(k for k in range(1, min(every, sensor_every) + 1) if sensor_every % k == 0)
         n_steps = max(1, round(duration_s / dt_s))
         return RunSettings(dt_s=dt_s, n_steps=n_steps, dump_every=every, units=self.unit_system,
                            sensor_every=sensor_every)

@@ -74,10 +74,10 @@ def lammps_tsuji_coefficient(alpha: float) -> float:
     def applied(c: float) -> float:
         return float(np.polynomial.polynomial.polyval(c, TSUJI_POLYNOMIAL))
 
-    if not applied(1.0) <= alpha <= applied(0.05):
-        raise HexdemError(f"damping {alpha:.4g} is outside what LAMMPS's damping tsuji can express "
-                          f"({applied(1.0):.2g} to {applied(0.05):.3g}); choose a restitution in [0.1, 0.9995]")
-    return float(brentq(lambda c: applied(c) - alpha, 0.05, 1.0, xtol=1e-14))
+    if not applied(1.0) <= alpha <= applied(0.0):
+        raise HexdemError(f"LAMMPS's damping tsuji cannot express the restitution {restitution_of(alpha):.4g}: "
+                          f"use one in [{restitution_of(applied(0.0)):.3f}, {restitution_of(applied(1.0)):.4f}] or 1")
+    return float(brentq(lambda c: applied(c) - alpha, 0.0, 1.0, xtol=1e-14))
 
 
 def check_restitution(name: str, value) -> float:

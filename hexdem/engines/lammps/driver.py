@@ -36,6 +36,9 @@ from hexdem.errors import HexdemError
 
 #: The comment line that opens the output section of hexdem's impact decks.
 OUTPUT_MARKER = "# --- output"
+#: Environment variable naming the file where a rank that fails inside a sampling callback
+#: leaves its one-line error before it aborts the MPI job (set by the job runner).
+ERROR_FILE_VARIABLE = "HEXDEM_JOB_ERROR"
 STREAM_FIX = "hexdem_stream"
 
 
@@ -62,8 +65,8 @@ def split_deck(text: str) -> tuple[str, str]:
 class _Stream:
     """The ``fix external`` callback: full-step samples of the local atoms, with progress."""
 
-    def __init__(self, lmp, deck: Deck, on_sample, show_progress: bool):
-        self.lmp, self.on_sample = lmp, on_sample
+    def __init__(self, lmp, deck: Deck, on_sample, show_progress: bool, comm=None):
+        self.lmp, self.on_sample, self.comm = lmp, on_sample, comm
         self.every, self.dt = deck.settings.dump_every, float(lmp.extract_global("dt"))
         self.sensor_every = deck.settings.sensor_every
         self.bar = progress_bar(deck.settings.n_steps, "LAMMPS", unit="step") if show_progress else None
@@ -79,7 +82,12 @@ class _Stream:
 
     def initial(self) -> None:
         ids, positions, velocities = self.local_state()
-        accelerations = np.zeros_like(velocities) if self.sensor_every else None  # no force computed yet
+        accelerations = None
+        if self.sensor_every:
+            self.lmp.command("run 0 post no")  # computes the forces at t = 0
+            n = len(ids)
+            accelerations = (self.lmp.numpy.extract_atom("f")[:n, :2]
+                             / self.lmp.numpy.extract_atom("rmass")[:n, None])
         self.on_sample(Sample(0, 0, 0.0, ids, positions, velocities, accelerations))
 
     def __call__(self, caller, step, nlocal, tag, x, fexternal) -> None:
@@ -98,6 +106,16 @@ class _Stream:
                 self.bar.update(int(step) - self.bar.n)
         except BaseException as exc:  # a ctypes callback cannot raise: keep it for after the run
             self.error = exc
+            if self.comm is not None and self.comm.Get_size() > 1:
+                self.abort(exc)
+
+    def abort(self, exc: BaseException) -> None:
+        """End the whole MPI job: the other ranks would wait for this one in a collective call."""
+        message = str(exc) if isinstance(exc, HexdemError) else f"{type(exc).__name__}: {exc}"
+        path = os.environ.get(ERROR_FILE_VARIABLE)
+        if path:
+            Path(path).write_text(message.replace("\n", " ") + "\n")
+        self.comm.Abort(1)
 
 
 def _raise_lammps_error(deck: Deck, exc: Exception):
@@ -133,7 +151,7 @@ def run_streaming(deck: Deck, on_sample, comm=None, dump: bool = False, show_pro
         stream = None
         try:
             _lammps(deck, lmp.commands_string, setup + (output if dump else ""))
-            stream = _Stream(lmp, deck, on_sample, show_progress and root)
+            stream = _Stream(lmp, deck, on_sample, show_progress and root, comm)
             stream.initial()
             _lammps(deck, lmp.command, f"fix {STREAM_FIX} all external pf/callback {deck.settings.dump_every} 1")
             lmp.set_fix_external_callback(STREAM_FIX, stream, None)
