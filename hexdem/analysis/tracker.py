@@ -193,11 +193,12 @@ class PulseTracker:
 
     def _sense(self, sample: Sample) -> None:
         """Velocity and acceleration of the sensor beads this rank owns, at a sensor sample."""
-        row = {int(b): k for k, b in enumerate(sample.ids - 1)}
-        for k, bead in enumerate(self.sensor_beads.tolist()):
-            if bead in row:
-                j = row[bead]
-                self.sensors[sample.step // self.sensor_every, k] = (*sample.velocities[j], *sample.accelerations[j])
+        row = np.full(self.n_bodies + 1, -1, dtype=np.int64)
+        row[sample.ids] = np.arange(len(sample.ids))
+        mine = row[self.sensor_beads + 1]
+        here = mine >= 0
+        self.sensors[sample.step // self.sensor_every, here] = np.hstack(
+            [sample.velocities[mine[here]], sample.accelerations[mine[here]]])
 
     def _audit(self, sample: Sample) -> None:
         state = self._gather(sample, sample.ids, np.hstack([sample.positions, sample.velocities]))
