@@ -172,6 +172,17 @@ def _shifted(out, q, cv, v, ca, a):
 
 
 @_jit
+def _stage(k, x, y, u, w, cv, ca, ax, ay, bx, by, tx, ty, tu, tw):
+    """An RK4 stage's state: positions (tx, ty) = q + cv·v + ca·a, and, for a damped model whose
+    forces depend on velocity, velocities (tu, tw) = v + cv·b."""
+    _shifted(tx, x, cv, u, ca, ax)
+    _shifted(ty, y, cv, w, ca, ay)
+    if k.damped:
+        _shifted(tu, u, cv, bx, 0.0, bx)
+        _shifted(tw, w, cv, by, 0.0, by)
+
+
+@_jit
 def _advance(q, v, h, a1, a2, a3, a4):
     """Classical RK4 update of q'' = a(q): q += h v + h²/6 (a1+a2+a3), v += h/6 (a1+2a2+2a3+a4)."""
     for c in range(q.shape[0]):
@@ -194,23 +205,11 @@ def integrate(k, x, y, u, w, h, n_steps):
     half, sq = 0.5 * h, h * h
     for _ in range(n_steps):
         forces(k, x, y, u, w, k.inv_mass, bond_fx, bond_fy, a[0], a[1])
-        _shifted(tx, x, half, u, 0.0, a[0])
-        _shifted(ty, y, half, w, 0.0, a[1])
-        if k.damped:
-            _shifted(tu, u, half, a[0], 0.0, a[0])
-            _shifted(tw, w, half, a[1], 0.0, a[1])
+        _stage(k, x, y, u, w, half, 0.0, a[0], a[1], a[0], a[1], tx, ty, tu, tw)
         forces(k, tx, ty, tu, tw, k.inv_mass, bond_fx, bond_fy, a[2], a[3])
-        _shifted(tx, x, half, u, 0.25 * sq, a[0])
-        _shifted(ty, y, half, w, 0.25 * sq, a[1])
-        if k.damped:
-            _shifted(tu, u, half, a[2], 0.0, a[2])
-            _shifted(tw, w, half, a[3], 0.0, a[3])
+        _stage(k, x, y, u, w, half, 0.25 * sq, a[0], a[1], a[2], a[3], tx, ty, tu, tw)
         forces(k, tx, ty, tu, tw, k.inv_mass, bond_fx, bond_fy, a[4], a[5])
-        _shifted(tx, x, h, u, 0.5 * sq, a[2])
-        _shifted(ty, y, h, w, 0.5 * sq, a[3])
-        if k.damped:
-            _shifted(tu, u, h, a[4], 0.0, a[4])
-            _shifted(tw, w, h, a[5], 0.0, a[5])
+        _stage(k, x, y, u, w, h, 0.5 * sq, a[2], a[3], a[4], a[5], tx, ty, tu, tw)
         forces(k, tx, ty, tu, tw, k.inv_mass, bond_fx, bond_fy, a[6], a[7])
         _advance(x, u, h, a[0], a[2], a[4], a[6])
         _advance(y, w, h, a[1], a[3], a[5], a[7])
