@@ -103,17 +103,23 @@ class EnergyAudit:
 ROUND_OFF = 1e-8
 
 
-def energy_error(energies_j, impact_energy_j: float, dissipative: bool = False) -> float:
-    """The energy audit's figure of merit, 0 for an exact integrator, relative to the energy the
-    impact brought in, K(0) (a precompressed or settled packing also stores static contact
-    energy, which would dilute the figure), but at least :data:`ROUND_OFF` of E(0).
+def energy_scale_j(energies_j, impact_energy_j: float) -> float:
+    """The audit's yardstick [J]: the energy the impact brought in, K(0) (a precompressed or
+    settled packing also stores static contact energy, which would dilute the figures), but at
+    least :data:`ROUND_OFF` of E(0)."""
+    return max(impact_energy_j, ROUND_OFF * abs(float(np.asarray(energies_j)[0])))
 
-    Conservative model: max_t |E(t) − E(0)| / K(0). Dissipative model (restitution < 1): the
-    energy may only fall, so the largest rise above the lowest energy reached before,
-    max_t [E(t) − min_{s ≤ t} E(s)] / K(0).
+
+def energy_error(energies_j, impact_energy_j: float, dissipative: bool = False) -> float:
+    """The energy audit's figure of merit, 0 for an exact integrator, relative to
+    :func:`energy_scale_j`.
+
+    Conservative model: max_t |E(t) − E(0)|. Dissipative model (restitution < 1): the energy may
+    only fall, so the largest rise above the lowest energy reached before,
+    max_t [E(t) − min_{s ≤ t} E(s)].
     """
     energies_j = np.asarray(energies_j, float)
-    scale = max(impact_energy_j, ROUND_OFF * abs(energies_j[0]))
+    scale = energy_scale_j(energies_j, impact_energy_j)
     if dissipative:
         return float(np.max(energies_j - np.minimum.accumulate(energies_j)) / scale)
     return float(np.max(np.abs(energies_j - energies_j[0])) / scale)

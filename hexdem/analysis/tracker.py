@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hexdem.analysis.energy import ROUND_OFF, EnergyAudit, energy_error, kinetic_energy_j
+from hexdem.analysis.energy import EnergyAudit, energy_error, energy_scale_j, kinetic_energy_j
 from hexdem.analysis.peaks import refine_peak
 from hexdem.analysis.tracker_kernel import first_crossing, rung, update
 from hexdem.engines.sampling import Sample
@@ -148,13 +148,9 @@ class PulseTracker:
             if self.root:
                 array[counts == 0] = np.nan
 
-    def _gather(self, sample: Sample, ids, values):
+    def _gather(self, ids, values):
         """(n_bodies, k) ``values`` of all bodies on rank 0 (None elsewhere)."""
-        if self.comm is None:
-            whole = np.empty((self.n_bodies,) + values.shape[1:])
-            whole[ids - 1] = values
-            return whole
-        parts = self.comm.gather((ids, values), root=0)
+        parts = [(ids, values)] if self.comm is None else self.comm.gather((ids, values), root=0)
         if not self.root:
             return None
         whole = np.empty((self.n_bodies,) + values.shape[1:])
@@ -179,10 +175,8 @@ class PulseTracker:
             self.owned[index] = True
         update(index, speeds, s, self.rung, *self._state())
         if len(self.trace_beads):
-            mine = np.flatnonzero(self.owned[self.trace_beads])
-            lookup = np.full(self.n_beads, -1, dtype=np.int64)
-            lookup[index] = np.arange(len(index))
-            self.traces[s, mine] = speeds[lookup[self.trace_beads[mine]]]
+            here, rows = self._rows(sample, self.trace_beads)
+            self.traces[s, here] = np.hypot(sample.velocities[rows, 0], sample.velocities[rows, 1])
         if self.sensor_every and sample.step % self.sensor_every == 0 and len(self.sensor_beads):
             self._sense(sample)
         if s in self.field_samples:
@@ -191,17 +185,21 @@ class PulseTracker:
             self._audit(sample)
         self.count = s + 1
 
-    def _sense(self, sample: Sample) -> None:
-        """Velocity and acceleration of the sensor beads this rank owns, at a sensor sample."""
+    def _rows(self, sample: Sample, beads: np.ndarray):
+        """(mask of ``beads`` this rank owns, their rows in ``sample``)."""
         row = np.full(self.n_bodies + 1, -1, dtype=np.int64)
         row[sample.ids] = np.arange(len(sample.ids))
-        mine = row[self.sensor_beads + 1]
-        here = mine >= 0
+        rows = row[beads + 1]
+        return rows >= 0, rows[rows >= 0]
+
+    def _sense(self, sample: Sample) -> None:
+        """Velocity and acceleration of the sensor beads this rank owns, at a sensor sample."""
+        here, rows = self._rows(sample, self.sensor_beads)
         self.sensors[sample.step // self.sensor_every, here] = np.hstack(
-            [sample.velocities[mine[here]], sample.accelerations[mine[here]]])
+            [sample.velocities[rows], sample.accelerations[rows]])
 
     def _audit(self, sample: Sample) -> None:
-        state = self._gather(sample, sample.ids, np.hstack([sample.positions, sample.velocities]))
+        state = self._gather(sample.ids, np.hstack([sample.positions, sample.velocities]))
         if state is not None:
             units = self.settings.units
             velocities = state[:, 2:] * units.velocity_m_s
@@ -230,10 +228,11 @@ class PulseTracker:
             arrival[b] = interval * first_crossing(0.5 * peak[b], self.rec_index[b, :n], self.rec_value[b, :n],
                                                    self.rec_prev[b, :n], self.first_index[b, :n],
                                                    self.first_value[b, :n], self.first_prev[b, :n], n)
-        return TrackedPulses(peak_speed=peak, t_peak=t_peak, arrival_time=arrival, 
+        scale = energy_scale_j(self.energies, self.impact_energy)
+        return TrackedPulses(peak_speed=peak, t_peak=t_peak, arrival_time=arrival,
                              energy_drift=energy_error(self.energies, self.impact_energy, self.model.dissipative),
-                             energy_lost=(self.energies[0] - self.energies[-1])
-                             / max(self.impact_energy, ROUND_OFF * abs(self.energies[0])), energy_times=np.array(self.energy_times),
+                             energy_lost=(self.energies[0] - self.energies[-1]) / scale,
+                             energy_times=np.array(self.energy_times),
                              n_samples=self.count, trace_beads=self.trace_beads,
                              trace_times=np.arange(self.count) * interval, trace_speeds=self.traces[:self.count],
                              field_times=self.field_samples * interval, field_speeds=self.fields,

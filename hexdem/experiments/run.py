@@ -62,8 +62,8 @@ def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples
     log(f"running {config.engine}: {model.lattice.shape}, {model.n_bodies} bodies, "
         f"{settings.n_steps} steps of {settings.dt_s:.4g} s ({settings.duration_s * 1e3:.4g} ms), "
         f"{config.ranks if config.engine == 'lammps' else 1} rank(s), {settings.n_samples} samples analysed in the run")
-    job = ImpactJob(model, settings, config.engine, workdir, dump=config.dump, trace_beads=tuple(int(b) for line in trace_lines
-                                                             for b in model.lattice.line(line)),
+    traced = tuple(int(bead) for line in trace_lines for bead in model.lattice.line(line))
+    job = ImpactJob(model, settings, config.engine, workdir, dump=config.dump, trace_beads=traced,
                     field_samples=tuple(field_samples))
     analysis = track_impact(job, config.ranks)
     check_energy(analysis, workdir)
