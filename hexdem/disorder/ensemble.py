@@ -148,11 +148,9 @@ class Ensemble:
     def stage_dir(self, k: int, stage: str) -> Path:
         return self.realization_dir(k) / stage
 
-    def impact_dir(self, k: int, v: float) -> Path:
-        return self.realization_dir(k) / velocity_name(v)
-
-    def ideal_dir(self, v: float) -> Path:
-        return self.out / "ideal" / velocity_name(v)
+    def impact_dir(self, k: int | None, v: float) -> Path:
+        """The impact deck of realization k (None: the ideal lattice) at striker speed ``v``."""
+        return (self.out / "ideal" if k is None else self.realization_dir(k)) / velocity_name(v)
 
     def result_path(self, k: int | None) -> Path:
         """``result.npz`` of realization k (None: the ideal lattice)."""
@@ -160,7 +158,7 @@ class Ensemble:
 
     def impact_dirs(self, k: int | None) -> list[Path]:
         """The impact decks of realization k (None: the ideal lattice), one per velocity."""
-        return [self.ideal_dir(v) if k is None else self.impact_dir(k, v) for v in self.config.velocities_m_s]
+        return [self.impact_dir(k, v) for v in self.config.velocities_m_s]
 
     # ---- models
     def settings(self, v: float) -> RunSettings:

@@ -22,8 +22,7 @@ from hexdem.common.io import atomic_path
 from hexdem.disorder.ensemble import Ensemble, EnsembleConfig
 from hexdem.disorder.preparation import STAGES, contact_overlaps_m, read_stage
 from hexdem.engines.lammps.partitions import loop_time_s
-from hexdem.errors import HexdemError
-from hexdem.experiments.run import MAX_ENERGY_DRIFT
+from hexdem.experiments.run import check_energy
 from hexdem.experiments.tracked_run import ImpactJob, track_impact
 
 IMPACT_NAME = "impact.npz"
@@ -45,15 +44,13 @@ def run_impact(ensemble: Ensemble, k: int | None, v: float, dump: bool, comm=Non
     """Run and analyse one impact of realization k (None: ideal) at striker speed ``v`` [m/s]
     on the ranks of ``comm`` (None: this process); write its ``impact.npz``. Returns the
     LAMMPS version."""
-    directory = ensemble.ideal_dir(v) if k is None else ensemble.impact_dir(k, v)
+    directory = ensemble.impact_dir(k, v)
     gravity = None if k is None else tuple(float(g) for g in ensemble.gravity_m_s2)
     job = ImpactJob(ensemble.impact_model(k, v), ensemble.settings(v), "lammps", directory, dump=dump,
                     gravity_m_s2=gravity, show_progress=False)
     analysis: ImpactAnalysis = track_impact(job, comm=comm)
+    check_energy(analysis, analysis.engine["deck"])
     r = analysis.results
-    if not r.energy_drift <= MAX_ENERGY_DRIFT:
-        raise HexdemError(f"energy drift {r.energy_drift:.1e} exceeds {MAX_ENERGY_DRIFT:g} in "
-                          f"{analysis.engine['deck']}: the run is not trustworthy")
     _save(directory / IMPACT_NAME, {"peak_speed": r.peak_speed, "t_peak": r.t_peak, "arrival_time": r.arrival_time,
                                     "energy_drift": r.energy_drift, "far_wall_reached": r.far_wall_reached,
                                     "impact_lammps_s": analysis.engine["wall_time_s"]})
@@ -82,8 +79,7 @@ class ImpactTasks:
 
 
 def impact_done(ensemble: Ensemble, k: int | None, v: float) -> bool:
-    directory = ensemble.ideal_dir(v) if k is None else ensemble.impact_dir(k, v)
-    return (directory / IMPACT_NAME).exists()
+    return (ensemble.impact_dir(k, v) / IMPACT_NAME).exists()
 
 
 def publish_result(ensemble: Ensemble, k: int | None) -> None:
