@@ -28,7 +28,7 @@ from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.driver import ERROR_FILE_VARIABLE
 from hexdem.engines.lammps.library import environment_command, load_lammps
 from hexdem.engines.lammps.partitions import die_with_parent
-from hexdem.errors import HexdemError
+from hexdem.errors import HexdemError, one_line
 
 JOB_NAME, RESULT_NAME, ERROR_NAME = "job.pickle", "job.result.pickle", "job.error"
 #: Seconds between looks at a running job's progress.
@@ -105,8 +105,7 @@ def _rank_main(job_path: Path) -> None:
     try:
         result = pickle.loads(job_path.read_bytes())(comm)
     except BaseException as exc:
-        message = str(exc) if isinstance(exc, HexdemError) else f"{type(exc).__name__}: {exc}"
-        (job_path.parent / ERROR_NAME).write_text(message.replace("\n", " ") + "\n")
+        (job_path.parent / ERROR_NAME).write_text(one_line(exc) + "\n")
         sys.stderr.flush()
         comm.Abort(1)
     if comm.Get_rank() == 0:

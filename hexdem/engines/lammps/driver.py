@@ -30,9 +30,9 @@ import numpy as np
 from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.deck import Deck
 from hexdem.engines.lammps.library import load_lammps
-from hexdem.engines.lammps.runner import RunInfo, error_line, log_version
+from hexdem.engines.lammps.runner import RunInfo, lammps_failure, log_version
 from hexdem.engines.sampling import Sample
-from hexdem.errors import HexdemError
+from hexdem.errors import HexdemError, one_line
 
 #: The comment line that opens the output section of hexdem's impact decks.
 OUTPUT_MARKER = "# --- output"
@@ -80,14 +80,17 @@ class _Stream:
         velocities = np.array(lmp.numpy.extract_atom("v")[:n, :2])
         return ids, positions, velocities
 
+    def forces_and_masses(self, n: int):
+        """(n, 2) forces and (n,) masses of the first ``n`` local atoms."""
+        return self.lmp.numpy.extract_atom("f")[:n, :2], self.lmp.numpy.extract_atom("rmass")[:n]
+
     def initial(self) -> None:
         ids, positions, velocities = self.local_state()
         accelerations = None
         if self.sensor_every:
             self.lmp.command("run 0 post no")  # computes the forces at t = 0
-            n = len(ids)
-            accelerations = (self.lmp.numpy.extract_atom("f")[:n, :2]
-                             / self.lmp.numpy.extract_atom("rmass")[:n, None])
+            force, mass = self.forces_and_masses(len(ids))
+            accelerations = force / mass[:, None]
         self.on_sample(Sample(0, 0, 0.0, ids, positions, velocities, accelerations))
 
     def __call__(self, caller, step, nlocal, tag, x, fexternal) -> None:
@@ -95,8 +98,7 @@ class _Stream:
             return
         try:
             ids, positions, velocities = self.local_state()
-            force = self.lmp.numpy.extract_atom("f")[:nlocal, :2]
-            mass = self.lmp.numpy.extract_atom("rmass")[:nlocal]
+            force, mass = self.forces_and_masses(nlocal)
             velocities += (0.5 * self.dt / mass)[:, None] * force
             sensed = self.sensor_every and step % self.sensor_every == 0
             accelerations = force / mass[:, None] if sensed else None
@@ -111,16 +113,10 @@ class _Stream:
 
     def abort(self, exc: BaseException) -> None:
         """End the whole MPI job: the other ranks would wait for this one in a collective call."""
-        message = str(exc) if isinstance(exc, HexdemError) else f"{type(exc).__name__}: {exc}"
         path = os.environ.get(ERROR_FILE_VARIABLE)
         if path:
-            Path(path).write_text(message.replace("\n", " ") + "\n")
+            Path(path).write_text(one_line(exc) + "\n")
         self.comm.Abort(1)
-
-
-def _raise_lammps_error(deck: Deck, exc: Exception):
-    log = deck.log_path.read_text() if deck.log_path.exists() else ""
-    raise HexdemError(f"LAMMPS failed on {deck.input_path}: {error_line(log if 'ERROR' in log else str(exc))}") from None
 
 
 def _lammps(deck: Deck, call, text: str) -> None:
@@ -128,7 +124,7 @@ def _lammps(deck: Deck, call, text: str) -> None:
     try:
         call(text)
     except Exception as exc:
-        _raise_lammps_error(deck, exc)
+        raise lammps_failure(deck, str(exc)) from None
 
 
 def run_streaming(deck: Deck, on_sample, comm=None, dump: bool = False, show_progress: bool = True) -> RunInfo:
@@ -147,7 +143,7 @@ def run_streaming(deck: Deck, on_sample, comm=None, dump: bool = False, show_pro
         try:
             lmp = lammps.lammps(cmdargs=args) if comm is None else lammps.lammps(cmdargs=args, comm=comm)
         except Exception as exc:
-            _raise_lammps_error(deck, exc)
+            raise lammps_failure(deck, str(exc)) from None
         stream = None
         try:
             _lammps(deck, lmp.commands_string, setup + (output if dump else ""))

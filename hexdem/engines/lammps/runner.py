@@ -42,8 +42,11 @@ def error_line(text: str) -> str:
     return re.sub(r"\s*\([^()]*\.cpp:\d+\)", "", line).strip()
 
 
-def _fail(deck: Deck, message: str) -> HexdemError:
-    return HexdemError(f"LAMMPS failed on {deck.input_path}: {error_line(message)}")
+def lammps_failure(deck: Deck, output: str) -> HexdemError:
+    """The one-line error of a failed run of ``deck``: LAMMPS's ERROR line from its log, or else
+    from ``output`` (what the run printed or raised)."""
+    log = deck.log_path.read_text() if deck.log_path.exists() else ""
+    return HexdemError(f"LAMMPS failed on {deck.input_path}: {error_line(log if 'ERROR' in log else output)}")
 
 
 def run_bare(deck: Deck, ranks: int = 1, input_name: str = DECK_NAME) -> RunInfo:
@@ -55,6 +58,5 @@ def run_bare(deck: Deck, ranks: int = 1, input_name: str = DECK_NAME) -> RunInfo
     start = time.perf_counter()
     done = subprocess.run(command, cwd=deck.directory, capture_output=True, text=True)
     if done.returncode != 0:
-        log = deck.log_path.read_text() if deck.log_path.exists() else ""
-        raise _fail(deck, log if "ERROR" in log else done.stderr + done.stdout)
+        raise lammps_failure(deck, done.stderr + done.stdout)
     return RunInfo(log_version(deck.log_path), ranks, time.perf_counter() - start)
