@@ -38,9 +38,10 @@ MIN_STEPS_PER_CONTACT = 20
 #: The analysis needs at least this many samples per contact time at V0, and this many in all.
 MIN_SAMPLES_PER_CONTACT = 4
 MIN_SAMPLES = 10
-#: Memory a run needs on each process: a fixed part (Python, NumPy, SciPy, numba, LAMMPS and
-#: the plotting libraries loaded) and a part per bead (LAMMPS's atoms and neighbour lists, the
-#: lattice, the tracker's state); measured by benchmarks/bench_scale.py.
+#: Memory a run needs on each process, a conservative bound: a fixed part (Python, NumPy, SciPy,
+#: numba, LAMMPS and the plotting libraries loaded) and a part per bead (LAMMPS's atoms and
+#: neighbour lists, the lattice, the tracker's state). benchmarks/bench_scale.py measured
+#: 267 MB at 331 beads and 313 MB at 29,701 (about 2 kB per bead).
 MEMORY_BASE_BYTES = 400e6
 MEMORY_PER_BEAD_BYTES = 8e3
 
@@ -59,9 +60,9 @@ class RunConfig:
     ``sensors``: sensor particles, each ``"line:n"`` (e.g. ``"0:1"``, ``"+30:6"``) or a bead id;
     sampled at ``sensor_rate_hz`` (the paper's 500 kS/s); ``sensor_mass_factor``: a sensor
     bead's mass relative to a plain bead's.
-    ``dt = None`` takes the Hertz contact time at V0 / 700; ``duration = None`` runs until
-    the leading wave has crossed the packing: one two-bead contact time at V0 per layer
-    between the struck bead and the far wall (the pulse resides less than that on each
+    ``dt = None`` takes the contact time (:meth:`contact_time_s`) / 700; ``duration = None``
+    runs until the leading wave has crossed the packing: one contact time per layer between
+    the struck bead and the far wall (the pulse resides less than that on each
     layer: 0.82 ms are needed, 1.43 ms are run for the default experiment).
     """
 
