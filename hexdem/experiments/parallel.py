@@ -24,11 +24,11 @@ from pathlib import Path
 
 from hexdem.common.checks import positive_int
 from hexdem.common.io import atomic_path
+from hexdem.common.job_failure import ERROR_FILE_VARIABLE, abort_job
 from hexdem.common.progress import progress_bar
-from hexdem.engines.lammps.driver import ERROR_FILE_VARIABLE
 from hexdem.engines.lammps.library import environment_command, load_lammps
 from hexdem.engines.lammps.partitions import die_with_parent
-from hexdem.errors import HexdemError, one_line
+from hexdem.errors import HexdemError
 
 JOB_NAME, RESULT_NAME, ERROR_NAME = "job.pickle", "job.result.pickle", "job.error"
 #: Seconds between looks at a running job's progress.
@@ -86,8 +86,9 @@ def run_on_ranks(job, ranks: int, directory, launcher: str | None = None, progre
                               env={**os.environ, ERROR_FILE_VARIABLE: str(paths[ERROR_NAME].resolve())},
                               preexec_fn=functools.partial(die_with_parent, os.getpid()))
     if done.returncode != 0 or not paths[RESULT_NAME].exists():
-        if paths[ERROR_NAME].exists():
-            raise HexdemError(paths[ERROR_NAME].read_text().strip())
+        reported = paths[ERROR_NAME].read_text().strip() if paths[ERROR_NAME].exists() else ""
+        if reported:
+            raise HexdemError(reported)
         raise HexdemError(f"the MPI job on {ranks} ranks failed (exit status {done.returncode}): "
                           f"{(done.stdout.strip().splitlines() or ['no output'])[-1]}")
     result = pickle.loads(paths[RESULT_NAME].read_bytes())
@@ -105,9 +106,7 @@ def _rank_main(job_path: Path) -> None:
     try:
         result = pickle.loads(job_path.read_bytes())(comm)
     except BaseException as exc:
-        (job_path.parent / ERROR_NAME).write_text(one_line(exc) + "\n")
-        sys.stderr.flush()
-        comm.Abort(1)
+        abort_job(comm, exc)
     if comm.Get_rank() == 0:
         with atomic_path(job_path.parent / RESULT_NAME) as tmp:
             tmp.write_bytes(pickle.dumps(result))

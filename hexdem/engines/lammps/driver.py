@@ -27,18 +27,16 @@ from pathlib import Path
 
 import numpy as np
 
+from hexdem.common.job_failure import abort_job
 from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.deck import Deck
 from hexdem.engines.lammps.library import load_lammps
 from hexdem.engines.lammps.runner import RunInfo, lammps_failure, log_version
 from hexdem.engines.sampling import Sample
-from hexdem.errors import HexdemError, one_line
+from hexdem.errors import HexdemError
 
 #: The comment line that opens the output section of hexdem's impact decks.
 OUTPUT_MARKER = "# --- output"
-#: Environment variable naming the file where a rank that fails inside a sampling callback
-#: leaves its one-line error before it aborts the MPI job (set by the job runner).
-ERROR_FILE_VARIABLE = "HEXDEM_JOB_ERROR"
 STREAM_FIX = "hexdem_stream"
 
 
@@ -109,14 +107,7 @@ class _Stream:
         except BaseException as exc:  # a ctypes callback cannot raise: keep it for after the run
             self.error = exc
             if self.comm is not None and self.comm.Get_size() > 1:
-                self.abort(exc)
-
-    def abort(self, exc: BaseException) -> None:
-        """End the whole MPI job: the other ranks would wait for this one in a collective call."""
-        path = os.environ.get(ERROR_FILE_VARIABLE)
-        if path:
-            Path(path).write_text(one_line(exc) + "\n")
-        self.comm.Abort(1)
+                abort_job(self.comm, exc)
 
 
 def _lammps(deck: Deck, call, text: str) -> None:
