@@ -32,6 +32,29 @@ def _complete_beads(sweep: Sweep, combination: Combination) -> int:
     return int(np.argmin(complete)) if not complete.all() else len(complete)
 
 
+def read_sweep_peaks(out) -> tuple[np.ndarray, dict]:
+    """(V₀ (K,), {combination: peak speeds (K, L)}) from the ``peaks.csv`` of a finished
+    ``hexdem scaling`` in ``out``: the sweep again, for new fits without new runs."""
+    import csv
+    from pathlib import Path
+
+    from hexdem.errors import HexdemError
+
+    path = Path(out) / "peaks.csv"
+    try:
+        with open(path, newline="") as fh:
+            rows = [(float(r["strike_deg"]), r["line"], float(r["v0"]), int(r["n"]), float(r["peak_speed"]))
+                    for r in csv.DictReader(fh)]
+    except (OSError, KeyError, ValueError):
+        raise HexdemError(f"{path} is missing or is not the peaks.csv of hexdem scaling") from None
+    v0 = np.array(sorted({r[2] for r in rows}))
+    beads = max(r[3] for r in rows) + 1
+    table = {(strike, line): np.full((len(v0), beads), np.nan) for strike, line, *_ in rows}
+    for strike, line, v, n, peak in rows:
+        table[(strike, line)][np.searchsorted(v0, v), n] = peak
+    return v0, {name: table[(c.strike_deg, c.line)] for name, c in COMBINATIONS.items()}
+
+
 def write_outputs(sweep: Sweep, out, last: int | None = None, kind: str = "loglinear") -> dict:
     """Fit all four combinations and publish :data:`OUTPUT_FILES` in ``out``; returns the
     contents of ``scaling.json``."""

@@ -18,7 +18,8 @@ name       strike, line  start s   law         V_s / V₀
 
 **Per-V₀ fit** (:func:`fit_decay`). V_n = V_s c^{n − s} on the window s < n ≤ ``last``, with
 V_s the measured peak of the start bead (the paper's "V₁ is the maximum velocity of the
-first bead"), so c is the only free parameter. ``kind="loglinear"`` (default) regresses
+first bead"), so c is the only free parameter (a free V_s is the other reading the fit
+protocol search of :mod:`hexdem.theory.protocols` tries). ``kind="loglinear"`` (default) regresses
 log(V_n / V_s) on n − s through the origin; ``kind="nonlinear"`` is least squares on V_n
 itself (``scipy.optimize.curve_fit``). Both return c and its standard error, which is
 conditional on V_s (the measured start bead is taken as exact).
@@ -121,28 +122,38 @@ def polynomial_fit(x, y, degree: int, names) -> Fit:
     return Fit(tuple(names), values, covariance, rss, dof)
 
 
-def fit_decay(n, v, start: int, last: int, kind: str = "loglinear") -> tuple[float, float]:
-    """(c, stderr of c) of V_n = V_start c^{n − start} over start < n ≤ last, V_start = v[start]
-    (the stderr treats V_start as exact).
+def fit_decay(n, v, start: int, last: int, kind: str = "loglinear", anchored: bool = True) -> tuple[float, float]:
+    """(c, stderr of c) of V_n = V_s c^{n − s}, s = ``start``, from one line's peak speeds.
 
-    ``n`` bead numbers and ``v`` peak speeds of one line (n ascending from 0).
+    ``n`` bead numbers and ``v`` peak speeds of one line (n ascending from 0). Anchored (the
+    paper's reading), V_s = v[start] is the measured peak and the window is s < n ≤ last (the
+    stderr treats V_s as exact); free, V_s is a second parameter fitted with c over
+    s ≤ n ≤ last.
     """
     if kind not in FIT_KINDS:
         raise HexdemError(f"unknown fit type {kind!r}; use one of: {', '.join(FIT_KINDS)}")
     n, v = np.asarray(n), np.asarray(v, float)
-    window = (n > start) & (n <= last)
-    if np.count_nonzero(window) < 2:
+    window = (n > start - (not anchored)) & (n <= last)
+    if np.count_nonzero(window) < 2 + (not anchored):
         raise HexdemError(f"the window {start}..{last} needs at least two beads after the start bead")
-    anchor = v[n == start][0]
     k, vk = n[window] - start, v[window]
+    anchor = v[n == start][0]
     if not np.all(np.isfinite(vk)) or not np.isfinite(anchor):
         raise HexdemError(f"peak speeds missing in the window {start}..{last}: the run was too short")
-    slope = float(k @ np.log(vk / anchor) / (k @ k))
-    residual = np.log(vk / anchor) - slope * k
-    slope_err = math.sqrt(residual @ residual / (len(k) - 1) / (k @ k))
-    c, c_err = math.exp(slope), math.exp(slope) * slope_err
+    if anchored:
+        y, design = np.log(vk / anchor), k[:, None].astype(float)
+    else:
+        y, design = np.log(vk), np.vander(k.astype(float), 2)
+    coefficients, *_ = np.linalg.lstsq(design, y, rcond=None)
+    residual = y - design @ coefficients
+    covariance = residual @ residual / (len(k) - design.shape[1]) * np.linalg.inv(design.T @ design)
+    c, c_err = math.exp(coefficients[0]), math.exp(coefficients[0]) * math.sqrt(covariance[0, 0])
     if kind == "nonlinear":
-        popt, pcov = curve_fit(lambda kk, cc: anchor * cc**kk, k.astype(float), vk, p0=[c])
+        if anchored:
+            popt, pcov = curve_fit(lambda kk, cc: anchor * cc**kk, k.astype(float), vk, p0=[c])
+        else:
+            popt, pcov = curve_fit(lambda kk, cc, amplitude: amplitude * cc**kk, k.astype(float), vk,
+                                   p0=[c, math.exp(coefficients[1])])
         c, c_err = float(popt[0]), float(np.sqrt(pcov[0, 0]))
     return c, c_err
 
