@@ -18,13 +18,14 @@ from hexdem.disorder.preparation import (
     TOLERANCE_M,
     Disorder,
     Preparation,
-    contact_overlaps_m,
     edge_directions,
     read_data_file,
     read_stage,
     spaced_lattice,
+    walls_for_settling,
     write_stage_deck,
 )
+from hexdem.disorder.prestress import touching_pairs
 from hexdem.engines.lammps.engine import LammpsEngine
 from hexdem.engines.lammps.partitions import run_partitioned
 from hexdem.errors import HexdemError
@@ -68,7 +69,7 @@ def test_the_spaced_lattice_has_no_overlap(seed):
     distances = np.linalg.norm(lattice.positions_m[i] - lattice.positions_m[j], axis=1)
     gaps = distances - lattice.radii_m[i] - lattice.radii_m[j]
     assert gaps.min() >= -1e-15
-    assert len(contact_overlaps_m(lattice.positions_m, lattice.diameters_m)) == 0
+    assert len(touching_pairs(lattice.positions_m, lattice.diameters_m)[2]) == 0
     assert disorder.spacing_m(lattice.diameters_m) >= D + TOLERANCE_M
 
 
@@ -96,10 +97,21 @@ def test_edge_beads_are_pushed_inward_perpendicular_to_their_edge():
     (lambda: Preparation(push_force_n=0.0), "push_force_n must be a positive number"),
     (lambda: Preparation(settled_rms_speed_m_s=float("nan")), "settled_rms_speed_m_s must be a positive number"),
     (lambda: Preparation(max_steps=10.5), "max_steps must be an integer"),
+    (lambda: Preparation(wall_slack_m=-1e-6), "wall_slack_m must be a positive number"),
 ])
 def test_bad_preparation_parameters_are_refused(make, message):
     with pytest.raises(HexdemError, match=message):
         make()
+
+
+@pytest.mark.parametrize("slack", [0.0, 12.7e-6])
+def test_the_settling_walls_stand_back_from_every_member_by_the_slack(slack):
+    lattice = hexagon(4, D)
+    walled = walls_for_settling(lattice, Preparation(wall_slack_m=slack))
+    for wall in walled.walls:
+        members = np.asarray(wall.members)
+        np.testing.assert_allclose(wall.gaps_m(lattice.positions_m[members], lattice.radii_m[members]), slack,
+                                   atol=1e-15)
 
 
 # --------------------------------------------------------------------------- settling on LAMMPS
@@ -173,7 +185,7 @@ def test_overlaps_stay_below_those_of_the_whole_applied_load(prepared):
     pushed = np.count_nonzero(np.linalg.norm(edge_directions(prepared.compact.lattice), axis=1))
     bound = hertz_overlap(prepared.model, pushed * prepared.preparation.push_force_n + masses.sum() * 9.81)
     for state in (prepared.compacted, prepared.settled):
-        assert 0 < contact_overlaps_m(state.positions_m, state.diameters_m).max() < bound
+        assert 0 < touching_pairs(state.positions_m, state.diameters_m)[2].max() < bound
 
 
 def test_the_settled_packing_is_in_static_equilibrium(prepared):

@@ -44,6 +44,7 @@ from hexdem.disorder.preparation import (
     read_data_file,
     read_stage,
     spaced_lattice,
+    walls_for_settling,
 )
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
@@ -168,12 +169,14 @@ class Ensemble:
         return self.config.disorder.diameters_m(len(self.ideal), self.config.seed, k)
 
     def stage_model(self, k: int, stage: str) -> GranularModel:
-        """The packing a preparation stage starts from: spaced (compact) or compacted with walls (settle)."""
+        """The packing a preparation stage starts from: spaced (compact) or compacted with walls
+        (settle; the walls touch it, or stand back by the preparation's slack)."""
         if stage == "compact":
             spaced = spaced_lattice(self.ideal, self.diameters_m(k), self.config.disorder)
             return replace(self._base_model, lattice=spaced)
         compacted = self._stage_state(k, "compact")
-        return replace(self._base_model, lattice=self.ideal.with_geometry(compacted.positions_m, compacted.diameters_m))
+        walled = self.ideal.with_geometry(compacted.positions_m, compacted.diameters_m)
+        return replace(self._base_model, lattice=walls_for_settling(walled, self.config.preparation))
 
     def _stage_state(self, k: int, stage: str):
         directory = self.stage_dir(k, stage)

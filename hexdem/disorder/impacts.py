@@ -18,16 +18,18 @@ from pathlib import Path
 import numpy as np
 
 from hexdem.analysis.impact import ImpactAnalysis
+from hexdem.analysis.leading_pulse import leading_pulse_amplitude
 from hexdem.common.io import atomic_path
 from hexdem.disorder.ensemble import Ensemble, EnsembleConfig
-from hexdem.disorder.preparation import STAGES, contact_overlaps_m, read_stage
+from hexdem.disorder.preparation import STAGES, read_stage
+from hexdem.disorder.prestress import prestress, touching_pairs
 from hexdem.engines.lammps.partitions import loop_time_s
 from hexdem.experiments.run import check_energy
 from hexdem.experiments.tracked_run import ImpactJob, track_impact
 
 IMPACT_NAME = "impact.npz"
 #: Arrays of ``impact.npz``, stacked over the striker speeds in ``result.npz``.
-IMPACT_ARRAYS = ("peak_speed", "t_peak", "arrival_time", "energy_drift", "far_wall_reached", "impact_lammps_s")
+IMPACT_ARRAYS = ("peak_speed", "lead_speed", "t_peak", "arrival_time", "energy_drift", "far_wall_reached", "impact_lammps_s")
 
 
 def _save(path: Path, arrays: dict) -> None:
@@ -46,13 +48,17 @@ def run_impact(ensemble: Ensemble, k: int | None, v: float, dump: bool, comm=Non
     LAMMPS version."""
     directory = ensemble.impact_dir(k, v)
     gravity = None if k is None else tuple(float(g) for g in ensemble.gravity_m_s2)
+    line_beads = tuple(sorted({int(b) for beads in ensemble.ideal.lines().values() for b in beads}))
     job = ImpactJob(ensemble.impact_model(k, v), ensemble.settings(v), "lammps", directory, dump=dump,
-                    gravity_m_s2=gravity, show_progress=False)
+                    gravity_m_s2=gravity, trace_beads=line_beads, show_progress=False)
     analysis: ImpactAnalysis = track_impact(job, comm=comm)
     check_energy(analysis, analysis.engine["deck"])
     r = analysis.results
-    _save(directory / IMPACT_NAME, {"peak_speed": r.peak_speed, "t_peak": r.t_peak, "arrival_time": r.arrival_time,
-                                    "energy_drift": r.energy_drift, "far_wall_reached": r.far_wall_reached,
+    lead = np.full(len(r.peak_speed), np.nan)
+    lead[list(line_beads)] = leading_pulse_amplitude(analysis.tracked.trace_speeds)
+    _save(directory / IMPACT_NAME, {"peak_speed": r.peak_speed, "lead_speed": lead, "t_peak": r.t_peak,
+                                    "arrival_time": r.arrival_time, "energy_drift": r.energy_drift,
+                                    "far_wall_reached": r.far_wall_reached,
                                     "impact_lammps_s": analysis.engine["wall_time_s"]})
     return analysis.engine["version"]
 
@@ -84,16 +90,18 @@ def impact_done(ensemble: Ensemble, k: int | None, v: float) -> bool:
 
 def publish_result(ensemble: Ensemble, k: int | None) -> None:
     """Assemble realization k's (None: the ideal lattice's) ``result.npz`` from its impacts
-    (stacked over the striker speeds) and, for a realization, its packing and preparation."""
+    (stacked over the striker speeds) and, for a realization, its packing, the prestress it
+    keeps and its preparation."""
     impacts = [_load(directory / IMPACT_NAME) for directory in ensemble.impact_dirs(k)]
     arrays = {"velocities_m_s": np.array(ensemble.config.velocities_m_s)}
     arrays.update({name: np.array([impact[name] for impact in impacts]) for name in IMPACT_ARRAYS})
     if k is not None:
         lattice = ensemble.settled_lattice(k)
+        overlaps = touching_pairs(lattice.positions_m, lattice.diameters_m)[2]
         arrays.update(diameters_m=lattice.diameters_m, positions_m=lattice.positions_m,
                       wall_offsets_m=np.array([w.offset_m for w in lattice.walls]),
-                      max_overlap_m=float(np.max(contact_overlaps_m(lattice.positions_m, lattice.diameters_m),
-                                                 initial=0.0)))
+                      max_overlap_m=float(np.max(overlaps, initial=0.0)),
+                      **prestress(ensemble.impact_model(k, ensemble.config.velocities_m_s[0])).as_arrays())
         for stage in STAGES:
             result = read_stage(ensemble.stage_dir(k, stage))
             arrays[f"{stage}_steps"] = result.steps

@@ -15,7 +15,8 @@ random numbers would depend on the rank count).
    ``fix momentum`` removes both (fixed-direction forces on a rotated hexagon would drive
    the spin further). Artificial viscous drag F = −γ v settles the packing.
 2. ``settle``: the walls are placed touching the compacted packing
-   (:meth:`~hexdem.model.lattice.Lattice.with_geometry`), the 5 N forces are removed, gravity
+   (:meth:`~hexdem.model.lattice.Lattice.with_geometry`; or ``wall_slack_m`` further out, a
+   variant without prestress), the 5 N forces are removed, gravity
    g sin(tilt) acts along the strike direction (the set-up's tilt, 5° by default:
    0.855 m/s²), and a ten times weaker drag settles the packing again.
 
@@ -23,7 +24,8 @@ Damping times M/γ: 1.5 ms, then 15 ms. The settled packing (``settle/settled.da
 its contact overlaps) is the starting state of every striker velocity; the walls stay where
 step 2 put them. Walls placed around the compressed packing keep part of its compression
 once the 5 N are gone (overlaps of a few 0.1 µm, forces of order 1 N): even equal beads
-(σ = 0) prepared this way transmit 5-17 % less than the uncompressed ideal lattice.
+(σ = 0) prepared this way transmit 5-17 % less than the uncompressed ideal lattice
+(:mod:`hexdem.disorder.prestress` measures the load).
 
 **Settled** means, at a check every 100 steps after at least 1000 steps: the total kinetic
 energy Σ ½ m v² is below ½ (Σ m) v_rms², v_rms = 10 µm/s (4.8e-10 J for the 331 beads of
@@ -50,7 +52,6 @@ from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from hexdem.common.checks import is_number
 from hexdem.engines.lammps.deck import (
@@ -124,7 +125,10 @@ class Preparation:
 
     ``push_force_n`` inward force on edge beads in stage 1 [N]; ``tilt_deg`` tilt of the set-up,
     gravity g sin(tilt) along the strike [deg]; ``gravity_m_s2`` g; ``compact_damping_s`` and
-    ``settle_damping_s`` damping times M/γ of the two stages [s]; ``settled_rms_speed_m_s`` and
+    ``settle_damping_s`` damping times M/γ of the two stages [s]; ``wall_slack_m`` how far
+    the walls of stage 2 stand back from touching the compacted packing [m] (0: the paper's
+    scheme, which keeps a prestress; a slack larger than the compaction's overlaps gives a
+    packing held by gravity alone); ``settled_rms_speed_m_s`` and
     ``settled_max_force_n`` the rms bead speed [m/s] and the net force component [N] below which
     a stage is settled; ``max_dt_s`` and ``max_step_m`` bound the
     time step and the distance a bead moves per step; ``check_every``, ``min_steps`` and
@@ -136,6 +140,7 @@ class Preparation:
     gravity_m_s2: float = STANDARD_GRAVITY_M_S2
     compact_damping_s: float = 1.5e-3
     settle_damping_s: float = 15e-3
+    wall_slack_m: float = 0.0
     settled_rms_speed_m_s: float = 1e-5
     settled_max_force_n: float = 1e-4
     max_dt_s: float = 2e-5
@@ -147,7 +152,7 @@ class Preparation:
     def __post_init__(self):
         for f in fields(self):
             value = getattr(self, f.name)
-            if not is_number(value) or value < 0 or (value == 0 and f.name != "tilt_deg"):
+            if not is_number(value) or value < 0 or (value == 0 and f.name not in ("tilt_deg", "wall_slack_m")):
                 raise HexdemError(f"preparation parameter {f.name} must be a positive number, got {value!r}")
             if f.type == "int" and int(value) != value:
                 raise HexdemError(f"preparation parameter {f.name} must be an integer, got {value!r}")
@@ -161,6 +166,12 @@ class Preparation:
     def kinetic_tolerance_j(self, masses_kg) -> float:
         """The settling criterion: Σ ½ m v² below ½ (Σ m) v_rms² [J]."""
         return 0.5 * float(np.sum(masses_kg)) * self.settled_rms_speed_m_s**2
+
+
+def walls_for_settling(compacted: Lattice, preparation: Preparation) -> Lattice:
+    """The compacted packing with the walls of stage 2: touching it, moved back by the slack."""
+    walls = tuple(replace(wall, offset_m=wall.offset_m - preparation.wall_slack_m) for wall in compacted.walls)
+    return replace(compacted, walls=walls)
 
 
 def edge_directions(lattice: Lattice) -> np.ndarray:
@@ -317,12 +328,3 @@ def read_data_file(path) -> DataFileState:
         raise HexdemError(f"{path} is not a complete LAMMPS data file") from None
     return DataFileState(diameters_m=atoms[:, 2], positions_m=atoms[:, 4:6],
                          velocities_m_s=np.zeros((count, 2)) if velocities is None else velocities[:, 1:3])
-
-
-def contact_overlaps_m(positions_m, diameters_m) -> np.ndarray:
-    """Overlaps δ > 0 of every touching pair of beads [m]."""
-    positions_m, radii = np.asarray(positions_m, float), np.asarray(diameters_m, float) / 2
-    pairs = cKDTree(positions_m).query_pairs(2 * radii.max(), output_type="ndarray")
-    i, j = pairs.T
-    overlap = radii[i] + radii[j] - np.linalg.norm(positions_m[i] - positions_m[j], axis=1)
-    return overlap[overlap > 0]

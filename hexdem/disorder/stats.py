@@ -2,7 +2,8 @@
 
 Loads every realization's ``result.npz`` and the ideal lattice's (:mod:`hexdem.disorder.ensemble`
 runs them) and writes, into the ensemble directory, the tables ``peaks_stats.csv``,
-``ideal_peaks.csv``, ``arrival_map.csv`` and ``disorder_effect.csv`` and the figures of
+``ideal_peaks.csv``, ``arrival_map.csv``, ``disorder_effect.csv`` (peak speeds over the run)
+and ``leading_pulse_effect.csv`` (the leading pulses' amplitudes) and the figures of
 :mod:`hexdem.disorder.figures`; the summary goes to ``ensemble.json``.
 """
 
@@ -16,6 +17,7 @@ import numpy as np
 from hexdem.common.io import write_csv
 from hexdem.disorder.ensemble import Ensemble, velocity_name
 from hexdem.disorder.preparation import STAGES
+from hexdem.disorder.prestress import PRESTRESS_ARRAYS
 from hexdem.errors import HexdemError
 from hexdem.model.lattice import Lattice
 
@@ -32,16 +34,26 @@ EFFECT_FIRST_N = 2
 
 @dataclass(frozen=True)
 class EnsembleResults:
-    """Stacked results: ``peak_speed`` and ``arrival_time`` (R, V, N) for R realizations, V
-    striker velocities [m/s] and N beads [m/s, s]; ``ideal_*`` the ideal lattice's (V, N);
-    ``per_realization`` every other array of the realizations' ``result.npz``, stacked."""
+    """Stacked results: ``peak_speed``, ``lead_speed`` (the leading pulse's amplitude, NaN off
+    the lines, :mod:`hexdem.analysis.leading_pulse`) and ``arrival_time`` (R, V, N) for R
+    realizations, V striker velocities [m/s] and N beads [m/s, s]; ``ideal_*`` the ideal
+    lattice's (V, N); ``per_realization`` every other array of the realizations'
+    ``result.npz``, stacked."""
 
     velocities_m_s: np.ndarray
     peak_speed: np.ndarray
+    lead_speed: np.ndarray
     arrival_time: np.ndarray
     ideal_peak_speed: np.ndarray
+    ideal_lead_speed: np.ndarray
     ideal_arrival_time: np.ndarray
     per_realization: dict
+
+    def speeds(self, measure: str) -> tuple[np.ndarray, np.ndarray]:
+        """(disordered (R, V, N), ideal (V, N)) speeds of ``measure``: "peak" or "lead"."""
+        if measure == "lead":
+            return self.lead_speed, self.ideal_lead_speed
+        return self.peak_speed, self.ideal_peak_speed
 
 
 def _load(path: Path) -> dict:
@@ -58,12 +70,12 @@ def load_results(ensemble: Ensemble) -> EnsembleResults:
                           "rerun hexdem ensemble to complete it")
     runs = [_load(ensemble.result_path(k)) for k in range(config.realizations)]
     ideal = _load(ensemble.result_path(None))
+    stacked = ("peak_speed", "lead_speed", "arrival_time")
     return EnsembleResults(velocities_m_s=ideal["velocities_m_s"],
-                           peak_speed=np.array([r["peak_speed"] for r in runs]),
-                           arrival_time=np.array([r["arrival_time"] for r in runs]),
-                           ideal_peak_speed=ideal["peak_speed"], ideal_arrival_time=ideal["arrival_time"],
+                           **{name: np.array([r[name] for r in runs]) for name in stacked},
+                           **{f"ideal_{name}": ideal[name] for name in stacked},
                            per_realization={key: np.array([r[key] for r in runs]) for key in runs[0]
-                                            if key not in ("peak_speed", "arrival_time", "t_peak")}
+                                            if key not in (*stacked, "t_peak")}
                            | {"ideal_energy_drift": ideal["energy_drift"],
                               "ideal_lammps_s": ideal["impact_lammps_s"]})
 
@@ -109,22 +121,24 @@ def arrival_rows(results: EnsembleResults, lattice: Lattice, reference: int) -> 
             for bead, ((m, n), (x, y)) in enumerate(zip(lattice.indices, lattice.positions_m))]
 
 
-def disorder_effect(results: EnsembleResults, lattice: Lattice) -> list[tuple]:
+def disorder_effect(results: EnsembleResults, lattice: Lattice, measure: str = "peak") -> list[tuple]:
     """Transmission along each line, disordered / ideal (the paper's claim of Sec. VI-B).
 
     For each realization, the ratio V_n / V_n(ideal) averaged over beads n ≥ 2 of the line
-    whose ideal peak was seen; then the mean, sample standard deviation and standard error
-    over realizations. "±30" pools both 30° lines of each realization.
+    whose ideal speed was seen; then the mean, sample standard deviation and standard error
+    over realizations. "±30" pools both 30° lines of each realization. ``measure``: V_n is the
+    peak speed over the run ("peak") or the leading pulse's amplitude ("lead").
     """
     rows = []
     lines = lattice.lines()
+    speeds, ideal_speeds = results.speeds(measure)
     for iv, v in enumerate(results.velocities_m_s):
         ratios = {}
         for line, beads in lines.items():
             beads = beads[EFFECT_FIRST_N:]
-            beads = beads[np.isfinite(results.ideal_peak_speed[iv, beads])]
+            beads = beads[np.isfinite(ideal_speeds[iv, beads])]
             with np.errstate(invalid="ignore"):
-                ratios[line] = (results.peak_speed[:, iv, beads] / results.ideal_peak_speed[iv, beads], beads)
+                ratios[line] = (speeds[:, iv, beads] / ideal_speeds[iv, beads], beads)
         longer = max(ratios["+30"][1], ratios["-30"][1], key=len)
         ratios["±30"] = (np.concatenate([ratios["+30"][0], ratios["-30"][0]], axis=1), longer)
         for line, (ratio, beads) in ratios.items():
@@ -140,7 +154,7 @@ def write_statistics(ensemble: Ensemble, laws: dict | None = None) -> dict:
     """Write the tables and figures of a finished ensemble; returns the summary for ensemble.json.
 
     Tables: ``peaks_stats.csv``, ``ideal_peaks.csv``, ``arrival_map.csv`` (relative to the
-    reference bead), ``disorder_effect.csv``. Figures: ``fig9_all_directions.png`` (with the
+    reference bead), ``disorder_effect.csv``, ``leading_pulse_effect.csv``. Figures: ``fig9_all_directions.png`` (with the
     fitted ``laws`` {line: ScalingLaw} if any) and ``fig8_expnumsim_v<V>.png`` per velocity.
     """
     from hexdem.disorder import figures as ensemble_plots
@@ -149,11 +163,12 @@ def write_statistics(ensemble: Ensemble, laws: dict | None = None) -> dict:
     results = load_results(ensemble)
     reference = lattice.index_of(*config.reference_bead)
     stats, ideal = peak_statistics(results, lattice), ideal_peaks(results, lattice)
-    effect = disorder_effect(results, lattice)
+    effect, lead_effect = disorder_effect(results, lattice), disorder_effect(results, lattice, "lead")
     write_csv(out / "peaks_stats.csv", STATS_COLUMNS, stats)
     write_csv(out / "ideal_peaks.csv", IDEAL_COLUMNS, ideal)
     write_csv(out / "arrival_map.csv", ARRIVAL_COLUMNS, arrival_rows(results, lattice, reference))
     write_csv(out / "disorder_effect.csv", EFFECT_COLUMNS, effect)
+    write_csv(out / "leading_pulse_effect.csv", EFFECT_COLUMNS, lead_effect)
     ensemble_plots.all_directions(stats, ideal, laws or {}, out / "fig9_all_directions.png")
     ideal_rel, disordered_rel = relative_arrivals(results, reference)
     for iv, v in enumerate(results.velocities_m_s):
@@ -163,6 +178,9 @@ def write_statistics(ensemble: Ensemble, laws: dict | None = None) -> dict:
     per = results.per_realization
     return {
         "disorder_effect": [dict(zip(EFFECT_COLUMNS, row)) for row in effect],
+        "leading_pulse_effect": [dict(zip(EFFECT_COLUMNS, row)) for row in lead_effect],
+        "prestress": {name: {"mean": float(np.mean(per[name])), "std": float(np.std(per[name], ddof=1))
+                             if len(per[name]) > 1 else 0.0} for name in PRESTRESS_ARRAYS},
         "preparation": {stage: {"mean_steps": float(np.mean(per[f"{stage}_steps"])),
                                 "max_steps": int(np.max(per[f"{stage}_steps"])),
                                 "mean_simulated_time_s": float(np.mean(per[f"{stage}_time_s"])),

@@ -1,0 +1,54 @@
+"""The amplitude of a bead's leading pulse, as opposed to its largest speed over the run.
+
+In an ideal lattice a bead's speed has one clear maximum, the passing wavefront. In a
+disordered packing the front can break up: a weaker pulse arrives first and later motion
+(a slower part of the front, scattered waves, the walls' echoes) can outgrow it. The peak
+speed over the run (:mod:`hexdem.analysis.peaks`) then measures the largest of these, not
+what the front transmitted.
+
+**Definition.** The leading pulse of a bead is its first maximum of |v| that reaches
+:data:`LEAD_THRESHOLD` of the bead's largest speed over the run and after which |v| falls
+below :data:`LEAD_FALL` of that maximum before it rises above it again: the first clear
+hump of the signal, wiggles of less than 20 % not counting as one. Its amplitude is the
+vertex of the parabola through the largest sample and its two neighbours (the speed at a
+sampled maximum, corrected for the sampling grid). A bead whose signal never falls that far
+after its first hump, or never moved, gets NaN.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: The leading pulse must reach this fraction of the bead's largest speed.
+LEAD_THRESHOLD = 0.2
+#: ... and be followed by a fall below this fraction of its own maximum.
+LEAD_FALL = 0.8
+
+
+def _parabola_vertex(before: float, peak: float, after: float) -> float:
+    curvature = before - 2 * peak + after
+    if curvature >= 0:
+        return peak
+    return peak - (after - before) ** 2 / (8 * curvature)
+
+
+def leading_pulse_amplitude(speeds, threshold: float = LEAD_THRESHOLD, fall: float = LEAD_FALL) -> np.ndarray:
+    """(B,) leading-pulse amplitudes of the speed signals ``speeds`` (S samples, B beads)."""
+    speeds = np.asarray(speeds, float)
+    amplitudes = np.full(speeds.shape[1], np.nan)
+    for bead, signal in enumerate(speeds.T):
+        largest = np.nanmax(signal) if np.any(np.isfinite(signal)) else 0.0
+        if not largest > 0:
+            continue
+        above = np.flatnonzero(signal >= threshold * largest)
+        best, index = -np.inf, -1
+        for k in range(above[0], len(signal)):
+            if signal[k] > best:
+                best, index = signal[k], k
+            elif signal[k] < fall * best:
+                break
+        else:
+            continue
+        if 0 < index < len(signal) - 1:
+            amplitudes[bead] = _parabola_vertex(signal[index - 1], best, signal[index + 1])
+    return amplitudes
