@@ -33,6 +33,16 @@ def dumped_run(tmp_path_factory):
     return out, analysis
 
 
+@pytest.fixture(scope="session")
+def paper_quick(tmp_path_factory):
+    """``hexdem paper --quick`` once per session (about two minutes): its output directory."""
+    from hexdem.cli.main import main
+
+    out = tmp_path_factory.mktemp("paper") / "out"
+    assert main(["paper", "--out", str(out), "--quick"]) == 0
+    return out
+
+
 def record(engine, model, settings, directory, **options):
     """Run ``model`` with ``engine`` on one rank, keeping every sample: the whole trajectory (SI)."""
     recorder = TrajectoryRecorder(model, settings)

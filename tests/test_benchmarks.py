@@ -2,7 +2,8 @@
 
 The quick modes take the full modes' code paths on small packings and few steps (seconds
 each), so that an API change that breaks a benchmark is caught here rather than when
-someone next measures.
+someone next measures. The paper benchmark resumes the session's ``hexdem paper --quick``
+(tests/test_paper.py) rather than running the two-minute pipeline a second time.
 """
 
 import subprocess
@@ -24,6 +25,8 @@ EXPECTED = {
                           "phase", "compact", "settle", "impacts", "target <= 120 s"),
     "bench_scale.py": ("beads", "ranks", "bare loop [s]", "end-to-end [s]", "ratio", "peak RSS per process [MB]",
                        "hexdem bytes", "bare bytes", "target"),
+    "bench_paper.py": ("hexdem paper --quick", "part", "wall [s]", "scaling", "disorder-sigma6tol",
+                       "sum of parts", "this invocation", "target <= 120 s"),
 }
 
 
@@ -32,8 +35,10 @@ def test_every_benchmark_is_checked():
 
 
 @pytest.mark.parametrize("script", sorted(EXPECTED))
-def test_quick_benchmark_runs(script):
-    done = subprocess.run([sys.executable, str(BENCHMARKS / script), "--quick"], cwd=ROOT, check=False,
+def test_quick_benchmark_runs(script, request):
+    # the paper benchmark reports on the session's quick paper run instead of a second one
+    extra = ["--out", str(request.getfixturevalue("paper_quick"))] if script == "bench_paper.py" else []
+    done = subprocess.run([sys.executable, str(BENCHMARKS / script), "--quick", *extra], cwd=ROOT, check=False,
                           capture_output=True, text=True, timeout=180)
     assert done.returncode == 0, f"{script} --quick failed:\n{done.stdout}\n{done.stderr[-3000:]}"
     lines = done.stdout.splitlines()

@@ -1,0 +1,1 @@
+"""``hexdem paper``: the whole paper in one command, published numbers beside computed ones."""

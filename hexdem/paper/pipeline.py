@@ -1,0 +1,159 @@
+"""``hexdem paper``: every part of the paper, resumable, behind one progress display.
+
+The parts, each writing into its own folder of ``DIR``:
+
+=====================  =====================================================================
+``tca/``               ω, c and Fig. 5 (both lattices simulated)
+``fig3/``, ``fig4/``   wavefront snapshots, Figs. 3 and 4 (Fig. 4 on ``workers`` MPI ranks)
+``scaling/``           the V₀ sweep and the four laws, Figs. 6 and 7
+``fit_protocols/``     the fit-protocol search on that sweep
+``disorder/<name>/``   the disorder study's ensembles; ``sigma6tol`` holds Figs. 8 and 9
+``disorder/``          the study's tables, figure and verdict
+=====================  =====================================================================
+
+then ``report.html``, ``report.md`` and ``published_vs_computed.csv`` (:mod:`hexdem.paper.report`).
+
+**Resuming.** A finished part leaves ``DIR/parts/<name>.json`` (its summary, written
+atomically last); a rerun skips every part that has one, and the ensembles resume
+realization by realization. ``DIR/paper.json`` records the settings: a rerun with others
+(``--quick`` or not) is refused rather than mixed.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from pathlib import Path
+
+from hexdem.common.io import ensure_writable_dir, write_json
+from hexdem.common.progress import progress_bar, silenced
+from hexdem.errors import HexdemError
+from hexdem.paper.disorder_study import (
+    FIGURES_ENSEMBLE,
+    prestress_rows,
+    run_study_ensemble,
+    study_ensembles,
+    study_figure,
+    study_rows,
+    verdict,
+)
+from hexdem.paper.settings import PaperSettings
+
+SETTINGS_NAME = "paper.json"
+#: Snapshot times of Fig. 4 on the quick run's smaller half-hexagon [ms].
+QUICK_FIG4_TIMES_MS = (0.2, 0.4, 0.6, 0.8, 1.0, 1.2)
+
+
+def _tca(out: Path) -> dict:
+    from hexdem.theory import tca
+    from hexdem.theory.tca_lattice import write_fig5
+
+    result = {**tca.summary(), "lattice": write_fig5(ensure_writable_dir(out / "tca"), "reference", _quiet)}
+    write_json(out / "tca" / "tca.json", result)
+    return result
+
+
+def _snapshots(settings: PaperSettings, out: Path, shape: str) -> dict:
+    from hexdem.experiments.snapshots import DEFAULT_TIMES_MS, run_snapshots
+    from hexdem.model.config import RunConfig
+
+    long_edge, short_edge = settings.half_hexagon
+    half = shape == "half-hexagon"
+    config = RunConfig(shape=shape, long_edge=long_edge, short_edge=short_edge, impact="striker", v0=0.4,
+                       ranks=settings.workers if half else 1)
+    times_ms = QUICK_FIG4_TIMES_MS if half and settings.quick else DEFAULT_TIMES_MS[shape]
+    folder = out / ("fig4" if half else "fig3")
+    run_snapshots(config, [t * 1e-3 for t in times_ms], folder, outline_edge=11 if half else None, log=_quiet)
+    return json.loads((folder / "snapshots.json").read_text())
+
+
+def _scaling(settings: PaperSettings, out: Path) -> dict:
+    from hexdem.theory.outputs import write_outputs
+    from hexdem.theory.sweep import SweepSettings, run_sweep
+
+    sweep = run_sweep(SweepSettings(n_v0=settings.n_v0, workers=settings.workers), log=_quiet)
+    return write_outputs(sweep, out / "scaling")
+
+
+def _fit_protocols(out: Path) -> dict:
+    from hexdem.paper.fit_protocols import run_search
+
+    return run_search(out / "scaling", ensure_writable_dir(out / "fit_protocols"))
+
+
+def _disorder_summary(summaries: list[dict], out: Path) -> dict:
+    from hexdem.common.io import write_csv
+    from hexdem.paper.disorder_study import PRESTRESS_COLUMNS, STUDY_COLUMNS
+
+    rows = study_rows(summaries)
+    folder = out / "disorder"
+    write_csv(folder / "disorder_study.csv", STUDY_COLUMNS, rows)
+    write_csv(folder / "prestress.csv", PRESTRESS_COLUMNS, prestress_rows(summaries))
+    study_figure(rows, folder / "disorder_study.png")
+    result = {"rows": [dict(zip(STUDY_COLUMNS, row)) for row in rows], "verdict": verdict(rows),
+              "prestress": [dict(zip(PRESTRESS_COLUMNS, row)) for row in prestress_rows(summaries)],
+              "figures_ensemble": FIGURES_ENSEMBLE}
+    write_json(folder / "disorder_study.json", result)
+    return result
+
+
+def _quiet(message: str) -> None:
+    """The parts' own logs: the paper's progress display replaces them."""
+
+
+def _check_settings(out: Path, settings: PaperSettings) -> None:
+    path = out / SETTINGS_NAME
+    if path.exists():
+        try:
+            previous = json.loads(path.read_text())["identity"]
+        except (OSError, ValueError, KeyError, TypeError):
+            raise HexdemError(f"{path} is unreadable: {out} does not hold a hexdem paper run; "
+                              "choose another --out") from None
+        if previous != settings.identity():
+            raise HexdemError(f"{out} holds a hexdem paper run with other settings ({previous}); "
+                              "rerun with the same ones to resume it, or choose another --out")
+    write_json(path, {"identity": settings.identity(), "settings": settings.as_dict()})
+
+
+def run_paper(settings: PaperSettings, out, log=None) -> dict:
+    """Run (or resume) every part into ``out`` and write the report; returns the parts' summaries."""
+    from hexdem.paper.report import write_report
+
+    log = log or (lambda message: print(f"hexdem paper: {message}", file=sys.stderr, flush=True))
+    out = ensure_writable_dir(out)
+    _check_settings(out, settings)
+    scaling_json = out / "scaling" / "scaling.json"
+    ensembles = study_ensembles()
+    parts = [("tca", "TCA and Fig. 5", lambda: _tca(out)),
+             ("fig3", "Fig. 3 snapshots", lambda: _snapshots(settings, out, "hexagon")),
+             ("fig4", "Fig. 4 snapshots", lambda: _snapshots(settings, out, "half-hexagon")),
+             ("scaling", f"V0 sweep ({settings.n_v0} values) and laws, Figs. 6-7", lambda: _scaling(settings, out)),
+             ("fit_protocols", "fit-protocol search", lambda: _fit_protocols(out))]
+    parts += [(f"disorder-{e.name}", f"ensemble {e.name}",
+               lambda e=e: run_study_ensemble(e, settings, out / "disorder", scaling_json)) for e in ensembles]
+    parts.append(("disorder", "disorder study and verdict",
+                  lambda: _disorder_summary([summaries[f"disorder-{e.name}"] for e in ensembles], out)))
+    summaries: dict = {}
+    bar = progress_bar(len(parts), "hexdem paper", unit="part")
+    start = time.perf_counter()
+    with silenced():
+        for k, (name, label, work) in enumerate(parts, 1):
+            marker = out / "parts" / f"{name}.json"
+            bar.set_description(label)
+            if marker.exists():
+                summaries[name] = json.loads(marker.read_text())["summary"]
+                bar.write(f"hexdem paper: [{k}/{len(parts)}] {label}: done before", file=sys.stderr)
+            else:
+                begun = time.perf_counter()
+                summary = work()
+                ensure_writable_dir(marker.parent)
+                write_json(marker, {"summary": summary, "wall_time_s": time.perf_counter() - begun})
+                summaries[name] = json.loads(marker.read_text())["summary"]
+                bar.write(f"hexdem paper: [{k}/{len(parts)}] {label}: {time.perf_counter() - begun:.1f} s",
+                          file=sys.stderr)
+            bar.update(1)
+        bar.close()
+        write_report(out, settings, summaries, time.perf_counter() - start)
+    log(f"report in {out / 'report.html'} ({time.perf_counter() - start:.0f} s)")
+    return summaries

@@ -1,0 +1,62 @@
+"""What ``hexdem paper`` computes: the full paper, or ``--quick`` (fewer V₀ and realizations).
+
+Both run the same code paths; ``--quick`` only thins the sweep and the ensembles, so that
+it checks the whole pipeline in about two minutes. Its numbers are rough.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+from hexdem.common.checks import positive_int
+from hexdem.disorder.preparation import TOLERANCE_M
+
+#: Disorder strengths σ / tol of the disorder study (the paper's is 6).
+SIGMA_PER_TOL = (0.0, 1.0, 2.0, 3.0, 6.0)
+#: Striker speed of the disorder study [m/s] and those of Fig. 9 (σ = 6 tol).
+STUDY_VELOCITY_M_S = 0.40
+FIG9_VELOCITIES_M_S = (0.25, 0.40, 0.70)
+#: σ / tol at which the preparation is also run without prestress.
+RELAXED_SIGMA_PER_TOL = (0.0, 6.0)
+#: Slack of the walls in the preparation without prestress [m]: one diameter tolerance,
+#: twice the compaction's total shrinkage across the 21-bead hexagon (about 6 µm).
+RELAXED_WALL_SLACK_M = TOLERANCE_M
+
+
+@dataclass(frozen=True)
+class PaperSettings:
+    """``quick``: the thinned variant; ``workers``: processes (sweep runs, LAMMPS partitions,
+    MPI ranks of Fig. 4) at once.
+
+    ``n_v0`` V₀ values of the scaling sweep (0.01 … 0.30); ``realizations`` per disordered
+    ensemble (σ = 0 needs one: equal beads prepared the same way are identical);
+    ``half_hexagon`` (long, short) edges of Fig. 4's packing.
+    """
+
+    quick: bool = False
+    workers: int = 2
+
+    def __post_init__(self):
+        positive_int("--workers", self.workers)
+
+    @property
+    def n_v0(self) -> int:
+        return 8 if self.quick else 30
+
+    @property
+    def realizations(self) -> int:
+        return 2 if self.quick else 20
+
+    @property
+    def half_hexagon(self) -> tuple[int, int]:
+        return (41, 21) if self.quick else (91, 46)
+
+    def identity(self) -> dict:
+        """What the results depend on (not the number of workers)."""
+        return {"quick": self.quick}
+
+    def as_dict(self) -> dict:
+        return {**asdict(self), "n_v0": self.n_v0, "realizations": self.realizations,
+                "half_hexagon": list(self.half_hexagon), "sigma_per_tol": list(SIGMA_PER_TOL),
+                "study_velocity_m_s": STUDY_VELOCITY_M_S, "fig9_velocities_m_s": list(FIG9_VELOCITIES_M_S),
+                "relaxed_sigma_per_tol": list(RELAXED_SIGMA_PER_TOL), "relaxed_wall_slack_m": RELAXED_WALL_SLACK_M}
