@@ -18,7 +18,9 @@ from conftest import read_csv
 
 from hexdem.cli.main import main
 from hexdem.disorder.ensemble import Ensemble, EnsembleConfig
+from hexdem.disorder.preparation import SETTLED_NAME, Preparation
 from hexdem.disorder.runner import run_ensemble
+from hexdem.disorder.sharing import adopt_compaction, adopt_ideal_impacts
 from hexdem.disorder.stats import STATS_COLUMNS
 from hexdem.engines.lammps.partitions import DONE_MARKER, run_partitioned
 from hexdem.errors import HexdemError
@@ -98,6 +100,25 @@ def test_another_seed_draws_other_diameters(reference):
     other = Ensemble(EnsembleConfig(**SMALL, seed=1), ensemble.out)
     assert np.all(other.diameters_m(0) != ensemble.diameters_m(0))
     np.testing.assert_allclose(results(ensemble, 2)["diameters_m"], ensemble.diameters_m(2), rtol=1e-15)
+
+
+def test_identical_work_of_another_ensemble_is_adopted_and_gives_the_same_results(reference, tmp_path):
+    """Walls stood back (another settle) share the compaction and the ideal impacts; another
+    seed shares only the ideal impacts; another size shares nothing."""
+    ensemble, _ = reference
+    slack = EnsembleConfig(**SMALL, preparation=Preparation(wall_slack_m=1e-6))
+    sharing = Ensemble(slack, tmp_path / "slack")
+    assert adopt_compaction(sharing, ensemble) == 3 and adopt_ideal_impacts(sharing, ensemble) == 2
+    run_ensemble(slack, sharing.out, workers=2, log=quiet)
+    np.testing.assert_array_equal(results(sharing, None)["peak_speed"], results(ensemble, None)["peak_speed"])
+    for k in range(3):
+        assert (sharing.stage_dir(k, "compact") / SETTLED_NAME).read_bytes() == \
+            (ensemble.stage_dir(k, "compact") / SETTLED_NAME).read_bytes()
+        assert not np.array_equal(results(sharing, k)["wall_offsets_m"], results(ensemble, k)["wall_offsets_m"])
+    seeded = Ensemble(EnsembleConfig(**SMALL, seed=1), tmp_path / "seed")
+    assert adopt_compaction(seeded, ensemble) == 0 and adopt_ideal_impacts(seeded, ensemble) == 2
+    larger = Ensemble(EnsembleConfig(**{**SMALL, "edge_beads": 5}), tmp_path / "larger")
+    assert adopt_compaction(larger, ensemble) == 0 and adopt_ideal_impacts(larger, ensemble) == 0
 
 
 def wait_for_unlock(out, timeout_s=60):

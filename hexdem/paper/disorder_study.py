@@ -27,12 +27,12 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.disorder.ensemble import EnsembleConfig
+from hexdem.disorder.ensemble import Ensemble, EnsembleConfig
 from hexdem.disorder.preparation import TOLERANCE_M, Disorder, Preparation
 from hexdem.disorder.runner import run_ensemble
+from hexdem.disorder.sharing import adopt_compaction, adopt_ideal_impacts
 from hexdem.model.materials import PAPER_DIAMETER_M
 from hexdem.paper.settings import (
-    FIG9_VELOCITIES_M_S,
     RELAXED_SIGMA_PER_TOL,
     RELAXED_WALL_SLACK_M,
     SIGMA_PER_TOL,
@@ -76,16 +76,28 @@ class StudyEnsemble:
                               velocities_m_s=self.velocities_m_s, disorder=disorder, preparation=preparation)
 
 
-def study_ensembles() -> list[StudyEnsemble]:
+def study_ensembles(settings: PaperSettings) -> list[StudyEnsemble]:
     """Every ensemble of the study; the paper's (σ = 6 tol, prestressed) also at Fig. 9's speeds."""
-    ensembles = [StudyEnsemble(s, False, FIG9_VELOCITIES_M_S if s == 6 else (STUDY_VELOCITY_M_S,))
+    ensembles = [StudyEnsemble(s, False, settings.fig9_velocities_m_s if s == 6 else (STUDY_VELOCITY_M_S,))
                  for s in SIGMA_PER_TOL]
     return ensembles + [StudyEnsemble(s, True, (STUDY_VELOCITY_M_S,)) for s in RELAXED_SIGMA_PER_TOL]
 
 
-def run_study_ensemble(entry: StudyEnsemble, settings: PaperSettings, out: Path, scaling_json) -> dict:
-    """Run (or resume) one ensemble of the study into ``out / entry.name``; its summary."""
-    summary = run_ensemble(entry.config(settings.realizations), out / entry.name, workers=settings.workers,
+def run_study_ensemble(entry: StudyEnsemble, settings: PaperSettings, out: Path, scaling_json,
+                       others: list[StudyEnsemble] = ()) -> dict:
+    """Run (or resume) one ensemble of the study into ``out / entry.name``; its summary.
+
+    What ``others`` (the study's other ensembles, in ``out``) have already run identically,
+    the ideal impacts and compactions, is copied rather than run again
+    (:mod:`hexdem.disorder.sharing`)."""
+    config = entry.config(settings.realizations)
+    ensemble = Ensemble(config, out / entry.name)
+    for other in others:
+        if other != entry and (out / other.name).is_dir():
+            source = Ensemble(other.config(settings.realizations), out / other.name)
+            adopt_ideal_impacts(ensemble, source)
+            adopt_compaction(ensemble, source)
+    summary = run_ensemble(config, out / entry.name, workers=settings.workers,
                            scaling_json=scaling_json, log=lambda message: None)
     return {"name": entry.name, "sigma_per_tol": entry.sigma_per_tol, "preparation": entry.preparation_name,
             **{key: summary[key] for key in ("prestress", "this_run", *MEASURES.values())}}

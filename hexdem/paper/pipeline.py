@@ -124,14 +124,15 @@ def run_paper(settings: PaperSettings, out, log=None) -> dict:
     out = ensure_writable_dir(out)
     _check_settings(out, settings)
     scaling_json = out / "scaling" / "scaling.json"
-    ensembles = study_ensembles()
+    ensembles = study_ensembles(settings)
     parts = [("tca", "TCA and Fig. 5", lambda: _tca(out)),
              ("fig3", "Fig. 3 snapshots", lambda: _snapshots(settings, out, "hexagon")),
              ("fig4", "Fig. 4 snapshots", lambda: _snapshots(settings, out, "half-hexagon")),
              ("scaling", f"V0 sweep ({settings.n_v0} values) and laws, Figs. 6-7", lambda: _scaling(settings, out)),
              ("fit_protocols", "fit-protocol search", lambda: _fit_protocols(out))]
     parts += [(f"disorder-{e.name}", f"ensemble {e.name}",
-               lambda e=e: run_study_ensemble(e, settings, out / "disorder", scaling_json)) for e in ensembles]
+               lambda e=e: run_study_ensemble(e, settings, out / "disorder", scaling_json, ensembles))
+              for e in ensembles]
     parts.append(("disorder", "disorder study and verdict",
                   lambda: _disorder_summary([summaries[f"disorder-{e.name}"] for e in ensembles], out)))
     summaries: dict = {}

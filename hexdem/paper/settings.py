@@ -30,7 +30,8 @@ class PaperSettings:
 
     ``n_v0`` V₀ values of the scaling sweep (0.01 … 0.30); ``realizations`` per disordered
     ensemble (σ = 0 needs one: equal beads prepared the same way are identical);
-    ``half_hexagon`` (long, short) edges of Fig. 4's packing.
+    ``half_hexagon`` (long, short) edges of Fig. 4's packing; ``fig9_velocities_m_s`` the
+    striker speeds of Figs. 8 and 9 (the quick run: the study's speed only).
     """
 
     quick: bool = False
@@ -48,6 +49,10 @@ class PaperSettings:
         return 2 if self.quick else 20
 
     @property
+    def fig9_velocities_m_s(self) -> tuple[float, ...]:
+        return (STUDY_VELOCITY_M_S,) if self.quick else FIG9_VELOCITIES_M_S
+
+    @property
     def half_hexagon(self) -> tuple[int, int]:
         return (41, 21) if self.quick else (91, 46)
 
@@ -58,5 +63,5 @@ class PaperSettings:
     def as_dict(self) -> dict:
         return {**asdict(self), "n_v0": self.n_v0, "realizations": self.realizations,
                 "half_hexagon": list(self.half_hexagon), "sigma_per_tol": list(SIGMA_PER_TOL),
-                "study_velocity_m_s": STUDY_VELOCITY_M_S, "fig9_velocities_m_s": list(FIG9_VELOCITIES_M_S),
+                "study_velocity_m_s": STUDY_VELOCITY_M_S, "fig9_velocities_m_s": list(self.fig9_velocities_m_s),
                 "relaxed_sigma_per_tol": list(RELAXED_SIGMA_PER_TOL), "relaxed_wall_slack_m": RELAXED_WALL_SLACK_M}

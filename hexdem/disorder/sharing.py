@@ -1,0 +1,64 @@
+"""Work that two ensembles have in common, done once: the ideal lattice's impacts and
+compaction decks that are the same to the byte.
+
+A study that runs several ensembles (``hexdem paper``: one per disorder strength and
+preparation) would otherwise strike the same ideal lattice at the same speed in every one,
+and compact the same diameters twice when only the walls' placement after compaction
+differs. LAMMPS being deterministic on one rank, a run that is the same is not repeated but
+its finished files are copied from the ensemble that has them:
+
+* an ideal impact, when both ensembles' runs at that speed have equal configurations
+  (:meth:`~hexdem.disorder.ensemble.EnsembleConfig.run_config`) and the source's
+  ``impact.npz`` exists;
+* a realization's compaction, when both render the same deck and data file and the
+  source's stage is finished (its done marker).
+
+Copies are made before the ensemble runs; it then resumes as if it had run them itself.
+"""
+
+from __future__ import annotations
+
+import shutil
+import tempfile
+from pathlib import Path
+
+from hexdem.disorder.ensemble import Ensemble
+from hexdem.disorder.impacts import IMPACT_NAME
+from hexdem.disorder.preparation import write_stage_deck
+from hexdem.engines.lammps.deck import DATA_NAME, DECK_NAME
+from hexdem.engines.lammps.partitions import is_done
+
+
+def adopt_ideal_impacts(ensemble: Ensemble, source: Ensemble) -> int:
+    """Copy ``source``'s finished ideal impacts that ``ensemble`` would run identically; how many."""
+    adopted = 0
+    for v in ensemble.config.velocities_m_s:
+        theirs, ours = source.impact_dir(None, v) / IMPACT_NAME, ensemble.impact_dir(None, v) / IMPACT_NAME
+        same = v in source.config.velocities_m_s and source.config.run_config(v) == ensemble.config.run_config(v)
+        if same and theirs.exists() and not ours.exists():
+            ours.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(theirs, ours)
+            adopted += 1
+    return adopted
+
+
+def _same_deck(a: Path, b: Path) -> bool:
+    return all((a / name).read_bytes() == (b / name).read_bytes() for name in (DECK_NAME, DATA_NAME))
+
+
+def adopt_compaction(ensemble: Ensemble, source: Ensemble) -> int:
+    """Copy ``source``'s finished compaction of every realization whose compaction deck
+    ``ensemble`` would render identically; how many."""
+    adopted = 0
+    with tempfile.TemporaryDirectory(prefix="hexdem-compact-") as scratch:
+        for k in range(min(ensemble.config.realizations, source.config.realizations)):
+            theirs, ours = source.stage_dir(k, "compact"), ensemble.stage_dir(k, "compact")
+            if not is_done(theirs) or is_done(ours):
+                continue
+            rendered = write_stage_deck(ensemble.stage_model(k, "compact"), "compact", ensemble.config.preparation,
+                                        Path(scratch) / f"r{k}")
+            if _same_deck(rendered, theirs):
+                shutil.rmtree(ours, ignore_errors=True)
+                shutil.copytree(theirs, ours)
+                adopted += 1
+    return adopted
