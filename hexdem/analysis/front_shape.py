@@ -19,8 +19,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.interpolate import LinearNDInterpolator
-from scipy.spatial import ConvexHull, QhullError, cKDTree
+from scipy.spatial import ConvexHull, Delaunay, QhullError, cKDTree
 
 from hexdem.errors import HexdemError
 
@@ -72,13 +71,34 @@ def _checked(positions, arrival_times, origin):
     return positions - origin, arrival_times
 
 
+def linear_field(points, values):
+    """f(xi): ``values`` interpolated linearly on the Delaunay triangles of ``points`` (n, 2), NaN
+    outside their hull: what ``scipy.interpolate.LinearNDInterpolator`` computes, without
+    importing ``scipy.interpolate`` into every run."""
+    triangulation = Delaunay(points)
+    values = np.asarray(values, float)
+
+    def field(xi):
+        xi = np.asarray(xi, float)
+        flat = xi.reshape(-1, 2)
+        simplex = triangulation.find_simplex(flat)
+        transform = triangulation.transform[simplex]
+        weights = np.einsum("ijk,ik->ij", transform[:, :2], flat - transform[:, 2])
+        weights = np.column_stack([weights, 1.0 - weights.sum(axis=1)])
+        result = np.sum(weights * values[triangulation.simplices[simplex]], axis=1)
+        result[simplex < 0] = np.nan
+        return result.reshape(xi.shape[:-1])
+
+    return field
+
+
 def _rays(positions, arrival_times, origin, n_bins) -> _Rays:
     if int(n_bins) != n_bins or n_bins < MIN_BINS:
         raise HexdemError(f"n_bins must be an integer >= {MIN_BINS} to resolve a sixfold shape, got {n_bins}")
     relative, arrival_times = _checked(positions, arrival_times, origin)
     known = np.isfinite(arrival_times)
     try:
-        field = LinearNDInterpolator(relative[known], arrival_times[known])
+        field = linear_field(relative[known], arrival_times[known])
     except (QhullError, ValueError):
         raise HexdemError(f"arrival times known at only {known.sum()} beads, too few or collinear for a front") from None
     theta = -np.pi + (np.arange(int(n_bins)) + 0.5) * 2 * np.pi / n_bins

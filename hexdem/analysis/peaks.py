@@ -20,7 +20,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.interpolate import CubicSpline
+
+from hexdem.analysis.local_spline import LocalSpline
 
 #: Samples on each side of the discrete maximum used for the spline refinement.
 HALF_WINDOW = 3
@@ -35,9 +36,10 @@ class PulseTimes:
     arrival_time: np.ndarray
 
 
-def _spline_window(times, values, centre):
+def _spline_window(times, values, centre) -> tuple[LocalSpline, int]:
+    """The spline through the samples around ``centre`` and the index of its first sample."""
     lo, hi = max(0, centre - HALF_WINDOW), min(len(times), centre + HALF_WINDOW + 1)
-    return CubicSpline(times[lo:hi], values[lo:hi]), times[lo], times[hi - 1]
+    return LocalSpline(times[lo:hi], values[lo:hi]), lo
 
 
 def refine_peak(times, values) -> tuple[float, float]:
@@ -45,9 +47,8 @@ def refine_peak(times, values) -> tuple[float, float]:
     k = int(np.argmax(values))
     if k == 0 or k == len(values) - 1:
         return float(times[k]), float(values[k])
-    spline, lo, hi = _spline_window(times, values, k)
-    candidates = [t for t in spline.derivative().roots(extrapolate=False) if lo <= t <= hi]
-    candidates.append(times[k])
+    spline, _ = _spline_window(times, values, k)
+    candidates = [*spline.stationary_points(), times[k]]
     best = max(candidates, key=lambda t: float(spline(t)))
     return float(best), float(spline(best))
 
@@ -60,8 +61,8 @@ def rising_crossing(times, values, level) -> float:
     k = int(above[0])
     if k == 0:
         return float(times[0])
-    spline, _, _ = _spline_window(times, values, k)
-    roots = [t for t in spline.solve(level, extrapolate=False) if times[k - 1] <= t <= times[k]]
+    spline, lo = _spline_window(times, values, k)
+    roots = [t for t in spline.crossings(level, piece=k - 1 - lo) if times[k - 1] <= t <= times[k]]
     return float(min(roots)) if roots else float(np.interp(level, values[k - 1:k + 1], times[k - 1:k + 1]))
 
 
