@@ -97,7 +97,7 @@ def test_edge_beads_are_pushed_inward_perpendicular_to_their_edge():
     (lambda: Preparation(push_force_n=0.0), "push_force_n must be a positive number"),
     (lambda: Preparation(settled_rms_speed_m_s=float("nan")), "settled_rms_speed_m_s must be a positive number"),
     (lambda: Preparation(max_steps=10.5), "max_steps must be an integer"),
-    (lambda: Preparation(wall_slack_m=-1e-6), "wall_slack_m must be a positive number"),
+    (lambda: Preparation(wall_slack_m=-1e-6), "wall_slack_m must be a non-negative number"),
 ])
 def test_bad_preparation_parameters_are_refused(make, message):
     with pytest.raises(HexdemError, match=message):

@@ -18,7 +18,7 @@ from conftest import read_csv
 
 from hexdem.cli.main import main
 from hexdem.disorder.ensemble import Ensemble, EnsembleConfig
-from hexdem.disorder.preparation import SETTLED_NAME, Preparation
+from hexdem.disorder.preparation import Preparation
 from hexdem.disorder.runner import run_ensemble
 from hexdem.disorder.sharing import adopt_compaction, adopt_ideal_impacts
 from hexdem.disorder.stats import STATS_COLUMNS
@@ -102,19 +102,21 @@ def test_another_seed_draws_other_diameters(reference):
     np.testing.assert_allclose(results(ensemble, 2)["diameters_m"], ensemble.diameters_m(2), rtol=1e-15)
 
 
-def test_identical_work_of_another_ensemble_is_adopted_and_gives_the_same_results(reference, tmp_path):
-    """Walls stood back (another settle) share the compaction and the ideal impacts; another
+def test_adopting_another_ensembles_identical_runs_gives_what_running_them_gives(reference, tmp_path):
+    """Walls stood back (another settle) share the compactions and the ideal impacts; another
     seed shares only the ideal impacts; another size shares nothing."""
     ensemble, _ = reference
     slack = EnsembleConfig(**SMALL, preparation=Preparation(wall_slack_m=1e-6))
-    sharing = Ensemble(slack, tmp_path / "slack")
-    assert adopt_compaction(sharing, ensemble) == 3 and adopt_ideal_impacts(sharing, ensemble) == 2
-    run_ensemble(slack, sharing.out, workers=2, log=quiet)
-    np.testing.assert_array_equal(results(sharing, None)["peak_speed"], results(ensemble, None)["peak_speed"])
-    for k in range(3):
-        assert (sharing.stage_dir(k, "compact") / SETTLED_NAME).read_bytes() == \
-            (ensemble.stage_dir(k, "compact") / SETTLED_NAME).read_bytes()
-        assert not np.array_equal(results(sharing, k)["wall_offsets_m"], results(ensemble, k)["wall_offsets_m"])
+    run_ensemble(slack, tmp_path / "adopted", workers=2, log=quiet, share_from=(ensemble,))
+    run_ensemble(slack, tmp_path / "own", workers=2, log=quiet)
+    adopted, own = Ensemble(slack, tmp_path / "adopted"), Ensemble(slack, tmp_path / "own")
+    for k in (None, 0, 1, 2):
+        for name in ("peak_speed", "t_peak", "arrival_time") + (() if k is None else ("positions_m",)):
+            np.testing.assert_array_equal(results(adopted, k)[name], results(own, k)[name])
+    for k in range(3):  # copied, not rerun: even LAMMPS's timings in the log are the reference's
+        assert (adopted.stage_dir(k, "compact") / "log.lammps").read_bytes() == \
+            (ensemble.stage_dir(k, "compact") / "log.lammps").read_bytes()
+        assert not np.array_equal(results(adopted, k)["wall_offsets_m"], results(ensemble, k)["wall_offsets_m"])
     seeded = Ensemble(EnsembleConfig(**SMALL, seed=1), tmp_path / "seed")
     assert adopt_compaction(seeded, ensemble) == 0 and adopt_ideal_impacts(seeded, ensemble) == 2
     larger = Ensemble(EnsembleConfig(**{**SMALL, "edge_beads": 5}), tmp_path / "larger")

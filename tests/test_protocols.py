@@ -65,6 +65,4 @@ def test_the_search_finds_the_protocols_an_outlier_does_not_touch():
     assert search.distance[search.start >= 2].max() < 1e-8
     best = search.closest()[0]
     assert search.start[best] >= 2 or not search.anchored[best]
-    shares = search.consistent_shares()
-    assert shares["count"] == np.count_nonzero(search.consistent)
-    assert shares["start_2"] + shares["start_3"] + shares["start_1"] == pytest.approx(1.0, abs=2e-3)
+    assert search.consistent_shares()["start_1"] < 1 / 3  # the anchored start-1 protocols drop out

@@ -12,7 +12,8 @@ below :data:`LEAD_FALL` of that maximum before it rises above it again: the firs
 hump of the signal, wiggles of less than 20 % not counting as one. Its amplitude is the
 vertex of the parabola through the largest sample and its two neighbours (the speed at a
 sampled maximum, corrected for the sampling grid). A bead whose signal never falls that far
-after its first hump, or never moved, gets NaN.
+after its first hump, whose hump peaks at the first or last sample, or that never moved,
+gets NaN.
 """
 
 from __future__ import annotations

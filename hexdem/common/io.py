@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import fcntl
 import json
 import math
 import os
@@ -28,6 +29,22 @@ def atomic_path(path):
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
+
+
+@contextmanager
+def locked_directory(out: Path, holder: str):
+    """Hold ``out/.lock`` so that two runs never share ``out``; yields the lock's file
+    descriptor (MPI launchers started inside inherit it, so the lock lasts as long as they do).
+    ``holder`` names who else may hold it, for the refusal."""
+    fd = os.open(Path(out) / ".lock", os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise HexdemError(f"{out} is in use by {holder}; wait for it or choose another --out") from None
+        yield fd
+    finally:
+        os.close(fd)
 
 
 def write_text(path, text: str) -> None:

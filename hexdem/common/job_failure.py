@@ -14,7 +14,7 @@ from hexdem.common.io import write_text
 from hexdem.errors import one_line
 
 #: Environment variable naming the file where a failing rank leaves its one-line error
-#: before it aborts the MPI job (set by the job launcher).
+#: before it aborts the MPI job (each rank of a job sets it from the job's path).
 ERROR_FILE_VARIABLE = "HEXDEM_JOB_ERROR"
 
 

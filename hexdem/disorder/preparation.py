@@ -152,8 +152,10 @@ class Preparation:
     def __post_init__(self):
         for f in fields(self):
             value = getattr(self, f.name)
-            if not is_number(value) or value < 0 or (value == 0 and f.name not in ("tilt_deg", "wall_slack_m")):
-                raise HexdemError(f"preparation parameter {f.name} must be a positive number, got {value!r}")
+            may_be_zero = f.name in ("tilt_deg", "wall_slack_m")
+            if not is_number(value) or value < 0 or (value == 0 and not may_be_zero):
+                raise HexdemError(f"preparation parameter {f.name} must be a {'non-negative' if may_be_zero else 'positive'} "
+                                  f"number, got {value!r}")
             if f.type == "int" and int(value) != value:
                 raise HexdemError(f"preparation parameter {f.name} must be an integer, got {value!r}")
         if self.tilt_deg >= 90:

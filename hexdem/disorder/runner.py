@@ -10,40 +10,23 @@ MPI ranks with the tracker inside (:mod:`hexdem.disorder.impacts`), each publish
 
 from __future__ import annotations
 
-import fcntl
 import json
-import os
 import shutil
 import sys
 import time
-from contextlib import contextmanager
 from pathlib import Path
 
 from hexdem.common.checks import positive_int
-from hexdem.common.io import ensure_writable_dir, write_json
+from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
 from hexdem.disorder.ensemble import MANIFEST_NAME, PHASE_LABELS, Ensemble, EnsembleConfig
 from hexdem.disorder.figures import fitted_laws
 from hexdem.disorder.impacts import ImpactTasks, impact_done, publish_result
 from hexdem.disorder.preparation import STAGES, write_stage_deck
+from hexdem.disorder.sharing import adopt_compaction, adopt_ideal_impacts
 from hexdem.disorder.stats import write_statistics
 from hexdem.engines.lammps.partitions import is_done, run_partitioned
 from hexdem.errors import HexdemError
 from hexdem.experiments.parallel import run_on_ranks
-
-
-@contextmanager
-def _locked(out: Path):
-    """Hold ``OUT/.lock`` (also inherited by the MPI launcher) so two runs never share OUT."""
-    fd = os.open(out / ".lock", os.O_RDWR | os.O_CREAT, 0o644)
-    try:
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            raise HexdemError(f"{out} is in use by another hexdem ensemble (or its LAMMPS is still "
-                              "shutting down); wait for it or choose another --out") from None
-        yield fd
-    finally:
-        os.close(fd)
 
 
 def _check_manifest(out: Path, config: EnsembleConfig) -> dict:
@@ -72,21 +55,29 @@ def _pending_impacts(ensemble: Ensemble, groups) -> list[tuple[int | None, float
 
 
 def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | None = None,
-                 keep_dumps: bool = False, scaling_json=None, log=None) -> dict:
+                 keep_dumps: bool = False, scaling_json=None, log=None, share_from=()) -> dict:
     """Run (or resume) the ensemble in ``out`` and write its statistics; returns the summary.
 
     ``workers`` LAMMPS partitions run at once, started by ``launcher`` (default: this
-    environment's ``mpiexec``); ``scaling_json`` adds the fitted laws to Fig. 9.
+    environment's ``mpiexec``); ``scaling_json`` adds the fitted laws to Fig. 9;
+    ``share_from`` other :class:`Ensemble` s whose identical finished runs are copied rather
+    than run again (:mod:`hexdem.disorder.sharing`).
     """
     log = log or (lambda message: print(f"hexdem ensemble: {message}", file=sys.stderr, flush=True))
     positive_int("--workers", workers)
     laws = fitted_laws(scaling_json, config.disorder.diameter_m) if scaling_json else {}
     out = ensure_writable_dir(out)
     ensemble = Ensemble(config, out)
-    with _locked(out) as lock:
+    with locked_directory(out, "another hexdem ensemble (or its LAMMPS is still shutting down)") as lock:
         manifest = _check_manifest(out, config)
-        for leftover in out.rglob(".*.part"):  # atomic writes cut short by a killed run
-            leftover.unlink()
+        for leftover in out.rglob(".*.part"):  # atomic writes and copies cut short by a killed run
+            if leftover.is_dir():
+                shutil.rmtree(leftover)
+            else:
+                leftover.unlink()
+        for source in share_from:
+            adopt_ideal_impacts(ensemble, source)
+            adopt_compaction(ensemble, source)
         todo = [k for k in range(config.realizations) if not ensemble.result_path(k).exists()]
         ideal_todo = not ensemble.result_path(None).exists()
         log(f"{config.realizations} realizations x {len(config.velocities_m_s)} striker velocities, "

@@ -13,15 +13,20 @@ its finished files are copied from the ensemble that has them:
 * a realization's compaction, when both render the same deck and data file and the
   source's stage is finished (its done marker).
 
-Copies are made before the ensemble runs; it then resumes as if it had run them itself.
+Copies are made by the ensemble's run, under its lock, before anything runs
+(:func:`~hexdem.disorder.runner.run_ensemble`, ``share_from``); it then resumes as if it had
+run them itself. Every copy is atomic (a temporary sibling renamed into place), so an
+interrupted copy never looks finished.
 """
 
 from __future__ import annotations
 
+import os
 import shutil
 import tempfile
 from pathlib import Path
 
+from hexdem.common.io import atomic_path
 from hexdem.disorder.ensemble import Ensemble
 from hexdem.disorder.impacts import IMPACT_NAME
 from hexdem.disorder.preparation import write_stage_deck
@@ -37,7 +42,8 @@ def adopt_ideal_impacts(ensemble: Ensemble, source: Ensemble) -> int:
         same = v in source.config.velocities_m_s and source.config.run_config(v) == ensemble.config.run_config(v)
         if same and theirs.exists() and not ours.exists():
             ours.parent.mkdir(parents=True, exist_ok=True)
-            shutil.copy2(theirs, ours)
+            with atomic_path(ours) as tmp:
+                shutil.copyfile(theirs, tmp)
             adopted += 1
     return adopted
 
@@ -59,6 +65,9 @@ def adopt_compaction(ensemble: Ensemble, source: Ensemble) -> int:
                                         Path(scratch) / f"r{k}")
             if _same_deck(rendered, theirs):
                 shutil.rmtree(ours, ignore_errors=True)
-                shutil.copytree(theirs, ours)
+                partial = ours.with_name(f".{ours.name}.part")
+                shutil.rmtree(partial, ignore_errors=True)
+                shutil.copytree(theirs, partial)
+                os.replace(partial, ours)
                 adopted += 1
     return adopted

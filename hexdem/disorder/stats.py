@@ -176,11 +176,13 @@ def write_statistics(ensemble: Ensemble, laws: dict | None = None) -> dict:
         ensemble_plots.expnumsim(lattice, ensemble.impact_model(None, v).walls, ideal_rel[iv], mean, reference,
                                  float(v), config.realizations, out / f"fig8_expnumsim_{velocity_name(v)}.png")
     per = results.per_realization
+    effect_beads = np.concatenate([beads[EFFECT_FIRST_N:] for beads in lattice.lines().values()])
     return {
         "disorder_effect": [dict(zip(EFFECT_COLUMNS, row)) for row in effect],
         "leading_pulse_effect": [dict(zip(EFFECT_COLUMNS, row)) for row in lead_effect],
+        "leading_pulse_defined_fraction": float(np.mean(np.isfinite(results.lead_speed[:, :, effect_beads]))),
         "prestress": {name: {"mean": float(np.mean(per[name])), "std": float(np.std(per[name], ddof=1))
-                             if len(per[name]) > 1 else 0.0} for name in PRESTRESS_ARRAYS},
+                             if len(per[name]) > 1 else float("nan")} for name in PRESTRESS_ARRAYS},
         "preparation": {stage: {"mean_steps": float(np.mean(per[f"{stage}_steps"])),
                                 "max_steps": int(np.max(per[f"{stage}_steps"])),
                                 "mean_simulated_time_s": float(np.mean(per[f"{stage}_time_s"])),

@@ -83,7 +83,6 @@ def run_on_ranks(job, ranks: int, directory, launcher: str | None = None, progre
     command = [*prefix, "-n", str(ranks), sys.executable, "-m", __name__, str(paths[JOB_NAME].resolve())]
     with _progress(progress):
         done = subprocess.run(command, stdout=subprocess.PIPE, stderr=None, text=True,
-                              env={**os.environ, ERROR_FILE_VARIABLE: str(paths[ERROR_NAME].resolve())},
                               preexec_fn=functools.partial(die_with_parent, os.getpid()))
     if done.returncode != 0 or not paths[RESULT_NAME].exists():
         reported = paths[ERROR_NAME].read_text().strip() if paths[ERROR_NAME].exists() else ""
@@ -103,6 +102,8 @@ def _rank_main(job_path: Path) -> None:
     from mpi4py import MPI
 
     comm = MPI.COMM_WORLD
+    # the report's path, also where the launcher's environment does not reach this rank
+    os.environ[ERROR_FILE_VARIABLE] = str((job_path.parent / ERROR_NAME).resolve())
     try:
         result = pickle.loads(job_path.read_bytes())(comm)
     except BaseException as exc:

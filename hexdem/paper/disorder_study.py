@@ -30,7 +30,6 @@ import numpy as np
 from hexdem.disorder.ensemble import Ensemble, EnsembleConfig
 from hexdem.disorder.preparation import TOLERANCE_M, Disorder, Preparation
 from hexdem.disorder.runner import run_ensemble
-from hexdem.disorder.sharing import adopt_compaction, adopt_ideal_impacts
 from hexdem.model.materials import PAPER_DIAMETER_M
 from hexdem.paper.settings import (
     RELAXED_SIGMA_PER_TOL,
@@ -91,16 +90,13 @@ def run_study_ensemble(entry: StudyEnsemble, settings: PaperSettings, out: Path,
     the ideal impacts and compactions, is copied rather than run again
     (:mod:`hexdem.disorder.sharing`)."""
     config = entry.config(settings.realizations)
-    ensemble = Ensemble(config, out / entry.name)
-    for other in others:
-        if other != entry and (out / other.name).is_dir():
-            source = Ensemble(other.config(settings.realizations), out / other.name)
-            adopt_ideal_impacts(ensemble, source)
-            adopt_compaction(ensemble, source)
-    summary = run_ensemble(config, out / entry.name, workers=settings.workers,
-                           scaling_json=scaling_json, log=lambda message: None)
+    sources = tuple(Ensemble(other.config(settings.realizations), out / other.name) for other in others
+                    if other != entry and (out / other.name).is_dir())
+    summary = run_ensemble(config, out / entry.name, workers=settings.workers, scaling_json=scaling_json,
+                           log=lambda message: None, share_from=sources)
     return {"name": entry.name, "sigma_per_tol": entry.sigma_per_tol, "preparation": entry.preparation_name,
-            **{key: summary[key] for key in ("prestress", "this_run", *MEASURES.values())}}
+            **{key: summary[key] for key in ("prestress", "this_run", "leading_pulse_defined_fraction",
+                                             *MEASURES.values())}}
 
 
 def _number(value) -> float:
@@ -136,10 +132,13 @@ def prestress_rows(summaries: list[dict]) -> list[tuple]:
             for s in sorted(summaries, key=lambda s: (s["preparation"], s["sigma_per_tol"]))]
 
 
-def change(mean: float, sem: float) -> str:
-    """"rises", "falls" or "unchanged": the ratio against 1 at two standard errors (an
-    exact ratio, from one deterministic realization, has no error)."""
-    margin = 0.0 if not np.isfinite(sem) else 2 * sem
+def change(mean: float, sem: float, realizations: int) -> str:
+    """"rises", "falls" or "unchanged": the ratio against 1 at two standard errors. One
+    realization is exact (equal beads prepared alike are identical) and has no error;
+    "undetermined" where the mean, or the error of several realizations, is missing."""
+    if not np.isfinite(mean) or (realizations > 1 and not np.isfinite(sem)):
+        return "undetermined"
+    margin = 2 * sem if realizations > 1 else 0.0
     if mean - margin > 1:
         return "rises"
     if mean + margin < 1:
@@ -151,8 +150,9 @@ def verdict(rows: list[tuple]) -> dict:
     """Where transmission along ±30° rises, as the paper says, and what the 0° line does there.
 
     Returns ``conditions`` (every (σ/tol, preparation, measure) with the ±30° and 0° changes),
-    ``rises_at`` (those where ±30° rises and 0° falls, the paper's full claim), ``paper_case``
-    (σ = 6 tol, the paper's preparation, peak over the run) and ``summary`` (one sentence).
+    ``rises_at`` (those where ±30° rises and 0° falls, the paper's full claim),
+    ``pm30_rises_at`` (those where ±30° rises, whatever 0° does), ``paper_case`` (σ = 6 tol,
+    the paper's preparation, peak over the run) and ``summary`` (one sentence).
     """
     table = {(r[0], r[2], r[3], r[4]): r for r in rows}
     conditions = []
@@ -161,8 +161,8 @@ def verdict(rows: list[tuple]) -> dict:
             continue
         zero = table[(sigma, preparation, measure, "0")]
         conditions.append({"sigma_per_tol": sigma, "preparation": preparation, "measure": measure,
-                           "pm30": change(row[5], row[6]), "pm30_ratio": row[5], "pm30_sem": row[6],
-                           "zero": change(zero[5], zero[6]), "zero_ratio": zero[5], "zero_sem": zero[6]})
+                           "pm30": change(row[5], row[6], row[8]), "pm30_ratio": row[5], "pm30_sem": row[6],
+                           "zero": change(zero[5], zero[6], zero[8]), "zero_ratio": zero[5], "zero_sem": zero[6]})
     rises = [c for c in conditions if c["pm30"] == "rises"]
     claim = [c for c in rises if c["zero"] == "falls"]
     paper = next((c for c in conditions if c["sigma_per_tol"] == 6 and c["preparation"] == "prestressed"

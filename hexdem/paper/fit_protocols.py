@@ -15,7 +15,7 @@ import numpy as np
 
 from hexdem.common.io import write_csv, write_json
 from hexdem.paper.published import published
-from hexdem.theory.outputs import read_sweep_peaks
+from hexdem.theory.outputs import complete_beads, read_sweep_peaks
 from hexdem.theory.protocols import PROTOCOL_COLUMNS, ProtocolSearch, Target, search_protocols
 from hexdem.theory.scaling import COMBINATIONS, DEFAULT_LAST
 
@@ -49,8 +49,7 @@ def run_search(scaling_dir, out) -> dict:
     v0, peaks = read_sweep_peaks(scaling_dir)
     searches, summary, rows = {}, {}, []
     for name in COMBINATIONS:
-        complete = np.all(np.isfinite(peaks[name]), axis=0)
-        max_last = (int(np.argmin(complete)) if not complete.all() else len(complete)) - 1
+        max_last = complete_beads(peaks[name]) - 1
         search = search_protocols(name, v0, peaks[name][:, :max_last + 1], target(name), max_last)
         searches[name] = search
         stated, closest = stated_protocol(search), search.closest(CLOSEST)

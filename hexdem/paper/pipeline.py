@@ -14,9 +14,10 @@ The parts, each writing into its own folder of ``DIR``:
 then ``report.html``, ``report.md`` and ``published_vs_computed.csv`` (:mod:`hexdem.paper.report`).
 
 **Resuming.** A finished part leaves ``DIR/parts/<name>.json`` (its summary, written
-atomically last); a rerun skips every part that has one, and the ensembles resume
-realization by realization. ``DIR/paper.json`` records the settings: a rerun with others
-(``--quick`` or not) is refused rather than mixed.
+atomically last); a rerun skips every part that has one, unless a part whose results it
+reads was computed again, and the ensembles resume realization by realization. ``DIR/paper.json`` records the settings: a rerun with others
+(``--quick`` or not) is refused rather than mixed, and ``DIR/.lock`` refuses a second
+``hexdem paper`` while one runs.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ import sys
 import time
 from pathlib import Path
 
-from hexdem.common.io import ensure_writable_dir, write_json
+from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
 from hexdem.common.progress import progress_bar, silenced
 from hexdem.errors import HexdemError
 from hexdem.paper.disorder_study import (
@@ -93,7 +94,8 @@ def _disorder_summary(summaries: list[dict], out: Path) -> dict:
     study_figure(rows, folder / "disorder_study.png")
     result = {"rows": [dict(zip(STUDY_COLUMNS, row)) for row in rows], "verdict": verdict(rows),
               "prestress": [dict(zip(PRESTRESS_COLUMNS, row)) for row in prestress_rows(summaries)],
-              "figures_ensemble": FIGURES_ENSEMBLE}
+              "figures_ensemble": FIGURES_ENSEMBLE,
+              "leading_pulse_defined_fraction": {s["name"]: s["leading_pulse_defined_fraction"] for s in summaries}}
     write_json(folder / "disorder_study.json", result)
     return result
 
@@ -118,31 +120,43 @@ def _check_settings(out: Path, settings: PaperSettings) -> None:
 
 def run_paper(settings: PaperSettings, out, log=None) -> dict:
     """Run (or resume) every part into ``out`` and write the report; returns the parts' summaries."""
-    from hexdem.paper.report import write_report
-
     log = log or (lambda message: print(f"hexdem paper: {message}", file=sys.stderr, flush=True))
     out = ensure_writable_dir(out)
-    _check_settings(out, settings)
+    with locked_directory(out, "another hexdem paper"):
+        _check_settings(out, settings)
+        summaries, wall_time_s = _run_parts(settings, out)
+    log(f"report in {out / 'report.html'} ({wall_time_s:.0f} s)")
+    return summaries
+
+
+def _run_parts(settings: PaperSettings, out: Path) -> tuple[dict, float]:
+    """Every part in order (skipping the finished ones), then the report; (summaries, wall time [s])."""
+    from hexdem.paper.report import write_report
+
     scaling_json = out / "scaling" / "scaling.json"
     ensembles = study_ensembles(settings)
-    parts = [("tca", "TCA and Fig. 5", lambda: _tca(out)),
-             ("fig3", "Fig. 3 snapshots", lambda: _snapshots(settings, out, "hexagon")),
-             ("fig4", "Fig. 4 snapshots", lambda: _snapshots(settings, out, "half-hexagon")),
-             ("scaling", f"V0 sweep ({settings.n_v0} values) and laws, Figs. 6-7", lambda: _scaling(settings, out)),
-             ("fit_protocols", "fit-protocol search", lambda: _fit_protocols(out))]
-    parts += [(f"disorder-{e.name}", f"ensemble {e.name}",
+    ensemble_parts = [f"disorder-{e.name}" for e in ensembles]
+    # (name, label, the parts whose results it reads, work)
+    parts = [("tca", "TCA and Fig. 5", (), lambda: _tca(out)),
+             ("fig3", "Fig. 3 snapshots", (), lambda: _snapshots(settings, out, "hexagon")),
+             ("fig4", "Fig. 4 snapshots", (), lambda: _snapshots(settings, out, "half-hexagon")),
+             ("scaling", f"V0 sweep ({settings.n_v0} values) and laws, Figs. 6-7", (),
+              lambda: _scaling(settings, out)),
+             ("fit_protocols", "fit-protocol search", ("scaling",), lambda: _fit_protocols(out))]
+    parts += [(name, f"ensemble {e.name}", ("scaling",),
                lambda e=e: run_study_ensemble(e, settings, out / "disorder", scaling_json, ensembles))
-              for e in ensembles]
-    parts.append(("disorder", "disorder study and verdict",
-                  lambda: _disorder_summary([summaries[f"disorder-{e.name}"] for e in ensembles], out)))
+              for name, e in zip(ensemble_parts, ensembles)]
+    parts.append(("disorder", "disorder study and verdict", tuple(ensemble_parts),
+                  lambda: _disorder_summary([summaries[name] for name in ensemble_parts], out)))
     summaries: dict = {}
+    computed: set = set()
     bar = progress_bar(len(parts), "hexdem paper", unit="part")
     start = time.perf_counter()
     with silenced():
-        for k, (name, label, work) in enumerate(parts, 1):
+        for k, (name, label, inputs, work) in enumerate(parts, 1):
             marker = out / "parts" / f"{name}.json"
             bar.set_description(label)
-            if marker.exists():
+            if marker.exists() and not computed.intersection(inputs):
                 summaries[name] = json.loads(marker.read_text())["summary"]
                 bar.write(f"hexdem paper: [{k}/{len(parts)}] {label}: done before", file=sys.stderr)
             else:
@@ -151,10 +165,10 @@ def run_paper(settings: PaperSettings, out, log=None) -> dict:
                 ensure_writable_dir(marker.parent)
                 write_json(marker, {"summary": summary, "wall_time_s": time.perf_counter() - begun})
                 summaries[name] = json.loads(marker.read_text())["summary"]
+                computed.add(name)
                 bar.write(f"hexdem paper: [{k}/{len(parts)}] {label}: {time.perf_counter() - begun:.1f} s",
                           file=sys.stderr)
             bar.update(1)
         bar.close()
         write_report(out, settings, summaries, time.perf_counter() - start)
-    log(f"report in {out / 'report.html'} ({time.perf_counter() - start:.0f} s)")
-    return summaries
+    return summaries, time.perf_counter() - start

@@ -15,8 +15,15 @@ from datetime import datetime, timezone
 from importlib.metadata import version
 from pathlib import Path
 
+from hexdem.analysis.leading_pulse import LEAD_FALL, LEAD_THRESHOLD
 from hexdem.common.io import write_csv, write_text
-from hexdem.paper.comparison import COMPARISON_COLUMNS, comparison_rows, largest_differences
+from hexdem.paper.comparison import (
+    COMPARISON_COLUMNS,
+    comparison_rows,
+    largest_differences,
+)
+from hexdem.paper.settings import STUDY_VELOCITY_M_S
+from hexdem.theory.protocols import CONSISTENT_SIGMAS, MIN_V0, STARTS
 
 #: The paper's figures as hexdem draws them: (file under DIR, caption).
 PAPER_FIGURES = (
@@ -72,9 +79,10 @@ def _protocol_blocks(protocols: dict) -> list:
             notes.append(f"{name}: no protocol is consistent with the published (m, b).")
     return [("h2", "2. The fit protocol"),
             ("p", "The paper does not say over which beads, which V0 or how it fitted c(V0) = m V0 + b. Every "
-                  "protocol (first bead 1–3, last bead, anchored or free start, log-linear or nonlinear, any "
-                  "contiguous range of at least 5 of the sweep's V0) was fitted to the same sweep. Consistent: "
-                  "m and b both within 2 standard errors plus half a unit of the published last digit. With "
+                  f"protocol (first bead {min(STARTS)}–{max(STARTS)}, last bead, anchored or free start, log-linear "
+                  f"or nonlinear, any contiguous range of at least {MIN_V0} of the sweep's V0) was fitted to the "
+                  f"same sweep. Consistent: m and b both within {CONSISTENT_SIGMAS:g} standard errors plus half a "
+                  "unit of the published last digit. With "
                   "tens of thousands of protocols a close match somewhere is likely by chance: what the "
                   "consistent protocols share is the informative part."),
             ("table", ("combination", "published m, b", "stated protocol m, b (± 1 SE)", "closest protocol",
@@ -91,21 +99,37 @@ def _prestress_finding(rows: list[dict]) -> str:
                     f"preparation and {load[(s, 'relaxed')]:.3g} N with the walls stood back." for s in pairs)
 
 
+def _ratio(value, sem=None) -> str:
+    """A transmission ratio to 3 decimals, ± its standard error if any, "–" if missing."""
+    if value is None:
+        return "–"
+    return f"{value:.3f}" + (f" ± {sem:.3f}" if sem is not None else "")
+
+
+def _lead_coverage(study: dict) -> str:
+    """How many line beads had a leading pulse at all (the others are left out of 'lead')."""
+    fractions = [f for name, f in study["leading_pulse_defined_fraction"].items() if not name.startswith("sigma0tol")]
+    if not fractions:
+        return ""
+    return (f"A leading pulse was found for {100 * min(fractions):.0f}–{100 * max(fractions):.0f} % of the line "
+            "beads (n ≥ 2) of the disordered realizations; 'lead' averages over those.")
+
+
 def _disorder_blocks(study: dict) -> list:
-    rows = [(_fmt(r["sigma_per_tol"]), r["preparation"], r["measure"], r["line"],
-             f"{r['ratio_to_ideal']:.3f} ± {r['sem']:.3f}" if r["sem"] is not None else f"{r['ratio_to_ideal']:.3f}",
-             str(r["realizations"]), f"{r['ratio_to_equal_beads']:.3f}") for r in study["rows"]]
+    rows = [(_fmt(r["sigma_per_tol"]), r["preparation"], r["measure"], r["line"], _ratio(r["ratio_to_ideal"], r["sem"]),
+             str(r["realizations"]), _ratio(r["ratio_to_equal_beads"])) for r in study["rows"]]
     prestress = [(_fmt(r["sigma_per_tol"]), r["preparation"], f"{r['mean_contact_force_n']:.3g}",
                   f"{r['max_contact_force_n']:.3g}", f"{r['wall_force_n']:.3g}") for r in study["prestress"]]
     return [("h2", "3. Weak disorder: does transmission along ±30° rise?"),
             ("p", f"Verdict: {study['verdict']['summary']}"),
             ("p", "Transmission: mean over beads n ≥ 2 of V_n / V_n(ideal) per realization, mean ± standard error "
-                  "over realizations, striker at 0.40 m/s. 'peak' is the maximum over the run, 'lead' the "
-                  "leading pulse's amplitude (its first maximum that reaches 20 % of the bead's largest speed "
-                  "and is followed by a fall below 80 % of itself). 'relaxed' stands the walls back so that no "
+                  f"over realizations, striker at {STUDY_VELOCITY_M_S:.2f} m/s. 'peak' is the maximum over the run, "
+                  "'lead' the leading pulse's amplitude (its first maximum that reaches "
+                  f"{100 * LEAD_THRESHOLD:.0f} % of the bead's largest speed and is followed by a fall below "
+                  f"{100 * LEAD_FALL:.0f} % of itself). 'relaxed' stands the walls back so that no "
                   "prestress remains; 'over equal beads' divides by the σ = 0 packing prepared the same way. "
                   "σ = 0 has one realization: equal beads prepared the same way are identical (LAMMPS is "
-                  "deterministic on one rank), so its ratio is exact."),
+                  "deterministic on one rank), so its ratio is exact. " + _lead_coverage(study)),
             ("table", ("σ / tol", "preparation", "measure", "line", "disordered / ideal", "realizations",
                        "over equal beads"), rows),
             ("p", "Prestress the packings keep after the preparation (mean over realizations). "

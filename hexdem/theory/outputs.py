@@ -26,9 +26,9 @@ def _trace(sweep: Sweep, combination: Combination):
     return times, speeds, run.peaks[combination.line], run.t_peak[combination.line], run.v0
 
 
-def _complete_beads(sweep: Sweep, combination: Combination) -> int:
-    """Number of leading beads of the line whose peaks were seen at every V₀."""
-    complete = np.all(np.isfinite(sweep.peaks(combination)), axis=0)
+def complete_beads(peaks) -> int:
+    """Number of leading beads of a line whose peaks ``peaks`` (K, L) were seen at every V₀."""
+    complete = np.all(np.isfinite(peaks), axis=0)
     return int(np.argmin(complete)) if not complete.all() else len(complete)
 
 
@@ -85,7 +85,7 @@ def write_outputs(sweep: Sweep, out, last: int | None = None, kind: str = "logli
               [(name, v, c, e, vs, vs / v, float(f.law.decay_rate(v)), float(f.law.start_ratio(v)))
                for name, f in fits.items() for v, c, e, vs in zip(f.v0, f.c, f.c_stderr, f.v_start)])
     sensitivity_rows = [row for c in COMBINATIONS.values()
-                        for row in sensitivity(c, sweep.v0, sweep.peaks(c), range(c.start + 2, _complete_beads(sweep, c)))]
+                        for row in sensitivity(c, sweep.v0, sweep.peaks(c), range(c.start + 2, complete_beads(sweep.peaks(c))))]
     write_csv(out / "sensitivity.csv", tuple(sensitivity_rows[0]), [tuple(r.values()) for r in sensitivity_rows])
     write_csv(out / "decay_form.csv",
               ("combination", "v0", "rss_geometric", "rss_power", "q", "p", "ratio_slope", "ratio_slope_stderr",

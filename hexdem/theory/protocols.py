@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hexdem.errors import HexdemError
 from hexdem.theory.scaling import FIT_KINDS, fit_decay
 
 #: Fewest V₀ values a protocol's line c(V₀) is fitted to.
@@ -84,9 +85,12 @@ class ProtocolSearch:
 
     def find(self, start: int, last: int, anchored: bool, kind: str, first: int, final: int) -> int:
         """Index of one protocol (e.g. the paper's stated one)."""
-        match = ((self.start == start) & (self.last == last) & (self.anchored == anchored)
-                 & (self.kind == FIT_KINDS.index(kind)) & (self.first == first) & (self.final == final))
-        return int(np.flatnonzero(match)[0])
+        match = np.flatnonzero((self.start == start) & (self.last == last) & (self.anchored == anchored)
+                               & (self.kind == FIT_KINDS.index(kind)) & (self.first == first) & (self.final == final))
+        if len(match) == 0:
+            raise HexdemError(f"{self.combination}: no protocol with window {start}..{last}, "
+                              f"{'anchored' if anchored else 'free'} {kind}, V0 indices {first}..{final} was searched")
+        return int(match[0])
 
     def consistent_shares(self) -> dict:
         """Among the consistent protocols, the share of each choice (what they have in common)."""

@@ -21,8 +21,8 @@ V_s the measured peak of the start bead (the paper's "V₁ is the maximum veloci
 first bead"), so c is the only free parameter (a free V_s is the other reading the fit
 protocol search of :mod:`hexdem.theory.protocols` tries). ``kind="loglinear"`` (default) regresses
 log(V_n / V_s) on n − s through the origin; ``kind="nonlinear"`` is least squares on V_n
-itself (``scipy.optimize.curve_fit``). Both return c and its standard error, which is
-conditional on V_s (the measured start bead is taken as exact).
+itself (``scipy.optimize.curve_fit``). Both return c and its standard error, which for an
+anchored start is conditional on V_s (the measured start bead is taken as exact).
 
 **Laws.** c(V₀) = m V₀ + b and V_s/V₀ = the polynomial above are ordinary least squares
 (:func:`polynomial_fit`), with standard errors from the residual variance. Together:
