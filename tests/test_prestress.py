@@ -28,6 +28,7 @@ def test_pair_forces_follow_hertz_with_each_contacts_own_radius():
     load = prestress(squeezed)
     expected = model.pair_stiffness_pa * np.sqrt(d / 4) * delta**1.5
     assert load.contacts == len(i)
+    assert load.max_overlap_m == pytest.approx(delta, rel=1e-6)
     assert load.mean_contact_force_n == pytest.approx(expected, rel=1e-5)
     assert load.max_contact_force_n == pytest.approx(expected, rel=1e-5)
 

@@ -22,7 +22,7 @@ from hexdem.analysis.leading_pulse import leading_pulse_amplitude
 from hexdem.common.io import atomic_path
 from hexdem.disorder.ensemble import Ensemble, EnsembleConfig
 from hexdem.disorder.preparation import STAGES, read_stage
-from hexdem.disorder.prestress import prestress, touching_pairs
+from hexdem.disorder.prestress import prestress
 from hexdem.engines.lammps.partitions import loop_time_s
 from hexdem.experiments.run import check_energy
 from hexdem.experiments.tracked_run import ImpactJob, track_impact
@@ -96,12 +96,11 @@ def publish_result(ensemble: Ensemble, k: int | None) -> None:
     arrays = {"velocities_m_s": np.array(ensemble.config.velocities_m_s)}
     arrays.update({name: np.array([impact[name] for impact in impacts]) for name in IMPACT_ARRAYS})
     if k is not None:
-        lattice = ensemble.settled_lattice(k)
-        overlaps = touching_pairs(lattice.positions_m, lattice.diameters_m)[2]
+        model = ensemble.impact_model(k, ensemble.config.velocities_m_s[0])
+        lattice, load = model.lattice, prestress(model)
         arrays.update(diameters_m=lattice.diameters_m, positions_m=lattice.positions_m,
                       wall_offsets_m=np.array([w.offset_m for w in lattice.walls]),
-                      max_overlap_m=float(np.max(overlaps, initial=0.0)),
-                      **prestress(ensemble.impact_model(k, ensemble.config.velocities_m_s[0])).as_arrays())
+                      max_overlap_m=load.max_overlap_m, **load.as_arrays())
         for stage in STAGES:
             result = read_stage(ensemble.stage_dir(k, stage))
             arrays[f"{stage}_steps"] = result.steps

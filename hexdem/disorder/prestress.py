@@ -39,11 +39,12 @@ def touching_pairs(positions_m, diameters_m):
 
 @dataclass(frozen=True)
 class Prestress:
-    """Static load of a packing at rest: ``contacts`` touching bead pairs, their
-    ``mean_contact_force_n`` and ``max_contact_force_n`` [N] (0 without contacts), and
-    ``wall_force_n``, the sum of the normal forces the walls exert [N]."""
+    """Static load of a packing at rest: ``contacts`` touching bead pairs, their largest
+    overlap ``max_overlap_m`` [m], ``mean_contact_force_n`` and ``max_contact_force_n`` [N]
+    (0 without contacts), and ``wall_force_n``, the sum of the normal forces the walls exert [N]."""
 
     contacts: int
+    max_overlap_m: float
     mean_contact_force_n: float
     max_contact_force_n: float
     wall_force_n: float
@@ -64,5 +65,5 @@ def prestress(model: GranularModel) -> Prestress:
         members = np.asarray(wall.members, dtype=int)
         depth = np.maximum(-wall.gaps_m(lattice.positions_m[members], radii[members]), 0.0)
         wall_force += float(np.sum(model.wall_stiffness_pa * np.sqrt(radii[members]) * depth**1.5))
-    return Prestress(len(forces), float(forces.mean()) if len(forces) else 0.0,
+    return Prestress(len(forces), float(overlap.max(initial=0.0)), float(forces.mean()) if len(forces) else 0.0,
                      float(forces.max(initial=0.0)), wall_force)

@@ -70,11 +70,11 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
     ensemble = Ensemble(config, out)
     with locked_directory(out, "another hexdem ensemble (or its LAMMPS is still shutting down)") as lock:
         manifest = _check_manifest(out, config)
-        for leftover in out.rglob(".*.part"):  # atomic writes and copies cut short by a killed run
+        for leftover in list(out.rglob(".*.part")):  # atomic writes and copies cut short by a killed run
             if leftover.is_dir():
-                shutil.rmtree(leftover)
+                shutil.rmtree(leftover, ignore_errors=True)
             else:
-                leftover.unlink()
+                leftover.unlink(missing_ok=True)
         for source in share_from:
             adopt_ideal_impacts(ensemble, source)
             adopt_compaction(ensemble, source)

@@ -106,10 +106,7 @@ def _number(value) -> float:
 
 def study_rows(summaries: list[dict]) -> list[tuple]:
     """Rows of ``disorder_study.csv`` at the study's striker speed, from the ensembles' summaries."""
-    controls = {}
-    for s in summaries:
-        if s["sigma_per_tol"] == 0:
-            controls[s["preparation"]] = s
+    controls = {s["preparation"]: s for s in summaries if s["sigma_per_tol"] == 0}
     rows = []
     for s in sorted(summaries, key=lambda s: (s["preparation"], s["sigma_per_tol"])):
         for measure, key in MEASURES.items():

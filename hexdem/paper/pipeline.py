@@ -87,13 +87,13 @@ def _disorder_summary(summaries: list[dict], out: Path) -> dict:
     from hexdem.common.io import write_csv
     from hexdem.paper.disorder_study import PRESTRESS_COLUMNS, STUDY_COLUMNS
 
-    rows = study_rows(summaries)
+    rows, loads = study_rows(summaries), prestress_rows(summaries)
     folder = out / "disorder"
     write_csv(folder / "disorder_study.csv", STUDY_COLUMNS, rows)
-    write_csv(folder / "prestress.csv", PRESTRESS_COLUMNS, prestress_rows(summaries))
+    write_csv(folder / "prestress.csv", PRESTRESS_COLUMNS, loads)
     study_figure(rows, folder / "disorder_study.png")
     result = {"rows": [dict(zip(STUDY_COLUMNS, row)) for row in rows], "verdict": verdict(rows),
-              "prestress": [dict(zip(PRESTRESS_COLUMNS, row)) for row in prestress_rows(summaries)],
+              "prestress": [dict(zip(PRESTRESS_COLUMNS, row)) for row in loads],
               "figures_ensemble": FIGURES_ENSEMBLE,
               "leading_pulse_defined_fraction": {s["name"]: s["leading_pulse_defined_fraction"] for s in summaries}}
     write_json(folder / "disorder_study.json", result)
