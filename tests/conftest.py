@@ -34,12 +34,26 @@ def dumped_run(tmp_path_factory):
 
 
 @pytest.fixture(scope="session")
-def paper_quick(tmp_path_factory):
-    """``hexdem paper --quick`` once per session (about two minutes): its output directory."""
+def launcher(tmp_path_factory):
+    """(command, log): an MPI launcher that notes its arguments in ``log``, one line per job,
+    and hands them to this environment's ``mpiexec`` (as ``mpiexec -f hosts`` or ``srun`` would)."""
+    from hexdem.engines.lammps.library import environment_command
+
+    folder = tmp_path_factory.mktemp("launcher")
+    log, script = folder / "launched.log", folder / "launch"
+    script.write_text(f'#!/bin/sh\nprintf "%s\\n" "$*" >> "{log}"\nexec "{environment_command("mpiexec")}" "$@"\n')
+    script.chmod(0o755)
+    return str(script), log
+
+
+@pytest.fixture(scope="session")
+def paper_quick(tmp_path_factory, launcher):
+    """``hexdem paper --quick --launcher`` once per session (about two minutes): its output
+    directory (every MPI job it started is in the launcher's log)."""
     from hexdem.cli.main import main
 
     out = tmp_path_factory.mktemp("paper") / "out"
-    assert main(["paper", "--out", str(out), "--quick"]) == 0
+    assert main(["paper", "--out", str(out), "--quick", "--launcher", launcher[0]]) == 0
     return out
 
 

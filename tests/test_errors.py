@@ -103,8 +103,9 @@ def test_runs_that_cannot_be_analysed_or_cannot_fit_are_refused(tmp_path, capsys
 
 
 @pytest.mark.parametrize("ranks", [1, 2])
-def test_deck_error_is_reported_with_lammps_message(tmp_path, ranks):
-    """By hand (``lmp -in``) and through the streaming driver on 1 and 2 MPI ranks."""
+def test_deck_error_is_reported_with_lammps_message(tmp_path, capfd, ranks):
+    """By hand (``lmp -in``) and through the streaming driver on 1 and 2 MPI ranks; the ranks
+    that abort print no traceback."""
     config = RunConfig(edge_beads=3)
     rendered = write_deck(config.model(), config.settings(), tmp_path / "deck")
     rendered.input_path.write_text(rendered.input_path.read_text().replace("pair_style      granular", "pair_style nonsense"))
@@ -113,6 +114,7 @@ def test_deck_error_is_reported_with_lammps_message(tmp_path, ranks):
         with pytest.raises(HexdemError, match=r"LAMMPS failed on .*in\.hexdem: ERROR: .*nonsense") as info:
             attempt()
         assert "\n" not in str(info.value)
+    assert "Traceback" not in capfd.readouterr().err
 
 
 def test_corrupt_dump_is_a_clear_error(tmp_path):
@@ -150,7 +152,7 @@ def test_lammps_loads_without_ld_library_path():
     assert np.isfinite(float(instance.version()))
 
 
-def test_an_observer_failing_on_two_ranks_is_one_line(tmp_path):
+def test_an_observer_failing_on_two_ranks_is_one_line(tmp_path, capfd):
     """The failing rank aborts the MPI job (the others would wait in a collective call) and its
     message reaches the user through job.error."""
     config = RunConfig(edge_beads=3)
@@ -158,3 +160,4 @@ def test_an_observer_failing_on_two_ranks_is_one_line(tmp_path):
     with pytest.raises(HexdemError, match="TypeError: object of type 'Sample' has no len") as info:
         run_on_ranks(functools.partial(run_streaming, rendered, len), 2, tmp_path / "job")
     assert "\n" not in str(info.value)
+    assert "Traceback" not in capfd.readouterr().err

@@ -103,6 +103,14 @@ def test_a_rerun_resumes_without_recomputing(quick, capsys):
     assert {p.name: p.stat().st_mtime_ns for p in sorted((quick / "parts").glob("*.json"))} == before
 
 
+def test_every_mpi_job_of_the_paper_went_through_the_launcher(quick, launcher):
+    """Fig. 4 on 2 ranks, the sweep's runs on 2 ranks, and the ensembles' partitions and impacts."""
+    jobs = launcher[1].read_text().splitlines()
+    assert any("-partition" in job for job in jobs), "the ensembles' preparation partitions"
+    parallel = [job for job in jobs if "hexdem.experiments.parallel" in job]
+    assert len(parallel) >= 3 and all(job.startswith("-n 2 ") for job in parallel)
+
+
 def test_other_settings_in_the_same_directory_are_refused(quick, capsys):
     assert main(["paper", "--out", str(quick)]) == 2
     lines = capsys.readouterr().err.strip().splitlines()

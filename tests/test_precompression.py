@@ -97,3 +97,17 @@ def test_weak_impulses_travel_at_the_longitudinal_sound_speed(tmp_path, engine):
 def test_bad_precompression_is_refused(changes, message):
     with pytest.raises(HexdemError, match=message):
         RunConfig(**changes)
+
+
+def test_far_wall_is_reached_when_the_front_has_crossed_although_the_box_keeps_ringing(tmp_path):
+    """20 N, V0 = 1e-3 m/s, 11 per edge: the front (c_L ≈ 500 m/s) reaches the far wall at about
+    0.68 ms of the default 1.75 ms run, while reflections keep driving its corner beads to the end
+    (their largest speed comes in the last samples, so they have no arrival time). Cut at 0.5 ms,
+    before the front gets there, the far wall is not reached."""
+    config = RunConfig(precompression_n=20.0, v0=1e-3)
+    analysis = simulate(config, tmp_path / "whole")
+    r, model = analysis.results, analysis.model
+    far = min(model.walls, key=lambda wall: float(np.dot(wall.normal, model.impact.direction))).members
+    assert np.isnan(r.arrival_time[far]).any(), "the corners are still driven at the end"
+    assert np.nanmax(r.reach_time[far]) < 0.9e-3 and r.far_wall_reached  # measured: 0.81 ms at the latest
+    assert not simulate(config.replace(duration=0.5e-3), tmp_path / "cut").results.far_wall_reached

@@ -28,20 +28,20 @@ class ImpactAnalysis:
     """Peaks, times of peak and arrival times of every bead, and the energy drift.
 
     ``results``: ``units``, ``length_unit_m``, ``positions`` (N, 2), ``peak_speed``, ``t_peak``,
-    ``arrival_time`` (N,), ``lines`` {name: bead indices}, ``energy_drift``,
+    ``arrival_time``, ``reach_time`` (N,), ``lines`` {name: bead indices}, ``energy_drift``,
     ``far_wall_reached``. ``tracked``: the :class:`TrackedPulses` (traces, fields) of a
     tracked run, else None.
     """
 
     def __init__(self, model: GranularModel, settings: RunSettings, engine: dict, peak_speed, t_peak, arrival_time,
-                 energy_drift: float, tracked: TrackedPulses | None = None):
+                 reach_time, energy_drift: float, tracked: TrackedPulses | None = None):
         self.model, self.settings, self.engine, self.tracked = model, settings, engine, tracked
         units = settings.units
         self.results = r = SimpleNamespace()
         r.units = units.name
         r.length_unit_m = units.length_m
         r.positions = model.lattice.positions_m / units.length_m
-        r.peak_speed, r.t_peak, r.arrival_time = peak_speed, t_peak, arrival_time
+        r.peak_speed, r.t_peak, r.arrival_time, r.reach_time = peak_speed, t_peak, arrival_time, reach_time
         r.lines = model.lattice.lines()
         r.energy_drift = energy_drift
         r.far_wall_reached = self._far_wall_reached()
@@ -50,7 +50,7 @@ class ImpactAnalysis:
     def from_tracker(cls, model: GranularModel, settings: RunSettings, tracked: TrackedPulses,
                      engine: dict) -> "ImpactAnalysis":
         return cls(model, settings, engine, tracked.peak_speed, tracked.t_peak, tracked.arrival_time,
-                   tracked.energy_drift, tracked)
+                   tracked.reach_time, tracked.energy_drift, tracked)
 
     @classmethod
     def from_trajectory(cls, model: GranularModel, settings: RunSettings, trajectory: Trajectory) -> "ImpactAnalysis":
@@ -58,15 +58,22 @@ class ImpactAnalysis:
         pulses = pulse_times(trajectory.times_s / units.time_s,
                              trajectory.speeds_m_s[:, :len(model.lattice)] / units.velocity_m_s)
         return cls(model, settings, trajectory.engine, pulses.peak_speed, pulses.t_peak, pulses.arrival_time,
-                   trajectory.energy_drift(model))
+                   pulses.reach_time, trajectory.energy_drift(model))
 
     def _far_wall_reached(self) -> bool:
-        """Did the leading wave reach (and pass) every bead at the wall facing the strike?"""
-        arrival = self.results.arrival_time
-        if not self.model.walls:
-            return bool(np.all(np.isfinite(arrival)))
-        far = min(self.model.walls, key=lambda wall: float(np.dot(wall.normal, self.model.impact.direction)))
-        return bool(np.all(np.isfinite(arrival[far.members])))
+        """Did the leading wave reach every bead at the wall facing the strike (every bead, without
+        walls) within the run? A bead counts as reached when its speed rose to half of its largest
+        value at least one impact time scale (``settings.contact_time_s``) before the run ended:
+        a bead still on its first rise at the end has not been passed by the front, while one
+        whose speed keeps growing under reflections (a precompressed box rings) has."""
+        r = self.results
+        beads = np.arange(len(r.reach_time))
+        if self.model.walls:
+            far = min(self.model.walls, key=lambda wall: float(np.dot(wall.normal, self.model.impact.direction)))
+            beads = far.members
+        units = self.settings.units
+        latest = (self.settings.duration_s - self.settings.contact_time_s) / units.time_s
+        return bool(np.all(r.reach_time[beads] <= latest))
 
     def line_trace(self, line: str) -> tuple[np.ndarray, np.ndarray]:
         """(times (S,), speeds (S, L)) of the beads of observation ``line`` at every sample, in

@@ -13,6 +13,11 @@ Definitions (used for LAMMPS dumps and for the reference integrator alike):
 A bead whose largest sample is among the last two of the record has not yet been passed
 by its pulse: its three values are NaN (the run was too short to see its peak). A bead
 that never moved (peak exactly 0) also gets NaN.
+
+* **reach time**: when |v| first reached half of its largest sample of the record: the
+  arrival time where that is defined, and also for beads whose speed is largest at the end of
+  the record (a bead still rising, or one that reflections keep driving, as in a
+  precompressed packing). A bead reached it long before the end if a wave had got there.
 """
 
 from __future__ import annotations
@@ -29,11 +34,13 @@ HALF_WINDOW = 3
 
 @dataclass(frozen=True)
 class PulseTimes:
-    """Per-bead results, each an (n_beads,) array: ``peak_speed``, ``t_peak``, ``arrival_time``."""
+    """Per-bead results, each an (n_beads,) array: ``peak_speed``, ``t_peak``, ``arrival_time``,
+    ``reach_time``."""
 
     peak_speed: np.ndarray
     t_peak: np.ndarray
     arrival_time: np.ndarray
+    reach_time: np.ndarray
 
 
 def _spline_window(times, values, centre) -> tuple[LocalSpline, int]:
@@ -74,13 +81,16 @@ def pulse_times(times, speeds) -> PulseTimes:
     times = np.asarray(times, float)
     speeds = np.asarray(speeds, float)
     n_beads = speeds.shape[1]
-    peak, t_peak, arrival = (np.full(n_beads, np.nan) for _ in range(3))
+    peak, t_peak, arrival, reach = (np.full(n_beads, np.nan) for _ in range(4))
     last_complete = len(times) - 3
     for bead in range(n_beads):
         series = speeds[:, bead]
         k = int(np.argmax(series))
-        if series[k] <= 0.0 or k > last_complete:
+        if series[k] <= 0.0:
+            continue
+        if k > last_complete:
+            reach[bead] = rising_crossing(times, series, 0.5 * series[k])
             continue
         t_peak[bead], peak[bead] = refine_peak(times, series)
-        arrival[bead] = rising_crossing(times[:k + 1], series[:k + 1], 0.5 * peak[bead])
-    return PulseTimes(peak, t_peak, arrival)
+        arrival[bead] = reach[bead] = rising_crossing(times[:k + 1], series[:k + 1], 0.5 * peak[bead])
+    return PulseTimes(peak, t_peak, arrival, reach)

@@ -48,7 +48,8 @@ RECORD_CAPACITY = 64
 class TrackedPulses:
     """What a :class:`PulseTracker` found, in the run's unit system.
 
-    Per bead (N,): ``peak_speed``, ``t_peak``, ``arrival_time``.
+    Per bead (N,): ``peak_speed``, ``t_peak``, ``arrival_time``, ``reach_time`` (see
+    :mod:`hexdem.analysis.peaks`).
     ``energy_drift`` the audit's error over ``energy_times`` (see
     :func:`~hexdem.analysis.energy.energy_error`); ``energy_lost`` (E0 − E_end) relative to the
     impact's kinetic energy; ``n_samples``;
@@ -61,6 +62,7 @@ class TrackedPulses:
     peak_speed: np.ndarray
     t_peak: np.ndarray
     arrival_time: np.ndarray
+    reach_time: np.ndarray
     energy_drift: float
     energy_lost: float
     energy_times: np.ndarray
@@ -216,20 +218,23 @@ class PulseTracker:
         if not self.root:
             return None
         interval = self.settings.dump_every * self.settings.dt_s / self.settings.units.time_s
-        peak, t_peak, arrival = (np.full(self.n_beads, np.nan) for _ in range(3))
+        peak, t_peak, arrival, reach = (np.full(self.n_beads, np.nan) for _ in range(4))
         for b in range(self.n_beads):
             k = int(self.peak_index[b])
-            if self.peak[b] <= 0.0 or k > self.count - 3:
+            if self.peak[b] <= 0.0:
+                continue
+            n = int(self.rec_len[b])
+            records = (self.rec_index[b, :n], self.rec_value[b, :n], self.rec_prev[b, :n], self.first_index[b, :n],
+                       self.first_value[b, :n], self.first_prev[b, :n], n)
+            if k > self.count - 3:
+                reach[b] = interval * first_crossing(0.5 * self.peak[b], *records)
                 continue
             index = np.arange(k - 3, k + 4)
             valid = (index >= 0) & (index < self.count) & np.isfinite(self.window[b])
             t_peak[b], peak[b] = refine_peak(index[valid] * interval, self.window[b, valid])
-            n = int(self.rec_len[b])
-            arrival[b] = interval * first_crossing(0.5 * peak[b], self.rec_index[b, :n], self.rec_value[b, :n],
-                                                   self.rec_prev[b, :n], self.first_index[b, :n],
-                                                   self.first_value[b, :n], self.first_prev[b, :n], n)
+            arrival[b] = reach[b] = interval * first_crossing(0.5 * peak[b], *records)
         scale = energy_scale_j(self.energies, self.impact_energy)
-        return TrackedPulses(peak_speed=peak, t_peak=t_peak, arrival_time=arrival,
+        return TrackedPulses(peak_speed=peak, t_peak=t_peak, arrival_time=arrival, reach_time=reach,
                              energy_drift=energy_error(self.energies, self.impact_energy, self.model.dissipative),
                              energy_lost=(self.energies[0] - self.energies[-1]) / scale,
                              energy_times=np.array(self.energy_times),

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from hexdem.cli.options import add_launcher
 from hexdem.cli.run import config_from_args
 from hexdem.errors import HexdemError
 
@@ -13,6 +14,7 @@ def add_arguments(parser) -> None:
                         help="output directory (default: compare/): compare.csv, compare.json, compare.png, "
                         "and each engine's run in lammps/ and reference/")
     parser.add_argument("--ranks", type=int, metavar="N", help="MPI ranks for LAMMPS (default 1, in-process)")
+    add_launcher(parser)
     parser.add_argument("--peak-tol", type=float, metavar="REL",
                         help="allowed relative peak-speed difference (default 0.005)")
     parser.add_argument("--arrival-tol", type=float, metavar="SECONDS",

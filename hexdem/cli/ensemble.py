@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 import re
 
+from hexdem.cli.options import add_launcher
 from hexdem.errors import HexdemError
 
 DEFAULT_VELOCITIES = "0.25,0.40,0.70"
@@ -44,9 +45,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--seed", type=int, default=0, help="seed of the diameters (default 0)")
     parser.add_argument("--workers", type=int, default=os.cpu_count() or 1, metavar="N",
                         help="LAMMPS partitions (processes) at once (default: the number of cores)")
-    parser.add_argument("--launcher", metavar="CMD",
-                        help='MPI launcher to which "-n N lmp -partition Nx1 -in run.in" is appended '
-                             '(default: this environment\'s mpiexec), e.g. "mpiexec -f hosts" or "srun"')
+    add_launcher(parser, "-n N lmp -partition Nx1 -in run.in")
     parser.add_argument("--edge-beads", type=int, default=11, help="beads per hexagon edge (default 11)")
     parser.add_argument("--tol-mm", type=float, help="diameter tolerance tol in mm (default 0.0127)")
     parser.add_argument("--sigma-mm", type=float, help="standard deviation of the diameters in mm (default 6 tol)")

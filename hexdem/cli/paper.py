@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import os
 
+from hexdem.cli.options import add_launcher
+
 
 def add_arguments(parser) -> None:
     parser.add_argument("--out", metavar="DIR", required=True, help="output directory (rerun to resume)")
@@ -16,10 +18,11 @@ def add_arguments(parser) -> None:
                         help="processes at once: sweep runs, LAMMPS partitions, MPI ranks (default 2)")
     parser.add_argument("--quick", action="store_true",
                         help="fewer V0 values and realizations, same code paths (about 2 minutes; rough numbers)")
+    add_launcher(parser, "-n N and each MPI job or LAMMPS partition run")
 
 
 def run(args) -> None:
     from hexdem.paper.pipeline import run_paper
     from hexdem.paper.settings import PaperSettings
 
-    run_paper(PaperSettings(quick=args.quick, workers=args.workers), args.out)
+    run_paper(PaperSettings(quick=args.quick, workers=args.workers, launcher=args.launcher), args.out)

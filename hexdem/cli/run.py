@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from hexdem.cli.options import add_launcher
 from hexdem.model.config import ENGINES, RunConfig
 
 
@@ -11,6 +12,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--out", metavar="DIR", default="results", help="output directory (default: results/)")
     parser.add_argument("--ranks", type=int, metavar="N", help="MPI ranks for LAMMPS (default 1, in-process)")
     parser.add_argument("--engine", choices=ENGINES, help="integrator (default: lammps)")
+    add_launcher(parser)
     parser.add_argument("--dump", action="store_true", default=None,
                         help="also write LAMMPS's full trajectory dump into DIR/deck (config key dump = true)")
 
@@ -19,7 +21,7 @@ def config_from_args(args) -> RunConfig:
     """The config file (or the defaults) with command-line overrides applied."""
     config = RunConfig.from_toml(args.config) if args.config else RunConfig()
     overrides = {key: value for key, value in (("ranks", args.ranks), ("engine", args.engine),
-                                                                  ("dump", args.dump)) if value is not None}
+                                               ("dump", args.dump), ("launcher", args.launcher)) if value is not None}
     return config.replace(**overrides)
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import sys
 
+from hexdem.cli.options import add_launcher
 from hexdem.model.config import ENGINES
 
 
@@ -35,6 +36,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--duration", type=float, default=d.duration_contacts, metavar="CONTACT_TIMES",
                         help=f"run length in contact times at V0 (default {d.duration_contacts:g})")
     parser.add_argument("--workers", type=int, default=d.workers, help=f"runs in parallel (default {d.workers})")
+    add_launcher(parser)
     parser.add_argument("--json", action="store_true", help="also print scaling.json to stdout")
 
 
@@ -45,7 +47,7 @@ def run(args) -> None:
 
     settings = SweepSettings(v0_min=args.v0_min, v0_max=args.v0_max, n_v0=args.n_v0, last=args.last,
                              steps_per_contact=args.steps_per_contact, duration_contacts=args.duration,
-                             engine=args.engine, workers=args.workers)
+                             engine=args.engine, workers=args.workers, launcher=args.launcher)
     ensure_writable_dir(args.out)
     summary = write_outputs(run_sweep(settings), args.out, kind=args.fit)
     print(f"hexdem scaling: results in {args.out}", file=sys.stderr)

@@ -7,6 +7,7 @@ in ``deck/`` (see :mod:`hexdem.experiments.snapshots`).
 
 from __future__ import annotations
 
+from hexdem.cli.options import add_launcher
 from hexdem.model.config import SHAPES
 
 
@@ -20,6 +21,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--v-striker", type=float, default=0.4, help="striker speed in m/s (default 0.4)")
     parser.add_argument("--ranks", type=int, default=1, metavar="N",
                         help="MPI ranks for LAMMPS (default 1, in-process; more run through mpiexec)")
+    add_launcher(parser)
     parser.add_argument("--edge-beads", type=int, default=11, help="hexagon: beads per edge (default 11)")
     parser.add_argument("--long-edge", type=int, default=91, help="half-hexagon: beads on the long edge (default 91)")
     parser.add_argument("--short-edge", type=int, default=46,
@@ -34,7 +36,8 @@ def run(args) -> None:
     from hexdem.model.config import RunConfig
 
     config = RunConfig(shape=args.shape, edge_beads=args.edge_beads, long_edge=args.long_edge,
-                       short_edge=args.short_edge, impact="striker", v0=args.v_striker, ranks=args.ranks)
+                       short_edge=args.short_edge, impact="striker", v0=args.v_striker, ranks=args.ranks,
+                       launcher=args.launcher)
     times_ms = (DEFAULT_TIMES_MS[args.shape] if args.times is None
                 else parse_numbers(args.times, "--times", "ms", "0.2,0.4,0.6"))
     outline = args.outline_edge if args.outline_edge is not None else (11 if args.shape == "half-hexagon" else None)

@@ -20,7 +20,8 @@ ERROR_FILE_VARIABLE = "HEXDEM_JOB_ERROR"
 
 def abort_job(comm, exc: BaseException) -> None:
     """Leave ``exc``'s one-line message where ``$HEXDEM_JOB_ERROR`` says, then end the whole
-    MPI job (the other ranks would wait for this one in a collective call)."""
+    MPI job (the other ranks would wait for this one in a collective call). ``MPI_Abort``
+    need not stop its caller at once: a caller must return, not go on with its work."""
     path = os.environ.get(ERROR_FILE_VARIABLE)
     if path:
         write_text(path, one_line(exc) + "\n")

@@ -24,6 +24,7 @@ from hexdem.disorder.ensemble import Ensemble, EnsembleConfig
 from hexdem.disorder.preparation import STAGES, read_stage
 from hexdem.disorder.prestress import prestress
 from hexdem.engines.lammps.partitions import loop_time_s
+from hexdem.experiments.parallel import spread_tasks
 from hexdem.experiments.run import check_energy
 from hexdem.experiments.tracked_run import ImpactJob, track_impact
 
@@ -75,13 +76,8 @@ class ImpactTasks:
 
     def __call__(self, comm):
         ensemble = Ensemble(self.config, self.out)
-        rank, size = (0, 1) if comm is None else (comm.Get_rank(), comm.Get_size())
-        alone = None if comm is None else comm.Split(color=rank, key=0)  # one LAMMPS per rank
-        versions = [run_impact(ensemble, k, v, self.dump, alone) for k, v in self.tasks[rank::size]]
-        every = [versions] if comm is None else comm.gather(versions, root=0)
-        if rank != 0:
-            return None
-        return next((version for part in every for version in part), "unknown")
+        versions = spread_tasks(comm, self.tasks, lambda task, alone: run_impact(ensemble, *task, self.dump, alone))
+        return None if versions is None else next(iter(versions), "unknown")
 
 
 def impact_done(ensemble: Ensemble, k: int | None, v: float) -> bool:

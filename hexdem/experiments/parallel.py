@@ -2,10 +2,11 @@
 
 A *job* is a picklable callable ``job(comm)`` that every rank calls with the mpi4py world
 communicator (None when it runs alone, in-process); rank 0 returns the result, the others
-None. For N > 1 ranks hexdem pickles the job into its directory and starts
-``mpiexec -n N python -m hexdem.experiments.parallel job.pickle`` (both from this
+None. For N > 1 ranks (or any launcher) hexdem pickles the job into its directory and
+starts ``mpiexec -n N python -P -m hexdem.experiments.parallel job.pickle`` (both from this
 environment: the ``mpich`` wheel's launcher and this Python), which writes rank 0's result
-atomically beside the job. A failure on any rank is written to ``job.error`` in one line and
+atomically beside the job. ``-P`` keeps the current directory off ``sys.path``, so that the
+ranks import the hexdem that is installed even when they start inside a source checkout. A failure on any rank is written to ``job.error`` in one line and
 aborts the whole MPI job, so that no rank waits forever in a collective call (a failure inside
 a LAMMPS sampling callback is written there too, through ``HEXDEM_JOB_ERROR``).
 """
@@ -80,7 +81,7 @@ def run_on_ranks(job, ranks: int, directory, launcher: str | None = None, progre
         path.unlink(missing_ok=True)
     paths[JOB_NAME].write_bytes(pickle.dumps(job))
     prefix = shlex.split(launcher) if launcher else [environment_command("mpiexec")]
-    command = [*prefix, "-n", str(ranks), sys.executable, "-m", __name__, str(paths[JOB_NAME].resolve())]
+    command = [*prefix, "-n", str(ranks), sys.executable, "-P", "-m", __name__, str(paths[JOB_NAME].resolve())]
     with _progress(progress):
         done = subprocess.run(command, stdout=subprocess.PIPE, stderr=None, text=True,
                               preexec_fn=functools.partial(die_with_parent, os.getpid()))
@@ -96,6 +97,20 @@ def run_on_ranks(job, ranks: int, directory, launcher: str | None = None, progre
     return result
 
 
+def spread_tasks(comm, tasks, work) -> list | None:
+    """``work(task, alone)`` for every task, rank r of ``comm`` taking tasks r, r + P, r + 2P, …
+    with ``alone`` a one-rank communicator of its own (one LAMMPS per rank; None when ``comm``
+    is None). Rank 0 returns the results in the order of ``tasks``, the other ranks None."""
+    rank, size = (0, 1) if comm is None else (comm.Get_rank(), comm.Get_size())
+    alone = None if comm is None else comm.Split(color=rank, key=0)
+    mine = [(i, work(task, alone)) for i, task in enumerate(tasks) if i % size == rank]
+    parts = [mine] if comm is None else comm.gather(mine, root=0)
+    if rank != 0:
+        return None
+    results = dict(pair for part in parts for pair in part)
+    return [results[i] for i in range(len(tasks))]
+
+
 def _rank_main(job_path: Path) -> None:
     """One rank of an MPI job: run it, publish rank 0's result, or report and abort."""
     load_lammps()  # loads the mpich wheel's MPI library before mpi4py looks for one
@@ -108,6 +123,7 @@ def _rank_main(job_path: Path) -> None:
         result = pickle.loads(job_path.read_bytes())(comm)
     except BaseException as exc:
         abort_job(comm, exc)
+        return
     if comm.Get_rank() == 0:
         with atomic_path(job_path.parent / RESULT_NAME) as tmp:
             tmp.write_bytes(pickle.dumps(result))

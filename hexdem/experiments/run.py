@@ -44,8 +44,11 @@ def _replace_dir(source: Path, target: Path) -> None:
     source.rename(target)
 
 
-def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples=()) -> ImpactAnalysis:
+def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples=(), comm=None) -> ImpactAnalysis:
     """Run ``config`` with its engine in ``workdir``, analysed while it runs (no result files).
+
+    ``comm``: a one-rank mpi4py communicator when this runs inside an MPI job of several
+    independent runs (see :func:`~hexdem.experiments.parallel.spread_tasks`), else None.
 
     ``trace_lines`` (observation line names) keep the speeds of those lines' beads at every
     sample, ``field_samples`` every bead's speed at those samples (see
@@ -65,7 +68,7 @@ def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples
     traced = tuple(int(bead) for line in trace_lines for bead in model.lattice.line(line))
     job = ImpactJob(model, settings, config.engine, workdir, dump=config.dump, trace_beads=traced,
                     field_samples=tuple(field_samples))
-    analysis = track_impact(job, config.ranks)
+    analysis = track_impact(job, config.ranks, comm, config.launcher)
     check_energy(analysis, workdir)
     return analysis
 
@@ -169,5 +172,6 @@ def run_experiment(config: RunConfig, out, log=None) -> ImpactAnalysis:
     write_results(config, analysis, out, time.perf_counter() - start)
     log(f"energy drift {analysis.results.energy_drift:.2e}; results in {out}")
     if not analysis.results.far_wall_reached:
-        log("warning: the leading wave did not pass the far wall within the run; increase 'duration'")
+        log("warning: the leading wave had not reached every bead at the far wall one contact time before the run "
+            "ended; increase 'duration'")
     return analysis

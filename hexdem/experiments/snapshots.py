@@ -77,7 +77,7 @@ def take_snapshots(config: RunConfig, times_s, directory) -> Snapshots:
     wanted = np.array([round(t * 1e6) * 1e-6 for t in sorted(times_s)])
     samples = np.rint(wanted / (settings.dump_every * settings.dt_s)).astype(int)
     job = ImpactJob(model, settings, "lammps", Path(directory), dump=config.dump, field_samples=tuple(samples))
-    analysis = track_impact(job, config.ranks)
+    analysis = track_impact(job, config.ranks, launcher=config.launcher)
     tracked = analysis.tracked
     return Snapshots(config, model.lattice, tracked.field_times * settings.units.time_s, tracked.field_speeds,
                      analysis.engine)

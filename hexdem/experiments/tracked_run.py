@@ -48,14 +48,15 @@ class ImpactJob:
         return None if tracked is None else (tracked, description)
 
 
-def track_impact(job: ImpactJob, ranks: int = 1, comm=None) -> ImpactAnalysis | None:
-    """Run ``job`` on ``ranks`` MPI ranks (LAMMPS only; 1: in this process) and analyse it.
-    Given ``comm``, every rank of that communicator calls this instead; rank 0 gets the
-    analysis, the others None."""
+def track_impact(job: ImpactJob, ranks: int = 1, comm=None, launcher: str | None = None) -> ImpactAnalysis | None:
+    """Run ``job`` on ``ranks`` MPI ranks (LAMMPS only; 1 without ``launcher``: in this
+    process) started by ``launcher`` (see :func:`~hexdem.experiments.parallel.run_on_ranks`)
+    and analyse it. Given ``comm``, every rank of that communicator calls this instead; rank 0
+    gets the analysis, the others None."""
     if comm is not None:
         result = job(comm)
     else:
-        result = run_on_ranks(job, ranks if job.engine == "lammps" else 1, job.directory)
+        result = run_on_ranks(job, ranks if job.engine == "lammps" else 1, job.directory, launcher)
     if result is None:
         return None
     tracked, description = result

@@ -60,6 +60,9 @@ class RunConfig:
     ``sensors``: sensor particles, each ``"line:n"`` (e.g. ``"0:1"``, ``"+30:6"``) or a bead id;
     sampled at ``sensor_rate_hz`` (the paper's 500 kS/s); ``sensor_mass_factor``: a sensor
     bead's mass relative to a plain bead's.
+    ``launcher``: the MPI launcher command that starts the ranks (None: this environment's
+    ``mpiexec``; e.g. ``"mpiexec -f hosts"`` or ``"srun"`` to span machines); given, the run goes
+    through it even on one rank.
     ``dt = None`` takes the contact time (:meth:`contact_time_s`) / 700; ``duration = None``
     runs until the leading wave has crossed the packing: one contact time per layer between
     the struck bead and the far wall (the pulse resides less than that on each
@@ -89,6 +92,7 @@ class RunConfig:
     sensors: tuple = ()
     sensor_rate_hz: float = 500e3
     sensor_mass_factor: float = 1.0
+    launcher: str | None = None
 
     def __post_init__(self):
         for name, allowed in (("shape", SHAPES), ("impact", IMPACTS), ("units", UNITS), ("engine", ENGINES)):
@@ -101,6 +105,8 @@ class RunConfig:
             raise HexdemError(f"sensor_rate_hz must be > 0, got {self.sensor_rate_hz!r}")
         if not (is_number(self.precompression_n) and self.precompression_n >= 0):
             raise HexdemError(f"precompression_n must be a force >= 0 N, got {self.precompression_n!r}")
+        if self.launcher is not None and not (isinstance(self.launcher, str) and self.launcher.split()):
+            raise HexdemError(f"launcher must be a command such as \"mpiexec -f hosts\", got {self.launcher!r}")
         if not isinstance(self.dump, bool):
             raise HexdemError(f"dump must be true or false, got {self.dump!r}")
         for name in ("dt", "duration"):
@@ -255,4 +261,4 @@ class RunConfig:
             dt_s = 1.0 / self.sensor_rate_hz / sensor_every
         n_steps = max(1, round(duration_s / dt_s))
         return RunSettings(dt_s=dt_s, n_steps=n_steps, dump_every=every, units=self.unit_system,
-                           sensor_every=sensor_every)
+                           sensor_every=sensor_every, contact_time_s=self.contact_time_s())

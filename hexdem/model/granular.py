@@ -156,13 +156,16 @@ class RunSettings:
     """Time integration of one run: ``dt_s`` step [s], ``n_steps``, a sample every ``dump_every``
     steps; ``units`` is the system the engine works in and the results are reported in;
     ``sensor_every`` steps between two samples of the sensor particles (0: no sensors), a
-    multiple of ``dump_every``."""
+    multiple of ``dump_every``; ``contact_time_s`` the impact's time scale [s] (the two-bead
+    Hertz contact time at V0, or the precompressed contact's half period: see
+    :meth:`~hexdem.model.config.RunConfig.contact_time_s`; 0 where a run was set up by hand)."""
 
     dt_s: float
     n_steps: int
     dump_every: int
     units: UnitSystem = SI
     sensor_every: int = 0
+    contact_time_s: float = 0.0
 
     @property
     def duration_s(self) -> float:

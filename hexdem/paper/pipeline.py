@@ -62,7 +62,7 @@ def _snapshots(settings: PaperSettings, out: Path, shape: str) -> dict:
     long_edge, short_edge = settings.half_hexagon
     half = shape == "half-hexagon"
     config = RunConfig(shape=shape, long_edge=long_edge, short_edge=short_edge, impact="striker", v0=0.4,
-                       ranks=settings.workers if half else 1)
+                       ranks=settings.workers if half else 1, launcher=settings.launcher)
     times_ms = QUICK_FIG4_TIMES_MS if half and settings.quick else DEFAULT_TIMES_MS[shape]
     folder = out / ("fig4" if half else "fig3")
     run_snapshots(config, [t * 1e-3 for t in times_ms], folder, outline_edge=11 if half else None, log=_quiet)
@@ -73,7 +73,8 @@ def _scaling(settings: PaperSettings, out: Path) -> dict:
     from hexdem.theory.outputs import write_outputs
     from hexdem.theory.sweep import SweepSettings, run_sweep
 
-    sweep = run_sweep(SweepSettings(n_v0=settings.n_v0, workers=settings.workers), log=_quiet)
+    sweep = run_sweep(SweepSettings(n_v0=settings.n_v0, workers=settings.workers, launcher=settings.launcher),
+                      log=_quiet)
     return write_outputs(sweep, out / "scaling")
 
 

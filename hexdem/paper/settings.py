@@ -26,7 +26,8 @@ RELAXED_WALL_SLACK_M = TOLERANCE_M
 @dataclass(frozen=True)
 class PaperSettings:
     """``quick``: the thinned variant; ``workers``: processes (sweep runs, LAMMPS partitions,
-    MPI ranks of Fig. 4) at once.
+    MPI ranks of Fig. 4) at once; ``launcher``: the MPI launcher command that starts them
+    (None: this environment's ``mpiexec``, and the sweep in local processes).
 
     ``n_v0`` V₀ values of the scaling sweep (0.01 … 0.30); ``realizations`` per disordered
     ensemble (σ = 0 needs one: equal beads prepared the same way are identical);
@@ -36,6 +37,7 @@ class PaperSettings:
 
     quick: bool = False
     workers: int = 2
+    launcher: str | None = None
 
     def __post_init__(self):
         positive_int("--workers", self.workers)

@@ -16,6 +16,7 @@ the fitted beads (a larger hexagon gives identical peaks).
 
 from __future__ import annotations
 
+import os
 import sys
 import tempfile
 import time
@@ -26,10 +27,13 @@ from multiprocessing import get_context
 import numpy as np
 
 from hexdem.errors import HexdemError
+from hexdem.experiments.parallel import run_on_ranks, spread_tasks
 from hexdem.theory.scaling import DEFAULT_LAST, Combination, CombinationFit, fit_combination
 
 #: Strike angles of the sweep [deg]: each one serves two combinations.
 STRIKES_DEG = (0.0, 30.0)
+#: Names of the markers that runs of the sweep on MPI ranks leave when they finish.
+DONE_PREFIX = "done-"
 
 
 @dataclass(frozen=True)
@@ -39,7 +43,10 @@ class SweepSettings:
     ``v0_min``, ``v0_max``, ``n_v0``: evenly spaced V₀; ``last``: the last bead any fit may
     use; ``edge_beads``: hexagon size (None: ``last`` + 4); ``steps_per_contact``: time step
     τ(V₀)/this; ``samples_per_contact``: output samples per τ(V₀); ``duration_contacts``: run
-    length in τ(V₀); ``engine``: "reference" or "lammps"; ``workers``: parallel runs.
+    length in τ(V₀); ``engine``: "reference" or "lammps"; ``workers``: parallel runs;
+    ``launcher``: an MPI launcher command (e.g. ``"mpiexec -f hosts"``): the runs then go to
+    ``workers`` MPI ranks it starts, on as many machines as it reaches, instead of local
+    processes.
     """
 
     v0_min: float = 0.01
@@ -52,6 +59,7 @@ class SweepSettings:
     duration_contacts: float = 16.0
     engine: str = "reference"
     workers: int = 2
+    launcher: str | None = None
 
     def __post_init__(self):
         if not (0 < self.v0_min < self.v0_max and self.n_v0 >= 4):
@@ -101,14 +109,15 @@ class RunPeaks:
     wall_time_s: float
 
 
-def run_one(settings: SweepSettings, v0: float, strike_deg: float) -> RunPeaks:
-    """Simulate one V₀ and strike of the sweep in a scratch directory."""
+def run_one(settings: SweepSettings, v0: float, strike_deg: float, comm=None) -> RunPeaks:
+    """Simulate one V₀ and strike of the sweep in a scratch directory (``comm``: a one-rank
+    communicator inside an MPI job, else None)."""
     from hexdem.experiments.run import simulate
 
     start = time.perf_counter()
     config = settings.config(v0, strike_deg)
     with tempfile.TemporaryDirectory(prefix="hexdem-scaling-") as scratch:
-        analysis = simulate(config, scratch, trace_lines=("0", "+30"))
+        analysis = simulate(config, scratch, trace_lines=("0", "+30"), comm=comm)
     r = analysis.results
     lines = {name: r.lines[name][:settings.last + 2] for name in ("0", "+30")}
     traces = {}
@@ -167,9 +176,45 @@ def run_sweep(settings: SweepSettings, log=None) -> Sweep:
     return sweep
 
 
+@dataclass(frozen=True)
+class SweepTasks:
+    """An MPI job: the sweep's runs ``jobs`` [(strike, i, V₀)] spread over the ranks, one
+    engine per rank; each finished run leaves a marker in ``directory`` (for the progress)."""
+
+    settings: SweepSettings
+    jobs: tuple
+    directory: str
+
+    def __call__(self, comm):
+        return spread_tasks(comm, self.jobs, self._run)
+
+    def _run(self, job, alone) -> RunPeaks:
+        strike, i, v0 = job
+        result = run_one(self.settings, v0, strike, alone)
+        open(os.path.join(self.directory, f"{DONE_PREFIX}{strike:g}-{i}"), "w").close()
+        return result
+
+
+def _on_ranks(settings: SweepSettings, jobs):
+    """Yield ((strike, i), RunPeaks) of every run, the runs spread over MPI ranks that
+    ``settings.launcher`` starts."""
+    with tempfile.TemporaryDirectory(prefix="hexdem-sweep-") as directory:
+        def count_done() -> int:
+            return sum(name.startswith(DONE_PREFIX) for name in os.listdir(directory))
+
+        results = run_on_ranks(SweepTasks(settings, tuple(jobs), directory), min(settings.workers, len(jobs)),
+                               directory, settings.launcher, progress=(len(jobs), "V0 sweep", count_done))
+    for (strike, i, _), result in zip(jobs, results):
+        yield (strike, i), result
+
+
 def _results(settings: SweepSettings, jobs):
-    """Yield ((strike, i), RunPeaks) as runs finish: in this process for one worker, else in
-    spawned processes (callers' scripts need an ``if __name__ == "__main__":`` guard)."""
+    """Yield ((strike, i), RunPeaks) as runs finish: on MPI ranks with a launcher, in this
+    process for one worker, else in spawned processes (callers' scripts need an
+    ``if __name__ == "__main__":`` guard)."""
+    if settings.launcher is not None:
+        yield from _on_ranks(settings, jobs)
+        return
     if settings.workers == 1:
         for strike, i, v0 in jobs:
             yield (strike, i), run_one(settings, v0, strike)

@@ -1,0 +1,12 @@
+"""Command-line options that several subcommands share."""
+
+from __future__ import annotations
+
+
+def add_launcher(parser, appended: str = "-n N python -P -m hexdem.experiments.parallel JOB") -> None:
+    """``--launcher CMD``: the MPI launcher that starts hexdem's ranks, on this machine or across
+    as many as it reaches; ``appended`` is what hexdem adds to it (for the help text)."""
+    parser.add_argument("--launcher", metavar="CMD",
+                        help=f'MPI launcher to which "{appended}" is appended (default: this environment\'s '
+                             'mpiexec), e.g. "mpiexec -f hosts" or "srun"; given, the job goes through it even '
+                             'on one rank')
