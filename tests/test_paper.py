@@ -104,11 +104,13 @@ def test_a_rerun_resumes_without_recomputing(quick, capsys):
 
 
 def test_every_mpi_job_of_the_paper_went_through_the_launcher(quick, launcher):
-    """Fig. 4 on 2 ranks, the sweep's runs on 2 ranks, and the ensembles' partitions and impacts."""
+    """Fig. 3 on 1 rank and Fig. 4 on 2, the sweep's runs, the ensembles' preparation partitions and
+    their impacts (the launcher's log also holds the jobs of test_launcher.py)."""
     jobs = launcher[1].read_text().splitlines()
-    assert any("-partition" in job for job in jobs), "the ensembles' preparation partitions"
-    parallel = [job for job in jobs if "hexdem.experiments.parallel" in job]
-    assert len(parallel) >= 3 and all(job.startswith("-n 2 ") for job in parallel)
+    for folder, ranks in (("fig3", 1), ("fig4", 2), ("disorder/sigma6tol/lammps/impacts", 2)):
+        assert [job.split()[:2] for job in jobs if f"{quick}/{folder}/" in job] == [["-n", str(ranks)]], folder
+    assert any("hexdem-sweep-" in job for job in jobs), "the V0 sweep"
+    assert any("-partition 2x1 -in run.in" in job for job in jobs), "the ensembles' preparation"
 
 
 def test_other_settings_in_the_same_directory_are_refused(quick, capsys):
