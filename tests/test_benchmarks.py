@@ -16,6 +16,8 @@ ROOT = Path(__file__).resolve().parents[1]
 BENCHMARKS = ROOT / "benchmarks"
 #: Words each benchmark's printed table must contain (headers, row names, the target line).
 EXPECTED = {
+    "bench_accuracy.py": ("case", "engine", "steps/τ", "peak error", "arrival [µs]", "energy drift", "order",
+                          "wall [s]", "lammps", "reference", "target at 140 steps per contact"),
     "bench_run.py": ("runner", "wall [s]", "loop [s]", "wall / bare loop", "hexdem run (CLI, subprocess)",
                      "run_experiment (in-process)", "bare lmp -in in.nooutput", "target end to end",
                      "where the CLI's time goes"),

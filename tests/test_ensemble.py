@@ -80,7 +80,7 @@ def test_every_impact_is_prepared_settled_and_conserves_energy(reference):
     ensemble, _ = reference
     for k in range(3):
         r = results(ensemble, k)
-        assert np.all(r["energy_drift"] < 1e-5)
+        assert np.all(r["energy_drift"] < 1e-4)  # Verlet at 140 steps per contact: about 0.9/140²
         assert r["compact_kinetic_energy_j"] > 0 and r["settle_max_force_n"] < 1e-4
         assert np.all(r["peak_speed"][:, ensemble.ideal.struck] > 0.5 * np.array(VELOCITIES))
 

@@ -81,9 +81,10 @@ def test_sphere_on_a_delrin_wall_uses_the_walls_own_modulus(tmp_path):
 @pytest.mark.parametrize("changes", [{}, {"impact": "striker", "strike_angle_deg": 30.0}],
                          ids=["velocity-0deg", "striker-30deg"])
 def test_energy_is_conserved(tmp_path, changes):
+    """RK4 at the default 140 steps per contact: about 3e-7 (bench_accuracy.py), against Verlet's 4.5e-5."""
     analysis = simulate(SMALL.replace(**changes), tmp_path)
     assert analysis.results.far_wall_reached  # the wave has hit the walls: every contact kind acted
-    assert analysis.results.energy_drift < 1e-7
+    assert analysis.results.energy_drift < 1e-6
 
 
 def line_peaks(analysis, line):
@@ -95,7 +96,7 @@ def test_halving_the_time_step_changes_peaks_by_less_than_1e_4(tmp_path):
     config = SMALL.replace(strike_angle_deg=30.0)
     dt = config.settings().dt_s
     coarse = simulate(config, tmp_path / "dt")
-    fine = simulate(config.replace(dt=dt / 2, dump_every=2 * config.dump_every), tmp_path / "dt2")
+    fine = simulate(config.replace(dt=dt / 2, dump_every=2 * config.settings().dump_every), tmp_path / "dt2")
     for line in ("0", "+30", "-30"):
         (p1, t1), (p2, t2) = line_peaks(coarse, line), line_peaks(fine, line)
         moving = p1 > 0.01 * config.v0

@@ -28,8 +28,10 @@ def test_default_run_writes_the_contracted_files(default_run):
 
 
 def test_default_run_conserves_energy(default_run):
+    """Velocity Verlet's energy error is about 0.9/N² for N steps per contact
+    (benchmarks/bench_accuracy.py): 4.5e-5 at the default 140."""
     _, analysis = default_run
-    assert analysis.results.energy_drift < 1e-5
+    assert analysis.results.energy_drift < 1e-4
 
 
 def test_zero_degree_strike_is_mirror_symmetric(default_run):
@@ -84,7 +86,7 @@ def test_striker_impact_matches_initial_velocity_impact(default_run, tmp_path):
     ideal = default_run[1].results
     struck = simulate(RunConfig(impact="striker"), tmp_path)
     assert "group           impactor id 332" in (tmp_path / "in.hexdem").read_text()
-    assert struck.results.energy_drift < 1e-5
+    assert struck.results.energy_drift < 1e-4
     for beads in ideal.lines.values():
         far = beads[2:]
         np.testing.assert_allclose(struck.results.peak_speed[far], ideal.peak_speed[far], rtol=0.03)

@@ -30,10 +30,18 @@ SHAPES = ("hexagon", "half-hexagon")
 IMPACTS = ("velocity", "striker")
 UNITS = ("si", "nondimensional")
 ENGINES = ("lammps", "reference")
-#: Default time step: this many steps per two-bead Hertz contact at V0 (1.02e-7 s at 0.4 m/s).
-STEPS_PER_CONTACT = 700
+#: Default time step: this many steps per two-bead Hertz contact at V0 (5.1e-7 s at 0.4 m/s).
+#: Chosen by accuracy (benchmarks/bench_accuracy.py): velocity Verlet's errors fall as dt²,
+#: about 0.7/N² relative in peak speed for N steps per contact, so 140 steps keep the peaks
+#: within 1e-4 (measured: 3.7e-5) and the arrival times within 0.05 µs of the converged answer,
+#: at the experiment's 0.4 m/s and over the sweep's V0 = 0.01–0.30 alike (the Hertz lattice is
+#: scale-invariant in units of the contact time).
+STEPS_PER_CONTACT = 140
+#: The analysis takes this many samples per contact time, whatever the time step (one every
+#: 2.05 µs at 0.4 m/s): the default ``dump_every`` is STEPS_PER_CONTACT / this.
+SAMPLES_PER_CONTACT = 35
 #: A time step must resolve the Hertz contact at V0 with at least this many steps (energy drift
-#: grows as dt²: about 2e-6 at 700 steps, 1e-3 at about 30).
+#: grows as dt²: about 4e-5 at 140 steps, 1e-3 at about 30).
 MIN_STEPS_PER_CONTACT = 20
 #: The analysis needs at least this many samples per contact time at V0, and this many in all.
 MIN_SAMPLES_PER_CONTACT = 4
@@ -50,9 +58,13 @@ MEMORY_PER_BEAD_BYTES = 8e3
 class RunConfig:
     """One simulation. Lengths in m; ``v0``, ``dt``, ``duration`` in ``units``.
 
-    ``dump_every`` steps between samples: the analysis inside the run takes one every
-    ``dump_every`` steps, and so does the full LAMMPS dump, written only with ``dump = true``
-    (the deck's ``in.hexdem`` always writes it when rerun by hand).
+    ``steps_per_contact``: the default time step is the contact time (:meth:`contact_time_s`)
+    over this (at least 20), shortened if need be so that the default sampling interval, 1/35
+    of the contact time, is a whole number of steps.
+    ``dump_every`` steps between samples (None: the steps of 1/35 of the contact time, fixed in
+    time whatever the step): the analysis inside the run takes one every ``dump_every``
+    steps, and so does the full LAMMPS dump, written only with ``dump = true`` (the deck's
+    ``in.hexdem`` always writes it when rerun by hand).
     ``restitution``: bead–bead coefficient of restitution (1.0: the paper's ideal model);
     ``wall_restitution``: bead–wall (None: the same as ``restitution``).
     ``precompression_n``: static force per bead–bead contact [N] (0: uncompressed; see
@@ -63,7 +75,7 @@ class RunConfig:
     ``launcher``: the MPI launcher command that starts the ranks (None: this environment's
     ``mpiexec``; e.g. ``"mpiexec -f hosts"`` or ``"srun"`` to span machines); given, the run goes
     through it even on one rank.
-    ``dt = None`` takes the contact time (:meth:`contact_time_s`) / 700; ``duration = None``
+    ``dt = None`` takes the step that ``steps_per_contact`` gives; ``duration = None``
     runs until the leading wave has crossed the packing: one contact time per layer between
     the struck bead and the far wall (the pulse resides less than that on each
     layer: 0.82 ms are needed, 1.43 ms are run for the default experiment).
@@ -81,8 +93,9 @@ class RunConfig:
     strike_angle_deg: float = 0.0
     impact: str = "velocity"
     dt: float | None = None
+    steps_per_contact: int = STEPS_PER_CONTACT
     duration: float | None = None
-    dump_every: int = 20
+    dump_every: int | None = None
     ranks: int = 1
     engine: str = "lammps"
     dump: bool = False
@@ -99,7 +112,11 @@ class RunConfig:
             if getattr(self, name) not in allowed:
                 raise HexdemError(f"unknown {name} {getattr(self, name)!r}; use one of: {', '.join(allowed)}")
         for name in ("dump_every", "ranks"):
-            positive_int(name, getattr(self, name))
+            if getattr(self, name) is not None:
+                positive_int(name, getattr(self, name))
+        if positive_int("steps_per_contact", self.steps_per_contact) < MIN_STEPS_PER_CONTACT:
+            raise HexdemError(f"steps_per_contact must be at least {MIN_STEPS_PER_CONTACT} (the Hertz contact "
+                              f"needs them), got {self.steps_per_contact}")
         object.__setattr__(self, "sensors", tuple(self.sensors))
         if not (is_number(self.sensor_rate_hz) and self.sensor_rate_hz > 0):
             raise HexdemError(f"sensor_rate_hz must be > 0, got {self.sensor_rate_hz!r}")
@@ -240,13 +257,27 @@ class RunConfig:
             return hertz
         return min(hertz, math.pi * math.sqrt(mass / 2 / spring_stiffness(self.precompression_n, coefficient)))
 
+    def _step_and_sampling(self) -> tuple[float, int]:
+        """(dt [s], steps between samples): ``dt`` or the contact time over ``steps_per_contact``,
+        and ``dump_every`` or the steps of one default sampling interval (1/35 of the contact
+        time), the default step shortened so that this interval is a whole number of steps."""
+        contact_s = self.contact_time_s()
+        interval_s = contact_s / SAMPLES_PER_CONTACT
+        if self.dt is not None:
+            dt_s = self.dt * self.unit_system.time_s
+            return dt_s, self.dump_every or max(1, round(interval_s / dt_s))
+        if self.dump_every is not None:
+            return contact_s / self.steps_per_contact, self.dump_every
+        every = math.ceil(self.steps_per_contact / SAMPLES_PER_CONTACT)
+        return interval_s / every, every
+
     def settings(self, model: GranularModel | None = None) -> RunSettings:
         """Time step, step count and dump interval in SI, with the defaults resolved. With sensors,
         the time step is shortened (at most by one sample's worth) so that a sensor sample is a
         whole number of analysis samples of ``dump_every`` steps."""
         model = model or self.model()
         scale = self.unit_system.time_s
-        dt_s = self.dt * scale if self.dt is not None else self.contact_time_s() / STEPS_PER_CONTACT
+        dt_s, every = self._step_and_sampling()
         if self.duration is not None:
             duration_s = self.duration * scale
         else:
@@ -254,7 +285,7 @@ class RunConfig:
             reach = (lattice.positions_m - lattice.positions_m[lattice.struck]) @ model.impact.direction
             layers = math.ceil(reach.max() / (math.sqrt(3) / 2 * lattice.diameter_m))
             duration_s = layers * self.contact_time_s()
-        every, sensor_every = self.dump_every, 0
+        sensor_every = 0
         if self.sensors:
             samples = math.ceil(1.0 / self.sensor_rate_hz / (dt_s * every) - 1e-9)
             sensor_every = samples * every

@@ -1,0 +1,79 @@
+"""Convergence in the time step, for both engines: why the default is 140 steps per contact.
+
+Usage: python benchmarks/bench_accuracy.py [--quick]
+
+For each case, the same run at several numbers of steps per two-bead Hertz contact time (the
+sampling interval fixed at 1/35 of it), each measured against the Richardson-extrapolated answer
+of its two finest runs (:mod:`hexdem.experiments.convergence`): the largest relative peak-speed
+error and the largest arrival-time error over the observation lines' beads above 1 % of V0, the
+energy drift, the observed order of the peak error, and the run's wall time. Cases:
+
+* the paper's experiment (11 per edge, 0.4 m/s, delrin walls), LAMMPS (velocity Verlet) and the
+  reference integrator (RK4);
+* the V0 sweep's runs (nondimensional, no walls) at its smallest and largest V0, 0.01 and 0.30,
+  LAMMPS.
+
+Target: at the default steps per contact, peaks within 1e-4 and arrival times within 0.05 µs
+(in contact times: 7e-4 τ, the same share of the contact at every V0) of the converged answer.
+``--quick``: a 5-per-edge hexagon and three steps per contact (the same code path, seconds).
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+
+from machine import describe
+
+from hexdem.experiments.convergence import study_time_step
+from hexdem.model.config import STEPS_PER_CONTACT, RunConfig
+
+PEAK_TARGET = 1e-4
+ARRIVAL_TARGET_S = 0.05e-6
+
+
+def cases(quick: bool) -> list[tuple[str, RunConfig, tuple[int, ...]]]:
+    if quick:
+        return [("experiment, 5 per edge", RunConfig(edge_beads=5), (70, STEPS_PER_CONTACT, 280)),
+                ("experiment, 5 per edge", RunConfig(edge_beads=5, engine="reference"), (70, STEPS_PER_CONTACT, 280))]
+    sweep = RunConfig(edge_beads=16, wall_material="none", units="nondimensional")
+    return [("experiment", RunConfig(), (35, 70, 105, STEPS_PER_CONTACT, 175, 350, 700)),
+            ("experiment", RunConfig(engine="reference"), (35, 70, 105, STEPS_PER_CONTACT, 175, 350, 700)),
+            ("sweep, V0 = 0.01", sweep.replace(v0=0.01), (35, 70, STEPS_PER_CONTACT, 280, 560)),
+            ("sweep, V0 = 0.30", sweep.replace(v0=0.30), (35, 70, STEPS_PER_CONTACT, 280, 560))]
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="small packing, three steps (seconds)")
+    args = parser.parse_args()
+    tau_experiment = RunConfig().contact_time_s()
+    arrival_target = ARRIVAL_TARGET_S / tau_experiment
+    print(f"machine: {describe()}")
+    print(f"errors against the Richardson extrapolation of each case's two finest runs; default: "
+          f"{STEPS_PER_CONTACT} steps per contact; contact time τ at V0; order: of the peak error from a row to the next")
+    print(f"{'case':<24} {'engine':<10} {'steps/τ':>8} {'peak error':>11} {'arrival [µs]':>13} "
+          f"{'arrival [τ]':>12} {'energy drift':>13} {'order':>6} {'wall [s]':>9}")
+    verdicts = []
+    with tempfile.TemporaryDirectory(prefix="hexdem-accuracy-") as scratch:
+        for k, (name, config, steps) in enumerate(cases(args.quick)):
+            study = study_time_step(config, steps, f"{scratch}/{k}")
+            orders = [f"{order:6.2f}" for order in study.observed_orders] + [f"{'-':>6}"] * 2
+            for run, order in zip(study.runs, orders):
+                micro = (f"{run.arrival_error_contacts * config.contact_time_s() * 1e6:13.2e}"
+                         if config.units == "si" else f"{'-':>13}")
+                print(f"{name:<24} {config.engine:<10} {run.steps_per_contact:8d} {run.peak_error:11.2e} {micro} "
+                      f"{run.arrival_error_contacts:12.2e} {run.energy_drift:13.2e} {order} {run.wall_time_s:9.2f}")
+            default = study.at(STEPS_PER_CONTACT)
+            met = default.peak_error < PEAK_TARGET and default.arrival_error_contacts < arrival_target
+            verdicts.append(f"{name}, {config.engine}: peak {default.peak_error:.1e}, arrival "
+                            f"{default.arrival_error_contacts:.1e} τ: {'met' if met else 'NOT met'}")
+    print(f"target at {STEPS_PER_CONTACT} steps per contact: peaks within {PEAK_TARGET:g}, arrival within "
+          f"{ARRIVAL_TARGET_S * 1e6:g} µs ({arrival_target:.1e} τ)")
+    for line in verdicts:
+        print(f"  {line}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,110 @@
+"""Convergence in the time step: one configuration at several steps per contact, each measured
+against a Richardson-extrapolated answer.
+
+Both integrators converge at a known order p in the step h (velocity Verlet in LAMMPS: 2,
+classical RK4 in the reference engine: 4). For a quantity Q(h) = Q₀ + C h^p + …, the two finest
+runs h and h·r (r the ratio of their steps) give Q₀ ≈ Q(h) + (Q(h) − Q(h r)) / (r^p − 1), and
+every run's error is its distance from that. The sampling interval is the same for every run
+(a fixed time, ``dump_every`` scaled with the step), so that only the integration changes.
+
+Measured quantities, over the observation lines' beads whose peak exceeds ``threshold`` V0:
+the largest relative peak-speed error, the largest arrival-time error (in the run's time unit
+and in contact times), and the energy drift (:mod:`hexdem.analysis.energy`).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from hexdem.errors import HexdemError
+from hexdem.model.config import SAMPLES_PER_CONTACT, RunConfig
+
+#: Order of the error in the time step of each engine's integrator.
+ORDERS = {"lammps": 2, "reference": 4}
+#: Beads with a peak above this fraction of V0 are measured (as in ``hexdem compare``).
+THRESHOLD = 0.01
+
+
+@dataclass(frozen=True)
+class StepError:
+    """One run of a convergence study: ``steps_per_contact``, ``dt`` (run units), the largest
+    relative ``peak_error``, the largest ``arrival_error`` (run units) and ``arrival_error_contacts``
+    (in contact times at V0), ``energy_drift``, and the run's ``wall_time_s``."""
+
+    steps_per_contact: int
+    dt: float
+    peak_error: float
+    arrival_error: float
+    arrival_error_contacts: float
+    energy_drift: float
+    wall_time_s: float
+
+
+@dataclass(frozen=True)
+class Convergence:
+    """A study's runs (coarse to fine), the engine's ``order``, the observed orders of the
+    peak error between successive runs, and the number of beads measured."""
+
+    engine: str
+    order: int
+    runs: tuple[StepError, ...]
+    observed_orders: tuple[float, ...]
+    n_beads: int
+
+    def at(self, steps_per_contact: int) -> StepError:
+        return next(run for run in self.runs if run.steps_per_contact == steps_per_contact)
+
+
+def richardson(fine: np.ndarray, coarse: np.ndarray, ratio: float, order: int) -> np.ndarray:
+    """The extrapolated limit of a quantity computed with steps h (``fine``) and h·``ratio``."""
+    return fine + (fine - coarse) / (ratio**order - 1.0)
+
+
+def steps_config(config: RunConfig, steps_per_contact: int) -> RunConfig:
+    """``config`` at ``steps_per_contact`` with its samples every 1/35 of the contact time (the
+    steps per contact must be a multiple of 35 so that every run samples at the same times)."""
+    if steps_per_contact % SAMPLES_PER_CONTACT:
+        raise HexdemError(f"a convergence study needs multiples of {SAMPLES_PER_CONTACT} steps per contact "
+                          f"(the same sampling times in every run), got {steps_per_contact}")
+    return config.replace(dt=None, dump_every=None, steps_per_contact=steps_per_contact)
+
+
+def study_time_step(config: RunConfig, steps, workdir, log=None) -> Convergence:
+    """Run ``config`` at every number of steps per contact in ``steps`` (multiples of 35, the two
+    largest in the ratio of the finest pair) and measure each against the extrapolation."""
+    from hexdem.experiments.run import simulate
+
+    log = log or (lambda message: None)
+    steps = sorted(int(n) for n in steps)
+    if len(steps) < 3:
+        raise HexdemError(f"a convergence study needs at least 3 time steps, got {steps}")
+    results = []
+    for n in steps:
+        begun = time.perf_counter()
+        analysis = simulate(steps_config(config, n), Path(workdir) / f"steps{n}")
+        results.append((analysis, time.perf_counter() - begun))
+        log(f"{n} steps per contact: {results[-1][1]:.1f} s")
+    first = results[-1][0]
+    r = first.results
+    line_beads = np.unique(np.concatenate(list(r.lines.values())))
+    beads = line_beads[r.peak_speed[line_beads] > THRESHOLD * config.v0]
+    order = ORDERS[config.engine]
+    peaks = np.array([a.results.peak_speed[beads] for a, _ in results])
+    arrivals = np.array([a.results.arrival_time[beads] for a, _ in results])
+    ratio = steps[-1] / steps[-2]
+    exact_peak = richardson(peaks[-1], peaks[-2], ratio, order)
+    exact_arrival = richardson(arrivals[-1], arrivals[-2], ratio, order)
+    contact = first.settings.contact_time_s / first.settings.units.time_s
+    runs = []
+    for n, (analysis, wall), peak, arrival in zip(steps, results, peaks, arrivals):
+        arrival_error = float(np.max(np.abs(arrival - exact_arrival)))
+        runs.append(StepError(n, analysis.settings.dt_s / analysis.settings.units.time_s,
+                              float(np.max(np.abs(peak / exact_peak - 1.0))), arrival_error,
+                              arrival_error / contact, float(analysis.results.energy_drift), wall))
+    observed = tuple(float(np.log(a.peak_error / b.peak_error) / np.log(b.steps_per_contact / a.steps_per_contact))
+                     for a, b in zip(runs[:-2], runs[1:-1]))
+    return Convergence(config.engine, order, tuple(runs), observed, len(beads))
