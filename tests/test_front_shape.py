@@ -14,9 +14,9 @@ from hexdem.analysis.front_shape import (
     FRONT_SHAPE_COLUMNS,
     HEXAGON_SIXFOLD,
     FrontShape,
-    default_front_times,
     front_radius,
     front_shape,
+    front_times,
     sixfold_roundness,
 )
 from hexdem.errors import HexdemError
@@ -135,16 +135,36 @@ def test_front_times_without_enough_bins_are_nan_rows():
     assert [len(row) for row in shape.rows()] == [len(FRONT_SHAPE_COLUMNS)] * 3
 
 
-def test_default_times_end_when_the_front_reaches_the_corners_of_the_struck_edge():
+def test_front_times_end_when_the_front_is_readable_over_only_60_degrees():
+    """A circular front in the 11-per-edge hexagon struck at the centre of its vertical left edge
+    (edge length L = 10): rays within ±16° leave through the far wall (x = √3 L), the others
+    through the slanted walls, at 3√3 L / (4 sin(30° + |θ|)) beyond ±16°, nearer the further
+    they turn. The 24 rays of 2.5° (60°) that reach farthest end at ±28.75°: the front is readable
+    over 60° until it is within the margin of that wall there."""
     lattice = hexagon(11, 1.0)
     points = lattice.positions_m
     origin = points[lattice.struck]
     arrival = np.hypot(*(points - origin).T) / C
-    times = default_front_times(points, arrival, origin, count=5)
-    # The struck edge runs 5 beads either side of the struck bead; every other wall is farther.
-    assert times[-1] == pytest.approx(5.0 / C)
-    assert times[0] == pytest.approx(np.quantile(arrival, 0.05))
-    assert np.all(np.diff(times) > 0) and len(times) == 5
+    for margin in (0.0, 2.0):
+        times = front_times(points, arrival, origin, count=5, wall_margin=margin)
+        assert times[-1] * C == pytest.approx(3 * np.sqrt(3) * 10 / 4 / np.sin(np.radians(58.75)) - margin, abs=0.05)
+        assert times[0] == pytest.approx(np.quantile(arrival, 0.05))
+        assert np.all(np.diff(times) > 0) and len(times) == 5
+        shape = front_shape(points, arrival, origin, [times[-1] * 0.999, times[-1] * 1.01], wall_margin=margin)
+        assert shape.bins_used.tolist() == [24, 22] and shape.sixfold_amplitude[0] < 1e-2
+    geometric = front_times(points, arrival, origin, count=5, geometric=True)
+    assert np.diff(np.log(geometric)) == pytest.approx(np.full(4, np.log(geometric[1] / geometric[0])))
+
+
+def test_a_ray_is_read_only_until_the_front_nears_the_packings_edge():
+    """The half disc of radius 30 of triangular_disc (cut at |y| <= 31 √3/2 = 26.8): every ray of
+    the half plane leaves it between 26.8 and 30. A circular front is seen along all 72 rays of the
+    half plane until it comes within the margin of that edge, and along none once it is past."""
+    points = triangular_disc(30, half_plane=True)
+    arrival = np.hypot(*points.T) / C
+    for margin in (0.0, 3.0):
+        shape = front_shape(points, arrival, ORIGIN, (np.array([26.7, 30.1]) - margin) / C, wall_margin=margin)
+        assert shape.bins_used.tolist() == [72, 0]
 
 
 @pytest.mark.parametrize("call, message", [
@@ -167,4 +187,24 @@ def test_front_shape_figure_is_written(tmp_path):
               "hexagon": front_shape(points, hexagon_gauge(points, 0.0) / C, ORIGIN, times)}
     assert all(isinstance(shape, FrontShape) for shape in curves.values())
     front_shape_figure(curves, tmp_path / "front_shape.png")
+    assert (tmp_path / "front_shape.png").read_bytes().startswith(b"\x89PNG")
+
+
+def test_the_front_study_follows_a_hexagonal_front_that_rounds_as_it_grows(tmp_path):
+    """The study on a 24-per-edge hexagon (its 60° window readable from 5 to about 24 d): the
+    uncompressed front starts as a hexagon (A within 15 % of a regular hexagon's at 5 d) and its
+    sixfold amplitude falls as it grows; both packings are fitted and every file is written."""
+    from hexdem.experiments.front_study import STUDY_COLUMNS, FrontStudy, run_front_study
+
+    summary = run_front_study(FrontStudy(edge_beads=24, ranks=1, fronts=16), tmp_path, log=lambda message: None)
+    with open(tmp_path / "front_shape.csv") as fh:
+        header, *rows = [line.strip().split(",") for line in fh]
+    assert tuple(header) == STUDY_COLUMNS
+    uncompressed = np.array([[float(r[2]), float(r[3])] for r in rows if r[0] == "uncompressed"])
+    uncompressed = uncompressed[np.isfinite(uncompressed).all(axis=1)]
+    radius, amplitude = uncompressed.T
+    assert radius.min() < 5.5 and radius.max() > 20.0
+    assert amplitude[np.argmin(np.abs(radius - 5.0))] == pytest.approx(HEXAGON_SIXFOLD, rel=0.15)
+    assert np.all(np.diff(amplitude) < 0)
+    assert set(summary["fits"]) == {"uncompressed", "precompressed"}
     assert (tmp_path / "front_shape.png").read_bytes().startswith(b"\x89PNG")

@@ -1,66 +1,54 @@
-"""How the wavefront turns from hexagonal to circular as it grows, in one command.
+"""Does the uncompressed lattice's front become round, and how fast? One command.
 
-    python workflows/front_shape.py --out results/front-shape [--ranks 2] [--edge-beads 100]
+    python workflows/front_shape.py --out results/front-shape [--ranks 2] [--edge-beads 110] [--launcher CMD]
 
-Runs ``hexdem run`` (the experiment's steel beads, delrin walls, V0 = 0.4 m/s on the centre
-bead of an edge, 0° strike, analysis inside the run, no dump) on a hexagon with
-``--edge-beads`` per edge (default 100: 29,701 beads, several minutes on 2 ranks) into
-``OUT/hexagon`` and on the half-hexagon of Fig. 4 (long edge 91, short edges 46) into
-``OUT/half-hexagon``, each writing its own ``front_shape.csv``. Then it writes
-``OUT/front_shape.csv`` (both packings, with a ``packing`` column) and ``OUT/front_shape.png``
-(the relative sixfold amplitude of the half-maximum arrival front against its mean radius in
-bead diameters: 0 for a circle, 0.058 for a regular hexagon) and ``OUT/workflow.json``.
+Strikes a hexagon of ``--edge-beads`` per edge (default 110: 35,971 beads) as in the experiment
+(steel, delrin walls, 0.4 m/s, 0°) and, as a control, the same hexagon precompressed at 20 N per
+contact and struck weakly (1e-4 m/s); follows the relative sixfold amplitude of the half-maximum
+arrival front against its mean radius from 5 to beyond 150 bead diameters, over one sixfold
+period of rays about the strike direction, each read until the front is 10 d from the wall; and
+fits A(R) = A∞ + B (R/d)^−p (:mod:`hexdem.experiments.front_study`). Writes
+``OUT/front_shape.csv`` (``packing,time,mean_radius_d,sixfold_amplitude,bins_used``),
+``OUT/front_shape_fit.json``, ``OUT/front_shape.png``, both runs' ``hexdem run`` files in
+``OUT/uncompressed`` and ``OUT/precompressed``, and ``OUT/workflow.json``.
 """
 
 from __future__ import annotations
 
 import argparse
-import csv
 import sys
+import time
 from pathlib import Path
-from types import SimpleNamespace
 
-import numpy as np
-from record import WorkflowRecord
-
-from hexdem.analysis import figures
-from hexdem.analysis.front_shape import FRONT_SHAPE_COLUMNS
-from hexdem.common.io import write_csv
-
-
-def read_shape(path: Path) -> tuple[SimpleNamespace, list[dict]]:
-    """The front shape of one run (for the figure) and its table's rows as written."""
-    with open(path, newline="") as fh:
-        rows = list(csv.DictReader(fh))
-    columns = {key: np.array([float(row[key]) for row in rows]) for key in FRONT_SHAPE_COLUMNS}
-    return SimpleNamespace(**columns, mean_radius=columns["mean_radius_d"]), rows
+from hexdem.cli.options import add_launcher
+from hexdem.common.io import write_json
+from hexdem.errors import HexdemError
+from hexdem.experiments.front_study import FrontStudy, run_front_study
 
 
 def run(argv=None) -> int:
+    defaults = FrontStudy()
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", required=True, metavar="DIR")
-    parser.add_argument("--ranks", type=int, default=2, help="MPI ranks per run (default 2)")
-    parser.add_argument("--edge-beads", type=int, default=100, help="beads per edge of the hexagon (default 100)")
+    parser.add_argument("--ranks", type=int, default=defaults.ranks, help="MPI ranks per run (default 2)")
+    parser.add_argument("--edge-beads", type=int, default=defaults.edge_beads,
+                        help=f"beads per edge of the hexagon (default {defaults.edge_beads})")
+    parser.add_argument("--fronts", type=int, default=defaults.fronts, help=f"front times (default {defaults.fronts})")
+    add_launcher(parser)
     args = parser.parse_args(argv)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    configs = {"hexagon": f"shape = \"hexagon\"\nedge_beads = {args.edge_beads}\n",
-               "half-hexagon": "shape = \"half-hexagon\"\nlong_edge = 91\nshort_edge = 46\n"}
-    record = WorkflowRecord(__file__, argv)
-    shapes, rows = {}, []
-    for name, text in configs.items():
-        (out / f"{name}.toml").write_text(text)
-        command = ["run", "--config", str(out / f"{name}.toml"), "--ranks", str(args.ranks), "--out", str(out / name)]
-        status = record.run(name, command)
-        if status:
-            return status
-        shape, table = read_shape(out / name / "front_shape.csv")
-        label = f"{name}, {'%d per edge' % args.edge_beads if name == 'hexagon' else 'long edge 91, short edges 46'}"
-        shapes[label] = shape
-        rows += [(name, *(row[key] for key in FRONT_SHAPE_COLUMNS)) for row in table]
-    write_csv(out / "front_shape.csv", ("packing", *FRONT_SHAPE_COLUMNS), rows)
-    figures.front_shape_figure(shapes, out / "front_shape.png", title="Roundness of the wavefront as it grows")
-    record.finish(out)
+    study = FrontStudy(edge_beads=args.edge_beads, ranks=args.ranks, launcher=args.launcher, fronts=args.fronts)
+    start = time.perf_counter()
+    try:
+        summary = run_front_study(study, args.out, log=lambda message: print(f"front_shape: {message}", file=sys.stderr))
+    except HexdemError as exc:
+        print(f"front_shape: error: {exc}", file=sys.stderr)
+        return 2
+    wall = time.perf_counter() - start
+    write_json(Path(args.out) / "workflow.json", {"command": "python workflows/front_shape.py " + " ".join(
+        sys.argv[1:] if argv is None else argv), "wall_time_s": wall})
+    for name, fit in summary["fits"].items():
+        print(f"{name}: A = {fit['a_inf']:.4f} ± {fit['a_inf_se']:.4f} + {fit['b']:.3f} (R/d)^-{fit['p']:.2f} over "
+              f"R = {fit['radius_min_d']:.1f}..{fit['radius_max_d']:.1f} d ({wall:.0f} s in all)")
     return 0
 
 

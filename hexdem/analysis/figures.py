@@ -92,17 +92,28 @@ def peak_decay(rows_by_line: dict, path, units_name: str, v0: float, title="Peak
     save(fig, path)
 
 
-def front_shape_figure(curves: dict, path, title="Roundness of the wavefront") -> None:
+def front_shape_figure(curves: dict, path, title="Roundness of the wavefront", fits: dict | None = None) -> None:
     """Relative sixfold amplitude of the front vs its mean radius, one curve per labelled packing.
 
     ``curves`` maps a label to a :class:`~hexdem.analysis.front_shape.FrontShape` (or anything
     with ``mean_radius`` in bead diameters and ``sixfold_amplitude``). A regular hexagon's value
-    is drawn dashed and a circle's, 0, solid.
+    is drawn dashed and a circle's, 0, solid. ``fits`` maps labels to
+    :class:`~hexdem.analysis.roundness_fit.RoundnessFit`: each law is drawn over its fronts
+    (with its constant A∞ dotted) on a logarithmic radius axis.
     """
     fig, ax = plt.subplots(figsize=(6, 4.5))
     fig.subplots_adjust(**SINGLE_PLOT_MARGINS)
     for label, shape in curves.items():
-        ax.plot(shape.mean_radius, shape.sixfold_amplitude, marker="o", linestyle="-", label=label)
+        line, = ax.plot(shape.mean_radius, shape.sixfold_amplitude, marker="o", linestyle="-" if not fits else "",
+                        markersize=4 if fits else 6, label=label)
+        fit = (fits or {}).get(label)
+        if fit is not None:
+            radius = np.geomspace(fit.radius_min_d, fit.radius_max_d, 100)
+            ax.plot(radius, fit(radius), color=line.get_color(),
+                    label=f"A∞ + B R^-p: A∞ = {fit.a_inf:.4f} ± {fit.a_inf_se:.4f}, p = {fit.p:.2f}")
+            ax.axhline(fit.a_inf, color=line.get_color(), linestyle=":", linewidth=1)
+    if fits:
+        ax.set_xscale("log")
     ax.axhline(HEXAGON_SIXFOLD, color="k", linestyle="--", linewidth=1, label=f"regular hexagon ({HEXAGON_SIXFOLD:.4f})")
     ax.axhline(0.0, color="grey", linestyle="-", linewidth=1, label="circle (0)")
     ax.set_xlabel("mean front radius $a_0$ [d]")

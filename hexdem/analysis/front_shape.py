@@ -12,6 +12,20 @@ of the beads whose time is known (NaN beads are left out), and R is the first ra
 ray where that field rises past t. Unlike regressing r on t over the beads inside each bin,
 this recovers a circle exactly and a hexagon's amplitude to within the rays' sampling of its
 corners (−0.3 % at 144 rays). Lengths are in the positions' unit (callers pass bead diameters).
+
+**Walls, direction by direction.** A ray is read only until the front comes within
+``wall_margin`` of where the ray leaves the packing: beyond, the front has met the wall in that
+direction and what it does there is the wall's. The other rays go on, so the front is followed
+until fewer than 60° of rays (one sixfold period) are left, not only until it first meets a
+wall: in a hexagon struck at the centre of an edge the walls beside the struck edge come at
+0.43 of the edge length, the far wall at 1.73.
+
+**A fixed window.** As rays drop out one by one, the fit's angular range shrinks and what it
+measures changes (a front from an edge impact has other harmonics than the sixth, which alias
+differently over different ranges). ``window_deg`` keeps the range fixed instead: only the rays
+within ±``window_deg``/2 of +x (into the packing from its left edge) are fitted, and a front
+counts only while all of them see it. A window of 60° is one sixfold period: a regular hexagon
+keeps its amplitude there, and a 60°-periodic front is measured as on the whole circle.
 """
 
 from __future__ import annotations
@@ -19,7 +33,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import ConvexHull, Delaunay, QhullError, cKDTree
+from scipy.spatial import Delaunay, QhullError
 
 from hexdem.errors import HexdemError
 
@@ -54,11 +68,17 @@ class FrontShape:
 
 @dataclass(frozen=True)
 class _Rays:
-    """Arrival time along each ray: ``theta`` (n_bins,), ``radius`` (n_samples,), ``time`` (n_bins, n_samples)."""
+    """Arrival time along each ray: ``theta`` (n_bins,), ``radius`` (n_samples,), ``time`` (n_bins, n_samples),
+    and ``extent`` (n_bins,): the radius at which each ray leaves the beads (NaN for a ray outside them)."""
 
     theta: np.ndarray
     radius: np.ndarray
     time: np.ndarray
+    extent: np.ndarray
+
+    def usable(self, wall_margin: float) -> np.ndarray:
+        """(n_bins, n_samples) mask of the samples at least ``wall_margin`` inside the packing."""
+        return self.radius[None, :] <= (self.extent - wall_margin)[:, None]
 
 
 def _checked(positions, arrival_times, origin):
@@ -104,13 +124,19 @@ def _rays(positions, arrival_times, origin, n_bins) -> _Rays:
     theta = -np.pi + (np.arange(int(n_bins)) + 0.5) * 2 * np.pi / n_bins
     radius = np.linspace(0.0, np.hypot(*relative[known].T).max(), RAY_SAMPLES)
     directions = np.column_stack([np.cos(theta), np.sin(theta)])
-    return _Rays(theta, radius, field(radius[None, :, None] * directions[:, None, :]))
+    time = field(radius[None, :, None] * directions[:, None, :])
+    inside = np.isfinite(time)
+    last = len(radius) - 1 - np.argmax(inside[:, ::-1], axis=1)
+    extent = np.where(inside.any(axis=1), radius[last], np.nan)
+    return _Rays(theta, radius, time, extent)
 
 
-def _crossings(rays: _Rays, time: float) -> np.ndarray:
-    """First radius along each ray where the arrival time rises past ``time``; NaN if it never does."""
+def _crossings(rays: _Rays, time: float, wall_margin: float = 0.0) -> np.ndarray:
+    """First radius along each ray where the arrival time rises past ``time``, at least
+    ``wall_margin`` inside the packing; NaN if it never does."""
+    usable = rays.usable(wall_margin)
     before, after = rays.time[:, :-1], rays.time[:, 1:]
-    rising = (before <= time) & (after > time)
+    rising = (before <= time) & (after > time) & usable[:, 1:]
     hit = np.flatnonzero(rising.any(axis=1))
     k = np.argmax(rising[hit], axis=1)
     fraction = (time - before[hit, k]) / (after[hit, k] - before[hit, k])
@@ -147,48 +173,60 @@ def sixfold_roundness(theta, radius) -> tuple[float, float]:
     return float(a0), float(np.hypot(a6, b6) / a0)
 
 
-def front_shape(positions, arrival_times, origin, times, n_bins=DEFAULT_BINS, min_bins=None) -> FrontShape:
+def _window(rays: _Rays, window_deg: float | None) -> np.ndarray:
+    """Mask of the rays within ±``window_deg``/2 of +x (all rays for None)."""
+    if window_deg is None:
+        return np.ones(len(rays.theta), dtype=bool)
+    return np.abs(rays.theta) <= np.radians(window_deg) / 2
+
+
+def front_shape(positions, arrival_times, origin, times, n_bins=DEFAULT_BINS, min_bins=None,
+                wall_margin=0.0, window_deg=None) -> FrontShape:
     """Mean radius and sixfold amplitude of the front at each of ``times``.
 
-    Times at which fewer than ``min_bins`` rays (default ``n_bins // 6``: 60°, one sixfold
-    period) meet the front get NaN radius and amplitude; ``bins_used`` counts those rays.
+    Each ray is read up to ``wall_margin`` from where it leaves the packing; with
+    ``window_deg``, only the rays of that window about +x are used. Times at which fewer than
+    ``min_bins`` rays (default ``n_bins // 6``: 60°, one sixfold period; with a window, all of
+    its rays) meet the front get NaN radius and amplitude; ``bins_used`` counts those rays.
     """
     rays = _rays(positions, arrival_times, origin, n_bins)
-    min_bins = int(n_bins) // 6 if min_bins is None else min_bins
+    window = _window(rays, window_deg)
+    if min_bins is None:
+        min_bins = int(n_bins) // 6 if window_deg is None else int(window.sum())
     times = np.atleast_1d(np.asarray(times, float))
     mean, amplitude, used = np.full(len(times), np.nan), np.full(len(times), np.nan), np.zeros(len(times), int)
     for i, time in enumerate(times):
-        radius = _crossings(rays, time)
+        radius = np.where(window, _crossings(rays, time, wall_margin), np.nan)
         used[i] = np.isfinite(radius).sum()
         if used[i] >= min_bins:
             mean[i], amplitude[i] = sixfold_roundness(rays.theta, radius)
     return FrontShape(times, mean, amplitude, used)
 
 
-def _wall_beads(relative) -> np.ndarray:
-    """Beads within half a bead spacing of a side of the packing's convex hull that misses the origin."""
-    spacing = np.median(cKDTree(relative).query(relative, k=2)[0][:, 1])
-    sides = ConvexHull(relative).equations
-    walls = sides[np.abs(sides[:, 2]) > spacing / 2]
-    return (np.abs(relative @ walls[:, :2].T + walls[:, 2]) < spacing / 2).any(axis=1)
-
-
-def default_front_times(positions, arrival_times, origin, count=8, start_quantile=0.05) -> np.ndarray:
-    """``count`` front times evenly spaced from early on to when the front first meets a wall.
+def front_times(positions, arrival_times, origin, count=8, start_quantile=0.05, n_bins=DEFAULT_BINS,
+                wall_margin=0.0, geometric=False, window_deg=None) -> np.ndarray:
+    """``count`` front times from early on to the last time the front can be read over 60°.
 
     Start: the ``start_quantile`` quantile of the known arrival times, so the front is already a
-    few beads across rather than the struck bead's neighbourhood. End: the earliest arrival at a
-    wall bead, one next to a side of the packing other than the struck one (the side through
-    ``origin``, along which the front runs from the start); after that the walls cut the front.
-    If the wave never reached a wall, the latest known arrival time ends the range.
+    few beads across rather than the struck bead's neighbourhood. End: the latest time at which
+    ``n_bins // 6`` rays (60°, one sixfold period) still see the front at least ``wall_margin``
+    inside the packing (:func:`front_shape`): each ray's last readable time is the arrival time
+    where it comes within ``wall_margin`` of the packing's edge; with ``window_deg``, the latest
+    time at which every ray of that window still does (:func:`front_shape`). Evenly spaced, or
+    evenly in log time (``geometric``: as many fronts per factor of radius near the impact as
+    far away).
     """
     relative, arrival_times = _checked(positions, arrival_times, origin)
     known = np.isfinite(arrival_times)
     if known.sum() < 3:
         raise HexdemError(f"arrival times known at only {known.sum()} beads, too few for a front")
     start = np.quantile(arrival_times[known], start_quantile)
-    at_walls = arrival_times[_wall_beads(relative) & known]
-    end = at_walls.min() if len(at_walls) else arrival_times[known].max()
-    if not end > start:
-        raise HexdemError(f"the front meets a wall (t = {end:.4g}) before the start time {start:.4g}")
-    return np.linspace(start, end, count)
+    rays = _rays(positions, arrival_times, origin, n_bins)
+    readable = np.where(rays.usable(wall_margin) & np.isfinite(rays.time), rays.time, -np.inf).max(axis=1)
+    needed = int(n_bins) // 6 if window_deg is None else int(_window(rays, window_deg).sum())
+    latest = readable[_window(rays, window_deg)]
+    # just before the needed-th ray's last readable time: that ray still brackets the front
+    last = np.nextafter(np.sort(latest)[::-1][needed - 1], -np.inf)
+    if not last > start:
+        raise HexdemError(f"the front cannot be read over 60° after t = {last:.4g}, before the start time {start:.4g}")
+    return np.geomspace(start, last, count) if geometric else np.linspace(start, last, count)

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from hexdem.analysis import figures as plots
-from hexdem.analysis.front_shape import FRONT_SHAPE_COLUMNS, FrontShape, default_front_times, front_shape
+from hexdem.analysis.front_shape import FRONT_SHAPE_COLUMNS, FrontShape, front_shape, front_times
 from hexdem.analysis.impact import PEAK_COLUMNS, ImpactAnalysis
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.common.machine import free_disk_bytes
@@ -36,6 +36,9 @@ RESULT_FILES = ("peaks.csv", "summary.json", "arrival_map.png", "peak_decay.png"
 DUMP_BYTES_PER_ATOM_FRAME = 150
 #: A conservative model whose energy wanders more than this was integrated too coarsely.
 MAX_ENERGY_DRIFT = 1e-3
+#: The front is read along each direction until it comes this close to the packing's edge [d]:
+#: the last bead before a wall moves as the wall lets it.
+FRONT_WALL_MARGIN_D = 2.0
 
 
 def _replace_dir(source: Path, target: Path) -> None:
@@ -136,18 +139,24 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
     plots.front_shape_figure({analysis.model.lattice.shape: shape}, out / "front_shape.png")
 
 
-def measure_front_shape(analysis: ImpactAnalysis) -> FrontShape:
+def measure_front_shape(analysis: ImpactAnalysis, count: int = 8, geometric: bool = False,
+                        window_deg: float | None = None, start_quantile: float = 0.05,
+                        wall_margin_d: float = FRONT_WALL_MARGIN_D) -> FrontShape:
     """Roundness of the half-maximum arrival front about the struck bead against its mean radius
-    in bead diameters, from a little after the impact until the front first meets a wall; no
-    rows when the packing is too small for the front to grow before it meets one."""
+    in bead diameters at ``count`` times (:func:`~hexdem.analysis.front_shape.front_times`), each
+    direction read until the front comes within ``wall_margin_d`` of the packing's edge there
+    (``window_deg``: only the rays of that window about +x), from the
+    ``start_quantile`` of the arrival times on; no rows when the packing is too small for the
+    front to grow before it meets one."""
     model, r = analysis.model, analysis.results
     positions = model.lattice.positions_m / model.lattice.diameter_m
     origin = positions[model.lattice.struck]
     try:
-        times = default_front_times(positions, r.arrival_time, origin)
+        times = front_times(positions, r.arrival_time, origin, count, start_quantile, wall_margin=wall_margin_d,
+                            geometric=geometric, window_deg=window_deg)
     except HexdemError:
         times = []
-    return front_shape(positions, r.arrival_time, origin, times)
+    return front_shape(positions, r.arrival_time, origin, times, wall_margin=wall_margin_d, window_deg=window_deg)
 
 
 def run_experiment(config: RunConfig, out, log=None) -> ImpactAnalysis:
