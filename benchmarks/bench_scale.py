@@ -1,11 +1,12 @@
 """hexdem at scale: end to end vs bare LAMMPS, peak memory per process and bytes written.
 
-Usage: python benchmarks/bench_scale.py [--sizes 331,3151,29701] [--ranks 1,2] [--repeats 1] [--quick]
+Usage: python benchmarks/bench_scale.py [--sizes 331,3151,29701] [--ranks 1,2] [--steps 700,140] [--repeats 1] [--quick]
 
 For 331 beads (hexagon, 11 per edge), 3151 beads (half-hexagon 91/46) and 29,701 beads
 (hexagon, 100 per edge), each with its default run length (the 29,701-bead run takes
-minutes), on 1 and 2 ranks, alternating for each size and rank count (so that both see the
-same machine load):
+minutes), on 1 and 2 ranks, at each of ``--steps`` steps per contact (default: the former
+default 700 beside today's 140, in one run), alternating for each size, rank count and step
+(so that all see the same machine load):
 
 * **hexdem end to end**: ``hexdem run --config FILE --out DIR --ranks N`` as a subprocess
   (Python start-up, imports, MPI launch, the run with its analysis inside, the result files);
@@ -21,8 +22,8 @@ same machine load):
 * **bytes written**: all files in hexdem's output directory after the run (deck, log,
   results, figures), and in the bare deck directory (deck, ``in.nooutput``, log).
 
-Targets per row: end to end <= 1.3 x bare loop + 2 s; for 29,701 beads on 2 ranks also
-end to end <= 6 min and <= 500 MB per process.
+Targets per row: end to end <= 1.3 x bare loop + 2 s; for 29,701 beads on 2 ranks at the
+default step also end to end <= 3 min and <= 500 MB per process.
 ``--quick``: hexagons of 5 and 7 per edge for 0.2 ms on 1 and 2 ranks (the same code path, seconds).
 """
 
@@ -42,7 +43,7 @@ from hexdem.engines.lammps.deck import DECK_NAME
 from hexdem.engines.lammps.library import environment_command
 from hexdem.engines.lammps.partitions import loop_time_s
 from hexdem.engines.lammps.runner import run_bare
-from hexdem.model.config import RunConfig
+from hexdem.model.config import STEPS_PER_CONTACT, RunConfig
 
 SIZES = {331: RunConfig(shape="hexagon", edge_beads=11),
          3151: RunConfig(shape="half-hexagon", long_edge=91, short_edge=46),
@@ -51,19 +52,20 @@ QUICK_SIZES = {61: RunConfig(shape="hexagon", edge_beads=5, duration=2e-4),
                127: RunConfig(shape="hexagon", edge_beads=7, duration=2e-4)}
 TARGET_FACTOR, TARGET_OFFSET_S = 1.3, 2.0
 #: The large-run targets: (beads, ranks) → (end-to-end seconds, bytes per process).
-LARGE_TARGETS = {(29701, 2): (360.0, 500 * MB)}
+LARGE_TARGETS = {(29701, 2, STEPS_PER_CONTACT): (180.0, 500 * MB)}
 
 
 def parse_list(text: str) -> list[int]:
     return [int(item) for item in text.replace("_", "").split(",") if item.strip()]
 
 
-def measure(config: RunConfig, ranks: int, work: Path, repeat: int) -> dict:
-    """hexdem end to end, then bare LAMMPS, on ``ranks`` ranks: one row's measurements."""
-    config = config.replace(ranks=ranks)
+def measure(config: RunConfig, ranks: int, steps: int, work: Path, repeat: int) -> dict:
+    """hexdem end to end, then bare LAMMPS, on ``ranks`` ranks at ``steps`` steps per contact: one
+    row's measurements."""
+    config = config.replace(ranks=ranks, steps_per_contact=steps)
     model = config.model()
     settings = config.settings(model)
-    tag = f"{config.n_beads()}-{ranks}-{repeat}"
+    tag = f"{config.n_beads()}-{ranks}-{steps}-{repeat}"
     config_path = write_config(config, work / f"{tag}.toml")
     deck = nooutput_deck(model, settings, work / f"bare-{tag}")
     out = work / f"hexdem-{tag}"
@@ -96,6 +98,8 @@ def main() -> None:
     parser.add_argument("--sizes", type=parse_list, help=f"bead counts among {', '.join(map(str, SIZES))} "
                         "(default: all)")
     parser.add_argument("--ranks", type=parse_list, default=[1, 2], help="rank counts (default 1,2)")
+    parser.add_argument("--steps", type=parse_list, default=[700, STEPS_PER_CONTACT],
+                        help=f"steps per contact time (default 700,{STEPS_PER_CONTACT}: the former default beside today's)")
     parser.add_argument("--repeats", type=int, default=1, help="alternating repeats per row (default 1)")
     parser.add_argument("--quick", action="store_true", help="5- and 7-per-edge hexagons for 0.2 ms (seconds)")
     args = parser.parse_args()
@@ -110,34 +114,35 @@ def main() -> None:
     try:
         for beads in sizes:
             for ranks in args.ranks:
-                rows = [measure(table[beads], ranks, work, repeat) for repeat in range(args.repeats)]
-                results[beads, ranks] = median_row(rows)
-                r = results[beads, ranks]
-                print(f"  measured {beads} beads on {ranks} rank(s): hexdem {r['wall']:.2f} s, "
-                      f"bare loop {r['bare loop']:.2f} s", flush=True)
+                for steps in args.steps:
+                    rows = [measure(table[beads], ranks, steps, work, repeat) for repeat in range(args.repeats)]
+                    results[beads, ranks, steps] = r = median_row(rows)
+                    print(f"  measured {beads} beads on {ranks} rank(s), {steps} steps per contact: hexdem "
+                          f"{r['wall']:.2f} s, bare loop {r['bare loop']:.2f} s", flush=True)
     finally:
         shutil.rmtree(work)
     print(f"hexdem run (CLI) vs bare lmp -in {NOOUTPUT_NAME} on the same deck; median of {args.repeats} "
           f"alternating run(s); target: end to end <= {TARGET_FACTOR:g} x loop + {TARGET_OFFSET_S:g} s")
-    header = (f"{'beads':>6} {'ranks':>5} {'steps':>7} {'bare loop [s]':>13} {'bare wall [s]':>13} "
+    header = (f"{'beads':>6} {'ranks':>5} {'steps/τ':>7} {'steps':>7} {'bare loop [s]':>13} {'bare wall [s]':>13} "
               f"{'hexdem loop [s]':>15} {'end-to-end [s]':>14} {'ratio':>6} {'target [s]':>10} {'met':>4} "
               f"{'peak RSS per process [MB]':>25} {'hexdem bytes':>13} {'bare bytes':>11}")
     print(header)
-    for (beads, ranks), r in results.items():
+    for (beads, ranks, steps), r in results.items():
         target = TARGET_FACTOR * r["bare loop"] + TARGET_OFFSET_S
-        print(f"{beads:>6} {ranks:>5} {r['steps']:>7.0f} {r['bare loop']:>13.2f} {r['bare wall']:>13.2f} "
+        print(f"{beads:>6} {ranks:>5} {steps:>7} {r['steps']:>7.0f} {r['bare loop']:>13.2f} {r['bare wall']:>13.2f} "
               f"{r['hexdem loop']:>15.2f} {r['wall']:>14.2f} {r['wall'] / r['bare loop']:>6.2f} {target:>10.2f} "
               f"{'yes' if r['wall'] <= target else 'NO':>4} {r['rss'] / MB:>25.0f} {r['hexdem bytes']:>13,.0f} "
               f"{r['bare bytes']:>11,.0f}")
     print("sampled peak RSS [MB] of the processes above 20 MB (hexdem = the CLI, python = an MPI rank):")
-    for (beads, ranks), r in results.items():
-        print(f"  {beads} beads, {ranks} rank(s): {r['breakdown']}")
-    for (beads, ranks), (seconds, memory) in LARGE_TARGETS.items():
-        if (beads, ranks) in results:
-            r = results[beads, ranks]
+    for (beads, ranks, steps), r in results.items():
+        print(f"  {beads} beads, {ranks} rank(s), {steps} steps per contact: {r['breakdown']}")
+    for (beads, ranks, steps), (seconds, memory) in LARGE_TARGETS.items():
+        if (beads, ranks, steps) in results:
+            r = results[beads, ranks, steps]
             met = r["wall"] <= seconds and r["rss"] <= memory
-            print(f"target {beads} beads on {ranks} ranks: <= {seconds / 60:g} min and <= {memory / MB:.0f} MB per "
-                  f"process: {r['wall'] / 60:.2f} min, {r['rss'] / MB:.0f} MB: {'met' if met else 'NOT met'}")
+            print(f"target {beads} beads on {ranks} ranks, {steps} steps per contact: <= {seconds / 60:g} min and "
+                  f"<= {memory / MB:.0f} MB per process: {r['wall'] / 60:.2f} min, {r['rss'] / MB:.0f} MB: "
+                  f"{'met' if met else 'NOT met'}")
 
 
 if __name__ == "__main__":

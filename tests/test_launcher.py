@@ -17,6 +17,13 @@ from hexdem.model.config import RunConfig
 SMALL = "edge_beads = 5\n"
 
 
+def small_config(folder) -> str:
+    """A config file of the 5-per-edge experiment in ``folder``: its path."""
+    path = folder / "small.toml"
+    path.write_text(SMALL)
+    return str(path)
+
+
 def launched_since(log, count: int) -> list[str]:
     """The jobs the launcher started after the first ``count``."""
     return log.read_text().splitlines()[count:] if log.exists() else []
@@ -29,9 +36,7 @@ def jobs_so_far(log) -> int:
 def test_run_goes_through_the_launcher_with_the_same_peaks(launcher, tmp_path):
     command, log = launcher
     before = jobs_so_far(log)
-    config = tmp_path / "small.toml"
-    config.write_text(SMALL)
-    assert main(["run", "--config", str(config), "--ranks", "2", "--launcher", command,
+    assert main(["run", "--config", small_config(tmp_path), "--ranks", "2", "--launcher", command,
                  "--out", str(tmp_path / "out")]) == 0
     (job,) = launched_since(log, before)
     assert job.startswith("-n 2 ") and "-P -m hexdem.experiments.parallel" in job
@@ -52,9 +57,7 @@ def test_one_rank_through_a_launcher_is_not_run_in_process(launcher, tmp_path):
 def test_compare_and_snapshots_go_through_the_launcher(launcher, tmp_path):
     command, log = launcher
     before = jobs_so_far(log)
-    config = tmp_path / "small.toml"
-    config.write_text(SMALL)
-    assert main(["compare", "--config", str(config), "--ranks", "2", "--launcher", command,
+    assert main(["compare", "--config", small_config(tmp_path), "--ranks", "2", "--launcher", command,
                  "--out", str(tmp_path / "compare")]) == 0
     assert main(["snapshots", "--edge-beads", "5", "--times", "0.1,0.2", "--ranks", "2", "--launcher", command,
                  "--out", str(tmp_path / "snapshots")]) == 0
