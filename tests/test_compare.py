@@ -31,8 +31,9 @@ def test_reference_agrees_with_lammps_on_the_default_experiment(default_run, tmp
 
 
 @pytest.mark.parametrize("changes", [{"impact": "striker", "strike_angle_deg": 30.0},
-                                     {"units": "nondimensional", "v0": 0.05, "strike_angle_deg": -30.0}],
-                         ids=["striker-30deg", "nondimensional"])
+                                     {"units": "nondimensional", "v0": 0.05, "strike_angle_deg": -30.0},
+                                     {"shape": "half-disc", "radius_beads": 7}],
+                         ids=["striker-30deg", "nondimensional", "half-disc"])
 def test_engines_agree_on_small_lattices(tmp_path, changes):
     comparison = run_comparison(SMALL.replace(**changes), tmp_path, log=lambda message: None)
     assert comparison.agree, comparison.verdict()

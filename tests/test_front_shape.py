@@ -191,12 +191,14 @@ def test_front_shape_figure_is_written(tmp_path):
 
 
 def test_the_front_study_follows_a_hexagonal_front_that_rounds_as_it_grows(tmp_path):
-    """The study on a 24-per-edge hexagon (its 60° window readable from 5 to about 24 d): the
-    uncompressed front starts as a hexagon (A within 15 % of a regular hexagon's at 5 d) and its
-    sixfold amplitude falls as it grows; both packings are fitted and every file is written."""
+    """The study on a half-disc of radius 34 d (its 60° window readable from 5 to 24 d) and a
+    24-per-edge control: the uncompressed front starts as a hexagon (A within 15 % of a regular
+    hexagon's at 5 d) and its sixfold amplitude falls as it grows; both packings are fitted and
+    every file is written."""
     from hexdem.experiments.front_study import STUDY_COLUMNS, FrontStudy, run_front_study
 
-    summary = run_front_study(FrontStudy(edge_beads=24, ranks=1, fronts=16), tmp_path, log=lambda message: None)
+    study = FrontStudy(edge_beads=24, radius_beads=34, ranks=1, fronts=16)
+    summary = run_front_study(study, tmp_path, log=lambda message: None)
     with open(tmp_path / "front_shape.csv") as fh:
         header, *rows = [line.strip().split(",") for line in fh]
     assert tuple(header) == STUDY_COLUMNS

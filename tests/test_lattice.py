@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from hexdem.errors import HexdemError
-from hexdem.model.lattice import half_hexagon, hexagon, strike_direction
+from hexdem.model.lattice import half_disc, half_hexagon, hexagon, strike_direction
 
 D = 0.01905
 
@@ -87,3 +87,17 @@ def test_a_protruding_struck_bead_sits_in_the_hole_and_does_not_move_its_wall():
     struck_wall = next(w for w in grown.walls if w.name == "wall_000")
     assert struck_wall.offset_m == pytest.approx(-D / 2)
     assert struck_wall.gaps_m(grown.positions_m[lattice.struck], grown.radii_m[lattice.struck]) < 0
+
+
+def test_half_disc_holds_every_site_within_its_radius_on_the_struck_side():
+    """Radius 12: every lattice site {m, n} (m + n even, n >= 0) within 12 d of the struck bead,
+    and no other; one wall, the struck edge's, touching the n = 0 beads but the struck one."""
+    lattice = half_disc(12, 1.0)
+    expected = {(m, n) for n in range(0, 15) for m in range(-24, 25)
+                if (m + n) % 2 == 0 and 0.75 * n**2 + 0.25 * m**2 <= 144 + 1e-9}
+    assert {tuple(mn) for mn in lattice.indices.tolist()} == expected
+    assert np.hypot(*lattice.positions_m.T).max() <= 12.0 + 1e-12
+    (wall,) = lattice.walls
+    assert wall.normal == (1.0, 0.0) and wall.offset_m == pytest.approx(-0.5)
+    assert set(wall.members.tolist()) == set(np.flatnonzero(lattice.indices[:, 1] == 0)) - {lattice.struck}
+    assert len(lattice.line("0")) == 7 and len(lattice.line("+30")) == 13

@@ -1,13 +1,15 @@
 """Does the uncompressed lattice's front become round, and how fast? One command.
 
-    python workflows/front_shape.py --out results/front-shape [--ranks 2] [--edge-beads 110] [--launcher CMD]
+    python workflows/front_shape.py --out results/front-shape [--ranks 2] [--radius-beads 170] [--edge-beads 110]
+                                    [--launcher CMD]
 
-Strikes a hexagon of ``--edge-beads`` per edge (default 110: 35,971 beads) as in the experiment
-(steel, delrin walls, 0.4 m/s, 0°) and, as a control, the same hexagon precompressed at 20 N per
-contact and struck weakly (1e-4 m/s); follows the relative sixfold amplitude of the half-maximum
-arrival front against its mean radius from 5 to beyond 150 bead diameters, over one sixfold
-period of rays about the strike direction, each read until the front is 10 d from the wall; and
-fits A(R) = A∞ + B (R/d)^−p (:mod:`hexdem.experiments.front_study`). Writes
+Strikes a half-disc of ``--radius-beads`` d about the struck bead (default 170: 52,599 beads) as
+in the experiment (steel, 0.4 m/s, 0°, the struck edge's delrin wall) and, as a control, a hexagon
+of ``--edge-beads`` per edge precompressed at 20 N per contact and struck weakly (1e-4 m/s);
+follows the relative sixfold amplitude of the half-maximum arrival front against its mean radius
+from 5 to beyond 150 bead diameters, over one sixfold period of rays about the strike direction,
+each read until the front is 10 d from the packing's edge; and fits A(R) = A∞ + B (R/d)^−p
+(:mod:`hexdem.experiments.front_study`). Writes
 ``OUT/front_shape.csv`` (``packing,time,mean_radius_d,sixfold_amplitude,bins_used``),
 ``OUT/front_shape_fit.json``, ``OUT/front_shape.png``, both runs' ``hexdem run`` files in
 ``OUT/uncompressed`` and ``OUT/precompressed``, and ``OUT/workflow.json``.
@@ -31,12 +33,15 @@ def run(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", required=True, metavar="DIR")
     parser.add_argument("--ranks", type=int, default=defaults.ranks, help="MPI ranks per run (default 2)")
+    parser.add_argument("--radius-beads", type=int, default=defaults.radius_beads,
+                        help=f"radius of the half-disc in bead diameters (default {defaults.radius_beads})")
     parser.add_argument("--edge-beads", type=int, default=defaults.edge_beads,
-                        help=f"beads per edge of the hexagon (default {defaults.edge_beads})")
+                        help=f"beads per edge of the control's hexagon (default {defaults.edge_beads})")
     parser.add_argument("--fronts", type=int, default=defaults.fronts, help=f"front times (default {defaults.fronts})")
     add_launcher(parser)
     args = parser.parse_args(argv)
-    study = FrontStudy(edge_beads=args.edge_beads, ranks=args.ranks, launcher=args.launcher, fronts=args.fronts)
+    study = FrontStudy(edge_beads=args.edge_beads, radius_beads=args.radius_beads, ranks=args.ranks,
+                       launcher=args.launcher, fronts=args.fronts)
     start = time.perf_counter()
     try:
         summary = run_front_study(study, args.out, log=lambda message: print(f"front_shape: {message}", file=sys.stderr))

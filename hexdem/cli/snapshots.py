@@ -8,12 +8,13 @@ in ``deck/`` (see :mod:`hexdem.experiments.snapshots`).
 from __future__ import annotations
 
 from hexdem.cli.options import add_launcher
-from hexdem.model.config import SHAPES
 
 
 def add_arguments(parser) -> None:
     parser.add_argument("--out", metavar="DIR", default="snapshots", help="output directory (default: snapshots/)")
-    parser.add_argument("--shape", choices=SHAPES, default="hexagon",
+    from hexdem.experiments.snapshots import FIGURE_NAMES
+
+    parser.add_argument("--shape", choices=tuple(FIGURE_NAMES), default="hexagon",
                         help="hexagon (Fig. 3, default) or half-hexagon (Fig. 4)")
     parser.add_argument("--times", metavar="T1,T2,...",
                         help="snapshot times in ms, rounded to 1 µs (default: 0.15,0.3,...,0.9 for the hexagon, "

@@ -1,19 +1,23 @@
 """Does the front of an impulse in the uncompressed lattice become round, and how fast?
 
 The paper leaves open how the front turns from hexagonal to circular (Secs. III, VI-B). This
-study strikes a large hexagon (the experiment's steel beads, delrin walls, 0.4 m/s, 0°) and
-follows the half-maximum arrival front's relative sixfold amplitude A against its mean radius R,
-from a few bead diameters to beyond 150, each direction read until the front nears the wall in
-that direction (:func:`~hexdem.analysis.front_shape.front_times`); then it fits
+study strikes a half-disc of radius ``radius_beads`` d about the struck bead (the experiment's
+steel beads, 0.4 m/s, 0°; only the struck edge has a wall, and the free arc of an
+uncompressed packing sends nothing back) and follows the half-maximum arrival front's relative
+sixfold amplitude A against its mean radius R, from a few bead diameters to beyond 150, over
+one sixfold period of rays about the strike direction, each read until the front nears the
+packing's edge (:func:`~hexdem.analysis.front_shape.front_times`); then it fits
 A(R) = A∞ + B (R/d)^−p (:mod:`hexdem.analysis.roundness_fit`).
 
-**Control.** The same hexagon precompressed at ``control_force_n`` per contact and struck
-weakly by a striker (``control_v0_m_s``, a strain far below the static one; the striker's
-Hertz contact, 0.38 ms, makes a pulse of about 10 d, long against the lattice spacing, where
-an initial velocity would excite every wavelength down to the spacing): its waves are linear, and the
-long-wave limit of the triangular spring lattice is isotropic, so its front must become round,
-A → 0. That checks the measure itself. The control runs until its front, at the longitudinal
-sound speed c_L, has crossed ``control_crossings`` times the distance to the far wall.
+**Control.** A hexagon of ``edge_beads`` per edge precompressed at ``control_force_n`` per
+contact (a precompressed packing needs walls all round) and struck weakly by a striker
+(``control_v0_m_s``, a strain far below the static one; the striker's Hertz contact, 0.38 ms,
+makes a pulse of about 10 d, long against the lattice spacing, where an initial velocity
+would excite every wavelength down to the spacing): its waves are linear, and the long-wave
+limit of the triangular spring lattice is isotropic, so its front must become round, A → 0.
+That checks the measure itself, as far as the walls let it. The control runs until its front,
+at the longitudinal sound speed c_L, has crossed ``control_crossings`` times the distance to
+the far wall.
 
 ``hexdem run``'s files of both runs are kept in ``OUT/uncompressed`` and ``OUT/precompressed``.
 """
@@ -45,16 +49,18 @@ START_RADIUS_FRACTION = 0.8
 
 @dataclass(frozen=True)
 class FrontStudy:
-    """``edge_beads`` of the hexagon (110: 35,971 beads; a 60° window about the strike
-    direction stays inside it to 1.5 edge lengths, 163 d), MPI ``ranks`` per run and their
-    ``launcher``, ``fronts`` front times (evenly in log time), ``window_deg`` the rays fitted (one sixfold period about the strike
-    direction, see :mod:`hexdem.analysis.front_shape`) each read until ``wall_margin_d`` from
-    the wall (the control's pulse is about 10 d long: closer, its wall's echo overlaps it),
-    ``radius_min_d`` the smallest radius fitted; the uncompressed
-    impact ``v0_m_s``; the control's ``control_force_n`` per contact, ``control_v0_m_s`` and
-    ``control_crossings``."""
+    """``radius_beads`` of the uncompressed half-disc (170: 52,599 beads, its window readable to
+    160 d) and ``edge_beads`` of the control's hexagon (110: 35,971 beads; the window stays
+    inside it to 1.5 edge lengths), MPI ``ranks`` per run and their ``launcher``, ``fronts``
+    front times (evenly in log time), ``window_deg`` the rays fitted (one sixfold period about
+    the strike direction, see :mod:`hexdem.analysis.front_shape`), each read until
+    ``wall_margin_d`` from the packing's edge (the control's pulse is about 10 d long: closer,
+    its wall's echo overlaps it), ``radius_min_d`` the smallest radius fitted; the
+    uncompressed impact ``v0_m_s``; the control's ``control_force_n`` per contact,
+    ``control_v0_m_s`` and ``control_crossings``."""
 
     edge_beads: int = 110
+    radius_beads: int = 170
     ranks: int = 2
     launcher: str | None = None
     fronts: int = 40
@@ -74,7 +80,7 @@ class FrontStudy:
         c_l = longitudinal_sound_speed(self.control_force_n, coefficient, float(sphere_mass(d, bead)),
                                        d - static_overlap(self.control_force_n, coefficient))
         far_m = math.sqrt(3) * (self.edge_beads - 1) * d
-        return {"uncompressed": base.replace(v0=self.v0_m_s),
+        return {"uncompressed": base.replace(shape="half-disc", radius_beads=self.radius_beads, v0=self.v0_m_s),
                 "precompressed": base.replace(precompression_n=self.control_force_n, v0=self.control_v0_m_s, impact="striker",
                                               duration=self.control_crossings * far_m / c_l)}
 
@@ -95,10 +101,10 @@ def run_front_study(study: FrontStudy, out, log=None) -> dict:
         shapes[name], fits[name] = shape, fit_roundness(shape.mean_radius, shape.sixfold_amplitude, study.radius_min_d)
         rows += [(name, *row) for row in shape.rows()]
     write_csv(out / "front_shape.csv", STUDY_COLUMNS, rows)
-    labels = {"uncompressed": f"uncompressed, {study.v0_m_s:g} m/s",
+    labels = {"uncompressed": f"uncompressed half-disc, {study.v0_m_s:g} m/s",
               "precompressed": f"{study.control_force_n:g} N per contact, {study.control_v0_m_s:g} m/s (control)"}
     figures.front_shape_figure({labels[name]: shape for name, shape in shapes.items()}, out / "front_shape.png",
-                               title=f"Roundness of the front, hexagon of {study.edge_beads} per edge",
+                               title="Roundness of the front as it grows",
                                fits={labels[name]: fit for name, fit in fits.items()})
     summary = {"study": asdict(study),
                "fits": {name: fit.as_dict() for name, fit in fits.items()},

@@ -21,12 +21,12 @@ from hexdem.errors import HexdemError
 from hexdem.model.dissipation import damping_coefficient, lammps_tsuji_coefficient
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time
-from hexdem.model.lattice import LINE_STEPS, Lattice, half_hexagon, hexagon
+from hexdem.model.lattice import LINE_STEPS, Lattice, half_disc, half_hexagon, hexagon
 from hexdem.model.materials import PAPER_DIAMETER_M, hertz_coefficient, hertz_stiffness, material, sphere_mass
 from hexdem.model.precompression import hole_force, precompressed_lattice, spring_stiffness
 from hexdem.model.units import SI, UnitSystem, nondimensional
 
-SHAPES = ("hexagon", "half-hexagon")
+SHAPES = ("hexagon", "half-hexagon", "half-disc")
 IMPACTS = ("velocity", "striker")
 UNITS = ("si", "nondimensional")
 ENGINES = ("lammps", "reference")
@@ -85,6 +85,7 @@ class RunConfig:
     edge_beads: int = 11
     long_edge: int = 91
     short_edge: int = 46
+    radius_beads: int = 100
     diameter_m: float = PAPER_DIAMETER_M
     bead_material: str = "steel316"
     wall_material: str = "delrin"
@@ -134,10 +135,13 @@ class RunConfig:
         self._check_sampling(self.settings(self.model()))
 
     def n_beads(self) -> int:
-        """Beads of the packing, counted without building it: 3N(N − 1) + 1 for a hexagon with N
-        per edge, S(3S − 1)/2 for a half-hexagon with short edges of S."""
+        """Beads of the packing: 3N(N − 1) + 1 for a hexagon with N per edge, S(3S − 1)/2 for a
+        half-hexagon with short edges of S (both counted without building them), a half-disc's
+        counted on its lattice."""
         if self.shape == "hexagon":
             return 3 * self.edge_beads * (self.edge_beads - 1) + 1
+        if self.shape == "half-disc":
+            return len(self.lattice())
         return self.short_edge * (3 * self.short_edge - 1) // 2
 
     def memory_estimate_bytes(self) -> float:
@@ -145,7 +149,8 @@ class RunConfig:
         return MEMORY_BASE_BYTES + MEMORY_PER_BEAD_BYTES * self.n_beads()
 
     def _check_size(self) -> None:
-        sizes = (self.edge_beads,) if self.shape == "hexagon" else (self.short_edge, self.long_edge)
+        sizes = {"hexagon": (self.edge_beads,), "half-hexagon": (self.short_edge, self.long_edge),
+                 "half-disc": (self.radius_beads,)}[self.shape]
         if not all(isinstance(n, int) and not isinstance(n, bool) and n >= 2 for n in sizes):
             return  # the lattice builder words the error
         needed = self.memory_estimate_bytes() * (self.ranks if self.engine == "lammps" else 1)
@@ -204,6 +209,8 @@ class RunConfig:
     def lattice(self) -> Lattice:
         if self.shape == "hexagon":
             return hexagon(self.edge_beads, self.diameter_m)
+        if self.shape == "half-disc":
+            return half_disc(self.radius_beads, self.diameter_m)
         return half_hexagon(self.long_edge, self.short_edge, self.diameter_m)
 
     def model(self) -> GranularModel:
@@ -219,6 +226,8 @@ class RunConfig:
         if self.precompression_n > 0:
             if wall is None:
                 raise HexdemError("a precompressed packing needs walls to hold it (wall_material = \"none\")")
+            if self.shape == "half-disc":
+                raise HexdemError("a precompressed packing needs walls all round; the half-disc's arc is free")
             coefficient = float(hertz_coefficient(self.diameter_m, bead))
             lattice = precompressed_lattice(lattice, self.precompression_n, coefficient, hertz_stiffness(bead, wall))
             held = tuple(float(f) for f in hole_force(lattice, self.precompression_n))

@@ -14,10 +14,13 @@ start at the struck bead (n = 0 on every line):
 * ``"+30"`` beads {k, k}: touching beads at +30°, spacing d;
 * ``"-30"`` beads {−k, k}: touching beads at −30°, spacing d.
 
-Shapes: :func:`hexagon` (N beads per edge, 3N(N−1)+1 beads; N = 11 is the experiment) and
+Shapes: :func:`hexagon` (N beads per edge, 3N(N−1)+1 beads; N = 11 is the experiment),
 :func:`half_hexagon` (Fig. 4: a hexagon cut along its long diagonal, which becomes the
-struck edge). Each shape carries its flat confining walls, placed touching the outermost
-beads without compressing them, with the hole at the impact site.
+struck edge) and :func:`half_disc` (the beads within a radius of the struck bead on the
+packing's side of the struck edge: a front grows in it to that radius before it meets an
+edge). Each shape carries its flat confining walls, placed touching the outermost beads
+without compressing them, with the hole at the impact site; the half-disc has only the
+struck edge's wall (its arc is free: an uncompressed packing's free edge sends nothing back).
 """
 
 from __future__ import annotations
@@ -170,6 +173,17 @@ def hexagon(edge_beads: int, diameter_m: float = 1.0) -> Lattice:
     heights = [k + min(n, 2 * k - n) for n in range(2 * k + 1)]
     return _from_layers(heights, diameter_m, (0, 180, 60, -60, 120, -120), f"hexagon, {k + 1} per edge",
                         shift=k % 2)
+
+
+def half_disc(radius_beads: int, diameter_m: float = 1.0) -> Lattice:
+    """The beads within ``radius_beads`` d of the struck bead with x >= 0, and the struck edge's
+    wall only (``radius_beads`` = 170: about 52,000 beads)."""
+    if int(radius_beads) != radius_beads or radius_beads < 2:
+        raise HexdemError(f"a half-disc needs a radius of at least 2 bead diameters, got {radius_beads}")
+    radius = int(radius_beads)
+    layers = int(np.floor(2 * radius / np.sqrt(3)))
+    heights = [int(np.floor(2 * np.sqrt(radius**2 - 0.75 * n**2) + 1e-9)) for n in range(layers + 1)]
+    return _from_layers(heights, diameter_m, (0,), f"half-disc, radius {radius} d")
 
 
 def half_hexagon(long_edge: int = 91, short_edge: int = 46, diameter_m: float = 1.0) -> Lattice:
