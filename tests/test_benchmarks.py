@@ -24,11 +24,11 @@ EXPECTED = {
     "bench_reference.py": ("lattice", "beads", "engine", "steps", "M (bead|atom)-steps/s", "reference (RK4, 1 thread)",
                            "LAMMPS in hexdem, 1 rank", "LAMMPS bare, 2 ranks", "target >= 20"),
     "bench_ensemble.py": ("runner", "LAMMPS [s]", "hexdem, 1 rank", "hexdem, 2 ranks", "bare lmp, 2 ranks",
-                          "phase", "compact", "settle", "impacts", "target <= 120 s"),
+                          "phase", "compact", "settle", "impacts", "target <= 60 s", "700 steps per contact"),
     "bench_scale.py": ("beads", "ranks", "steps/τ", "bare loop [s]", "end-to-end [s]", "ratio", "peak RSS per process [MB]",
                        "hexdem bytes", "bare bytes", "target"),
     "bench_paper.py": ("hexdem paper --quick", "part", "wall [s]", "scaling", "disorder-sigma6tol",
-                       "sum of parts", "this invocation", "target <= 120 s"),
+                       "sum of parts", "this invocation", "target <= 120 s", "140 steps"),
 }
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 
 from hexdem.cli.options import add_launcher
+from hexdem.model.config import STEPS_PER_CONTACT
 
 
 def add_arguments(parser) -> None:
@@ -19,10 +20,14 @@ def add_arguments(parser) -> None:
     parser.add_argument("--quick", action="store_true",
                         help="fewer V0 values and realizations, same code paths (about 2 minutes; rough numbers)")
     add_launcher(parser, "-n N and each MPI job or LAMMPS partition run")
+    parser.add_argument("--steps-per-contact", type=int, default=STEPS_PER_CONTACT, metavar="N",
+                        help=f"time step of the LAMMPS impacts: the Hertz contact time / N (default {STEPS_PER_CONTACT}; "
+                             "700 was the former default)")
 
 
 def run(args) -> None:
     from hexdem.paper.pipeline import run_paper
     from hexdem.paper.settings import PaperSettings
 
-    run_paper(PaperSettings(quick=args.quick, workers=args.workers, launcher=args.launcher), args.out)
+    run_paper(PaperSettings(quick=args.quick, workers=args.workers, launcher=args.launcher,
+                            steps_per_contact=args.steps_per_contact), args.out)

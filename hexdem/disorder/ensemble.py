@@ -47,12 +47,14 @@ from hexdem.disorder.preparation import (
     walls_for_settling,
 )
 from hexdem.errors import HexdemError
-from hexdem.model.config import RunConfig
+from hexdem.model.config import STEPS_PER_CONTACT, RunConfig
 from hexdem.model.granular import GranularModel, RunSettings
 from hexdem.model.lattice import Lattice
 
 RESULT_NAME = "result.npz"
 MANIFEST_NAME = "ensemble.json"
+#: An impact is sampled this many times per contact time (every 10 steps of the default τ/140).
+IMPACT_SAMPLES_PER_CONTACT = 14
 #: Progress-bar labels of the phases.
 PHASE_LABELS = {"compact": "compacting", "settle": "settling", "impacts": "impacts"}
 
@@ -63,9 +65,10 @@ class EnsembleConfig:
     each struck at every striker speed of ``velocities_m_s`` [m/s].
 
     ``seed`` seeds every realization's diameters; ``disorder`` and ``preparation`` are Sec.
-    VI-A; ``dump_every`` steps between samples (10 steps of the default τ/140: τ/14, 5 µs at
-    0.4 m/s; peaks within 1e-4 and arrival times within 3 ns of every-other-step sampling);
-    ``duration_s`` run length [s]
+    VI-A; ``steps_per_contact`` the impacts' time step, τ/this (τ the two-bead Hertz contact
+    time at the striker speed; see :class:`~hexdem.model.config.RunConfig`); the impacts are
+    sampled every τ/:data:`IMPACT_SAMPLES_PER_CONTACT` (5 µs at 0.4 m/s: peaks within 1e-4 and arrival
+    times within 3 ns of every-other-step sampling); ``duration_s`` run length [s]
     (None: the ideal crossing estimate of :class:`~hexdem.model.config.RunConfig` times
     ``duration_factor``: 1.5 lets the slower disordered wave reach the lines' far beads,
     while the far wall's reflection has not yet changed the ideal lattice's peaks, which it
@@ -79,14 +82,17 @@ class EnsembleConfig:
     edge_beads: int = 11
     disorder: Disorder = field(default_factory=lambda: Disorder(RunConfig().diameter_m))
     preparation: Preparation = field(default_factory=Preparation)
-    dump_every: int = 10
+    steps_per_contact: int = STEPS_PER_CONTACT
     duration_s: float | None = None
     duration_factor: float = 1.5
     reference_bead: tuple[int, int] = (0, 2)
 
     def __post_init__(self):
         positive_int("the number of realizations", self.realizations)
-        positive_int("dump_every", self.dump_every)
+        if positive_int("steps_per_contact", self.steps_per_contact) % IMPACT_SAMPLES_PER_CONTACT:
+            raise HexdemError(f"an ensemble's steps_per_contact must be a multiple of {IMPACT_SAMPLES_PER_CONTACT} "
+                              f"(its impacts are sampled every 1/{IMPACT_SAMPLES_PER_CONTACT} of the contact time), "
+                              f"got {self.steps_per_contact}")
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
             raise HexdemError(f"the seed must be a non-negative integer, got {self.seed!r}")
         speeds = tuple(self.velocities_m_s)
@@ -106,7 +112,8 @@ class EnsembleConfig:
     def run_config(self, v_striker: float) -> RunConfig:
         """The ideal-lattice striker run at ``v_striker`` (also sets every run's dt and length)."""
         base = RunConfig(shape="hexagon", edge_beads=self.edge_beads, diameter_m=self.disorder.diameter_m,
-                         impact="striker", v0=float(v_striker), dump_every=self.dump_every)
+                         impact="striker", v0=float(v_striker), steps_per_contact=self.steps_per_contact,
+                         dump_every=self.steps_per_contact // IMPACT_SAMPLES_PER_CONTACT)
         if self.duration_s is not None:
             return base.replace(duration=self.duration_s)
         return base.replace(duration=self.duration_factor * base.settings().duration_s)

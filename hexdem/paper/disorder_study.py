@@ -68,11 +68,12 @@ class StudyEnsemble:
     def preparation_name(self) -> str:
         return "relaxed" if self.relaxed else "prestressed"
 
-    def config(self, realizations: int) -> EnsembleConfig:
+    def config(self, settings: PaperSettings) -> EnsembleConfig:
         disorder = Disorder(PAPER_DIAMETER_M, sigma_m=self.sigma_per_tol * TOLERANCE_M)
         preparation = Preparation(wall_slack_m=RELAXED_WALL_SLACK_M if self.relaxed else 0.0)
-        return EnsembleConfig(realizations=1 if self.sigma_per_tol == 0 else realizations,
-                              velocities_m_s=self.velocities_m_s, disorder=disorder, preparation=preparation)
+        return EnsembleConfig(realizations=1 if self.sigma_per_tol == 0 else settings.realizations,
+                              velocities_m_s=self.velocities_m_s, disorder=disorder, preparation=preparation,
+                              steps_per_contact=settings.steps_per_contact)
 
 
 def study_ensembles(settings: PaperSettings) -> list[StudyEnsemble]:
@@ -89,8 +90,8 @@ def run_study_ensemble(entry: StudyEnsemble, settings: PaperSettings, out: Path,
     What ``others`` (the study's other ensembles, in ``out``) have already run identically,
     the ideal impacts and compactions, is copied rather than run again
     (:mod:`hexdem.disorder.sharing`)."""
-    config = entry.config(settings.realizations)
-    sources = tuple(Ensemble(other.config(settings.realizations), out / other.name) for other in others
+    config = entry.config(settings)
+    sources = tuple(Ensemble(other.config(settings), out / other.name) for other in others
                     if other != entry and (out / other.name).is_dir())
     summary = run_ensemble(config, out / entry.name, workers=settings.workers, launcher=settings.launcher,
                            scaling_json=scaling_json, log=lambda message: None, share_from=sources)

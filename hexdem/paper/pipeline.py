@@ -62,7 +62,8 @@ def _snapshots(settings: PaperSettings, out: Path, shape: str) -> dict:
     long_edge, short_edge = settings.half_hexagon
     half = shape == "half-hexagon"
     config = RunConfig(shape=shape, long_edge=long_edge, short_edge=short_edge, impact="striker", v0=0.4,
-                       ranks=settings.workers if half else 1, launcher=settings.launcher)
+                       ranks=settings.workers if half else 1, launcher=settings.launcher,
+                       steps_per_contact=settings.steps_per_contact)
     times_ms = QUICK_FIG4_TIMES_MS if half and settings.quick else DEFAULT_TIMES_MS[shape]
     folder = out / ("fig4" if half else "fig3")
     run_snapshots(config, [t * 1e-3 for t in times_ms], folder, outline_edge=11 if half else None, log=_quiet)

@@ -10,6 +10,7 @@ from dataclasses import asdict, dataclass
 
 from hexdem.common.checks import positive_int
 from hexdem.disorder.preparation import TOLERANCE_M
+from hexdem.model.config import STEPS_PER_CONTACT
 
 #: Disorder strengths σ / tol of the disorder study (the paper's is 6).
 SIGMA_PER_TOL = (0.0, 1.0, 2.0, 3.0, 6.0)
@@ -27,7 +28,9 @@ RELAXED_WALL_SLACK_M = TOLERANCE_M
 class PaperSettings:
     """``quick``: the thinned variant; ``workers``: processes (sweep runs, LAMMPS partitions,
     MPI ranks of Fig. 4) at once; ``launcher``: the MPI launcher command that starts them
-    (None: this environment's ``mpiexec``, and the sweep in local processes).
+    (None: this environment's ``mpiexec``, and the sweep in local processes);
+    ``steps_per_contact`` the time step of the LAMMPS impacts (snapshots, ensembles), τ/this:
+    the sweep keeps its own 140 (:class:`~hexdem.theory.sweep.SweepSettings`).
 
     ``n_v0`` V₀ values of the scaling sweep (0.01 … 0.30); ``realizations`` per disordered
     ensemble (σ = 0 needs one: equal beads prepared the same way are identical);
@@ -38,6 +41,7 @@ class PaperSettings:
     quick: bool = False
     workers: int = 2
     launcher: str | None = None
+    steps_per_contact: int = STEPS_PER_CONTACT
 
     def __post_init__(self):
         positive_int("--workers", self.workers)
@@ -59,8 +63,8 @@ class PaperSettings:
         return (41, 21) if self.quick else (91, 46)
 
     def identity(self) -> dict:
-        """What the results depend on (not the number of workers)."""
-        return {"quick": self.quick}
+        """What the results depend on (not the number of workers nor the launcher)."""
+        return {"quick": self.quick, "steps_per_contact": self.steps_per_contact}
 
     def as_dict(self) -> dict:
         return {**asdict(self), "n_v0": self.n_v0, "realizations": self.realizations,
