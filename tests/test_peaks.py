@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from hexdem.analysis.peaks import pulse_times, refine_peak
+from hexdem.analysis.peaks import pulse_times, refine_peak, refine_peaks
 
 
 def hertz_like_pulse(t, centre, width, height):
@@ -38,3 +38,23 @@ def test_initial_velocity_is_its_own_peak_at_time_zero():
     assert refine_peak(times, falling) == (0.0, 0.4)
     result = pulse_times(times, falling[:, None])
     assert result.arrival_time[0] == 0.0
+
+
+def test_many_windows_at_once_equal_one_window_at_a_time():
+    """Noisy Gaussian pulses whose largest sample is the middle one: the batched refinement gives
+    the same peaks and times of peak as refine_peak window by window, to round-off."""
+    rng = np.random.default_rng(0)
+    knots = np.arange(-3.0, 4.0)
+    windows = []
+    while len(windows) < 300:
+        centre, width = rng.uniform(-0.5, 0.5), rng.uniform(0.6, 3.0)
+        window = rng.uniform(0.5, 2.0) * np.exp(-((knots - centre) / width) ** 2) + rng.normal(0.0, 0.01, 7)
+        if np.argmax(window) == 3:
+            windows.append(window)
+    interval = 2.5e-6
+    offset, peaks = refine_peaks(np.array(windows), interval)
+    expected = np.array([refine_peak(knots * interval, window) for window in windows])
+    np.testing.assert_allclose(peaks, expected[:, 1], rtol=1e-13)
+    np.testing.assert_allclose(offset, expected[:, 0], rtol=0, atol=1e-13 * interval)
+    flat = np.full((1, 7), 1.0)  # a plateau: the middle sample is the peak
+    assert refine_peaks(flat, interval)[1][0] == pytest.approx(1.0)

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from hexdem.analysis.energy import EnergyAudit, energy_error, energy_scale_j, kinetic_energy_j
-from hexdem.analysis.peaks import refine_peak
+from hexdem.analysis.peaks import refine_peak, refine_peaks
 from hexdem.analysis.tracker_kernel import first_crossing, rung, update
 from hexdem.engines.sampling import Sample
 from hexdem.model.granular import GranularModel, RunSettings
@@ -219,19 +219,22 @@ class PulseTracker:
             return None
         interval = self.settings.dump_every * self.settings.dt_s / self.settings.units.time_s
         peak, t_peak, arrival, reach = (np.full(self.n_beads, np.nan) for _ in range(4))
-        for b in range(self.n_beads):
-            k = int(self.peak_index[b])
-            if self.peak[b] <= 0.0:
-                continue
+        moved = self.peak > 0.0
+        complete = moved & (self.peak_index <= self.count - 3)
+        full = complete & np.isfinite(self.window).all(axis=1)  # the 7 samples: one refinement for all
+        offset, peak[full] = refine_peaks(self.window[full], interval)
+        t_peak[full] = self.peak_index[full] * interval + offset
+        for b in np.flatnonzero(moved):
             n = int(self.rec_len[b])
             records = (self.rec_index[b, :n], self.rec_value[b, :n], self.rec_prev[b, :n], self.first_index[b, :n],
                        self.first_value[b, :n], self.first_prev[b, :n], n)
-            if k > self.count - 3:
+            if not complete[b]:
                 reach[b] = interval * first_crossing(0.5 * self.peak[b], *records)
                 continue
-            index = np.arange(k - 3, k + 4)
-            valid = (index >= 0) & (index < self.count) & np.isfinite(self.window[b])
-            t_peak[b], peak[b] = refine_peak(index[valid] * interval, self.window[b, valid])
+            if not full[b]:
+                index = np.arange(self.peak_index[b] - 3, self.peak_index[b] + 4)
+                valid = (index >= 0) & (index < self.count) & np.isfinite(self.window[b])
+                t_peak[b], peak[b] = refine_peak(index[valid] * interval, self.window[b, valid])
             arrival[b] = reach[b] = interval * first_crossing(0.5 * peak[b], *records)
         scale = energy_scale_j(self.energies, self.impact_energy)
         return TrackedPulses(peak_speed=peak, t_peak=t_peak, arrival_time=arrival, reach_time=reach,
