@@ -30,3 +30,12 @@ def test_fronts_inside_the_minimum_radius_are_left_out_and_too_few_are_refused()
     assert fit_roundness(RADII, amplitude, radius_min_d=20.0).radius_min_d >= 20.0
     with pytest.raises(HexdemError, match="at least 6 fronts"):
         fit_roundness(RADII[:4], amplitude[:4])
+
+
+def test_a_signed_component_that_turns_over_is_fitted_and_its_constant_is_finite():
+    """a6/a0 = −0.01 + 0.3 R^−0.8 crosses zero at R = 30^(1/0.8) ≈ 70 d: the law is recovered, its
+    negative constant is finite, and the pure power law (positive data only) is not fitted."""
+    amplitude = -0.01 + 0.3 * RADII**-0.8 + np.random.default_rng(3).normal(0.0, 1e-4, RADII.size)
+    fit = fit_roundness(RADII, amplitude)
+    assert fit.a_inf == pytest.approx(-0.01, abs=3 * fit.a_inf_se) and fit.finite
+    assert fit.p == pytest.approx(0.8, rel=0.1) and np.isnan(fit.p_zero)

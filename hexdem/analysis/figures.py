@@ -98,19 +98,23 @@ def peak_decay(rows_by_line: dict, path, units_name: str, v0: float, title="Peak
     save(fig, path)
 
 
-def front_shape_figure(curves: dict, path, title="Roundness of the wavefront", fits: dict | None = None) -> None:
+def front_shape_figure(curves: dict, path, title="Roundness of the wavefront", fits: dict | None = None,
+                       signed: bool = False) -> None:
     """Relative sixfold amplitude of the front vs its mean radius, one curve per labelled packing.
 
     ``curves`` maps a label to a :class:`~hexdem.analysis.front_shape.FrontShape` (or anything
     with ``mean_radius`` in bead diameters and ``sixfold_amplitude``). A regular hexagon's value
     is drawn dashed and a circle's, 0, solid. ``fits`` maps labels to
     :class:`~hexdem.analysis.roundness_fit.RoundnessFit`: each law is drawn over its fronts
-    (with its constant A∞ dotted) on a logarithmic radius axis.
+    (with its constant A∞ dotted) on a logarithmic radius axis. ``signed``: the sixfold component
+    a6/a0 with its sign (see :class:`~hexdem.analysis.front_shape.FrontShape`) instead of the
+    amplitude, a hexagon of either orientation drawn dashed.
     """
     fig, ax = plt.subplots(figsize=(6, 4.5))
     fig.subplots_adjust(**SINGLE_PLOT_MARGINS)
     for label, shape in curves.items():
-        line, = ax.plot(shape.mean_radius, shape.sixfold_amplitude, marker="o", linestyle="-" if not fits else "",
+        values = shape.sixfold_cos if signed else shape.sixfold_amplitude
+        line, = ax.plot(shape.mean_radius, values, marker="o", linestyle="-" if not fits else "",
                         markersize=4 if fits else 6, label=label)
         fit = (fits or {}).get(label)
         if fit is not None:
@@ -121,9 +125,11 @@ def front_shape_figure(curves: dict, path, title="Roundness of the wavefront", f
     if fits:
         ax.set_xscale("log")
     ax.axhline(HEXAGON_SIXFOLD, color="k", linestyle="--", linewidth=1, label=f"regular hexagon ({HEXAGON_SIXFOLD:.4f})")
+    if signed:
+        ax.axhline(-HEXAGON_SIXFOLD, color="k", linestyle="--", linewidth=1)
     ax.axhline(0.0, color="grey", linestyle="-", linewidth=1, label="circle (0)")
     ax.set_xlabel("mean front radius $a_0$ [d]")
-    ax.set_ylabel("sixfold amplitude $\\sqrt{a_6^2 + b_6^2}\\,/\\,a_0$  [–]")
+    ax.set_ylabel("sixfold component $a_6/a_0$  [–]" if signed else "sixfold amplitude $\\sqrt{a_6^2 + b_6^2}\\,/\\,a_0$  [–]")
     set_title(ax, title)
     ax.grid(True, alpha=0.3)
     ax.legend()

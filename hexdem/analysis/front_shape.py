@@ -53,12 +53,19 @@ FRONT_SHAPE_COLUMNS = ("time", "mean_radius_d", "sixfold_amplitude", "bins_used"
 
 @dataclass(frozen=True)
 class FrontShape:
-    """One value per front time, each an (n_times,) array; NaN where too few rays met the front."""
+    """One value per front time, each an (n_times,) array; NaN where too few rays met the front.
+
+    ``sixfold_cos`` and ``sixfold_sin`` are a6/a0 and b6/a0 with their signs (the amplitude is
+    their norm): a6 > 0 puts the front's six farthest points at 0° and every 60° from it (+x, the
+    strike of an edge impact), a6 < 0 its six faces there.
+    """
 
     time: np.ndarray
     mean_radius: np.ndarray
     sixfold_amplitude: np.ndarray
     bins_used: np.ndarray
+    sixfold_cos: np.ndarray
+    sixfold_sin: np.ndarray
 
     def rows(self) -> list[tuple]:
         """Rows following :data:`FRONT_SHAPE_COLUMNS`."""
@@ -156,11 +163,18 @@ def front_radius(positions, arrival_times, origin, time, n_bins=DEFAULT_BINS):
 
 
 def sixfold_roundness(theta, radius) -> tuple[float, float]:
-    """(a0, sqrt(a6² + b6²)/a0) of R(θ) ≈ a0 + a6 cos 6θ + b6 sin 6θ, fitted over the finite R.
+    """(a0, sqrt(a6² + b6²)/a0) of R(θ) ≈ a0 + a6 cos 6θ + b6 sin 6θ, fitted over the finite R
+    (see :func:`sixfold_components`)."""
+    a0, a6, b6 = sixfold_components(theta, radius)
+    return a0, float(np.hypot(a6, b6) / a0)
+
+
+def sixfold_components(theta, radius) -> tuple[float, float, float]:
+    """(a0, a6, b6) of R(θ) ≈ a0 + a6 cos 6θ + b6 sin 6θ, fitted over the finite R.
 
     Least squares handles a front seen over part of the circle (half a plane for an edge
-    impact). Returns (NaN, NaN) when the finite bins cannot determine the three
-    coefficients (fewer than four, or rank-deficient): a front time without a usable front.
+    impact). Returns NaNs when the finite bins cannot determine the three coefficients (fewer
+    than four, or rank-deficient): a front time without a usable front.
     """
     theta, radius = np.asarray(theta, float), np.asarray(radius, float)
     if theta.shape != radius.shape or theta.ndim != 1:
@@ -168,9 +182,9 @@ def sixfold_roundness(theta, radius) -> tuple[float, float]:
     finite = np.isfinite(radius) & np.isfinite(theta)
     basis = np.column_stack([np.ones(finite.sum()), np.cos(6 * theta[finite]), np.sin(6 * theta[finite])])
     if finite.sum() < 4 or np.linalg.matrix_rank(basis) < 3:
-        return float("nan"), float("nan")
+        return float("nan"), float("nan"), float("nan")
     a0, a6, b6 = np.linalg.lstsq(basis, radius[finite], rcond=None)[0]
-    return float(a0), float(np.hypot(a6, b6) / a0)
+    return float(a0), float(a6), float(b6)
 
 
 def _window(rays: _Rays, window_deg: float | None) -> np.ndarray:
@@ -194,13 +208,15 @@ def front_shape(positions, arrival_times, origin, times, n_bins=DEFAULT_BINS, mi
     if min_bins is None:
         min_bins = int(n_bins) // 6 if window_deg is None else int(window.sum())
     times = np.atleast_1d(np.asarray(times, float))
-    mean, amplitude, used = np.full(len(times), np.nan), np.full(len(times), np.nan), np.zeros(len(times), int)
+    mean, cos6, sin6 = (np.full(len(times), np.nan) for _ in range(3))
+    used = np.zeros(len(times), int)
     for i, time in enumerate(times):
         radius = np.where(window, _crossings(rays, time, wall_margin), np.nan)
         used[i] = np.isfinite(radius).sum()
         if used[i] >= min_bins:
-            mean[i], amplitude[i] = sixfold_roundness(rays.theta, radius)
-    return FrontShape(times, mean, amplitude, used)
+            mean[i], a6, b6 = sixfold_components(rays.theta, radius)
+            cos6[i], sin6[i] = a6 / mean[i], b6 / mean[i]
+    return FrontShape(times, mean, np.hypot(cos6, sin6), used, cos6, sin6)
 
 
 def front_times(positions, arrival_times, origin, count=8, start_quantile=0.05, n_bins=DEFAULT_BINS,

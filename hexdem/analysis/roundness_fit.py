@@ -6,10 +6,11 @@ uncompressed lattice becomes round as it grows, A → 0, or keeps a finite sixfo
 
     A(R) = A∞ + B (R/d)^(−p)
 
-by least squares (:func:`scipy.optimize.curve_fit`) and, for comparison, the same law with
-A∞ = 0. The answer is A∞ with its standard error: a constant more than two standard errors
-from zero is a finite anisotropy. ``radius_d`` is in bead diameters, so B is the amplitude at
-R = d above A∞.
+by least squares (:func:`scipy.optimize.curve_fit`) and, for comparison and where every A is
+positive, the same law with A∞ = 0. A may be the signed sixfold component a6/a0 (a front whose
+hexagon turns over passes through zero). The answer is A∞ with its standard error: a constant
+more than two standard errors from zero is a finite anisotropy. ``radius_d`` is in bead
+diameters, so B is the amplitude at R = d above A∞.
 """
 
 from __future__ import annotations
@@ -28,9 +29,9 @@ MIN_FRONTS = 6
 @dataclass(frozen=True)
 class RoundnessFit:
     """``a_inf``, ``b``, ``p`` of A = a_inf + b R^−p with standard errors (``*_se``); ``rms`` its
-    residual; ``p_zero``, ``b_zero``, ``rms_zero`` of the law with a_inf = 0; the fronts used
-    (``n_fronts``) and their radii (``radius_min_d``, ``radius_max_d``); ``finite``: a_inf is
-    more than two standard errors above zero."""
+    residual; ``p_zero``, ``b_zero``, ``rms_zero`` of the law with a_inf = 0 (NaN unless every A
+    is positive); the fronts used (``n_fronts``) and their radii (``radius_min_d``,
+    ``radius_max_d``); ``finite``: a_inf is more than two standard errors from zero."""
 
     a_inf: float
     a_inf_se: float
@@ -48,7 +49,7 @@ class RoundnessFit:
 
     @property
     def finite(self) -> bool:
-        return bool(self.a_inf > 2.0 * self.a_inf_se)
+        return bool(abs(self.a_inf) > 2.0 * self.a_inf_se)
 
     def as_dict(self) -> dict:
         return {**asdict(self), "finite": self.finite}
@@ -67,21 +68,23 @@ def fit_roundness(radius_d, amplitude, radius_min_d: float = 5.0) -> RoundnessFi
     from scipy.optimize import OptimizeWarning, curve_fit
 
     radius_d, amplitude = np.asarray(radius_d, float), np.asarray(amplitude, float)
-    use = np.isfinite(radius_d) & np.isfinite(amplitude) & (radius_d >= radius_min_d) & (amplitude > 0)
+    use = np.isfinite(radius_d) & np.isfinite(amplitude) & (radius_d >= radius_min_d)
     r, a = radius_d[use], amplitude[use]
     if len(r) < MIN_FRONTS or r.max() < 2 * r.min():
         raise HexdemError(f"a roundness fit needs at least {MIN_FRONTS} fronts over a factor 2 in radius beyond "
                           f"{radius_min_d:g} d, got {len(r)}" + (f" from {r.min():.3g} to {r.max():.3g} d" if len(r) else ""))
-    slope, intercept = np.polyfit(np.log(r), np.log(a), 1)  # the pure power law on log scales: a start
-    with warnings.catch_warnings():  # only the parameters of the comparison law are used, not their errors
-        warnings.simplefilter("ignore", OptimizeWarning)
-        (b_zero, p_zero), _ = curve_fit(lambda x, b, p: _power_law(x, 0.0, b, p), r, a,
-                                        p0=(float(np.exp(intercept)), -slope), maxfev=20000)
-    start = (0.5 * a.min(), float(np.exp(intercept)), max(-slope, 0.1))
+    b_zero = p_zero = rms_zero = float("nan")
+    if np.all(a > 0):
+        slope, intercept = np.polyfit(np.log(r), np.log(a), 1)  # the pure power law on log scales: a start
+        with warnings.catch_warnings():  # only the parameters of the comparison law are used, not their errors
+            warnings.simplefilter("ignore", OptimizeWarning)
+            (b_zero, p_zero), _ = curve_fit(lambda x, b, p: _power_law(x, 0.0, b, p), r, a,
+                                            p0=(float(np.exp(intercept)), -slope), maxfev=20000)
+        rms_zero = float(np.sqrt(np.mean((_power_law(r, 0.0, b_zero, p_zero) - a) ** 2)))
+    start = (float(a[np.argmax(r)]), float((a[np.argmin(r)] - a[np.argmax(r)]) * r.min()), 1.0)
     params, covariance = curve_fit(_power_law, r, a, p0=start, maxfev=20000)
     errors = np.sqrt(np.diag(covariance))
     rms = float(np.sqrt(np.mean((_power_law(r, *params) - a) ** 2)))
-    rms_zero = float(np.sqrt(np.mean((_power_law(r, 0.0, b_zero, p_zero) - a) ** 2)))
     return RoundnessFit(float(params[0]), float(errors[0]), float(params[1]), float(errors[1]), float(params[2]),
                         float(errors[2]), rms, float(p_zero), float(b_zero), rms_zero, int(len(r)),
                         float(r.min()), float(r.max()))

@@ -7,7 +7,9 @@ uncompressed packing sends nothing back) and follows the half-maximum arrival fr
 sixfold amplitude A against its mean radius R, from a few bead diameters to beyond 150, over
 one sixfold period of rays about the strike direction, each read until the front nears the
 packing's edge (:func:`~hexdem.analysis.front_shape.front_times`); then it fits
-A(R) = A∞ + B (R/d)^−p (:mod:`hexdem.analysis.roundness_fit`).
+A(R) = A∞ + B (R/d)^−p (:mod:`hexdem.analysis.roundness_fit`) to the signed component a6/a0
+(the strike is mirror-symmetric, so b6 vanishes): positive while the front's farthest points lie
+at 0° and ±60°, negative once its faces do, so that a front whose hexagon turns over is seen to.
 
 **Control.** A hexagon of ``edge_beads`` per edge precompressed at ``control_force_n`` per
 contact (a precompressed packing needs walls all round) and struck weakly by a striker
@@ -41,7 +43,7 @@ from hexdem.model.precompression import longitudinal_sound_speed, static_overlap
 
 #: The packings of the study, in order.
 PACKINGS = ("uncompressed", "precompressed")
-STUDY_COLUMNS = ("packing", *FRONT_SHAPE_COLUMNS)
+STUDY_COLUMNS = ("packing", *FRONT_SHAPE_COLUMNS, "sixfold_cos", "sixfold_sin")
 #: The first front is taken when the beads within this fraction of the smallest fitted radius
 #: have been reached, so that the fronts cover the fitted range from its start.
 START_RADIUS_FRACTION = 0.8
@@ -98,14 +100,15 @@ def run_front_study(study: FrontStudy, out, log=None) -> dict:
         start = float(np.mean(distance_d <= START_RADIUS_FRACTION * study.radius_min_d))  # fronts from there on
         shape = measure_front_shape(analysis, study.fronts, geometric=True, window_deg=study.window_deg,
                                     start_quantile=start, wall_margin_d=study.wall_margin_d)
-        shapes[name], fits[name] = shape, fit_roundness(shape.mean_radius, shape.sixfold_amplitude, study.radius_min_d)
-        rows += [(name, *row) for row in shape.rows()]
+        shapes[name], fits[name] = shape, fit_roundness(shape.mean_radius, shape.sixfold_cos, study.radius_min_d)
+        rows += [(name, *row, float(cos6), float(sin6))
+                 for row, cos6, sin6 in zip(shape.rows(), shape.sixfold_cos, shape.sixfold_sin)]
     write_csv(out / "front_shape.csv", STUDY_COLUMNS, rows)
     labels = {"uncompressed": f"uncompressed half-disc, {study.v0_m_s:g} m/s",
               "precompressed": f"{study.control_force_n:g} N per contact, {study.control_v0_m_s:g} m/s (control)"}
     figures.front_shape_figure({labels[name]: shape for name, shape in shapes.items()}, out / "front_shape.png",
                                title="Roundness of the front as it grows",
-                               fits={labels[name]: fit for name, fit in fits.items()})
+                               fits={labels[name]: fit for name, fit in fits.items()}, signed=True)
     summary = {"study": asdict(study),
                "fits": {name: fit.as_dict() for name, fit in fits.items()},
                "largest_radius_d": {name: float(np.nanmax(shape.mean_radius)) for name, shape in shapes.items()}}
