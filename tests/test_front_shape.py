@@ -197,7 +197,8 @@ def test_the_front_study_follows_a_hexagonal_front_that_rounds_as_it_grows(tmp_p
     every file is written."""
     from hexdem.experiments.front_study import STUDY_COLUMNS, FrontStudy, run_front_study
 
-    study = FrontStudy(edge_beads=24, radius_beads=34, ranks=1, fronts=16)
+    study = FrontStudy(edge_beads=24, radius_beads=34, ranks=1, fronts=16, fit_range_d=(5.0, 25.0),
+                       control_fit_range_d=(5.0, 25.0))
     summary = run_front_study(study, tmp_path, log=lambda message: None)
     with open(tmp_path / "front_shape.csv") as fh:
         header, *rows = [line.strip().split(",") for line in fh]

@@ -63,12 +63,13 @@ def _power_law(radius, a_inf, b, p):
     return a_inf + b * radius**-p
 
 
-def fit_roundness(radius_d, amplitude, radius_min_d: float = 5.0) -> RoundnessFit:
-    """Fit A(R) = A∞ + B R^−p to the fronts with R ≥ ``radius_min_d`` (see the module docstring)."""
+def fit_roundness(radius_d, amplitude, radius_min_d: float = 5.0, radius_max_d: float = np.inf) -> RoundnessFit:
+    """Fit A(R) = A∞ + B R^−p to the fronts with ``radius_min_d`` <= R <= ``radius_max_d`` (see
+    the module docstring)."""
     from scipy.optimize import OptimizeWarning, curve_fit
 
     radius_d, amplitude = np.asarray(radius_d, float), np.asarray(amplitude, float)
-    use = np.isfinite(radius_d) & np.isfinite(amplitude) & (radius_d >= radius_min_d)
+    use = np.isfinite(radius_d) & np.isfinite(amplitude) & (radius_d >= radius_min_d) & (radius_d <= radius_max_d)
     r, a = radius_d[use], amplitude[use]
     if len(r) < MIN_FRONTS or r.max() < 2 * r.min():
         raise HexdemError(f"a roundness fit needs at least {MIN_FRONTS} fronts over a factor 2 in radius beyond "
