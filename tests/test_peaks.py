@@ -58,3 +58,4 @@ def test_many_windows_at_once_equal_one_window_at_a_time():
     np.testing.assert_allclose(offset, expected[:, 0], rtol=0, atol=1e-13 * interval)
     flat = np.full((1, 7), 1.0)  # a plateau: the middle sample is the peak
     assert refine_peaks(flat, interval)[1][0] == pytest.approx(1.0)
+    assert [len(a) for a in refine_peaks(np.empty((0, 7)), interval)] == [0, 0]  # no bead has peaked yet

@@ -10,7 +10,7 @@ follows the relative sixfold amplitude of the half-maximum arrival front against
 from 5 to beyond 150 bead diameters, over one sixfold period of rays about the strike direction,
 each read until the front is 10 d from the packing's edge; and fits A(R) = A∞ + B (R/d)^−p
 (:mod:`hexdem.experiments.front_study`). Writes
-``OUT/front_shape.csv`` (``packing,time,mean_radius_d,sixfold_amplitude,bins_used``),
+``OUT/front_shape.csv`` (``packing,time,mean_radius_d,sixfold_amplitude,bins_used,sixfold_cos,sixfold_sin``),
 ``OUT/front_shape_fit.json``, ``OUT/front_shape.png``, both runs' ``hexdem run`` files in
 ``OUT/uncompressed`` and ``OUT/precompressed``, and ``OUT/workflow.json``.
 """

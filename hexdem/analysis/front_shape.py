@@ -76,7 +76,8 @@ class FrontShape:
 @dataclass(frozen=True)
 class _Rays:
     """Arrival time along each ray: ``theta`` (n_bins,), ``radius`` (n_samples,), ``time`` (n_bins, n_samples),
-    and ``extent`` (n_bins,): the radius at which each ray leaves the beads (NaN for a ray outside them)."""
+    and ``extent`` (n_bins,): the radius at which each ray leaves the beads whose arrival is known
+    (NaN for a ray outside them)."""
 
     theta: np.ndarray
     radius: np.ndarray

@@ -62,14 +62,15 @@ class ImpactAnalysis:
 
     def _far_wall_reached(self) -> bool:
         """Did the leading wave reach every bead at the wall facing the strike (every bead, without
-        walls) within the run? A bead counts as reached when its speed rose to half of its largest
+        such a wall: no walls, or only the struck edge's) within the run? A bead counts as reached when its speed rose to half of its largest
         value at least one impact time scale (``settings.contact_time_s``) before the run ended:
         a bead still on its first rise at the end has not been passed by the front, while one
         whose speed keeps growing under reflections (a precompressed box rings) has."""
         r = self.results
         beads = np.arange(len(r.reach_time))
-        if self.model.walls:
-            far = min(self.model.walls, key=lambda wall: float(np.dot(wall.normal, self.model.impact.direction)))
+        facing = [wall for wall in self.model.walls if np.dot(wall.normal, self.model.impact.direction) < 0]
+        if facing:
+            far = min(facing, key=lambda wall: float(np.dot(wall.normal, self.model.impact.direction)))
             beads = far.members
         units = self.settings.units
         latest = (self.settings.duration_s - self.settings.contact_time_s) / units.time_s

@@ -76,7 +76,9 @@ def refine_peaks(windows, interval: float) -> tuple[np.ndarray, np.ndarray]:
     peak relative to the middle sample and (B,) peaks, equal to the one-window refinement to
     round-off (the same spline and candidates: every stationary point on the pieces and the
     middle sample, the largest taken)."""
-    windows = np.asarray(windows, float)
+    windows = np.asarray(windows, float).reshape(-1, 2 * HALF_WINDOW + 1)
+    if not len(windows):
+        return np.empty(0), np.empty(0)
     coefficients = np.einsum("pcs,bs->bpc", _UNIT_OPERATOR, windows)  # (B, pieces, 4)
     a, b, c, d = np.moveaxis(coefficients, -1, 0)
     quadratic, linear, constant = 3 * d, 2 * c, b

@@ -79,11 +79,17 @@ def fit_roundness(radius_d, amplitude, radius_min_d: float = 5.0, radius_max_d: 
         slope, intercept = np.polyfit(np.log(r), np.log(a), 1)  # the pure power law on log scales: a start
         with warnings.catch_warnings():  # only the parameters of the comparison law are used, not their errors
             warnings.simplefilter("ignore", OptimizeWarning)
-            (b_zero, p_zero), _ = curve_fit(lambda x, b, p: _power_law(x, 0.0, b, p), r, a,
-                                            p0=(float(np.exp(intercept)), -slope), maxfev=20000)
-        rms_zero = float(np.sqrt(np.mean((_power_law(r, 0.0, b_zero, p_zero) - a) ** 2)))
+            try:
+                (b_zero, p_zero), _ = curve_fit(lambda x, b, p: _power_law(x, 0.0, b, p), r, a,
+                                                p0=(float(np.exp(intercept)), -slope), maxfev=20000)
+                rms_zero = float(np.sqrt(np.mean((_power_law(r, 0.0, b_zero, p_zero) - a) ** 2)))
+            except RuntimeError:  # the comparison law does not fit: left as NaN
+                pass
     start = (float(a[np.argmax(r)]), float((a[np.argmin(r)] - a[np.argmax(r)]) * r.min()), 1.0)
-    params, covariance = curve_fit(_power_law, r, a, p0=start, maxfev=20000)
+    try:
+        params, covariance = curve_fit(_power_law, r, a, p0=start, maxfev=20000)
+    except RuntimeError as exc:  # curve_fit's "optimal parameters not found"
+        raise HexdemError(f"the roundness fit over {r.min():.3g}-{r.max():.3g} d did not converge: {exc}") from None
     errors = np.sqrt(np.diag(covariance))
     rms = float(np.sqrt(np.mean((_power_law(r, *params) - a) ** 2)))
     return RoundnessFit(float(params[0]), float(errors[0]), float(params[1]), float(errors[1]), float(params[2]),

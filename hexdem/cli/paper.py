@@ -22,7 +22,7 @@ def add_arguments(parser) -> None:
     add_launcher(parser, "-n N and each MPI job or LAMMPS partition run")
     parser.add_argument("--steps-per-contact", type=int, default=STEPS_PER_CONTACT, metavar="N",
                         help=f"time step of the LAMMPS impacts: the Hertz contact time / N (default {STEPS_PER_CONTACT}; "
-                             "700 was the former default)")
+                             "a multiple of 14 of at least 28: the impacts are sampled every 1/14 of it; 700 was the former default)")
 
 
 def run(args) -> None:

@@ -47,7 +47,7 @@ from hexdem.disorder.preparation import (
     walls_for_settling,
 )
 from hexdem.errors import HexdemError
-from hexdem.model.config import STEPS_PER_CONTACT, RunConfig
+from hexdem.model.config import MIN_STEPS_PER_CONTACT, STEPS_PER_CONTACT, RunConfig
 from hexdem.model.granular import GranularModel, RunSettings
 from hexdem.model.lattice import Lattice
 
@@ -57,6 +57,18 @@ MANIFEST_NAME = "ensemble.json"
 IMPACT_SAMPLES_PER_CONTACT = 14
 #: Progress-bar labels of the phases.
 PHASE_LABELS = {"compact": "compacting", "settle": "settling", "impacts": "impacts"}
+
+
+def check_impact_steps(name: str, steps_per_contact) -> int:
+    """``steps_per_contact`` of an ensemble's impacts: at least the run's minimum, and a multiple
+    of :data:`IMPACT_SAMPLES_PER_CONTACT` (they are sampled every τ/that); ``name`` is the
+    option or key the value came from."""
+    positive_int(name, steps_per_contact)
+    if steps_per_contact < MIN_STEPS_PER_CONTACT or steps_per_contact % IMPACT_SAMPLES_PER_CONTACT:
+        raise HexdemError(f"{name} of the ensembles' impacts must be a multiple of {IMPACT_SAMPLES_PER_CONTACT} "
+                          f"of at least {MIN_STEPS_PER_CONTACT} (they are sampled every 1/{IMPACT_SAMPLES_PER_CONTACT} "
+                          f"of the contact time), got {steps_per_contact}")
+    return steps_per_contact
 
 
 @dataclass(frozen=True)
@@ -89,10 +101,7 @@ class EnsembleConfig:
 
     def __post_init__(self):
         positive_int("the number of realizations", self.realizations)
-        if positive_int("steps_per_contact", self.steps_per_contact) % IMPACT_SAMPLES_PER_CONTACT:
-            raise HexdemError(f"an ensemble's steps_per_contact must be a multiple of {IMPACT_SAMPLES_PER_CONTACT} "
-                              f"(its impacts are sampled every 1/{IMPACT_SAMPLES_PER_CONTACT} of the contact time), "
-                              f"got {self.steps_per_contact}")
+        check_impact_steps("steps_per_contact", self.steps_per_contact)
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
             raise HexdemError(f"the seed must be a non-negative integer, got {self.seed!r}")
         speeds = tuple(self.velocities_m_s)

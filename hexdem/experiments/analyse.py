@@ -26,6 +26,10 @@ from hexdem.experiments.run import CONFIG_NAME, write_results
 from hexdem.model.config import RunConfig
 
 
+#: The time step of decks written before ``steps_per_contact`` existed: τ/700.
+LEGACY_STEPS_PER_CONTACT = 700
+
+
 def deck_config(deck_dir: Path) -> RunConfig:
     """The :class:`RunConfig` a ``hexdem run`` deck directory was written for."""
     path = deck_dir / CONFIG_NAME
@@ -35,6 +39,7 @@ def deck_config(deck_dir: Path) -> RunConfig:
         raise HexdemError(f"{deck_dir} has no {CONFIG_NAME}: it is not a deck directory written by hexdem run") from None
     except ValueError:
         raise HexdemError(f"{path} is not valid JSON") from None
+    data.setdefault("steps_per_contact", LEGACY_STEPS_PER_CONTACT)  # a deck written before the key existed
     return RunConfig.from_dict(data, source=str(path))
 
 

@@ -88,8 +88,8 @@ def study_time_step(config: RunConfig, steps, workdir, log=None) -> Convergence:
         analysis = simulate(steps_config(config, n), Path(workdir) / f"steps{n}")
         results.append((analysis, time.perf_counter() - begun))
         log(f"{n} steps per contact: {results[-1][1]:.1f} s")
-    first = results[-1][0]
-    r = first.results
+    finest = results[-1][0]
+    r = finest.results
     line_beads = np.unique(np.concatenate(list(r.lines.values())))
     beads = line_beads[r.peak_speed[line_beads] > THRESHOLD * config.v0]
     order = ORDERS[config.engine]
@@ -98,7 +98,7 @@ def study_time_step(config: RunConfig, steps, workdir, log=None) -> Convergence:
     ratio = steps[-1] / steps[-2]
     exact_peak = richardson(peaks[-1], peaks[-2], ratio, order)
     exact_arrival = richardson(arrivals[-1], arrivals[-2], ratio, order)
-    contact = first.settings.contact_time_s / first.settings.units.time_s
+    contact = finest.settings.contact_time_s / finest.settings.units.time_s
     runs = []
     for n, (analysis, wall), peak, arrival in zip(steps, results, peaks, arrivals):
         arrival_error = float(np.max(np.abs(arrival - exact_arrival)))

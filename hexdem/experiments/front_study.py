@@ -105,11 +105,13 @@ def run_front_study(study: FrontStudy, out, log=None) -> dict:
         start = float(np.mean(distance_d <= START_RADIUS_FRACTION * study.radius_min_d))  # fronts from there on
         shape = measure_front_shape(analysis, study.fronts, geometric=True, window_deg=study.window_deg,
                                     start_quantile=start, wall_margin_d=study.wall_margin_d)
-        low, high = study.fit_range_d if name == "uncompressed" else study.control_fit_range_d
-        shapes[name], fits[name] = shape, fit_roundness(shape.mean_radius, shape.sixfold_cos, low, high)
+        shapes[name] = shape
         rows += [(name, *row, float(cos6), float(sin6))
                  for row, cos6, sin6 in zip(shape.rows(), shape.sixfold_cos, shape.sixfold_sin)]
-    write_csv(out / "front_shape.csv", STUDY_COLUMNS, rows)
+    write_csv(out / "front_shape.csv", STUDY_COLUMNS, rows)  # the measurement stays if a fit fails
+    for name, shape in shapes.items():
+        low, high = study.fit_range_d if name == "uncompressed" else study.control_fit_range_d
+        fits[name] = fit_roundness(shape.mean_radius, shape.sixfold_cos, low, high)
     labels = {"uncompressed": f"uncompressed half-disc, {study.v0_m_s:g} m/s",
               "precompressed": f"{study.control_force_n:g} N per contact, {study.control_v0_m_s:g} m/s (control)"}
     figures.front_shape_figure({labels[name]: shape for name, shape in shapes.items()}, out / "front_shape.png",

@@ -83,8 +83,11 @@ def run_on_ranks(job, ranks: int, directory, launcher: str | None = None, progre
     prefix = shlex.split(launcher) if launcher else [environment_command("mpiexec")]
     command = [*prefix, "-n", str(ranks), sys.executable, "-P", "-m", __name__, str(paths[JOB_NAME].resolve())]
     with _progress(progress):
-        done = subprocess.run(command, stdout=subprocess.PIPE, stderr=None, text=True,
-                              preexec_fn=functools.partial(die_with_parent, os.getpid()))
+        try:
+            done = subprocess.run(command, stdout=subprocess.PIPE, stderr=None, text=True,
+                                  preexec_fn=functools.partial(die_with_parent, os.getpid()))
+        except OSError as exc:
+            raise HexdemError(f"cannot start the MPI launcher {prefix[0]!r}: {exc.strerror}") from None
     if done.returncode != 0 or not paths[RESULT_NAME].exists():
         reported = paths[ERROR_NAME].read_text().strip() if paths[ERROR_NAME].exists() else ""
         if reported:

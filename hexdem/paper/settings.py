@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 from hexdem.common.checks import positive_int
+from hexdem.disorder.ensemble import check_impact_steps
 from hexdem.disorder.preparation import TOLERANCE_M
 from hexdem.model.config import STEPS_PER_CONTACT
 
@@ -45,6 +46,7 @@ class PaperSettings:
 
     def __post_init__(self):
         positive_int("--workers", self.workers)
+        check_impact_steps("--steps-per-contact", self.steps_per_contact)
 
     @property
     def n_v0(self) -> int:

@@ -197,8 +197,9 @@ class SweepTasks:
 
 def _on_ranks(settings: SweepSettings, jobs):
     """Yield ((strike, i), RunPeaks) of every run, the runs spread over MPI ranks that
-    ``settings.launcher`` starts."""
-    with tempfile.TemporaryDirectory(prefix="hexdem-sweep-") as directory:
+    ``settings.launcher`` starts. The runs are handed over in a hidden directory under the
+    current one, which ranks on other machines must share (a local /tmp would not be)."""
+    with tempfile.TemporaryDirectory(prefix=".hexdem-sweep-", dir=os.getcwd()) as directory:
         def count_done() -> int:
             return sum(name.startswith(DONE_PREFIX) for name in os.listdir(directory))
 

@@ -125,8 +125,12 @@ def run_partitioned(directories, workers: int, run_dir, description: str = "LAMM
     output = run_dir / "launcher.out"
     pending, bar = list(directories), progress_bar(len(directories), f"{description} x{partitions}", unit="deck")
     with open(output, "w") as out:
-        process = subprocess.Popen(command, cwd=run_dir, stdout=out, stderr=subprocess.STDOUT, pass_fds=pass_fds,
-                                   preexec_fn=functools.partial(die_with_parent, os.getpid()))
+        try:
+            process = subprocess.Popen(command, cwd=run_dir, stdout=out, stderr=subprocess.STDOUT, pass_fds=pass_fds,
+                                       preexec_fn=functools.partial(die_with_parent, os.getpid()))
+        except OSError as exc:
+            bar.close()
+            raise HexdemError(f"cannot start the MPI launcher {prefix[0]!r}: {exc.strerror}") from None
     try:
         while pending:
             finished = process.poll() is not None
