@@ -108,7 +108,7 @@ def test_deck_error_is_reported_with_lammps_message(tmp_path, capfd, ranks):
     that abort print no traceback."""
     config = RunConfig(edge_beads=3)
     rendered = write_deck(config.model(), config.settings(), tmp_path / "deck")
-    rendered.input_path.write_text(rendered.input_path.read_text().replace("pair_style      granular", "pair_style nonsense"))
+    rendered.input_path.write_text(rendered.input_path.read_text().replace("pair_style      gran/hertz/history", "pair_style nonsense"))
     for attempt in (lambda: run_bare(rendered, ranks),
                     lambda: run_on_ranks(functools.partial(run_streaming, rendered, repr), ranks, tmp_path / "job")):
         with pytest.raises(HexdemError, match=r"LAMMPS failed on .*in\.hexdem: ERROR: .*nonsense") as info:
