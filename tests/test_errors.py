@@ -46,6 +46,15 @@ def assert_no_results(directory):
     ("ranks = 0", "ranks must be a positive integer"),
     ("velocity = 0.4", "unknown parameter(s) velocity"),
     ("v0 = [", "not valid TOML"),
+    ('shape = "sites"\nsites = [[0, 0], [2, 0], [0, 0]]', "site {0, 0} is listed twice"),
+    ('shape = "sites"\nsites = [[2, 0], [4, 0]]', "the struck site {0, 0} is not in the packing"),
+    ('shape = "sites"\nsites = [[0, 0], [1, 0]]', "m + n odd"),
+    ('shape = "sites"\nsites_file = "missing.csv"', "cannot read sites_file missing.csv"),
+    ("vacancies = [[0, 0]]", "the struck bead cannot be a vacancy"),
+    ("vacancies = [[40, 2]]", "vacancy {40, 2} is not a site"),
+    ('shape = "triangle"\nedge_beads = 2', "a triangle needs at least 3 beads per edge"),
+    ('shape = "parallelogram"\ndepth_beads = 1', "a parallelogram needs depth_beads >= 2"),
+    ('bead_material = "unobtainium"', "unobtainium"),
 ])
 def test_bad_config_is_one_line_and_writes_nothing(tmp_path, capsys, config_text, message):
     code, err = run_cli(tmp_path, capsys, config_text)

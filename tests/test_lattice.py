@@ -4,7 +4,9 @@ import numpy as np
 import pytest
 
 from hexdem.errors import HexdemError
-from hexdem.model.lattice import half_disc, half_hexagon, hexagon, strike_direction
+from hexdem.model.config import RunConfig
+from hexdem.model.lattice import (from_sites, half_disc, half_hexagon, hexagon, parallelogram, strike_direction,
+                                   triangle, without_sites)
 
 D = 0.01905
 
@@ -101,3 +103,83 @@ def test_half_disc_holds_every_site_within_its_radius_on_the_struck_side():
     assert wall.normal == (1.0, 0.0) and wall.offset_m == pytest.approx(-0.5)
     assert set(wall.members.tolist()) == set(np.flatnonzero(lattice.indices[:, 1] == 0)) - {lattice.struck}
     assert len(lattice.line("0")) == 7 and len(lattice.line("+30")) == 13
+
+
+@pytest.mark.parametrize("edge", [3, 4, 11])
+def test_triangle_holds_a_triangular_number_of_beads_with_three_walls(edge):
+    """N per edge: N(N + 1)/2 beads; the struck edge (x = 0) and the two edges at ±60° from it
+    each hold N beads, every one touching its wall (the struck bead in its hole)."""
+    lattice = triangle(edge, D)
+    assert len(lattice) == edge * (edge + 1) // 2
+    assert tuple(lattice.indices[lattice.struck]) == (0, 0)
+    apex = lattice.positions_m[:, 0].max()
+    assert apex == pytest.approx(np.sqrt(3) / 2 * (edge - 1) * D)
+    for wall in lattice.walls:
+        gaps = wall.gaps_m(lattice.positions_m[wall.members], lattice.radii_m[wall.members])
+        np.testing.assert_allclose(gaps, 0.0, atol=1e-15)
+        assert len(wall.members) == edge - (wall.name == "wall_000")
+    assert sorted(w.name for w in lattice.walls) == ["wall_000", "wall_120", "wall_m120"]
+
+
+def test_parallelogram_has_equal_layers_sheared_along_30_degrees():
+    lattice = parallelogram(5, 7, D)
+    assert len(lattice) == 35
+    layers = np.bincount(lattice.indices[:, 1])
+    assert list(layers) == [5] * 7
+    lowest = [lattice.indices[lattice.indices[:, 1] == n, 0].min() for n in range(7)]
+    assert np.all(np.diff(lowest) == 1), "each layer one half-diameter higher: edges at +30 deg"
+    counts = {wall.name: len(wall.members) for wall in lattice.walls}
+    assert counts == {"wall_000": 4, "wall_180": 5, "wall_120": 7, "wall_m60": 7}
+    i, j = lattice.bonds().T
+    np.testing.assert_allclose(np.linalg.norm(lattice.positions_m[i] - lattice.positions_m[j], axis=1), D)
+
+
+def test_listed_sites_are_the_packing_and_their_walls_touch_it():
+    sites = [(0, 0), (2, 0), (-2, 0), (1, 1), (-1, 1), (0, 2)]
+    lattice = from_sites(sites, D, (0,), "six")
+    assert [tuple(mn) for mn in lattice.indices.tolist()] == sites
+    (wall,) = lattice.walls
+    assert set(wall.members.tolist()) == {1, 2}, "the n = 0 beads but the struck one"
+
+
+@pytest.mark.parametrize("sites, message", [([(0, 0), (2, 0), (0, 0)], "listed twice"),
+                                            ([(0, 0), (1, 0)], "m [+] n odd"),
+                                            ([(2, 0), (4, 0)], "struck site"),
+                                            ([(0, 0)], "at least 2 beads")])
+def test_bad_site_lists_are_refused(sites, message):
+    with pytest.raises(HexdemError, match=message):
+        from_sites(sites, D)
+
+
+def test_vacancies_leave_sites_out_and_keep_the_walls():
+    full = hexagon(5, D)
+    holed = without_sites(full, [(1, 1), (4, 4)])
+    assert len(holed) == len(full) - 2
+    assert holed.index_of(1, 1) is None and holed.index_of(4, 4) is None
+    assert tuple(holed.indices[holed.struck]) == (0, 0)
+    for before, after in zip(full.walls, holed.walls):
+        assert after.offset_m == before.offset_m
+        kept = [tuple(full.indices[i]) for i in before.members if tuple(full.indices[i]) not in {(1, 1), (4, 4)}]
+        assert [tuple(holed.indices[i]) for i in after.members] == kept
+    bonds = {tuple(sorted(map(tuple, holed.indices[pair]))) for pair in holed.bonds()}
+    assert not any((1, 1) in bond or (4, 4) in bond for bond in bonds)
+    with pytest.raises(HexdemError, match="struck bead cannot be a vacancy"):
+        without_sites(full, [(0, 0)])
+    with pytest.raises(HexdemError, match="not a site"):
+        without_sites(full, [(40, 0)])
+
+
+def test_config_reads_sites_from_csv_and_toml(tmp_path):
+    csv_file, toml_file = tmp_path / "sites.csv", tmp_path / "sites.toml"
+    csv_file.write_text("m,n\n0,0\n2,0\n1,1\n")
+    toml_file.write_text("sites = [[0, 0], [2, 0], [1, 1]]\n")
+    inline = RunConfig(shape="sites", sites=[[0, 0], [2, 0], [1, 1]]).lattice()
+    for path in (csv_file, toml_file):
+        lattice = RunConfig(shape="sites", sites_file=str(path)).lattice()
+        np.testing.assert_array_equal(lattice.indices, inline.indices)
+        assert lattice.walls == ()
+    (tmp_path / "bad.csv").write_text("m,n\n0,0\nx,1\n")
+    with pytest.raises(HexdemError, match="two integers"):
+        RunConfig(shape="sites", sites_file=str(tmp_path / "bad.csv"))
+    with pytest.raises(HexdemError, match="exactly one of"):
+        RunConfig(shape="sites")

@@ -1,9 +1,12 @@
-"""README.md's Python example runs verbatim, so the documentation cannot rot."""
+"""README.md's Python example runs verbatim and its packing configs build, so the documentation cannot rot."""
 
 import re
 import subprocess
 import sys
+import tomllib
 from pathlib import Path
+
+from hexdem.model.config import RunConfig
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 
@@ -24,3 +27,12 @@ def test_the_python_api_example_runs(tmp_path):
     assert lines[-2] == "omega = 0.381966, c = 0.845276"
     assert lines[-1].startswith("30/30: c = ")
     assert sorted(path.name for path in tmp_path.iterdir()) == ["example.py"], "no files unless asked for"
+
+
+def test_every_packing_config_of_the_readme_builds_the_packing_its_comment_names():
+    section = README.read_text().split("#### Packings", 1)[1].split("\n## ", 1)[0]
+    blocks = re.findall(r"```toml\n(.*?)```", section, flags=re.DOTALL)
+    assert len(blocks) == 4
+    lattices = [RunConfig(**tomllib.loads(block)).lattice() for block in blocks]
+    assert [len(lattice) for lattice in lattices] == [28, 30, 329, 10]
+    assert [len(lattice.walls) for lattice in lattices] == [3, 4, 6, 1]

@@ -61,17 +61,20 @@ class ImpactAnalysis:
                    pulses.reach_time, trajectory.energy_drift(model))
 
     def _far_wall_reached(self) -> bool:
-        """Did the leading wave reach every bead at the wall facing the strike (every bead, without
-        such a wall: no walls, or only the struck edge's) within the run? A bead counts as reached when its speed rose to half of its largest
-        value at least one impact time scale (``settings.contact_time_s``) before the run ended:
-        a bead still on its first rise at the end has not been passed by the front, while one
-        whose speed keeps growing under reflections (a precompressed box rings) has."""
+        """Did the leading wave reach every bead at the walls facing the strike within the run?
+        Those walls are the ones whose inward normal points most against the strike (the far
+        wall of a hexagon, both far walls of a triangle); without such a wall (no walls, or only
+        the struck edge's) every bead counts. A bead counts as reached when its speed rose to
+        half of its largest value at least one impact time scale (``settings.contact_time_s``)
+        before the run ended: a bead still on its first rise at the end has not been passed by
+        the front, while one whose speed keeps growing under reflections (a precompressed box
+        rings) has."""
         r = self.results
         beads = np.arange(len(r.reach_time))
-        facing = [wall for wall in self.model.walls if np.dot(wall.normal, self.model.impact.direction) < 0]
-        if facing:
-            far = min(facing, key=lambda wall: float(np.dot(wall.normal, self.model.impact.direction)))
-            beads = far.members
+        facing = [float(np.dot(wall.normal, self.model.impact.direction)) for wall in self.model.walls]
+        if facing and min(facing) < 0:
+            far = [wall.members for wall, dot in zip(self.model.walls, facing) if dot <= min(facing) + 1e-9]
+            beads = np.unique(np.concatenate(far))
         units = self.settings.units
         latest = (self.settings.duration_s - self.settings.contact_time_s) / units.time_s
         return bool(np.all(r.reach_time[beads] <= latest))

@@ -21,12 +21,13 @@ from hexdem.errors import HexdemError
 from hexdem.model.dissipation import damping_coefficient, lammps_tsuji_coefficient
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time
-from hexdem.model.lattice import LINE_STEPS, Lattice, half_disc, half_hexagon, hexagon
+from hexdem.model.lattice import LINE_STEPS, Lattice, half_disc, half_hexagon, hexagon, parallelogram, triangle, without_sites
+from hexdem.model.sites import read_sites
 from hexdem.model.materials import PAPER_DIAMETER_M, hertz_coefficient, hertz_stiffness, material, sphere_mass
 from hexdem.model.precompression import hole_force, precompressed_lattice, spring_stiffness
 from hexdem.model.units import SI, UnitSystem, nondimensional
 
-SHAPES = ("hexagon", "half-hexagon", "half-disc")
+SHAPES = ("hexagon", "half-hexagon", "half-disc", "triangle", "parallelogram", "sites")
 IMPACTS = ("velocity", "striker")
 UNITS = ("si", "nondimensional")
 ENGINES = ("lammps", "reference")
@@ -72,6 +73,14 @@ class RunConfig:
     ``sensors``: sensor particles, each ``"line:n"`` (e.g. ``"0:1"``, ``"+30:6"``) or a bead id;
     sampled at ``sensor_rate_hz`` (the paper's 500 kS/s); ``sensor_mass_factor``: a sensor
     bead's mass relative to a plain bead's.
+    Packings (``shape``): ``hexagon`` (``edge_beads`` per edge), ``half-hexagon`` (``long_edge``,
+    ``short_edge``), ``half-disc`` (``radius_beads``), ``triangle`` (``edge_beads``),
+    ``parallelogram`` (``edge_beads`` along the struck edge, ``depth_beads`` layers, None: as
+    many), each with the walls of its basin; ``sites``: the sites listed in ``sites`` (pairs
+    [m, n]) or in ``sites_file`` (CSV with columns m,n, or TOML with ``sites = [[m, n], …]``),
+    struck at {0, 0}, with flat walls touching it whose inward normals point at the angles
+    ``site_walls_deg`` (none: a free packing). ``vacancies``: sites [m, n] left out of any
+    packing (the walls stay).
     ``launcher``: the MPI launcher command that starts the ranks (None: this environment's
     ``mpiexec``; e.g. ``"mpiexec -f hosts"`` or ``"srun"`` to span machines); given, the run goes
     through it even on one rank.
@@ -86,6 +95,11 @@ class RunConfig:
     long_edge: int = 91
     short_edge: int = 46
     radius_beads: int = 100
+    depth_beads: int | None = None
+    sites: tuple = ()
+    sites_file: str | None = None
+    site_walls_deg: tuple = ()
+    vacancies: tuple = ()
     diameter_m: float = PAPER_DIAMETER_M
     bead_material: str = "steel316"
     wall_material: str = "delrin"
@@ -118,7 +132,10 @@ class RunConfig:
         if positive_int("steps_per_contact", self.steps_per_contact) < MIN_STEPS_PER_CONTACT:
             raise HexdemError(f"steps_per_contact must be at least {MIN_STEPS_PER_CONTACT} (the Hertz contact "
                               f"needs them), got {self.steps_per_contact}")
-        object.__setattr__(self, "sensors", tuple(self.sensors))
+        for name in ("sensors", "sites", "site_walls_deg", "vacancies"):
+            if not isinstance(getattr(self, name), (list, tuple)):
+                raise HexdemError(f"{name} must be a list, got {getattr(self, name)!r}")
+            object.__setattr__(self, name, tuple(tuple(v) if isinstance(v, list) else v for v in getattr(self, name)))
         if not (is_number(self.sensor_rate_hz) and self.sensor_rate_hz > 0):
             raise HexdemError(f"sensor_rate_hz must be > 0, got {self.sensor_rate_hz!r}")
         if not (is_number(self.precompression_n) and self.precompression_n >= 0):
@@ -136,13 +153,13 @@ class RunConfig:
 
     def n_beads(self) -> int:
         """Beads of the packing: 3N(N − 1) + 1 for a hexagon with N per edge, S(3S − 1)/2 for a
-        half-hexagon with short edges of S (both counted without building them), a half-disc's
-        counted on its lattice."""
+        half-hexagon with short edges of S (both counted without building them, less the
+        vacancies), any other packing's counted on its lattice."""
         if self.shape == "hexagon":
-            return 3 * self.edge_beads * (self.edge_beads - 1) + 1
-        if self.shape == "half-disc":
-            return len(self.lattice())
-        return self.short_edge * (3 * self.short_edge - 1) // 2
+            return 3 * self.edge_beads * (self.edge_beads - 1) + 1 - len(self.vacancies)
+        if self.shape == "half-hexagon":
+            return self.short_edge * (3 * self.short_edge - 1) // 2 - len(self.vacancies)
+        return len(self.lattice())
 
     def memory_estimate_bytes(self) -> float:
         """Peak memory of the run on each of its processes [bytes] (see MEMORY_PER_BEAD_BYTES)."""
@@ -150,7 +167,8 @@ class RunConfig:
 
     def _check_size(self) -> None:
         sizes = {"hexagon": (self.edge_beads,), "half-hexagon": (self.short_edge, self.long_edge),
-                 "half-disc": (self.radius_beads,)}[self.shape]
+                 "half-disc": (self.radius_beads,), "triangle": (self.edge_beads,),
+                 "parallelogram": (self.edge_beads, self.depth_beads or self.edge_beads), "sites": ()}[self.shape]
         if not all(isinstance(n, int) and not isinstance(n, bool) and n >= 2 for n in sizes):
             return  # the lattice builder words the error
         needed = self.memory_estimate_bytes() * (self.ranks if self.engine == "lammps" else 1)
@@ -207,11 +225,20 @@ class RunConfig:
         return SI if self.units == "si" else nondimensional(self.diameter_m, material(self.bead_material))
 
     def lattice(self) -> Lattice:
-        if self.shape == "hexagon":
-            return hexagon(self.edge_beads, self.diameter_m)
-        if self.shape == "half-disc":
-            return half_disc(self.radius_beads, self.diameter_m)
-        return half_hexagon(self.long_edge, self.short_edge, self.diameter_m)
+        """The packing: the ``shape``'s sites less the ``vacancies``, with its walls."""
+        builders = {
+            "hexagon": lambda: hexagon(self.edge_beads, self.diameter_m),
+            "half-hexagon": lambda: half_hexagon(self.long_edge, self.short_edge, self.diameter_m),
+            "half-disc": lambda: half_disc(self.radius_beads, self.diameter_m),
+            "triangle": lambda: triangle(self.edge_beads, self.diameter_m),
+            "parallelogram": lambda: parallelogram(self.edge_beads, self.depth_beads or self.edge_beads,
+                                                   self.diameter_m),
+            "sites": lambda: read_sites(self.sites, self.sites_file, self.diameter_m, self.site_walls_deg),
+        }
+        if self.shape != "sites" and (self.sites or self.sites_file or self.site_walls_deg):
+            raise HexdemError(f"sites, sites_file and site_walls_deg describe shape = \"sites\", not {self.shape!r}")
+        lattice = builders[self.shape]()
+        return without_sites(lattice, self.vacancies) if self.vacancies else lattice
 
     def model(self) -> GranularModel:
         """The SI :class:`GranularModel` this configuration describes."""

@@ -126,19 +126,65 @@ def strike_direction(angle_deg: float) -> np.ndarray:
     return np.array([np.cos(np.radians(angle)), np.sin(np.radians(angle))])
 
 
-def _from_layers(half_heights, diameter_m: float, wall_angles_deg, shape: str, shift: int = 0) -> Lattice:
-    """Packing whose layer n (x = (√3/2) d n) holds the beads |m − shift| ≤ half_heights[n]."""
-    if not diameter_m > 0:
+def from_sites(labels, diameter_m: float = 1.0, wall_angles_deg=(), shape: str = "listed sites",
+               struck=(0, 0)) -> Lattice:
+    """The packing of the listed sites {m, n} (m + n even), with flat walls touching it whose
+    inward normals point at ``wall_angles_deg`` (none: a free packing), struck at ``struck``.
+
+    Any packing is this: the built-in shapes list their sites, and a user's list (a vacancy is
+    a site left out) works the same everywhere downstream."""
+    if not (isinstance(diameter_m, (int, float)) and diameter_m > 0):
         raise HexdemError(f"bead diameter must be > 0 m, got {diameter_m}")
-    labels = np.array([(m, n) for n, h in enumerate(half_heights)
-                       for m in range(shift - h, shift + h + 1) if (m + n) % 2 == 0], dtype=int)
+    try:
+        labels = np.asarray(labels, dtype=int).reshape(-1, 2)
+    except (TypeError, ValueError):
+        raise HexdemError(f"{shape}: sites must be pairs of integers [m, n]") from None
+    odd = labels[(labels.sum(axis=1) % 2) != 0]
+    if len(odd):
+        raise HexdemError(f"{shape}: site {{{odd[0, 0]}, {odd[0, 1]}}} has m + n odd: it is not a site of the "
+                          "hexagonal packing (m + n must be even)")
+    unique, counts = np.unique(labels, axis=0, return_counts=True)
+    if np.any(counts > 1):
+        m, n = unique[np.argmax(counts > 1)]
+        raise HexdemError(f"{shape}: site {{{m}, {n}}} is listed twice")
+    if len(labels) < 2:
+        raise HexdemError(f"{shape}: a packing needs at least 2 beads, got {len(labels)}")
+    hit = np.flatnonzero((labels[:, 0] == struck[0]) & (labels[:, 1] == struck[1]))
+    if not len(hit):
+        raise HexdemError(f"{shape}: the struck site {{{struck[0]}, {struck[1]}}} is not in the packing")
     positions = np.column_stack([np.sqrt(3) / 2 * labels[:, 1], labels[:, 0] / 2.0]) * diameter_m
     lattice = Lattice(indices=labels, positions_m=positions,
                       diameters_m=np.full(len(labels), float(diameter_m)), diameter_m=float(diameter_m),
-                      struck=int(np.flatnonzero((labels[:, 0] == 0) & (labels[:, 1] == 0))[0]),
-                      walls=(), shape=shape)
+                      struck=int(hit[0]), walls=(), shape=shape)
     normals = [(np.cos(np.radians(a)), np.sin(np.radians(a))) for a in wall_angles_deg]
     return replace(lattice, walls=touching_walls(lattice, normals))
+
+
+def _layer_sites(bounds) -> list[tuple[int, int]]:
+    """Sites {m, n} of layers n = 0, 1, … (x = (√3/2) d n) holding lo_n <= m <= hi_n, m + n even."""
+    return [(m, n) for n, (lo, hi) in enumerate(bounds) for m in range(lo, hi + 1) if (m + n) % 2 == 0]
+
+
+def without_sites(lattice: Lattice, vacancies) -> Lattice:
+    """``lattice`` with the beads at the ``vacancies`` {m, n} left out; the walls stay where the
+    full packing put them (a vacancy at an edge leaves a gap at the wall)."""
+    vacancies = [tuple(int(v) for v in site) for site in vacancies]
+    missing = [site for site in vacancies if lattice.index_of(*site) is None]
+    if missing:
+        raise HexdemError(f"vacancy {{{missing[0][0]}, {missing[0][1]}}} is not a site of the {lattice.shape}")
+    if len(set(vacancies)) != len(vacancies):
+        raise HexdemError("a vacancy is listed twice")
+    removed = np.array([lattice.index_of(*site) for site in vacancies], dtype=int)
+    if lattice.struck in removed:
+        raise HexdemError("the struck bead cannot be a vacancy")
+    keep = np.setdiff1d(np.arange(len(lattice)), removed)
+    new_index = np.full(len(lattice), -1)
+    new_index[keep] = np.arange(len(keep))
+    walls = tuple(replace(wall, members=new_index[np.setdiff1d(wall.members, removed)]) for wall in lattice.walls)
+    shape = f"{lattice.shape}, {len(removed)} vacanc{'y' if len(removed) == 1 else 'ies'}"
+    return replace(lattice, indices=lattice.indices[keep], positions_m=lattice.positions_m[keep],
+                   diameters_m=lattice.diameters_m[keep], struck=int(new_index[lattice.struck]), walls=walls,
+                   shape=shape)
 
 
 def touching_walls(lattice: Lattice, normals) -> tuple[Wall, ...]:
@@ -171,8 +217,8 @@ def hexagon(edge_beads: int, diameter_m: float = 1.0) -> Lattice:
         raise HexdemError(f"a hexagon needs at least 2 beads per edge, got {edge_beads}")
     k = int(edge_beads) - 1
     heights = [k + min(n, 2 * k - n) for n in range(2 * k + 1)]
-    return _from_layers(heights, diameter_m, (0, 180, 60, -60, 120, -120), f"hexagon, {k + 1} per edge",
-                        shift=k % 2)
+    sites = _layer_sites([(k % 2 - h, k % 2 + h) for h in heights])
+    return from_sites(sites, diameter_m, (0, 180, 60, -60, 120, -120), f"hexagon, {k + 1} per edge")
 
 
 def half_disc(radius_beads: int, diameter_m: float = 1.0) -> Lattice:
@@ -183,7 +229,7 @@ def half_disc(radius_beads: int, diameter_m: float = 1.0) -> Lattice:
     radius = int(radius_beads)
     layers = int(np.floor(2 * radius / np.sqrt(3)))
     heights = [int(np.floor(2 * np.sqrt(radius**2 - 0.75 * n**2) + 1e-9)) for n in range(layers + 1)]
-    return _from_layers(heights, diameter_m, (0,), f"half-disc, radius {radius} d")
+    return from_sites(_layer_sites([(-h, h) for h in heights]), diameter_m, (0,), f"half-disc, radius {radius} d")
 
 
 def half_hexagon(long_edge: int = 91, short_edge: int = 46, diameter_m: float = 1.0) -> Lattice:
@@ -195,5 +241,27 @@ def half_hexagon(long_edge: int = 91, short_edge: int = 46, diameter_m: float = 
         raise HexdemError(f"a half-hexagon needs long_edge = 2*short_edge - 1 >= 3, "
                           f"got long {long_edge}, short {short_edge}")
     heights = [long_edge - 1 - n for n in range(int(short_edge))]
-    return _from_layers(heights, diameter_m, (0, 180, 120, -120),
-                        f"half-hexagon, long edge {long_edge}, short edges {short_edge}")
+    return from_sites(_layer_sites([(-h, h) for h in heights]), diameter_m, (0, 180, 120, -120),
+                      f"half-hexagon, long edge {long_edge}, short edges {short_edge}")
+
+
+def triangle(edge_beads: int, diameter_m: float = 1.0) -> Lattice:
+    """Equilateral triangle with ``edge_beads`` per edge, N(N + 1)/2 beads: the struck edge
+    vertical, its apex towards +x, the walls of a triangular basin (Hua & Van Gorder)."""
+    if int(edge_beads) != edge_beads or edge_beads < 3:
+        raise HexdemError(f"a triangle needs at least 3 beads per edge, got {edge_beads}")
+    k = int(edge_beads) - 1
+    sites = _layer_sites([(k % 2 - (k - n), k % 2 + (k - n)) for n in range(k + 1)])
+    return from_sites(sites, diameter_m, (0, 120, -120), f"triangle, {k + 1} per edge")
+
+
+def parallelogram(edge_beads: int, depth_beads: int, diameter_m: float = 1.0) -> Lattice:
+    """Rhombus-like cell of ``depth_beads`` layers of ``edge_beads`` each (the struck edge
+    vertical, the other two edges along +30°): a strip of the lattice with four walls."""
+    for name, value in (("edge_beads", edge_beads), ("depth_beads", depth_beads)):
+        if int(value) != value or value < 2:
+            raise HexdemError(f"a parallelogram needs {name} >= 2, got {value}")
+    k = int(edge_beads) - 1
+    sites = _layer_sites([(k % 2 - k + n, k % 2 + k + n) for n in range(int(depth_beads))])
+    return from_sites(sites, diameter_m, (0, 180, 120, -60),
+                      f"parallelogram, {k + 1} per edge, {int(depth_beads)} deep")
