@@ -55,6 +55,8 @@ def assert_no_results(directory):
     ('shape = "triangle"\nedge_beads = 2', "a triangle needs at least 3 beads per edge"),
     ('shape = "parallelogram"\ndepth_beads = 1', "a parallelogram needs depth_beads >= 2"),
     ('bead_material = "unobtainium"', "unobtainium"),
+    ('shape = "disc"\nradius_beads = 1', "a disc needs a radius of at least 2 bead diameters"),
+    ('shape = "disc"\nradius_beads = 5\nprecompression_n = 20.0', "precompression is built for flat-walled basins"),
 ])
 def test_bad_config_is_one_line_and_writes_nothing(tmp_path, capsys, config_text, message):
     code, err = run_cli(tmp_path, capsys, config_text)

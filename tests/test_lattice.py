@@ -5,7 +5,7 @@ import pytest
 
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
-from hexdem.model.lattice import (from_sites, half_disc, half_hexagon, hexagon, parallelogram, strike_direction,
+from hexdem.model.lattice import (disc, from_sites, half_disc, half_hexagon, hexagon, parallelogram, strike_direction,
                                    triangle, without_sites)
 
 D = 0.01905
@@ -183,3 +183,18 @@ def test_config_reads_sites_from_csv_and_toml(tmp_path):
         RunConfig(shape="sites", sites_file=str(tmp_path / "bad.csv"))
     with pytest.raises(HexdemError, match="exactly one of"):
         RunConfig(shape="sites")
+
+
+def test_disc_holds_every_site_within_its_radius_inside_a_touching_circle():
+    """Radius 12: every site within 12 d of (12 d, 0) and no other; the circle touches the
+    outermost beads (the struck bead, at the edge's centre, sits in its hole)."""
+    lattice = disc(12, 1.0)
+    expected = {(m, n) for n in range(0, 28) for m in range(-24, 25)
+                if (m + n) % 2 == 0 and (np.sqrt(3) / 2 * n - 12) ** 2 + (m / 2) ** 2 <= 144 + 1e-9}
+    assert {tuple(mn) for mn in lattice.indices.tolist()} == expected
+    (wall,) = lattice.walls
+    gaps = wall.gaps_m(lattice.positions_m, lattice.radii_m)
+    others = np.delete(gaps, lattice.struck)
+    assert others.min() == pytest.approx(0.0, abs=1e-12) and lattice.struck not in wall.members
+    assert set(wall.members.tolist()) == set(np.flatnonzero(gaps < 0.25).tolist()) - {lattice.struck}
+    np.testing.assert_allclose(np.linalg.norm(wall.normals_at(lattice.positions_m[wall.members]), axis=1), 1.0)

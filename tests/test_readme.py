@@ -32,7 +32,7 @@ def test_the_python_api_example_runs(tmp_path):
 def test_every_packing_config_of_the_readme_builds_the_packing_its_comment_names():
     section = README.read_text().split("#### Packings", 1)[1].split("\n## ", 1)[0]
     blocks = re.findall(r"```toml\n(.*?)```", section, flags=re.DOTALL)
-    assert len(blocks) == 4
+    assert len(blocks) == 5
     lattices = [RunConfig(**tomllib.loads(block)).lattice() for block in blocks]
-    assert [len(lattice) for lattice in lattices] == [28, 30, 329, 10]
-    assert [len(lattice.walls) for lattice in lattices] == [3, 4, 6, 1]
+    assert [len(lattice) for lattice in lattices] == [28, 30, 514, 329, 10]
+    assert [len(lattice.walls) for lattice in lattices] == [3, 4, 1, 6, 1]

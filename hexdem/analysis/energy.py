@@ -34,14 +34,15 @@ def _pair_energy_j(positions_m, i, j, radii, stiffness_pa: float) -> float:
 
 
 def wall_energy_j(positions_m, model: GranularModel) -> float:
-    """Hertz energy [J] of the bead–wall overlaps (sphere against half-plane, R_eff = R)."""
+    """Hertz energy [J] of the bead–wall overlaps (R_eff of each wall: R against a plane)."""
     radii = model.diameters_m / 2
     energy = 0.0
     for wall in model.walls:
         members = wall.members
         depth = -wall.gaps_m(positions_m[members], radii[members])
         inside = depth > 0
-        energy += 0.4 * model.wall_stiffness_pa * float(np.sum(np.sqrt(radii[members][inside]) * depth[inside] ** 2.5))
+        r_eff = wall.contact_radii_m(radii[members][inside])
+        energy += 0.4 * model.wall_stiffness_pa * float(np.sum(np.sqrt(r_eff) * depth[inside] ** 2.5))
     return energy
 
 

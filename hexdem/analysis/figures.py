@@ -16,6 +16,7 @@ from matplotlib.patches import Circle  # noqa: E402
 
 from hexdem.analysis.front_shape import HEXAGON_SIXFOLD  # noqa: E402
 from hexdem.common.io import atomic_path  # noqa: E402
+from hexdem.model.lattice import CurvedWall  # noqa: E402
 
 UNIT_LABELS = {"si": {"length": "m", "speed": "m/s", "time": "ms", "time_scale": 1e3},
                "nondimensional": {"length": "d", "speed": "$\\sqrt{A/M}\\,d^{5/4}$", "time": "T", "time_scale": 1.0}}
@@ -52,8 +53,14 @@ def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=No
 
 
 def draw_walls(ax, walls, positions, radii, scale=1.0, **style):
-    """Each wall as the segment along its member beads, at its plane."""
+    """Each flat wall as the segment along its member beads, at its plane; a curved wall as its circle."""
     for wall in walls:
+        if isinstance(wall, CurvedWall):
+            angle = np.linspace(0.0, 2 * np.pi, 361)
+            circle = np.asarray(wall.centre_m) * scale + wall.radius_m * scale * np.column_stack([np.cos(angle),
+                                                                                              np.sin(angle)])
+            ax.plot(circle[:, 0], circle[:, 1], **{"color": "k", "linewidth": 2, **style})
+            continue
         normal = np.asarray(wall.normal)
         tangent = np.array([-normal[1], normal[0]])
         along = positions[wall.members] @ tangent

@@ -21,6 +21,9 @@ from hexdem.model.granular import GranularModel, RunSettings
 from hexdem.model.lattice import LINE_STEPS
 
 #: Columns of ``peaks.csv`` (a contract: scripts read them by name).
+#: A wall bead faces the strike when its inward normal points against it at least cos 30° as
+#: much as the most-facing wall bead's (a disc's far arc of ±30°; a hexagon's far wall alone).
+FAR_WALL_COSINE = np.cos(np.radians(30.0))
 PEAK_COLUMNS = ("line", "n", "bead_id", "x", "y", "peak_speed", "t_peak", "arrival_time")
 
 
@@ -62,19 +65,22 @@ class ImpactAnalysis:
 
     def _far_wall_reached(self) -> bool:
         """Did the leading wave reach every bead at the walls facing the strike within the run?
-        Those walls are the ones whose inward normal points most against the strike (the far
-        wall of a hexagon, both far walls of a triangle); without such a wall (no walls, or only
-        the struck edge's) every bead counts. A bead counts as reached when its speed rose to
+        Those are the wall beads whose inward normal points against the strike within 30° as
+        much as the most-facing one's does (the far wall of a hexagon, both far walls of a
+        triangle, the far arc of a disc); without such a wall (no walls, or only the struck
+        edge's) every bead counts. A bead counts as reached when its speed rose to
         half of its largest value at least one impact time scale (``settings.contact_time_s``)
         before the run ended: a bead still on its first rise at the end has not been passed by
         the front, while one whose speed keeps growing under reflections (a precompressed box
         rings) has."""
         r = self.results
         beads = np.arange(len(r.reach_time))
-        facing = [float(np.dot(wall.normal, self.model.impact.direction)) for wall in self.model.walls]
-        if facing and min(facing) < 0:
-            far = [wall.members for wall, dot in zip(self.model.walls, facing) if dot <= min(facing) + 1e-9]
-            beads = np.unique(np.concatenate(far))
+        positions, walls = self.model.lattice.positions_m, self.model.walls
+        members = np.concatenate([np.zeros(0, dtype=int)] + [wall.members for wall in walls]).astype(int)
+        normals = np.concatenate([np.zeros((0, 2))] + [wall.normals_at(positions[wall.members]) for wall in walls])
+        against = -normals @ self.model.impact.direction
+        if len(against) and against.max() > 1e-9:
+            beads = np.unique(members[against >= against.max() * FAR_WALL_COSINE - 1e-9])
         units = self.settings.units
         latest = (self.settings.duration_s - self.settings.contact_time_s) / units.time_s
         return bool(np.all(r.reach_time[beads] <= latest))

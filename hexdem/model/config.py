@@ -21,13 +21,14 @@ from hexdem.errors import HexdemError
 from hexdem.model.dissipation import damping_coefficient, lammps_tsuji_coefficient
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time
-from hexdem.model.lattice import LINE_STEPS, Lattice, half_disc, half_hexagon, hexagon, parallelogram, triangle, without_sites
+from hexdem.model.lattice import (LINE_STEPS, Lattice, disc, half_disc, half_hexagon, hexagon, parallelogram, triangle,
+                                   without_sites)
 from hexdem.model.sites import read_sites
 from hexdem.model.materials import PAPER_DIAMETER_M, hertz_coefficient, hertz_stiffness, material, sphere_mass
 from hexdem.model.precompression import hole_force, precompressed_lattice, spring_stiffness
 from hexdem.model.units import SI, UnitSystem, nondimensional
 
-SHAPES = ("hexagon", "half-hexagon", "half-disc", "triangle", "parallelogram", "sites")
+SHAPES = ("hexagon", "half-hexagon", "half-disc", "triangle", "parallelogram", "disc", "sites")
 IMPACTS = ("velocity", "striker")
 UNITS = ("si", "nondimensional")
 ENGINES = ("lammps", "reference")
@@ -76,7 +77,7 @@ class RunConfig:
     Packings (``shape``): ``hexagon`` (``edge_beads`` per edge), ``half-hexagon`` (``long_edge``,
     ``short_edge``), ``half-disc`` (``radius_beads``), ``triangle`` (``edge_beads``),
     ``parallelogram`` (``edge_beads`` along the struck edge, ``depth_beads`` layers, None: as
-    many), each with the walls of its basin; ``sites``: the sites listed in ``sites`` (pairs
+    many), ``disc`` (``radius_beads``, a curved wall), each with the walls of its basin; ``sites``: the sites listed in ``sites`` (pairs
     [m, n]) or in ``sites_file`` (CSV with columns m,n, or TOML with ``sites = [[m, n], …]``),
     struck at {0, 0}, with flat walls touching it whose inward normals point at the angles
     ``site_walls_deg`` (none: a free packing). ``vacancies``: sites [m, n] left out of any
@@ -167,7 +168,7 @@ class RunConfig:
 
     def _check_size(self) -> None:
         sizes = {"hexagon": (self.edge_beads,), "half-hexagon": (self.short_edge, self.long_edge),
-                 "half-disc": (self.radius_beads,), "triangle": (self.edge_beads,),
+                 "half-disc": (self.radius_beads,), "disc": (self.radius_beads,), "triangle": (self.edge_beads,),
                  "parallelogram": (self.edge_beads, self.depth_beads or self.edge_beads), "sites": ()}[self.shape]
         if not all(isinstance(n, int) and not isinstance(n, bool) and n >= 2 for n in sizes):
             return  # the lattice builder words the error
@@ -231,6 +232,7 @@ class RunConfig:
             "half-hexagon": lambda: half_hexagon(self.long_edge, self.short_edge, self.diameter_m),
             "half-disc": lambda: half_disc(self.radius_beads, self.diameter_m),
             "triangle": lambda: triangle(self.edge_beads, self.diameter_m),
+            "disc": lambda: disc(self.radius_beads, self.diameter_m),
             "parallelogram": lambda: parallelogram(self.edge_beads, self.depth_beads or self.edge_beads,
                                                    self.diameter_m),
             "sites": lambda: read_sites(self.sites, self.sites_file, self.diameter_m, self.site_walls_deg),
@@ -255,6 +257,9 @@ class RunConfig:
                 raise HexdemError("a precompressed packing needs walls to hold it (wall_material = \"none\")")
             if self.shape == "half-disc":
                 raise HexdemError("a precompressed packing needs walls all round; the half-disc's arc is free")
+            if self.shape in ("disc", "sites"):
+                raise HexdemError(f"precompression is built for flat-walled basins (hexagon, half-hexagon, triangle, "
+                                  f"parallelogram), not shape = {self.shape!r}")
             coefficient = float(hertz_coefficient(self.diameter_m, bead))
             lattice = precompressed_lattice(lattice, self.precompression_n, coefficient, hertz_stiffness(bead, wall))
             held = tuple(float(f) for f in hole_force(lattice, self.precompression_n))

@@ -56,6 +56,47 @@ class Wall:
         """Signed gap between each bead surface and the wall (negative = overlap) [m]."""
         return np.asarray(positions_m) @ np.asarray(self.normal) - radii_m - self.offset_m
 
+    def normals_at(self, positions_m) -> np.ndarray:
+        """(N, 2) inward unit normals of the wall where beads at ``positions_m`` (N, 2) touch it."""
+        return np.tile(np.asarray(self.normal, float), (len(positions_m), 1))
+
+    def contact_radii_m(self, radii_m):
+        """R_eff of the Hertz contact of beads of radii ``radii_m`` with the wall: R for a plane."""
+        return np.asarray(radii_m, float)
+
+
+@dataclass(frozen=True)
+class CurvedWall:
+    """The inside of a circle {x : |x − centre_m| = radius_m} (a cylinder in 3D), pushing beads
+    towards its centre: the curved wall of a disc-shaped basin.
+
+    ``members`` as for :class:`Wall`. The Hertz law of a sphere of radius r inside it uses
+    LAMMPS's contact radius for a curved region, R_eff = r · 2R / (2R − r) (``region cylinder``
+    stores the inside surface's radius as −2R and ``fix wall/gran/region`` combines it with the
+    sphere's like a pair, r R' / (r + R'); measured: a sphere's contact time inside R = 3r is
+    that of this R_eff to 0.1 µs), so that both engines share one law.
+    """
+
+    name: str
+    centre_m: tuple[float, float]
+    radius_m: float
+    members: np.ndarray
+
+    def gaps_m(self, positions_m, radii_m):
+        """Signed gap between each bead surface and the wall (negative = overlap) [m]."""
+        offsets = np.asarray(positions_m, float) - np.asarray(self.centre_m)
+        return self.radius_m - np.linalg.norm(offsets, axis=-1) - radii_m
+
+    def normals_at(self, positions_m) -> np.ndarray:
+        """(N, 2) inward unit normals (towards the centre) where beads at ``positions_m`` touch it."""
+        inward = np.asarray(self.centre_m) - np.asarray(positions_m, float).reshape(-1, 2)
+        return inward / np.linalg.norm(inward, axis=1)[:, None]
+
+    def contact_radii_m(self, radii_m):
+        """R_eff = r · 2R / (2R − r) of beads of radii r = ``radii_m`` (see the class docstring)."""
+        radii_m = np.asarray(radii_m, float)
+        return radii_m * 2 * self.radius_m / (2 * self.radius_m - radii_m)
+
 
 @dataclass(frozen=True)
 class Lattice:
@@ -72,7 +113,7 @@ class Lattice:
     diameters_m: np.ndarray
     diameter_m: float
     struck: int
-    walls: tuple[Wall, ...]
+    walls: tuple[Wall | CurvedWall, ...]
     shape: str
     _lookup: dict = field(default=None, repr=False, compare=False)
 
@@ -243,6 +284,27 @@ def half_hexagon(long_edge: int = 91, short_edge: int = 46, diameter_m: float = 
     heights = [long_edge - 1 - n for n in range(int(short_edge))]
     return from_sites(_layer_sites([(-h, h) for h in heights]), diameter_m, (0, 180, 120, -120),
                       f"half-hexagon, long edge {long_edge}, short edges {short_edge}")
+
+
+def disc(radius_beads: int, diameter_m: float = 1.0) -> Lattice:
+    """The sites within ``radius_beads`` d of a centre ``radius_beads`` d to the right of the
+    struck bead (the disc's leftmost site), inside a curved wall touching the outermost beads
+    (a circular basin, Hua & Van Gorder; the struck bead in its hole); 36,000 beads at radius 100."""
+    if int(radius_beads) != radius_beads or radius_beads < 2:
+        raise HexdemError(f"a disc needs a radius of at least 2 bead diameters, got {radius_beads}")
+    radius = int(radius_beads)
+    layers = int(np.floor(4 * radius / np.sqrt(3) + 1e-9))
+    bounds = []
+    for n in range(layers + 1):
+        h = int(np.floor(2 * np.sqrt(max(radius**2 - (np.sqrt(3) / 2 * n - radius) ** 2, 0.0)) + 1e-9))
+        bounds.append((-h, h))
+    lattice = from_sites(_layer_sites(bounds), diameter_m, (), f"disc, radius {radius} d")
+    centre = np.array([radius * diameter_m, 0.0])
+    reach = np.linalg.norm(lattice.positions_m - centre, axis=1) + lattice.radii_m
+    reach[lattice.struck] = -np.inf  # in the hole: it does not decide where the wall is
+    wall_radius = float(reach.max())
+    members = np.flatnonzero(wall_radius - reach < WALL_GROUP_GAP * lattice.diameter_m)
+    return replace(lattice, walls=(CurvedWall("wall_disc", (float(centre[0]), 0.0), wall_radius, members),))
 
 
 def triangle(edge_beads: int, diameter_m: float = 1.0) -> Lattice:

@@ -20,6 +20,7 @@ import numpy as np
 
 from hexdem.model.dissipation import lammps_tsuji_coefficient
 from hexdem.model.granular import GranularModel, RunSettings
+from hexdem.model.lattice import CurvedWall
 from hexdem.model.units import UnitSystem
 
 DECK_NAME = "in.hexdem"
@@ -73,18 +74,31 @@ def data_file(model: GranularModel, units: UnitSystem) -> str:
     return "\n".join(lines) + "\n"
 
 
+#: A curved wall's cylinder reaches this many bead diameters above and below the plane (LAMMPS
+#: takes no INF there), so that its end caps never touch a bead.
+CYLINDER_HALF_HEIGHT_D = 1000.0
+
+
 def walls_block(model: GranularModel, units: UnitSystem) -> str:
-    """Deck commands for the walls of ``model``: member group, plane region and wall fix each."""
+    """Deck commands for the walls of ``model``: member group, region (a plane, or a cylinder for a
+    curved wall) and wall fix each."""
     if not model.walls:
         return "# (no walls)\n"
     stiffness = _fmt(model.wall_stiffness_pa / units.stress_pa)
     block = []
     for wall in model.walls:
-        point = np.asarray(wall.normal) * wall.offset_m / units.length_m
         ids = " ".join(str(i + 1) for i in wall.members)
+        if isinstance(wall, CurvedWall):  # its Hertz law: LAMMPS's own contact radius of a cylinder
+            centre = np.asarray(wall.centre_m) / units.length_m
+            height = CYLINDER_HALF_HEIGHT_D * model.lattice.diameter_m / units.length_m  # the 2D beads at z = 0
+            region = (f"cylinder z {_fmt(centre[0])} {_fmt(centre[1])} {_fmt(wall.radius_m / units.length_m)} "
+                      f"{_fmt(-height)} {_fmt(height)} side in")
+        else:
+            point = np.asarray(wall.normal) * wall.offset_m / units.length_m
+            region = (f"plane {_fmt(point[0])} {_fmt(point[1])} 0.0 "
+                      f"{_fmt(wall.normal[0])} {_fmt(wall.normal[1])} 0.0 side in")
         block += [f"group           {wall.name} id {ids}",
-                  f"region          {wall.name} plane {_fmt(point[0])} {_fmt(point[1])} 0.0 "
-                  f"{_fmt(wall.normal[0])} {_fmt(wall.normal[1])} 0.0 side in",
+                  f"region          {wall.name} {region}",
                   f"fix             {wall.name} {wall.name} wall/gran/region granular hertz {stiffness} "
                   f"{damping_model(model.wall_damping)} tangential linear_nohistory 0.0 0.0 region {wall.name}"]
     return "\n".join(block) + "\n"

@@ -38,7 +38,7 @@ from hexdem.engines.reference.kernel import KernelArrays, forces, integrate
 from hexdem.engines.sampling import Sample
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel, RunSettings
-from hexdem.model.lattice import BOND_STEPS, Lattice
+from hexdem.model.lattice import BOND_STEPS, CurvedWall, Lattice
 from hexdem.model.units import UnitSystem
 
 #: Description of the run written into the engine's directory.
@@ -135,16 +135,22 @@ def _striker_pairs(model: GranularModel, cells: np.ndarray, units: UnitSystem):
 
 
 def _wall_contacts(model: GranularModel, cells: np.ndarray, units: UnitSystem):
-    """(cell, n_x, n_y, rest gap, A_w, η_w) of every wall member: sphere–half-plane Hertz."""
+    """(cell, n_x, n_y, rest gap, curvature, A_w, η_w) of every wall member: sphere–wall Hertz,
+    n the inward normal at the bead's rest position, curvature 1/ρ with ρ the distance from
+    the rest position to a curved wall's centre (0 for a plane), A_w = k_n,wall sqrt(R_eff)."""
     lattice, walls = model.lattice, model.walls
+    positions, radii = lattice.positions_m, lattice.radii_m
     beads = np.concatenate([np.zeros(0, dtype=np.int64)] + [wall.members for wall in walls]).astype(np.int64)
-    normals = np.concatenate([np.zeros((0, 2))] + [np.tile(wall.normal, (len(wall.members), 1)) for wall in walls])
-    radii = lattice.radii_m[beads]
-    gaps = np.concatenate([np.zeros(0)] + [wall.gaps_m(lattice.positions_m[wall.members], lattice.radii_m[wall.members])
-                                           for wall in walls])
-    stiffness = _coefficient(model.wall_stiffness_pa if walls else 0.0, radii, units)
+    normals = np.concatenate([np.zeros((0, 2))] + [wall.normals_at(positions[wall.members]) for wall in walls])
+    gaps = np.concatenate([np.zeros(0)] + [wall.gaps_m(positions[wall.members], radii[wall.members]) for wall in walls])
+    curvature = np.concatenate([np.zeros(0)] + [
+        1.0 / np.linalg.norm(positions[wall.members] - np.asarray(wall.centre_m), axis=1)
+        if isinstance(wall, CurvedWall) else np.zeros(len(wall.members)) for wall in walls])
+    r_eff = np.concatenate([np.zeros(0)] + [wall.contact_radii_m(radii[wall.members]) for wall in walls])
+    stiffness = _coefficient(model.wall_stiffness_pa if walls else 0.0, r_eff, units)
     damping = model.wall_damping * np.sqrt(model.masses_kg[beads] / units.mass_kg * stiffness)
-    return cells[beads], normals[:, 0].copy(), normals[:, 1].copy(), gaps / units.length_m, stiffness, damping
+    return (cells[beads], normals[:, 0].copy(), normals[:, 1].copy(), gaps / units.length_m,
+            curvature * units.length_m, stiffness, damping)
 
 
 def _cell_forces(forces, cells: np.ndarray, n_cells: int):

@@ -4,7 +4,9 @@ The paper's equations of motion (Sec. III, eq. (model)) with V(r) = (2/5) A [c �
 give each fixed bond a repulsive force A [c − r]_+^{3/2} along the current line of centres,
 where r = |rest + q_j − q_i| is the current distance of the bond's beads (rest vector
 ``rest`` plus displacements q) and c their contact distance. A bead touching a flat wall
-with normal n feels A_w [−(g₀ + q·n)]_+^{3/2} along n (g₀ its gap at rest).
+with normal n feels A_w [−(g₀ + q·n)]_+^{3/2} along n (g₀ its gap at rest). Inside a curved
+wall (a circle whose centre is ρ from the bead's rest position along n) the depth is exact,
+−(g₀ + q·n) + (|ρn − q| − (ρ − q·n)), and the force acts along the current radius.
 
 Layout (built by :mod:`hexdem.engines.reference.engine`): every body owns a *cell* of flat arrays. Lattice
 bead {m, n} sits in the padded grid cell (n + 1)·C + (m + n)/2 + 1, so the paper's three
@@ -37,8 +39,8 @@ class KernelArrays(NamedTuple):
     distance c = R_i + R_j, ``stiffness`` A = k_n sqrt(R_eff) (0: no bond). Per cell:
     ``inv_mass`` 1/M (0 for padding). Explicit pairs (i → j): ``pair_i``, ``pair_j``,
     ``pair_rest_x``, ``pair_rest_y``, ``pair_contact``, ``pair_stiffness``. Wall contacts:
-    ``wall_cell``, inward normal ``wall_nx``, ``wall_ny``, rest gap ``wall_gap``,
-    ``wall_stiffness`` A_w = k_n,wall sqrt(R). Tsuji damping (:mod:`hexdem.model.dissipation`)
+    ``wall_cell``, inward normal ``wall_nx``, ``wall_ny`` at rest, rest gap ``wall_gap``,
+    ``wall_curvature`` 1/ρ (0: a plane), ``wall_stiffness`` A_w = k_n,wall sqrt(R_eff). Tsuji damping (:mod:`hexdem.model.dissipation`)
     η = α sqrt(m_eff A) of each lattice bond (3, hi), explicit pair and wall contact:
     ``damping``, ``pair_damping``, ``wall_damping``; ``damped`` whether any is non-zero. Per cell: ``external_x``, ``external_y`` constant
     forces (the held force of a precompressed packing's struck bead).
@@ -62,6 +64,7 @@ class KernelArrays(NamedTuple):
     wall_nx: np.ndarray
     wall_ny: np.ndarray
     wall_gap: np.ndarray
+    wall_curvature: np.ndarray
     wall_stiffness: np.ndarray
     damping: np.ndarray
     pair_damping: np.ndarray
@@ -128,13 +131,21 @@ def _pair_forces(k, x, y, u, w, scale, fx, fy):
 def _wall_forces(k, x, y, u, v, scale, fx, fy):
     for w in range(k.wall_cell.shape[0]):
         c = k.wall_cell[w]
-        depth = -(k.wall_gap[w] + x[c] * k.wall_nx[w] + y[c] * k.wall_ny[w])
+        nx, ny = k.wall_nx[w], k.wall_ny[w]
+        along = x[c] * nx + y[c] * ny
+        depth = -(k.wall_gap[w] + along)
+        kappa = k.wall_curvature[w]
+        if kappa != 0.0:  # the circle's centre is at ρn: depth from the distance to it, direction along it
+            ax, ay = nx - kappa * x[c], ny - kappa * y[c]
+            reach = np.sqrt(ax * ax + ay * ay)  # |ρn − q| / ρ
+            depth += (reach - (1.0 - kappa * along)) / kappa
+            nx, ny = ax / reach, ay / reach
         if depth > 0.0:
-            rate = -(u[c] * k.wall_nx[w] + v[c] * k.wall_ny[w])
+            rate = -(u[c] * nx + v[c] * ny)
             root = np.sqrt(depth)
             f = (k.wall_stiffness[w] * depth * root + k.wall_damping[w] * np.sqrt(root) * rate) * scale[c]
-            fx[c] += f * k.wall_nx[w]
-            fy[c] += f * k.wall_ny[w]
+            fx[c] += f * nx
+            fy[c] += f * ny
 
 
 @_jit
