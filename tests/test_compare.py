@@ -38,10 +38,11 @@ def test_reference_agrees_with_lammps_on_the_default_experiment(default_run, tmp
                                      {"shape": "parallelogram", "edge_beads": 5, "depth_beads": 6, "impact": "striker",
                                       "strike_angle_deg": 30.0},
                                      {"edge_beads": 6, "vacancies": [[1, 1], [0, 6], [3, 5]]},
+                                     {"bead_material": "ptfe", "wall_material": "brass"},
                                      {"shape": "sites", "site_walls_deg": [0],
                                       "sites": [[m, n] for n in range(6) for m in range(-4, 5) if (m + n) % 2 == 0]}],
                          ids=["striker-30deg", "nondimensional", "half-disc", "triangle", "disc-striker-20deg", "parallelogram-striker-30deg",
-                              "vacancies", "listed-sites"])
+                              "vacancies", "ptfe-in-brass", "listed-sites"])
 def test_engines_agree_on_small_lattices(tmp_path, changes):
     comparison = run_comparison(SMALL.replace(**changes), tmp_path, log=lambda message: None)
     assert comparison.agree, comparison.verdict()

@@ -4,7 +4,10 @@ import numpy as np
 import pytest
 
 from hexdem.errors import HexdemError
-from hexdem.model.materials import DELRIN, STEEL_316, Material, effective_modulus, hertz_coefficient, sphere_mass
+from hexdem.model.config import RunConfig
+from hexdem.model.hertz import contact_time
+from hexdem.model.materials import (DELRIN, MATERIALS, STEEL_316, Material, effective_modulus, hertz_coefficient,
+                                     sphere_mass)
 from hexdem.model.units import nondimensional, to_nondimensional_velocity, to_physical_velocity
 
 D = 0.01905
@@ -36,3 +39,33 @@ def test_bad_material_values():
     with pytest.raises(HexdemError, match="Poisson"):
         Material("rubberish", 1e6, 0.6, 1000.0)
 
+
+
+def test_every_preset_material_is_physical_and_sourced():
+    assert {"steel316", "delrin", "brass", "aluminium", "glass", "ptfe"} <= set(MATERIALS)
+    for mat in MATERIALS.values():
+        assert mat.source and 1e9 <= mat.youngs_modulus_pa <= 3e11 and 0 < mat.poisson_ratio < 0.5
+        assert 1000 <= mat.density_kg_m3 <= 9000
+
+
+@pytest.mark.parametrize("name", ["brass", "ptfe"])
+def test_a_packing_of_another_material_takes_its_hertz_law_and_mass(name):
+    """The contact time τ = 2.9432 δ_max / V, δ_max = (5 μ V² / (4 A))^{2/5}, of two beads: μ = M/2,
+    A = E sqrt(d)/(3(1 − ν²)), M = ρ π d³/6, written out from the material's E, ν, ρ."""
+    mat = MATERIALS[name]
+    mass = mat.density_kg_m3 * np.pi * D**3 / 6
+    a = mat.youngs_modulus_pa * np.sqrt(D) / (3 * (1 - mat.poisson_ratio**2))
+    config = RunConfig(bead_material=name, edge_beads=3)
+    assert config.contact_time_s() == pytest.approx(contact_time(mass / 2, a, 0.4), rel=1e-12)
+    assert config.contact_time_s() == pytest.approx(2.9432 * (5 * mass / 2 * 0.4**2 / (4 * a)) ** 0.4 / 0.4, rel=1e-4)
+    assert config.model().masses_kg[0] == pytest.approx(mass)
+
+
+def test_a_configuration_defines_its_own_material():
+    table = {"bronze": {"youngs_modulus_pa": 1.2e11, "poisson_ratio": 0.34, "density_kg_m3": 8800.0}}
+    model = RunConfig(bead_material="bronze", materials=table, edge_beads=3).model()
+    assert model.bead == Material("bronze", 1.2e11, 0.34, 8800.0, "this configuration")
+    with pytest.raises(HexdemError, match="built in"):
+        RunConfig(materials={"brass": table["bronze"]})
+    with pytest.raises(HexdemError, match="missing density_kg_m3"):
+        RunConfig(bead_material="bronze", materials={"bronze": {"youngs_modulus_pa": 1e11, "poisson_ratio": 0.3}})

@@ -38,7 +38,7 @@ from hexdem.analysis.roundness_fit import fit_roundness
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.experiments.run import measure_front_shape, run_experiment
 from hexdem.model.config import RunConfig
-from hexdem.model.materials import hertz_coefficient, material, sphere_mass
+from hexdem.model.materials import hertz_coefficient, sphere_mass
 from hexdem.model.precompression import longitudinal_sound_speed, static_overlap
 
 #: The packings of the study, in order.
@@ -82,7 +82,7 @@ class FrontStudy:
     def configs(self) -> dict[str, RunConfig]:
         """The run of each packing."""
         base = RunConfig(edge_beads=self.edge_beads, ranks=self.ranks, launcher=self.launcher)
-        bead, d = material(base.bead_material), base.diameter_m
+        bead, d = base.material(base.bead_material), base.diameter_m
         coefficient = float(hertz_coefficient(d, bead))
         c_l = longitudinal_sound_speed(self.control_force_n, coefficient, float(sphere_mass(d, bead)),
                                        d - static_overlap(self.control_force_n, coefficient))

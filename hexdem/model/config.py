@@ -24,7 +24,8 @@ from hexdem.model.hertz import contact_time
 from hexdem.model.lattice import (LINE_STEPS, Lattice, disc, half_disc, half_hexagon, hexagon, parallelogram, triangle,
                                    without_sites)
 from hexdem.model.sites import read_sites
-from hexdem.model.materials import PAPER_DIAMETER_M, hertz_coefficient, hertz_stiffness, material, sphere_mass
+from hexdem.model.materials import (PAPER_DIAMETER_M, Material, custom_materials, hertz_coefficient, hertz_stiffness,
+                                     material, sphere_mass)
 from hexdem.model.precompression import hole_force, precompressed_lattice, spring_stiffness
 from hexdem.model.units import SI, UnitSystem, nondimensional
 
@@ -82,6 +83,9 @@ class RunConfig:
     struck at {0, 0}, with flat walls touching it whose inward normals point at the angles
     ``site_walls_deg`` (none: a free packing). ``vacancies``: sites [m, n] left out of any
     packing (the walls stay).
+    ``bead_material``, ``wall_material``: a preset (steel316, delrin, brass, aluminium, glass,
+    ptfe; :mod:`hexdem.model.materials`) or a material of ``materials``, this configuration's own
+    table {name: {youngs_modulus_pa, poisson_ratio, density_kg_m3[, source]}}.
     ``launcher``: the MPI launcher command that starts the ranks (None: this environment's
     ``mpiexec``; e.g. ``"mpiexec -f hosts"`` or ``"srun"`` to span machines); given, the run goes
     through it even on one rank.
@@ -104,6 +108,7 @@ class RunConfig:
     diameter_m: float = PAPER_DIAMETER_M
     bead_material: str = "steel316"
     wall_material: str = "delrin"
+    materials: dict = dataclasses.field(default_factory=dict)
     units: str = "si"
     v0: float = 0.4
     strike_angle_deg: float = 0.0
@@ -220,10 +225,14 @@ class RunConfig:
     def as_dict(self) -> dict:
         return dataclasses.asdict(self)
 
+    def material(self, name: str) -> Material:
+        """The material called ``name``: a preset or one of this configuration's ``materials``."""
+        return material(name, custom_materials(self.materials))
+
     @property
     def unit_system(self) -> UnitSystem:
         """The units of ``v0``, ``dt``, ``duration`` and of every result of this run."""
-        return SI if self.units == "si" else nondimensional(self.diameter_m, material(self.bead_material))
+        return SI if self.units == "si" else nondimensional(self.diameter_m, self.material(self.bead_material))
 
     def lattice(self) -> Lattice:
         """The packing: the ``shape``'s sites less the ``vacancies``, with its walls."""
@@ -246,12 +255,12 @@ class RunConfig:
         """The SI :class:`GranularModel` this configuration describes."""
         if not (is_number(self.v0) and self.v0 > 0):
             raise HexdemError(f"v0 must be > 0 (the impact moves into the packing), got {self.v0!r}")
-        wall = None if self.wall_material == "none" else material(self.wall_material)
+        wall = None if self.wall_material == "none" else self.material(self.wall_material)
         impact = Impact(self.v0 * self.unit_system.velocity_m_s, self.strike_angle_deg, self.impact == "striker")
         wall_restitution = self.restitution if self.wall_restitution is None else self.wall_restitution
         for alpha in {damping_coefficient(self.restitution), damping_coefficient(wall_restitution)} - {0.0}:
             lammps_tsuji_coefficient(alpha)
-        bead, lattice, held = material(self.bead_material), self.lattice(), (0.0, 0.0)
+        bead, lattice, held = self.material(self.bead_material), self.lattice(), (0.0, 0.0)
         if self.precompression_n > 0:
             if wall is None:
                 raise HexdemError("a precompressed packing needs walls to hold it (wall_material = \"none\")")
@@ -290,7 +299,7 @@ class RunConfig:
     def contact_time_s(self) -> float:
         """The natural time scale of the impact [s]: the two-bead Hertz contact time at V0, or, if
         shorter, half the period of two beads on the linearized precompressed contact, π sqrt(m/2k)."""
-        bead = material(self.bead_material)
+        bead = self.material(self.bead_material)
         mass = float(sphere_mass(self.diameter_m, bead))
         coefficient = float(hertz_coefficient(self.diameter_m, bead))
         hertz = float(contact_time(mass / 2, coefficient, self.v0 * self.unit_system.velocity_m_s))

@@ -22,15 +22,20 @@ class Material:
     """An isotropic elastic material.
 
     Attributes: ``name``; ``youngs_modulus_pa`` E [Pa]; ``poisson_ratio`` ν [-];
-    ``density_kg_m3`` ρ [kg/m³].
+    ``density_kg_m3`` ρ [kg/m³]; ``source`` where the values come from.
     """
 
     name: str
     youngs_modulus_pa: float
     poisson_ratio: float
     density_kg_m3: float
+    source: str = ""
 
     def __post_init__(self):
+        for key in ("youngs_modulus_pa", "poisson_ratio", "density_kg_m3"):
+            value = getattr(self, key)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
+                raise HexdemError(f"material {self.name}: {key} must be a number, got {value!r}")
         if not self.youngs_modulus_pa > 0:
             raise HexdemError(f"material {self.name}: Young's modulus must be > 0 Pa")
         if not -1.0 < self.poisson_ratio < 0.5:
@@ -45,22 +50,58 @@ class Material:
 
 
 #: Stainless steel type 316 as used in the paper's experiment (Sec. II).
-STEEL_316 = Material("steel316", youngs_modulus_pa=193e9, poisson_ratio=0.3, density_kg_m3=8000.0)
+STEEL_316 = Material("steel316", youngs_modulus_pa=193e9, poisson_ratio=0.3, density_kg_m3=8000.0,
+                     source="the paper, Sec. II")
 #: Delrin, the soft lining of the confining walls (Sec. II).
-DELRIN = Material("delrin", youngs_modulus_pa=3.1e9, poisson_ratio=0.35, density_kg_m3=1400.0)
+DELRIN = Material("delrin", youngs_modulus_pa=3.1e9, poisson_ratio=0.35, density_kg_m3=1400.0,
+                  source="the paper, Sec. II")
+#: Cartridge brass (C26000), typical handbook values.
+BRASS = Material("brass", youngs_modulus_pa=110e9, poisson_ratio=0.375, density_kg_m3=8530.0,
+                 source="C26000 cartridge brass, ASM handbook typical values")
+#: Aluminium alloy 6061-T6, typical handbook values.
+ALUMINIUM = Material("aluminium", youngs_modulus_pa=68.9e9, poisson_ratio=0.33, density_kg_m3=2700.0,
+                     source="6061-T6, ASM handbook typical values")
+#: Soda-lime glass, typical handbook values.
+GLASS = Material("glass", youngs_modulus_pa=72e9, poisson_ratio=0.22, density_kg_m3=2520.0,
+                 source="soda-lime glass, typical handbook values")
+#: PTFE (Teflon) beads as measured for granular chains.
+PTFE = Material("ptfe", youngs_modulus_pa=1.46e9, poisson_ratio=0.46, density_kg_m3=2200.0,
+                source="Daraio et al., Phys. Rev. E 72, 016603 (2005), Teflon beads")
 
-MATERIALS = {m.name: m for m in (STEEL_316, DELRIN)}
+MATERIALS = {m.name: m for m in (STEEL_316, DELRIN, BRASS, ALUMINIUM, GLASS, PTFE)}
 
 #: Bead diameter of the experiment, d = 19.05 mm (3/4 inch).
 PAPER_DIAMETER_M = 0.01905
 
 
-def material(name: str) -> Material:
-    """Look up a preset material by name (``steel316`` or ``delrin``)."""
+def material(name: str, custom: dict | None = None) -> Material:
+    """The material called ``name``: a preset (:data:`MATERIALS`) or one of ``custom``
+    ({name: Material}, a configuration's own)."""
+    known = {**MATERIALS, **(custom or {})}
     try:
-        return MATERIALS[name]
-    except KeyError:
-        raise HexdemError(f"unknown material {name!r}; known: {', '.join(MATERIALS)}") from None
+        return known[name]
+    except (KeyError, TypeError):
+        raise HexdemError(f"unknown material {name!r}; known: {', '.join(known)}") from None
+
+
+def custom_materials(table) -> dict[str, Material]:
+    """{name: Material} of a configuration's ``materials`` table, {name: {youngs_modulus_pa,
+    poisson_ratio, density_kg_m3[, source]}}; a preset's name cannot be redefined."""
+    if not isinstance(table, dict):
+        raise HexdemError(f"materials must be a table of named materials, got {table!r}")
+    materials = {}
+    for name, values in table.items():
+        if name in MATERIALS or name == "none":
+            raise HexdemError(f"material {name!r} is built in; give your own material another name")
+        if not isinstance(values, dict):
+            raise HexdemError(f"material {name!r} must be a table of youngs_modulus_pa, poisson_ratio, density_kg_m3")
+        missing = sorted({"youngs_modulus_pa", "poisson_ratio", "density_kg_m3"} - set(values))
+        unknown = sorted(set(values) - {"youngs_modulus_pa", "poisson_ratio", "density_kg_m3", "source"})
+        if missing or unknown:
+            raise HexdemError(f"material {name!r}: " + "; ".join(
+                ([f"missing {', '.join(missing)}"] if missing else []) + ([f"unknown {', '.join(unknown)}"] if unknown else [])))
+        materials[name] = Material(name, **{"source": "this configuration", **values})
+    return materials
 
 
 def effective_modulus(a: Material, b: Material) -> float:
