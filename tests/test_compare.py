@@ -39,10 +39,15 @@ def test_reference_agrees_with_lammps_on_the_default_experiment(default_run, tmp
                                       "strike_angle_deg": 30.0},
                                      {"edge_beads": 6, "vacancies": [[1, 1], [0, 6], [3, 5]]},
                                      {"bead_material": "ptfe", "wall_material": "brass"},
+                                     {"edge_beads": 7, "regions": [{"material": "brass", "x_min_d": 4.0}]},
+                                     {"edge_beads": 6, "impact": "striker", "striker_material": "ptfe",
+                                      "striker_diameter_m": 0.012,
+                                      "regions": [{"material": "glass", "sites": [[0, 4], [1, 3], [-1, 5]]}]},
                                      {"shape": "sites", "site_walls_deg": [0],
                                       "sites": [[m, n] for n in range(6) for m in range(-4, 5) if (m + n) % 2 == 0]}],
                          ids=["striker-30deg", "nondimensional", "half-disc", "triangle", "disc-striker-20deg", "parallelogram-striker-30deg",
-                              "vacancies", "ptfe-in-brass", "listed-sites"])
+                              "vacancies", "ptfe-in-brass", "steel|brass-interface",
+                              "glass-intruders-ptfe-striker", "listed-sites"])
 def test_engines_agree_on_small_lattices(tmp_path, changes):
     comparison = run_comparison(SMALL.replace(**changes), tmp_path, log=lambda message: None)
     assert comparison.agree, comparison.verdict()

@@ -145,7 +145,7 @@ def prepared(tmp_path_factory):
 def hertz_overlap(model, force_n):
     """Overlap of the softest bead pair carrying ``force_n``: F = k_n sqrt(R_eff) δ^{3/2}."""
     r_eff = model.lattice.radii_m.min() / 2
-    return (force_n / (model.pair_stiffness_pa * np.sqrt(r_eff))) ** (2 / 3)
+    return (force_n / (model.stiffness_table_pa[0, 0] * np.sqrt(r_eff))) ** (2 / 3)
 
 
 def net_forces(model, gravity):
@@ -157,13 +157,13 @@ def net_forces(model, gravity):
         gap = pos[i] - pos[j]
         distance = np.linalg.norm(gap)
         if r[i] + r[j] > distance:
-            push = model.pair_stiffness_pa * np.sqrt(r[i] * r[j] / (r[i] + r[j])) * (r[i] + r[j] - distance) ** 1.5
+            push = model.stiffness_table_pa[0, 0] * np.sqrt(r[i] * r[j] / (r[i] + r[j])) * (r[i] + r[j] - distance) ** 1.5
             force[i] += push * gap / distance
             force[j] -= push * gap / distance
     for wall in model.walls:
         depth = -wall.gaps_m(pos[wall.members], r[wall.members])
         inside = depth > 0
-        push = model.wall_stiffness_pa * np.sqrt(r[wall.members][inside]) * depth[inside] ** 1.5
+        push = model.wall_stiffness_pa([0])[0] * np.sqrt(r[wall.members][inside]) * depth[inside] ** 1.5
         force[wall.members[inside]] += np.outer(push, wall.normal)
     return force
 

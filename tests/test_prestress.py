@@ -26,7 +26,7 @@ def test_pair_forces_follow_hertz_with_each_contacts_own_radius():
     np.testing.assert_allclose(overlap, delta, rtol=1e-6)
     assert len(i) == 9 * 11**2 - 15 * 11 + 6  # the bonds of a hexagon of 11 beads per edge
     load = prestress(squeezed)
-    expected = model.pair_stiffness_pa * np.sqrt(d / 4) * delta**1.5
+    expected = model.stiffness_table_pa[0, 0] * np.sqrt(d / 4) * delta**1.5
     assert load.contacts == len(i)
     assert load.max_overlap_m == pytest.approx(delta, rel=1e-6)
     assert load.mean_contact_force_n == pytest.approx(expected, rel=1e-5)
@@ -41,6 +41,6 @@ def test_a_wall_pushed_in_by_delta_loads_each_of_its_beads_by_hertz():
     pushed = replace(model, lattice=replace(lattice, walls=(replace(wall, offset_m=wall.offset_m + delta),
                                                             *lattice.walls[1:])))
     load = prestress(pushed)
-    per_bead = model.wall_stiffness_pa * np.sqrt(lattice.diameter_m / 2) * delta**1.5
+    per_bead = model.wall_stiffness_pa([0])[0] * np.sqrt(lattice.diameter_m / 2) * delta**1.5
     assert load.contacts == 0
     assert load.wall_force_n == pytest.approx(len(wall.members) * per_bead, rel=1e-6)

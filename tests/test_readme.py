@@ -6,6 +6,8 @@ import sys
 import tomllib
 from pathlib import Path
 
+import numpy as np
+
 from hexdem.model.config import RunConfig
 
 README = Path(__file__).resolve().parents[1] / "README.md"
@@ -36,3 +38,13 @@ def test_every_packing_config_of_the_readme_builds_the_packing_its_comment_names
     lattices = [RunConfig(**tomllib.loads(block)).lattice() for block in blocks]
     assert [len(lattice) for lattice in lattices] == [28, 30, 514, 329, 10]
     assert [len(lattice.walls) for lattice in lattices] == [3, 4, 1, 6, 1]
+
+
+def test_the_readme_interface_config_builds_its_materials():
+    section = README.read_text().split("#### Materials", 1)[1].split("#### Packings", 1)[0]
+    (block,) = re.findall(r"```toml\n(.*?)```", section, flags=re.DOTALL)
+    model = RunConfig(**tomllib.loads(block)).model()
+    assert [m.name for m in model.materials] == ["steel316", "brass", "ptfe", "glass"]
+    # brass: the layers n with (√3/2) n >= 10, n = 12 … 20, holding 11 + (20 − n) beads each: 135
+    brass = sum(11 + 20 - n for n in range(12, 21))
+    assert list(np.bincount(model.material_ids)) == [331 - brass - 2, brass, 2, 1] and model.diameters_m[-1] == 0.012

@@ -26,11 +26,21 @@ def _pairs(positions_m, cutoff_m: float) -> tuple[np.ndarray, np.ndarray]:
     return i, j
 
 
-def _pair_energy_j(positions_m, i, j, radii, stiffness_pa: float) -> float:
+def hertz_energy_j(stiffness_pa, r_eff_m, overlap_m) -> float:
+    """Σ (2/5) k_n sqrt(R_eff) δ^{5/2} [J] over contacts with overlap δ > 0 (k_n per contact; one
+    value factored out when all are equal, the single-material sum as it always was)."""
+    stiffness_pa = np.asarray(stiffness_pa, float)
+    terms = np.sqrt(r_eff_m) * overlap_m**2.5
+    if stiffness_pa.size and np.all(stiffness_pa == stiffness_pa.flat[0]):
+        return 0.4 * float(stiffness_pa.flat[0]) * float(np.sum(terms))
+    return 0.4 * float(np.sum(stiffness_pa * terms))
+
+
+def _pair_energy_j(positions_m, i, j, radii, model: GranularModel) -> float:
     overlap = radii[i] + radii[j] - np.linalg.norm(positions_m[i] - positions_m[j], axis=1)
     touching = overlap > 0
     r_eff = radii[i] * radii[j] / (radii[i] + radii[j])
-    return 0.4 * stiffness_pa * float(np.sum(np.sqrt(r_eff[touching]) * overlap[touching] ** 2.5))
+    return hertz_energy_j(model.contact_stiffness_pa(i[touching], j[touching]), r_eff[touching], overlap[touching])
 
 
 def wall_energy_j(positions_m, model: GranularModel) -> float:
@@ -41,8 +51,8 @@ def wall_energy_j(positions_m, model: GranularModel) -> float:
         members = wall.members
         depth = -wall.gaps_m(positions_m[members], radii[members])
         inside = depth > 0
-        r_eff = wall.contact_radii_m(radii[members][inside])
-        energy += 0.4 * model.wall_stiffness_pa * float(np.sum(np.sqrt(r_eff) * depth[inside] ** 2.5))
+        energy += hertz_energy_j(model.wall_stiffness_pa(members[inside]),
+                                 wall.contact_radii_m(radii[members][inside]), depth[inside])
     return energy
 
 
@@ -51,7 +61,7 @@ def contact_energy_j(positions_m, model: GranularModel) -> float:
     positions_m = np.asarray(positions_m, float)
     radii = model.diameters_m / 2
     i, j = _pairs(positions_m, 2 * radii.max())
-    return _pair_energy_j(positions_m, i, j, radii, model.pair_stiffness_pa) + wall_energy_j(positions_m, model)
+    return _pair_energy_j(positions_m, i, j, radii, model) + wall_energy_j(positions_m, model)
 
 
 def kinetic_energy_j(velocities_m_s, model: GranularModel) -> float:
@@ -92,7 +102,7 @@ class EnergyAudit:
         positions_m = np.asarray(positions_m, float)
         i, j = self._candidate_pairs(positions_m)
         energy = (kinetic_energy_j(velocities_m_s, self.model)
-                  + _pair_energy_j(positions_m, i, j, self.radii_m, self.model.pair_stiffness_pa)
+                  + _pair_energy_j(positions_m, i, j, self.radii_m, self.model)
                   + wall_energy_j(positions_m, self.model))
         return energy - float(np.sum((positions_m - self.start_m) * self.external_n))
 

@@ -59,11 +59,11 @@ def prestress(model: GranularModel) -> Prestress:
     radii = lattice.diameters_m / 2
     i, j, overlap = touching_pairs(lattice.positions_m, lattice.diameters_m)
     reduced = radii[i] * radii[j] / (radii[i] + radii[j])
-    forces = model.pair_stiffness_pa * np.sqrt(reduced) * overlap**1.5
+    forces = model.contact_stiffness_pa(i, j) * np.sqrt(reduced) * overlap**1.5
     wall_force = 0.0
     for wall in model.walls:
         members = np.asarray(wall.members, dtype=int)
         depth = np.maximum(-wall.gaps_m(lattice.positions_m[members], radii[members]), 0.0)
-        wall_force += float(np.sum(model.wall_stiffness_pa * np.sqrt(wall.contact_radii_m(radii[members])) * depth**1.5))
+        wall_force += float(np.sum(model.wall_stiffness_pa(members) * np.sqrt(wall.contact_radii_m(radii[members])) * depth**1.5))
     return Prestress(len(forces), float(overlap.max(initial=0.0)), float(forces.mean()) if len(forces) else 0.0,
                      float(forces.max(initial=0.0)), wall_force)

@@ -10,6 +10,7 @@ keys are the field names. ``v0``, ``dt`` and ``duration`` are in the run's ``uni
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 import tomllib
 from dataclasses import dataclass
@@ -27,6 +28,7 @@ from hexdem.model.sites import read_sites
 from hexdem.model.materials import (PAPER_DIAMETER_M, Material, custom_materials, hertz_coefficient, hertz_stiffness,
                                      material, sphere_mass)
 from hexdem.model.precompression import hole_force, precompressed_lattice, spring_stiffness
+from hexdem.model.regions import assign_materials
 from hexdem.model.units import SI, UnitSystem, nondimensional
 
 SHAPES = ("hexagon", "half-hexagon", "half-disc", "triangle", "parallelogram", "disc", "sites")
@@ -86,6 +88,10 @@ class RunConfig:
     ``bead_material``, ``wall_material``: a preset (steel316, delrin, brass, aluminium, glass,
     ptfe; :mod:`hexdem.model.materials`) or a material of ``materials``, this configuration's own
     table {name: {youngs_modulus_pa, poisson_ratio, density_kg_m3[, source]}}.
+    ``regions``: tables {material, sites, x_min_d, x_max_d, y_min_d, y_max_d} giving the beads
+    they select another material (:mod:`hexdem.model.regions`): interfaces, strips, intruders.
+    ``striker_material``, ``striker_diameter_m``: the striker's (None: the beads' material and
+    the nominal diameter).
     ``launcher``: the MPI launcher command that starts the ranks (None: this environment's
     ``mpiexec``; e.g. ``"mpiexec -f hosts"`` or ``"srun"`` to span machines); given, the run goes
     through it even on one rank.
@@ -109,6 +115,9 @@ class RunConfig:
     bead_material: str = "steel316"
     wall_material: str = "delrin"
     materials: dict = dataclasses.field(default_factory=dict)
+    regions: tuple = ()
+    striker_material: str | None = None
+    striker_diameter_m: float | None = None
     units: str = "si"
     v0: float = 0.4
     strike_angle_deg: float = 0.0
@@ -138,7 +147,7 @@ class RunConfig:
         if positive_int("steps_per_contact", self.steps_per_contact) < MIN_STEPS_PER_CONTACT:
             raise HexdemError(f"steps_per_contact must be at least {MIN_STEPS_PER_CONTACT} (the Hertz contact "
                               f"needs them), got {self.steps_per_contact}")
-        for name in ("sensors", "sites", "site_walls_deg", "vacancies"):
+        for name in ("sensors", "sites", "site_walls_deg", "vacancies", "regions"):
             if not isinstance(getattr(self, name), (list, tuple)):
                 raise HexdemError(f"{name} must be a list, got {getattr(self, name)!r}")
             object.__setattr__(self, name, tuple(tuple(v) if isinstance(v, list) else v for v in getattr(self, name)))
@@ -260,8 +269,11 @@ class RunConfig:
         wall_restitution = self.restitution if self.wall_restitution is None else self.wall_restitution
         for alpha in {damping_coefficient(self.restitution), damping_coefficient(wall_restitution)} - {0.0}:
             lammps_tsuji_coefficient(alpha)
-        bead, lattice, held = self.material(self.bead_material), self.lattice(), (0.0, 0.0)
+        bead, held = self.material(self.bead_material), (0.0, 0.0)
+        lattice, extra = assign_materials(self.lattice(), self.regions, bead, self.material)
         if self.precompression_n > 0:
+            if extra:
+                raise HexdemError("precompression is built for a packing of one material; drop the regions")
             if wall is None:
                 raise HexdemError("a precompressed packing needs walls to hold it (wall_material = \"none\")")
             if self.shape == "half-disc":
@@ -272,8 +284,10 @@ class RunConfig:
             coefficient = float(hertz_coefficient(self.diameter_m, bead))
             lattice = precompressed_lattice(lattice, self.precompression_n, coefficient, hertz_stiffness(bead, wall))
             held = tuple(float(f) for f in hole_force(lattice, self.precompression_n))
+        striker = None if self.striker_material is None else self.material(self.striker_material)
         return GranularModel(lattice, impact, bead, wall, self.restitution, wall_restitution, held,
-                             tuple(self.sensor_beads(lattice).values()), self.sensor_mass_factor)
+                             tuple(self.sensor_beads(lattice).values()), self.sensor_mass_factor, extra, striker,
+                             self.striker_diameter_m)
 
     def sensor_beads(self, lattice: Lattice) -> dict[str, int]:
         """{label: bead index} of the ``sensors``, in the order given ("line:n" or a bead id)."""
@@ -296,13 +310,33 @@ class RunConfig:
             raise HexdemError(f"sensors {list(self.sensors)} name the same bead twice")
         return beads
 
+    def _unlike_contact_times_s(self, speed_m_s: float) -> list[float]:
+        """Hertz contact times at ``speed_m_s`` of every other pair of bodies the packing holds:
+        beads of the regions' materials with each other and with the beads', and the striker
+        with each of them when it is of its own material or size."""
+        bead = self.material(self.bead_material)
+        bodies = [(bead, self.diameter_m)] + [(self.material(name), self.diameter_m)
+                                              for name in dict.fromkeys(r["material"] for r in self.regions)
+                                              if self.material(name) != bead]
+        pairs = list(itertools.combinations_with_replacement(bodies, 2))[1:]
+        if self.impact == "striker" and (self.striker_material is not None or self.striker_diameter_m is not None):
+            striker = (self.material(self.striker_material or self.bead_material), self.striker_diameter_m or self.diameter_m)
+            pairs += [(striker, body) for body in bodies]
+        times = []
+        for (a, da), (b, db) in pairs:
+            ma, mb = float(sphere_mass(da, a)), float(sphere_mass(db, b))
+            coefficient = hertz_stiffness(a, b) * math.sqrt(da * db / (2 * (da + db)))
+            times.append(float(contact_time(ma * mb / (ma + mb), coefficient, speed_m_s)))
+        return times
+
     def contact_time_s(self) -> float:
         """The natural time scale of the impact [s]: the two-bead Hertz contact time at V0, or, if
         shorter, half the period of two beads on the linearized precompressed contact, π sqrt(m/2k)."""
         bead = self.material(self.bead_material)
         mass = float(sphere_mass(self.diameter_m, bead))
         coefficient = float(hertz_coefficient(self.diameter_m, bead))
-        hertz = float(contact_time(mass / 2, coefficient, self.v0 * self.unit_system.velocity_m_s))
+        speed = self.v0 * self.unit_system.velocity_m_s
+        hertz = min([float(contact_time(mass / 2, coefficient, speed)), *self._unlike_contact_times_s(speed)])
         if self.precompression_n <= 0:
             return hertz
         return min(hertz, math.pi * math.sqrt(mass / 2 / spring_stiffness(self.precompression_n, coefficient)))

@@ -17,7 +17,7 @@ from hexdem.common.checks import is_number
 from hexdem.errors import HexdemError
 from hexdem.model.dissipation import check_restitution, damping_coefficient
 from hexdem.model.lattice import Lattice, strike_direction
-from hexdem.model.materials import DELRIN, STEEL_316, Material, hertz_stiffness, sphere_mass
+from hexdem.model.materials import DELRIN, STEEL_316, Material, hertz_stiffness
 from hexdem.model.units import SI, UnitSystem
 
 
@@ -55,6 +55,11 @@ class GranularModel:
     struck bead, the force its missing wall would exert on a precompressed packing
     (:mod:`hexdem.model.precompression`); ``sensor_beads`` bead indices of the sensor particles,
     whose mass is ``sensor_mass_factor`` times a plain bead's (the accelerometer inside).
+
+    Materials: bead material id 0 is ``bead``, ids 1, 2, … are ``extra_materials`` (the
+    lattice's ``material_ids`` say which bead is which); the striker is of ``striker_material``
+    (None: ``bead``) and of diameter ``striker_diameter_m`` (None: the nominal d). Every
+    contact is Hertz's with the pair's own E* and R_eff (:meth:`contact_stiffness_pa`).
     """
 
     lattice: Lattice
@@ -66,12 +71,20 @@ class GranularModel:
     held_force_n: tuple[float, float] = (0.0, 0.0)
     sensor_beads: tuple[int, ...] = ()
     sensor_mass_factor: float = 1.0
+    extra_materials: tuple[Material, ...] = ()
+    striker_material: Material | None = None
+    striker_diameter_m: float | None = None
 
     def __post_init__(self):
         check_restitution("restitution", self.restitution)
         check_restitution("wall_restitution", self.wall_restitution)
         if not (is_number(self.sensor_mass_factor) and self.sensor_mass_factor > 0):
             raise HexdemError(f"sensor_mass_factor must be > 0, got {self.sensor_mass_factor!r}")
+        if len(self.lattice) and self.lattice.material_ids.max() > len(self.extra_materials):
+            raise HexdemError(f"bead material id {self.lattice.material_ids.max()} has no material "
+                              f"({1 + len(self.extra_materials)} given)")
+        if self.striker_diameter_m is not None and not (is_number(self.striker_diameter_m) and self.striker_diameter_m > 0):
+            raise HexdemError(f"striker diameter must be > 0 m, got {self.striker_diameter_m!r}")
 
     @property
     def dissipative(self) -> bool:
@@ -104,13 +117,50 @@ class GranularModel:
 
     @property
     def diameters_m(self) -> np.ndarray:
-        extra = [self.lattice.diameter_m] if self.has_striker else []
+        extra = [self.striker_diameter_m or self.lattice.diameter_m] if self.has_striker else []
         return np.concatenate([self.lattice.diameters_m, extra])
 
     @property
+    def materials(self) -> tuple[Material, ...]:
+        """Materials by id: the beads' (``bead``, then ``extra_materials``), then the striker's
+        if it has its own."""
+        striker = (self.striker_material,) if self.striker_material is not None else ()
+        return (self.bead, *self.extra_materials, *striker)
+
+    @property
+    def material_ids(self) -> np.ndarray:
+        """(n_bodies,) each body's index into :attr:`materials`."""
+        if not self.has_striker:
+            return self.lattice.material_ids
+        striker = len(self.materials) - 1 if self.striker_material is not None else 0
+        return np.append(self.lattice.material_ids, striker)
+
+    @property
+    def densities_kg_m3(self) -> np.ndarray:
+        """(n_bodies,) each body's density ρ [kg/m³]."""
+        return np.array([m.density_kg_m3 for m in self.materials])[self.material_ids]
+
+    @property
     def masses_kg(self) -> np.ndarray:
-        """(n_bodies,) masses [kg]: 3D spheres of the bead material, sensor beads scaled."""
-        return sphere_mass(self.diameters_m, self.bead) * self.mass_factors
+        """(n_bodies,) masses [kg]: 3D spheres ρ π d³/6 of each body's material, sensor beads scaled."""
+        return self.densities_kg_m3 * np.pi * self.diameters_m**3 / 6.0 * self.mass_factors
+
+    @property
+    def stiffness_table_pa(self) -> np.ndarray:
+        """(K, K) k_n = (4/3) E* [Pa] of every pair of :attr:`materials`."""
+        return np.array([[hertz_stiffness(a, b) for b in self.materials] for a in self.materials])
+
+    def contact_stiffness_pa(self, i, j) -> np.ndarray:
+        """k_n = (4/3) E* [Pa] of the contacts between bodies ``i`` and ``j`` (arrays of indices):
+        F = k_n sqrt(R_eff) δ^{3/2}."""
+        ids = self.material_ids
+        return self.stiffness_table_pa[ids[np.asarray(i, int)], ids[np.asarray(j, int)]]
+
+    @property
+    def uniform_contacts(self) -> bool:
+        """Whether every bead–bead and striker contact has the same k_n (one material)."""
+        table = self.stiffness_table_pa[np.ix_(np.unique(self.material_ids), np.unique(self.material_ids))]
+        return bool(np.all(table == table.flat[0]))
 
     @property
     def mass_factors(self) -> np.ndarray:
@@ -119,17 +169,13 @@ class GranularModel:
         factors[list(self.sensor_beads)] = self.sensor_mass_factor
         return factors
 
-    @property
-    def pair_stiffness_pa(self) -> float:
-        """k_n = (4/3) E* of a bead–bead contact: F = k_n sqrt(R_eff) δ^{3/2}."""
-        return hertz_stiffness(self.bead, self.bead)
-
-    @property
-    def wall_stiffness_pa(self) -> float:
-        """k_n = (4/3) E* of a bead–wall contact with the wall's own E, ν (R_eff = bead radius)."""
+    def wall_stiffness_pa(self, beads) -> np.ndarray:
+        """k_n = (4/3) E* [Pa] of the contacts of ``beads`` (indices) with the walls, each bead's
+        material against the wall's own E, ν."""
         if self.wall is None:
             raise HexdemError("this model has no walls")
-        return hertz_stiffness(self.bead, self.wall)
+        table = np.array([hertz_stiffness(m, self.wall) for m in self.materials])
+        return table[self.material_ids[np.asarray(beads, int)]]
 
     @property
     def walls(self):
@@ -141,7 +187,7 @@ class GranularModel:
         if not self.has_striker:
             return pos.copy()
         struck = self.lattice.struck
-        gap = (self.lattice.diameters_m[struck] + self.lattice.diameter_m) / 2
+        gap = (self.lattice.diameters_m[struck] + self.diameters_m[-1]) / 2
         return np.vstack([pos, pos[struck] - gap * self.impact.direction])
 
     def initial_velocities_m_s(self) -> np.ndarray:

@@ -105,7 +105,8 @@ class Lattice:
     ``indices`` (N, 2) int paper labels {m, n}; ``positions_m`` (N, 2) bead centres [m];
     ``diameters_m`` (N,) per-bead diameters [m] (all equal for the ideal lattice);
     ``diameter_m`` the nominal diameter d; ``struck`` index of the struck bead;
-    ``walls`` the confining walls; ``shape`` a readable description.
+    ``walls`` the confining walls; ``shape`` a readable description; ``material_ids`` (N,)
+    each bead's material, an index into the model's materials (None: all 0, the bead material).
     """
 
     indices: np.ndarray
@@ -115,10 +116,15 @@ class Lattice:
     struck: int
     walls: tuple[Wall | CurvedWall, ...]
     shape: str
+    material_ids: np.ndarray | None = None
     _lookup: dict = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
         object.__setattr__(self, "_lookup", {tuple(mn): i for i, mn in enumerate(self.indices.tolist())})
+        ids = np.zeros(len(self.indices), dtype=int) if self.material_ids is None else np.asarray(self.material_ids, int)
+        if ids.shape != (len(self.indices),) or (len(ids) and ids.min() < 0):
+            raise HexdemError(f"material_ids must hold one non-negative index per bead ({len(self.indices)})")
+        object.__setattr__(self, "material_ids", ids)
 
     def __len__(self) -> int:
         return len(self.indices)
@@ -225,7 +231,7 @@ def without_sites(lattice: Lattice, vacancies) -> Lattice:
     shape = f"{lattice.shape}, {len(removed)} vacanc{'y' if len(removed) == 1 else 'ies'}"
     return replace(lattice, indices=lattice.indices[keep], positions_m=lattice.positions_m[keep],
                    diameters_m=lattice.diameters_m[keep], struck=int(new_index[lattice.struck]), walls=walls,
-                   shape=shape)
+                   shape=shape, material_ids=lattice.material_ids[keep])
 
 
 def touching_walls(lattice: Lattice, normals) -> tuple[Wall, ...]:

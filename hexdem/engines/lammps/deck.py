@@ -27,7 +27,6 @@ DECK_NAME = "in.hexdem"
 DATA_NAME = "data.hexdem"
 DUMP_NAME = "dump.lammpstrj"
 #: Atom types: lattice beads and the striker.
-BEAD_TYPE, STRIKER_TYPE = 1, 2
 
 
 @dataclass(frozen=True)
@@ -55,18 +54,29 @@ def _fmt(value: float) -> str:
     return repr(float(value))
 
 
+def atom_types(model: GranularModel) -> np.ndarray:
+    """(n_bodies,) LAMMPS atom type of each body: a bead's material id + 1, then the striker's
+    own type (2 for the paper's one material)."""
+    types = model.lattice.material_ids + 1
+    return np.append(types, len(model.extra_materials) + 2) if model.has_striker else types
+
+
+def type_materials(model: GranularModel) -> list[int]:
+    """The material id (index into ``model.materials``) of each LAMMPS atom type, 1, 2, …"""
+    striker = int(model.material_ids[-1]) if model.has_striker else 0
+    return [*range(1 + len(model.extra_materials)), striker]
+
+
 def data_file(model: GranularModel, units: UnitSystem) -> str:
     """The text of ``data.hexdem``: every body of ``model`` at its initial position."""
     pos = model.initial_positions_m() / units.length_m
     diam = model.diameters_m / units.length_m
-    densities = model.bead.density_kg_m3 * model.mass_factors / units.density_kg_m3
+    densities = model.densities_kg_m3 * model.mass_factors / units.density_kg_m3
     margin = 2.0 * diam.max()
     lo, hi = pos.min(axis=0) - margin, pos.max(axis=0) + margin
-    types = np.full(model.n_bodies, BEAD_TYPE)
-    if model.has_striker:
-        types[-1] = STRIKER_TYPE
+    types = atom_types(model)
     lines = [f"hexdem data file: {model.lattice.shape}", "",
-             f"{model.n_bodies} atoms", "2 atom types", "",
+             f"{model.n_bodies} atoms", f"{len(type_materials(model))} atom types", "",
              f"{_fmt(lo[0])} {_fmt(hi[0])} xlo xhi", f"{_fmt(lo[1])} {_fmt(hi[1])} ylo yhi",
              f"{_fmt(-diam.max())} {_fmt(diam.max())} zlo zhi", "", "Atoms # sphere", ""]
     lines += [f"{i + 1} {t} {_fmt(d)} {_fmt(rho)} {_fmt(x)} {_fmt(y)} 0.0"
@@ -84,10 +94,8 @@ def walls_block(model: GranularModel, units: UnitSystem) -> str:
     curved wall) and wall fix each."""
     if not model.walls:
         return "# (no walls)\n"
-    stiffness = _fmt(model.wall_stiffness_pa / units.stress_pa)
     block = []
     for wall in model.walls:
-        ids = " ".join(str(i + 1) for i in wall.members)
         if isinstance(wall, CurvedWall):  # its Hertz law: LAMMPS's own contact radius of a cylinder
             centre = np.asarray(wall.centre_m) / units.length_m
             height = CYLINDER_HALF_HEIGHT_D * model.lattice.diameter_m / units.length_m  # the 2D beads at z = 0
@@ -97,10 +105,16 @@ def walls_block(model: GranularModel, units: UnitSystem) -> str:
             point = np.asarray(wall.normal) * wall.offset_m / units.length_m
             region = (f"plane {_fmt(point[0])} {_fmt(point[1])} 0.0 "
                       f"{_fmt(wall.normal[0])} {_fmt(wall.normal[1])} 0.0 side in")
-        block += [f"group           {wall.name} id {ids}",
-                  f"region          {wall.name} {region}",
-                  f"fix             {wall.name} {wall.name} wall/gran/region granular hertz {stiffness} "
-                  f"{damping_model(model.wall_damping)} tangential linear_nohistory 0.0 0.0 region {wall.name}"]
+        groups, fixes = [], []
+        materials = model.material_ids[wall.members]
+        for material in np.unique(materials):  # one fix per material touching the wall: its own k_n
+            members = wall.members[materials == material]
+            group = wall.name if len(np.unique(materials)) == 1 else f"{wall.name}_{model.materials[material].name}"
+            stiffness = _fmt(model.wall_stiffness_pa(members[:1])[0] / units.stress_pa)
+            groups.append(f"group           {group} id {' '.join(str(i + 1) for i in members)}")
+            fixes.append(f"fix             {group} {group} wall/gran/region granular hertz {stiffness} "
+                         f"{damping_model(model.wall_damping)} tangential linear_nohistory 0.0 0.0 region {wall.name}")
+        block += [*groups, f"region          {wall.name} {region}", *fixes]
     return "\n".join(block) + "\n"
 
 
@@ -120,16 +134,27 @@ def damping_model(alpha: float) -> str:
 def pair_block(model: GranularModel, units: UnitSystem) -> str:
     """The Hertz pair potential F = k_n sqrt(R_eff) δ^{3/2} of ``model``, without tangential force.
 
-    An elastic contact is rendered as ``pair_style gran/hertz/history k_n NULL 0 NULL 0 0``:
+    Unlike materials get ``pair_style granular`` with one ``pair_coeff`` per pair of atom types,
+    k_n = (4/3) E* of that pair. With one material, an elastic contact is rendered as ``pair_style gran/hertz/history k_n NULL 0 NULL 0 0``:
     with no damping and a friction coefficient of 0 its normal force is the same expression
     as ``pair_style granular``'s ``hertz`` and its tangential force is exactly zero, and it
     costs about a third less per step (``tests/test_pair_styles.py`` shows the forces equal
     to round-off). Damped contacts keep ``pair_style granular`` with ``damping tsuji``."""
-    stiffness = _fmt(model.pair_stiffness_pa / units.stress_pa)
-    if model.pair_damping == 0.0:
-        return f"pair_style      gran/hertz/history {stiffness} NULL 0.0 NULL 0.0 0\npair_coeff      * *"
-    return ("pair_style      granular\n"
-            f"pair_coeff      * * hertz {stiffness} {damping_model(model.pair_damping)} tangential linear_nohistory 0.0 0.0")
+    table = model.stiffness_table_pa / units.stress_pa
+    present = int(model.material_ids[0])
+    if model.uniform_contacts:
+        stiffness = _fmt(table[present, present])
+        if model.pair_damping == 0.0:
+            return f"pair_style      gran/hertz/history {stiffness} NULL 0.0 NULL 0.0 0\npair_coeff      * *"
+        return ("pair_style      granular\n"
+                f"pair_coeff      * * hertz {stiffness} {damping_model(model.pair_damping)} tangential linear_nohistory 0.0 0.0")
+    kinds = type_materials(model)  # unlike materials: each pair of atom types its own k_n = (4/3) E*
+    lines = ["pair_style      granular"]
+    for a in range(len(kinds)):
+        for b in range(a, len(kinds)):
+            lines.append(f"pair_coeff      {a + 1} {b + 1} hertz {_fmt(table[kinds[a], kinds[b]])} "
+                         f"{damping_model(model.pair_damping)} tangential linear_nohistory 0.0 0.0")
+    return "\n".join(lines)
 
 
 def granular_block(model: GranularModel, units: UnitSystem) -> str:

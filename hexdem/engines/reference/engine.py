@@ -107,7 +107,7 @@ def _lattice_bonds(model: GranularModel, grid: Grid, units: UnitSystem):
     cell, radii = grid.cells[i], lattice.radii_m
     rest_x[d, cell], rest_y[d, cell] = (lattice.positions_m[j] - lattice.positions_m[i]).T / units.length_m
     contact[d, cell] = (radii[i] + radii[j]) / units.length_m
-    stiffness[d, cell] = _coefficient(model.pair_stiffness_pa, _reduced_radius(radii[i], radii[j]), units)
+    stiffness[d, cell] = _coefficient(model.contact_stiffness_pa(i, j), _reduced_radius(radii[i], radii[j]), units)
     masses = model.masses_kg / units.mass_kg
     damping[d, cell] = model.pair_damping * np.sqrt(_reduced_radius(masses[i], masses[j]) * stiffness[d, cell])
     return rest_x, rest_y, contact, stiffness, damping
@@ -126,7 +126,7 @@ def _striker_pairs(model: GranularModel, cells: np.ndarray, units: UnitSystem):
     beads = np.flatnonzero((gap < STRIKER_REACH * model.lattice.diameter_m) & model.has_striker)
     rest = (pos[beads] - pos[striker]) / units.length_m
     r_eff = _reduced_radius(radii[beads], radii[striker])
-    stiffness = _coefficient(model.pair_stiffness_pa, r_eff, units)
+    stiffness = _coefficient(model.contact_stiffness_pa(beads, np.full(len(beads), striker)), r_eff, units)
     masses = model.masses_kg / units.mass_kg
     damping = model.pair_damping * np.sqrt(_reduced_radius(masses[beads], masses[striker]) * stiffness)
     return (np.full(len(beads), cells[striker], dtype=np.int64), cells[beads].astype(np.int64),
@@ -147,7 +147,7 @@ def _wall_contacts(model: GranularModel, cells: np.ndarray, units: UnitSystem):
         1.0 / np.linalg.norm(positions[wall.members] - np.asarray(wall.centre_m), axis=1)
         if isinstance(wall, CurvedWall) else np.zeros(len(wall.members)) for wall in walls])
     r_eff = np.concatenate([np.zeros(0)] + [wall.contact_radii_m(radii[wall.members]) for wall in walls])
-    stiffness = _coefficient(model.wall_stiffness_pa if walls else 0.0, r_eff, units)
+    stiffness = _coefficient(model.wall_stiffness_pa(beads) if walls else np.zeros(0), r_eff, units)
     damping = model.wall_damping * np.sqrt(model.masses_kg[beads] / units.mass_kg * stiffness)
     return (cells[beads], normals[:, 0].copy(), normals[:, 1].copy(), gaps / units.length_m,
             curvature * units.length_m, stiffness, damping)
