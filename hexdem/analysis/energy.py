@@ -106,6 +106,45 @@ class EnergyAudit:
                   + wall_energy_j(positions_m, self.model))
         return energy - float(np.sum((positions_m - self.start_m) * self.external_n))
 
+    def by_region(self, positions_m, velocities_m_s) -> np.ndarray:
+        """(R, 2) kinetic and contact energy [J] of each :func:`energy_regions` region: a
+        contact's Hertz energy half to each of its bodies' regions, a wall contact's to its bead's."""
+        positions_m = np.asarray(positions_m, float)
+        i, j = self._candidate_pairs(positions_m)
+        return region_energies_j(positions_m, velocities_m_s, self.model, i, j)
+
+
+def energy_regions(model: GranularModel) -> tuple[list[str], np.ndarray]:
+    """(names, (n_bodies,) region of each body): the beads by material, then the striker, if
+    any, as a region of its own (so that what it keeps is not counted in the packing)."""
+    names = [m.name for m in model.materials[:1 + len(model.extra_materials)]]
+    regions = model.lattice.material_ids
+    if model.has_striker:
+        names, regions = [*names, "striker"], np.append(regions, len(names))
+    return names, regions
+
+
+def region_energies_j(positions_m, velocities_m_s, model: GranularModel, i, j) -> np.ndarray:
+    """(R, 2) kinetic and contact energy [J] of each region (:func:`energy_regions`), the
+    contacts found among the candidate pairs ``i``, ``j``."""
+    names, regions = energy_regions(model)
+    velocities_m_s = np.asarray(velocities_m_s, float)
+    kinetic = np.bincount(regions, 0.5 * model.masses_kg * np.sum(velocities_m_s**2, axis=1), len(names))
+    radii = model.diameters_m / 2
+    overlap = radii[i] + radii[j] - np.linalg.norm(positions_m[i] - positions_m[j], axis=1)
+    t = overlap > 0
+    i, j, overlap = i[t], j[t], overlap[t]
+    pair = 0.4 * model.contact_stiffness_pa(i, j) * np.sqrt(radii[i] * radii[j] / (radii[i] + radii[j])) * overlap**2.5
+    contact = np.bincount(regions[i], pair / 2, len(names)) + np.bincount(regions[j], pair / 2, len(names))
+    for wall in model.walls:
+        members = wall.members
+        depth = -wall.gaps_m(positions_m[members], radii[members])
+        inside = members[depth > 0]
+        energy = (0.4 * model.wall_stiffness_pa(inside) * np.sqrt(wall.contact_radii_m(radii[inside]))
+                  * depth[depth > 0] ** 2.5)
+        contact += np.bincount(regions[inside], energy, len(names))
+    return np.column_stack([kinetic, contact])
+
 
 #: The audit's yardstick never falls below this fraction of the total energy: the round-off of a
 #: large static energy is not integration error. A precompressed packing's overlaps (~1e-6 m)

@@ -105,6 +105,25 @@ def peak_decay(rows_by_line: dict, path, units_name: str, v0: float, title="Peak
     save(fig, path)
 
 
+def energy_regions_figure(results, path, title="Where the energy is") -> None:
+    """Each region's share of the total mechanical energy (kinetic + contact) against time: what
+    an interface transmits, or traps on one side."""
+    units = UNIT_LABELS[results.units]
+    energies = results.region_energies.sum(axis=2)
+    shares = energies / energies.sum(axis=1, keepdims=True)
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    fig.subplots_adjust(**SINGLE_PLOT_MARGINS)
+    for k, name in enumerate(results.region_names):
+        ax.plot(results.region_times * units["time_scale"], shares[:, k], label=name)
+    ax.set_xlabel(f"time [{units['time']}]")
+    ax.set_ylabel("share of the energy")
+    ax.set_ylim(0.0, 1.0)
+    set_title(ax, title)
+    ax.grid(True, alpha=0.3)
+    ax.legend()
+    save(fig, path)
+
+
 def front_shape_figure(curves: dict, path, title="Roundness of the wavefront", fits: dict | None = None,
                        signed: bool = False) -> None:
     """Relative sixfold amplitude of the front vs its mean radius, one curve per labelled packing.

@@ -14,7 +14,8 @@ from types import SimpleNamespace
 import numpy as np
 
 from hexdem.analysis.peaks import pulse_times
-from hexdem.analysis.tracker import TrackedPulses
+from hexdem.analysis.energy import energy_regions
+from hexdem.analysis.tracker import ENERGY_SAMPLES, TrackedPulses
 from hexdem.analysis.trajectory import Trajectory
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel, RunSettings
@@ -32,12 +33,13 @@ class ImpactAnalysis:
 
     ``results``: ``units``, ``length_unit_m``, ``positions`` (N, 2), ``peak_speed``, ``t_peak``,
     ``arrival_time``, ``reach_time`` (N,), ``lines`` {name: bead indices}, ``energy_drift``,
-    ``far_wall_reached``. ``tracked``: the :class:`TrackedPulses` (traces, fields) of a
-    tracked run, else None.
+    ``far_wall_reached``, ``region_names``, ``region_times`` (T,) and ``region_energies`` (T, R, 2)
+    [J] (:func:`~hexdem.analysis.energy.energy_regions`). ``tracked``: the
+    :class:`TrackedPulses` (traces, fields) of a tracked run, else None.
     """
 
     def __init__(self, model: GranularModel, settings: RunSettings, engine: dict, peak_speed, t_peak, arrival_time,
-                 reach_time, energy_drift: float, tracked: TrackedPulses | None = None):
+                 reach_time, energy_drift: float, region_energies, tracked: TrackedPulses | None = None):
         self.model, self.settings, self.engine, self.tracked = model, settings, engine, tracked
         units = settings.units
         self.results = r = SimpleNamespace()
@@ -47,21 +49,24 @@ class ImpactAnalysis:
         r.peak_speed, r.t_peak, r.arrival_time, r.reach_time = peak_speed, t_peak, arrival_time, reach_time
         r.lines = model.lattice.lines()
         r.energy_drift = energy_drift
+        r.region_names = energy_regions(model)[0]
+        r.region_times, r.region_energies = region_energies
         r.far_wall_reached = self._far_wall_reached()
 
     @classmethod
     def from_tracker(cls, model: GranularModel, settings: RunSettings, tracked: TrackedPulses,
                      engine: dict) -> "ImpactAnalysis":
         return cls(model, settings, engine, tracked.peak_speed, tracked.t_peak, tracked.arrival_time,
-                   tracked.reach_time, tracked.energy_drift, tracked)
+                   tracked.reach_time, tracked.energy_drift, (tracked.energy_times, tracked.region_energies), tracked)
 
     @classmethod
     def from_trajectory(cls, model: GranularModel, settings: RunSettings, trajectory: Trajectory) -> "ImpactAnalysis":
         units = settings.units
         pulses = pulse_times(trajectory.times_s / units.time_s,
                              trajectory.speeds_m_s[:, :len(model.lattice)] / units.velocity_m_s)
+        times_s, energies = trajectory.region_energies_j(model, ENERGY_SAMPLES)
         return cls(model, settings, trajectory.engine, pulses.peak_speed, pulses.t_peak, pulses.arrival_time,
-                   pulses.reach_time, trajectory.energy_drift(model))
+                   pulses.reach_time, trajectory.energy_drift(model), (times_s / units.time_s, energies))
 
     def _far_wall_reached(self) -> bool:
         """Did the leading wave reach every bead at the walls facing the strike within the run?

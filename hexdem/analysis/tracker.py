@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hexdem.analysis.energy import EnergyAudit, energy_error, energy_scale_j, kinetic_energy_j
+from hexdem.analysis.energy import EnergyAudit, energy_error, energy_regions, energy_scale_j, kinetic_energy_j
 from hexdem.analysis.peaks import refine_peak, refine_peaks
 from hexdem.analysis.tracker_kernel import first_crossing, rung, update
 from hexdem.engines.sampling import Sample
@@ -52,7 +52,9 @@ class TrackedPulses:
     :mod:`hexdem.analysis.peaks`).
     ``energy_drift`` the audit's error over ``energy_times`` (see
     :func:`~hexdem.analysis.energy.energy_error`); ``energy_lost`` (E0 − E_end) relative to the
-    impact's kinetic energy; ``n_samples``;
+    impact's kinetic energy; ``region_energies`` (len(energy_times), R, 2) the kinetic and contact
+    energy [J] of each region (:func:`~hexdem.analysis.energy.energy_regions`) at those times;
+    ``n_samples``;
     ``trace_times`` (S,) and ``trace_speeds`` (S, len(trace_beads)); ``field_times`` (F,) and
     ``field_speeds`` (F, N) at the requested snapshot samples; ``sensor_times`` (K,) and
     ``sensor_states`` (K, n_sensors, 4): vx, vy, ax, ay of the model's sensor beads every
@@ -66,6 +68,7 @@ class TrackedPulses:
     energy_drift: float
     energy_lost: float
     energy_times: np.ndarray
+    region_energies: np.ndarray
     n_samples: int
     trace_beads: np.ndarray
     trace_times: np.ndarray
@@ -115,7 +118,7 @@ class PulseTracker:
         self.fields = np.full((len(self.field_samples), n), np.nan)
         self.energy_every = max(1, (total - 1) // ENERGY_SAMPLES)
         self.audit = EnergyAudit(model, gravity_m_s2) if self.root else None
-        self.energies, self.energy_times, self.impact_energy = [], [], None
+        self.energies, self.energy_times, self.impact_energy, self.region_energies = [], [], None, []
         self.count = 0
 
     # ---- state shared across ranks
@@ -208,6 +211,7 @@ class PulseTracker:
             if self.impact_energy is None:
                 self.impact_energy = kinetic_energy_j(velocities, self.model)
             self.energies.append(self.audit(state[:, :2] * units.length_m, velocities))
+            self.region_energies.append(self.audit.by_region(state[:, :2] * units.length_m, velocities))
             self.energy_times.append(sample.time)
 
     # ---- results
@@ -241,6 +245,8 @@ class PulseTracker:
                              energy_drift=energy_error(self.energies, self.impact_energy, self.model.dissipative),
                              energy_lost=(self.energies[0] - self.energies[-1]) / scale,
                              energy_times=np.array(self.energy_times),
+                             region_energies=np.array(self.region_energies).reshape(
+                                 len(self.energy_times), len(energy_regions(self.model)[0]), 2),
                              n_samples=self.count, trace_beads=self.trace_beads,
                              trace_times=np.arange(self.count) * interval, trace_speeds=self.traces[:self.count],
                              field_times=self.field_samples * interval, field_speeds=self.fields,

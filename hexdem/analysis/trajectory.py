@@ -44,6 +44,15 @@ class Trajectory:
         start = model.initial_positions_m()
         return np.array([audit(start + u, v) for u, v in zip(self.displacements_m, self.velocities_m_s)])
 
+    def region_energies_j(self, model: GranularModel, samples: int) -> tuple[np.ndarray, np.ndarray]:
+        """(times [s] (T,), (T, R, 2) kinetic and contact energy [J] of each region) at about
+        ``samples`` evenly spaced samples (see :meth:`EnergyAudit.by_region`)."""
+        audit = EnergyAudit(model, self.gravity_m_s2)
+        start = model.initial_positions_m()
+        picked = np.unique(np.linspace(0, len(self.times_s) - 1, min(samples, len(self.times_s))).round().astype(int))
+        return self.times_s[picked], np.array([audit.by_region(start + self.displacements_m[k], self.velocities_m_s[k])
+                                               for k in picked])
+
     def energy_drift(self, model: GranularModel) -> float:
         """The energy audit's error (:func:`~hexdem.analysis.energy.energy_error`)."""
         return energy_error(self.energies_j(model), kinetic_energy_j(self.velocities_m_s[0], model), model.dissipative)

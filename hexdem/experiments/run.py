@@ -31,7 +31,9 @@ from hexdem.model.config import RunConfig
 #: The configuration of a LAMMPS deck, in its directory (read by ``hexdem analyse``).
 CONFIG_NAME = "hexdem.json"
 RESULT_FILES = ("peaks.csv", "summary.json", "arrival_map.png", "peak_decay.png", "front_shape.csv",
-                "front_shape.png")
+                "front_shape.png", "energy_regions.csv")
+#: Columns of ``energy_regions.csv``: time in the run's units, energies in J, share of the total.
+ENERGY_REGION_COLUMNS = ("time", "region", "kinetic_energy_j", "contact_energy_j", "energy_fraction")
 #: Bytes per atom and frame of a full-precision dump (measured: 30 MB for 331 atoms x 701 frames).
 DUMP_BYTES_PER_ATOM_FRAME = 150
 #: A conservative model whose energy wanders more than this was integrated too coarsely.
@@ -137,6 +139,19 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
     shape = measure_front_shape(analysis)
     write_csv(out / "front_shape.csv", FRONT_SHAPE_COLUMNS, shape.rows())
     plots.front_shape_figure({analysis.model.lattice.shape: shape}, out / "front_shape.png")
+    write_csv(out / "energy_regions.csv", ENERGY_REGION_COLUMNS, energy_region_rows(r))
+    if analysis.model.extra_materials:
+        plots.energy_regions_figure(r, out / "energy_regions.png",
+                                    title=f"Where the energy is, {', '.join(r.region_names)}")
+
+
+def energy_region_rows(results) -> list[tuple]:
+    """Rows of ``energy_regions.csv``: per audited time and region, its kinetic and contact
+    energy [J] and its share of the total."""
+    totals = results.region_energies.sum(axis=(1, 2))
+    return [(float(t), name, float(kinetic), float(contact), float((kinetic + contact) / total))
+            for t, energies, total in zip(results.region_times, results.region_energies, totals)
+            for name, (kinetic, contact) in zip(results.region_names, energies)]
 
 
 def measure_front_shape(analysis: ImpactAnalysis, count: int = 8, geometric: bool = False,
