@@ -15,6 +15,16 @@ from hexdem.model.config import RunConfig
 from hexdem.model.granular import RunSettings
 
 
+
+class NoAudit:
+    """Synthetic speeds: no mechanics to audit."""
+
+    def __call__(self, positions, velocities):
+        return 1.0
+
+    def by_region(self, positions, velocities):
+        return np.zeros((1, 2))
+
 def test_streaming_agrees_with_hexdem_analyse_of_the_dump(dumped_run, tmp_path):
     """Same run, two analyses: in the run, and ``hexdem analyse`` of its dump through MDAnalysis.
     Required: peak speed within 1e-4 relative, arrival within 0.1 µs, time of peak within 0.5 µs."""
@@ -56,7 +66,7 @@ def test_tracker_reproduces_the_whole_record_definitions(n_samples):
     speeds = _synthetic_speeds(times, n, rng)
     settings = RunSettings(dt_s=times[1], n_steps=n_samples - 1, dump_every=1)
     tracker = PulseTracker(model, settings)
-    tracker.audit = lambda positions, velocities: 1.0  # synthetic speeds: no mechanics to audit
+    tracker.audit = NoAudit()
     ids = np.arange(1, n + 1)
     for s, row in enumerate(speeds):
         tracker(Sample(s, s, times[s], ids, np.zeros((n, 2)), np.column_stack([row, np.zeros(n)])))
@@ -104,7 +114,7 @@ def test_an_earlier_small_pulse_just_above_half_the_peak_is_the_arrival():
     series[20:49] = np.sin(np.linspace(0.0, np.pi, 29))
     series[34] = 1.0
     tracker = PulseTracker(model, RunSettings(dt_s=1.0, n_steps=59, dump_every=1))
-    tracker.audit = lambda positions, velocities: 1.0  # synthetic speeds: no mechanics to audit
+    tracker.audit = NoAudit()
     for s, v in enumerate(series):
         tracker(Sample(s, s, float(s), np.arange(1, n + 1), np.zeros((n, 2)),
                        np.column_stack([np.full(n, v), np.zeros(n)])))

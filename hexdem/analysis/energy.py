@@ -128,21 +128,25 @@ def region_energies_j(positions_m, velocities_m_s, model: GranularModel, i, j) -
     """(R, 2) kinetic and contact energy [J] of each region (:func:`energy_regions`), the
     contacts found among the candidate pairs ``i``, ``j``."""
     names, regions = energy_regions(model)
+
+    def by_region(bodies, energies) -> np.ndarray:  # (float even when empty, unlike bincount's)
+        return np.bincount(bodies, energies, len(names)).astype(float)
+
     velocities_m_s = np.asarray(velocities_m_s, float)
-    kinetic = np.bincount(regions, 0.5 * model.masses_kg * np.sum(velocities_m_s**2, axis=1), len(names))
+    kinetic = by_region(regions, 0.5 * model.masses_kg * np.sum(velocities_m_s**2, axis=1))
     radii = model.diameters_m / 2
     overlap = radii[i] + radii[j] - np.linalg.norm(positions_m[i] - positions_m[j], axis=1)
     t = overlap > 0
     i, j, overlap = i[t], j[t], overlap[t]
     pair = 0.4 * model.contact_stiffness_pa(i, j) * np.sqrt(radii[i] * radii[j] / (radii[i] + radii[j])) * overlap**2.5
-    contact = np.bincount(regions[i], pair / 2, len(names)) + np.bincount(regions[j], pair / 2, len(names))
+    contact = by_region(regions[i], pair / 2) + by_region(regions[j], pair / 2)
     for wall in model.walls:
         members = wall.members
         depth = -wall.gaps_m(positions_m[members], radii[members])
         inside = members[depth > 0]
         energy = (0.4 * model.wall_stiffness_pa(inside) * np.sqrt(wall.contact_radii_m(radii[inside]))
                   * depth[depth > 0] ** 2.5)
-        contact += np.bincount(regions[inside], energy, len(names))
+        contact += by_region(regions[inside], energy)
     return np.column_stack([kinetic, contact])
 
 
