@@ -15,7 +15,6 @@ from hexdem.model.config import RunConfig
 from hexdem.model.granular import RunSettings
 
 
-
 class NoAudit:
     """Synthetic speeds: no mechanics to audit."""
 
@@ -24,6 +23,7 @@ class NoAudit:
 
     def by_region(self, positions, velocities):
         return np.zeros((1, 2))
+
 
 def test_streaming_agrees_with_hexdem_analyse_of_the_dump(dumped_run, tmp_path):
     """Same run, two analyses: in the run, and ``hexdem analyse`` of its dump through MDAnalysis.
