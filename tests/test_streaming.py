@@ -18,11 +18,8 @@ from hexdem.model.granular import RunSettings
 class NoAudit:
     """Synthetic speeds: no mechanics to audit."""
 
-    def __call__(self, positions, velocities):
-        return 1.0
-
-    def by_region(self, positions, velocities):
-        return np.zeros((1, 2))
+    def measure(self, positions, velocities):
+        return 1.0, np.zeros((1, 2))
 
 
 def test_streaming_agrees_with_hexdem_analyse_of_the_dump(dumped_run, tmp_path):

@@ -26,6 +26,11 @@ def _pairs(positions_m, cutoff_m: float) -> tuple[np.ndarray, np.ndarray]:
     return i, j
 
 
+def _hertz_energies_j(stiffness_pa, r_eff_m, overlap_m) -> np.ndarray:
+    """(2/5) k_n sqrt(R_eff) δ^{5/2} [J] of each contact with overlap δ > 0."""
+    return 0.4 * np.asarray(stiffness_pa, float) * np.sqrt(r_eff_m) * overlap_m**2.5
+
+
 def hertz_energy_j(stiffness_pa, r_eff_m, overlap_m) -> float:
     """Σ (2/5) k_n sqrt(R_eff) δ^{5/2} [J] over contacts with overlap δ > 0 (k_n per contact; one
     value factored out when all are equal, the single-material sum as it always was)."""
@@ -36,24 +41,31 @@ def hertz_energy_j(stiffness_pa, r_eff_m, overlap_m) -> float:
     return 0.4 * float(np.sum(stiffness_pa * terms))
 
 
-def _pair_energy_j(positions_m, i, j, radii, model: GranularModel) -> float:
+def _pair_contacts(positions_m, i, j, radii, model: GranularModel):
+    """(i, j, k_n, R_eff, δ) of the touching pairs among the candidate pairs ``i``, ``j``."""
     overlap = radii[i] + radii[j] - np.linalg.norm(positions_m[i] - positions_m[j], axis=1)
     touching = overlap > 0
-    r_eff = radii[i] * radii[j] / (radii[i] + radii[j])
-    return hertz_energy_j(model.contact_stiffness_pa(i[touching], j[touching]), r_eff[touching], overlap[touching])
+    i, j = i[touching], j[touching]
+    return i, j, model.contact_stiffness_pa(i, j), radii[i] * radii[j] / (radii[i] + radii[j]), overlap[touching]
 
 
-def wall_energy_j(positions_m, model: GranularModel) -> float:
-    """Hertz energy [J] of the bead–wall overlaps (R_eff of each wall: R against a plane)."""
+def _wall_contacts(positions_m, model: GranularModel) -> list[tuple]:
+    """Per wall, (beads, k_n, R_eff, δ) of its members that touch it (R_eff of each wall: R
+    against a plane)."""
     radii = model.diameters_m / 2
-    energy = 0.0
+    contacts = []
     for wall in model.walls:
         members = wall.members
         depth = -wall.gaps_m(positions_m[members], radii[members])
         inside = depth > 0
-        energy += hertz_energy_j(model.wall_stiffness_pa(members[inside]),
-                                 wall.contact_radii_m(radii[members][inside]), depth[inside])
-    return energy
+        contacts.append((members[inside], model.wall_stiffness_pa(members[inside]),
+                         wall.contact_radii_m(radii[members][inside]), depth[inside]))
+    return contacts
+
+
+def _wall_energy_j(walls) -> float:
+    """Hertz energy [J] of the wall contacts (:func:`_wall_contacts`), wall by wall."""
+    return sum((hertz_energy_j(*wall[1:]) for wall in walls), 0.0)
 
 
 def contact_energy_j(positions_m, model: GranularModel) -> float:
@@ -61,7 +73,8 @@ def contact_energy_j(positions_m, model: GranularModel) -> float:
     positions_m = np.asarray(positions_m, float)
     radii = model.diameters_m / 2
     i, j = _pairs(positions_m, 2 * radii.max())
-    return _pair_energy_j(positions_m, i, j, radii, model) + wall_energy_j(positions_m, model)
+    pairs = _pair_contacts(positions_m, i, j, radii, model)
+    return hertz_energy_j(*pairs[2:]) + _wall_energy_j(_wall_contacts(positions_m, model))
 
 
 def kinetic_energy_j(velocities_m_s, model: GranularModel) -> float:
@@ -98,20 +111,26 @@ class EnergyAudit:
             self._pairs = _pairs(positions_m, 2 * self.radii_m.max() + self.skin_m)
         return self._pairs
 
-    def __call__(self, positions_m, velocities_m_s) -> float:
-        positions_m = np.asarray(positions_m, float)
+    def _contacts(self, positions_m):
         i, j = self._candidate_pairs(positions_m)
-        energy = (kinetic_energy_j(velocities_m_s, self.model)
-                  + _pair_energy_j(positions_m, i, j, self.radii_m, self.model)
-                  + wall_energy_j(positions_m, self.model))
+        return _pair_contacts(positions_m, i, j, self.radii_m, self.model), _wall_contacts(positions_m, self.model)
+
+    def _total(self, positions_m, velocities_m_s, pairs, walls) -> float:
+        energy = (kinetic_energy_j(velocities_m_s, self.model) + hertz_energy_j(*pairs[2:])
+                  + _wall_energy_j(walls))
         return energy - float(np.sum((positions_m - self.start_m) * self.external_n))
 
-    def by_region(self, positions_m, velocities_m_s) -> np.ndarray:
-        """(R, 2) kinetic and contact energy [J] of each :func:`energy_regions` region: a
-        contact's Hertz energy half to each of its bodies' regions, a wall contact's to its bead's."""
+    def __call__(self, positions_m, velocities_m_s) -> float:
         positions_m = np.asarray(positions_m, float)
-        i, j = self._candidate_pairs(positions_m)
-        return region_energies_j(positions_m, velocities_m_s, self.model, i, j)
+        return self._total(positions_m, velocities_m_s, *self._contacts(positions_m))
+
+    def measure(self, positions_m, velocities_m_s) -> tuple[float, np.ndarray]:
+        """(the total energy [J] as :meth:`__call__` gives it, (R, 2) kinetic and contact energy [J]
+        of each :func:`energy_regions` region), from one search of the contacts."""
+        positions_m = np.asarray(positions_m, float)
+        pairs, walls = self._contacts(positions_m)
+        return (self._total(positions_m, velocities_m_s, pairs, walls),
+                _region_energies_j(velocities_m_s, self.model, pairs, walls))
 
 
 def energy_regions(model: GranularModel) -> tuple[list[str], np.ndarray]:
@@ -124,9 +143,9 @@ def energy_regions(model: GranularModel) -> tuple[list[str], np.ndarray]:
     return names, regions
 
 
-def region_energies_j(positions_m, velocities_m_s, model: GranularModel, i, j) -> np.ndarray:
-    """(R, 2) kinetic and contact energy [J] of each region (:func:`energy_regions`), the
-    contacts found among the candidate pairs ``i``, ``j``."""
+def _region_energies_j(velocities_m_s, model: GranularModel, pairs, walls) -> np.ndarray:
+    """(R, 2) kinetic and contact energy [J] of each region (:func:`energy_regions`): a
+    contact's Hertz energy half to each of its bodies' regions, a wall contact's to its bead's."""
     names, regions = energy_regions(model)
 
     def by_region(bodies, energies) -> np.ndarray:  # (float even when empty, unlike bincount's)
@@ -134,19 +153,11 @@ def region_energies_j(positions_m, velocities_m_s, model: GranularModel, i, j) -
 
     velocities_m_s = np.asarray(velocities_m_s, float)
     kinetic = by_region(regions, 0.5 * model.masses_kg * np.sum(velocities_m_s**2, axis=1))
-    radii = model.diameters_m / 2
-    overlap = radii[i] + radii[j] - np.linalg.norm(positions_m[i] - positions_m[j], axis=1)
-    t = overlap > 0
-    i, j, overlap = i[t], j[t], overlap[t]
-    pair = 0.4 * model.contact_stiffness_pa(i, j) * np.sqrt(radii[i] * radii[j] / (radii[i] + radii[j])) * overlap**2.5
-    contact = by_region(regions[i], pair / 2) + by_region(regions[j], pair / 2)
-    for wall in model.walls:
-        members = wall.members
-        depth = -wall.gaps_m(positions_m[members], radii[members])
-        inside = members[depth > 0]
-        energy = (0.4 * model.wall_stiffness_pa(inside) * np.sqrt(wall.contact_radii_m(radii[inside]))
-                  * depth[depth > 0] ** 2.5)
-        contact += by_region(regions[inside], energy)
+    i, j, *pair = pairs
+    halves = _hertz_energies_j(*pair) / 2
+    contact = by_region(regions[i], halves) + by_region(regions[j], halves)
+    for beads, *wall in walls:
+        contact += by_region(regions[beads], _hertz_energies_j(*wall))
     return np.column_stack([kinetic, contact])
 
 

@@ -210,8 +210,9 @@ class PulseTracker:
             velocities = state[:, 2:] * units.velocity_m_s
             if self.impact_energy is None:
                 self.impact_energy = kinetic_energy_j(velocities, self.model)
-            self.energies.append(self.audit(state[:, :2] * units.length_m, velocities))
-            self.region_energies.append(self.audit.by_region(state[:, :2] * units.length_m, velocities))
+            energy, by_region = self.audit.measure(state[:, :2] * units.length_m, velocities)
+            self.energies.append(energy)
+            self.region_energies.append(by_region)
             self.energy_times.append(sample.time)
 
     # ---- results

@@ -46,11 +46,11 @@ class Trajectory:
 
     def region_energies_j(self, model: GranularModel, samples: int) -> tuple[np.ndarray, np.ndarray]:
         """(times [s] (T,), (T, R, 2) kinetic and contact energy [J] of each region) at about
-        ``samples`` evenly spaced samples (see :meth:`EnergyAudit.by_region`)."""
+        ``samples`` evenly spaced samples (see :meth:`EnergyAudit.measure`)."""
         audit = EnergyAudit(model, self.gravity_m_s2)
         start = model.initial_positions_m()
         picked = np.unique(np.linspace(0, len(self.times_s) - 1, min(samples, len(self.times_s))).round().astype(int))
-        return self.times_s[picked], np.array([audit.by_region(start + self.displacements_m[k], self.velocities_m_s[k])
+        return self.times_s[picked], np.array([audit.measure(start + self.displacements_m[k], self.velocities_m_s[k])[1]
                                                for k in picked])
 
     def energy_drift(self, model: GranularModel) -> float:
