@@ -64,6 +64,10 @@ class Wall:
         """R_eff of the Hertz contact of beads of radii ``radii_m`` with the wall: R for a plane."""
         return np.asarray(radii_m, float)
 
+    def curvatures_at(self, positions_m) -> np.ndarray:
+        """(N,) 1/ρ, ρ the distance from each of ``positions_m`` to the wall's centre: 0 for a plane."""
+        return np.zeros(len(positions_m))
+
 
 @dataclass(frozen=True)
 class CurvedWall:
@@ -96,6 +100,10 @@ class CurvedWall:
         """R_eff = r · 2R / (2R − r) of beads of radii r = ``radii_m`` (see the class docstring)."""
         radii_m = np.asarray(radii_m, float)
         return radii_m * 2 * self.radius_m / (2 * self.radius_m - radii_m)
+
+    def curvatures_at(self, positions_m) -> np.ndarray:
+        """(N,) 1/ρ, ρ the distance from each of ``positions_m`` (N, 2) to the circle's centre."""
+        return 1.0 / np.linalg.norm(np.asarray(positions_m, float) - np.asarray(self.centre_m), axis=1)
 
 
 @dataclass(frozen=True)

@@ -38,7 +38,7 @@ from hexdem.engines.reference.kernel import KernelArrays, forces, integrate
 from hexdem.engines.sampling import Sample
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel, RunSettings
-from hexdem.model.lattice import BOND_STEPS, CurvedWall, Lattice
+from hexdem.model.lattice import BOND_STEPS, Lattice
 from hexdem.model.units import UnitSystem
 
 #: Description of the run written into the engine's directory.
@@ -143,9 +143,7 @@ def _wall_contacts(model: GranularModel, cells: np.ndarray, units: UnitSystem):
     beads = np.concatenate([np.zeros(0, dtype=np.int64)] + [wall.members for wall in walls]).astype(np.int64)
     normals = np.concatenate([np.zeros((0, 2))] + [wall.normals_at(positions[wall.members]) for wall in walls])
     gaps = np.concatenate([np.zeros(0)] + [wall.gaps_m(positions[wall.members], radii[wall.members]) for wall in walls])
-    curvature = np.concatenate([np.zeros(0)] + [
-        1.0 / np.linalg.norm(positions[wall.members] - np.asarray(wall.centre_m), axis=1)
-        if isinstance(wall, CurvedWall) else np.zeros(len(wall.members)) for wall in walls])
+    curvature = np.concatenate([np.zeros(0)] + [wall.curvatures_at(positions[wall.members]) for wall in walls])
     r_eff = np.concatenate([np.zeros(0)] + [wall.contact_radii_m(radii[wall.members]) for wall in walls])
     stiffness = _coefficient(model.wall_stiffness_pa(beads) if walls else np.zeros(0), r_eff, units)
     damping = model.wall_damping * np.sqrt(model.masses_kg[beads] / units.mass_kg * stiffness)
