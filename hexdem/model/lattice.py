@@ -220,6 +220,14 @@ def _layer_sites(bounds) -> list[tuple[int, int]]:
     return [(m, n) for n, (lo, hi) in enumerate(bounds) for m in range(lo, hi + 1) if (m + n) % 2 == 0]
 
 
+def _circle_sites(radius: int, centre_x: float) -> list[tuple[int, int]]:
+    """Sites {m, n} with n >= 0 within ``radius`` of the point (``centre_x``, 0), in bead diameters."""
+    layers = int(np.floor(2 * (radius + centre_x) / np.sqrt(3) + 1e-9))
+    heights = [int(np.floor(2 * np.sqrt(max(radius**2 - (np.sqrt(3) / 2 * n - centre_x) ** 2, 0.0)) + 1e-9))
+               for n in range(layers + 1)]
+    return _layer_sites([(-h, h) for h in heights])
+
+
 def without_sites(lattice: Lattice, vacancies) -> Lattice:
     """``lattice`` with the beads at the ``vacancies`` {m, n} left out; the walls stay where the
     full packing put them (a vacancy at an edge leaves a gap at the wall)."""
@@ -282,9 +290,7 @@ def half_disc(radius_beads: int, diameter_m: float = 1.0) -> Lattice:
     if int(radius_beads) != radius_beads or radius_beads < 2:
         raise HexdemError(f"a half-disc needs a radius of at least 2 bead diameters, got {radius_beads}")
     radius = int(radius_beads)
-    layers = int(np.floor(2 * radius / np.sqrt(3)))
-    heights = [int(np.floor(2 * np.sqrt(radius**2 - 0.75 * n**2) + 1e-9)) for n in range(layers + 1)]
-    return from_sites(_layer_sites([(-h, h) for h in heights]), diameter_m, (0,), f"half-disc, radius {radius} d")
+    return from_sites(_circle_sites(radius, 0.0), diameter_m, (0,), f"half-disc, radius {radius} d")
 
 
 def half_hexagon(long_edge: int = 91, short_edge: int = 46, diameter_m: float = 1.0) -> Lattice:
@@ -307,12 +313,7 @@ def disc(radius_beads: int, diameter_m: float = 1.0) -> Lattice:
     if int(radius_beads) != radius_beads or radius_beads < 2:
         raise HexdemError(f"a disc needs a radius of at least 2 bead diameters, got {radius_beads}")
     radius = int(radius_beads)
-    layers = int(np.floor(4 * radius / np.sqrt(3) + 1e-9))
-    bounds = []
-    for n in range(layers + 1):
-        h = int(np.floor(2 * np.sqrt(max(radius**2 - (np.sqrt(3) / 2 * n - radius) ** 2, 0.0)) + 1e-9))
-        bounds.append((-h, h))
-    lattice = from_sites(_layer_sites(bounds), diameter_m, (), f"disc, radius {radius} d")
+    lattice = from_sites(_circle_sites(radius, radius), diameter_m, (), f"disc, radius {radius} d")
     centre = np.array([radius * diameter_m, 0.0])
     reach = np.linalg.norm(lattice.positions_m - centre, axis=1) + lattice.radii_m
     reach[lattice.struck] = -np.inf  # in the hole: it does not decide where the wall is
