@@ -181,10 +181,10 @@ class RunConfig:
         return MEMORY_BASE_BYTES + MEMORY_PER_BEAD_BYTES * self.n_beads()
 
     def _check_size(self) -> None:
-        sizes = {"hexagon": (self.edge_beads,), "half-hexagon": (self.short_edge, self.long_edge),
-                 "half-disc": (self.radius_beads,), "disc": (self.radius_beads,), "triangle": (self.edge_beads,),
-                 "parallelogram": (self.edge_beads, self.depth_beads or self.edge_beads), "sites": ()}[self.shape]
-        if not all(isinstance(n, int) and not isinstance(n, bool) and n >= 2 for n in sizes):
+        # the packings counted without building them (n_beads) need sizes the count holds for;
+        # the others are built, and their builders word any error
+        counted = {"hexagon": (self.edge_beads,), "half-hexagon": (self.short_edge, self.long_edge)}
+        if not all(isinstance(n, int) and not isinstance(n, bool) and n >= 2 for n in counted.get(self.shape, ())):
             return  # the lattice builder words the error
         needed = self.memory_estimate_bytes() * (self.ranks if self.engine == "lammps" else 1)
         available = available_memory_bytes()

@@ -17,6 +17,10 @@ import numpy as np
 from hexdem.errors import HexdemError
 
 
+#: The numbers a material is made of; a configuration's own material gives them (and may add a ``source``).
+MATERIAL_KEYS = ("youngs_modulus_pa", "poisson_ratio", "density_kg_m3")
+
+
 @dataclass(frozen=True)
 class Material:
     """An isotropic elastic material.
@@ -32,7 +36,7 @@ class Material:
     source: str = ""
 
     def __post_init__(self):
-        for key in ("youngs_modulus_pa", "poisson_ratio", "density_kg_m3"):
+        for key in MATERIAL_KEYS:
             value = getattr(self, key)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
                 raise HexdemError(f"material {self.name}: {key} must be a number, got {value!r}")
@@ -94,9 +98,9 @@ def custom_materials(table) -> dict[str, Material]:
         if name in MATERIALS or name == "none":
             raise HexdemError(f"material {name!r} is built in; give your own material another name")
         if not isinstance(values, dict):
-            raise HexdemError(f"material {name!r} must be a table of youngs_modulus_pa, poisson_ratio, density_kg_m3")
-        missing = sorted({"youngs_modulus_pa", "poisson_ratio", "density_kg_m3"} - set(values))
-        unknown = sorted(set(values) - {"youngs_modulus_pa", "poisson_ratio", "density_kg_m3", "source"})
+            raise HexdemError(f"material {name!r} must be a table of {', '.join(MATERIAL_KEYS)}")
+        missing = sorted(set(MATERIAL_KEYS) - set(values))
+        unknown = sorted(set(values) - {*MATERIAL_KEYS, "source"})
         if missing or unknown:
             raise HexdemError(f"material {name!r}: " + "; ".join(
                 ([f"missing {', '.join(missing)}"] if missing else []) + ([f"unknown {', '.join(unknown)}"] if unknown else [])))
