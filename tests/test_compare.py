@@ -44,10 +44,18 @@ def test_reference_agrees_with_lammps_on_the_default_experiment(default_run, tmp
                                       "striker_diameter_m": 0.012,
                                       "regions": [{"material": "glass", "sites": [[0, 4], [1, 3], [-1, 5]]}]},
                                      {"shape": "sites", "site_walls_deg": [0],
-                                      "sites": [[m, n] for n in range(6) for m in range(-4, 5) if (m + n) % 2 == 0]}],
+                                      "sites": [[m, n] for n in range(6) for m in range(-4, 5) if (m + n) % 2 == 0]},
+                                     {"edge_beads": 5, "impacts": [{"site": [0, 0]},
+                                                                   {"site": [0, 8], "angle_deg": 180.0, "kind": "striker",
+                                                                    "striker_material": "brass"}]},
+                                     {"shape": "triangle", "edge_beads": 8, "impact": "striker",
+                                      "impacts": [{"edge_deg": 0.0}],
+                                      "lines": [{"name": "across", "site": [-5, 1], "angle_deg": 90}]},
+                                     {"edge_beads": 6, "precompression_n": 5.0, "impacts": [{"site": [0, 4], "v0": 0.05}]}],
                          ids=["striker-30deg", "nondimensional", "half-disc", "triangle", "disc-striker-20deg", "parallelogram-striker-30deg",
                               "vacancies", "ptfe-in-brass", "steel|brass-interface",
-                              "glass-intruders-ptfe-striker", "listed-sites"])
+                              "glass-intruders-ptfe-striker", "listed-sites", "double-strike", "flat-striker",
+                              "precompressed-interior-impact"])
 def test_engines_agree_on_small_lattices(tmp_path, changes):
     comparison = run_comparison(SMALL.replace(**changes), tmp_path, log=lambda message: None)
     assert comparison.agree, comparison.verdict()

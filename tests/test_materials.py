@@ -32,8 +32,8 @@ def by_hand(a, b, da, db):
 @pytest.mark.parametrize("engine", [LammpsEngine(), ReferenceEngine()], ids=lambda e: e.name)
 @pytest.mark.parametrize("striker", [BRASS, PTFE], ids=lambda m: m.name)
 def test_a_striker_of_another_material_and_size_leaves_as_momentum_and_energy_say(engine, striker, tmp_path):
-    model = GranularModel(single_bead(D), Impact(V0, striker=True), STEEL_316, wall=None, striker_material=striker,
-                          striker_diameter_m=STRIKER_D)
+    model = GranularModel(single_bead(D), Impact(V0, striker=True, striker_material=striker,
+                                                 striker_diameter_m=STRIKER_D), STEEL_316, wall=None)
     m1, m2, a = by_hand(striker, STEEL_316, STRIKER_D, D)
     mu = m1 * m2 / (m1 + m2)
     delta_max = (5 * mu * V0**2 / (4 * a)) ** 0.4

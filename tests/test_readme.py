@@ -32,7 +32,7 @@ def test_the_python_api_example_runs(tmp_path):
 
 
 def test_every_packing_config_of_the_readme_builds_the_packing_its_comment_names():
-    section = README.read_text().split("#### Packings", 1)[1].split("\n## ", 1)[0]
+    section = README.read_text().split("#### Packings", 1)[1].split("#### Impacts", 1)[0]
     blocks = re.findall(r"```toml\n(.*?)```", section, flags=re.DOTALL)
     assert len(blocks) == 5
     lattices = [RunConfig(**tomllib.loads(block)).lattice() for block in blocks]
@@ -48,3 +48,15 @@ def test_the_readme_interface_config_builds_its_materials():
     # brass: the layers n with (√3/2) n >= 10, n = 12 … 20, holding 11 + (20 − n) beads each: 135
     brass = sum(11 + 20 - n for n in range(12, 21))
     assert list(np.bincount(model.material_ids)) == [331 - brass - 2, brass, 2, 1] and model.diameters_m[-1] == 0.012
+
+
+def test_the_readme_impact_configs_build_their_impacts_and_lines():
+    section = README.read_text().split("#### Impacts", 1)[1].split("\n## ", 1)[0]
+    blocks = re.findall(r"```toml\n(.*?)```", section, flags=re.DOTALL)
+    assert len(blocks) == 4
+    *impacts, lines = [RunConfig(**tomllib.loads(block)) for block in blocks]
+    models = [config.model() for config in impacts]
+    assert [len(model.impacts) for model in models] == [2, 11, 1]  # double strike, the 11 beads of an edge, interior
+    assert [len(model.strikers) for model in models] == [0, 11, 0]
+    assert [list(lattice.indices[b]) for lattice in [models[2].lattice] for b in models[2].struck_beads] == [[0, 14]]
+    assert len(lines.lattice().line("across")) == 21  # the middle column of 11 per edge: 2 * 11 - 1 beads

@@ -7,7 +7,7 @@ import pytest
 from conftest import read_csv
 
 from hexdem.analysis.impact import PEAK_COLUMNS
-from hexdem.experiments.run import RESULT_FILES, simulate
+from hexdem.experiments.run import BEAD_COLUMNS, RESULT_FILES, simulate
 from hexdem.model.config import RunConfig
 
 
@@ -25,6 +25,32 @@ def test_default_run_writes_the_contracted_files(default_run):
     assert summary["lattice"]["n_beads"] == 331
     assert summary["lammps_version"].startswith("LAMMPS")
     assert summary["far_wall_reached"] is True
+    assert not (out / "movie.gif").exists(), "no movie unless asked for"
+    header, beads = read_csv(out / "beads.csv")
+    assert header == BEAD_COLUMNS and len(beads) == 331
+    by_id = {int(row["bead_id"]): row for row in beads}
+    for row in rows:  # the lines' beads carry the same pulse in both tables
+        bead = by_id[int(row["bead_id"])]
+        assert (bead["peak_speed"], bead["arrival_time"], bead["x"]) == (row["peak_speed"], row["arrival_time"], row["x"])
+        assert {bead["material"]} == {"steel316"}
+
+
+def test_run_movie_animates_the_speed_field_sampled_in_the_run(tmp_path):
+    """``hexdem run --movie``: 60 frames from the tracker's fields; the first is t = 0, when only
+    the struck bead moves, at V0."""
+    from PIL import Image
+
+    from hexdem.cli.main import main
+
+    config = tmp_path / "small.toml"
+    config.write_text('edge_beads = 5\nengine = "reference"\n')
+    assert main(["run", "--config", str(config), "--out", str(tmp_path / "out"), "--movie"]) == 0
+    with Image.open(tmp_path / "out" / "movie.gif") as movie:
+        assert movie.n_frames == 60
+    analysis = simulate(RunConfig(edge_beads=5, engine="reference", movie=True), tmp_path / "again")
+    first = analysis.tracked.field_speeds[0]
+    assert first[analysis.model.lattice.struck] == 0.4 and np.count_nonzero(first) == 1
+    assert len(analysis.tracked.field_times) == 60 and analysis.tracked.field_times[0] == 0.0
 
 
 def test_default_run_conserves_energy(default_run):

@@ -134,12 +134,12 @@ class EnergyAudit:
 
 
 def energy_regions(model: GranularModel) -> tuple[list[str], np.ndarray]:
-    """(names, (n_bodies,) region of each body): the beads by material, then the striker, if
-    any, as a region of its own (so that what it keeps is not counted in the packing)."""
+    """(names, (n_bodies,) region of each body): the beads by material, then the strikers, if
+    any, as one region of their own (so that what they keep is not counted in the packing)."""
     names = [m.name for m in model.materials[:1 + len(model.extra_materials)]]
     regions = model.lattice.material_ids
     if model.has_striker:
-        names, regions = [*names, "striker"], np.append(regions, len(names))
+        names, regions = [*names, "striker"], np.append(regions, np.full(len(model.strikers), len(names)))
     return names, regions
 
 

@@ -1,4 +1,4 @@
-"""Figures a researcher would publish: arrival-time maps (Fig. 8) and peak decay (Figs. 6, 9).
+"""Figures a researcher would publish: arrival-time and peak maps (Fig. 8) and peak decay (Figs. 6, 9).
 
 Every function draws into a new figure and saves it atomically as PNG (non-interactive
 Agg backend, so it works on machines without a display).
@@ -12,6 +12,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import PatchCollection  # noqa: E402
+from matplotlib.colors import LogNorm  # noqa: E402
 from matplotlib.patches import Circle  # noqa: E402
 
 from hexdem.analysis.front_shape import HEXAGON_SIXFOLD  # noqa: E402
@@ -38,9 +39,10 @@ def save(fig, path) -> None:
     plt.close(fig)
 
 
-def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=None):
-    """Beads as true-size circles coloured by ``values`` (NaN drawn grey); returns the mappable."""
-    circles = PatchCollection([Circle(p, d / 2) for p, d in zip(positions, diameters)],
+def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=None, norm=None):
+    """Beads as true-size circles coloured by ``values`` (NaN drawn grey) through ``norm`` (None:
+    linear); returns the mappable."""
+    circles = PatchCollection([Circle(p, d / 2) for p, d in zip(positions, diameters)], norm=norm,
                               cmap=plt.get_cmap(cmap).with_extremes(bad="lightgrey"), edgecolor="k", linewidth=0.2)
     circles.set_array(np.ma.masked_invalid(values))
     if clim is not None:
@@ -70,23 +72,38 @@ def draw_walls(ax, walls, positions, radii, scale=1.0, **style):
         ax.plot(ends[:, 0], ends[:, 1], **{"color": "k", "linewidth": 2, **style})
 
 
-def arrival_map(results, model, path, title="Wavefront arrival time") -> None:
-    """Every bead's arrival time on the lattice (like Fig. 8a), walls drawn, struck bead marked."""
+def lattice_map(results, model, values, path, label: str, title: str, cmap="viridis", norm=None) -> None:
+    """One value per bead drawn on the lattice (like Fig. 8a), walls drawn, struck beads marked."""
     units = UNIT_LABELS[results.units]
     scale = 1.0 / results.length_unit_m
     positions = results.positions
     diameters = model.lattice.diameters_m * scale
     fig, ax = plt.subplots(figsize=(7, 6))
     fig.subplots_adjust(left=0.12, right=0.98, bottom=0.09, top=0.94)
-    bead_map(ax, positions, diameters, results.arrival_time * units["time_scale"],
-             cmap="viridis_r", label=f"arrival time [{units['time']}]")
+    bead_map(ax, positions, diameters, values, cmap=cmap, label=label, norm=norm)
     draw_walls(ax, model.walls, positions, diameters / 2, scale=scale)
-    struck = positions[model.lattice.struck]
-    ax.plot(*struck, marker="x", color="w", markersize=8, mew=2)
+    struck = positions[np.unique(model.struck_beads)]
+    ax.plot(struck[:, 0], struck[:, 1], linestyle="", marker="x", color="w", markersize=8, mew=2)
     ax.set_xlabel(f"x [{units['length']}]")
     ax.set_ylabel(f"y [{units['length']}]")
     set_title(ax, title)
     save(fig, path)
+
+
+def arrival_map(results, model, path, title="Wavefront arrival time") -> None:
+    """Every bead's arrival time on the lattice (like Fig. 8a)."""
+    units = UNIT_LABELS[results.units]
+    lattice_map(results, model, results.arrival_time * units["time_scale"], path,
+                f"arrival time [{units['time']}]", title, cmap="viridis_r")
+
+
+def peak_map(results, model, v0: float, path, title="Peak speed") -> None:
+    """Every bead's peak speed over V0 on the lattice, on a logarithmic scale (the fronts decay
+    by decades as they spread)."""
+    ratio = results.peak_speed / v0
+    floor = max(float(np.nanmin(ratio[ratio > 0])) if np.any(ratio > 0) else 1e-3, 1e-3)
+    lattice_map(results, model, ratio, path, "peak speed $V_{max} / V_0$", title, cmap="magma",
+                norm=LogNorm(floor, max(float(np.nanmax(ratio)), floor * 10)))
 
 
 def peak_decay(rows_by_line: dict, path, units_name: str, v0: float, title="Peak speed along the observation lines"):

@@ -202,7 +202,8 @@ def front_shape(positions, arrival_times, origin, times, n_bins=DEFAULT_BINS, mi
     Each ray is read up to ``wall_margin`` from where it leaves the packing; with
     ``window_deg``, only the rays of that window about +x are used. Times at which fewer than
     ``min_bins`` rays (default ``n_bins // 6``: 60°, one sixfold period; with a window, all of
-    its rays) meet the front get NaN radius and amplitude; ``bins_used`` counts those rays.
+    its rays) meet the front get NaN radius and amplitude (a front of mean radius 0, NaN
+    amplitude); ``bins_used`` counts those rays.
     """
     rays = _rays(positions, arrival_times, origin, n_bins)
     window = _window(rays, window_deg)
@@ -216,7 +217,8 @@ def front_shape(positions, arrival_times, origin, times, n_bins=DEFAULT_BINS, mi
         used[i] = np.isfinite(radius).sum()
         if used[i] >= min_bins:
             mean[i], a6, b6 = sixfold_components(rays.theta, radius)
-            cos6[i], sin6[i] = a6 / mean[i], b6 / mean[i]
+            if mean[i] > 0:  # (a front not round the origin, a flat striker's, may have none)
+                cos6[i], sin6[i] = a6 / mean[i], b6 / mean[i]
     return FrontShape(times, mean, np.hypot(cos6, sin6), used, cos6, sin6)
 
 

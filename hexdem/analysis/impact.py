@@ -19,7 +19,6 @@ from hexdem.analysis.tracker import ENERGY_SAMPLES, TrackedPulses
 from hexdem.analysis.trajectory import Trajectory
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel, RunSettings
-from hexdem.model.lattice import LINE_STEPS
 
 #: Columns of ``peaks.csv`` (a contract: scripts read them by name).
 #: A wall bead faces the strike when its inward normal points against it at least cos 30° as
@@ -100,11 +99,12 @@ class ImpactAnalysis:
         return self.tracked.trace_times, self.tracked.trace_speeds[:, [traced[int(b)] for b in beads]]
 
     def line_rows(self) -> list[tuple]:
-        """Rows of ``peaks.csv``: one per bead on each observation line, n from 0."""
+        """Rows of ``peaks.csv``: one per bead on each observation line (the paper's three first,
+        then the extra ones), n from 0."""
         r = self.results
         rows = []
-        for name in LINE_STEPS:
-            for n, bead in enumerate(r.lines[name]):
+        for name, beads in r.lines.items():
+            for n, bead in enumerate(beads):
                 rows.append((name, n, int(bead) + 1, *(float(v) for v in r.positions[bead]),
                              float(r.peak_speed[bead]), float(r.t_peak[bead]), float(r.arrival_time[bead])))
         return rows

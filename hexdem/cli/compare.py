@@ -19,7 +19,7 @@ def add_arguments(parser) -> None:
                         help="allowed relative peak-speed difference (default 0.005)")
     parser.add_argument("--arrival-tol", type=float, metavar="SECONDS",
                         help="allowed arrival-time difference in seconds (default 2e-6)")
-    parser.set_defaults(engine=None, dump=None)
+    parser.set_defaults(engine=None, dump=None, movie=None)
 
 
 def run(args) -> None:

@@ -15,13 +15,17 @@ def add_arguments(parser) -> None:
     add_launcher(parser)
     parser.add_argument("--dump", action="store_true", default=None,
                         help="also write LAMMPS's full trajectory dump into DIR/deck (config key dump = true)")
+    parser.add_argument("--movie", action="store_true", default=None,
+                        help="also write DIR/movie.gif, the speed field animated from samples taken in the run "
+                             "(config key movie = true)")
 
 
 def config_from_args(args) -> RunConfig:
     """The config file (or the defaults) with command-line overrides applied."""
     config = RunConfig.from_toml(args.config) if args.config else RunConfig()
     overrides = {key: value for key, value in (("ranks", args.ranks), ("engine", args.engine),
-                                               ("dump", args.dump), ("launcher", args.launcher)) if value is not None}
+                                               ("dump", args.dump), ("movie", args.movie),
+                                               ("launcher", args.launcher)) if value is not None}
     return config.replace(**overrides)
 
 

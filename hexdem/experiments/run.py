@@ -2,9 +2,11 @@
 
 :func:`run_experiment` validates everything before it touches the disk, runs the engine in
 ``OUT/deck.inprogress`` and, only when the run and its analysis succeeded, publishes
-``OUT/deck`` (inputs, log, the dump if asked for), ``peaks.csv``, ``summary.json``,
-``arrival_map.png``, ``peak_decay.png``, ``front_shape.csv`` and ``front_shape.png``, each
-written atomically. A failed run leaves its inputs and log in
+``OUT/deck`` (inputs, log, the dump if asked for) and :data:`RESULT_FILES` (``peaks.csv``
+along the observation lines, ``beads.csv`` of every bead, ``summary.json``, the arrival and
+peak maps, ``peak_decay.png``, ``front_shape.csv`` and ``.png``, ``energy_regions.csv``), with
+``energy_regions.png`` when the beads are of several materials and ``movie.gif`` on request,
+each written atomically. A failed run leaves its inputs and log in
 ``OUT/deck.failed`` for inspection and no result files.
 """
 
@@ -21,6 +23,7 @@ import numpy as np
 from hexdem.analysis import figures as plots
 from hexdem.analysis.front_shape import FRONT_SHAPE_COLUMNS, FrontShape, front_shape, front_times
 from hexdem.analysis.impact import PEAK_COLUMNS, ImpactAnalysis
+from hexdem.analysis.movie import movie_samples, speed_movie
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.common.machine import free_disk_bytes
 from hexdem.errors import HexdemError
@@ -31,7 +34,9 @@ from hexdem.model.config import RunConfig
 #: The configuration of a LAMMPS deck, in its directory (read by ``hexdem analyse``).
 CONFIG_NAME = "hexdem.json"
 RESULT_FILES = ("peaks.csv", "summary.json", "arrival_map.png", "peak_decay.png", "front_shape.csv",
-                "front_shape.png", "energy_regions.csv")
+                "front_shape.png", "energy_regions.csv", "beads.csv", "peak_map.png")
+#: Columns of ``beads.csv``: every bead's label, position, material and pulse (run's units).
+BEAD_COLUMNS = ("bead_id", "m", "n", "x", "y", "material", "peak_speed", "t_peak", "arrival_time")
 #: Columns of ``energy_regions.csv``: time in the run's units, energies in J, share of the total.
 ENERGY_REGION_COLUMNS = ("time", "region", "kinetic_energy_j", "contact_energy_j", "energy_fraction")
 #: Bytes per atom and frame of a full-precision dump (measured: 30 MB for 331 atoms x 701 frames).
@@ -57,7 +62,8 @@ def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples
 
     ``trace_lines`` (observation line names) keep the speeds of those lines' beads at every
     sample, ``field_samples`` every bead's speed at those samples (see
-    :class:`~hexdem.analysis.tracker.PulseTracker`). A LAMMPS deck directory also gets
+    :class:`~hexdem.analysis.tracker.PulseTracker`), and those of the movie's frames
+    (:func:`~hexdem.analysis.movie.movie_samples`) with ``config.movie``. A LAMMPS deck directory also gets
     ``hexdem.json`` (the configuration), which ``hexdem analyse`` reads.
     """
     log = log or (lambda message: None)
@@ -71,8 +77,9 @@ def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples
         f"{settings.n_steps} steps of {settings.dt_s:.4g} s ({settings.duration_s * 1e3:.4g} ms), "
         f"{config.ranks if config.engine == 'lammps' else 1} rank(s), {settings.n_samples} samples analysed in the run")
     traced = tuple(int(bead) for line in trace_lines for bead in model.lattice.line(line))
+    frames = movie_samples(settings.n_samples) if config.movie else ()
     job = ImpactJob(model, settings, config.engine, workdir, dump=config.dump, trace_beads=traced,
-                    field_samples=tuple(field_samples))
+                    field_samples=tuple(sorted(set(field_samples) | set(frames))))
     analysis = track_impact(job, config.ranks, comm, config.launcher)
     check_energy(analysis, workdir)
     return analysis
@@ -82,8 +89,8 @@ def check_dump_space(config: RunConfig, out: Path) -> None:
     """Refuse a run whose requested dump would not fit on the disk of ``out``."""
     if not (config.dump and config.engine == "lammps"):
         return
-    settings = config.settings()
-    needed = DUMP_BYTES_PER_ATOM_FRAME * settings.n_samples * (config.n_beads() + (config.impact == "striker"))
+    model = config.model()
+    needed = DUMP_BYTES_PER_ATOM_FRAME * config.settings(model).n_samples * model.n_bodies
     free = free_disk_bytes(out)
     if needed > free:
         raise HexdemError(f"the dump would take about {needed / 1e9:.3g} GB and {out} has {free / 1e9:.3g} GB free; "
@@ -128,10 +135,12 @@ def summary(config: RunConfig, analysis: ImpactAnalysis, wall_time_s: float) -> 
 def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_time_s: float) -> None:
     rows = analysis.line_rows()
     write_csv(out / "peaks.csv", PEAK_COLUMNS, rows)
+    write_csv(out / "beads.csv", BEAD_COLUMNS, bead_rows(analysis))
     write_json(out / "summary.json", summary(config, analysis, wall_time_s))
-    r = analysis.results
-    plots.arrival_map(r, analysis.model, out / "arrival_map.png",
-                      title=f"Arrival time, {analysis.model.lattice.shape}, V0 = {config.v0:g}")
+    r, model = analysis.results, analysis.model
+    plots.arrival_map(r, model, out / "arrival_map.png", title=f"Arrival time, {model.lattice.shape}, V0 = {config.v0:g}")
+    v0 = max(impact.speed_m_s for impact in model.impacts) / analysis.settings.units.velocity_m_s
+    plots.peak_map(r, model, v0, out / "peak_map.png", title=f"Peak speed, {model.lattice.shape}")
     by_line = {name: (np.arange(len(beads)), r.peak_speed[beads]) for name, beads in r.lines.items()}
     plots.peak_decay(by_line, out / "peak_decay.png", r.units, config.v0)
     if config.sensors:
@@ -143,6 +152,20 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
     if analysis.model.extra_materials:
         plots.energy_regions_figure(r, out / "energy_regions.png",
                                     title=f"Where the energy is, {', '.join(r.region_names)}")
+    tracked = analysis.tracked
+    if config.movie and tracked is not None and len(tracked.field_times):  # (a dump read back has no fields)
+        speed_movie(r, model, tracked.field_times, tracked.field_speeds, v0, out / "movie.gif", title=model.lattice.shape)
+
+
+def bead_rows(analysis: ImpactAnalysis) -> list[tuple]:
+    """Rows of ``beads.csv``: every bead, id from 1, with its label {m, n}, position, material
+    and pulse."""
+    r, model = analysis.results, analysis.model
+    names = [material.name for material in model.materials]
+    return [(b + 1, int(m), int(n), float(x), float(y), names[material], float(peak), float(t_peak), float(arrival))
+            for b, ((m, n), (x, y), material, peak, t_peak, arrival)
+            in enumerate(zip(model.lattice.indices, r.positions, model.lattice.material_ids, r.peak_speed, r.t_peak,
+                             r.arrival_time))]
 
 
 def energy_region_rows(results) -> list[tuple]:

@@ -10,7 +10,6 @@ keys are the field names. ``v0``, ``dt`` and ``duration`` are in the run's ``uni
 from __future__ import annotations
 
 import dataclasses
-import itertools
 import math
 import tomllib
 from dataclasses import dataclass
@@ -21,14 +20,16 @@ from hexdem.common.machine import available_memory_bytes
 from hexdem.errors import HexdemError
 from hexdem.model.dissipation import damping_coefficient, lammps_tsuji_coefficient
 from hexdem.model.granular import GranularModel, Impact, RunSettings
-from hexdem.model.hertz import contact_time
+from hexdem.model.impacts import ImpactSpec, impact_specs, resolve_impacts, struck_site
 from hexdem.model.lattice import (LINE_STEPS, Lattice, disc, half_disc, half_hexagon, hexagon, parallelogram, triangle,
-                                   without_sites)
+                                   with_holes, without_sites)
+from hexdem.model.lines import with_lines
 from hexdem.model.sites import read_sites
 from hexdem.model.materials import (PAPER_DIAMETER_M, Material, custom_materials, hertz_coefficient, hertz_stiffness,
-                                     material, sphere_mass)
-from hexdem.model.precompression import hole_force, precompressed_lattice, spring_stiffness
+                                     material)
+from hexdem.model.precompression import hole_force, precompressed_lattice
 from hexdem.model.regions import assign_materials
+from hexdem.model.timescale import impact_contact_time_s
 from hexdem.model.units import SI, UnitSystem, nondimensional
 
 SHAPES = ("hexagon", "half-hexagon", "half-disc", "triangle", "parallelogram", "disc", "sites")
@@ -92,6 +93,12 @@ class RunConfig:
     they select another material (:mod:`hexdem.model.regions`): interfaces, strips, intruders.
     ``striker_material``, ``striker_diameter_m``: the striker's (None: the beads' material and
     the nominal diameter).
+    ``impacts``: several impacts, or one elsewhere than {0, 0}: tables {site = [m, n] or
+    edge_deg, v0, angle_deg, kind, striker_material, striker_diameter_m}, each defaulting to the
+    run's own (:mod:`hexdem.model.impacts`); empty: the paper's single impact (``v0``,
+    ``strike_angle_deg``, ``impact`` on {0, 0}).
+    ``lines``: observation lines besides the paper's, tables {name, site, angle_deg}
+    (:mod:`hexdem.model.lines`). ``movie``: ``hexdem run`` also writes ``movie.gif``.
     ``launcher``: the MPI launcher command that starts the ranks (None: this environment's
     ``mpiexec``; e.g. ``"mpiexec -f hosts"`` or ``"srun"`` to span machines); given, the run goes
     through it even on one rank.
@@ -118,6 +125,9 @@ class RunConfig:
     regions: tuple = ()
     striker_material: str | None = None
     striker_diameter_m: float | None = None
+    impacts: tuple = ()
+    lines: tuple = ()
+    movie: bool = False
     units: str = "si"
     v0: float = 0.4
     strike_angle_deg: float = 0.0
@@ -147,7 +157,7 @@ class RunConfig:
         if positive_int("steps_per_contact", self.steps_per_contact) < MIN_STEPS_PER_CONTACT:
             raise HexdemError(f"steps_per_contact must be at least {MIN_STEPS_PER_CONTACT} (the Hertz contact "
                               f"needs them), got {self.steps_per_contact}")
-        for name in ("sensors", "sites", "site_walls_deg", "vacancies", "regions"):
+        for name in ("sensors", "sites", "site_walls_deg", "vacancies", "regions", "impacts", "lines"):
             if not isinstance(getattr(self, name), (list, tuple)):
                 raise HexdemError(f"{name} must be a list, got {getattr(self, name)!r}")
             object.__setattr__(self, name, tuple(tuple(v) if isinstance(v, list) else v for v in getattr(self, name)))
@@ -157,8 +167,9 @@ class RunConfig:
             raise HexdemError(f"precompression_n must be a force >= 0 N, got {self.precompression_n!r}")
         if self.launcher is not None and not (isinstance(self.launcher, str) and self.launcher.split()):
             raise HexdemError(f"launcher must be a command such as \"mpiexec -f hosts\", got {self.launcher!r}")
-        if not isinstance(self.dump, bool):
-            raise HexdemError(f"dump must be true or false, got {self.dump!r}")
+        for name in ("dump", "movie"):
+            if not isinstance(getattr(self, name), bool):
+                raise HexdemError(f"{name} must be true or false, got {getattr(self, name)!r}")
         for name in ("dt", "duration"):
             value = getattr(self, name)
             if value is not None and not (is_number(value) and value > 0):
@@ -243,29 +254,36 @@ class RunConfig:
         """The units of ``v0``, ``dt``, ``duration`` and of every result of this run."""
         return SI if self.units == "si" else nondimensional(self.diameter_m, self.material(self.bead_material))
 
+    def impact_specs(self) -> list[ImpactSpec]:
+        """The configured impacts, the run's values filled in (:func:`~hexdem.model.impacts.impact_specs`)."""
+        return impact_specs(self.impacts, self.v0, self.strike_angle_deg, self.impact, self.striker_material,
+                            self.striker_diameter_m)
+
     def lattice(self) -> Lattice:
-        """The packing: the ``shape``'s sites less the ``vacancies``, with its walls."""
+        """The packing: the ``shape``'s sites less the ``vacancies``, with its walls, struck at the
+        first impact's site, with the extra observation ``lines``."""
+        struck = struck_site(self.impact_specs())
         builders = {
-            "hexagon": lambda: hexagon(self.edge_beads, self.diameter_m),
-            "half-hexagon": lambda: half_hexagon(self.long_edge, self.short_edge, self.diameter_m),
-            "half-disc": lambda: half_disc(self.radius_beads, self.diameter_m),
-            "triangle": lambda: triangle(self.edge_beads, self.diameter_m),
-            "disc": lambda: disc(self.radius_beads, self.diameter_m),
+            "hexagon": lambda: hexagon(self.edge_beads, self.diameter_m, struck),
+            "half-hexagon": lambda: half_hexagon(self.long_edge, self.short_edge, self.diameter_m, struck),
+            "half-disc": lambda: half_disc(self.radius_beads, self.diameter_m, struck),
+            "triangle": lambda: triangle(self.edge_beads, self.diameter_m, struck),
+            "disc": lambda: disc(self.radius_beads, self.diameter_m, struck),
             "parallelogram": lambda: parallelogram(self.edge_beads, self.depth_beads or self.edge_beads,
-                                                   self.diameter_m),
-            "sites": lambda: read_sites(self.sites, self.sites_file, self.diameter_m, self.site_walls_deg),
+                                                   self.diameter_m, struck),
+            "sites": lambda: read_sites(self.sites, self.sites_file, self.diameter_m, self.site_walls_deg, struck),
         }
         if self.shape != "sites" and (self.sites or self.sites_file or self.site_walls_deg):
             raise HexdemError(f"sites, sites_file and site_walls_deg describe shape = \"sites\", not {self.shape!r}")
         lattice = builders[self.shape]()
-        return without_sites(lattice, self.vacancies) if self.vacancies else lattice
+        lattice = without_sites(lattice, self.vacancies) if self.vacancies else lattice
+        return with_lines(lattice, self.lines) if self.lines else lattice
 
     def model(self) -> GranularModel:
         """The SI :class:`GranularModel` this configuration describes."""
         if not (is_number(self.v0) and self.v0 > 0):
             raise HexdemError(f"v0 must be > 0 (the impact moves into the packing), got {self.v0!r}")
         wall = None if self.wall_material == "none" else self.material(self.wall_material)
-        impact = Impact(self.v0 * self.unit_system.velocity_m_s, self.strike_angle_deg, self.impact == "striker")
         wall_restitution = self.restitution if self.wall_restitution is None else self.wall_restitution
         for alpha in {damping_coefficient(self.restitution), damping_coefficient(wall_restitution)} - {0.0}:
             lammps_tsuji_coefficient(alpha)
@@ -284,10 +302,25 @@ class RunConfig:
             coefficient = float(hertz_coefficient(self.diameter_m, bead))
             lattice = precompressed_lattice(lattice, self.precompression_n, coefficient, hertz_stiffness(bead, wall))
             held = tuple(float(f) for f in hole_force(lattice, self.precompression_n))
-        striker = None if self.striker_material is None else self.material(self.striker_material)
-        return GranularModel(lattice, impact, bead, wall, self.restitution, wall_restitution, held,
-                             tuple(self.sensor_beads(lattice).values()), self.sensor_mass_factor, extra, striker,
-                             self.striker_diameter_m)
+        impacts = self._impacts(lattice)
+        if self.impacts:
+            beads = [lattice.struck if i.bead is None else i.bead for i in impacts]
+            holed = with_holes(lattice, beads, [i.direction for i in impacts])
+            if self.precompression_n > 0 and _wall_contacts(holed) != _wall_contacts(lattice):
+                raise HexdemError("a precompressed packing holds only the first impact's bead in a hole of its wall; "
+                                  "strike the other beads inside the packing")
+            lattice = holed
+        return GranularModel(lattice, impacts[0], bead, wall, self.restitution, wall_restitution, held,
+                             tuple(self.sensor_beads(lattice).values()), self.sensor_mass_factor, extra,
+                             tuple(impacts[1:]))
+
+    def _impacts(self, lattice: Lattice) -> list[Impact]:
+        """The model's impacts: the paper's single one on the struck bead, or those of ``impacts``."""
+        if not self.impacts:
+            striker = None if self.striker_material is None else self.material(self.striker_material)
+            return [Impact(self.v0 * self.unit_system.velocity_m_s, self.strike_angle_deg, self.impact == "striker",
+                           None, striker, self.striker_diameter_m)]
+        return resolve_impacts(self.impact_specs(), lattice, self.unit_system.velocity_m_s, self.material)
 
     def sensor_beads(self, lattice: Lattice) -> dict[str, int]:
         """{label: bead index} of the ``sensors``, in the order given ("line:n" or a bead id)."""
@@ -310,36 +343,17 @@ class RunConfig:
             raise HexdemError(f"sensors {list(self.sensors)} name the same bead twice")
         return beads
 
-    def _unlike_contact_times_s(self, speed_m_s: float) -> list[float]:
-        """Hertz contact times at ``speed_m_s`` of every other pair of bodies the packing holds:
-        beads of the regions' materials with each other and with the beads', and the striker
-        with each of them when it is of its own material or size."""
-        bead = self.material(self.bead_material)
-        bodies = [(bead, self.diameter_m)] + [(self.material(name), self.diameter_m)
-                                              for name in dict.fromkeys(r["material"] for r in self.regions)
-                                              if self.material(name) != bead]
-        pairs = list(itertools.combinations_with_replacement(bodies, 2))[1:]
-        if self.impact == "striker" and (self.striker_material is not None or self.striker_diameter_m is not None):
-            striker = (self.material(self.striker_material or self.bead_material), self.striker_diameter_m or self.diameter_m)
-            pairs += [(striker, body) for body in bodies]
-        times = []
-        for (a, da), (b, db) in pairs:
-            ma, mb = float(sphere_mass(da, a)), float(sphere_mass(db, b))
-            coefficient = hertz_stiffness(a, b) * math.sqrt(da * db / (2 * (da + db)))
-            times.append(float(contact_time(ma * mb / (ma + mb), coefficient, speed_m_s)))
-        return times
-
     def contact_time_s(self) -> float:
-        """The natural time scale of the impact [s]: the two-bead Hertz contact time at V0, or, if
-        shorter, half the period of two beads on the linearized precompressed contact, π sqrt(m/2k)."""
-        bead = self.material(self.bead_material)
-        mass = float(sphere_mass(self.diameter_m, bead))
-        coefficient = float(hertz_coefficient(self.diameter_m, bead))
-        speed = self.v0 * self.unit_system.velocity_m_s
-        hertz = min([float(contact_time(mass / 2, coefficient, speed)), *self._unlike_contact_times_s(speed)])
-        if self.precompression_n <= 0:
-            return hertz
-        return min(hertz, math.pi * math.sqrt(mass / 2 / spring_stiffness(self.precompression_n, coefficient)))
+        """The natural time scale of the impacts [s] (:func:`~hexdem.model.timescale.impact_contact_time_s`):
+        the shortest two-body Hertz contact time at an impact's V0, or, if shorter, half the
+        period of two beads on the linearized precompressed contact."""
+        strikers = [(spec.v0 * self.unit_system.velocity_m_s,
+                     (self.material(spec.striker_material or self.bead_material), spec.striker_diameter_m or self.diameter_m)
+                     if spec.striker and (spec.striker_material is not None or spec.striker_diameter_m is not None)
+                     else None) for spec in self.impact_specs()]
+        return impact_contact_time_s(self.material(self.bead_material), self.diameter_m,
+                                     [self.material(r["material"]) for r in self.regions], strikers,
+                                     self.precompression_n)
 
     def _step_and_sampling(self) -> tuple[float, int]:
         """(dt [s], steps between samples): ``dt`` or the contact time over ``steps_per_contact``,
@@ -366,8 +380,9 @@ class RunConfig:
             duration_s = self.duration * scale
         else:
             lattice = model.lattice
-            reach = (lattice.positions_m - lattice.positions_m[lattice.struck]) @ model.impact.direction
-            layers = math.ceil(reach.max() / (math.sqrt(3) / 2 * lattice.diameter_m))
+            reach = max(float(((lattice.positions_m - lattice.positions_m[bead]) @ impact.direction).max())
+                        for bead, impact in zip(model.struck_beads, model.impacts))
+            layers = math.ceil(reach / (math.sqrt(3) / 2 * lattice.diameter_m))
             duration_s = layers * self.contact_time_s()
         sensor_every = 0
         if self.sensors:
@@ -377,3 +392,8 @@ class RunConfig:
         n_steps = max(1, round(duration_s / dt_s))
         return RunSettings(dt_s=dt_s, n_steps=n_steps, dump_every=every, units=self.unit_system,
                            sensor_every=sensor_every, contact_time_s=self.contact_time_s())
+
+
+def _wall_contacts(lattice: Lattice) -> int:
+    """How many bead–wall contacts the walls of ``lattice`` hold."""
+    return sum(len(wall.members) for wall in lattice.walls)

@@ -2,9 +2,10 @@
 
 A :class:`GranularModel` says everything an engine needs to integrate the paper's
 Hamiltonian (Sec. III): bead masses, Hertz stiffnesses of bead–bead and bead–wall
-contacts, the walls, and the initial state. The optional striker is an extra body (the
-last one), a sphere of the bead material and nominal diameter that touches the struck
-bead at t = 0 and moves towards it.
+contacts, the walls, and the initial state. The model is struck by one or more
+:class:`Impact` s; each either sets its bead moving or sends a striker sphere at it. The
+strikers are extra bodies after the beads, in the order of the impacts, each touching its
+bead at t = 0 and moving towards it.
 """
 
 from __future__ import annotations
@@ -23,30 +24,49 @@ from hexdem.model.units import SI, UnitSystem
 
 @dataclass(frozen=True)
 class Impact:
-    """How the packing is struck.
+    """One impact on the packing.
 
-    ``speed_m_s`` V0 > 0 [m/s]; ``angle_deg`` strike angle from +x; ``striker`` False:
+    ``speed_m_s`` V0 > 0 [m/s]; ``angle_deg`` direction of motion from +x; ``striker`` False:
     V0 is given to the struck bead (the paper's numerics); True: a striker sphere moving
-    at V0 hits it (the experiment).
+    at V0 hits it (the experiment), of ``striker_material`` (None: the beads' material) and
+    diameter ``striker_diameter_m`` (None: the nominal d). ``bead``: the index of the struck
+    bead (None: the lattice's struck bead, on the paper's edge, where the angle must point
+    into the packing, |angle| < 90°).
     """
 
     speed_m_s: float
     angle_deg: float = 0.0
     striker: bool = False
+    bead: int | None = None
+    striker_material: Material | None = None
+    striker_diameter_m: float | None = None
 
     def __post_init__(self):
         if not (is_number(self.speed_m_s) and self.speed_m_s > 0):
             raise HexdemError(f"impact velocity V0 must be > 0 (towards the packing), got {self.speed_m_s}")
-        strike_direction(self.angle_deg)
+        if self.bead is None:
+            strike_direction(self.angle_deg)
+        elif not (is_number(self.angle_deg) and np.isfinite(self.angle_deg)):
+            raise HexdemError(f"impact angle must be a number of degrees, got {self.angle_deg!r}")
+        if self.striker_diameter_m is not None and not (is_number(self.striker_diameter_m) and self.striker_diameter_m > 0):
+            raise HexdemError(f"striker diameter must be > 0 m, got {self.striker_diameter_m!r}")
 
     @property
     def direction(self) -> np.ndarray:
-        return strike_direction(self.angle_deg)
+        """Unit vector of the impact's motion."""
+        if self.bead is None:
+            return strike_direction(self.angle_deg)
+        return np.array([np.cos(np.radians(self.angle_deg)), np.sin(np.radians(self.angle_deg))])
+
+
+#: A striker may start closer than this many d to another body only by round-off (an oblique
+#: striker, or the spheres of a flat striker, touch their neighbours exactly).
+STRIKER_OVERLAP_D = 1e-6
 
 
 @dataclass(frozen=True)
 class GranularModel:
-    """Lattice, materials and impact of one simulation (SI units).
+    """Lattice, materials and impacts of one simulation (SI units).
 
     ``wall`` is the wall-lining material, or None for a packing without walls;
     ``restitution`` and ``wall_restitution`` the coefficients of restitution of bead–bead and
@@ -57,9 +77,11 @@ class GranularModel:
     whose mass is ``sensor_mass_factor`` times a plain bead's (the accelerometer inside).
 
     Materials: bead material id 0 is ``bead``, ids 1, 2, … are ``extra_materials`` (the
-    lattice's ``material_ids`` say which bead is which); the striker is of ``striker_material``
-    (None: ``bead``) and of diameter ``striker_diameter_m`` (None: the nominal d). Every
-    contact is Hertz's with the pair's own E* and R_eff (:meth:`contact_stiffness_pa`).
+    lattice's ``material_ids`` say which bead is which); then the strikers' own materials.
+    Every contact is Hertz's with the pair's own E* and R_eff (:meth:`contact_stiffness_pa`).
+
+    Impacts: ``impact`` (the paper's single impact by default) and ``more_impacts``, each on
+    its own bead (:attr:`impacts`).
     """
 
     lattice: Lattice
@@ -72,8 +94,7 @@ class GranularModel:
     sensor_beads: tuple[int, ...] = ()
     sensor_mass_factor: float = 1.0
     extra_materials: tuple[Material, ...] = ()
-    striker_material: Material | None = None
-    striker_diameter_m: float | None = None
+    more_impacts: tuple[Impact, ...] = ()
 
     def __post_init__(self):
         check_restitution("restitution", self.restitution)
@@ -83,8 +104,52 @@ class GranularModel:
         if len(self.lattice) and self.lattice.material_ids.max() > len(self.extra_materials):
             raise HexdemError(f"bead material id {self.lattice.material_ids.max()} has no material "
                               f"({1 + len(self.extra_materials)} given)")
-        if self.striker_diameter_m is not None and not (is_number(self.striker_diameter_m) and self.striker_diameter_m > 0):
-            raise HexdemError(f"striker diameter must be > 0 m, got {self.striker_diameter_m!r}")
+        beads = self.struck_beads
+        outside = [int(b) for b in beads if not 0 <= b < len(self.lattice)]
+        if outside:
+            raise HexdemError(f"an impact strikes bead index {outside[0]}, not in the packing of {len(self.lattice)}")
+        struck, counts = np.unique(beads, return_counts=True)
+        if counts.max() > 1:
+            twice = self.lattice.indices[struck[counts.argmax()]]
+            raise HexdemError(f"two impacts strike the same bead {{{twice[0]}, {twice[1]}}}")
+        if self.has_striker:
+            self._check_strikers_clear()
+
+    def _check_strikers_clear(self) -> None:
+        """Refuse a striker that starts inside another body (it must come from outside the packing)."""
+        positions, radii = self.initial_positions_m(), self.diameters_m / 2
+        n_beads = len(self.lattice)
+        for k, body in enumerate(range(n_beads, self.n_bodies)):
+            gaps = np.linalg.norm(positions - positions[body], axis=1) - radii - radii[body]
+            gaps[body] = np.inf
+            worst = int(np.argmin(gaps))
+            if gaps[worst] < -STRIKER_OVERLAP_D * self.lattice.diameter_m:
+                bead = self.lattice.indices[self.struck_beads[self._striker_impacts[k]]]
+                other = (f"bead {{{self.lattice.indices[worst][0]}, {self.lattice.indices[worst][1]}}}"
+                         if worst < n_beads else "another striker")
+                raise HexdemError(f"the striker of the impact on bead {{{bead[0]}, {bead[1]}}} would start inside "
+                                  f"{other} ({-gaps[worst] / self.lattice.diameter_m:.3g} d overlap): strike from "
+                                  "outside the packing, or use a velocity impact")
+
+    @property
+    def impacts(self) -> tuple[Impact, ...]:
+        """Every impact, ``impact`` first."""
+        return (self.impact, *self.more_impacts)
+
+    @property
+    def struck_beads(self) -> np.ndarray:
+        """(n_impacts,) the bead index each impact strikes."""
+        return np.array([self.lattice.struck if i.bead is None else i.bead for i in self.impacts], dtype=int)
+
+    @property
+    def _striker_impacts(self) -> list[int]:
+        """Indices into :attr:`impacts` of the impacts by a striker, in body order."""
+        return [k for k, impact in enumerate(self.impacts) if impact.striker]
+
+    @property
+    def strikers(self) -> tuple[Impact, ...]:
+        """The impacts by a striker sphere, in the order of their bodies (after the beads)."""
+        return tuple(self.impacts[k] for k in self._striker_impacts)
 
     @property
     def dissipative(self) -> bool:
@@ -108,32 +173,35 @@ class GranularModel:
 
     @property
     def has_striker(self) -> bool:
-        return self.impact.striker
+        return any(impact.striker for impact in self.impacts)
 
     @property
     def n_bodies(self) -> int:
-        """Beads plus the striker, if any (the striker is the last body)."""
-        return len(self.lattice) + int(self.has_striker)
+        """Beads plus the strikers (the strikers are the last bodies)."""
+        return len(self.lattice) + len(self.strikers)
 
     @property
     def diameters_m(self) -> np.ndarray:
-        extra = [self.striker_diameter_m or self.lattice.diameter_m] if self.has_striker else []
-        return np.concatenate([self.lattice.diameters_m, extra])
+        strikers = [s.striker_diameter_m or self.lattice.diameter_m for s in self.strikers]
+        return np.concatenate([self.lattice.diameters_m, strikers])
+
+    @property
+    def _striker_materials(self) -> tuple[Material, ...]:
+        return tuple(dict.fromkeys(s.striker_material for s in self.strikers if s.striker_material is not None))
 
     @property
     def materials(self) -> tuple[Material, ...]:
-        """Materials by id: the beads' (``bead``, then ``extra_materials``), then the striker's
-        if it has its own."""
-        striker = (self.striker_material,) if self.striker_material is not None else ()
-        return (self.bead, *self.extra_materials, *striker)
+        """Materials by id: the beads' (``bead``, then ``extra_materials``), then the strikers'
+        own, each once."""
+        return (self.bead, *self.extra_materials, *self._striker_materials)
 
     @property
     def material_ids(self) -> np.ndarray:
         """(n_bodies,) each body's index into :attr:`materials`."""
-        if not self.has_striker:
-            return self.lattice.material_ids
-        striker = len(self.materials) - 1 if self.striker_material is not None else 0
-        return np.append(self.lattice.material_ids, striker)
+        first = 1 + len(self.extra_materials)
+        own = {m: first + k for k, m in enumerate(self._striker_materials)}
+        strikers = [own.get(s.striker_material, 0) for s in self.strikers]
+        return np.append(self.lattice.material_ids, np.array(strikers, dtype=int))
 
     @property
     def densities_kg_m3(self) -> np.ndarray:
@@ -181,19 +249,26 @@ class GranularModel:
     def walls(self):
         return self.lattice.walls if self.wall is not None else ()
 
+    def impact_bodies(self) -> np.ndarray:
+        """(n_impacts,) the body each impact sets moving: its striker, or its bead."""
+        bodies, striker = self.struck_beads.copy(), len(self.lattice)
+        for k in self._striker_impacts:
+            bodies[k], striker = striker, striker + 1
+        return bodies
+
     def initial_positions_m(self) -> np.ndarray:
-        """(n_bodies, 2) positions at t = 0; a striker touches the struck bead from outside."""
+        """(n_bodies, 2) positions at t = 0; each striker touches its bead from outside."""
         pos = self.lattice.positions_m
-        if not self.has_striker:
-            return pos.copy()
-        struck = self.lattice.struck
-        gap = (self.lattice.diameters_m[struck] + self.diameters_m[-1]) / 2
-        return np.vstack([pos, pos[struck] - gap * self.impact.direction])
+        beads, diameters = self.struck_beads, self.diameters_m
+        strikers = [pos[beads[k]] - (diameters[beads[k]] + diameters[body]) / 2 * self.impacts[k].direction
+                    for k, body in zip(self._striker_impacts, self.impact_bodies()[self._striker_impacts])]
+        return np.vstack([pos, *strikers]) if strikers else pos.copy()
 
     def initial_velocities_m_s(self) -> np.ndarray:
-        """(n_bodies, 2) velocities at t = 0: V0 on the striker, or on the struck bead."""
+        """(n_bodies, 2) velocities at t = 0: each impact's V0 on its striker, or on its bead."""
         vel = np.zeros((self.n_bodies, 2))
-        vel[-1 if self.has_striker else self.lattice.struck] = self.impact.speed_m_s * self.impact.direction
+        for impact, body in zip(self.impacts, self.impact_bodies()):
+            vel[body] = impact.speed_m_s * impact.direction
         return vel
 
 

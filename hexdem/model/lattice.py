@@ -33,6 +33,11 @@ from hexdem.errors import HexdemError
 
 #: Observation lines and the step in (m, n) between consecutive beads on each.
 LINE_STEPS = {"0": (0, 2), "+30": (1, 1), "-30": (-1, 1)}
+#: The step in (m, n) between consecutive sites along each of the lattice's twelve directions, by
+#: angle from +x [deg]: odd multiples of 30° run along touching beads (spacing d), multiples of
+#: 60° between them (spacing √3 d).
+DIRECTION_STEPS = {0: (0, 2), 30: (1, 1), 60: (3, 1), 90: (2, 0), 120: (3, -1), 150: (1, -1), 180: (0, -2),
+                   -150: (-1, -1), -120: (-3, -1), -90: (-2, 0), -60: (-3, 1), -30: (-1, 1)}
 #: Index offsets of the three neighbours counted once per bond (paper's e₁, e₂, e₃).
 BOND_STEPS = ((2, 0), (1, 1), (-1, 1))
 #: A bead belongs to a wall's contact group when its gap to the wall is below this many d.
@@ -114,7 +119,9 @@ class Lattice:
     ``diameters_m`` (N,) per-bead diameters [m] (all equal for the ideal lattice);
     ``diameter_m`` the nominal diameter d; ``struck`` index of the struck bead;
     ``walls`` the confining walls; ``shape`` a readable description; ``material_ids`` (N,)
-    each bead's material, an index into the model's materials (None: all 0, the bead material).
+    each bead's material, an index into the model's materials (None: all 0, the bead material);
+    ``extra_lines`` observation lines besides the paper's three, each (name, start site (m, n),
+    step (dm, dn)).
     """
 
     indices: np.ndarray
@@ -125,6 +132,7 @@ class Lattice:
     walls: tuple[Wall | CurvedWall, ...]
     shape: str
     material_ids: np.ndarray | None = None
+    extra_lines: tuple = ()
     _lookup: dict = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
@@ -151,11 +159,19 @@ class Lattice:
                  for dm, dn in BOND_STEPS if (j := self.index_of(m + dm, n + dn)) is not None]
         return np.array(pairs, dtype=int).reshape(-1, 2)
 
+    def _line_starts(self) -> dict:
+        """{line name: (start site, step)}: the paper's lines from the struck bead, then the extra ones."""
+        struck = tuple(int(v) for v in self.indices[self.struck])
+        return {**{name: (struck, step) for name, step in LINE_STEPS.items()},
+                **{name: (tuple(site), tuple(step)) for name, site, step in self.extra_lines}}
+
     def line(self, name: str) -> np.ndarray:
-        """Bead indices on observation line ``name`` ("0", "+30", "-30"), from the struck bead."""
-        if name not in LINE_STEPS:
-            raise HexdemError(f"unknown observation line {name!r}; known: {', '.join(LINE_STEPS)}")
-        (m0, n0), (dm, dn) = self.indices[self.struck], LINE_STEPS[name]
+        """Bead indices on observation line ``name`` ("0", "+30", "-30" from the struck bead, or an
+        extra line from its own start), from its start on."""
+        starts = self._line_starts()
+        if name not in starts:
+            raise HexdemError(f"unknown observation line {name!r}; known: {', '.join(starts)}")
+        (m0, n0), (dm, dn) = starts[name]
         beads, k = [], 0
         while (i := self.index_of(m0 + k * dm, n0 + k * dn)) is not None:
             beads.append(i)
@@ -163,7 +179,7 @@ class Lattice:
         return np.array(beads, dtype=int)
 
     def lines(self) -> dict[str, np.ndarray]:
-        return {name: self.line(name) for name in LINE_STEPS}
+        return {name: self.line(name) for name in self._line_starts()}
 
     def with_geometry(self, positions_m, diameters_m) -> "Lattice":
         """The same labels with new positions and diameters, walls re-placed to touch them."""
@@ -250,19 +266,37 @@ def without_sites(lattice: Lattice, vacancies) -> Lattice:
                    shape=shape, material_ids=lattice.material_ids[keep])
 
 
+#: A struck bead sits in a hole of every wall whose inward normal is within 60° of its motion
+#: (the wall it would be pushed through; not the other wall of a corner bead struck along an edge).
+HOLE_COSINE = 0.5 + 1e-9
+
+
+def with_holes(lattice: Lattice, beads, directions) -> Lattice:
+    """``lattice`` with each of ``beads`` (indices) taken out of the walls it would be pushed
+    through moving along its unit vector of ``directions`` (N, 2): the holes of several impacts.
+    A wall left without members is dropped (an edge struck whole)."""
+    walls = []
+    for wall in lattice.walls:
+        members = set(wall.members.tolist())
+        for bead, direction in zip(beads, np.asarray(directions, float).reshape(-1, 2)):
+            if bead in members and wall.normals_at(lattice.positions_m[[bead]])[0] @ direction > HOLE_COSINE:
+                members.discard(bead)
+        if members:
+            walls.append(replace(wall, members=np.array(sorted(members), dtype=int)))
+    return replace(lattice, walls=tuple(walls))
+
+
 def touching_walls(lattice: Lattice, normals) -> tuple[Wall, ...]:
     """Flat walls with the given inward normals, each touching the packing without overlap.
 
-    The wall whose normal is +x (the struck edge) has a hole: the struck bead is not a member
-    and, sitting in the hole, does not decide where that wall is (it may protrude when the
-    diameters vary).
+    The struck bead's wall has a hole: the struck bead is a member of no wall and, sitting in
+    the hole, does not decide where a wall is (it may protrude when the diameters vary).
     """
     walls = []
     for normal in normals:
         normal = (float(normal[0]), float(normal[1]))
         reach = lattice.positions_m @ np.asarray(normal) - lattice.radii_m
-        if np.isclose(normal[0], 1.0):
-            reach[lattice.struck] = np.inf
+        reach[lattice.struck] = np.inf
         offset = float(reach.min())
         members = np.flatnonzero(reach - offset < WALL_GROUP_GAP * lattice.diameter_m)
         angle = int(round(np.degrees(np.arctan2(normal[1], normal[0]))))
@@ -270,7 +304,7 @@ def touching_walls(lattice: Lattice, normals) -> tuple[Wall, ...]:
     return tuple(walls)
 
 
-def hexagon(edge_beads: int, diameter_m: float = 1.0) -> Lattice:
+def hexagon(edge_beads: int, diameter_m: float = 1.0, struck=(0, 0)) -> Lattice:
     """Regular hexagon with ``edge_beads`` beads per edge, struck edge vertical (N = 11: 331 beads).
 
     With an even count the struck edge has two middle beads; the struck bead {0, 0} is the
@@ -281,19 +315,19 @@ def hexagon(edge_beads: int, diameter_m: float = 1.0) -> Lattice:
     k = int(edge_beads) - 1
     heights = [k + min(n, 2 * k - n) for n in range(2 * k + 1)]
     sites = _layer_sites([(k % 2 - h, k % 2 + h) for h in heights])
-    return from_sites(sites, diameter_m, (0, 180, 60, -60, 120, -120), f"hexagon, {k + 1} per edge")
+    return from_sites(sites, diameter_m, (0, 180, 60, -60, 120, -120), f"hexagon, {k + 1} per edge", struck)
 
 
-def half_disc(radius_beads: int, diameter_m: float = 1.0) -> Lattice:
+def half_disc(radius_beads: int, diameter_m: float = 1.0, struck=(0, 0)) -> Lattice:
     """The beads within ``radius_beads`` d of the struck bead with x >= 0, and the struck edge's
     wall only (``radius_beads`` = 170: about 52,000 beads)."""
     if int(radius_beads) != radius_beads or radius_beads < 2:
         raise HexdemError(f"a half-disc needs a radius of at least 2 bead diameters, got {radius_beads}")
     radius = int(radius_beads)
-    return from_sites(_circle_sites(radius, 0.0), diameter_m, (0,), f"half-disc, radius {radius} d")
+    return from_sites(_circle_sites(radius, 0.0), diameter_m, (0,), f"half-disc, radius {radius} d", struck)
 
 
-def half_hexagon(long_edge: int = 91, short_edge: int = 46, diameter_m: float = 1.0) -> Lattice:
+def half_hexagon(long_edge: int = 91, short_edge: int = 46, diameter_m: float = 1.0, struck=(0, 0)) -> Lattice:
     """Half of a hexagon cut along its long diagonal (Fig. 4): that diagonal is the struck edge.
 
     ``long_edge`` = 2·``short_edge`` − 1 beads (91 and 46 → 3151 beads).
@@ -303,17 +337,17 @@ def half_hexagon(long_edge: int = 91, short_edge: int = 46, diameter_m: float = 
                           f"got long {long_edge}, short {short_edge}")
     heights = [long_edge - 1 - n for n in range(int(short_edge))]
     return from_sites(_layer_sites([(-h, h) for h in heights]), diameter_m, (0, 180, 120, -120),
-                      f"half-hexagon, long edge {long_edge}, short edges {short_edge}")
+                      f"half-hexagon, long edge {long_edge}, short edges {short_edge}", struck)
 
 
-def disc(radius_beads: int, diameter_m: float = 1.0) -> Lattice:
+def disc(radius_beads: int, diameter_m: float = 1.0, struck=(0, 0)) -> Lattice:
     """The sites within ``radius_beads`` d of a centre ``radius_beads`` d to the right of the
     struck bead (the disc's leftmost site), inside a curved wall touching the outermost beads
     (a circular basin, Hua & Van Gorder; the struck bead in its hole); 36,000 beads at radius 100."""
     if int(radius_beads) != radius_beads or radius_beads < 2:
         raise HexdemError(f"a disc needs a radius of at least 2 bead diameters, got {radius_beads}")
     radius = int(radius_beads)
-    lattice = from_sites(_circle_sites(radius, radius), diameter_m, (), f"disc, radius {radius} d")
+    lattice = from_sites(_circle_sites(radius, radius), diameter_m, (), f"disc, radius {radius} d", struck)
     centre = np.array([radius * diameter_m, 0.0])
     reach = np.linalg.norm(lattice.positions_m - centre, axis=1) + lattice.radii_m
     reach[lattice.struck] = -np.inf  # in the hole: it does not decide where the wall is
@@ -322,17 +356,17 @@ def disc(radius_beads: int, diameter_m: float = 1.0) -> Lattice:
     return replace(lattice, walls=(CurvedWall("wall_disc", (float(centre[0]), 0.0), wall_radius, members),))
 
 
-def triangle(edge_beads: int, diameter_m: float = 1.0) -> Lattice:
+def triangle(edge_beads: int, diameter_m: float = 1.0, struck=(0, 0)) -> Lattice:
     """Equilateral triangle with ``edge_beads`` per edge, N(N + 1)/2 beads: the struck edge
     vertical, its apex towards +x, the walls of a triangular basin (Hua & Van Gorder)."""
     if int(edge_beads) != edge_beads or edge_beads < 3:
         raise HexdemError(f"a triangle needs at least 3 beads per edge, got {edge_beads}")
     k = int(edge_beads) - 1
     sites = _layer_sites([(k % 2 - (k - n), k % 2 + (k - n)) for n in range(k + 1)])
-    return from_sites(sites, diameter_m, (0, 120, -120), f"triangle, {k + 1} per edge")
+    return from_sites(sites, diameter_m, (0, 120, -120), f"triangle, {k + 1} per edge", struck)
 
 
-def parallelogram(edge_beads: int, depth_beads: int, diameter_m: float = 1.0) -> Lattice:
+def parallelogram(edge_beads: int, depth_beads: int, diameter_m: float = 1.0, struck=(0, 0)) -> Lattice:
     """Rhombus-like cell of ``depth_beads`` layers of ``edge_beads`` each (the struck edge
     vertical, the other two edges along +30°): a strip of the lattice with four walls."""
     for name, value in (("edge_beads", edge_beads), ("depth_beads", depth_beads)):
@@ -341,4 +375,4 @@ def parallelogram(edge_beads: int, depth_beads: int, diameter_m: float = 1.0) ->
     k = int(edge_beads) - 1
     sites = _layer_sites([(k % 2 - k + n, k % 2 + k + n) for n in range(int(depth_beads))])
     return from_sites(sites, diameter_m, (0, 180, 120, -60),
-                      f"parallelogram, {k + 1} per edge, {int(depth_beads)} deep")
+                      f"parallelogram, {k + 1} per edge, {int(depth_beads)} deep", struck)

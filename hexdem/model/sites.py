@@ -1,7 +1,7 @@
 """A packing listed site by site: the labels {m, n} of the paper's convention, inline or in a file.
 
 ``sites_file`` is a CSV with columns ``m,n`` (a header line, then one site per line) or a TOML
-file with ``sites = [[m, n], …]``. The struck bead is {0, 0}; flat walls touch the packing at
+file with ``sites = [[m, n], …]``. The struck bead is {0, 0} (or the first impact's site); flat walls touch the packing at
 the inward-normal angles given (:func:`~hexdem.model.lattice.from_sites`), none by default.
 """
 
@@ -37,9 +37,9 @@ def _sites_from_file(path: Path) -> list:
         raise HexdemError(f"sites_file {path}: every line after the header must be two integers m,n") from None
 
 
-def read_sites(sites, sites_file, diameter_m: float, walls_deg=()) -> Lattice:
+def read_sites(sites, sites_file, diameter_m: float, walls_deg=(), struck=(0, 0)) -> Lattice:
     """The packing of ``sites`` (pairs [m, n]) or of the sites in ``sites_file`` (exactly one of
-    the two), with flat walls at the inward-normal angles ``walls_deg``."""
+    the two), with flat walls at the inward-normal angles ``walls_deg``, struck at ``struck``."""
     if bool(sites) == bool(sites_file):
         raise HexdemError('shape = "sites" needs exactly one of sites = [[m, n], ...] and sites_file')
     listed = _sites_from_file(Path(sites_file)) if sites_file else list(sites)
@@ -50,4 +50,4 @@ def read_sites(sites, sites_file, diameter_m: float, walls_deg=()) -> Lattice:
     except (TypeError, ValueError):
         raise HexdemError(f"site_walls_deg must be a list of angles in degrees, got {walls_deg!r}") from None
     source = f"sites of {sites_file}" if sites_file else "listed sites"
-    return from_sites(listed, diameter_m, angles, f"{len(listed)} {source}")
+    return from_sites(listed, diameter_m, angles, f"{len(listed)} {source}", struck)

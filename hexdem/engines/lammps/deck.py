@@ -18,6 +18,7 @@ from string import Template
 
 import numpy as np
 
+from hexdem.errors import HexdemError
 from hexdem.model.dissipation import lammps_tsuji_coefficient
 from hexdem.model.granular import GranularModel, RunSettings
 from hexdem.model.lattice import CurvedWall
@@ -26,7 +27,8 @@ from hexdem.model.units import UnitSystem
 DECK_NAME = "in.hexdem"
 DATA_NAME = "data.hexdem"
 DUMP_NAME = "dump.lammpstrj"
-#: Atom types: lattice beads and the striker.
+#: LAMMPS holds at most 32 groups; the impacts may take this many (one per distinct velocity).
+MAX_IMPACT_GROUPS = 16
 
 
 @dataclass(frozen=True)
@@ -54,17 +56,24 @@ def _fmt(value: float) -> str:
     return repr(float(value))
 
 
+def _striker_type_materials(model: GranularModel) -> list[int]:
+    """The material ids of the strikers' atom types: one per material the strikers are of, in
+    order of first use (one type, of the beads' material, when there is no striker)."""
+    return list(dict.fromkeys(model.material_ids[len(model.lattice):].tolist())) or [0]
+
+
 def atom_types(model: GranularModel) -> np.ndarray:
-    """(n_bodies,) LAMMPS atom type of each body: a bead's material id + 1, then the striker's
-    own type (2 for the paper's one material)."""
-    types = model.lattice.material_ids + 1
-    return np.append(types, len(model.extra_materials) + 2) if model.has_striker else types
+    """(n_bodies,) LAMMPS atom type of each body: a bead's material id + 1, then the strikers'
+    own types (2 for the paper's one material)."""
+    first = 2 + len(model.extra_materials)
+    striker_type = {material: first + k for k, material in enumerate(_striker_type_materials(model))}
+    strikers = [striker_type[m] for m in model.material_ids[len(model.lattice):].tolist()]
+    return np.append(model.lattice.material_ids + 1, np.array(strikers, dtype=int))
 
 
 def type_materials(model: GranularModel) -> list[int]:
     """The material id (index into ``model.materials``) of each LAMMPS atom type, 1, 2, …"""
-    striker = int(model.material_ids[-1]) if model.has_striker else 0
-    return [*range(1 + len(model.extra_materials)), striker]
+    return [*range(1 + len(model.extra_materials)), *_striker_type_materials(model)]
 
 
 def data_file(model: GranularModel, units: UnitSystem) -> str:
@@ -189,21 +198,42 @@ def held_force_block(model: GranularModel, units: UnitSystem) -> str:
             f"fix             hole hole addforce {_fmt(force[0])} {_fmt(force[1])} 0.0\n")
 
 
+def impact_block(model: GranularModel, units: UnitSystem) -> str:
+    """The impacts: a group of the bodies set moving with each distinct initial velocity (the
+    strikers, or the struck beads themselves) and its ``velocity`` command."""
+    velocities = model.initial_velocities_m_s()[model.impact_bodies()] / units.velocity_m_s
+    distinct = list(dict.fromkeys(map(tuple, velocities.tolist())))
+    if len(distinct) > MAX_IMPACT_GROUPS:
+        raise HexdemError(f"{len(distinct)} distinct impact velocities; a deck holds at most {MAX_IMPACT_GROUPS}")
+    block = []
+    for k, velocity in enumerate(distinct):
+        group = "impactor" if k == 0 else f"impactor_{k + 1}"
+        ids = model.impact_bodies()[[tuple(v) == velocity for v in velocities.tolist()]] + 1
+        block += [f"group           {group} id {' '.join(str(i) for i in ids)}",
+                  f"velocity        {group} set {_fmt(velocity[0])} {_fmt(velocity[1])} 0.0 units box"]
+    return "\n".join(block)
+
+
+def _impact_title(model: GranularModel, impact) -> str:
+    """One impact in the deck's title line."""
+    where = "" if impact.bead is None else " on bead {%d, %d}" % tuple(model.lattice.indices[impact.bead])
+    how = " by a striker" if impact.striker else ("" if where else " on the struck bead")
+    return f"V0 = {impact.speed_m_s} m/s at {impact.angle_deg} deg{how}{where}"
+
+
 def render_input(model: GranularModel, settings: RunSettings, gravity_m_s2=None) -> str:
     """The text of ``in.hexdem`` for ``model`` run with ``settings``, under uniform gravity
     ``gravity_m_s2`` (gx, gy) [m/s²] if given (the tilted set-up of Sec. VI-A)."""
     units = settings.units
-    impactor = model.n_bodies if model.has_striker else model.lattice.struck + 1
-    velocity = model.impact.speed_m_s * model.impact.direction / units.velocity_m_s
     note = ("SI (m, kg, s)" if units.name == "si" else
             f"nondimensional A = d = M = 1 (d = {units.length_m} m, M = {units.mass_kg} kg, "
             f"T = {units.time_s} s)")
     return template("impact.in").substitute(
-        title=f"{model.lattice.shape}, V0 = {model.impact.speed_m_s} m/s at {model.impact.angle_deg} deg"
-              + (" by a striker" if model.has_striker else " on the struck bead"),
+        title=f"{model.lattice.shape}, " + ("; ".join(_impact_title(model, impact) for impact in model.impacts)
+                                             if len(model.impacts) <= 3 else f"{len(model.impacts)} impacts"),
         units_note=note, granular=granular_block(model, units), walls=walls_block(model, units),
-        body_force=gravity_block(gravity_m_s2, units) + held_force_block(model, units), impactor_id=impactor,
-        vx=_fmt(velocity[0]), vy=_fmt(velocity[1]), dt=_fmt(settings.dt_s / units.time_s),
+        body_force=gravity_block(gravity_m_s2, units) + held_force_block(model, units),
+        impacts=impact_block(model, units), dt=_fmt(settings.dt_s / units.time_s),
         thermo_every=max(1, settings.n_steps // 20), dump_every=settings.dump_every,
         nsteps=settings.n_steps)
 

@@ -10,7 +10,7 @@ It integrates eq. (model) as the paper does, with classical 4th-order Runge–Ku
 * flat walls as sphere–half-plane Hertz contacts with the wall's own modulus
   (F = k_n,wall sqrt(R) δ^{3/2}, the paper's "spheres with an infinite radius"), acting on
   the wall's member beads only, so the struck bead sits in the impact hole as in the decks;
-* V0 on the struck bead, or on a striker sphere bonded to it (``Impact.striker``).
+* each impact's V0 on its bead, or on a striker sphere bonded to it (``Impact.striker``).
 
 It works in the run's unit system (SI, or the paper's A = d = M = 1 of eq. (scaling)) and
 hands its samples, taken like a LAMMPS dump's, to the same observer as LAMMPS, so the same
@@ -114,24 +114,30 @@ def _lattice_bonds(model: GranularModel, grid: Grid, units: UnitSystem):
 
 
 def _striker_pairs(model: GranularModel, cells: np.ndarray, units: UnitSystem):
-    """Bonds of the striker to every bead it touches or nearly touches at t = 0 (none without one).
+    """Bonds of each striker to every body it touches or nearly touches at t = 0 (none without
+    one): its bead, the other beads and strikers within reach.
 
     Besides the struck bead, an oblique striker touches a neighbour of it (at 30° the bead
-    {−2, 0}); LAMMPS, which counts every overlap, feels both. Bonds are repulsive only, so a
-    bond to a bead that the striker never reaches costs nothing.
+    {−2, 0}), and the spheres of a flat striker touch each other; LAMMPS, which counts every
+    overlap, feels them all. Bonds are repulsive only, so a bond to a body that the striker
+    never reaches costs nothing.
     """
     pos, radii = model.initial_positions_m(), model.diameters_m / 2
-    striker, n_beads = model.n_bodies - 1, len(model.lattice)
-    gap = np.linalg.norm(pos[:n_beads] - pos[striker], axis=1) - radii[:n_beads] - radii[striker]
-    beads = np.flatnonzero((gap < STRIKER_REACH * model.lattice.diameter_m) & model.has_striker)
-    rest = (pos[beads] - pos[striker]) / units.length_m
-    r_eff = _reduced_radius(radii[beads], radii[striker])
-    stiffness = _coefficient(model.contact_stiffness_pa(beads, np.full(len(beads), striker)), r_eff, units)
+    first = len(model.lattice)
+    strikers, bodies = [np.zeros(0, dtype=int)], [np.zeros(0, dtype=int)]
+    for striker in range(first, model.n_bodies):
+        gap = np.linalg.norm(pos[:striker] - pos[striker], axis=1) - radii[:striker] - radii[striker]
+        near = np.flatnonzero(gap < STRIKER_REACH * model.lattice.diameter_m)
+        strikers.append(np.full(len(near), striker))
+        bodies.append(near)
+    strikers, bodies = np.concatenate(strikers), np.concatenate(bodies)
+    rest = (pos[bodies] - pos[strikers]) / units.length_m
+    r_eff = _reduced_radius(radii[bodies], radii[strikers])
+    stiffness = _coefficient(model.contact_stiffness_pa(bodies, strikers), r_eff, units)
     masses = model.masses_kg / units.mass_kg
-    damping = model.pair_damping * np.sqrt(_reduced_radius(masses[beads], masses[striker]) * stiffness)
-    return (np.full(len(beads), cells[striker], dtype=np.int64), cells[beads].astype(np.int64),
-            rest[:, 0].copy(), rest[:, 1].copy(), (radii[beads] + radii[striker]) / units.length_m,
-            stiffness, damping)
+    damping = model.pair_damping * np.sqrt(_reduced_radius(masses[bodies], masses[strikers]) * stiffness)
+    return (cells[strikers].astype(np.int64), cells[bodies].astype(np.int64), rest[:, 0].copy(), rest[:, 1].copy(),
+            (radii[bodies] + radii[strikers]) / units.length_m, stiffness, damping)
 
 
 def _wall_contacts(model: GranularModel, cells: np.ndarray, units: UnitSystem):

@@ -1,0 +1,67 @@
+"""An animation of the speed field: the wave as people would rather watch it than read it.
+
+The frames are the speeds of every bead that the tracker kept at evenly spaced samples of the
+run (``field_samples``, no dump needed): :func:`movie_samples` picks them, :func:`speed_movie`
+draws each as the packing's beads coloured by |v|/V0 on a logarithmic scale (a solitary
+front decays by orders of magnitude as it spreads) and writes an animated GIF atomically.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.colors import LogNorm
+from PIL import Image
+
+from hexdem.analysis.figures import UNIT_LABELS, bead_map, draw_walls, plt
+from hexdem.common.io import atomic_path
+
+#: Frames of a movie, and how long each is shown [ms].
+MOVIE_FRAMES = 60
+FRAME_MS = 100
+#: Colours of the GIF's palette, shared by every frame.
+PALETTE_COLOURS = 192
+#: The colour scale spans this many decades below V0.
+DECADES = 3.0
+
+
+def movie_samples(n_samples: int, frames: int = MOVIE_FRAMES) -> tuple[int, ...]:
+    """Indices of ``frames`` samples evenly spread over a run of ``n_samples`` (the first and last included)."""
+    return tuple(int(k) for k in np.unique(np.linspace(0, n_samples - 1, min(frames, n_samples)).round()))
+
+
+def speed_movie(results, model, times, speeds, v0: float, path, title: str = "") -> None:
+    """Write ``path`` (GIF): one frame per row of ``speeds`` (F, N), the beads coloured by
+    |v|/``v0``, the frame's time from ``times`` (F,) in the run's units, walls and the struck
+    beads drawn."""
+    units = UNIT_LABELS[results.units]
+    scale = 1.0 / results.length_unit_m
+    diameters = model.lattice.diameters_m * scale
+    fig, ax = plt.subplots(figsize=(6.4, 5.4))
+    fig.subplots_adjust(left=0.1, right=0.97, bottom=0.09, top=0.92)
+    floor = 10.0 ** -DECADES
+    circles = bead_map(ax, results.positions, diameters, np.full(len(diameters), floor), cmap="inferno",
+                       label="speed $|v| / V_0$", norm=LogNorm(floor, 1.0))
+    draw_walls(ax, model.walls, results.positions, diameters / 2, scale=scale)
+    struck = results.positions[np.unique(model.struck_beads)]
+    ax.plot(struck[:, 0], struck[:, 1], linestyle="", marker="x", color="c", markersize=6, mew=1.5)
+    ax.set_xlabel(f"x [{units['length']}]")
+    ax.set_ylabel(f"y [{units['length']}]")
+    clock = ax.text(0.5, 1.01, "", transform=ax.transAxes, ha="center", va="bottom", fontsize=12)
+    for artist in (circles, clock):  # drawn on a background of everything else, rendered once
+        artist.set_animated(True)
+    fig.canvas.draw()
+    background = fig.canvas.copy_from_bbox(fig.bbox)
+    frames, palette = [], None
+    for time, field in zip(times, speeds):
+        fig.canvas.restore_region(background)
+        circles.set_array(np.clip(np.nan_to_num(np.asarray(field) / v0, nan=floor), floor, None))
+        clock.set_text(f"{title}   t = {time * units['time_scale']:.3g} {units['time']}")
+        ax.draw_artist(circles)
+        ax.draw_artist(clock)
+        image = Image.fromarray(np.asarray(fig.canvas.buffer_rgba())[..., :3])
+        # one palette for the movie, from the first frame (its colour bar holds the whole scale)
+        palette = palette or image.quantize(colors=PALETTE_COLOURS)
+        frames.append(image.quantize(palette=palette, dither=Image.Dither.NONE))
+    plt.close(fig)
+    with atomic_path(path) as tmp:
+        frames[0].save(tmp, format="GIF", save_all=True, append_images=frames[1:], duration=FRAME_MS, loop=0)

@@ -1,0 +1,123 @@
+"""Several impacts, flat strikers and extra observation lines: budgets, symmetry, and bad input."""
+
+import numpy as np
+import pytest
+from conftest import read_csv, record
+
+from hexdem.engines.lammps.engine import LammpsEngine
+from hexdem.engines.reference.engine import ReferenceEngine
+from hexdem.errors import HexdemError
+from hexdem.experiments.run import run_experiment, simulate
+from hexdem.model.config import RunConfig
+from hexdem.model.materials import BRASS, STEEL_316
+
+ENGINES = [LammpsEngine(), ReferenceEngine()]
+#: A free hexagon of 5 per edge (sites n = 0..8; {0, 8} is the middle of the right edge, {8, 4}
+#: the top of the middle column) struck by three strikers: steel from the left at 0.4 m/s, brass
+#: from the right at 0.3 m/s, steel from above at 0.4 m/s.
+THREE_STRIKERS = RunConfig(edge_beads=5, wall_material="none", impact="striker", duration=4e-4,
+                           impacts=[{"site": [0, 0]},
+                                    {"site": [0, 8], "angle_deg": 180.0, "striker_material": "brass", "v0": 0.3},
+                                    {"site": [8, 4], "angle_deg": -90.0}])
+
+
+def sphere_mass(material, d=0.01905):
+    return material.density_kg_m3 * np.pi * d**3 / 6
+
+
+@pytest.mark.parametrize("engine", ENGINES, ids=lambda e: e.name)
+def test_three_strikers_keep_the_momentum_and_energy_they_bring(engine, tmp_path):
+    """No walls and no external force: Σ m v stays the strikers' initial momentum, worked out by
+    hand, and the energy their kinetic energy, to the integrator's dt² error."""
+    model = THREE_STRIKERS.model()
+    assert model.n_bodies == 61 + 3 and len(model.strikers) == 3
+    steel, brass = sphere_mass(STEEL_316), sphere_mass(BRASS)
+    momentum = np.array([steel * 0.4 - brass * 0.3, -steel * 0.4])
+    energy = 0.5 * steel * 0.4**2 * 2 + 0.5 * brass * 0.3**2
+    trajectory = record(engine, model, THREE_STRIKERS.settings(model), tmp_path)
+    p = np.einsum("b,fbk->fk", model.masses_kg, trajectory.velocities_m_s)
+    np.testing.assert_allclose(p, np.tile(momentum, (len(p), 1)), rtol=0, atol=1e-12 * np.abs(momentum).max())
+    energies = trajectory.energies_j(model)
+    assert energies[0] == pytest.approx(energy, rel=1e-14)
+    assert np.max(np.abs(energies / energy - 1)) < 1e-4  # velocity Verlet at 140 steps per contact: ~4e-5
+    moved = trajectory.speeds_m_s[-1, :61] > 1e-3 * 0.3
+    assert moved.sum() > 40  # the waves went through the packing
+
+
+def mirror(lattice, site_map):
+    """Index of each bead's mirror image under ``site_map`` (m, n) → (m', n')."""
+    return np.array([lattice.index_of(*site_map(m, n)) for m, n in lattice.indices.tolist()])
+
+
+@pytest.mark.parametrize("engine", ["lammps", "reference"])
+@pytest.mark.parametrize("case", ["double-velocity", "double-striker", "flat-striker"])
+def test_a_symmetric_strike_gives_mirror_symmetric_pulses(engine, case, tmp_path):
+    """Two equal strikes on opposite edges of a hexagon (x → L − x: {m, n} → {m, 8 − n}), and a
+    flat striker on the left edge (y → −y: {m, n} → {−m, n}): mirror beads have equal peaks
+    and arrival times."""
+    double = [{"site": [0, 0]}, {"site": [0, 8], "angle_deg": 180.0}]
+    changes = {"double-velocity": {"impacts": double},
+               "double-striker": {"impacts": double, "impact": "striker"},
+               "flat-striker": {"impacts": [{"edge_deg": 0.0}], "impact": "striker"}}[case]
+    config = RunConfig(edge_beads=5, engine=engine, **changes)
+    analysis = simulate(config, tmp_path)
+    r, lattice = analysis.results, analysis.model.lattice
+    image = mirror(lattice, (lambda m, n: (-m, n)) if case == "flat-striker" else (lambda m, n: (m, 8 - n)))
+    assert np.all(image >= 0)
+    np.testing.assert_allclose(r.peak_speed[image], r.peak_speed, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(r.arrival_time[image], r.arrival_time, rtol=0, atol=1e-10)
+    assert np.sum(r.peak_speed > 0.01 * config.v0) > len(lattice) / 2  # the waves crossed the packing
+
+
+def test_a_flat_striker_is_one_sphere_per_edge_bead_and_replaces_the_wall():
+    model = RunConfig(impact="striker", impacts=[{"edge_deg": 0.0}]).model()
+    left = np.flatnonzero(model.lattice.indices[:, 1] == 0)
+    assert sorted(model.struck_beads) == sorted(left) and len(left) == 11
+    assert len(model.strikers) == 11 and "wall_000" not in [w.name for w in model.walls]
+    velocities = model.initial_velocities_m_s()[len(model.lattice):]
+    np.testing.assert_array_equal(velocities, np.tile([0.4, 0.0], (11, 1)))
+    gaps = np.diff(model.initial_positions_m()[len(model.lattice):, 1])
+    np.testing.assert_allclose(np.sort(np.abs(gaps)), 0.01905, rtol=1e-12)  # the spheres touch: a plate
+
+
+def test_every_struck_bead_sits_in_a_hole_of_the_wall_it_is_pushed_through():
+    model = RunConfig(edge_beads=5, impacts=[{"site": [0, 0]}, {"site": [0, 8], "angle_deg": 180.0},
+                                             {"site": [-4, 0], "angle_deg": 0.0}]).model()
+    members = {w.name: {tuple(model.lattice.indices[b]) for b in w.members} for w in model.walls}
+    assert (0, 0) not in members["wall_000"] and (0, 8) not in members["wall_180"]
+    assert (-4, 0) not in members["wall_000"] and (-4, 0) in members["wall_060"]  # the corner's other wall stays
+
+
+def test_extra_observation_lines_follow_the_lattice_from_any_bead(tmp_path):
+    config = RunConfig(edge_beads=5, engine="reference",
+                       lines=[{"name": "up", "site": [-8, 4], "angle_deg": 90},
+                              {"name": "sixty", "site": [0, 0], "angle_deg": 60}])
+    lattice = config.lattice()
+    assert [tuple(lattice.indices[b]) for b in lattice.line("up")] == [(m, 4) for m in range(-8, 9, 2)]
+    assert [tuple(lattice.indices[b]) for b in lattice.line("sixty")] == [(0, 0), (3, 1), (6, 2)]
+    run_experiment(config, tmp_path, log=lambda message: None)
+    header, rows = read_csv(tmp_path / "peaks.csv")
+    assert [row["line"] for row in rows if row["line"] in ("0", "+30", "-30")] == \
+           [row["line"] for row in rows[:sum(len(lattice.line(n)) for n in ("0", "+30", "-30"))]]
+    assert [int(row["n"]) for row in rows if row["line"] == "up"] == list(range(9))
+
+
+@pytest.mark.parametrize("changes, message", [
+    ({"impacts": [{"site": [0, 30]}]}, "not in the packing"),
+    ({"impacts": [{"site": [0, 0]}, {"site": [0, 0], "angle_deg": 10.0}]}, "two impacts strike the same bead"),
+    ({"impacts": [{"site": [0, 0]}, {"site": [0, 10], "kind": "striker"}]}, "would start inside bead"),
+    ({"impacts": [{"site": [0, 0], "edge_deg": 0.0}]}, "exactly one of site"),
+    ({"impacts": [{"site": [0, 0], "speed": 1.0}]}, "unknown key(s) speed"),
+    ({"impacts": [{"site": [0, 0], "kind": "hammer"}]}, "unknown kind 'hammer'"),
+    ({"impacts": [{"site": [0, 0], "v0": -1.0}]}, "v0 must be > 0"),
+    ({"impacts": [{"site": [0, 0], "striker_material": "unobtainium", "kind": "striker"}]}, "unobtainium"),
+    ({"precompression_n": 5.0, "impacts": [{"site": [0, 0]}, {"site": [0, 20], "angle_deg": 180.0}]},
+     "precompressed packing holds only"),
+    ({"lines": [{"name": "0", "site": [0, 0], "angle_deg": 90}]}, "must be a new"),
+    ({"lines": [{"name": "up", "site": [0, 0], "angle_deg": 45}]}, "not a lattice direction"),
+    ({"lines": [{"name": "up", "site": [1, 0], "angle_deg": 90}]}, "is not a bead"),
+])
+def test_bad_impacts_and_lines_get_one_line_errors(changes, message):
+    with pytest.raises(HexdemError, match=None) as error:
+        RunConfig(**changes)
+    assert message in str(error.value) and "\n" not in str(error.value)
