@@ -32,6 +32,7 @@ from hexdem.disorder.preparation import TOLERANCE_M, Disorder, Preparation
 from hexdem.disorder.runner import run_ensemble
 from hexdem.model.materials import PAPER_DIAMETER_M
 from hexdem.paper.settings import (
+    CROSSOVER_VELOCITIES_M_S,
     RELAXED_SIGMA_PER_TOL,
     RELAXED_WALL_SLACK_M,
     SIGMA_PER_TOL,
@@ -77,9 +78,11 @@ class StudyEnsemble:
 
 
 def study_ensembles(settings: PaperSettings) -> list[StudyEnsemble]:
-    """Every ensemble of the study; the paper's (σ = 6 tol, prestressed) also at Fig. 9's speeds."""
-    ensembles = [StudyEnsemble(s, False, settings.fig9_velocities_m_s if s == 6 else (STUDY_VELOCITY_M_S,))
-                 for s in SIGMA_PER_TOL]
+    """Every ensemble of the study and of the crossover sweep: the paper's preparation at every σ
+    of either, struck at the sweep's three speeds (those of Fig. 9, so σ = 6 tol gives Figs. 8
+    and 9), and the relaxed preparation at the study's speed."""
+    sigmas = sorted(set(SIGMA_PER_TOL) | set(settings.crossover_sigma_per_tol))
+    ensembles = [StudyEnsemble(s, False, CROSSOVER_VELOCITIES_M_S) for s in sigmas]
     return ensembles + [StudyEnsemble(s, True, (STUDY_VELOCITY_M_S,)) for s in RELAXED_SIGMA_PER_TOL]
 
 

@@ -7,8 +7,10 @@ The parts, each writing into its own folder of ``DIR``:
 ``fig3/``, ``fig4/``   wavefront snapshots, Figs. 3 and 4 (Fig. 4 on ``workers`` MPI ranks)
 ``scaling/``           the V₀ sweep and the four laws, Figs. 6 and 7
 ``fit_protocols/``     the fit-protocol search on that sweep
-``disorder/<name>/``   the disorder study's ensembles; ``sigma6tol`` holds Figs. 8 and 9
-``disorder/``          the study's tables, figure and verdict
+``disorder/<name>/``   the ensembles of the disorder study and of the crossover sweep;
+                       ``sigma6tol`` holds Figs. 8 and 9
+``disorder/``          the study's tables, figure and verdict; the crossover sweep's
+                       ``disorder_crossover.csv``, ``.json`` and ``.png``
 =====================  =====================================================================
 
 then ``report.html``, ``report.md`` and ``published_vs_computed.csv`` (:mod:`hexdem.paper.report`).
@@ -39,7 +41,7 @@ from hexdem.paper.disorder_study import (
     study_rows,
     verdict,
 )
-from hexdem.paper.settings import PaperSettings
+from hexdem.paper.settings import SIGMA_PER_TOL, PaperSettings
 
 SETTINGS_NAME = "paper.json"
 #: Snapshot times of Fig. 4 on the quick run's smaller half-hexagon [ms].
@@ -102,6 +104,31 @@ def _disorder_summary(summaries: list[dict], out: Path) -> dict:
     return result
 
 
+def _crossover(summaries: list[dict], out: Path) -> dict:
+    from hexdem.common.io import write_csv
+    from hexdem.paper.crossover import (
+        CROSSOVER_COLUMNS,
+        crossover_figure,
+        crossover_fits,
+        crossover_rows,
+        crossover_verdict,
+        overlap_test,
+        pm30_claim,
+    )
+
+    rows = crossover_rows(summaries)
+    fits = crossover_fits(rows)
+    tests = overlap_test(fits)
+    folder = out / "disorder"
+    write_csv(folder / "disorder_crossover.csv", CROSSOVER_COLUMNS, rows)
+    crossover_figure(rows, fits, folder / "disorder_crossover.png")
+    result = {"fits": fits, "overlap_test": tests, "verdict": crossover_verdict(fits, tests),
+              "pm30_claim": pm30_claim(rows),
+              "sigma_per_tol": sorted({r[3] for r in rows}), "velocities_m_s": sorted({r[0] for r in rows})}
+    write_json(folder / "disorder_crossover.json", result)
+    return result
+
+
 def _quiet(message: str) -> None:
     """The parts' own logs: the paper's progress display replaces them."""
 
@@ -148,8 +175,11 @@ def _run_parts(settings: PaperSettings, out: Path) -> tuple[dict, float]:
     parts += [(name, f"ensemble {e.name}", ("scaling",),
                lambda e=e: run_study_ensemble(e, settings, out / "disorder", scaling_json, ensembles))
               for name, e in zip(ensemble_parts, ensembles)]
-    parts.append(("disorder", "disorder study and verdict", tuple(ensemble_parts),
-                  lambda: _disorder_summary([summaries[name] for name in ensemble_parts], out)))
+    study_parts = [name for name, e in zip(ensemble_parts, ensembles) if e.sigma_per_tol in SIGMA_PER_TOL]
+    parts.append(("disorder", "disorder study and verdict", tuple(study_parts),
+                  lambda: _disorder_summary([summaries[name] for name in study_parts], out)))
+    parts.append(("crossover", "disorder crossover sweep", tuple(ensemble_parts),
+                  lambda: _crossover([summaries[name] for name in ensemble_parts], out)))
     summaries: dict = {}
     computed: set = set()
     bar = progress_bar(len(parts), "hexdem paper", unit="part")

@@ -18,6 +18,13 @@ SIGMA_PER_TOL = (0.0, 1.0, 2.0, 3.0, 6.0)
 #: Striker speed of the disorder study [m/s] and those of Fig. 9 (σ = 6 tol).
 STUDY_VELOCITY_M_S = 0.40
 FIG9_VELOCITIES_M_S = (0.25, 0.40, 0.70)
+#: σ / tol of the crossover sweep (:mod:`hexdem.paper.crossover`): log-spaced from 1e-3 tol (13 nm,
+#: a hundredth of the static overlaps' scale) to the paper's 6 tol, across the impact's overlap
+#: δ(V) = 0.53, 0.77 and 1.20 tol at 0.25, 0.40 and 0.70 m/s; the quick run's is coarse.
+CROSSOVER_SIGMA_PER_TOL = (0.001, 0.003, 0.01, 0.03, 0.1, 0.3, 1.0, 3.0, 6.0)
+QUICK_CROSSOVER_SIGMA_PER_TOL = (0.01, 0.1, 1.0, 6.0)
+#: Striker speeds of the crossover sweep [m/s]: every prestressed ensemble is struck at these.
+CROSSOVER_VELOCITIES_M_S = FIG9_VELOCITIES_M_S
 #: σ / tol at which the preparation is also run without prestress.
 RELAXED_SIGMA_PER_TOL = (0.0, 6.0)
 #: Slack of the walls in the preparation without prestress [m]: one diameter tolerance,
@@ -35,8 +42,8 @@ class PaperSettings:
 
     ``n_v0`` V₀ values of the scaling sweep (0.01 … 0.30); ``realizations`` per disordered
     ensemble (σ = 0 needs one: equal beads prepared the same way are identical);
-    ``half_hexagon`` (long, short) edges of Fig. 4's packing; ``fig9_velocities_m_s`` the
-    striker speeds of Figs. 8 and 9 (the quick run: the study's speed only).
+    ``half_hexagon`` (long, short) edges of Fig. 4's packing; ``crossover_sigma_per_tol`` the
+    σ / tol of the crossover sweep.
     """
 
     quick: bool = False
@@ -57,8 +64,8 @@ class PaperSettings:
         return 2 if self.quick else 20
 
     @property
-    def fig9_velocities_m_s(self) -> tuple[float, ...]:
-        return (STUDY_VELOCITY_M_S,) if self.quick else FIG9_VELOCITIES_M_S
+    def crossover_sigma_per_tol(self) -> tuple[float, ...]:
+        return QUICK_CROSSOVER_SIGMA_PER_TOL if self.quick else CROSSOVER_SIGMA_PER_TOL
 
     @property
     def half_hexagon(self) -> tuple[int, int]:
@@ -71,5 +78,7 @@ class PaperSettings:
     def as_dict(self) -> dict:
         return {**asdict(self), "n_v0": self.n_v0, "realizations": self.realizations,
                 "half_hexagon": list(self.half_hexagon), "sigma_per_tol": list(SIGMA_PER_TOL),
-                "study_velocity_m_s": STUDY_VELOCITY_M_S, "fig9_velocities_m_s": list(self.fig9_velocities_m_s),
-                "relaxed_sigma_per_tol": list(RELAXED_SIGMA_PER_TOL), "relaxed_wall_slack_m": RELAXED_WALL_SLACK_M}
+                "study_velocity_m_s": STUDY_VELOCITY_M_S, "fig9_velocities_m_s": list(FIG9_VELOCITIES_M_S),
+                "relaxed_sigma_per_tol": list(RELAXED_SIGMA_PER_TOL), "relaxed_wall_slack_m": RELAXED_WALL_SLACK_M,
+                "crossover_sigma_per_tol": list(self.crossover_sigma_per_tol),
+                "crossover_velocities_m_s": list(CROSSOVER_VELOCITIES_M_S)}
