@@ -1,5 +1,6 @@
 """Several impacts, flat strikers and extra observation lines: budgets, symmetry, and bad input."""
 
+import json
 import numpy as np
 import pytest
 from conftest import read_csv, record
@@ -88,6 +89,31 @@ def test_every_struck_bead_sits_in_a_hole_of_the_wall_it_is_pushed_through():
     assert (-4, 0) not in members["wall_000"] and (-4, 0) in members["wall_060"]  # the corner's other wall stays
 
 
+def test_holes_do_not_depend_on_the_order_of_the_impacts_and_only_struck_beads_sit_in_one():
+    first = RunConfig(edge_beads=4, impacts=[{"site": [0, 0]}, {"site": [2, 6], "angle_deg": -120.0}]).model()
+    second = RunConfig(edge_beads=4, impacts=[{"site": [2, 6], "angle_deg": -120.0}, {"site": [0, 0]}]).model()
+    assert {w.name: w.members.tolist() for w in first.walls} == {w.name: w.members.tolist() for w in second.walls}
+    far = RunConfig(edge_beads=4, impacts=[{"edge_deg": 180.0}]).model()  # {0, 0} is not struck: no hole there
+    assert far.lattice.struck in next(w for w in far.walls if w.name == "wall_000").members
+
+
+def test_the_papers_single_impact_keeps_its_one_hole_in_the_struck_edges_wall():
+    """In a hexagon of 2 per edge {0, 0} is also the corner of the lower-left edge: it stays on that wall."""
+    walls = {w.name: w.members for w in RunConfig(edge_beads=2).lattice().walls}
+    struck = RunConfig(edge_beads=2).lattice().struck
+    assert struck not in walls["wall_000"] and struck in walls["wall_060"]
+
+
+def test_a_deck_beyond_lammpss_32_groups_is_refused_before_it_runs(tmp_path):
+    from hexdem.engines.lammps.deck import render_input
+
+    interior = [[m, n] for n in range(2, 8) for m in range(-4, 5) if (m + n) % 2 == 0][:26]
+    config = RunConfig(edge_beads=5, impacts=[{"site": site, "v0": 0.1 + 0.01 * k} for k, site in enumerate(interior)])
+    model = config.model()
+    with pytest.raises(HexdemError, match="LAMMPS groups"):
+        render_input(model, config.settings(model))
+
+
 def test_extra_observation_lines_follow_the_lattice_from_any_bead(tmp_path):
     config = RunConfig(edge_beads=5, engine="reference",
                        lines=[{"name": "up", "site": [-8, 4], "angle_deg": 90},
@@ -96,6 +122,8 @@ def test_extra_observation_lines_follow_the_lattice_from_any_bead(tmp_path):
     assert [tuple(lattice.indices[b]) for b in lattice.line("up")] == [(m, 4) for m in range(-8, 9, 2)]
     assert [tuple(lattice.indices[b]) for b in lattice.line("sixty")] == [(0, 0), (3, 1), (6, 2)]
     run_experiment(config, tmp_path, log=lambda message: None)
+    assert json.loads((tmp_path / "summary.json").read_text())["impacts"] == [
+        {"bead_id": lattice.struck + 1, "site": [0, 0], "v0": 0.4, "angle_deg": 0.0, "kind": "velocity"}]
     header, rows = read_csv(tmp_path / "peaks.csv")
     assert [row["line"] for row in rows if row["line"] in ("0", "+30", "-30")] == \
            [row["line"] for row in rows[:sum(len(lattice.line(n)) for n in ("0", "+30", "-30"))]]
@@ -116,6 +144,9 @@ def test_extra_observation_lines_follow_the_lattice_from_any_bead(tmp_path):
     ({"lines": [{"name": "0", "site": [0, 0], "angle_deg": 90}]}, "must be a new"),
     ({"lines": [{"name": "up", "site": [0, 0], "angle_deg": 45}]}, "not a lattice direction"),
     ({"lines": [{"name": "up", "site": [1, 0], "angle_deg": 90}]}, "is not a bead"),
+    ({"lines": [{"name": "up", "site": [[0], 0], "angle_deg": 90}]}, "is not a bead"),
+    ({"impacts": [{"edge_deg": 30.0}]}, "no flat edge"),
+    ({"impacts": [{"site": [0, 0], "angle_deg": 150.0}]}, "points out of the packing through wall_000"),
 ])
 def test_bad_impacts_and_lines_get_one_line_errors(changes, message):
     with pytest.raises(HexdemError, match=None) as error:

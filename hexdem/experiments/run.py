@@ -129,6 +129,10 @@ def summary(config: RunConfig, analysis: ImpactAnalysis, wall_time_s: float) -> 
         "energy_lost": analysis.tracked.energy_lost if analysis.tracked is not None else None,
         "far_wall_reached": r.far_wall_reached,
         "beads_per_line": {name: len(beads) for name, beads in r.lines.items()},
+        "impacts": [{"bead_id": int(bead) + 1, "site": [int(v) for v in analysis.model.lattice.indices[bead]],
+                     "v0": impact.speed_m_s / settings.units.velocity_m_s, "angle_deg": float(impact.angle_deg),
+                     "kind": "striker" if impact.striker else "velocity"}
+                    for bead, impact in zip(analysis.model.struck_beads, analysis.model.impacts)],
     }
 
 
@@ -138,11 +142,11 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
     write_csv(out / "beads.csv", BEAD_COLUMNS, bead_rows(analysis))
     write_json(out / "summary.json", summary(config, analysis, wall_time_s))
     r, model = analysis.results, analysis.model
-    plots.arrival_map(r, model, out / "arrival_map.png", title=f"Arrival time, {model.lattice.shape}, V0 = {config.v0:g}")
-    v0 = max(impact.speed_m_s for impact in model.impacts) / analysis.settings.units.velocity_m_s
+    v0 = max(impact.speed_m_s for impact in model.impacts) / analysis.settings.units.velocity_m_s  # the fastest's
+    plots.arrival_map(r, model, out / "arrival_map.png", title=f"Arrival time, {model.lattice.shape}, V0 = {v0:g}")
     plots.peak_map(r, model, v0, out / "peak_map.png", title=f"Peak speed, {model.lattice.shape}")
     by_line = {name: (np.arange(len(beads)), r.peak_speed[beads]) for name, beads in r.lines.items()}
-    plots.peak_decay(by_line, out / "peak_decay.png", r.units, config.v0)
+    plots.peak_decay(by_line, out / "peak_decay.png", r.units, v0)
     if config.sensors:
         write_sensor_files(analysis, list(config.sensor_beads(analysis.model.lattice)), out)
     shape = measure_front_shape(analysis)

@@ -20,9 +20,9 @@ from hexdem.common.machine import available_memory_bytes
 from hexdem.errors import HexdemError
 from hexdem.model.dissipation import damping_coefficient, lammps_tsuji_coefficient
 from hexdem.model.granular import GranularModel, Impact, RunSettings
-from hexdem.model.impacts import ImpactSpec, impact_specs, resolve_impacts, struck_site
+from hexdem.model.impacts import ImpactSpec, cut_holes, impact_specs, resolve_impacts, struck_site
 from hexdem.model.lattice import (LINE_STEPS, Lattice, disc, half_disc, half_hexagon, hexagon, parallelogram, triangle,
-                                   with_holes, without_sites)
+                                   without_hole, without_sites)
 from hexdem.model.lines import with_lines
 from hexdem.model.sites import read_sites
 from hexdem.model.materials import (PAPER_DIAMETER_M, Material, custom_materials, hertz_coefficient, hertz_stiffness,
@@ -276,6 +276,7 @@ class RunConfig:
         if self.shape != "sites" and (self.sites or self.sites_file or self.site_walls_deg):
             raise HexdemError(f"sites, sites_file and site_walls_deg describe shape = \"sites\", not {self.shape!r}")
         lattice = builders[self.shape]()
+        lattice = without_hole(lattice) if self.impacts else lattice  # each impact cuts its own
         lattice = without_sites(lattice, self.vacancies) if self.vacancies else lattice
         return with_lines(lattice, self.lines) if self.lines else lattice
 
@@ -304,11 +305,12 @@ class RunConfig:
             held = tuple(float(f) for f in hole_force(lattice, self.precompression_n))
         impacts = self._impacts(lattice)
         if self.impacts:
-            beads = [lattice.struck if i.bead is None else i.bead for i in impacts]
-            holed = with_holes(lattice, beads, [i.direction for i in impacts])
-            if self.precompression_n > 0 and _wall_contacts(holed) != _wall_contacts(lattice):
-                raise HexdemError("a precompressed packing holds only the first impact's bead in a hole of its wall; "
-                                  "strike the other beads inside the packing")
+            holed, opened = cut_holes(lattice, impacts)
+            if self.precompression_n > 0:
+                if opened - {lattice.struck}:
+                    raise HexdemError("a precompressed packing holds only the first impact's bead in a hole of its "
+                                      "wall; strike the other beads inside the packing")
+                held = held if lattice.struck in opened else (0.0, 0.0)
             lattice = holed
         return GranularModel(lattice, impacts[0], bead, wall, self.restitution, wall_restitution, held,
                              tuple(self.sensor_beads(lattice).values()), self.sensor_mass_factor, extra,
@@ -392,8 +394,3 @@ class RunConfig:
         n_steps = max(1, round(duration_s / dt_s))
         return RunSettings(dt_s=dt_s, n_steps=n_steps, dump_every=every, units=self.unit_system,
                            sensor_every=sensor_every, contact_time_s=self.contact_time_s())
-
-
-def _wall_contacts(lattice: Lattice) -> int:
-    """How many bead–wall contacts the walls of ``lattice`` hold."""
-    return sum(len(wall.members) for wall in lattice.walls)

@@ -5,7 +5,7 @@ struck bead {0, 0} is the run's (``v0``, ``strike_angle_deg``, ``impact``). Each
 either
 
 * ``site = [m, n]``: one bead, boundary or interior (the first impact's bead is *the* struck
-  bead: the origin of the observation lines and of the regions' bounds, in a hole of its wall), or
+  bead: the origin of the observation lines and of the regions' bounds), or
 * ``edge_deg = A``: every bead of the packing's edge whose inward normal points at A degrees
   from +x (0: the struck edge, 180: the far edge of a hexagon), all at once and along that
   normal: a flat striker, the plane-wave-like excitation of Hua & Van Gorder. As velocities,
@@ -15,7 +15,8 @@ either
 and may set ``v0`` (in the run's units), ``angle_deg`` (the direction of motion from +x; for
 an edge, its inward normal), ``kind`` ("velocity" or "striker"), ``striker_material`` and
 ``striker_diameter_m``; each defaults to the run's own. Every struck bead sits in a hole of each
-wall it would be pushed through (:func:`~hexdem.model.lattice.with_holes`).
+wall it would be pushed through, whatever the impacts' order (:func:`cut_holes`); a bead
+nothing strikes sits in none, {0, 0} included. An edge must be flat (two beads at least).
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ import numpy as np
 from hexdem.common.checks import is_number
 from hexdem.errors import HexdemError
 from hexdem.model.granular import Impact
-from hexdem.model.lattice import WALL_GROUP_GAP, Lattice
+from hexdem.model.lattice import HOLE_COSINE, WALL_GROUP_GAP, Lattice, with_holes
 
 #: The keys of one impact's table.
 IMPACT_KEYS = ("site", "edge_deg", "v0", "angle_deg", "kind", "striker_material", "striker_diameter_m")
@@ -114,8 +115,31 @@ def resolve_impacts(specs: list[ImpactSpec], lattice: Lattice, velocity_scale_m_
             beads, angle = [bead], spec.angle_deg
         else:
             beads = edge_beads(lattice, spec.edge_deg)
+            if len(beads) < 2:
+                raise HexdemError(f"impact {k}: the packing has no flat edge whose inward normal points at "
+                                  f"{spec.edge_deg:g}° (one bead there); use the angle of a wall, e.g. 0")
             angle = spec.edge_deg if spec.angle_deg is None else spec.angle_deg
         striker = material(spec.striker_material) if spec.striker_material is not None else None
         impacts += [Impact(spec.v0 * velocity_scale_m_s, float(angle), spec.striker, int(bead), striker,
                            spec.striker_diameter_m) for bead in beads]
     return impacts
+
+
+def _wall_members(lattice: Lattice) -> set[int]:
+    return {int(b) for wall in lattice.walls for b in wall.members}
+
+
+def cut_holes(lattice: Lattice, impacts: list[Impact]) -> tuple[Lattice, set[int]]:
+    """(``lattice`` (its walls whole, :func:`~hexdem.model.lattice.without_hole`) with a hole for
+    each impact's bead in every wall it is pushed through, the beads that left every wall). An
+    impact on a wall bead that points out through that wall (within 60° of its outward normal;
+    a corner bead may still be pushed along or against its other wall) is refused."""
+    beads = [lattice.struck if impact.bead is None else impact.bead for impact in impacts]
+    for impact, bead in zip(impacts, beads):
+        for wall in lattice.walls:
+            if bead in wall.members and wall.normals_at(lattice.positions_m[[bead]])[0] @ impact.direction < -HOLE_COSINE:
+                m, n = lattice.indices[bead]
+                raise HexdemError(f"the impact on bead {{{m}, {n}}} at {impact.angle_deg:g}° points out of the packing "
+                                  f"through {wall.name}: strike it inwards")
+    holed = with_holes(lattice, beads, [impact.direction for impact in impacts])
+    return holed, _wall_members(lattice) - _wall_members(holed)

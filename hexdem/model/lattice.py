@@ -271,6 +271,18 @@ def without_sites(lattice: Lattice, vacancies) -> Lattice:
 HOLE_COSINE = 0.5 + 1e-9
 
 
+def without_hole(lattice: Lattice) -> Lattice:
+    """``lattice`` with its struck bead a member of every wall it touches: the walls whole, for
+    impacts that each cut their own hole (:func:`with_holes`)."""
+    bead, walls = lattice.struck, []
+    for wall in lattice.walls:
+        gap = wall.gaps_m(lattice.positions_m[[bead]], lattice.radii_m[[bead]])[0]
+        if gap < WALL_GROUP_GAP * lattice.diameter_m and bead not in wall.members:
+            wall = replace(wall, members=np.sort(np.append(wall.members, bead)))
+        walls.append(wall)
+    return replace(lattice, walls=tuple(walls))
+
+
 def with_holes(lattice: Lattice, beads, directions) -> Lattice:
     """``lattice`` with each of ``beads`` (indices) taken out of the walls it would be pushed
     through moving along its unit vector of ``directions`` (N, 2): the holes of several impacts.
@@ -289,14 +301,16 @@ def with_holes(lattice: Lattice, beads, directions) -> Lattice:
 def touching_walls(lattice: Lattice, normals) -> tuple[Wall, ...]:
     """Flat walls with the given inward normals, each touching the packing without overlap.
 
-    The struck bead's wall has a hole: the struck bead is a member of no wall and, sitting in
-    the hole, does not decide where a wall is (it may protrude when the diameters vary).
+    The wall whose normal is +x (the struck edge) has a hole: the struck bead is not a member
+    and, sitting in the hole, does not decide where that wall is (it may protrude when the
+    diameters vary).
     """
     walls = []
     for normal in normals:
         normal = (float(normal[0]), float(normal[1]))
         reach = lattice.positions_m @ np.asarray(normal) - lattice.radii_m
-        reach[lattice.struck] = np.inf
+        if np.isclose(normal[0], 1.0):
+            reach[lattice.struck] = np.inf
         offset = float(reach.min())
         members = np.flatnonzero(reach - offset < WALL_GROUP_GAP * lattice.diameter_m)
         angle = int(round(np.degrees(np.arctan2(normal[1], normal[0]))))

@@ -27,7 +27,9 @@ def with_lines(lattice: Lattice, entries) -> Lattice:
         name, site, angle = entry["name"], entry["site"], entry["angle_deg"]
         if not (isinstance(name, str) and name) or name in names:
             raise HexdemError(f"line {k}: name {name!r} must be a new, non-empty string (taken: {', '.join(sorted(names))})")
-        if not (isinstance(site, (list, tuple)) and len(site) == 2 and lattice.index_of(*site) is not None):
+        if not (isinstance(site, (list, tuple)) and len(site) == 2
+                and all(isinstance(v, int) and not isinstance(v, bool) for v in site)
+                and lattice.index_of(*site) is not None):
             raise HexdemError(f"line {name}: site {site!r} is not a bead [m, n] of the packing")
         if not (is_number(angle) and angle in DIRECTION_STEPS):
             raise HexdemError(f"line {name}: angle_deg {angle!r} is not a lattice direction; use one of "

@@ -27,8 +27,9 @@ from hexdem.model.units import UnitSystem
 DECK_NAME = "in.hexdem"
 DATA_NAME = "data.hexdem"
 DUMP_NAME = "dump.lammpstrj"
-#: LAMMPS holds at most 32 groups; the impacts may take this many (one per distinct velocity).
-MAX_IMPACT_GROUPS = 16
+#: LAMMPS holds at most this many groups, ``all`` included (the walls take one per wall and
+#: material touching it, the impacts one per distinct velocity, a held bead one).
+MAX_GROUPS = 32
 
 
 @dataclass(frozen=True)
@@ -203,8 +204,6 @@ def impact_block(model: GranularModel, units: UnitSystem) -> str:
     strikers, or the struck beads themselves) and its ``velocity`` command."""
     velocities = model.initial_velocities_m_s()[model.impact_bodies()] / units.velocity_m_s
     distinct = list(dict.fromkeys(map(tuple, velocities.tolist())))
-    if len(distinct) > MAX_IMPACT_GROUPS:
-        raise HexdemError(f"{len(distinct)} distinct impact velocities; a deck holds at most {MAX_IMPACT_GROUPS}")
     block = []
     for k, velocity in enumerate(distinct):
         group = "impactor" if k == 0 else f"impactor_{k + 1}"
@@ -228,12 +227,17 @@ def render_input(model: GranularModel, settings: RunSettings, gravity_m_s2=None)
     note = ("SI (m, kg, s)" if units.name == "si" else
             f"nondimensional A = d = M = 1 (d = {units.length_m} m, M = {units.mass_kg} kg, "
             f"T = {units.time_s} s)")
+    walls, body_force, impacts = (walls_block(model, units), gravity_block(gravity_m_s2, units)
+                                  + held_force_block(model, units), impact_block(model, units))
+    groups = 1 + sum(line.startswith("group ") for part in (walls, body_force, impacts) for line in part.splitlines())
+    if groups > MAX_GROUPS:
+        raise HexdemError(f"the deck needs {groups} LAMMPS groups (walls by material, impacts by distinct velocity), "
+                          f"more than LAMMPS's {MAX_GROUPS}: give the impacts fewer distinct velocities")
     return template("impact.in").substitute(
         title=f"{model.lattice.shape}, " + ("; ".join(_impact_title(model, impact) for impact in model.impacts)
                                              if len(model.impacts) <= 3 else f"{len(model.impacts)} impacts"),
-        units_note=note, granular=granular_block(model, units), walls=walls_block(model, units),
-        body_force=gravity_block(gravity_m_s2, units) + held_force_block(model, units),
-        impacts=impact_block(model, units), dt=_fmt(settings.dt_s / units.time_s),
+        units_note=note, granular=granular_block(model, units), walls=walls, body_force=body_force,
+        impacts=impacts, dt=_fmt(settings.dt_s / units.time_s),
         thermo_every=max(1, settings.n_steps // 20), dump_every=settings.dump_every,
         nsteps=settings.n_steps)
 

@@ -43,7 +43,7 @@ from hexdem.model.units import UnitSystem
 
 #: Description of the run written into the engine's directory.
 PARAMETERS_NAME = "reference.json"
-#: The striker is bonded to every bead closer than this many d to touching it at t = 0.
+#: A striker is bonded to every body closer than this many d to touching it at t = 0.
 STRIKER_REACH = 0.5
 
 
