@@ -17,7 +17,7 @@ from hexdem.engines.lammps.engine import LammpsEngine
 from hexdem.engines.reference.engine import ReferenceEngine
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time, max_overlap
-from hexdem.model.lattice import CurvedWall
+from hexdem.model.walls import CurvedWall
 from hexdem.model.materials import DELRIN, STEEL_316, hertz_stiffness, sphere_mass
 
 RADIUS = 1.5 * D  # three bead radii

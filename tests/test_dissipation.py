@@ -16,7 +16,7 @@ from hexdem.model.config import RunConfig
 from hexdem.model.dissipation import damping_coefficient, lammps_tsuji_coefficient, restitution_of
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time
-from hexdem.model.lattice import Wall
+from hexdem.model.walls import Wall
 from hexdem.model.materials import DELRIN, STEEL_316, hertz_stiffness, sphere_mass
 
 ENGINES = [LammpsEngine(), ReferenceEngine()]

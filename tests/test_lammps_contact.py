@@ -9,7 +9,7 @@ from conftest import V0, D, contact_history, record, single_bead
 from hexdem.engines.lammps.engine import LammpsEngine
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time, max_overlap
-from hexdem.model.lattice import Wall
+from hexdem.model.walls import Wall
 from hexdem.model.materials import DELRIN, STEEL_316, hertz_stiffness, sphere_mass
 
 

@@ -13,7 +13,7 @@ from hexdem.experiments.run import simulate
 from hexdem.model.config import RunConfig
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time, max_overlap
-from hexdem.model.lattice import Wall
+from hexdem.model.walls import Wall
 from hexdem.model.materials import DELRIN, STEEL_316, hertz_stiffness, sphere_mass
 from hexdem.model.units import SI, nondimensional
 

@@ -17,7 +17,7 @@ from matplotlib.patches import Circle  # noqa: E402
 
 from hexdem.analysis.front_shape import HEXAGON_SIXFOLD  # noqa: E402
 from hexdem.common.io import atomic_path  # noqa: E402
-from hexdem.model.lattice import CurvedWall  # noqa: E402
+from hexdem.model.walls import CurvedWall  # noqa: E402
 
 UNIT_LABELS = {"si": {"length": "m", "speed": "m/s", "time": "ms", "time_scale": 1e3},
                "nondimensional": {"length": "d", "speed": "$\\sqrt{A/M}\\,d^{5/4}$", "time": "T", "time_scale": 1.0}}
@@ -72,20 +72,28 @@ def draw_walls(ax, walls, positions, radii, scale=1.0, **style):
         ax.plot(ends[:, 0], ends[:, 1], **{"color": "k", "linewidth": 2, **style})
 
 
-def lattice_map(results, model, values, path, label: str, title: str, cmap="viridis", norm=None) -> None:
-    """One value per bead drawn on the lattice (like Fig. 8a), walls drawn, struck beads marked."""
+def draw_lattice(ax, results, model, values, label: str, cmap="viridis", norm=None, marker_colour="w"):
+    """The packing's beads coloured by ``values`` (one per bead, in the run's units), its walls,
+    its struck beads marked with crosses of ``marker_colour``, axes labelled; returns the beads'
+    mappable."""
     units = UNIT_LABELS[results.units]
     scale = 1.0 / results.length_unit_m
     positions = results.positions
     diameters = model.lattice.diameters_m * scale
-    fig, ax = plt.subplots(figsize=(7, 6))
-    fig.subplots_adjust(left=0.12, right=0.98, bottom=0.09, top=0.94)
-    bead_map(ax, positions, diameters, values, cmap=cmap, label=label, norm=norm)
+    circles = bead_map(ax, positions, diameters, values, cmap=cmap, label=label, norm=norm)
     draw_walls(ax, model.walls, positions, diameters / 2, scale=scale)
     struck = positions[np.unique(model.struck_beads)]
-    ax.plot(struck[:, 0], struck[:, 1], linestyle="", marker="x", color="w", markersize=8, mew=2)
+    ax.plot(struck[:, 0], struck[:, 1], linestyle="", marker="x", color=marker_colour, markersize=8, mew=2)
     ax.set_xlabel(f"x [{units['length']}]")
     ax.set_ylabel(f"y [{units['length']}]")
+    return circles
+
+
+def lattice_map(results, model, values, path, label: str, title: str, cmap="viridis", norm=None) -> None:
+    """One value per bead drawn on the lattice (like Fig. 8a), walls drawn, struck beads marked."""
+    fig, ax = plt.subplots(figsize=(7, 6))
+    fig.subplots_adjust(left=0.12, right=0.98, bottom=0.09, top=0.94)
+    draw_lattice(ax, results, model, values, label, cmap, norm)
     set_title(ax, title)
     save(fig, path)
 

@@ -19,6 +19,7 @@ from hexdem.analysis.tracker import ENERGY_SAMPLES, TrackedPulses
 from hexdem.analysis.trajectory import Trajectory
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel, RunSettings
+from hexdem.model.walls import wall_normals
 
 #: Columns of ``peaks.csv`` (a contract: scripts read them by name).
 #: A wall bead faces the strike when its inward normal points against it at least cos 30° as
@@ -79,9 +80,7 @@ class ImpactAnalysis:
         rings) has."""
         r = self.results
         beads = np.arange(len(r.reach_time))
-        positions, walls = self.model.lattice.positions_m, self.model.walls
-        members = np.concatenate([np.zeros(0, dtype=int)] + [wall.members for wall in walls]).astype(int)
-        normals = np.concatenate([np.zeros((0, 2))] + [wall.normals_at(positions[wall.members]) for wall in walls])
+        members, normals = wall_normals(self.model.walls, self.model.lattice.positions_m)
         against = -normals @ self.model.impact.direction
         if len(against) and against.max() > 1e-9:
             beads = np.unique(members[against >= against.max() * FAR_WALL_COSINE - 1e-9])

@@ -12,7 +12,7 @@ import numpy as np
 from matplotlib.colors import LogNorm
 from PIL import Image
 
-from hexdem.analysis.figures import UNIT_LABELS, bead_map, draw_walls, plt
+from hexdem.analysis.figures import UNIT_LABELS, draw_lattice, plt
 from hexdem.common.io import atomic_path
 
 #: Frames of a movie, and how long each is shown [ms].
@@ -34,18 +34,11 @@ def speed_movie(results, model, times, speeds, v0: float, path, title: str = "")
     |v|/``v0``, the frame's time from ``times`` (F,) in the run's units, walls and the struck
     beads drawn."""
     units = UNIT_LABELS[results.units]
-    scale = 1.0 / results.length_unit_m
-    diameters = model.lattice.diameters_m * scale
     fig, ax = plt.subplots(figsize=(6.4, 5.4))
     fig.subplots_adjust(left=0.1, right=0.97, bottom=0.09, top=0.92)
     floor = 10.0 ** -DECADES
-    circles = bead_map(ax, results.positions, diameters, np.full(len(diameters), floor), cmap="inferno",
-                       label="speed $|v| / V_0$", norm=LogNorm(floor, 1.0))
-    draw_walls(ax, model.walls, results.positions, diameters / 2, scale=scale)
-    struck = results.positions[np.unique(model.struck_beads)]
-    ax.plot(struck[:, 0], struck[:, 1], linestyle="", marker="x", color="c", markersize=6, mew=1.5)
-    ax.set_xlabel(f"x [{units['length']}]")
-    ax.set_ylabel(f"y [{units['length']}]")
+    circles = draw_lattice(ax, results, model, np.full(len(model.lattice), floor), "speed $|v| / V_0$",
+                           cmap="inferno", norm=LogNorm(floor, 1.0), marker_colour="c")
     clock = ax.text(0.5, 1.01, "", transform=ax.transAxes, ha="center", va="bottom", fontsize=12)
     for artist in (circles, clock):  # drawn on a background of everything else, rendered once
         artist.set_animated(True)

@@ -17,7 +17,7 @@ import numpy as np
 from hexdem.common.checks import is_number
 from hexdem.errors import HexdemError
 from hexdem.model.dissipation import check_restitution, damping_coefficient
-from hexdem.model.lattice import Lattice, strike_direction
+from hexdem.model.lattice import Lattice, strike_direction, unit_vector
 from hexdem.model.materials import DELRIN, STEEL_316, Material, hertz_stiffness
 from hexdem.model.units import SI, UnitSystem
 
@@ -54,9 +54,7 @@ class Impact:
     @property
     def direction(self) -> np.ndarray:
         """Unit vector of the impact's motion."""
-        if self.bead is None:
-            return strike_direction(self.angle_deg)
-        return np.array([np.cos(np.radians(self.angle_deg)), np.sin(np.radians(self.angle_deg))])
+        return unit_vector(self.angle_deg)
 
 
 #: A striker may start closer than this many d to another body only by round-off (an oblique
@@ -261,7 +259,7 @@ class GranularModel:
         pos = self.lattice.positions_m
         beads, diameters = self.struck_beads, self.diameters_m
         strikers = [pos[beads[k]] - (diameters[beads[k]] + diameters[body]) / 2 * self.impacts[k].direction
-                    for k, body in zip(self._striker_impacts, self.impact_bodies()[self._striker_impacts])]
+                    for body, k in enumerate(self._striker_impacts, start=len(self.lattice))]
         return np.vstack([pos, *strikers]) if strikers else pos.copy()
 
     def initial_velocities_m_s(self) -> np.ndarray:

@@ -28,7 +28,7 @@ import numpy as np
 from hexdem.common.checks import is_number
 from hexdem.errors import HexdemError
 from hexdem.model.granular import Impact
-from hexdem.model.lattice import HOLE_COSINE, WALL_GROUP_GAP, Lattice, with_holes
+from hexdem.model.lattice import HOLE_COSINE, Lattice, facing_edge, unit_vector, with_holes
 
 #: The keys of one impact's table.
 IMPACT_KEYS = ("site", "edge_deg", "v0", "angle_deg", "kind", "striker_material", "striker_diameter_m")
@@ -94,14 +94,6 @@ def struck_site(specs: list[ImpactSpec]) -> tuple[int, int]:
     return specs[0].site if specs[0].site is not None else (0, 0)
 
 
-def edge_beads(lattice: Lattice, angle_deg: float) -> np.ndarray:
-    """Indices of the beads of the edge whose inward normal points at ``angle_deg``: those within
-    a quarter diameter of the packing's extreme along the normal."""
-    normal = np.array([np.cos(np.radians(angle_deg)), np.sin(np.radians(angle_deg))])
-    reach = lattice.positions_m @ normal - lattice.radii_m
-    return np.flatnonzero(reach - reach.min() < WALL_GROUP_GAP * lattice.diameter_m)
-
-
 def resolve_impacts(specs: list[ImpactSpec], lattice: Lattice, velocity_scale_m_s: float, material) -> list[Impact]:
     """The model's :class:`Impact` s of ``specs`` on ``lattice`` (an edge: one per bead of it);
     ``velocity_scale_m_s`` converts the run's speeds to m/s and ``material(name)`` finds a
@@ -114,7 +106,7 @@ def resolve_impacts(specs: list[ImpactSpec], lattice: Lattice, velocity_scale_m_
                 raise HexdemError(f"impact {k}: site {{{spec.site[0]}, {spec.site[1]}}} is not a bead of the packing")
             beads, angle = [bead], spec.angle_deg
         else:
-            beads = edge_beads(lattice, spec.edge_deg)
+            beads = facing_edge(lattice, unit_vector(spec.edge_deg))[1]  # the beads a wall there would touch
             if len(beads) < 2:
                 raise HexdemError(f"impact {k}: the packing has no flat edge whose inward normal points at "
                                   f"{spec.edge_deg:g}° (one bead there); use the angle of a wall, e.g. 0")
@@ -131,10 +123,11 @@ def _wall_members(lattice: Lattice) -> set[int]:
 
 def cut_holes(lattice: Lattice, impacts: list[Impact]) -> tuple[Lattice, set[int]]:
     """(``lattice`` (its walls whole, :func:`~hexdem.model.lattice.without_hole`) with a hole for
-    each impact's bead in every wall it is pushed through, the beads that left every wall). An
+    the bead of each of ``impacts`` (:func:`resolve_impacts`'s, each naming its bead) in every
+    wall it is pushed through, the beads that left every wall). An
     impact on a wall bead that points out through that wall (within 60° of its outward normal;
     a corner bead may still be pushed along or against its other wall) is refused."""
-    beads = [lattice.struck if impact.bead is None else impact.bead for impact in impacts]
+    beads = [impact.bead for impact in impacts]
     for impact, bead in zip(impacts, beads):
         for wall in lattice.walls:
             if bead in wall.members and wall.normals_at(lattice.positions_m[[bead]])[0] @ impact.direction < -HOLE_COSINE:

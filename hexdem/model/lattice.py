@@ -30,85 +30,19 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from hexdem.errors import HexdemError
+from hexdem.model.walls import CurvedWall, Wall
 
-#: Observation lines and the step in (m, n) between consecutive beads on each.
-LINE_STEPS = {"0": (0, 2), "+30": (1, 1), "-30": (-1, 1)}
 #: The step in (m, n) between consecutive sites along each of the lattice's twelve directions, by
 #: angle from +x [deg]: odd multiples of 30° run along touching beads (spacing d), multiples of
 #: 60° between them (spacing √3 d).
 DIRECTION_STEPS = {0: (0, 2), 30: (1, 1), 60: (3, 1), 90: (2, 0), 120: (3, -1), 150: (1, -1), 180: (0, -2),
                    -150: (-1, -1), -120: (-3, -1), -90: (-2, 0), -60: (-3, 1), -30: (-1, 1)}
+#: The paper's observation lines and the step in (m, n) between consecutive beads on each.
+LINE_STEPS = {"0": DIRECTION_STEPS[0], "+30": DIRECTION_STEPS[30], "-30": DIRECTION_STEPS[-30]}
 #: Index offsets of the three neighbours counted once per bond (paper's e₁, e₂, e₃).
 BOND_STEPS = ((2, 0), (1, 1), (-1, 1))
 #: A bead belongs to a wall's contact group when its gap to the wall is below this many d.
 WALL_GROUP_GAP = 0.25
-
-
-@dataclass(frozen=True)
-class Wall:
-    """A flat wall {x : normal·x = offset_m} that pushes beads along ``normal`` (inward).
-
-    ``members`` are the indices of the beads that can touch it: the beads of that edge,
-    minus the struck bead for the wall with the impact hole.
-    """
-
-    name: str
-    normal: tuple[float, float]
-    offset_m: float
-    members: np.ndarray
-
-    def gaps_m(self, positions_m, radii_m):
-        """Signed gap between each bead surface and the wall (negative = overlap) [m]."""
-        return np.asarray(positions_m) @ np.asarray(self.normal) - radii_m - self.offset_m
-
-    def normals_at(self, positions_m) -> np.ndarray:
-        """(N, 2) inward unit normals of the wall where beads at ``positions_m`` (N, 2) touch it."""
-        return np.tile(np.asarray(self.normal, float), (len(positions_m), 1))
-
-    def contact_radii_m(self, radii_m):
-        """R_eff of the Hertz contact of beads of radii ``radii_m`` with the wall: R for a plane."""
-        return np.asarray(radii_m, float)
-
-    def curvatures_at(self, positions_m) -> np.ndarray:
-        """(N,) 1/ρ, ρ the distance from each of ``positions_m`` to the wall's centre: 0 for a plane."""
-        return np.zeros(len(positions_m))
-
-
-@dataclass(frozen=True)
-class CurvedWall:
-    """The inside of a circle {x : |x − centre_m| = radius_m} (a cylinder in 3D), pushing beads
-    towards its centre: the curved wall of a disc-shaped basin.
-
-    ``members`` as for :class:`Wall`. The Hertz law of a sphere of radius r inside it uses
-    LAMMPS's contact radius for a curved region, R_eff = r · 2R / (2R − r) (``region cylinder``
-    stores the inside surface's radius as −2R and ``fix wall/gran/region`` combines it with the
-    sphere's like a pair, r R' / (r + R'); measured: a sphere's contact time inside R = 3r is
-    that of this R_eff to 0.1 µs), so that both engines share one law.
-    """
-
-    name: str
-    centre_m: tuple[float, float]
-    radius_m: float
-    members: np.ndarray
-
-    def gaps_m(self, positions_m, radii_m):
-        """Signed gap between each bead surface and the wall (negative = overlap) [m]."""
-        offsets = np.asarray(positions_m, float) - np.asarray(self.centre_m)
-        return self.radius_m - np.linalg.norm(offsets, axis=-1) - radii_m
-
-    def normals_at(self, positions_m) -> np.ndarray:
-        """(N, 2) inward unit normals (towards the centre) where beads at ``positions_m`` touch it."""
-        inward = np.asarray(self.centre_m) - np.asarray(positions_m, float).reshape(-1, 2)
-        return inward / np.linalg.norm(inward, axis=1)[:, None]
-
-    def contact_radii_m(self, radii_m):
-        """R_eff = r · 2R / (2R − r) of beads of radii r = ``radii_m`` (see the class docstring)."""
-        radii_m = np.asarray(radii_m, float)
-        return radii_m * 2 * self.radius_m / (2 * self.radius_m - radii_m)
-
-    def curvatures_at(self, positions_m) -> np.ndarray:
-        """(N,) 1/ρ, ρ the distance from each of ``positions_m`` (N, 2) to the circle's centre."""
-        return 1.0 / np.linalg.norm(np.asarray(positions_m, float) - np.asarray(self.centre_m), axis=1)
 
 
 @dataclass(frozen=True)
@@ -188,13 +122,19 @@ class Lattice:
         return replace(moved, walls=touching_walls(moved, [w.normal for w in self.walls]))
 
 
+def unit_vector(angle_deg: float) -> np.ndarray:
+    """(cos, sin) of ``angle_deg`` from +x."""
+    angle = float(angle_deg)
+    return np.array([np.cos(np.radians(angle)), np.sin(np.radians(angle))])
+
+
 def strike_direction(angle_deg: float) -> np.ndarray:
     """Unit vector of a strike at ``angle_deg`` from +x; it must point into the packing."""
     angle = float(angle_deg)
     if not np.isfinite(angle) or abs(angle) >= 90.0:
         raise HexdemError(f"strike angle {angle_deg}° does not point into the packing; "
                           "use an angle in (-90°, 90°), e.g. 0 or 30")
-    return np.array([np.cos(np.radians(angle)), np.sin(np.radians(angle))])
+    return unit_vector(angle)
 
 
 def from_sites(labels, diameter_m: float = 1.0, wall_angles_deg=(), shape: str = "listed sites",
@@ -227,7 +167,7 @@ def from_sites(labels, diameter_m: float = 1.0, wall_angles_deg=(), shape: str =
     lattice = Lattice(indices=labels, positions_m=positions,
                       diameters_m=np.full(len(labels), float(diameter_m)), diameter_m=float(diameter_m),
                       struck=int(hit[0]), walls=(), shape=shape)
-    normals = [(np.cos(np.radians(a)), np.sin(np.radians(a))) for a in wall_angles_deg]
+    normals = [unit_vector(a) for a in wall_angles_deg]
     return replace(lattice, walls=touching_walls(lattice, normals))
 
 
@@ -298,6 +238,17 @@ def with_holes(lattice: Lattice, beads, directions) -> Lattice:
     return replace(lattice, walls=tuple(walls))
 
 
+def facing_edge(lattice: Lattice, normal, hole: int | None = None) -> tuple[float, np.ndarray]:
+    """(offset [m], beads) of the packing's edge facing the inward ``normal``: the extreme of
+    normal·x − r over the beads, and the beads within :data:`WALL_GROUP_GAP` d of it; ``hole``, a
+    bead index, neither counts nor decides where the edge is."""
+    reach = lattice.positions_m @ np.asarray(normal) - lattice.radii_m
+    if hole is not None:
+        reach[hole] = np.inf
+    offset = float(reach.min())
+    return offset, np.flatnonzero(reach - offset < WALL_GROUP_GAP * lattice.diameter_m)
+
+
 def touching_walls(lattice: Lattice, normals) -> tuple[Wall, ...]:
     """Flat walls with the given inward normals, each touching the packing without overlap.
 
@@ -308,11 +259,7 @@ def touching_walls(lattice: Lattice, normals) -> tuple[Wall, ...]:
     walls = []
     for normal in normals:
         normal = (float(normal[0]), float(normal[1]))
-        reach = lattice.positions_m @ np.asarray(normal) - lattice.radii_m
-        if np.isclose(normal[0], 1.0):
-            reach[lattice.struck] = np.inf
-        offset = float(reach.min())
-        members = np.flatnonzero(reach - offset < WALL_GROUP_GAP * lattice.diameter_m)
+        offset, members = facing_edge(lattice, normal, lattice.struck if np.isclose(normal[0], 1.0) else None)
         angle = int(round(np.degrees(np.arctan2(normal[1], normal[0]))))
         walls.append(Wall(f"wall_{angle:03d}".replace("-", "m"), normal, offset, members))
     return tuple(walls)

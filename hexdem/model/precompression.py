@@ -38,7 +38,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from hexdem.model.lattice import BOND_STEPS, Lattice, Wall
+from hexdem.model.lattice import BOND_STEPS, Lattice
+from hexdem.model.walls import Wall
 
 #: Neighbour offsets {Δm, Δn} of a bead in the paper's labels: the bond steps and their opposites.
 NEIGHBOURS = BOND_STEPS + tuple((-dm, -dn) for dm, dn in BOND_STEPS)

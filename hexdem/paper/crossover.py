@@ -33,12 +33,11 @@ from scipy.optimize import OptimizeWarning, curve_fit
 from hexdem.disorder.preparation import TOLERANCE_M
 from hexdem.model.hertz import max_overlap
 from hexdem.model.materials import PAPER_DIAMETER_M, STEEL_316, hertz_coefficient, sphere_mass
+from hexdem.paper.disorder_study import LINES, MEASURES, json_number
 
 #: Columns of ``disorder_crossover.csv`` (a contract).
 CROSSOVER_COLUMNS = ("v_striker", "line", "measure", "sigma_tol", "sigma_over_overlap", "transmission", "sem",
                      "realizations")
-LINES = ("0", "±30")
-MEASURES = {"peak": "disorder_effect", "lead": "leading_pulse_effect"}
 #: The slope of log σ_c against log V that the overlap hypothesis predicts.
 OVERLAP_EXPONENT = 0.8
 #: A crossover counts as measured when log10 σ_c is known to this many decades (a factor of 3).
@@ -67,12 +66,8 @@ def crossover_rows(summaries: list[dict]) -> list[tuple]:
                 v = float(effect["v_striker"])
                 sigma_m = s["sigma_per_tol"] * TOLERANCE_M
                 rows.append((v, effect["line"], measure, s["sigma_per_tol"], sigma_m / impact_overlap_m(v),
-                             _number(effect["mean_ratio"]), _number(effect["sem_ratio"]), int(effect["realizations"])))
+                             json_number(effect["mean_ratio"]), json_number(effect["sem_ratio"]), int(effect["realizations"])))
     return sorted(rows, key=lambda r: (r[0], r[1], r[2], r[3]))
-
-
-def _number(value) -> float:
-    return float("nan") if value is None else float(value)
 
 
 def _step(log_sigma, t0, t_inf, log_sigma_c, p):

@@ -103,7 +103,7 @@ def run_study_ensemble(entry: StudyEnsemble, settings: PaperSettings, out: Path,
                                              *MEASURES.values())}}
 
 
-def _number(value) -> float:
+def json_number(value) -> float:
     """A summary's number (null in JSON when it was NaN: one realization has no spread)."""
     return float("nan") if value is None else float(value)
 
@@ -120,9 +120,9 @@ def study_rows(summaries: list[dict]) -> list[tuple]:
                 control = next(c for c in controls[s["preparation"]][key]
                                if c["line"] == effect["line"] and np.isclose(c["v_striker"], STUDY_VELOCITY_M_S))
                 rows.append((s["sigma_per_tol"], s["sigma_per_tol"] * TOLERANCE_M * 1e3, s["preparation"], measure,
-                             effect["line"], _number(effect["mean_ratio"]), _number(effect["sem_ratio"]),
-                             _number(effect["std_ratio"]), effect["realizations"],
-                             _number(effect["mean_ratio"]) / _number(control["mean_ratio"])))
+                             effect["line"], json_number(effect["mean_ratio"]), json_number(effect["sem_ratio"]),
+                             json_number(effect["std_ratio"]), effect["realizations"],
+                             json_number(effect["mean_ratio"]) / json_number(control["mean_ratio"])))
     return rows
 
 

@@ -21,7 +21,7 @@ import numpy as np
 from hexdem.errors import HexdemError
 from hexdem.model.dissipation import lammps_tsuji_coefficient
 from hexdem.model.granular import GranularModel, RunSettings
-from hexdem.model.lattice import CurvedWall
+from hexdem.model.walls import CurvedWall
 from hexdem.model.units import UnitSystem
 
 DECK_NAME = "in.hexdem"
@@ -202,12 +202,13 @@ def held_force_block(model: GranularModel, units: UnitSystem) -> str:
 def impact_block(model: GranularModel, units: UnitSystem) -> str:
     """The impacts: a group of the bodies set moving with each distinct initial velocity (the
     strikers, or the struck beads themselves) and its ``velocity`` command."""
-    velocities = model.initial_velocities_m_s()[model.impact_bodies()] / units.velocity_m_s
+    bodies = model.impact_bodies()
+    velocities = model.initial_velocities_m_s()[bodies] / units.velocity_m_s
     distinct = list(dict.fromkeys(map(tuple, velocities.tolist())))
     block = []
     for k, velocity in enumerate(distinct):
         group = "impactor" if k == 0 else f"impactor_{k + 1}"
-        ids = model.impact_bodies()[[tuple(v) == velocity for v in velocities.tolist()]] + 1
+        ids = bodies[[tuple(v) == velocity for v in velocities.tolist()]] + 1
         block += [f"group           {group} id {' '.join(str(i) for i in ids)}",
                   f"velocity        {group} set {_fmt(velocity[0])} {_fmt(velocity[1])} 0.0 units box"]
     return "\n".join(block)

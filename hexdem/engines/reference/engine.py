@@ -39,6 +39,7 @@ from hexdem.engines.sampling import Sample
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel, RunSettings
 from hexdem.model.lattice import BOND_STEPS, Lattice
+from hexdem.model.walls import wall_normals
 from hexdem.model.units import UnitSystem
 
 #: Description of the run written into the engine's directory.
@@ -146,8 +147,7 @@ def _wall_contacts(model: GranularModel, cells: np.ndarray, units: UnitSystem):
     the rest position to a curved wall's centre (0 for a plane), A_w = k_n,wall sqrt(R_eff)."""
     lattice, walls = model.lattice, model.walls
     positions, radii = lattice.positions_m, lattice.radii_m
-    beads = np.concatenate([np.zeros(0, dtype=np.int64)] + [wall.members for wall in walls]).astype(np.int64)
-    normals = np.concatenate([np.zeros((0, 2))] + [wall.normals_at(positions[wall.members]) for wall in walls])
+    beads, normals = wall_normals(walls, positions)
     gaps = np.concatenate([np.zeros(0)] + [wall.gaps_m(positions[wall.members], radii[wall.members]) for wall in walls])
     curvature = np.concatenate([np.zeros(0)] + [wall.curvatures_at(positions[wall.members]) for wall in walls])
     r_eff = np.concatenate([np.zeros(0)] + [wall.contact_radii_m(radii[wall.members]) for wall in walls])
