@@ -14,7 +14,16 @@ The Python API (:mod:`hexdem.api`) is available here and imported on first use, 
 ``hexdem.tca``, ``hexdem.SweepSettings``, ``hexdem.scaling_laws``.
 """
 
-from hexdem.errors import HexdemError
+import os
+
+#: One BLAS thread. hexdem's linear algebra is small (fits of a few parameters, barycentric
+#: transforms of a few hundred triangles), and OpenBLAS's pool of spinning threads made it 20
+#: times slower whenever the other core was busy (measured: the default run's front-shape
+#: analysis 3.9 s instead of 0.18 s beside a second process; LAMMPS ranks are such processes).
+#: Set here, before NumPy loads its BLAS; a value the user set is kept.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+from hexdem.errors import HexdemError  # noqa: E402
 
 _API = ("RunConfig", "ImpactResult", "LineResult", "simulate_impact", "tca", "SweepSettings", "scaling_laws")
 __all__ = ["HexdemError", *_API]

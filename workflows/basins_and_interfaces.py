@@ -33,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.analysis.figures import SINGLE_PLOT_MARGINS, plt, save, set_title
+from hexdem.analysis.figures import SINGLE_PLOT_MARGINS, save, set_title, subplots
 from hexdem.common.io import atomic_path, write_csv, write_json
 from hexdem.errors import HexdemError
 from hexdem.experiments.run import run_experiment
@@ -105,7 +105,7 @@ def side_fractions(directory: Path) -> list[tuple[float, float, float]]:
 
 
 def interfaces_figure(rows: dict, path: Path) -> None:
-    fig, ax = plt.subplots(figsize=(6, 4.5))
+    fig, ax = subplots(figsize=(6, 4.5))
     fig.subplots_adjust(**SINGLE_PLOT_MARGINS)
     for case, series in rows.items():
         t, _, far = np.array(series).T

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 from record import WorkflowRecord
 
-from hexdem.analysis.figures import plt, save
+from hexdem.analysis.figures import save, subplots
 from hexdem.common.io import write_csv
 from hexdem.theory.scaling import fit_decay
 
@@ -52,7 +52,7 @@ def measure(run_dir: Path, restitution: float, f0: float) -> list[tuple]:
 
 
 def figure(rows: list[tuple], path: Path) -> None:
-    fig, axes = plt.subplots(2, 2, figsize=(10, 7), layout="constrained")
+    fig, axes = subplots(2, 2, figsize=(10, 7), layout="constrained")
     for column, (key, values, label) in enumerate(((0, RESTITUTIONS, "coefficient of restitution e  (f0 = 0)"),
                                                    (1, PRECOMPRESSIONS_N, "static contact force f0 [N]  (e = 1)"))):
         other = 1 - key

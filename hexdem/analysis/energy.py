@@ -41,25 +41,35 @@ def hertz_energy_j(stiffness_pa, r_eff_m, overlap_m) -> float:
     return 0.4 * float(np.sum(stiffness_pa * terms))
 
 
-def _pair_contacts(positions_m, i, j, radii, model: GranularModel):
-    """(i, j, k_n, R_eff, δ) of the touching pairs among the candidate pairs ``i``, ``j``."""
+def _pair_constants(model: GranularModel, i, j, radii) -> tuple:
+    """(i, j, k_n, R_eff) of the candidate pairs ``i``, ``j``: what a contact of each would be."""
+    return i, j, model.contact_stiffness_pa(i, j), radii[i] * radii[j] / (radii[i] + radii[j])
+
+
+def _pair_contacts(positions_m, radii, candidates):
+    """(i, j, k_n, R_eff, δ) of the touching pairs among the ``candidates`` (:func:`_pair_constants`)."""
+    i, j, stiffness, r_eff = candidates
     overlap = radii[i] + radii[j] - np.linalg.norm(positions_m[i] - positions_m[j], axis=1)
     touching = overlap > 0
-    i, j = i[touching], j[touching]
-    return i, j, model.contact_stiffness_pa(i, j), radii[i] * radii[j] / (radii[i] + radii[j]), overlap[touching]
+    return i[touching], j[touching], stiffness[touching], r_eff[touching], overlap[touching]
 
 
-def _wall_contacts(positions_m, model: GranularModel) -> list[tuple]:
-    """Per wall, (beads, k_n, R_eff, δ) of its members that touch it (R_eff of each wall: R
+def _wall_constants(model: GranularModel) -> list[tuple]:
+    """Per wall, (wall, members, their k_n against it, their radii, their contact radii R_eff: R
     against a plane)."""
     radii = model.diameters_m / 2
+    return [(wall, wall.members, model.wall_stiffness_pa(wall.members), radii[wall.members],
+             wall.contact_radii_m(radii[wall.members])) for wall in model.walls]
+
+
+def _wall_contacts(positions_m, walls) -> list[tuple]:
+    """Per wall of ``walls`` (:func:`_wall_constants`), (beads, k_n, R_eff, δ) of its members
+    that touch it."""
     contacts = []
-    for wall in model.walls:
-        members = wall.members
-        depth = -wall.gaps_m(positions_m[members], radii[members])
+    for wall, members, stiffness, radii, contact_radii in walls:
+        depth = -wall.gaps_m(positions_m[members], radii)
         inside = depth > 0
-        contacts.append((members[inside], model.wall_stiffness_pa(members[inside]),
-                         wall.contact_radii_m(radii[members][inside]), depth[inside]))
+        contacts.append((members[inside], stiffness[inside], contact_radii[inside], depth[inside]))
     return contacts
 
 
@@ -72,14 +82,17 @@ def contact_energy_j(positions_m, model: GranularModel) -> float:
     """Hertz energy [J] of all bead–bead and bead–wall overlaps at ``positions_m`` (n_bodies, 2)."""
     positions_m = np.asarray(positions_m, float)
     radii = model.diameters_m / 2
-    i, j = _pairs(positions_m, 2 * radii.max())
-    pairs = _pair_contacts(positions_m, i, j, radii, model)
-    return hertz_energy_j(*pairs[2:]) + _wall_energy_j(_wall_contacts(positions_m, model))
+    pairs = _pair_contacts(positions_m, radii, _pair_constants(model, *_pairs(positions_m, 2 * radii.max()), radii))
+    return hertz_energy_j(*pairs[2:]) + _wall_energy_j(_wall_contacts(positions_m, _wall_constants(model)))
+
+
+def _kinetic_j(velocities_m_s, masses_kg) -> float:
+    return float(0.5 * np.sum(masses_kg * np.sum(np.asarray(velocities_m_s) ** 2, axis=1)))
 
 
 def kinetic_energy_j(velocities_m_s, model: GranularModel) -> float:
     """Translational kinetic energy Σ ½ M v² [J] (no torques act, so no rotation)."""
-    return float(0.5 * np.sum(model.masses_kg * np.sum(np.asarray(velocities_m_s) ** 2, axis=1)))
+    return _kinetic_j(velocities_m_s, model.masses_kg)
 
 
 def total_energy_j(positions_m, velocities_m_s, model: GranularModel) -> float:
@@ -90,34 +103,39 @@ class EnergyAudit:
     """Total energy [J] of successive states of one run, for the drift of a conservative model.
 
     Equal to :func:`total_energy_j` minus the work of the constant forces (``gravity_m_s2``, if
-    given, and the model's held force on a precompressed packing's struck bead), but the
-    candidate contact pairs are kept between calls and searched again only after some body
-    has moved half of :data:`PAIR_SKIN_D` bead diameters, so a large packing costs a few
-    vector operations per state instead of a tree search.
+    given, and the model's held force on a precompressed packing's struck bead), but what does
+    not change during a run (masses, radii, regions, each wall's members and stiffness, the
+    candidate pairs' stiffness) is worked out once, and the candidate contact pairs are kept
+    between calls and searched again only after some body has moved half of
+    :data:`PAIR_SKIN_D` bead diameters, so a large packing costs a few vector operations per
+    state instead of a tree search.
     """
 
     def __init__(self, model: GranularModel, gravity_m_s2=None):
         self.model = model
         self.start_m = model.initial_positions_m()
+        self.masses_kg = model.masses_kg
         self.radii_m = model.diameters_m / 2
         self.skin_m = PAIR_SKIN_D * model.lattice.diameter_m
+        self.walls = _wall_constants(model)
+        self.region_names, self.regions = energy_regions(model)
         gravity = np.zeros(2) if gravity_m_s2 is None else np.asarray(gravity_m_s2, float)
-        self.external_n = model.external_forces_n() + model.masses_kg[:, None] * gravity
-        self._listed_at, self._pairs = None, None
+        self.external_n = model.external_forces_n() + self.masses_kg[:, None] * gravity
+        self._listed_at, self._candidates = None, None
 
     def _candidate_pairs(self, positions_m):
         if self._listed_at is None or np.max(np.linalg.norm(positions_m - self._listed_at, axis=1)) > self.skin_m / 2:
             self._listed_at = positions_m.copy()
-            self._pairs = _pairs(positions_m, 2 * self.radii_m.max() + self.skin_m)
-        return self._pairs
+            pairs = _pairs(positions_m, 2 * self.radii_m.max() + self.skin_m)
+            self._candidates = _pair_constants(self.model, *pairs, self.radii_m)
+        return self._candidates
 
     def _contacts(self, positions_m):
-        i, j = self._candidate_pairs(positions_m)
-        return _pair_contacts(positions_m, i, j, self.radii_m, self.model), _wall_contacts(positions_m, self.model)
+        return (_pair_contacts(positions_m, self.radii_m, self._candidate_pairs(positions_m)),
+                _wall_contacts(positions_m, self.walls))
 
     def _total(self, positions_m, velocities_m_s, pairs, walls) -> float:
-        energy = (kinetic_energy_j(velocities_m_s, self.model) + hertz_energy_j(*pairs[2:])
-                  + _wall_energy_j(walls))
+        energy = _kinetic_j(velocities_m_s, self.masses_kg) + hertz_energy_j(*pairs[2:]) + _wall_energy_j(walls)
         return energy - float(np.sum((positions_m - self.start_m) * self.external_n))
 
     def __call__(self, positions_m, velocities_m_s) -> float:
@@ -130,7 +148,7 @@ class EnergyAudit:
         positions_m = np.asarray(positions_m, float)
         pairs, walls = self._contacts(positions_m)
         return (self._total(positions_m, velocities_m_s, pairs, walls),
-                _region_energies_j(velocities_m_s, self.model, pairs, walls))
+                _region_energies_j(velocities_m_s, self.masses_kg, self.regions, len(self.region_names), pairs, walls))
 
 
 def energy_regions(model: GranularModel) -> tuple[list[str], np.ndarray]:
@@ -143,16 +161,16 @@ def energy_regions(model: GranularModel) -> tuple[list[str], np.ndarray]:
     return names, regions
 
 
-def _region_energies_j(velocities_m_s, model: GranularModel, pairs, walls) -> np.ndarray:
-    """(R, 2) kinetic and contact energy [J] of each region (:func:`energy_regions`): a
-    contact's Hertz energy half to each of its bodies' regions, a wall contact's to its bead's."""
-    names, regions = energy_regions(model)
+def _region_energies_j(velocities_m_s, masses_kg, regions, n_regions: int, pairs, walls) -> np.ndarray:
+    """(R, 2) kinetic and contact energy [J] of each region (``regions``: each body's, from
+    :func:`energy_regions`): a contact's Hertz energy half to each of its bodies' regions, a wall
+    contact's to its bead's."""
 
     def by_region(bodies, energies) -> np.ndarray:  # (float even when empty, unlike bincount's)
-        return np.bincount(bodies, energies, len(names)).astype(float)
+        return np.bincount(bodies, energies, n_regions).astype(float)
 
     velocities_m_s = np.asarray(velocities_m_s, float)
-    kinetic = by_region(regions, 0.5 * model.masses_kg * np.sum(velocities_m_s**2, axis=1))
+    kinetic = by_region(regions, 0.5 * masses_kg * np.sum(velocities_m_s**2, axis=1))
     i, j, *pair = pairs
     halves = _hertz_energies_j(*pair) / 2
     contact = by_region(regions[i], halves) + by_region(regions[j], halves)

@@ -1,23 +1,23 @@
 """Figures a researcher would publish: arrival-time and peak maps (Fig. 8) and peak decay (Figs. 6, 9).
 
-Every function draws into a new figure and saves it atomically as PNG (non-interactive
-Agg backend, so it works on machines without a display).
+Every function draws into a new figure and saves it atomically as PNG. Figures are
+:class:`matplotlib.figure.Figure` objects on the Agg canvas (:func:`subplots`), never
+``pyplot``: no display is needed, no global state is kept, and a run does not pay for
+importing pyplot and its interactive backends (about 0.5 s).
 """
 
 from __future__ import annotations
 
-import matplotlib
+import numpy as np
+from matplotlib import colormaps
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.collections import EllipseCollection
+from matplotlib.colors import LogNorm
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.collections import PatchCollection  # noqa: E402
-from matplotlib.colors import LogNorm  # noqa: E402
-from matplotlib.patches import Circle  # noqa: E402
-
-from hexdem.analysis.front_shape import HEXAGON_SIXFOLD  # noqa: E402
-from hexdem.common.io import atomic_path  # noqa: E402
-from hexdem.model.walls import CurvedWall  # noqa: E402
+from hexdem.analysis.front_shape import HEXAGON_SIXFOLD
+from hexdem.common.io import atomic_path
+from hexdem.model.walls import CurvedWall
 
 UNIT_LABELS = {"si": {"length": "m", "speed": "m/s", "time": "ms", "time_scale": 1e3},
                "nondimensional": {"length": "d", "speed": "$\\sqrt{A/M}\\,d^{5/4}$", "time": "T", "time_scale": 1.0}}
@@ -33,24 +33,40 @@ def set_title(ax, title: str) -> None:
     ax.set_title(title, y=1.0)
 
 
+#: PNG compression (zlib level 1 of 9): the figures' flat colours compress nearly as well as at
+#: the default level 6, at a fraction of the encoding time (measured on the default run's maps).
+PNG_COMPRESSION = 1
+
+
+def subplots(nrows: int = 1, ncols: int = 1, figsize=None, layout=None, **kwargs):
+    """(figure, axes) as ``pyplot.subplots`` gives them, on an Agg canvas of their own (see the
+    module docstring); ``kwargs`` go to :meth:`matplotlib.figure.Figure.subplots`."""
+    fig = Figure(figsize=figsize, layout=layout)
+    FigureCanvasAgg(fig)
+    return fig, fig.subplots(nrows, ncols, **kwargs)
+
+
 def save(fig, path) -> None:
+    """``fig`` as PNG at ``path``, written atomically."""
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=150)
-    plt.close(fig)
+        fig.savefig(tmp, format="png", dpi=150, pil_kwargs={"compress_level": PNG_COMPRESSION})
 
 
 def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=None, norm=None):
-    """Beads as true-size circles coloured by ``values`` (NaN drawn grey) through ``norm`` (None:
-    linear); returns the mappable."""
-    circles = PatchCollection([Circle(p, d / 2) for p, d in zip(positions, diameters)], norm=norm,
-                              cmap=plt.get_cmap(cmap).with_extremes(bad="lightgrey"), edgecolor="k", linewidth=0.2)
+    """Beads as true-size circles (one collection, sized in data units) coloured by ``values``
+    (NaN drawn grey) through ``norm`` (None: linear); returns the mappable."""
+    circles = EllipseCollection(diameters, diameters, np.zeros(len(diameters)), units="xy", offsets=positions,
+                                offset_transform=ax.transData, norm=norm,
+                                cmap=colormaps[cmap].with_extremes(bad="lightgrey"), edgecolor="k", linewidth=0.2)
     circles.set_array(np.ma.masked_invalid(values))
     if clim is not None:
         circles.set_clim(*clim)
     ax.add_collection(circles)
+    radius = np.max(diameters) / 2
+    ax.update_datalim(np.vstack([positions.min(axis=0) - radius, positions.max(axis=0) + radius]))
     ax.set_aspect("equal")
     ax.autoscale_view()
-    plt.colorbar(circles, ax=ax, label=label, shrink=0.8)
+    ax.figure.colorbar(circles, ax=ax, label=label, shrink=0.8)
     return circles
 
 
@@ -91,7 +107,7 @@ def draw_lattice(ax, results, model, values, label: str, cmap="viridis", norm=No
 
 def lattice_map(results, model, values, path, label: str, title: str, cmap="viridis", norm=None) -> None:
     """One value per bead drawn on the lattice (like Fig. 8a), walls drawn, struck beads marked."""
-    fig, ax = plt.subplots(figsize=(7, 6))
+    fig, ax = subplots(figsize=(7, 6))
     fig.subplots_adjust(left=0.12, right=0.98, bottom=0.09, top=0.94)
     draw_lattice(ax, results, model, values, label, cmap, norm)
     set_title(ax, title)
@@ -117,7 +133,7 @@ def peak_map(results, model, v0: float, path, title="Peak speed") -> None:
 def peak_decay(rows_by_line: dict, path, units_name: str, v0: float, title="Peak speed along the observation lines"):
     """Peak speed V_n / V0 vs n for each observation line, logarithmic axis."""
     units = UNIT_LABELS[units_name]
-    fig, ax = plt.subplots(figsize=(6, 4.5))
+    fig, ax = subplots(figsize=(6, 4.5))
     fig.subplots_adjust(**SINGLE_PLOT_MARGINS)
     markers = {"0": "o", "+30": "^", "-30": "v"}
     for line, (n, peak) in rows_by_line.items():
@@ -136,7 +152,7 @@ def energy_regions_figure(results, path, title="Where the energy is") -> None:
     units = UNIT_LABELS[results.units]
     energies = results.region_energies.sum(axis=2)
     shares = energies / energies.sum(axis=1, keepdims=True)
-    fig, ax = plt.subplots(figsize=(6, 4.5))
+    fig, ax = subplots(figsize=(6, 4.5))
     fig.subplots_adjust(**SINGLE_PLOT_MARGINS)
     for k, name in enumerate(results.region_names):
         ax.plot(results.region_times * units["time_scale"], shares[:, k], label=name)
@@ -161,7 +177,7 @@ def front_shape_figure(curves: dict, path, title="Roundness of the wavefront", f
     a6/a0 with its sign (see :class:`~hexdem.analysis.front_shape.FrontShape`) instead of the
     amplitude, a hexagon of either orientation drawn dashed.
     """
-    fig, ax = plt.subplots(figsize=(6, 4.5))
+    fig, ax = subplots(figsize=(6, 4.5))
     fig.subplots_adjust(**SINGLE_PLOT_MARGINS)
     for label, shape in curves.items():
         values = shape.sixfold_cos if signed else shape.sixfold_amplitude

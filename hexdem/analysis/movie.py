@@ -9,10 +9,7 @@ front decays by orders of magnitude as it spreads) and writes an animated GIF at
 from __future__ import annotations
 
 import numpy as np
-from matplotlib.colors import LogNorm
-from PIL import Image
 
-from hexdem.analysis.figures import UNIT_LABELS, draw_lattice, plt
 from hexdem.common.io import atomic_path
 
 #: Frames of a movie, and how long each is shown [ms].
@@ -33,8 +30,13 @@ def speed_movie(results, model, times, speeds, v0: float, path, title: str = "")
     """Write ``path`` (GIF): one frame per row of ``speeds`` (F, N), the beads coloured by
     |v|/``v0``, the frame's time from ``times`` (F,) in the run's units, walls and the struck
     beads drawn."""
+    from matplotlib.colors import LogNorm  # (drawing only: a run picks its frames without matplotlib)
+    from PIL import Image
+
+    from hexdem.analysis.figures import UNIT_LABELS, draw_lattice, subplots
+
     units = UNIT_LABELS[results.units]
-    fig, ax = plt.subplots(figsize=(6.4, 5.4))
+    fig, ax = subplots(figsize=(6.4, 5.4))
     fig.subplots_adjust(left=0.1, right=0.97, bottom=0.09, top=0.92)
     floor = 10.0 ** -DECADES
     circles = draw_lattice(ax, results, model, np.full(len(model.lattice), floor), "speed $|v| / V_0$",
@@ -55,6 +57,5 @@ def speed_movie(results, model, times, speeds, v0: float, path, title: str = "")
         # one palette for the movie, from the first frame (its colour bar holds the whole scale)
         palette = palette or image.quantize(colors=PALETTE_COLOURS)
         frames.append(image.quantize(palette=palette, dither=Image.Dither.NONE))
-    plt.close(fig)
     with atomic_path(path) as tmp:
         frames[0].save(tmp, format="GIF", save_all=True, append_images=frames[1:], duration=FRAME_MS, loop=0)

@@ -34,7 +34,7 @@ import numpy as np
 
 from hexdem.analysis.energy import EnergyAudit, energy_error, energy_regions, energy_scale_j, kinetic_energy_j
 from hexdem.analysis.peaks import refine_peak, refine_peaks
-from hexdem.analysis.tracker_kernel import first_crossing, rung, update
+from hexdem.analysis.tracker_kernel import PulseState
 from hexdem.engines.sampling import Sample
 from hexdem.model.granular import GranularModel, RunSettings
 
@@ -94,19 +94,7 @@ class PulseTracker:
         self.root = comm is None or comm.Get_rank() == 0
         n, total = len(model.lattice), settings.n_samples
         self.n_beads, self.n_bodies, self.n_samples_expected = n, model.n_bodies, total
-        self.ring = np.zeros((n, 3))
-        self.peak = np.full(n, -1.0)
-        self.peak_index = np.full(n, -1, dtype=np.int64)
-        self.window = np.full((n, 7), np.nan)
-        self.after = np.zeros(n, dtype=np.int64)
-        self.rung = rung(RECORD_CAPACITY)
-        self.rec_index = np.zeros((n, RECORD_CAPACITY), dtype=np.int64)
-        self.rec_value = np.zeros((n, RECORD_CAPACITY))
-        self.rec_prev = np.zeros((n, RECORD_CAPACITY))
-        self.rec_len = np.zeros(n, dtype=np.int64)
-        self.first_index = np.zeros((n, RECORD_CAPACITY), dtype=np.int64)
-        self.first_value = np.zeros((n, RECORD_CAPACITY))
-        self.first_prev = np.zeros((n, RECORD_CAPACITY))
+        self.pulses = PulseState(n, RECORD_CAPACITY)
         self.owned = np.zeros(n, dtype=np.bool_)
         self.trace_beads = np.asarray(trace_beads, dtype=np.int64)
         self.traces = np.full((total, len(self.trace_beads)), np.nan)
@@ -122,10 +110,6 @@ class PulseTracker:
         self.count = 0
 
     # ---- state shared across ranks
-    def _state(self) -> list[np.ndarray]:
-        return [self.ring, self.peak, self.peak_index, self.window, self.after, self.rec_index, self.rec_value,
-                self.rec_prev, self.rec_len, self.first_index, self.first_value, self.first_prev]
-
     def _owned(self, array: np.ndarray) -> np.ndarray:
         """``array`` with the rows of the beads this rank does not own zeroed (for a sum over ranks)."""
         mask = self.owned.reshape((-1,) + (1,) * (array.ndim - 1))
@@ -135,7 +119,7 @@ class PulseTracker:
         """Give every rank each bead's state from the rank that owned it until now."""
         from mpi4py import MPI
 
-        for array in self._state():
+        for array in self.pulses.arrays():
             self.comm.Allreduce(self._owned(array), array, op=MPI.SUM)
 
     def _collect(self) -> None:
@@ -143,7 +127,7 @@ class PulseTracker:
         taken by exactly one rank (NaN elsewhere)."""
         from mpi4py import MPI
 
-        for array in self._state():
+        for array in self.pulses.arrays():
             self.comm.Reduce(self._owned(array), array if self.root else None, op=MPI.SUM, root=0)
         for array in (self.traces, self.fields, self.sensors):
             taken = np.isfinite(array).astype(np.int64)
@@ -178,7 +162,7 @@ class PulseTracker:
             self.owned = owned
         else:
             self.owned[index] = True
-        update(index, speeds, s, self.rung, *self._state())
+        self.pulses.update(index, speeds, s)
         if len(self.trace_beads):
             here, rows = self._rows(sample, self.trace_beads)
             self.traces[s, here] = np.hypot(sample.velocities[rows, 0], sample.velocities[rows, 1])
@@ -224,23 +208,21 @@ class PulseTracker:
             return None
         interval = self.settings.dump_every * self.settings.dt_s / self.settings.units.time_s
         peak, t_peak, arrival, reach = (np.full(self.n_beads, np.nan) for _ in range(4))
-        moved = self.peak > 0.0
-        complete = moved & (self.peak_index <= self.count - 3)
-        full = complete & np.isfinite(self.window).all(axis=1)  # the 7 samples: one refinement for all
-        offset, peak[full] = refine_peaks(self.window[full], interval)
-        t_peak[full] = self.peak_index[full] * interval + offset
+        state = self.pulses
+        moved = state.peak > 0.0
+        complete = moved & (state.peak_index <= self.count - 3)
+        full = complete & np.isfinite(state.window).all(axis=1)  # the 7 samples: one refinement for all
+        offset, peak[full] = refine_peaks(state.window[full], interval)
+        t_peak[full] = state.peak_index[full] * interval + offset
         for b in np.flatnonzero(moved):
-            n = int(self.rec_len[b])
-            records = (self.rec_index[b, :n], self.rec_value[b, :n], self.rec_prev[b, :n], self.first_index[b, :n],
-                       self.first_value[b, :n], self.first_prev[b, :n], n)
             if not complete[b]:
-                reach[b] = interval * first_crossing(0.5 * self.peak[b], *records)
+                reach[b] = interval * state.first_crossing(b, 0.5 * state.peak[b])
                 continue
             if not full[b]:
-                index = np.arange(self.peak_index[b] - 3, self.peak_index[b] + 4)
-                valid = (index >= 0) & (index < self.count) & np.isfinite(self.window[b])
-                t_peak[b], peak[b] = refine_peak(index[valid] * interval, self.window[b, valid])
-            arrival[b] = reach[b] = interval * first_crossing(0.5 * peak[b], *records)
+                index = np.arange(state.peak_index[b] - 3, state.peak_index[b] + 4)
+                valid = (index >= 0) & (index < self.count) & np.isfinite(state.window[b])
+                t_peak[b], peak[b] = refine_peak(index[valid] * interval, state.window[b, valid])
+            arrival[b] = reach[b] = interval * state.first_crossing(b, 0.5 * peak[b])
         scale = energy_scale_j(self.energies, self.impact_energy)
         return TrackedPulses(peak_speed=peak, t_peak=t_peak, arrival_time=arrival, reach_time=reach,
                              energy_drift=energy_error(self.energies, self.impact_energy, self.model.dissipative),

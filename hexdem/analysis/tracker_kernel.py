@@ -1,4 +1,4 @@
-"""Compiled per-sample update of the pulse tracker (:mod:`hexdem.analysis.tracker`).
+"""Per-sample update of the pulse tracker (:mod:`hexdem.analysis.tracker`), vectorised over beads.
 
 For every bead it keeps, in fixed-size arrays, exactly what the definitions of
 :mod:`hexdem.analysis.peaks` need from a whole time series:
@@ -24,13 +24,20 @@ For every bead it keeps, in fixed-size arrays, exactly what the definitions of
   own slot and the crossing is exact. The one inexact case is a separate earlier pulse whose
   peak lies within a rung above both L and the slot's first record.
 
-Sample s of a bead is its s-th sample; ``ring`` holds its last three samples.
+Sample s of a bead is its s-th sample; ``ring`` holds its last three samples. Each bead's
+ladder is a circular buffer of the C slots from ``start``: dropping records moves ``start``
+instead of copying the slots.
+
+**Cost.** Most beads, at most samples, only enter the ring (and, for three samples after a
+new maximum, the peak window); the ladder's bookkeeping runs on the few beads whose running
+maximum rises at that sample. Every step is a NumPy operation over those beads: no Python per
+bead and no compiler to load (numba's start-up alone cost more than the default run's whole
+tracking).
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 
 def rung(capacity: int) -> float:
@@ -38,61 +45,95 @@ def rung(capacity: int) -> float:
     return 2.0 ** (1.0 / (capacity - 4))
 
 
-@njit(cache=True)
-def update(beads, speeds, s, q, ring, peak, peak_index, window, after, rec_index, rec_value, rec_prev,
-           rec_len, first_index, first_value, first_prev) -> None:
-    """Take sample ``s`` (speeds of ``beads``) into the per-bead state arrays, in place."""
-    for k in range(beads.shape[0]):
-        b, v = beads[k], speeds[k]
-        prev = ring[b, (s - 1) % 3] if s >= 1 else np.nan
-        if v > peak[b]:
-            peak[b] = v
-            peak_index[b] = s
-            for j in range(3):
-                window[b, j] = ring[b, (s - 3 + j) % 3] if s - 3 + j >= 0 else np.nan
-            window[b, 3] = v
-            for j in range(4, 7):
-                window[b, j] = np.nan
-            after[b] = 0
-            drop = 0
-            while drop + 1 < rec_len[b] and rec_value[b, drop + 1] < 0.5 * v:
-                drop += 1
-            n = rec_len[b] - drop
-            for j in range(n):
-                rec_index[b, j] = rec_index[b, j + drop]
-                rec_value[b, j] = rec_value[b, j + drop]
-                rec_prev[b, j] = rec_prev[b, j + drop]
-                first_index[b, j] = first_index[b, j + drop]
-                first_value[b, j] = first_value[b, j + drop]
-                first_prev[b, j] = first_prev[b, j + drop]
-            if n >= 2 and rec_value[b, n - 1] < q * rec_value[b, n - 2]:
-                n -= 1
-            else:
-                first_index[b, n] = s
-                first_value[b, n] = v
-                first_prev[b, n] = prev
-            rec_index[b, n] = s
-            rec_value[b, n] = v
-            rec_prev[b, n] = prev
-            rec_len[b] = n + 1
-        elif after[b] < 3:
-            window[b, 4 + after[b]] = v
-            after[b] += 1
-        ring[b, s % 3] = v
+class PulseState:
+    """The per-bead state of :mod:`hexdem.analysis.tracker` for ``n`` beads and a ladder of
+    ``capacity`` slots (module docstring); every array is indexed by bead first."""
 
+    def __init__(self, n: int, capacity: int):
+        self.q = rung(capacity)
+        self.ring = np.zeros((n, 3))
+        self.peak = np.full(n, -1.0)
+        self.peak_index = np.full(n, -1, dtype=np.int64)
+        self.window = np.full((n, 7), np.nan)
+        self.after = np.zeros(n, dtype=np.int64)
+        self.start = np.zeros(n, dtype=np.int64)
+        self.length = np.zeros(n, dtype=np.int64)
+        self.rec_index = np.zeros((n, capacity), dtype=np.int64)
+        self.rec_value = np.full((n, capacity), -np.inf)  # a free slot: below every record
+        self.rec_prev = np.zeros((n, capacity))
+        self.first_index = np.zeros((n, capacity), dtype=np.int64)
+        self.first_value = np.zeros((n, capacity))
+        self.first_prev = np.zeros((n, capacity))
 
-@njit(cache=True)
-def first_crossing(level, rec_index, rec_value, rec_prev, first_index, first_value, first_prev, n_records) -> float:
-    """Fractional sample index at which the samples first reached ``level`` (NaN if never)."""
-    for j in range(n_records):
-        if rec_value[j] >= level:
-            s0, v0, before0 = first_index[j], first_value[j], first_prev[j]
-            if v0 >= level:
-                if s0 == 0 or not before0 < level:
-                    return float(s0)
-                return s0 - 1 + (level - before0) / (v0 - before0)
-            s, before = rec_index[j], rec_prev[j]
-            if before < level:
-                return s - 1 + (level - before) / (rec_value[j] - before)
-            return s0 + (level - v0) / (before - v0) * (s - 1 - s0)
-    return np.nan
+    def arrays(self) -> list[np.ndarray]:
+        """Every state array (for merging the beads' states across MPI ranks)."""
+        return [self.ring, self.peak, self.peak_index, self.window, self.after, self.start, self.length,
+                self.rec_index, self.rec_value, self.rec_prev, self.first_index, self.first_value, self.first_prev]
+
+    def update(self, beads, speeds, s: int) -> None:
+        """Take sample ``s`` (speeds of ``beads``, distinct) into the state, in place."""
+        before = self.ring[beads, (s - 1) % 3] if s >= 1 else np.full(len(beads), np.nan)
+        rising = speeds > self.peak[beads]
+        if not rising.all():
+            self._enter_window(beads[~rising], speeds[~rising])
+        if rising.any():
+            self._new_maxima(beads[rising], speeds[rising], before[rising], s)
+        self.ring[beads, s % 3] = speeds
+
+    def _enter_window(self, beads, speeds) -> None:
+        """Beads past their running maximum: the sample fills the next of the three window slots
+        after the peak, while any is left."""
+        slot = self.after[beads]
+        open_ = slot < 3
+        self.window[beads[open_], 4 + slot[open_]] = speeds[open_]
+        self.after[beads[open_]] += 1
+
+    def _new_maxima(self, beads, speeds, before, s: int) -> None:
+        """Beads whose running maximum rises to ``speeds`` at sample ``s`` (``before``: their sample
+        s − 1): a new peak window, and the new record climbs the ladder (module docstring)."""
+        self.peak[beads] = speeds
+        self.peak_index[beads] = s
+        for j in range(3):
+            self.window[beads, j] = self.ring[beads, (s - 3 + j) % 3] if s - 3 + j >= 0 else np.nan
+        self.window[beads, 3] = speeds
+        self.window[beads, 4:] = np.nan
+        self.after[beads] = 0
+        capacity = self.rec_value.shape[1]
+        # records below half the new maximum cannot be the arrival: all but the last of them go.
+        # Records rise along the ladder, and a free slot holds -inf or a dropped record, which was
+        # below half of an earlier maximum: every free slot is below half of any new one. So the
+        # ladder's records below half are all slots below it but the free ones.
+        length = self.length[beads]
+        below = np.count_nonzero(self.rec_value[beads] < 0.5 * speeds[:, None], axis=1) - (capacity - length)
+        drop = np.maximum(below - 1, 0)
+        start = (self.start[beads] + drop) % capacity
+        n = length - drop
+        newest = self.rec_value[beads, (start + n - 1) % capacity]
+        same_rung = (n >= 2) & (newest < self.q * self.rec_value[beads, (start + n - 2) % capacity])
+        n = n - same_rung
+        slot = (start + n) % capacity
+        climbed = ~same_rung
+        self.first_index[beads[climbed], slot[climbed]] = s
+        self.first_value[beads[climbed], slot[climbed]] = speeds[climbed]
+        self.first_prev[beads[climbed], slot[climbed]] = before[climbed]
+        self.rec_index[beads, slot] = s
+        self.rec_value[beads, slot] = speeds
+        self.rec_prev[beads, slot] = before
+        self.start[beads] = start
+        self.length[beads] = n + 1
+
+    def first_crossing(self, bead: int, level: float) -> float:
+        """Fractional sample index at which ``bead``'s samples first reached ``level`` (NaN if never)."""
+        order = (self.start[bead] + np.arange(self.length[bead])) % self.rec_value.shape[1]
+        records = zip(self.rec_index[bead, order], self.rec_value[bead, order], self.rec_prev[bead, order],
+                      self.first_index[bead, order], self.first_value[bead, order], self.first_prev[bead, order])
+        for s, value, before, s0, v0, before0 in records:
+            if value >= level:
+                if v0 >= level:
+                    if s0 == 0 or not before0 < level:
+                        return float(s0)
+                    return s0 - 1 + (level - before0) / (v0 - before0)
+                if before < level:
+                    return s - 1 + (level - before) / (value - before)
+                return s0 + (level - v0) / (before - v0) * (s - 1 - s0)
+        return np.nan

@@ -58,14 +58,13 @@ def all_directions(stats_rows, ideal_rows, laws: dict, path) -> None:
     Grey band: mean ± σ over the disordered realizations (dotted: the mean); black dots:
     the ideal lattice struck by the same striker; red: the fitted law, if any.
     """
-    import matplotlib.pyplot as plt
     from matplotlib.ticker import MaxNLocator
 
     stats = _by_velocity_line(stats_rows, slice(3, 5))
     ideal = _by_velocity_line(ideal_rows, slice(3, 4))
     velocities = sorted({v for v, _ in stats})
-    fig, axes = plt.subplots(len(velocities), 2, figsize=(10, 3.2 * len(velocities)), squeeze=False,
-                             sharex="col")
+    fig, axes = plots.subplots(len(velocities), 2, figsize=(10, 3.2 * len(velocities)), squeeze=False,
+                               sharex="col")
     for row, v in enumerate(velocities):
         for col, line in enumerate(FIG9_LINES):
             ax = axes[row, col]
@@ -95,12 +94,11 @@ def expnumsim(lattice, walls, ideal_relative, mean_relative, reference: int, v_s
               realizations: int, path) -> None:
     """Fig. 8 (a), (c): arrival time relative to the reference bead (white x), ideal lattice
     beside the mean over the disordered realizations, one colour scale [ms]."""
-    import matplotlib.pyplot as plt
 
     finite = np.concatenate([ideal_relative[np.isfinite(ideal_relative)], mean_relative[np.isfinite(mean_relative)]])
     clim = (float(finite.min()) * 1e3, float(finite.max()) * 1e3)
     positions, diameters = lattice.positions_m, lattice.diameters_m
-    fig, axes = plt.subplots(1, 2, figsize=(13, 5.5))
+    fig, axes = plots.subplots(1, 2, figsize=(13, 5.5))
     panels = (("(a) ideal lattice", ideal_relative),
               (f"(c) weak disorder, mean of {realizations} realizations", mean_relative))
     for ax, (title, values) in zip(axes, panels):

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hexdem.analysis.figures import UNIT_LABELS, plt, save
+from hexdem.analysis.figures import UNIT_LABELS, save, subplots
 from hexdem.analysis.impact import ImpactAnalysis
 from hexdem.common.checks import is_number
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json
@@ -114,7 +114,7 @@ def comparison_plot(comparison: EngineComparison, v0: float, path) -> None:
     """Peak speed and arrival time per line from both engines (top), |differences| (bottom, log)."""
     units = UNIT_LABELS[comparison.units]
     scale = units["time_scale"]
-    fig, axes = plt.subplots(2, 2, figsize=(11, 7.5), sharex=True)
+    fig, axes = subplots(2, 2, figsize=(11, 7.5), sharex=True)
     for k, (name, marker) in enumerate(zip(LINE_STEPS, "o^v")):
         rows = [row for row in comparison.rows if row[0] == name]
         n = np.array([row[1] for row in rows])

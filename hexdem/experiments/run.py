@@ -20,10 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.analysis import figures as plots
 from hexdem.analysis.front_shape import FRONT_SHAPE_COLUMNS, FrontShape, front_shape, front_times
 from hexdem.analysis.impact import PEAK_COLUMNS, ImpactAnalysis
-from hexdem.analysis.movie import movie_samples, speed_movie
+from hexdem.analysis.movie import movie_samples
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.common.machine import free_disk_bytes
 from hexdem.errors import HexdemError
@@ -137,6 +136,10 @@ def summary(config: RunConfig, analysis: ImpactAnalysis, wall_time_s: float) -> 
 
 
 def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_time_s: float) -> None:
+    """Every result file of the run (see the module docstring), each written atomically."""
+    from hexdem.analysis import figures as plots  # matplotlib: only where figures are drawn
+    from hexdem.analysis.movie import speed_movie
+
     rows = analysis.line_rows()
     write_csv(out / "peaks.csv", PEAK_COLUMNS, rows)
     write_csv(out / "beads.csv", BEAD_COLUMNS, bead_rows(analysis))

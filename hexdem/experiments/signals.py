@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.analysis.figures import plt, save
+from hexdem.analysis.figures import save, subplots
 from hexdem.analysis.peaks import refine_peak, rising_crossing
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.errors import HexdemError
@@ -104,8 +104,8 @@ def _overlay(traces: dict, offset: float, path) -> None:
     """Speed of each sensor: simulated, and measured shifted by −offset."""
     count = len(traces)
     columns = min(2, count)
-    fig, axes = plt.subplots(math.ceil(count / columns), columns, figsize=(6 * columns, 3.2 * math.ceil(count / columns)),
-                             squeeze=False, layout="constrained")
+    fig, axes = subplots(math.ceil(count / columns), columns, figsize=(6 * columns, 3.2 * math.ceil(count / columns)),
+                         squeeze=False, layout="constrained")
     for ax, (sensor, ((ts, vs), (tm, vm))) in zip(axes.flat, traces.items()):
         ax.plot(ts * 1e3, vs, label="simulated", color="C0")
         ax.plot((tm - offset) * 1e3, vm, label="measured (aligned)", color="C3", alpha=0.8)

@@ -93,7 +93,6 @@ def snapshot_rows(snapshots: Snapshots) -> list[tuple]:
 def snapshot_figure(snapshots: Snapshots, walls, path, outline: Lattice | None = None) -> None:
     """Bead-speed maps, one panel per time (own colour scale), walls drawn; ``outline``: a
     smaller packing whose walls are drawn dashed (Fig. 4)."""
-    import matplotlib.pyplot as plt
 
     lattice, config = snapshots.lattice, snapshots.config
     count = len(snapshots.times_s)
@@ -102,8 +101,8 @@ def snapshot_figure(snapshots: Snapshots, walls, path, outline: Lattice | None =
     columns = count if tall else min(3, count)
     rows = math.ceil(count / columns)
     width = 3.2 if tall else 5.2
-    fig, axes = plt.subplots(rows, columns, figsize=(width * columns, 0.8 * width * aspect * rows + 0.8),
-                             squeeze=False, layout="constrained")
+    fig, axes = plots.subplots(rows, columns, figsize=(width * columns, 0.8 * width * aspect * rows + 0.8),
+                               squeeze=False, layout="constrained")
     for ax, t, speeds in zip(axes.flat, snapshots.times_s, snapshots.speeds):
         plots.bead_map(ax, lattice.positions_m, lattice.diameters_m, speeds, cmap="hot_r", label="speed [m/s]")
         plots.draw_walls(ax, walls, lattice.positions_m, lattice.radii_m, linewidth=1)

@@ -13,7 +13,6 @@ from pathlib import Path
 from hexdem.analysis.impact import ImpactAnalysis
 from hexdem.analysis.tracker import PulseTracker
 from hexdem.engines.lammps.engine import LammpsEngine
-from hexdem.engines.reference.engine import ReferenceEngine
 from hexdem.experiments.parallel import run_on_ranks
 from hexdem.model.granular import GranularModel, RunSettings
 
@@ -41,8 +40,12 @@ class ImpactJob:
     def __call__(self, comm):
         tracker = PulseTracker(self.model, self.settings, comm, self.trace_beads, self.field_samples,
                                self.gravity_m_s2)
-        engine = (ReferenceEngine() if self.engine == "reference"
-                  else LammpsEngine(dump=self.dump, gravity_m_s2=self.gravity_m_s2))
+        if self.engine == "reference":  # numba and its compiled kernels: only for the runs that use them
+            from hexdem.engines.reference.engine import ReferenceEngine
+
+            engine = ReferenceEngine()
+        else:
+            engine = LammpsEngine(dump=self.dump, gravity_m_s2=self.gravity_m_s2)
         description = engine.run(self.model, self.settings, self.directory, tracker, comm, self.show_progress)
         tracked = tracker.finish()
         return None if tracked is None else (tracked, description)

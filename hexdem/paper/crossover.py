@@ -178,12 +178,11 @@ def crossover_verdict(fits: list[dict], tests: list[dict]) -> str:
 def crossover_figure(rows: list[tuple], fits: list[dict], path) -> None:
     """Transmission against σ/tol (top) and σ/δ(V) (bottom), per line and measure (columns), one
     colour per striker speed: points ± 2 SEM, the fitted steps and their σ_c (dotted)."""
-    import matplotlib.pyplot as plt
 
     from hexdem.analysis import figures as plots
 
     panels = [(line, measure) for measure in MEASURES for line in LINES]
-    fig, axes = plt.subplots(2, len(panels), figsize=(16, 7), sharey=True, constrained_layout=True)
+    fig, axes = plots.subplots(2, len(panels), figsize=(16, 7), sharey=True, layout="constrained")
     speeds = sorted({r[0] for r in rows})
     for j, (line, measure) in enumerate(panels):
         for colour, v in zip(("C0", "C1", "C3", "C2"), speeds):

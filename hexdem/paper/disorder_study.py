@@ -184,11 +184,10 @@ def verdict(rows: list[tuple]) -> dict:
 def study_figure(rows: list[tuple], path) -> None:
     """Transmission (disordered / ideal) against σ/tol: lines 0° and ±30° (columns), peak over
     the run and leading pulse (rows), the paper's preparation and the relaxed one."""
-    import matplotlib.pyplot as plt
 
     from hexdem.analysis import figures as plots
 
-    fig, axes = plt.subplots(2, 2, figsize=(10, 7), sharex=True, sharey=True)
+    fig, axes = plots.subplots(2, 2, figsize=(10, 7), sharex=True, sharey=True)
     styles = {"prestressed": ("o-", "C0", "walls kept prestress (paper's scheme)"),
               "relaxed": ("s", "C3", "walls stood back (no prestress)")}
     for i, measure in enumerate(MEASURES):

@@ -70,11 +70,10 @@ def run_search(scaling_dir, out) -> dict:
 def protocol_figure(searches: dict, path) -> None:
     """(m, b) of every protocol per combination (anchored and free starts), the paper's stated
     protocol, the closest one and the published point."""
-    import matplotlib.pyplot as plt
 
     from hexdem.analysis import figures as plots
 
-    fig, axes = plt.subplots(2, 2, figsize=(11, 8.5), layout="constrained")
+    fig, axes = plots.subplots(2, 2, figsize=(11, 8.5), layout="constrained")
     for ax, (name, search) in zip(axes.ravel(), searches.items()):
         for anchored, colour, label in ((True, "C0", "anchored start"), (False, "C1", "free start")):
             chosen = search.anchored == anchored

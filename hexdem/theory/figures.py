@@ -7,14 +7,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from hexdem.analysis.figures import UNIT_LABELS, plt, save
+from hexdem.analysis.figures import UNIT_LABELS, save, subplots
 
 ND_SPEED = UNIT_LABELS["nondimensional"]["speed"]
 
 
 def _lattice_against_tca(n_lattice, lattice, n_tca, tca, hyperg, ylabel, title, path) -> None:
     """One quantity along the 30° line: lattice vs TCA vs eq. (hyperg)."""
-    fig, ax = plt.subplots(figsize=(6, 4.5))
+    fig, ax = subplots(figsize=(6, 4.5))
     ax.plot(n_lattice, lattice, "o", color="tab:blue", label="lattice simulation")
     ax.plot(n_tca, tca, "o", mfc="none", color="tab:red", markersize=9, label="TCA, eq. (TCA_strain)")
     ax.plot(n_tca, hyperg, "^", color="k", label="TCA closed form, eq. (hyperg)")
@@ -75,7 +75,7 @@ def _start_speed_panel(ax, fit, ylabel, title, extra=None):
 def vodecay30(trace, fit_30_30, fit_30_0, path) -> None:
     """Fig. 6: (a) the 30/30 traces with the fitted maxima; (b) c(V₀) = m V₀ + b; (c) V₁ against
     V₀; (d) V₂ against V₀ for 0° observation (30° strike)."""
-    fig, axes = plt.subplots(2, 2, figsize=(12, 9))
+    fig, axes = subplots(2, 2, figsize=(12, 9))
     law = fit_30_30.law
     _traces(axes[0, 0], trace, fit_30_30, "(a) 30° strike, 30° line")
     axes[0, 1].errorbar(fit_30_30.v0, fit_30_30.c, yerr=fit_30_30.c_stderr, fmt="o", label="per-$V_0$ fits")
@@ -93,7 +93,7 @@ def vodecay30(trace, fit_30_30, fit_30_0, path) -> None:
 
 def vodecay0(trace, fit_0_0, fit_0_30, path) -> None:
     """Fig. 7: (a) 0/0 traces with the fit from bead 2; (b) V₁ against V₀ for 0/30 with V₀/2."""
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4.5))
+    fig, axes = subplots(1, 2, figsize=(12, 4.5))
     _traces(axes[0], trace, fit_0_0, "(a) 0° strike, 0° line")
     _start_speed_panel(axes[1], fit_0_30, "$V_1$", "(b) $V_1$ against $V_0$, 0° strike, 30° line",
                        extra=("$V_0/2$", lambda v: v / 2))
@@ -103,7 +103,7 @@ def vodecay0(trace, fit_0_0, fit_0_30, path) -> None:
 
 def decay_rates(fits, path) -> None:
     """c(V₀) of every combination with its line m V₀ + b."""
-    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    fig, ax = subplots(figsize=(6.5, 4.5))
     for fit in fits:
         line = ax.errorbar(fit.v0, fit.c, yerr=fit.c_stderr, fmt="o", markersize=3, label=fit.combination.name)
         ax.plot(fit.v0, fit.law.decay_rate(fit.v0), "-", color=line[0].get_color())
@@ -118,8 +118,8 @@ def decay_form(ratios_by_combination, path) -> None:
 
     ``ratios_by_combination``: {name: [(v0, n, ratio), ...]}.
     """
-    fig, axes = plt.subplots(1, len(ratios_by_combination), figsize=(4 * len(ratios_by_combination), 4),
-                             sharey=True)
+    fig, axes = subplots(1, len(ratios_by_combination), figsize=(4 * len(ratios_by_combination), 4),
+                         sharey=True)
     for ax, (name, curves) in zip(np.atleast_1d(axes), ratios_by_combination.items()):
         for v0, n, ratio in curves:
             ax.plot(n, ratio, "o-", markersize=3, label=f"$V_0$ = {v0:.3g}")
