@@ -1,6 +1,8 @@
 """The analysis inside the run against the analysis of a whole record (issue 10's accuracy)."""
 
 import tracemalloc
+from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -10,6 +12,7 @@ from hexdem.analysis.peaks import pulse_times
 from hexdem.analysis.tracker import PulseTracker
 from hexdem.cli.main import main
 from hexdem.engines.sampling import Sample
+from hexdem.experiments.parallel import run_on_ranks
 from hexdem.experiments.run import RESULT_FILES, simulate
 from hexdem.model.config import RunConfig
 from hexdem.model.granular import RunSettings
@@ -74,6 +77,44 @@ def test_tracker_reproduces_the_whole_record_definitions(n_samples):
     spacing = times[1]
     tolerance = 0.05 if n_samples < 1000 else 0.01
     assert np.max(np.abs(tracked.arrival_time - whole.arrival_time)) < tolerance * spacing
+
+
+@dataclass(frozen=True)
+class MigratingBeads:
+    """An MPI job (see :func:`~hexdem.experiments.parallel.run_on_ranks`): the synthetic speeds of
+    a 4-per-edge hexagon fed to one tracker across the ranks, every bead handed to a random rank
+    every ``every`` samples, as LAMMPS migrates atoms."""
+
+    n_samples: int = 300
+    every: int = 7
+
+    def __call__(self, comm):
+        rng = np.random.default_rng(11)
+        times = np.linspace(0.0, 1.2, self.n_samples)
+        model = RunConfig(edge_beads=4).model()
+        n, ranks = len(model.lattice), 1 if comm is None else comm.Get_size()
+        speeds = _synthetic_speeds(times, n, rng)
+        owners = np.repeat(rng.integers(0, ranks, (self.n_samples // self.every + 1, n)), self.every, axis=0)
+        tracker = PulseTracker(model, RunSettings(dt_s=times[1], n_steps=self.n_samples - 1, dump_every=1), comm)
+        if tracker.root:
+            tracker.audit = NoAudit()
+        rank = 0 if comm is None else comm.Get_rank()
+        for s, row in enumerate(speeds):
+            ids = np.flatnonzero(owners[s] == rank) + 1
+            tracker(Sample(s, s, times[s], ids, np.zeros((len(ids), 2)), np.column_stack([row[ids - 1], np.zeros(len(ids))])))
+        return tracker.finish(), int(np.sum(owners[1:] != owners[:-1]))
+
+
+def test_beads_that_change_ranks_keep_their_pulses(tmp_path, monkeypatch):
+    """The same speeds, tracked on one rank and on two between which every bead moves at random
+    every 7 samples (each bead's state handed over from its last owner): identical results."""
+    monkeypatch.setenv("PYTHONPATH", str(Path(__file__).parent))  # the ranks unpickle the job from here
+    one, _ = MigratingBeads()(None)
+    two, handed_over = run_on_ranks(MigratingBeads(), 2, tmp_path)
+    assert handed_over > 500  # about half of 37 beads at each of 42 draws
+    assert np.isfinite(one.arrival_time).sum() > 20
+    for name in ("peak_speed", "t_peak", "arrival_time", "reach_time"):
+        np.testing.assert_array_equal(getattr(two, name), getattr(one, name), err_msg=name)
 
 
 def test_memory_does_not_grow_with_the_run_length(tmp_path):

@@ -21,9 +21,9 @@ every sample (pulse shapes for the theory), and the speed of every bead at the s
 **Several ranks.** Under MPI every rank owns some atoms and sees only those. Each rank keeps
 state arrays for all beads but updates only its own; the state of a bead is exact on the
 rank that owns it. When atoms change ranks (LAMMPS migrates them when it rebuilds its
-neighbour lists) the states are merged, each bead's from its previous owner, before the
-new sample is taken; :meth:`finish` merges them once more onto rank 0, which alone returns
-the results. The energy audit and the snapshot fields gather whole states onto rank 0.
+neighbour lists) each migrated bead's state is handed from its previous owner to its new one
+before the new sample is taken (only those beads' rows travel); :meth:`finish` brings every
+bead's state from its owner onto rank 0, which alone returns the results. The energy audit and the snapshot fields gather whole states onto rank 0.
 """
 
 from __future__ import annotations
@@ -110,25 +110,28 @@ class PulseTracker:
         self.count = 0
 
     # ---- state shared across ranks
-    def _owned(self, array: np.ndarray) -> np.ndarray:
-        """``array`` with the rows of the beads this rank does not own zeroed (for a sum over ranks)."""
-        mask = self.owned.reshape((-1,) + (1,) * (array.ndim - 1))
-        return np.where(mask, array, np.zeros((), array.dtype))
-
-    def _merge(self) -> None:
-        """Give every rank each bead's state from the rank that owned it until now."""
-        from mpi4py import MPI
-
-        for array in self.pulses.arrays():
-            self.comm.Allreduce(self._owned(array), array, op=MPI.SUM)
+    def _hand_over(self, owned: np.ndarray) -> None:
+        """Give each bead that changed ranks since the last sample (``owned``: this rank's beads
+        now) its state from the rank that owned it until now: only those beads' rows travel."""
+        arrays = self.pulses.arrays()
+        left = np.flatnonzero(self.owned & ~owned)
+        arrived = owned & ~self.owned
+        for beads, rows in self.comm.allgather((left, [array[left] for array in arrays])):
+            mine = beads[arrived[beads]]
+            for array, values in zip(arrays, rows):
+                array[mine] = values[arrived[beads]]
 
     def _collect(self) -> None:
-        """Merge the states onto rank 0 for the results; each sample of a trace or field was
-        taken by exactly one rank (NaN elsewhere)."""
+        """Bring every bead's state to rank 0 from its owner for the results; each sample of a
+        trace or field was taken by exactly one rank (NaN elsewhere)."""
         from mpi4py import MPI
 
-        for array in self.pulses.arrays():
-            self.comm.Reduce(self._owned(array), array if self.root else None, op=MPI.SUM, root=0)
+        arrays = self.pulses.arrays()
+        mine = np.flatnonzero(self.owned)
+        parts = self.comm.gather((mine, [array[mine] for array in arrays]), root=0)
+        for beads, rows in parts if self.root else ():
+            for array, values in zip(arrays, rows):
+                array[beads] = values
         for array in (self.traces, self.fields, self.sensors):
             taken = np.isfinite(array).astype(np.int64)
             counts = np.empty_like(taken) if self.root else None
@@ -158,7 +161,7 @@ class PulseTracker:
             owned[index] = True
             moved = s > 0 and not np.array_equal(owned, self.owned)
             if self.comm.allreduce(moved):
-                self._merge()
+                self._hand_over(owned)
             self.owned = owned
         else:
             self.owned[index] = True
