@@ -1,13 +1,15 @@
-"""Speed of Sec. VI's work: the default ensemble, and the half-hexagon snapshot run on one vs two ranks.
+"""Speed of Sec. VI's work: the default ensemble now and before, and the half-hexagon snapshot run on one vs two ranks.
 
-Usage: python benchmarks/bench_ensemble.py [--workers 2] [--repeats 3] [--steps 700,140] [--skip-ensemble]
+Usage: python benchmarks/bench_ensemble.py [--workers 2] [--repeats 3] [--before REV] [--skip-ensemble]
        [--skip-ranks] [--quick]
 
-1. ``run_ensemble`` with its defaults (20 realizations x 0.25, 0.40, 0.70 m/s, 11 per
-   edge) in a fresh directory, once per ``--steps`` (the impacts' steps per contact; default:
-   the former 700 beside today's 140, in one run): wall time per phase (compact, settle,
-   impacts; the impacts are analysed inside their runs) and LAMMPS's own time for settling a
-   realization vs one impact. Target at today's step: <= 60 s on 2 cores.
+1. ``hexdem ensemble`` with its defaults (20 realizations x 0.25, 0.40, 0.70 m/s, 11 per
+   edge, 140 steps per contact) in a fresh directory, with today's hexdem and with hexdem as
+   it was at ``--before`` (default e8fb865, the last commit before the speed work; skipped
+   when this clone lacks it), one after the other: wall time, and per phase (compact, settle,
+   impacts; the impacts are analysed inside their runs) as each run recorded it, and LAMMPS's
+   own time for settling a realization vs one impact. Targets: today's <= 60 s on 2 cores, and
+   at least 1.5 x faster than before.
 2. The half-hexagon of Fig. 4 (91/46, 3151 beads + striker, 0.4 m/s, the snapshot run's
    time step and length, fields taken at its 6 snapshot times inside the run): hexdem's
    ``take_snapshots`` on one rank (in-process) and two ranks (mpiexec), and bare
@@ -23,27 +25,29 @@ snapshot run on a 5-per-edge hexagon up to 0.1 ms, one repeat (the same code pat
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import shutil
 import statistics
+import subprocess
 import tempfile
 import time
-from dataclasses import replace
 from pathlib import Path
 
+from baseline import BEFORE, baseline_tree, hexdem_command, hexdem_env
 from harness import NOOUTPUT_NAME, nooutput_deck
 from machine import describe
 
-from hexdem.disorder.ensemble import EnsembleConfig
-from hexdem.disorder.runner import run_ensemble
+from hexdem.disorder.runner import MANIFEST_NAME
 from hexdem.engines.lammps.partitions import loop_time_s
 from hexdem.engines.lammps.runner import run_bare
 from hexdem.experiments.snapshots import DEFAULT_TIMES_MS, snapshot_config, take_snapshots
-from hexdem.model.config import STEPS_PER_CONTACT, RunConfig
+from hexdem.model.config import RunConfig
 
 ENSEMBLE_TARGET_S = 60.0
+ENSEMBLE_SPEED_UP_TARGET = 1.5
 SPEED_UP_TARGET = 1.6
-QUICK_ENSEMBLE = EnsembleConfig(realizations=2, velocities_m_s=(0.4,), edge_beads=4)
+QUICK_ENSEMBLE = ("--realizations", "2", "--velocities", "0.4", "--edge-beads", "4")
 SNAPSHOT_RUN = (RunConfig(shape="half-hexagon", impact="striker", v0=0.4),
                 tuple(t * 1e-3 for t in DEFAULT_TIMES_MS["half-hexagon"]))
 QUICK_SNAPSHOT_RUN = (RunConfig(shape="hexagon", edge_beads=5, impact="striker", v0=0.4), (0.05e-3, 0.1e-3))
@@ -53,23 +57,39 @@ def quiet(message: str) -> None:
     pass
 
 
-def bench_ensemble(work: Path, workers: int, config: EnsembleConfig) -> None:
+def ensemble(work: Path, workers: int, options, name: str, tree: Path | None) -> tuple[float, dict]:
+    """(wall time [s], manifest) of ``hexdem ensemble OPTIONS --workers N`` with the version
+    unpacked at ``tree`` (None: today's), in a fresh directory."""
+    out = work / f"ensemble-{name}"
     start = time.perf_counter()
-    summary = run_ensemble(config, work / f"ensemble-{config.steps_per_contact}", workers=workers, log=quiet)
-    total = time.perf_counter() - start
-    lammps, phases = summary["lammps_time_s"], summary["this_run"]["wall_time_s"]
-    verdict = (f"target <= {ENSEMBLE_TARGET_S:g} s: {'met' if total <= ENSEMBLE_TARGET_S else 'NOT met'}"
-               if config.steps_per_contact == STEPS_PER_CONTACT else "(the former default step)")
-    print(f"ensemble: {config.realizations} realizations x {len(config.velocities_m_s)} striker speed(s), "
-          f"{config.edge_beads} per edge, {workers} workers, {config.steps_per_contact} steps per contact: "
-          f"{total:.1f} s wall; {verdict}")
-    print(f"  {'phase':<10} {'wall [s]':>9}")
-    for name, seconds in phases.items():
-        print(f"  {name:<10} {seconds:>9.2f}")
-    print(f"  {'other':<10} {total - sum(phases.values()):>9.2f}  (decks, statistics, figures)")
-    print(f"  LAMMPS per realization: settle (compact + settle) {lammps['settle_per_realization']:.2f} s, "
-          f"one impact {lammps['impact_per_run']:.2f} s; totals: settle {lammps['settle_total']:.1f} s, "
-          f"impacts {lammps['impact_total']:.1f} s", flush=True)
+    done = subprocess.run(hexdem_command("ensemble", "--out", str(out), "--workers", str(workers), *options), cwd=work,
+                          env=hexdem_env(tree), capture_output=True, text=True, check=False)
+    if done.returncode:
+        raise SystemExit(f"hexdem ensemble ({name}) failed:\n{done.stderr[-3000:]}")
+    return time.perf_counter() - start, json.loads((out / MANIFEST_NAME).read_text())
+
+
+def bench_ensemble(work: Path, workers: int, options, before: str) -> None:
+    versions = {"now": None, f"{before} (before)": baseline_tree(work, before)}
+    if versions[f"{before} (before)"] is None:
+        print(f"(this clone lacks {before}: today's hexdem only)")
+        del versions[f"{before} (before)"]
+    runs = {name: ensemble(work, workers, options, name.split()[0], tree) for name, tree in versions.items()}
+    print(f"ensemble: hexdem ensemble {' '.join(options) or '(defaults: 20 realizations x 3 striker speeds, 11 per edge)'}"
+          f" --workers {workers}")
+    print(f"  {'version':<18} {'wall [s]':>9} " + " ".join(f"{phase:>9}" for phase in runs["now"][1]["this_run"]["wall_time_s"])
+          + f" {'LAMMPS settle / impact per run [s]':>36}")
+    for name, (total, manifest) in runs.items():
+        lammps = manifest["lammps_time_s"]
+        print(f"  {name:<18} {total:>9.2f} " + " ".join(f"{seconds:>9.2f}" for seconds in manifest["this_run"]["wall_time_s"].values())
+              + f" {lammps['settle_per_realization']:>17.2f} / {lammps['impact_per_run']:<16.2f}")
+    total = runs["now"][0]
+    print(f"  target <= {ENSEMBLE_TARGET_S:g} s: {'met' if total <= ENSEMBLE_TARGET_S else 'NOT met'} ({total:.1f} s)")
+    for name, (seconds, _) in runs.items():
+        if name != "now":
+            speed_up = seconds / total
+            print(f"  before / now: {speed_up:.2f} x; target >= {ENSEMBLE_SPEED_UP_TARGET:g}: "
+                  f"{'met' if speed_up >= ENSEMBLE_SPEED_UP_TARGET else 'NOT met'}", flush=True)
 
 
 def bench_ranks(work: Path, repeats: int, base: RunConfig, times_s) -> None:
@@ -116,8 +136,7 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--skip-ensemble", action="store_true")
     parser.add_argument("--skip-ranks", action="store_true")
-    parser.add_argument("--steps", default=f"700,{STEPS_PER_CONTACT}",
-                        help=f"the impacts' steps per contact, one ensemble each (default 700,{STEPS_PER_CONTACT})")
+    parser.add_argument("--before", default=BEFORE, metavar="REV", help=f"the revision to compare with (default {BEFORE})")
     parser.add_argument("--quick", action="store_true", help="a tiny ensemble and a small hexagon (seconds)")
     args = parser.parse_args()
     print(f"machine: {describe()}; load average {os.getloadavg()[0]:.2f}", flush=True)
@@ -127,9 +146,7 @@ def main() -> None:
             base, times_s = QUICK_SNAPSHOT_RUN if args.quick else SNAPSHOT_RUN
             bench_ranks(work, 1 if args.quick else args.repeats, base, times_s)
         if not args.skip_ensemble:
-            for steps in (int(n) for n in args.steps.split(",")):
-                config = QUICK_ENSEMBLE if args.quick else EnsembleConfig()
-                bench_ensemble(work, args.workers, replace(config, steps_per_contact=steps))
+            bench_ensemble(work, args.workers, QUICK_ENSEMBLE if args.quick else (), args.before)
     finally:
         shutil.rmtree(work)
 

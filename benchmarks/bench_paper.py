@@ -1,13 +1,14 @@
-"""Speed of ``hexdem paper``: the whole paper, part by part, at the former and today's time step.
+"""Speed of ``hexdem paper``: the whole paper, part by part, now and before.
 
-Usage: python benchmarks/bench_paper.py [--workers 2] [--quick] [--steps 700,140] [--out DIR]
+Usage: python benchmarks/bench_paper.py [--workers 2] [--quick] [--before REV] [--out DIR]
 
-Runs ``hexdem paper --steps-per-contact N`` (a subprocess, as a user would) into a fresh
-directory for each N of ``--steps`` (default: the former default 700 beside today's 140, in one
-run), or resumes the run in ``--out`` (at today's step only), and prints the wall time of every
-part as recorded when it was computed, their sum, and each invocation's wall time. The V0
-sweep keeps its own 140 steps per contact either way. Targets on 2 cores with ``--workers 2``,
-at today's step: the full paper <= 4 min, ``--quick`` <= 2 min.
+Runs ``hexdem paper`` (a subprocess, as a user would, at today's 140 steps per contact) into a
+fresh directory with today's hexdem and with hexdem as it was at ``--before`` (default
+e8fb865, the last commit before the speed work, warmed up; skipped when this clone lacks it),
+one after the other, or resumes the run in ``--out`` (today's only), and prints the wall time of
+every part as recorded when it was computed, their sum, and each invocation's wall time.
+Targets on 2 cores with ``--workers 2``: the full paper <= 4 min (``--quick`` <= 2 min), and
+at least 1.5 x faster than before.
 """
 
 from __future__ import annotations
@@ -20,20 +21,19 @@ import tempfile
 import time
 from pathlib import Path
 
+from baseline import BEFORE, baseline_tree, hexdem_command, hexdem_env
 from machine import describe
 
-from hexdem.model.config import STEPS_PER_CONTACT
-
 TARGETS_S = {False: 240.0, True: 120.0}
+SPEED_UP_TARGET = 1.5
 
 
-def paper(out: Path, steps: int, workers: int, quick: bool) -> tuple[dict, float] | int:
-    """({part: wall time [s]}, this invocation's wall time [s]) of ``hexdem paper`` in ``out``, or
-    its exit status if it failed."""
-    command = [sys.executable, "-m", "hexdem.cli.main", "paper", "--out", str(out), "--workers", str(workers),
-               "--steps-per-contact", str(steps), *(["--quick"] if quick else [])]
+def paper(out: Path, workers: int, quick: bool, tree: Path | None = None) -> tuple[dict, float] | int:
+    """({part: wall time [s]}, this invocation's wall time [s]) of ``hexdem paper`` in ``out``
+    with the version unpacked at ``tree`` (None: today's), or its exit status if it failed."""
+    command = hexdem_command("paper", "--out", str(out), "--workers", str(workers), *(["--quick"] if quick else []))
     start = time.perf_counter()
-    done = subprocess.run(command, capture_output=True, text=True, check=False)
+    done = subprocess.run(command, cwd=out.parent, env=hexdem_env(tree), capture_output=True, text=True, check=False)
     wall = time.perf_counter() - start
     if done.returncode:
         print(done.stderr, file=sys.stderr)
@@ -45,34 +45,42 @@ def run(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--quick", action="store_true", help="time hexdem paper --quick")
-    parser.add_argument("--steps", default=f"700,{STEPS_PER_CONTACT}",
-                        help=f"steps per contact of the runs to compare (default 700,{STEPS_PER_CONTACT})")
-    parser.add_argument("--out", metavar="DIR", help="resume (or report) the paper run in DIR, at today's step only")
+    parser.add_argument("--before", default=BEFORE, metavar="REV", help=f"the revision to compare with (default {BEFORE})")
+    parser.add_argument("--out", metavar="DIR", help="resume (or report) the paper run in DIR, today's hexdem only")
     args = parser.parse_args(argv)
-    steps = [STEPS_PER_CONTACT] if args.out else [int(n) for n in args.steps.split(",")]
     print(f"machine: {describe()}", flush=True)
     runs = {}
     with tempfile.TemporaryDirectory(prefix="hexdem-bench-paper-") as scratch:
-        for n in steps:
-            out = Path(args.out) if args.out else Path(scratch) / f"paper-{n}"
-            result = paper(out, n, args.workers, args.quick)
+        versions = {"now": None}
+        if not args.out:
+            versions[f"{args.before}"] = baseline_tree(Path(scratch), args.before)
+            if versions[args.before] is None:
+                print(f"(this clone lacks {args.before}: today's hexdem only)")
+                del versions[args.before]
+        for name, tree in versions.items():
+            out = Path(args.out) if args.out else Path(scratch) / f"paper-{name}"
+            out.parent.mkdir(parents=True, exist_ok=True)
+            result = paper(out, args.workers, args.quick, tree)
             if isinstance(result, int):
                 return result
-            runs[n] = result
-    names = list(runs[steps[-1]][0])
-    print(f"hexdem paper{' --quick' if args.quick else ''} --workers {args.workers}, wall [s] per part at each "
-          "number of steps per contact")
-    print(f"  {'part':<28}" + "".join(f" {f'{n} steps':>11}" for n in steps))
-    for name in names:
-        print(f"  {name:<28}" + "".join(f" {runs[n][0].get(name, float('nan')):>11.1f}" for n in steps))
-    print(f"  {'sum of parts':<28}" + "".join(f" {sum(runs[n][0].values()):>11.1f}" for n in steps))
-    print(f"  {'this invocation':<28}" + "".join(f" {runs[n][1]:>11.1f}" for n in steps)
+            runs[name] = result
+    names = list(runs["now"][0])
+    print(f"hexdem paper{' --quick' if args.quick else ''} --workers {args.workers}, wall [s] per part, "
+          "now and before, 140 steps per contact")
+    print(f"  {'part':<28}" + "".join(f" {name:>11}" for name in runs))
+    for part in names:
+        print(f"  {part:<28}" + "".join(f" {run[0].get(part, float('nan')):>11.1f}" for run in runs.values()))
+    print(f"  {'sum of parts':<28}" + "".join(f" {sum(run[0].values()):>11.1f}" for run in runs.values()))
+    print(f"  {'this invocation':<28}" + "".join(f" {run[1]:>11.1f}" for run in runs.values())
           + "  (a resumed run only writes the report)")
-    if len(steps) > 1:
-        print(f"  {'ratio of sums':<28} {sum(runs[steps[0]][0].values()) / sum(runs[steps[-1]][0].values()):>11.2f} "
-              f"({steps[0]} / {steps[-1]} steps)")
-    target, total = TARGETS_S[args.quick], sum(runs[steps[-1]][0].values())
-    print(f"target <= {target:g} s for the parts at {steps[-1]} steps per contact: {'met' if total <= target else 'NOT met'}")
+    total = sum(runs["now"][0].values())
+    for name, (parts, _) in runs.items():
+        if name != "now":
+            speed_up = sum(parts.values()) / total
+            print(f"  before / now (sums of parts): {speed_up:.2f} x; target >= {SPEED_UP_TARGET:g}: "
+                  f"{'met' if speed_up >= SPEED_UP_TARGET else 'NOT met'}")
+    target = TARGETS_S[args.quick]
+    print(f"target <= {target:g} s for the parts: {'met' if total <= target else 'NOT met'}")
     return 0
 
 
