@@ -1,15 +1,15 @@
 """The default time step is chosen by accuracy: both engines converge at their integrator's order
 (velocity Verlet 2, RK4 4), and at the default 140 steps per contact the peaks are within 1e-4 and
 the arrival times within 0.05 µs of the Richardson-extrapolated answer (the issue's target), on
-the paper's experiment and over the sweep's range of V0. The sampling interval stays 1/35 of the
-contact time whatever the step."""
+the paper's experiment and over the sweep's range of V0. The sampling interval stays 1/20 of the
+contact time whatever the step, and its own error leaves the step's inside the target."""
 
 import math
 
 import pytest
 
 from hexdem.errors import HexdemError
-from hexdem.experiments.convergence import richardson, steps_config, study_time_step
+from hexdem.experiments.convergence import richardson, sampling_error, steps_config, study_time_step
 from hexdem.model.config import SAMPLES_PER_CONTACT, STEPS_PER_CONTACT, RunConfig
 
 PEAK_TARGET, ARRIVAL_TARGET_S = 1e-4, 0.05e-6
@@ -23,7 +23,7 @@ def test_richardson_recovers_the_limit_of_a_power_law_error():
         assert richardson(value(0.1, p), value(0.3, p), 3.0, p) == pytest.approx(exact, rel=1e-12)
 
 
-@pytest.mark.parametrize("steps, dt_steps, every", [(None, 140, 4), (700, 700, 20), (100, 105, 3), (35, 35, 1)])
+@pytest.mark.parametrize("steps, dt_steps, every", [(None, 140, 7), (700, 700, 35), (110, 120, 6), (30, 40, 2)])
 def test_the_step_follows_steps_per_contact_and_the_sampling_stays_fixed_in_time(steps, dt_steps, every):
     config = RunConfig() if steps is None else RunConfig(steps_per_contact=steps)
     settings, tau = config.settings(), config.contact_time_s()
@@ -35,14 +35,14 @@ def test_the_step_follows_steps_per_contact_and_the_sampling_stays_fixed_in_time
 def test_too_few_steps_per_contact_is_refused():
     with pytest.raises(HexdemError, match="steps_per_contact must be at least 20"):
         RunConfig(steps_per_contact=10)
-    with pytest.raises(HexdemError, match="multiples of 35"):
-        steps_config(RunConfig(), 100)
+    with pytest.raises(HexdemError, match=f"multiples of {SAMPLES_PER_CONTACT}"):
+        steps_config(RunConfig(), 110)
 
 
 @pytest.mark.parametrize("config", [RunConfig(), RunConfig(edge_beads=8, wall_material="none", units="nondimensional",
                                                                      v0=0.3)], ids=["experiment", "V0=0.30"])
 def test_lammps_converges_at_second_order_and_its_default_meets_the_target(config, tmp_path):
-    study = study_time_step(config, (70, STEPS_PER_CONTACT, 280, 560), tmp_path)
+    study = study_time_step(config, (80, STEPS_PER_CONTACT, 280, 560), tmp_path)
     assert study.n_beads >= 20
     assert all(1.8 < order < 2.2 for order in study.observed_orders), study.observed_orders
     default = study.at(STEPS_PER_CONTACT)
@@ -52,8 +52,20 @@ def test_lammps_converges_at_second_order_and_its_default_meets_the_target(confi
 
 
 def test_the_reference_converges_faster_and_meets_the_target_at_the_default(tmp_path):
-    study = study_time_step(RunConfig(engine="reference"), (70, STEPS_PER_CONTACT, 280, 560), tmp_path)
+    study = study_time_step(RunConfig(engine="reference"), (80, STEPS_PER_CONTACT, 280, 560), tmp_path)
     assert study.observed_orders[-1] > 3.0, study.observed_orders
     default = study.at(STEPS_PER_CONTACT)
     assert default.peak_error < 1e-6 and default.arrival_error < 1e-3 * ARRIVAL_TARGET_S
     assert math.isfinite(default.energy_drift) and default.energy_drift < 1e-6
+
+
+def test_the_default_sampling_leaves_the_step_inside_the_target(tmp_path):
+    """The default run sampled every τ/20 against sampling every step (the same trajectory):
+    its sampling error plus the step's (the second-order LAMMPS study) stays inside the target,
+    and the parabolic half-maximum crossing keeps the arrivals' share small."""
+    sampled = sampling_error(RunConfig(), tmp_path)
+    assert sampled.dump_every == STEPS_PER_CONTACT // SAMPLES_PER_CONTACT and sampled.n_beads >= 20
+    step = study_time_step(RunConfig(), (80, STEPS_PER_CONTACT, 280), tmp_path / "steps").at(STEPS_PER_CONTACT)
+    assert step.peak_error + sampled.peak_error < PEAK_TARGET
+    assert step.arrival_error + sampled.arrival_error < ARRIVAL_TARGET_S
+    assert sampled.arrival_error < 0.3 * ARRIVAL_TARGET_S

@@ -61,23 +61,25 @@ class PulseState:
         self.rec_index = np.zeros((n, capacity), dtype=np.int64)
         self.rec_value = np.full((n, capacity), -np.inf)  # a free slot: below every record
         self.rec_prev = np.zeros((n, capacity))
+        self.rec_prev2 = np.zeros((n, capacity))
         self.first_index = np.zeros((n, capacity), dtype=np.int64)
         self.first_value = np.zeros((n, capacity))
         self.first_prev = np.zeros((n, capacity))
+        self.first_prev2 = np.zeros((n, capacity))
 
     def arrays(self) -> list[np.ndarray]:
         """Every state array (for merging the beads' states across MPI ranks)."""
-        return [self.ring, self.peak, self.peak_index, self.window, self.after, self.start, self.length,
-                self.rec_index, self.rec_value, self.rec_prev, self.first_index, self.first_value, self.first_prev]
+        return [self.ring, self.peak, self.peak_index, self.window, self.after, self.start, self.length, self.rec_index,
+                self.rec_value, self.rec_prev, self.rec_prev2, self.first_index, self.first_value, self.first_prev,
+                self.first_prev2]
 
     def update(self, beads, speeds, s: int) -> None:
         """Take sample ``s`` (speeds of ``beads``, distinct) into the state, in place."""
-        before = self.ring[beads, (s - 1) % 3] if s >= 1 else np.full(len(beads), np.nan)
         rising = speeds > self.peak[beads]
         if not rising.all():
             self._enter_window(beads[~rising], speeds[~rising])
         if rising.any():
-            self._new_maxima(beads[rising], speeds[rising], before[rising], s)
+            self._new_maxima(beads[rising], speeds[rising], s)
         self.ring[beads, s % 3] = speeds
 
     def _enter_window(self, beads, speeds) -> None:
@@ -88,9 +90,10 @@ class PulseState:
         self.window[beads[open_], 4 + slot[open_]] = speeds[open_]
         self.after[beads[open_]] += 1
 
-    def _new_maxima(self, beads, speeds, before, s: int) -> None:
-        """Beads whose running maximum rises to ``speeds`` at sample ``s`` (``before``: their sample
-        s − 1): a new peak window, and the new record climbs the ladder (module docstring)."""
+    def _new_maxima(self, beads, speeds, s: int) -> None:
+        """Beads whose running maximum rises to ``speeds`` at sample ``s``: a new peak window, and
+        the new record, with the two samples before it, climbs the ladder (module docstring)."""
+        before, before2 = ((self.ring[beads, (s - k) % 3] if s >= k else np.full(len(beads), np.nan)) for k in (1, 2))
         self.peak[beads] = speeds
         self.peak_index[beads] = s
         for j in range(3):
@@ -116,9 +119,11 @@ class PulseState:
         self.first_index[beads[climbed], slot[climbed]] = s
         self.first_value[beads[climbed], slot[climbed]] = speeds[climbed]
         self.first_prev[beads[climbed], slot[climbed]] = before[climbed]
+        self.first_prev2[beads[climbed], slot[climbed]] = before2[climbed]
         self.rec_index[beads, slot] = s
         self.rec_value[beads, slot] = speeds
         self.rec_prev[beads, slot] = before
+        self.rec_prev2[beads, slot] = before2
         self.start[beads] = start
         self.length[beads] = n + 1
 
@@ -126,14 +131,28 @@ class PulseState:
         """Fractional sample index at which ``bead``'s samples first reached ``level`` (NaN if never)."""
         order = (self.start[bead] + np.arange(self.length[bead])) % self.rec_value.shape[1]
         records = zip(self.rec_index[bead, order], self.rec_value[bead, order], self.rec_prev[bead, order],
-                      self.first_index[bead, order], self.first_value[bead, order], self.first_prev[bead, order])
-        for s, value, before, s0, v0, before0 in records:
+                      self.rec_prev2[bead, order], self.first_index[bead, order], self.first_value[bead, order],
+                      self.first_prev[bead, order], self.first_prev2[bead, order])
+        for s, value, before, before2, s0, v0, before0, before0_2 in records:
             if value >= level:
                 if v0 >= level:
                     if s0 == 0 or not before0 < level:
                         return float(s0)
-                    return s0 - 1 + (level - before0) / (v0 - before0)
+                    return s0 - 1 + parabolic_crossing(before0_2, before0, v0, level)
                 if before < level:
-                    return s - 1 + (level - before) / (value - before)
+                    return s - 1 + parabolic_crossing(before2, before, value, level)
                 return s0 + (level - v0) / (before - v0) * (s - 1 - s0)
         return np.nan
+
+
+def parabolic_crossing(before2: float, before: float, value: float, level: float) -> float:
+    """Where in [0, 1] the parabola through the samples (−1, ``before2``), (0, ``before``),
+    (1, ``value``) first reaches ``level`` (before < level <= value): the crossing's error is
+    third order in the sampling interval, where the straight line between the last two samples
+    is second order. The line is taken where ``before2`` is unknown (NaN) or the parabola does
+    not rise all through [0, 1]: at a rounded top it would turn over and cross too early."""
+    gap = level - before
+    slope, curvature = (value - before2) / 2, (before2 - 2 * before + value) / 2
+    if np.isfinite(before2) and slope >= 0 and slope + 2 * curvature >= 0:
+        return 2 * gap / (slope + np.sqrt(slope * slope + 4 * curvature * gap))
+    return gap / (value - before)

@@ -6,6 +6,8 @@ classical RK4 in the reference engine: 4). For a quantity Q(h) = Q₀ + C h^p + 
 runs h and h·r (r the ratio of their steps) give Q₀ ≈ Q(h) + (Q(h) − Q(h r)) / (r^p − 1), and
 every run's error is its distance from that. The sampling interval is the same for every run
 (a fixed time, ``dump_every`` scaled with the step), so that only the integration changes.
+The sampling's own error is measured apart (:func:`sampling_error`): the same run sampled at
+the default interval and at every step.
 
 Measured quantities, over the observation lines' beads whose peak exceeds ``threshold`` V0:
 the largest relative peak-speed error, the largest arrival-time error (in the run's time unit
@@ -59,14 +61,21 @@ class Convergence:
         return next(run for run in self.runs if run.steps_per_contact == steps_per_contact)
 
 
+def measured_beads(results, v0: float) -> np.ndarray:
+    """The observation lines' beads whose peak exceeds :data:`THRESHOLD` ``v0``."""
+    line_beads = np.unique(np.concatenate(list(results.lines.values())))
+    return line_beads[results.peak_speed[line_beads] > THRESHOLD * v0]
+
+
 def richardson(fine: np.ndarray, coarse: np.ndarray, ratio: float, order: int) -> np.ndarray:
     """The extrapolated limit of a quantity computed with steps h (``fine``) and h·``ratio``."""
     return fine + (fine - coarse) / (ratio**order - 1.0)
 
 
 def steps_config(config: RunConfig, steps_per_contact: int) -> RunConfig:
-    """``config`` at ``steps_per_contact`` with its samples every 1/35 of the contact time (the
-    steps per contact must be a multiple of 35 so that every run samples at the same times)."""
+    """``config`` at ``steps_per_contact`` with its samples every 1/SAMPLES_PER_CONTACT of the
+    contact time (the steps per contact must be a multiple of it so that every run samples at
+    the same times)."""
     if steps_per_contact % SAMPLES_PER_CONTACT:
         raise HexdemError(f"a convergence study needs multiples of {SAMPLES_PER_CONTACT} steps per contact "
                           f"(the same sampling times in every run), got {steps_per_contact}")
@@ -74,8 +83,9 @@ def steps_config(config: RunConfig, steps_per_contact: int) -> RunConfig:
 
 
 def study_time_step(config: RunConfig, steps, workdir, log=None) -> Convergence:
-    """Run ``config`` at every number of steps per contact in ``steps`` (multiples of 35, the two
-    largest in the ratio of the finest pair) and measure each against the extrapolation."""
+    """Run ``config`` at every number of steps per contact in ``steps`` (multiples of
+    SAMPLES_PER_CONTACT, the two largest in the ratio of the finest pair) and measure each
+    against the extrapolation."""
     from hexdem.experiments.run import simulate
 
     log = log or (lambda message: None)
@@ -89,9 +99,7 @@ def study_time_step(config: RunConfig, steps, workdir, log=None) -> Convergence:
         results.append((analysis, time.perf_counter() - begun))
         log(f"{n} steps per contact: {results[-1][1]:.1f} s")
     finest = results[-1][0]
-    r = finest.results
-    line_beads = np.unique(np.concatenate(list(r.lines.values())))
-    beads = line_beads[r.peak_speed[line_beads] > THRESHOLD * config.v0]
+    beads = measured_beads(finest.results, config.v0)
     order = ORDERS[config.engine]
     peaks = np.array([a.results.peak_speed[beads] for a, _ in results])
     arrivals = np.array([a.results.arrival_time[beads] for a, _ in results])
@@ -108,3 +116,29 @@ def study_time_step(config: RunConfig, steps, workdir, log=None) -> Convergence:
     observed = tuple(float(np.log(a.peak_error / b.peak_error) / np.log(b.steps_per_contact / a.steps_per_contact))
                      for a, b in zip(runs[:-2], runs[1:-1]))
     return Convergence(config.engine, order, tuple(runs), observed, len(beads))
+
+
+@dataclass(frozen=True)
+class SamplingError:
+    """The largest relative ``peak_error`` and ``arrival_error`` (run units) of ``config`` sampled
+    every ``dump_every`` steps against the same run sampled at every step, over ``n_beads``."""
+
+    dump_every: int
+    peak_error: float
+    arrival_error: float
+    n_beads: int
+
+
+def sampling_error(config: RunConfig, workdir) -> SamplingError:
+    """The error of the in-run analysis's sampling alone: ``config`` at its own sampling and at
+    every step, the same time step and so the same trajectory (see :class:`SamplingError`)."""
+    from hexdem.experiments.run import simulate
+
+    settings = config.settings()
+    sampled = simulate(config, Path(workdir) / "sampled").results
+    every_step = simulate(config.replace(dt=settings.dt_s / settings.units.time_s, dump_every=1),
+                          Path(workdir) / "every-step").results
+    beads = measured_beads(every_step, config.v0)
+    peak = np.max(np.abs(sampled.peak_speed[beads] / every_step.peak_speed[beads] - 1.0))
+    arrival = np.max(np.abs(sampled.arrival_time[beads] - every_step.arrival_time[beads]))
+    return SamplingError(settings.dump_every, float(peak), float(arrival), len(beads))
