@@ -107,7 +107,7 @@ class PulseState:
         # below half of an earlier maximum: every free slot is below half of any new one. So the
         # ladder's records below half are all slots below it but the free ones.
         length = self.length[beads]
-        below = np.count_nonzero(self.rec_value[beads] < 0.5 * speeds[:, None], axis=1) - (capacity - length)
+        below = np.add.reduce(self.rec_value[beads] < 0.5 * speeds[:, None], axis=1, dtype=np.int64) - (capacity - length)
         drop = np.maximum(below - 1, 0)
         start = (self.start[beads] + drop) % capacity
         n = length - drop
