@@ -133,13 +133,15 @@ def solve_contact(contact: Contact, normal_speed: float, slip_speed: float, capp
 @dataclass(frozen=True)
 class States:
     """Recorded states (SI): ``times`` (T,), ``positions``, ``velocities`` (T, N, 2), ``spins`` ω_z (T, N),
-    and from LAMMPS ``forces`` (T, N, 2)."""
+    from LAMMPS ``forces`` (T, N, 2), from the reference engine the wall contacts' ``wall_histories``
+    ξ (T, K) [m] as integrated (before the step that follows sets them back to the Coulomb cap)."""
 
     times: np.ndarray
     positions: np.ndarray
     velocities: np.ndarray
     spins: np.ndarray
     forces: np.ndarray | None = None
+    wall_histories: np.ndarray | None = None
 
 
 @contextmanager
@@ -182,11 +184,11 @@ def reference_states(model: GranularModel, settings: RunSettings, every: int = 1
 
     def emit(index, step, x, y, u, w):
         records.append((step * settings.dt_s, start + np.column_stack([x, y]), np.column_stack([u, w]),
-                        system.state["spins"].copy()))
+                        system.state["spins"].copy(), system.state["wall_xi"] * SI.length_m))
 
     system.integrate(model.initial_velocities_m_s(), settings.dt_s, replace(settings, dump_every=every), emit)
-    times, positions, velocities, spins = (np.array(values) for values in zip(*records))
-    return States(times, positions, velocities, spins)
+    times, positions, velocities, spins, histories = (np.array(values) for values in zip(*records))
+    return States(times, positions, velocities, spins, wall_histories=histories)
 
 
 def convergence_bound(coarse, fine, scale, steps):
