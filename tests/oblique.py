@@ -32,7 +32,7 @@ from hexdem.model.hertz import contact_time
 from hexdem.model.lattice import Lattice
 from hexdem.model.materials import DELRIN, STEEL_316
 from hexdem.model.units import SI
-from hexdem.model.walls import Wall
+from hexdem.model.walls import CurvedWall, Wall
 
 #: Lever and inertia of a solid sphere: I = INERTIA m r².
 INERTIA = 0.4
@@ -44,6 +44,13 @@ def sphere_on_wall(incidence_deg: float, friction: float, speed: float = V0) -> 
     wall = Wall("wall_090", (0.0, 1.0), -D / 2, np.array([0]))
     return GranularModel(replace(single_bead(D), walls=(wall,)), Impact(speed, incidence_deg - 90.0, bead=0),
                          STEEL_316, DELRIN, friction=Friction(friction, friction))
+
+
+def sphere_in_ring(incidence_deg: float, friction: float, ring_radius_d: float = 3.0) -> GranularModel:
+    """As :func:`sphere_on_wall`, inside a curved (cylindrical) wall of radius ``ring_radius_d`` d
+    touching the sphere from below."""
+    ring = CurvedWall("ring", (0.0, (ring_radius_d - 0.5) * D), ring_radius_d * D, np.array([0]))
+    return replace(sphere_on_wall(incidence_deg, friction), lattice=replace(single_bead(D), walls=(ring,)))
 
 
 def sphere_pair(incidence_deg: float, friction: float, speed: float = V0) -> GranularModel:

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from conftest import D, V0
 from oblique import (INERTIA, Contact, convergence_bound, impact_settings, lammps_states, reference_states,
-                     solve_contact, sphere_on_wall, sphere_pair)
+                     solve_contact, sphere_in_ring, sphere_on_wall, sphere_pair)
 
 from hexdem.engines.reference.engine import ReferenceEngine
 from hexdem.engines.reference.friction import FrictionalSystem
@@ -63,11 +63,12 @@ def test_reference_engine_follows_hertz_mindlin_on_a_wall_over_the_whole_inciden
         assert abs(moved[1] - impulse) <= convergence_bound(moved[0], moved[1], gross, STEPS), normalized
 
 
-@pytest.mark.parametrize("build", [sphere_on_wall, sphere_pair], ids=["wall", "pair"])
+@pytest.mark.parametrize("build", [sphere_on_wall, sphere_in_ring, sphere_pair], ids=["wall", "ring", "pair"])
 def test_engines_agree_on_rebound_and_spin_over_the_whole_incidence_range(tmp_path, build):
-    """LAMMPS against the reference engine, a sphere on a wall and two spheres (whose contact turns as
-    they slide, which both engines follow), on the rebound tangential velocity and the spin: within
-    the sum of the two engines' convergence bounds."""
+    """LAMMPS against the reference engine, a sphere on a flat wall, inside a curved wall (radius 3 d,
+    LAMMPS's contact radius for it, :class:`~hexdem.model.walls.CurvedWall`) and two spheres (whose
+    contact turns as they slide, which both engines follow), on the rebound tangential velocity and
+    the spin: within the sum of the two engines' convergence bounds."""
     worst = 0.0
     for k, normalized in enumerate(NORMALIZED_INCIDENCES):
         model = build(incidence_of(normalized), MU)
