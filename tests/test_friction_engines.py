@@ -8,14 +8,16 @@ tolerance comes from its own convergence in the time step (``oblique.convergence
 
 import numpy as np
 import pytest
-from conftest import D, V0
+from conftest import D, V0, record
 from oblique import (INERTIA, Contact, convergence_bound, impact_settings, lammps_states, reference_states,
                      solve_contact, sphere_in_ring, sphere_on_wall, sphere_pair)
 
-from hexdem.engines.reference.engine import ReferenceEngine
+from hexdem.engines.lammps.engine import LammpsEngine
+from hexdem.engines.reference.engine import ReferenceEngine, ReferenceSystem
 from hexdem.engines.reference.friction import FrictionalSystem
 from hexdem.model.config import RunConfig
-from hexdem.model.units import SI
+from hexdem.model.materials import STEEL_316
+from hexdem.model.units import SI, nondimensional
 
 MU = 0.3
 STEPS = 200
@@ -111,8 +113,6 @@ def test_free_packing_keeps_its_angular_momentum_in_the_reference_engine():
 def test_frictionless_models_keep_the_frictionless_kernel_and_frictional_ones_spin(tmp_path):
     """The engine picks its kernel from the contact law: a frictionless model runs the kernel of
     before (``reference.json`` counts its lattice bonds), a frictional one the frictional kernel."""
-    from hexdem.engines.reference.engine import ReferenceSystem
-
     config = RunConfig(edge_beads=4, impact="striker", strike_angle_deg=20.0, engine="reference")
     for friction, system in ((0.0, ReferenceSystem), (0.4, FrictionalSystem)):
         model = config.replace(friction=friction).model()
@@ -121,3 +121,21 @@ def test_frictionless_models_keep_the_frictionless_kernel_and_frictional_ones_sp
                                        show_progress=False)
         assert engine["n_bonds"] == system.from_model(model, SI).n_bonds
         assert np.isfinite(samples[-1].velocities).all()
+
+
+@pytest.mark.parametrize("engine", ["reference", "lammps"])
+def test_friction_in_the_papers_units_is_the_si_run_rescaled(tmp_path, engine):
+    """G* is a stress like E*, so the paper's A = d = M = 1 carry Mindlin's law as they carry Hertz's:
+    a frictional run in nondimensional units, rescaled to SI, is the SI run (4 per edge, 20° striker,
+    μ = 0.3 against the beads and the walls)."""
+    si = RunConfig(edge_beads=4, impact="striker", strike_angle_deg=20.0, friction=0.3, duration=2e-4)
+    units = nondimensional(si.diameter_m, STEEL_316)
+    scaled = si.replace(units="nondimensional", v0=si.v0 / units.velocity_m_s, duration=si.duration / units.time_s)
+    finals = []
+    for config in (si, scaled):
+        model = config.model()
+        run = ReferenceEngine() if engine == "reference" else LammpsEngine()
+        trajectory = record(run, model, config.settings(model), tmp_path / config.units)
+        finals.append(trajectory.velocities_m_s[-1])
+    assert np.abs(finals[0]).max() > 0.05 * V0
+    np.testing.assert_allclose(finals[1], finals[0], rtol=0, atol=1e-8 * V0)
