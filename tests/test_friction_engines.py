@@ -112,7 +112,8 @@ def test_free_packing_keeps_its_angular_momentum_in_the_reference_engine():
 
 def test_frictionless_models_keep_the_frictionless_kernel_and_frictional_ones_spin(tmp_path):
     """The engine picks its kernel from the contact law: a frictionless model runs the kernel of
-    before (``reference.json`` counts its lattice bonds), a frictional one the frictional kernel."""
+    before (``reference.json`` counts its lattice bonds) and its samples carry no spins, a frictional
+    one the frictional kernel, whose samples carry the spheres' spins."""
     config = RunConfig(edge_beads=4, impact="striker", strike_angle_deg=20.0, engine="reference")
     for friction, system in ((0.0, ReferenceSystem), (0.4, FrictionalSystem)):
         model = config.replace(friction=friction).model()
@@ -121,6 +122,8 @@ def test_frictionless_models_keep_the_frictionless_kernel_and_frictional_ones_sp
                                        show_progress=False)
         assert engine["n_bonds"] == system.from_model(model, SI).n_bonds
         assert np.isfinite(samples[-1].velocities).all()
+        spins = samples[-1].angular_velocities
+        assert (spins is None) if friction == 0 else (np.isfinite(spins).all() and np.abs(spins).max() > 0)
 
 
 @pytest.mark.parametrize("engine", ["reference", "lammps"])

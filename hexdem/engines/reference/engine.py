@@ -174,6 +174,10 @@ class ReferenceSystem:
     def n_wall_contacts(self) -> int:
         return len(self.kernel.wall_cell)
 
+    def angular_velocities(self) -> None:
+        """The bodies' spins: none, frictionless spheres never turn."""
+        return None
+
     def _cell_arrays(self, values):
         """(n_bodies, 2) body values → x and y arrays over all cells."""
         return _cell_forces(values, self.cells, self.n_cells)
@@ -245,7 +249,7 @@ class ReferenceEngine:
                 raise HexdemError(f"reference integration diverged (non-finite velocities at t = "
                                   f"{step * settings.dt_s:.4g} s): reduce the time step")
             on_sample(Sample(index, step, step * dt, ids, start_positions + np.column_stack([x[cells], y[cells]]),
-                             velocities, accelerations))
+                             velocities, accelerations, system.angular_velocities()))
             if bar is not None:
                 bar.update(step - bar.n)
 

@@ -83,6 +83,10 @@ class FrictionalSystem:
     def n_wall_contacts(self) -> int:
         return len(self.kernel.wall_cell)
 
+    def angular_velocities(self) -> np.ndarray:
+        """(n_bodies,) the spins ω_z of the integration under way, in ``units``."""
+        return self.state["spins"].copy()
+
     def accelerations(self, x, y, u, w) -> np.ndarray:
         """(n_bodies, 2) accelerations at the displacements (x, y) and velocities (u, w), with the
         spins and histories of the integration under way."""
