@@ -142,3 +142,24 @@ def test_friction_in_the_papers_units_is_the_si_run_rescaled(tmp_path, engine):
         finals.append(trajectory.velocities_m_s[-1])
     assert np.abs(finals[0]).max() > 0.05 * V0
     np.testing.assert_allclose(finals[1], finals[0], rtol=0, atol=1e-8 * V0)
+
+
+def test_engines_agree_on_a_frictional_packings_peak_speeds(tmp_path):
+    """A 5-per-edge hexagon with μ = 0.3 between beads and against the walls, struck at 15° by a brass
+    striker: every body's peak speed (the largest sampled), LAMMPS against the reference engine, within the sum of the engines' changes from 140 to 280 steps per contact
+    (plus their second-order floors) — the friction's whole network of stick and slip, not one contact."""
+    base = RunConfig(edge_beads=5, impact="striker", striker_material="brass", strike_angle_deg=15.0, friction=0.3)
+    peaks = {}
+    for steps in (140, 280):
+        config = base.replace(steps_per_contact=steps)
+        model = config.model()
+        for name, engine in (("lammps", LammpsEngine()), ("reference", ReferenceEngine())):
+            samples = []
+            engine.run(model, config.settings(model), tmp_path / f"{name}-{steps}", samples.append, show_progress=False)
+            speeds = np.array([np.linalg.norm(s.velocities[np.argsort(s.ids)], axis=1) for s in samples])
+            peaks[name, steps] = speeds.max(axis=0)  # by body id
+    floor = V0 / 280**2
+    bound = sum(np.abs(peaks[name, 140] - peaks[name, 280]) * 2 + floor for name in ("lammps", "reference"))
+    gap = np.abs(peaks["lammps", 280] - peaks["reference", 280])
+    assert np.all(gap <= bound), (gap / bound).max()
+    assert gap.max() < 1e-3 * V0, gap.max()

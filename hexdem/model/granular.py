@@ -154,7 +154,8 @@ class GranularModel:
 
     @property
     def dissipative(self) -> bool:
-        return self.restitution < 1.0 or (bool(self.walls) and self.wall_restitution < 1.0)
+        """Whether the contacts dissipate energy: damped (restitution < 1), or frictional."""
+        return self.restitution < 1.0 or (bool(self.walls) and self.wall_restitution < 1.0) or self.laws.tangential
 
     def external_forces_n(self) -> np.ndarray:
         """(n_bodies, 2) constant forces [N] on the bodies: the held force on the struck bead."""
