@@ -6,7 +6,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from hexdem.engines.lammps.deck import pair_block, render_input
+from hexdem.engines.lammps.deck import DECK_NAME, pair_block, render_input
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
 from hexdem.model.contact_law import ContactLaws, Friction
@@ -95,3 +95,14 @@ def test_one_material_with_friction_takes_one_pair_coeff():
     block = pair_block(model, SI)
     assert block.startswith("pair_style      granular\npair_coeff      * * hertz")
     assert block.endswith(f"tangential mindlin {mindlin_stiffness(STEEL_316, STEEL_316)!r} 0.0 0.25")
+
+
+def test_settle_decks_turn_frictional_spheres_too(tmp_path):
+    """The disorder preparation's decks integrate with the same rule as the impact's."""
+    from hexdem.disorder.preparation import Preparation, write_stage_deck
+
+    for friction, integrator in ((0.0, "nve"), (0.3, "nve/sphere")):
+        model = RunConfig(edge_beads=3, friction=friction).model()
+        deck = (write_stage_deck(model, "settle", Preparation(), tmp_path / str(friction)) / DECK_NAME).read_text()
+        assert f"fix             integrate all {integrator}\n" in deck
+        assert ("tangential mindlin" in deck) == (friction > 0)
