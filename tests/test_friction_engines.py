@@ -144,11 +144,17 @@ def test_friction_in_the_papers_units_is_the_si_run_rescaled(tmp_path, engine):
     np.testing.assert_allclose(finals[1], finals[0], rtol=0, atol=1e-8 * V0)
 
 
-def test_engines_agree_on_a_frictional_packings_peak_speeds(tmp_path):
-    """A 5-per-edge hexagon with μ = 0.3 between beads and against the walls, struck at 15° by a brass
-    striker: every body's peak speed (the largest sampled), LAMMPS against the reference engine, within the sum of the engines' changes from 140 to 280 steps per contact
-    (plus their second-order floors) — the friction's whole network of stick and slip, not one contact."""
-    base = RunConfig(edge_beads=5, impact="striker", striker_material="brass", strike_angle_deg=15.0, friction=0.3)
+@pytest.mark.parametrize("keys", [
+    {"edge_beads": 5, "striker_material": "brass", "strike_angle_deg": 15.0},
+    {"edge_beads": 4, "strike_angle_deg": 25.0, "sensors": ["0:1", "+30:2"], "sensor_mass_factor": 2.0},
+], ids=["brass-striker", "heavy-sensors"])
+def test_engines_agree_on_a_frictional_packings_peak_speeds(tmp_path, keys):
+    """A hexagon with μ = 0.3 between spheres and against the walls, struck obliquely by a striker
+    (of brass; or of steel, with sensor beads twice as heavy, whose I = (2/5) m r² follows their mass):
+    every body's peak speed (the largest sampled), LAMMPS against the reference engine, within the sum
+    of the engines' changes from 140 to 280 steps per contact (plus their second-order floors): the
+    friction's whole network of stick and slip, not one contact. The striker and the sensors turn."""
+    base = RunConfig(impact="striker", friction=0.3, **keys)
     peaks = {}
     for steps in (140, 280):
         config = base.replace(steps_per_contact=steps)
@@ -158,6 +164,8 @@ def test_engines_agree_on_a_frictional_packings_peak_speeds(tmp_path):
             engine.run(model, config.settings(model), tmp_path / f"{name}-{steps}", samples.append, show_progress=False)
             speeds = np.array([np.linalg.norm(s.velocities[np.argsort(s.ids)], axis=1) for s in samples])
             peaks[name, steps] = speeds.max(axis=0)  # by body id
+        spins = np.abs([s.angular_velocities for s in samples]).max(axis=0)  # the reference engine's
+        assert np.all(spins[[*model.sensor_beads, model.n_bodies - 1]] > 0)
     floor = V0 / 280**2
     bound = sum(np.abs(peaks[name, 140] - peaks[name, 280]) * 2 + floor for name in ("lammps", "reference"))
     gap = np.abs(peaks["lammps", 280] - peaks["reference", 280])
