@@ -60,6 +60,7 @@ from hexdem.engines.lammps.deck import (
     data_file,
     granular_block,
     gravity_block,
+    integrator,
     template,
     walls_block,
 )
@@ -253,7 +254,7 @@ def write_stage_deck(model: GranularModel, stage: str, preparation: Preparation,
         note += f"\n# and no net force component above {force!r} N"
     text = template("settle.in").substitute(
         stage=stage, title=f"{lattice.shape}, {len(lattice)} beads", loads_note=blocks["loads_note"],
-        granular=granular_block(model, SI),
+        granular=granular_block(model, SI), integrator=integrator(model),
         walls=blocks["walls"], loads=blocks["loads"], damping_time=repr(blocks["damping_s"]),
         gamma=repr(float(masses.mean()) / blocks["damping_s"]), max_step=repr(preparation.max_step_m),
         max_dt=repr(preparation.max_dt_s), first_dt=repr(preparation.max_dt_s / 100),

@@ -21,7 +21,8 @@ class Sample:
     simulated time; ``ids`` (n,) body ids, 1-based (beads 1..N as in the data file, then
     the striker); ``positions`` and ``velocities`` (n, 2) full-step values at ``step``;
     ``accelerations`` (n, 2), total force / mass, only at the sensor samples (every
-    ``settings.sensor_every`` steps), else None.
+    ``settings.sensor_every`` steps), else None; ``angular_velocities`` (n,) ω_z, the spins of a
+    frictional model's spheres (None: the engine gives none; frictionless spheres never turn).
     """
 
     index: int
@@ -31,4 +32,5 @@ class Sample:
     positions: np.ndarray
     velocities: np.ndarray
     accelerations: np.ndarray | None = None
+    angular_velocities: np.ndarray | None = None
 

@@ -18,6 +18,7 @@ from pathlib import Path
 from hexdem.common.checks import is_number, positive_int
 from hexdem.common.machine import available_memory_bytes
 from hexdem.errors import HexdemError
+from hexdem.model.contact_law import Friction
 from hexdem.model.dissipation import damping_coefficient, lammps_tsuji_coefficient
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.impacts import ImpactSpec, cut_holes, impact_specs, resolve_impacts, struck_site
@@ -74,8 +75,9 @@ class RunConfig:
     time whatever the step): the analysis inside the run takes one every ``dump_every``
     steps, and so does the full LAMMPS dump, written only with ``dump = true`` (the deck's
     ``in.hexdem`` always writes it when rerun by hand).
-    ``restitution``: bead–bead coefficient of restitution (1.0: the paper's ideal model);
-    ``wall_restitution``: bead–wall (None: the same as ``restitution``).
+    ``restitution``: bead–bead coefficient of restitution (1.0: the paper's ideal model); ``wall_restitution``:
+    bead–wall (None: ``restitution``). ``friction``, ``wall_friction`` (None: ``friction``), ``rolling_friction``:
+    Coulomb μ between bodies and against walls, rolling resistance (:mod:`hexdem.model.contact_law`).
     ``precompression_n``: static force per bead–bead contact [N] (0: uncompressed; see
     :mod:`hexdem.model.precompression`).
     ``sensors``: sensor particles, each ``"line:n"`` (e.g. ``"0:1"``, ``"+30:6"``) or a bead id;
@@ -105,10 +107,9 @@ class RunConfig:
     ``launcher``: the MPI launcher command that starts the ranks (None: this environment's
     ``mpiexec``; e.g. ``"mpiexec -f hosts"`` or ``"srun"`` to span machines); given, the run goes
     through it even on one rank.
-    ``dt = None`` takes the step that ``steps_per_contact`` gives; ``duration = None``
-    runs until the leading wave has crossed the packing: one contact time per layer between
-    the struck bead and the far wall (the pulse resides less than that on each
-    layer: 0.82 ms are needed, 1.43 ms are run for the default experiment).
+    ``dt = None`` takes the step that ``steps_per_contact`` gives; ``duration = None`` runs until the leading
+    wave has crossed the packing: one contact time per layer between the struck bead and the far wall (the pulse
+    resides less than that on each layer: 0.82 ms are needed, 1.43 ms are run for the default experiment).
     """
 
     shape: str = "hexagon"
@@ -144,6 +145,9 @@ class RunConfig:
     dump: bool = False
     restitution: float = 1.0
     wall_restitution: float | None = None
+    friction: float = 0.0
+    wall_friction: float | None = None
+    rolling_friction: float = 0.0
     precompression_n: float = 0.0
     sensors: tuple = ()
     sensor_rate_hz: float = 500e3
@@ -317,7 +321,7 @@ class RunConfig:
             lattice = holed
         return GranularModel(lattice, impacts[0], bead, wall, self.restitution, wall_restitution, held,
                              tuple(self.sensor_beads(lattice).values()), self.sensor_mass_factor, extra,
-                             tuple(impacts[1:]))
+                             tuple(impacts[1:]), Friction.of(self.friction, self.wall_friction, self.rolling_friction))
 
     def _impacts(self, lattice: Lattice) -> list[Impact]:
         """The model's impacts: the paper's single one on the struck bead, or those of ``impacts``."""

@@ -16,9 +16,10 @@ import numpy as np
 
 from hexdem.common.checks import is_number
 from hexdem.errors import HexdemError
+from hexdem.model.contact_law import NO_FRICTION, ContactLaws, Friction
 from hexdem.model.dissipation import check_restitution, damping_coefficient
 from hexdem.model.lattice import Lattice, strike_direction, unit_vector
-from hexdem.model.materials import DELRIN, STEEL_316, Material, hertz_stiffness
+from hexdem.model.materials import DELRIN, STEEL_316, Material
 from hexdem.model.units import SI, UnitSystem
 
 
@@ -76,7 +77,8 @@ class GranularModel:
 
     Materials: bead material id 0 is ``bead``, ids 1, 2, … are ``extra_materials`` (the
     lattice's ``material_ids`` say which bead is which); then the strikers' own materials.
-    Every contact is Hertz's with the pair's own E* and R_eff (:meth:`contact_stiffness_pa`).
+    Every contact is Hertz's with the pair's own E* and R_eff (:meth:`contact_stiffness_pa`);
+    ``friction`` adds Mindlin's tangential force and the bodies' rotation (:attr:`laws`).
 
     Impacts: ``impact`` (the paper's single impact by default) and ``more_impacts``, each on
     its own bead (:attr:`impacts`).
@@ -93,6 +95,7 @@ class GranularModel:
     sensor_mass_factor: float = 1.0
     extra_materials: tuple[Material, ...] = ()
     more_impacts: tuple[Impact, ...] = ()
+    friction: Friction = NO_FRICTION
 
     def __post_init__(self):
         check_restitution("restitution", self.restitution)
@@ -151,7 +154,8 @@ class GranularModel:
 
     @property
     def dissipative(self) -> bool:
-        return self.restitution < 1.0 or (bool(self.walls) and self.wall_restitution < 1.0)
+        """Whether the contacts dissipate energy: damped (restitution < 1), or frictional."""
+        return self.restitution < 1.0 or (bool(self.walls) and self.wall_restitution < 1.0) or self.laws.tangential
 
     def external_forces_n(self) -> np.ndarray:
         """(n_bodies, 2) constant forces [N] on the bodies: the held force on the struck bead."""
@@ -212,9 +216,15 @@ class GranularModel:
         return self.densities_kg_m3 * np.pi * self.diameters_m**3 / 6.0 * self.mass_factors
 
     @property
+    def laws(self) -> ContactLaws:
+        """The contact law of every pair of :attr:`materials` and of each against the wall
+        (:mod:`hexdem.model.contact_law`)."""
+        return ContactLaws.of(self.materials, self.wall, self.pair_damping, self.wall_damping, self.friction)
+
+    @property
     def stiffness_table_pa(self) -> np.ndarray:
         """(K, K) k_n = (4/3) E* [Pa] of every pair of :attr:`materials`."""
-        return np.array([[hertz_stiffness(a, b) for b in self.materials] for a in self.materials])
+        return self.laws.pair_table("normal_stiffness_pa")
 
     def contact_stiffness_pa(self, i, j) -> np.ndarray:
         """k_n = (4/3) E* [Pa] of the contacts between bodies ``i`` and ``j`` (arrays of indices):
@@ -240,8 +250,7 @@ class GranularModel:
         material against the wall's own E, ν."""
         if self.wall is None:
             raise HexdemError("this model has no walls")
-        table = np.array([hertz_stiffness(m, self.wall) for m in self.materials])
-        return table[self.material_ids[np.asarray(beads, int)]]
+        return self.laws.wall_table("normal_stiffness_pa")[self.material_ids[np.asarray(beads, int)]]
 
     @property
     def walls(self):

@@ -52,6 +52,11 @@ class Material:
         """(1 − ν²)/E, this body's share of 1/E* [1/Pa]."""
         return (1.0 - self.poisson_ratio**2) / self.youngs_modulus_pa
 
+    @property
+    def shear_compliance_per_pa(self) -> float:
+        """(2 − ν)/G with G = E/(2(1 + ν)), this body's share of 1/G* (Mindlin) [1/Pa]."""
+        return (2.0 - self.poisson_ratio) * 2.0 * (1.0 + self.poisson_ratio) / self.youngs_modulus_pa
+
 
 #: Stainless steel type 316 as used in the paper's experiment (Sec. II).
 STEEL_316 = Material("steel316", youngs_modulus_pa=193e9, poisson_ratio=0.3, density_kg_m3=8000.0,
@@ -111,6 +116,18 @@ def custom_materials(table) -> dict[str, Material]:
 def effective_modulus(a: Material, b: Material) -> float:
     """E* = 1/((1 − ν_a²)/E_a + (1 − ν_b²)/E_b) [Pa] of a Hertz contact between a and b."""
     return 1.0 / (a.compliance_per_pa + b.compliance_per_pa)
+
+
+def effective_shear_modulus(a: Material, b: Material) -> float:
+    """G* = 1/((2 − ν_a)/G_a + (2 − ν_b)/G_b) [Pa] of a Mindlin contact between a and b."""
+    return 1.0 / (a.shear_compliance_per_pa + b.shear_compliance_per_pa)
+
+
+def mindlin_stiffness(a: Material, b: Material) -> float:
+    """k_t = 8 G* [Pa]: Mindlin's no-slip tangential stiffness is k_t a for a contact of radius a
+    (against the normal 2 E* a), the ``k_t`` of LAMMPS's ``tangential mindlin``, which multiplies
+    it by the contact radius."""
+    return 8.0 * effective_shear_modulus(a, b)
 
 
 def hertz_stiffness(a: Material, b: Material) -> float:

@@ -5,7 +5,9 @@ The directory holds ``data.hexdem`` (atoms: id type diameter density x y z) and
 by hand. Quantities are written in the chosen :class:`~hexdem.model.units.UnitSystem`: SI
 (``units si``) or the paper's A = d = M = 1 (``units lj``). Contacts use the ``hertz k_n``
 model, F = k_n sqrt(R_eff δ) δ, for bead pairs and for the walls alike, so the walls carry
-their own modulus (the wall fix's ``hertz/material`` cannot mix materials, LAMMPS issue 4141).
+their own modulus (the wall fix's ``hertz/material`` cannot mix materials, LAMMPS issue 4141);
+with friction, Mindlin's ``tangential mindlin`` with each contact's own k_t = 8 G* (given, as
+LAMMPS cannot derive it from ``hertz k_n``), and ``fix nve/sphere`` turns the spheres.
 An optional uniform in-plane gravity (the tilted set-up of Sec. VI-A) adds ``fix gravity``.
 """
 
@@ -19,6 +21,7 @@ from string import Template
 import numpy as np
 
 from hexdem.errors import HexdemError
+from hexdem.model.contact_law import ContactLaw
 from hexdem.model.dissipation import lammps_tsuji_coefficient
 from hexdem.model.granular import GranularModel, RunSettings
 from hexdem.model.walls import CurvedWall
@@ -101,10 +104,10 @@ CYLINDER_HALF_HEIGHT_D = 1000.0
 
 def walls_block(model: GranularModel, units: UnitSystem) -> str:
     """Deck commands for the walls of ``model``: member group, region (a plane, or a cylinder for a
-    curved wall) and wall fix each."""
+    curved wall) and wall fix each, with the contact law of each material against the wall."""
     if not model.walls:
         return "# (no walls)\n"
-    block = []
+    block, laws = [], model.laws.walls
     for wall in model.walls:
         if isinstance(wall, CurvedWall):  # its Hertz law: LAMMPS's own contact radius of a cylinder
             centre = np.asarray(wall.centre_m) / units.length_m
@@ -117,13 +120,12 @@ def walls_block(model: GranularModel, units: UnitSystem) -> str:
                       f"{_fmt(wall.normal[0])} {_fmt(wall.normal[1])} 0.0 side in")
         groups, fixes = [], []
         materials = model.material_ids[wall.members]
-        for material in np.unique(materials):  # one fix per material touching the wall: its own k_n
+        for material in np.unique(materials):  # one fix per material touching the wall: its own law
             members = wall.members[materials == material]
             group = wall.name if len(np.unique(materials)) == 1 else f"{wall.name}_{model.materials[material].name}"
-            stiffness = _fmt(model.wall_stiffness_pa(members[:1])[0] / units.stress_pa)
             groups.append(f"group           {group} id {' '.join(str(i + 1) for i in members)}")
-            fixes.append(f"fix             {group} {group} wall/gran/region granular hertz {stiffness} "
-                         f"{damping_model(model.wall_damping)} tangential linear_nohistory 0.0 0.0 region {wall.name}")
+            fixes.append(f"fix             {group} {group} wall/gran/region granular "
+                         f"{contact_model(laws[material], units)} region {wall.name}")
         block += [*groups, f"region          {wall.name} {region}", *fixes]
     return "\n".join(block) + "\n"
 
@@ -141,39 +143,55 @@ def damping_model(alpha: float) -> str:
     return f"{_fmt(lammps_tsuji_coefficient(alpha))} damping tsuji"
 
 
-def pair_block(model: GranularModel, units: UnitSystem) -> str:
-    """The Hertz pair potential F = k_n sqrt(R_eff) δ^{3/2} of ``model``, without tangential force.
+def contact_model(law: ContactLaw, units: UnitSystem) -> str:
+    """A :class:`~hexdem.model.contact_law.ContactLaw` as LAMMPS's granular sub-models: ``hertz k_n``
+    with its damping, and ``tangential mindlin k_t 0 μ`` (k_t = 8 G*, which LAMMPS multiplies by the
+    contact radius a; no tangential damping), or no tangential force (``linear_nohistory 0 0``)."""
+    normal = f"hertz {_fmt(law.normal_stiffness_pa / units.stress_pa)} {damping_model(law.damping)}"
+    if not law.tangential:
+        return f"{normal} tangential linear_nohistory 0.0 0.0"
+    return f"{normal} tangential mindlin {_fmt(law.tangential_stiffness_pa / units.stress_pa)} 0.0 {_fmt(law.friction)}"
 
-    Unlike materials get ``pair_style granular`` with one ``pair_coeff`` per pair of atom types,
-    k_n = (4/3) E* of that pair. With one material, an elastic contact is rendered as ``pair_style gran/hertz/history k_n NULL 0 NULL 0 0``:
-    with no damping and a friction coefficient of 0 its normal force is the same expression
-    as ``pair_style granular``'s ``hertz`` and its tangential force is exactly zero, and it
-    costs about a third less per step (``tests/test_pair_styles.py`` shows the forces equal
-    to round-off). Damped contacts keep ``pair_style granular`` with ``damping tsuji``."""
-    table = model.stiffness_table_pa / units.stress_pa
-    present = int(model.material_ids[0])
+
+def pair_block(model: GranularModel, units: UnitSystem) -> str:
+    """The contacts of ``model``'s bodies: ``pair_style granular`` with each pair of atom types' own
+    law (:func:`contact_model`: k_n = (4/3) E*, F = k_n sqrt(R_eff) δ^{3/2}, and with friction
+    Mindlin's k_t = 8 G*), one ``pair_coeff * *`` for one material.
+
+    A frictionless elastic contact of one material is rendered as ``pair_style gran/hertz/history
+    k_n NULL 0 NULL 0 0``: with no damping and a friction coefficient of 0 its normal force is the
+    same expression as ``pair_style granular``'s ``hertz`` and its tangential force is exactly
+    zero, and it costs about a third less per step (``tests/test_pair_styles.py`` shows the forces
+    equal to round-off)."""
+    laws, kinds = model.laws, type_materials(model)
+    law = laws.pairs[int(model.material_ids[0])][int(model.material_ids[0])]
+    if model.uniform_contacts and law.damping == 0.0 and not laws.tangential:
+        return (f"pair_style      gran/hertz/history {_fmt(law.normal_stiffness_pa / units.stress_pa)} NULL 0.0 NULL 0.0 0"
+                "\npair_coeff      * *")
     if model.uniform_contacts:
-        stiffness = _fmt(table[present, present])
-        if model.pair_damping == 0.0:
-            return f"pair_style      gran/hertz/history {stiffness} NULL 0.0 NULL 0.0 0\npair_coeff      * *"
-        return ("pair_style      granular\n"
-                f"pair_coeff      * * hertz {stiffness} {damping_model(model.pair_damping)} tangential linear_nohistory 0.0 0.0")
-    kinds = type_materials(model)  # unlike materials: each pair of atom types its own k_n = (4/3) E*
-    lines = ["pair_style      granular"]
+        return f"pair_style      granular\npair_coeff      * * {contact_model(law, units)}"
+    lines = ["pair_style      granular"]  # unlike materials: each pair of atom types its own law
     for a in range(len(kinds)):
         for b in range(a, len(kinds)):
-            lines.append(f"pair_coeff      {a + 1} {b + 1} hertz {_fmt(table[kinds[a], kinds[b]])} "
-                         f"{damping_model(model.pair_damping)} tangential linear_nohistory 0.0 0.0")
+            lines.append(f"pair_coeff      {a + 1} {b + 1} {contact_model(laws.pairs[kinds[a]][kinds[b]], units)}")
     return "\n".join(lines)
 
 
 def granular_block(model: GranularModel, units: UnitSystem) -> str:
     """Deck commands shared by every hexdem deck: 2D sphere atoms from ``data.hexdem`` and
-    the Hertz pair potential of ``model`` without tangential force (:func:`pair_block`)."""
+    the contacts of ``model`` (:func:`pair_block`)."""
+    law = model.laws.pairs[0][0]
     return template("granular.in").substitute(
         lammps_units=units.lammps_units, pair=pair_block(model, units),
         damping_note="undamped" if model.restitution == 1.0 else f"Tsuji damping, restitution {model.restitution}",
+        tangential_note=f"Mindlin tangential force, mu = {law.friction}" if law.tangential else "no tangential force",
         skin=_fmt(0.1 * model.lattice.diameter_m / units.length_m))
+
+
+def integrator(model: GranularModel) -> str:
+    """``fix nve``, or ``fix nve/sphere`` (solid spheres, I = (2/5) m r², spinning about z under
+    ``enforce2d``) when the contacts have tangential forces."""
+    return "nve/sphere" if model.laws.tangential else "nve"
 
 
 def gravity_block(gravity_m_s2, units: UnitSystem) -> str:
@@ -238,7 +256,7 @@ def render_input(model: GranularModel, settings: RunSettings, gravity_m_s2=None)
         title=f"{model.lattice.shape}, " + ("; ".join(_impact_title(model, impact) for impact in model.impacts)
                                              if len(model.impacts) <= 3 else f"{len(model.impacts)} impacts"),
         units_note=note, granular=granular_block(model, units), walls=walls, body_force=body_force,
-        impacts=impacts, dt=_fmt(settings.dt_s / units.time_s),
+        impacts=impacts, integrator=integrator(model), dt=_fmt(settings.dt_s / units.time_s),
         thermo_every=max(1, settings.n_steps // 20), dump_every=settings.dump_every,
         nsteps=settings.n_steps)
 

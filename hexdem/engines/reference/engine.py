@@ -18,7 +18,9 @@ analysis judges both engines. Unlike LAMMPS, which
 treats every overlapping pair as a contact, bonds are fixed; in a lattice whose
 next-nearest neighbours never touch (all hexdem packings) the two coincide.
 
-The force and RK4 loops are compiled (:mod:`hexdem.engines.reference.kernel`, numba).
+The force and RK4 loops are compiled (:mod:`hexdem.engines.reference.kernel`, numba). A model whose
+contact law has a tangential force (friction) runs instead on the frictional kernel, with spins and
+contact histories (:mod:`hexdem.engines.reference.friction`); the engine picks the kernel from the law.
 """
 
 from __future__ import annotations
@@ -34,18 +36,17 @@ import numpy as np
 from hexdem.common.checks import is_number, positive_int
 from hexdem.common.io import write_json
 from hexdem.common.progress import progress_bar
+from hexdem.engines.reference.contacts import coefficient, reduced, striker_bodies, wall_geometry
+from hexdem.engines.reference.friction import FrictionalSystem
 from hexdem.engines.reference.kernel import KernelArrays, forces, integrate
 from hexdem.engines.sampling import Sample
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel, RunSettings
 from hexdem.model.lattice import BOND_STEPS, Lattice
-from hexdem.model.walls import wall_normals
 from hexdem.model.units import UnitSystem
 
 #: Description of the run written into the engine's directory.
 PARAMETERS_NAME = "reference.json"
-#: A striker is bonded to every body closer than this many d to touching it at t = 0.
-STRIKER_REACH = 0.5
 
 
 @dataclass(frozen=True)
@@ -85,15 +86,6 @@ class Grid:
         return self.n_cells - self.cols - 1
 
 
-def _coefficient(stiffness_pa: float, r_eff_m, units: UnitSystem):
-    """Hertz coefficient A = k_n sqrt(R_eff) [N/m^1.5] of a contact, in ``units``."""
-    return stiffness_pa * np.sqrt(r_eff_m) * units.length_m**1.5 / units.force_n
-
-
-def _reduced_radius(radius_i, radius_j):
-    return radius_i * radius_j / (radius_i + radius_j)
-
-
 def _lattice_bonds(model: GranularModel, grid: Grid, units: UnitSystem):
     """(rest_x, rest_y, contact, stiffness, damping), each (3, hi), of the lattice's fixed bonds."""
     lattice = model.lattice
@@ -108,50 +100,30 @@ def _lattice_bonds(model: GranularModel, grid: Grid, units: UnitSystem):
     cell, radii = grid.cells[i], lattice.radii_m
     rest_x[d, cell], rest_y[d, cell] = (lattice.positions_m[j] - lattice.positions_m[i]).T / units.length_m
     contact[d, cell] = (radii[i] + radii[j]) / units.length_m
-    stiffness[d, cell] = _coefficient(model.contact_stiffness_pa(i, j), _reduced_radius(radii[i], radii[j]), units)
+    stiffness[d, cell] = coefficient(model.contact_stiffness_pa(i, j), reduced(radii[i], radii[j]), units)
     masses = model.masses_kg / units.mass_kg
-    damping[d, cell] = model.pair_damping * np.sqrt(_reduced_radius(masses[i], masses[j]) * stiffness[d, cell])
+    damping[d, cell] = model.pair_damping * np.sqrt(reduced(masses[i], masses[j]) * stiffness[d, cell])
     return rest_x, rest_y, contact, stiffness, damping
 
 
 def _striker_pairs(model: GranularModel, cells: np.ndarray, units: UnitSystem):
-    """Bonds of each striker to every body it touches or nearly touches at t = 0 (none without
-    one): its bead, the other beads and strikers within reach.
-
-    Besides the struck bead, an oblique striker touches a neighbour of it (at 30° the bead
-    {−2, 0}), and the spheres of a flat striker touch each other; LAMMPS, which counts every
-    overlap, feels them all. Bonds are repulsive only, so a bond to a body that the striker
-    never reaches costs nothing.
-    """
+    """Bonds of each striker to the bodies within its reach (:func:`~hexdem.engines.reference.contacts.striker_bodies`)."""
     pos, radii = model.initial_positions_m(), model.diameters_m / 2
-    first = len(model.lattice)
-    strikers, bodies = [np.zeros(0, dtype=int)], [np.zeros(0, dtype=int)]
-    for striker in range(first, model.n_bodies):
-        gap = np.linalg.norm(pos[:striker] - pos[striker], axis=1) - radii[:striker] - radii[striker]
-        near = np.flatnonzero(gap < STRIKER_REACH * model.lattice.diameter_m)
-        strikers.append(np.full(len(near), striker))
-        bodies.append(near)
-    strikers, bodies = np.concatenate(strikers), np.concatenate(bodies)
+    strikers, bodies = striker_bodies(model)
     rest = (pos[bodies] - pos[strikers]) / units.length_m
-    r_eff = _reduced_radius(radii[bodies], radii[strikers])
-    stiffness = _coefficient(model.contact_stiffness_pa(bodies, strikers), r_eff, units)
+    r_eff = reduced(radii[bodies], radii[strikers])
+    stiffness = coefficient(model.contact_stiffness_pa(bodies, strikers), r_eff, units)
     masses = model.masses_kg / units.mass_kg
-    damping = model.pair_damping * np.sqrt(_reduced_radius(masses[bodies], masses[strikers]) * stiffness)
+    damping = model.pair_damping * np.sqrt(reduced(masses[bodies], masses[strikers]) * stiffness)
     return (cells[strikers].astype(np.int64), cells[bodies].astype(np.int64), rest[:, 0].copy(), rest[:, 1].copy(),
             (radii[bodies] + radii[strikers]) / units.length_m, stiffness, damping)
 
 
 def _wall_contacts(model: GranularModel, cells: np.ndarray, units: UnitSystem):
-    """(cell, n_x, n_y, rest gap, curvature, A_w, η_w) of every wall member: sphere–wall Hertz,
-    n the inward normal at the bead's rest position, curvature 1/ρ with ρ the distance from
-    the rest position to a curved wall's centre (0 for a plane), A_w = k_n,wall sqrt(R_eff)."""
-    lattice, walls = model.lattice, model.walls
-    positions, radii = lattice.positions_m, lattice.radii_m
-    beads, normals = wall_normals(walls, positions)
-    gaps = np.concatenate([np.zeros(0)] + [wall.gaps_m(positions[wall.members], radii[wall.members]) for wall in walls])
-    curvature = np.concatenate([np.zeros(0)] + [wall.curvatures_at(positions[wall.members]) for wall in walls])
-    r_eff = np.concatenate([np.zeros(0)] + [wall.contact_radii_m(radii[wall.members]) for wall in walls])
-    stiffness = _coefficient(model.wall_stiffness_pa(beads) if walls else np.zeros(0), r_eff, units)
+    """(cell, n_x, n_y, rest gap, curvature, A_w, η_w) of every wall member: sphere–wall Hertz
+    (:func:`~hexdem.engines.reference.contacts.wall_geometry`), A_w = k_n,wall sqrt(R_eff)."""
+    beads, normals, gaps, curvature, r_eff = wall_geometry(model)
+    stiffness = coefficient(model.wall_stiffness_pa(beads) if model.walls else np.zeros(0), r_eff, units)
     damping = model.wall_damping * np.sqrt(model.masses_kg[beads] / units.mass_kg * stiffness)
     return (cells[beads], normals[:, 0].copy(), normals[:, 1].copy(), gaps / units.length_m,
             curvature * units.length_m, stiffness, damping)
@@ -201,6 +173,10 @@ class ReferenceSystem:
     @property
     def n_wall_contacts(self) -> int:
         return len(self.kernel.wall_cell)
+
+    def angular_velocities(self) -> None:
+        """The bodies' spins: none, frictionless spheres never turn."""
+        return None
 
     def _cell_arrays(self, values):
         """(n_bodies, 2) body values → x and y arrays over all cells."""
@@ -258,7 +234,7 @@ class ReferenceEngine:
         units = settings.units
         directory = Path(directory)
         directory.mkdir(parents=True, exist_ok=True)
-        system = ReferenceSystem.from_model(model, units)
+        system = (FrictionalSystem if model.laws.tangential else ReferenceSystem).from_model(model, units)
         start_positions = model.initial_positions_m() / units.length_m
         ids = np.arange(1, model.n_bodies + 1)
         dt = settings.dt_s / units.time_s
@@ -273,7 +249,7 @@ class ReferenceEngine:
                 raise HexdemError(f"reference integration diverged (non-finite velocities at t = "
                                   f"{step * settings.dt_s:.4g} s): reduce the time step")
             on_sample(Sample(index, step, step * dt, ids, start_positions + np.column_stack([x[cells], y[cells]]),
-                             velocities, accelerations))
+                             velocities, accelerations, system.angular_velocities()))
             if bar is not None:
                 bar.update(step - bar.n)
 
@@ -284,6 +260,7 @@ class ReferenceEngine:
             if bar is not None:
                 bar.close()
         engine = {"name": self.name, "version": version("hexdem"), "ranks": 1, "integrator": "classical RK4",
+                  "friction": model.laws.tangential,
                   "units": units.name, "wall_time_s": time.perf_counter() - begin, "n_bonds": system.n_bonds,
                   "n_wall_contacts": system.n_wall_contacts}
         write_json(directory / PARAMETERS_NAME, {**engine, "model": model.lattice.shape, "n_bodies": model.n_bodies,
