@@ -44,11 +44,8 @@ ENGINES = ("lammps", "reference")
 #: at the experiment's 0.4 m/s and over the sweep's V0 = 0.01–0.30 alike (the Hertz lattice is
 #: scale-invariant in units of the contact time).
 STEPS_PER_CONTACT = 140
-#: The analysis takes this many samples per contact time, whatever the time step (one every
-#: 3.6 µs at 0.4 m/s): the default ``dump_every`` is STEPS_PER_CONTACT / this. Against sampling
-#: every step, the default run's peaks are within 3.4e-5 and its arrivals within 0.009 µs
-#: (``hexdem.experiments.convergence.sampling_error``): with the step's own error, inside the
-#: targets (1e-4, 0.05 µs) at a little more than half the callbacks of 35 per contact.
+#: Samples per contact time, whatever the step (every 3.6 µs at 0.4 m/s; its error with the step's
+#: stays inside the targets: ``convergence.sampling_error``); default ``dump_every``: STEPS_PER_CONTACT / this.
 SAMPLES_PER_CONTACT = 20
 #: A time step must resolve the Hertz contact at V0 with at least this many steps (energy drift
 #: grows as dt²: about 4e-5 at 140 steps, 1e-3 at about 30).
