@@ -21,8 +21,11 @@ from hexdem.model.granular import RunSettings
 class NoAudit:
     """Synthetic speeds: no mechanics to audit."""
 
-    def measure(self, positions, velocities):
+    def measure(self, positions, velocities, angular_velocities=None):
         return 1.0, np.zeros((1, 2))
+
+    def rotational_j(self, angular_velocities):
+        return np.zeros(1)
 
 
 def test_streaming_agrees_with_hexdem_analyse_of_the_dump(dumped_run, tmp_path):

@@ -1,4 +1,7 @@
-"""Total mechanical energy of a granular state: kinetic + Hertz contact (+ gravity) energy.
+"""Total mechanical energy of a granular state: kinetic (translational, and rotational for a
+frictional model's turning spheres, ½ I ω² with I = (2/5) m r²) + Hertz contact (+ gravity) energy.
+Mindlin's tangential springs and what friction dissipates are not counted: a frictional model's
+audit is that of a dissipative one (:attr:`~hexdem.model.granular.GranularModel.dissipative`).
 
 LAMMPS reports no potential energy for granular pairs, so hexdem computes it itself from
 positions: a contact of overlap δ stores U = (2/5) k_n sqrt(R_eff) δ^{5/2} (the integral of
@@ -95,6 +98,11 @@ def kinetic_energy_j(velocities_m_s, model: GranularModel) -> float:
     return _kinetic_j(velocities_m_s, model.masses_kg)
 
 
+def inertia_kg_m2(model: GranularModel) -> np.ndarray:
+    """(n_bodies,) moments of inertia of solid spheres, (2/5) m r² [kg m²]."""
+    return 0.4 * model.masses_kg * (model.diameters_m / 2) ** 2
+
+
 def total_energy_j(positions_m, velocities_m_s, model: GranularModel) -> float:
     return kinetic_energy_j(velocities_m_s, model) + contact_energy_j(positions_m, model)
 
@@ -115,6 +123,7 @@ class EnergyAudit:
         self.model = model
         self.start_m = model.initial_positions_m()
         self.masses_kg = model.masses_kg
+        self.inertia_kg_m2 = inertia_kg_m2(model)
         self.radii_m = model.diameters_m / 2
         self.skin_m = PAIR_SKIN_D * model.lattice.diameter_m
         self.walls = _wall_constants(model)
@@ -134,21 +143,31 @@ class EnergyAudit:
         return (_pair_contacts(positions_m, self.radii_m, self._candidate_pairs(positions_m)),
                 _wall_contacts(positions_m, self.walls))
 
-    def _total(self, positions_m, velocities_m_s, pairs, walls) -> float:
-        energy = _kinetic_j(velocities_m_s, self.masses_kg) + hertz_energy_j(*pairs[2:]) + _wall_energy_j(walls)
+    def rotational_j(self, angular_velocities_s) -> np.ndarray:
+        """(n_bodies,) ½ I ω² [J] of spins ω_z [rad/s] (None: spheres that do not turn, 0)."""
+        if angular_velocities_s is None:
+            return np.zeros(len(self.masses_kg))
+        return 0.5 * self.inertia_kg_m2 * np.asarray(angular_velocities_s, float) ** 2
+
+    def _total(self, positions_m, velocities_m_s, angular_velocities_s, pairs, walls) -> float:
+        energy = (_kinetic_j(velocities_m_s, self.masses_kg) + float(np.sum(self.rotational_j(angular_velocities_s)))
+                  + hertz_energy_j(*pairs[2:]) + _wall_energy_j(walls))
         return energy - float(np.sum((positions_m - self.start_m) * self.external_n))
 
-    def __call__(self, positions_m, velocities_m_s) -> float:
+    def __call__(self, positions_m, velocities_m_s, angular_velocities_s=None) -> float:
         positions_m = np.asarray(positions_m, float)
-        return self._total(positions_m, velocities_m_s, *self._contacts(positions_m))
+        return self._total(positions_m, velocities_m_s, angular_velocities_s, *self._contacts(positions_m))
 
-    def measure(self, positions_m, velocities_m_s) -> tuple[float, np.ndarray]:
-        """(the total energy [J] as :meth:`__call__` gives it, (R, 2) kinetic and contact energy [J]
-        of each :func:`energy_regions` region), from one search of the contacts."""
+    def measure(self, positions_m, velocities_m_s, angular_velocities_s=None) -> tuple[float, np.ndarray]:
+        """(the total energy [J] as :meth:`__call__` gives it, (R, 2) kinetic (translational and
+        rotational) and contact energy [J] of each :func:`energy_regions` region), from one search
+        of the contacts."""
         positions_m = np.asarray(positions_m, float)
         pairs, walls = self._contacts(positions_m)
-        return (self._total(positions_m, velocities_m_s, pairs, walls),
-                _region_energies_j(velocities_m_s, self.masses_kg, self.regions, len(self.region_names), pairs, walls))
+        kinetic = 0.5 * self.masses_kg * np.sum(np.asarray(velocities_m_s, float) ** 2, axis=1)
+        kinetic = kinetic + self.rotational_j(angular_velocities_s)
+        return (self._total(positions_m, velocities_m_s, angular_velocities_s, pairs, walls),
+                _region_energies_j(kinetic, self.regions, len(self.region_names), pairs, walls))
 
 
 def energy_regions(model: GranularModel) -> tuple[list[str], np.ndarray]:
@@ -161,16 +180,15 @@ def energy_regions(model: GranularModel) -> tuple[list[str], np.ndarray]:
     return names, regions
 
 
-def _region_energies_j(velocities_m_s, masses_kg, regions, n_regions: int, pairs, walls) -> np.ndarray:
+def _region_energies_j(kinetic_j, regions, n_regions: int, pairs, walls) -> np.ndarray:
     """(R, 2) kinetic and contact energy [J] of each region (``regions``: each body's, from
-    :func:`energy_regions`): a contact's Hertz energy half to each of its bodies' regions, a wall
-    contact's to its bead's."""
+    :func:`energy_regions`; ``kinetic_j`` each body's): a contact's Hertz energy half to each of its
+    bodies' regions, a wall contact's to its bead's."""
 
     def by_region(bodies, energies) -> np.ndarray:  # (float even when empty, unlike bincount's)
         return np.bincount(bodies, energies, n_regions).astype(float)
 
-    velocities_m_s = np.asarray(velocities_m_s, float)
-    kinetic = by_region(regions, 0.5 * masses_kg * np.sum(velocities_m_s**2, axis=1))
+    kinetic = by_region(regions, kinetic_j)
     i, j, *pair = pairs
     halves = _hertz_energies_j(*pair) / 2
     contact = by_region(regions[i], halves) + by_region(regions[j], halves)

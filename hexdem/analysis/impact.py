@@ -34,8 +34,11 @@ class ImpactAnalysis:
     ``results``: ``units``, ``length_unit_m``, ``positions`` (N, 2), ``peak_speed``, ``t_peak``,
     ``arrival_time``, ``reach_time`` (N,), ``lines`` {name: bead indices}, ``energy_drift``,
     ``far_wall_reached``, ``region_names``, ``region_times`` (T,) and ``region_energies`` (T, R, 2)
-    [J] (:func:`~hexdem.analysis.energy.energy_regions`). ``tracked``: the
-    :class:`TrackedPulses` (traces, fields) of a tracked run, else None.
+    [J] (:func:`~hexdem.analysis.energy.energy_regions`), ``peak_angular_speed`` (N,) each bead's
+    largest |ω_z| and ``rotational_energy_fraction`` the largest share of the energy held in
+    rotation (0 for spheres that do not turn; NaN for a frictional run read from a dump, which
+    holds no spins). ``tracked``: the :class:`TrackedPulses` (traces, fields) of a tracked run,
+    else None.
     """
 
     def __init__(self, model: GranularModel, settings: RunSettings, engine: dict, peak_speed, t_peak, arrival_time,
@@ -52,6 +55,9 @@ class ImpactAnalysis:
         r.region_names = energy_regions(model)[0]
         r.region_times, r.region_energies = region_energies
         r.far_wall_reached = self._far_wall_reached()
+        unknown = np.nan if model.laws.tangential else 0.0  # (without a tracker: read from a dump)
+        r.peak_angular_speed = np.full(len(peak_speed), unknown) if tracked is None else tracked.peak_angular_speed
+        r.rotational_energy_fraction = unknown if tracked is None else tracked.rotational_energy_fraction
 
     @classmethod
     def from_tracker(cls, model: GranularModel, settings: RunSettings, tracked: TrackedPulses,

@@ -61,7 +61,9 @@ class TrackedPulses:
     ``trace_times`` (S,) and ``trace_speeds`` (S, len(trace_beads)); ``field_times`` (F,) and
     ``field_speeds`` (F, N) at the requested snapshot samples; ``sensor_times`` (K,) and
     ``sensor_states`` (K, n_sensors, 4): vx, vy, ax, ay of the model's sensor beads every
-    ``settings.sensor_every`` steps.
+    ``settings.sensor_every`` steps. ``peak_angular_speed`` (N,) each bead's largest |ω_z| (0 for
+    spheres that do not turn); ``rotational_energy_fraction`` the largest share of the kinetic and
+    contact energy held in rotation at the audited times.
     """
 
     peak_speed: np.ndarray
@@ -80,6 +82,8 @@ class TrackedPulses:
     field_speeds: np.ndarray
     sensor_times: np.ndarray
     sensor_states: np.ndarray
+    peak_angular_speed: np.ndarray
+    rotational_energy_fraction: float
 
 
 class PulseTracker:
@@ -98,6 +102,7 @@ class PulseTracker:
         n, total = len(model.lattice), settings.n_samples
         self.n_beads, self.n_bodies, self.n_samples_expected = n, model.n_bodies, total
         self.pulses = PulseState(n, RECORD_CAPACITY)
+        self.peak_spin = np.zeros(n)
         self.owned = np.zeros(n, dtype=np.bool_)
         self.trace_beads = np.asarray(trace_beads, dtype=np.int64)
         self.traces = np.full((total, len(self.trace_beads)), np.nan)
@@ -110,13 +115,18 @@ class PulseTracker:
         self.energy_every = max(1, (total - 1) // ENERGY_SAMPLES)
         self.audit = EnergyAudit(model, gravity_m_s2) if self.root else None
         self.energies, self.energy_times, self.impact_energy, self.region_energies = [], [], None, []
+        self.rotational_energies = []
         self.count = 0
 
     # ---- state shared across ranks
+    def _bead_state(self) -> list[np.ndarray]:
+        """Every per-bead array that the bead's owner keeps up to date."""
+        return [*self.pulses.arrays(), self.peak_spin]
+
     def _hand_over(self, owned: np.ndarray) -> None:
         """Give each bead that changed ranks since the last sample (``owned``: this rank's beads
         now) its state from the rank that owned it until now: only those beads' rows travel."""
-        arrays = self.pulses.arrays()
+        arrays = self._bead_state()
         left = np.flatnonzero(self.owned & ~owned)
         arrived = owned & ~self.owned
         for beads, rows in self.comm.allgather((left, [array[left] for array in arrays])):
@@ -129,7 +139,7 @@ class PulseTracker:
         trace or field was taken by exactly one rank (NaN elsewhere)."""
         from mpi4py import MPI
 
-        arrays = self.pulses.arrays()
+        arrays = self._bead_state()
         mine = np.flatnonzero(self.owned)
         parts = self.comm.gather((mine, [array[mine] for array in arrays]), root=0)
         for beads, rows in parts if self.root else ():
@@ -169,6 +179,8 @@ class PulseTracker:
         else:
             self.owned[index] = True
         self.pulses.update(index, speeds, s)
+        if sample.angular_velocities is not None:
+            self.peak_spin[index] = np.maximum(self.peak_spin[index], np.abs(sample.angular_velocities[beads]))
         if len(self.trace_beads):
             here, rows = self._rows(sample, self.trace_beads)
             self.traces[s, here] = np.hypot(sample.velocities[rows, 0], sample.velocities[rows, 1])
@@ -194,15 +206,18 @@ class PulseTracker:
             [sample.velocities[rows], sample.accelerations[rows]])
 
     def _audit(self, sample: Sample) -> None:
-        state = self._gather(sample.ids, np.hstack([sample.positions, sample.velocities]))
+        spins = () if sample.angular_velocities is None else (sample.angular_velocities[:, None],)
+        state = self._gather(sample.ids, np.hstack([sample.positions, sample.velocities, *spins]))
         if state is not None:
             units = self.settings.units
-            velocities = state[:, 2:] * units.velocity_m_s
+            velocities = state[:, 2:4] * units.velocity_m_s
+            angular = state[:, 4] / units.time_s if spins else None
             if self.impact_energy is None:
                 self.impact_energy = kinetic_energy_j(velocities, self.model)
-            energy, by_region = self.audit.measure(state[:, :2] * units.length_m, velocities)
+            energy, by_region = self.audit.measure(state[:, :2] * units.length_m, velocities, angular)
             self.energies.append(energy)
             self.region_energies.append(by_region)
+            self.rotational_energies.append(float(np.sum(self.audit.rotational_j(angular))))
             self.energy_times.append(sample.time)
 
     # ---- results
@@ -240,4 +255,14 @@ class PulseTracker:
                              trace_times=np.arange(self.count) * interval, trace_speeds=self.traces[:self.count],
                              field_times=self.field_samples * interval, field_speeds=self.fields,
                              sensor_times=np.arange(len(self.sensors)) * self.sensor_every * self.settings.dt_s
-                             / self.settings.units.time_s, sensor_states=self.sensors)
+                             / self.settings.units.time_s, sensor_states=self.sensors,
+                             peak_angular_speed=self.peak_spin,
+                             rotational_energy_fraction=rotational_share(self.rotational_energies, self.region_energies))
+
+
+def rotational_share(rotational_j, region_energies_j) -> float:
+    """The largest share of the kinetic and contact energy (the regions' sum) held in rotation,
+    over the audited times (0 where there is no energy)."""
+    totals = np.array([np.sum(energies) for energies in region_energies_j])
+    shares = np.divide(rotational_j, totals, out=np.zeros(len(totals)), where=totals > 0)
+    return float(shares.max(initial=0.0))

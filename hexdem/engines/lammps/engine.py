@@ -31,6 +31,6 @@ class LammpsEngine:
         if comm is not None:
             comm.Barrier()
         deck = Deck(directory, settings, model.n_bodies)
-        info = run_streaming(deck, on_sample, comm, self.dump, show_progress)
+        info = run_streaming(deck, on_sample, comm, self.dump, show_progress, spins=model.laws.tangential)
         return {"name": self.name, "version": info.lammps_version, "ranks": info.ranks,
                 "wall_time_s": info.wall_time_s, "deck": str(deck.input_path)}
