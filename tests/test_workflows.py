@@ -28,4 +28,5 @@ def test_the_basins_and_interfaces_workflow_runs_in_one_command(tmp_path):
         assert float(series[0]["time_ms"]) == 0.0 and float(series[0]["far_side_fraction"]) == 0.0
         assert float(series[-1]["far_side_fraction"]) > 0.05
     trapping = json.loads((tmp_path / "trapping.json").read_text())
+    assert set(trapping) == {"steel_brass", "steel_ptfe"}, "one entry per interface case"
     assert all(0.0 < t["far_side_fraction_end"] <= t["far_side_fraction_max"] < 1.0 for t in trapping.values())
