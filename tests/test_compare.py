@@ -1,6 +1,7 @@
 """LAMMPS against the reference integrator: per-bead agreement of peaks and arrival times, and the CLI."""
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -11,7 +12,8 @@ from hexdem.cli.main import main
 from hexdem.engines.lammps.engine import LammpsEngine
 from hexdem.engines.reference.engine import PARAMETERS_NAME, ReferenceEngine
 from hexdem.errors import HexdemError
-from hexdem.experiments.compare import COMPARE_COLUMNS, MARGIN, Tolerances, compare_analyses, expected_error, run_comparison
+from hexdem.experiments.compare import (COMPARE_COLUMNS, MARGIN, Tolerances, compare_analyses, expected_error,
+                                         run_comparison)
 from hexdem.experiments.run import RESULT_FILES, simulate
 from hexdem.model.config import RunConfig
 from hexdem.model.granular import RunSettings
@@ -102,6 +104,23 @@ def test_default_tolerances_follow_lammps_expected_error_at_the_runs_steps_per_c
     assert given.for_run(SMALL.model(), RunSettings(dt_s=1e-7, n_steps=10, dump_every=1)) == given
     with pytest.raises(HexdemError, match="the default tolerances need the run's contact time"):
         Tolerances(peak_rel=0.01).for_run(SMALL.model(), RunSettings(dt_s=1e-7, n_steps=10, dump_every=1))
+
+
+def test_a_bead_stiffness_off_by_0_3_percent_in_one_engine_is_caught(tmp_path):
+    """The bias the cross-check exists for (a wrong E* or G* in one engine): the reference run on
+    beads 0.3 % stiffer, same step and samples, arrives 0.12 % early (times go as A^(−2/5)),
+    beyond the default tolerances, where the same run on the true beads agrees."""
+    model, settings = SMALL.model(), SMALL.settings()
+    stiffer = replace(model, bead=replace(model.bead, youngs_modulus_pa=1.003 * model.bead.youngs_modulus_pa))
+    runs = (("lammps", LammpsEngine(), model), ("true", ReferenceEngine(), model),
+            ("biased", ReferenceEngine(), stiffer))
+    lammps, true, biased = (ImpactAnalysis.from_trajectory(beads, settings,
+                                                           record(engine, beads, settings, tmp_path / name))
+                            for name, engine, beads in runs)
+    assert compare_analyses(lammps, true, SMALL.v0).agree
+    comparison = compare_analyses(lammps, biased, SMALL.v0)
+    assert not comparison.agree
+    assert comparison.max_arrival_diff > 2 * comparison.arrival_tolerance, comparison.verdict()
 
 
 def test_a_difference_beyond_tolerance_is_detected(tmp_path):
