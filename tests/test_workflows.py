@@ -6,9 +6,12 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 WORKFLOW = Path(__file__).resolve().parents[1] / "workflows" / "basins_and_interfaces.py"
 
 
+@pytest.mark.slow
 def test_the_basins_and_interfaces_workflow_runs_in_one_command(tmp_path):
     done = subprocess.run([sys.executable, str(WORKFLOW), "--out", str(tmp_path), "--quick"], cwd=tmp_path,
                           capture_output=True, text=True, timeout=600)
