@@ -17,6 +17,13 @@ from hexdem.model.materials import DELRIN, STEEL_316
 D, V0 = 0.01905, 0.4
 
 
+def pytest_collection_modifyitems(items):
+    """Every test that needs the session's ``hexdem paper --quick`` (two minutes) is ``slow``."""
+    for item in items:
+        if "paper_quick" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.slow)
+
+
 @pytest.fixture(scope="session")
 def default_run(tmp_path_factory):
     """``hexdem run`` with no options (11 per edge, steel, delrin walls, 0.4 m/s, 0°)."""

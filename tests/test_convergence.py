@@ -9,6 +9,7 @@ import math
 import pytest
 
 from hexdem.errors import HexdemError
+from hexdem.experiments.compare import expected_error
 from hexdem.experiments.convergence import richardson, sampling_error, steps_config, study_time_step
 from hexdem.model.config import SAMPLES_PER_CONTACT, STEPS_PER_CONTACT, RunConfig
 
@@ -49,6 +50,9 @@ def test_lammps_converges_at_second_order_and_its_default_meets_the_target(confi
     assert default.peak_error < PEAK_TARGET
     assert default.arrival_error_contacts < ARRIVAL_TARGET_S / RunConfig().contact_time_s()  # the same in τ
     assert default.energy_drift < PEAK_TARGET
+    for run in study.runs:  # the accuracy from which hexdem compare's default tolerances follow
+        peak, arrival = expected_error(run.steps_per_contact)
+        assert run.peak_error <= peak and run.arrival_error_contacts <= arrival, run
 
 
 def test_the_reference_converges_faster_and_meets_the_target_at_the_default(tmp_path):

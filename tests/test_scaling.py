@@ -119,13 +119,13 @@ def test_geometric_and_power_data_are_told_apart():
 def test_fit_windows_are_validated():
     combination = scaling.COMBINATIONS["0/0"]
     peaks = synthetic_peaks(combination)
-    with pytest.raises(HexdemError):
+    with pytest.raises(HexdemError, match="the window's last bead must lie in .*got 3"):
         scaling.fit_combination(combination, V0, peaks, last=3)
-    with pytest.raises(HexdemError):
+    with pytest.raises(HexdemError, match="the window's last bead must lie in .*got 14"):
         scaling.fit_combination(combination, V0, peaks, last=14)
-    with pytest.raises(HexdemError):
+    with pytest.raises(HexdemError, match="unknown fit type 'cubic'"):
         scaling.fit_decay(np.arange(14), peaks[0], 2, 10, kind="cubic")
-    with pytest.raises(HexdemError):
+    with pytest.raises(HexdemError, match="at least 4 values of V0"):
         sweep.SweepSettings(n_v0=3)
 
 

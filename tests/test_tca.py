@@ -129,9 +129,9 @@ def test_crossing_times_of_shifted_pulses():
 
 
 def test_bad_velocity_is_a_hexdem_error():
-    with pytest.raises(HexdemError):
+    with pytest.raises(HexdemError, match="the TCA needs a velocity > 0, got V0 = -1.0"):
         tca.equal_velocity(-1.0)
-    with pytest.raises(HexdemError):
+    with pytest.raises(HexdemError, match=r"need n_last >= n_first, got 3\.\.1"):
         tca.predict_pulses(0.1, 3, 1)
 
 

@@ -6,9 +6,12 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 WORKFLOW = Path(__file__).resolve().parents[1] / "workflows" / "basins_and_interfaces.py"
 
 
+@pytest.mark.slow
 def test_the_basins_and_interfaces_workflow_runs_in_one_command(tmp_path):
     done = subprocess.run([sys.executable, str(WORKFLOW), "--out", str(tmp_path), "--quick"], cwd=tmp_path,
                           capture_output=True, text=True, timeout=600)
@@ -28,4 +31,5 @@ def test_the_basins_and_interfaces_workflow_runs_in_one_command(tmp_path):
         assert float(series[0]["time_ms"]) == 0.0 and float(series[0]["far_side_fraction"]) == 0.0
         assert float(series[-1]["far_side_fraction"]) > 0.05
     trapping = json.loads((tmp_path / "trapping.json").read_text())
+    assert set(trapping) == {"steel_brass", "steel_ptfe"}, "one entry per interface case"
     assert all(0.0 < t["far_side_fraction_end"] <= t["far_side_fraction_max"] < 1.0 for t in trapping.values())

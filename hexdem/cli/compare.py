@@ -16,9 +16,11 @@ def add_arguments(parser) -> None:
     parser.add_argument("--ranks", type=int, metavar="N", help="MPI ranks for LAMMPS (default 1, in-process)")
     add_launcher(parser)
     parser.add_argument("--peak-tol", type=float, metavar="REL",
-                        help="allowed relative peak-speed difference (default 0.005)")
+                        help="allowed relative peak-speed difference (default: 4 times LAMMPS's expected error at "
+                        "the run's steps per contact, 1.6e-4 at the default 140 without damping)")
     parser.add_argument("--arrival-tol", type=float, metavar="SECONDS",
-                        help="allowed arrival-time difference in seconds (default 2e-6)")
+                        help="allowed arrival-time difference in seconds (default: likewise, 8.2e-4 contact "
+                        "times at 140 steps per contact, 0.059 µs on the paper's experiment)")
     parser.set_defaults(engine=None, dump=None, movie=None)
 
 

@@ -5,11 +5,17 @@
 arrival time bead by bead along the three observation lines and writes
 ``compare.csv`` (one row per bead), ``compare.json`` (largest differences, tolerances,
 verdict) and ``compare.png``. Values are in the run's units (SI or A = d = M = 1).
+
+The default tolerances follow from the engines' accuracy: the reference's RK4 is within 1e-6 of
+the converged answer, so the difference is LAMMPS's own error, :data:`MARGIN` times
+:func:`expected_error` at the run's steps per contact N (1.6e-4 in peak and 8e-4 contact times in
+arrival at the default N = 140, elastic). A systematic bias of one engine (a stiffness off by
+0.3 %) is several times larger than that.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -20,6 +26,8 @@ from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.errors import HexdemError
 from hexdem.experiments.run import run_experiment
 from hexdem.model.config import RunConfig
+from hexdem.model.dissipation import damping_coefficient
+from hexdem.model.granular import GranularModel, RunSettings
 from hexdem.model.lattice import LINE_STEPS
 
 ENGINE_NAMES = ("lammps", "reference")
@@ -29,20 +37,55 @@ COMPARE_COLUMNS = ("line", "n", "bead_id", "peak_lammps", "peak_reference", "pea
 PEAK_DIFF, ARRIVAL_DIFF, CHECKED = (COMPARE_COLUMNS.index(key) for key in ("peak_rel_diff", "arrival_diff", "checked"))
 
 
+#: LAMMPS's measured error at N steps per contact time τ, against the converged answer, over the
+#: lines' beads above 1 % of V0 (``benchmarks/bench_accuracy.py``, README "Time step"): velocity
+#: Verlet's peak-speed error is at most 0.77/N² relative and its arrival-time error 3.9 τ/N² (the
+#: coefficients below round them up). With Tsuji damping α LAMMPS evaluates the damping force at
+#: the half-step velocity, an error of first order: measured at most 1.43 α/N in peak and
+#: 2.34 α τ/N in arrival for bead–bead restitutions 0.8 to 0.99 (rounded up to 1.5 and 2.5 below).
+#: Bead–wall damping adds about 70 times less (1e-5 in peak at N = 140 with a wall restitution of
+#: 0.9), well inside the elastic terms' margin, and is left out.
+PEAK_ERROR_N2, ARRIVAL_ERROR_N2 = 0.8, 4.0
+PEAK_ERROR_ALPHA_N, ARRIVAL_ERROR_ALPHA_N = 1.5, 2.5
+#: The default tolerances are this many times LAMMPS's expected error.
+MARGIN = 4.0
+
+
+def expected_error(steps_per_contact: float, alpha: float = 0.0) -> tuple[float, float]:
+    """LAMMPS's expected (relative peak-speed error, arrival-time error in contact times) at
+    ``steps_per_contact`` with Tsuji damping ``alpha`` of the bead–bead contacts."""
+    n = float(steps_per_contact)
+    return (PEAK_ERROR_N2 / n**2 + PEAK_ERROR_ALPHA_N * alpha / n,
+            ARRIVAL_ERROR_N2 / n**2 + ARRIVAL_ERROR_ALPHA_N * alpha / n)
+
+
 @dataclass(frozen=True)
 class Tolerances:
-    """Required agreement (issue 3): ``peak_rel`` relative peak speed [-], ``arrival_s``
-    arrival time [s], on the beads whose peak exceeds ``min_peak_fraction`` of V0."""
+    """Required agreement: ``peak_rel`` relative peak speed [-], ``arrival_s`` arrival time [s],
+    on the beads whose peak exceeds ``min_peak_fraction`` of V0. ``None`` (the default):
+    :data:`MARGIN` times LAMMPS's :func:`expected_error` for the run (:meth:`for_run`)."""
 
-    peak_rel: float = 5e-3
-    arrival_s: float = 2e-6
+    peak_rel: float | None = None
+    arrival_s: float | None = None
     min_peak_fraction: float = 0.01
 
     def __post_init__(self):
         for name in ("peak_rel", "arrival_s", "min_peak_fraction"):
             value = getattr(self, name)
-            if not (is_number(value) and value >= 0):
+            defaulted = value is None and name != "min_peak_fraction"
+            if not defaulted and not (is_number(value) and value >= 0):
                 raise HexdemError(f"tolerance {name} must be a number >= 0, got {value!r}")
+
+    def for_run(self, model: GranularModel, settings: RunSettings) -> Tolerances:
+        """These tolerances with the defaults filled in for ``model`` run with ``settings``."""
+        if self.peak_rel is not None and self.arrival_s is not None:
+            return self
+        if not settings.contact_time_s > 0:
+            raise HexdemError("the default tolerances need the run's contact time; give peak_rel and arrival_s")
+        peak, arrival = expected_error(settings.contact_time_s / settings.dt_s, damping_coefficient(model.restitution))
+        peak_rel = MARGIN * peak if self.peak_rel is None else self.peak_rel
+        arrival_s = MARGIN * arrival * settings.contact_time_s if self.arrival_s is None else self.arrival_s
+        return replace(self, peak_rel=peak_rel, arrival_s=arrival_s)
 
 
 @dataclass(frozen=True)
@@ -92,6 +135,7 @@ def _difference(lammps: float, reference: float, relative: bool) -> float:
 def compare_analyses(lammps: ImpactAnalysis, reference: ImpactAnalysis, v0: float,
                      tolerances: Tolerances = Tolerances()) -> EngineComparison:
     """Compare two analyses of the same model; ``v0`` is the impact speed in the run's units."""
+    tolerances = tolerances.for_run(lammps.model, lammps.settings)
     a, b = lammps.results, reference.results
     rows = []
     for name in LINE_STEPS:
@@ -151,6 +195,7 @@ def run_comparison(config: RunConfig, out, log=None, tolerances: Tolerances = To
     out = ensure_writable_dir(out)
     analyses = {name: run_experiment(config.replace(engine=name), out / name, log) for name in ENGINE_NAMES}
     comparison = compare_analyses(analyses["lammps"], analyses["reference"], config.v0, tolerances)
+    tolerances = comparison.tolerances
     write_csv(out / "compare.csv", COMPARE_COLUMNS, comparison.rows)
     write_json(out / "compare.json", {
         "config": {key: value for key, value in config.as_dict().items() if key != "engine"},
