@@ -55,10 +55,13 @@ def _toml_value(value) -> str:
 
 
 def write_config(config: RunConfig, path) -> Path:
-    """``config`` as a TOML file that ``hexdem run --config`` reads back to the same config."""
+    """``config`` as a TOML file that ``hexdem run --config`` reads back to the same config: the keys
+    that differ from the defaults (so that an earlier hexdem, without today's newer keys, reads it)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    lines = [f"{key} = {_toml_value(value)}" for key, value in config.as_dict().items() if value is not None]
+    defaults = RunConfig().as_dict()
+    lines = [f"{key} = {_toml_value(value)}" for key, value in config.as_dict().items()
+             if value is not None and value != defaults[key]]
     path.write_text("\n".join(lines) + "\n")
     assert RunConfig.from_toml(path) == config
     return path
