@@ -234,9 +234,12 @@ class GranularModel:
 
     @property
     def uniform_contacts(self) -> bool:
-        """Whether every bead–bead and striker contact has the same k_n (one material)."""
-        table = self.stiffness_table_pa[np.ix_(np.unique(self.material_ids), np.unique(self.material_ids))]
-        return bool(np.all(table == table.flat[0]))
+        """Whether every bead–bead and striker contact has the same law (k_n and Mindlin's k_t: two
+        materials of equal E* may differ in G*)."""
+        present = np.ix_(np.unique(self.material_ids), np.unique(self.material_ids))
+        laws = self.laws
+        return all(bool(np.all(table == table.flat[0])) for table in
+                   (laws.pair_table(name)[present] for name in ("normal_stiffness_pa", "tangential_stiffness_pa")))
 
     @property
     def mass_factors(self) -> np.ndarray:

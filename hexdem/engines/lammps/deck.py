@@ -180,11 +180,12 @@ def pair_block(model: GranularModel, units: UnitSystem) -> str:
 def granular_block(model: GranularModel, units: UnitSystem) -> str:
     """Deck commands shared by every hexdem deck: 2D sphere atoms from ``data.hexdem`` and
     the contacts of ``model`` (:func:`pair_block`)."""
-    law = model.laws.pairs[0][0]
+    friction = model.friction
     return template("granular.in").substitute(
         lammps_units=units.lammps_units, pair=pair_block(model, units),
         damping_note="undamped" if model.restitution == 1.0 else f"Tsuji damping, restitution {model.restitution}",
-        tangential_note=f"Mindlin tangential force, mu = {law.friction}" if law.tangential else "no tangential force",
+        tangential_note=(f"Mindlin tangential force, mu = {friction.friction} (walls {friction.wall_friction})"
+                         if model.laws.tangential else "no tangential force"),
         skin=_fmt(0.1 * model.lattice.diameter_m / units.length_m))
 
 

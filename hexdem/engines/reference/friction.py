@@ -97,14 +97,14 @@ class FrictionalSystem:
                           np.zeros(len(pair_xi)), np.zeros(len(wall_xi)))
         return np.column_stack([fx * k.inv_mass, fy * k.inv_mass])
 
-    def integrate(self, velocities, dt: float, settings: RunSettings, emit, spins=None):
-        """RK4 from rest positions with ``velocities`` and ``spins`` ω (None: none; in ``units``);
+    def integrate(self, velocities, dt: float, settings: RunSettings, emit):
+        """RK4 from rest positions with ``velocities`` and no spin (in ``units``);
         ``emit(index, step, x, y, u, w)`` at step 0 and every ``settings.dump_every`` steps, the spins
         in ``state["spins"]`` meanwhile."""
         n = self.n_cells
         x, y = np.zeros(n), np.zeros(n)
         u, w = (np.array(column, float) for column in np.asarray(velocities, float).T)
-        self.state.update(spins=np.zeros(n) if spins is None else np.array(spins, float),
+        self.state.update(spins=np.zeros(n),
                           pair_xi=np.zeros(self.n_bonds), wall_xi=np.zeros(self.n_wall_contacts))
         every = settings.dump_every
         emit(0, 0, x, y, u, w)

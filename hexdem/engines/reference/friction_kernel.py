@@ -12,9 +12,9 @@ s = (v_j − v_i)·t − (R_i ω_i + R_j ω_j)   (a body on a wall: s = v·t −
 the tangential displacement ξ (a scalar along t, which turns with the contact: LAMMPS's history
 rotated into the tangent plane with its length kept) grows as ξ' = s, and is set to 0 at the start of
 every step that finds the bodies apart (so that it counts the slip since they touched, within a step,
-as LAMMPS's history created by the step that finds the contact), and the tangential force is f = K sqrt(δ) ξ, −f t on j and +f t on i (−f t on a body on a
-wall), capped at μ |F_n| (F_n with its damping): on slip ξ is set back to the capped force's
-displacement. Torques: +(R_i − δ/2) f on i and +(R_j − δ/2) f on j (LAMMPS's levers, which add up to
+as LAMMPS's history created by the step that finds the contact), and the tangential force is
+f = K sqrt(δ) ξ, −f t on j and +f t on i (−f t on a body on a wall), capped at μ |F_n| (F_n with its
+damping): on slip ξ is set back to the capped force's displacement. Torques: +(R_i − δ/2) f on i and +(R_j − δ/2) f on j (LAMMPS's levers, which add up to
 the distance of the centres, so that angular momentum is kept), +R f on a body on a wall. Moment of
 inertia of a solid sphere, I = (2/5) m R².
 
