@@ -14,9 +14,10 @@ rotated into the tangent plane with its length kept) grows as ξ' = s, and is se
 every step that finds the bodies apart (so that it counts the slip since they touched, within a step,
 as LAMMPS's history created by the step that finds the contact), and the tangential force is
 f = K sqrt(δ) ξ, −f t on j and +f t on i (−f t on a body on a wall), capped at μ |F_n| (F_n with its
-damping): on slip ξ is set back to the capped force's displacement. Torques: +(R_i − δ/2) f on i and +(R_j − δ/2) f on j (LAMMPS's levers, which add up to
-the distance of the centres, so that angular momentum is kept), +R f on a body on a wall. Moment of
-inertia of a solid sphere, I = (2/5) m R².
+damping): on slip ξ is set back to the capped force's displacement. Torques: +(R_i − δ/2) f on i
+and +(R_j − δ/2) f on j (LAMMPS's levers, which add up to the distance of the centres, so that
+angular momentum is kept), +R f on a body on a wall. Moment of inertia of a solid sphere,
+I = (2/5) m R².
 
 Time integration: classical RK4 of (q, v, ω, ξ); the cap is applied to the force at every stage and
 to the state ξ at the start of each step (as LAMMPS applies it at each force evaluation).
