@@ -54,6 +54,7 @@ def assert_no_results(directory):
     ("vacancies = [[40, 2]]", "vacancy {40, 2} is not a site"),
     ('shape = "triangle"\nedge_beads = 2', "a triangle needs at least 3 beads per edge"),
     ('shape = "parallelogram"\ndepth_beads = 1', "a parallelogram needs depth_beads >= 2"),
+    ('shape = "parallelogram"\ndepth_beads = 0', "a parallelogram needs depth_beads >= 2, got 0"),
     ('bead_material = "unobtainium"', "unobtainium"),
     ('shape = "disc"\nradius_beads = 1', "a disc needs a radius of at least 2 bead diameters"),
     ('shape = "disc"\nradius_beads = 5\nprecompression_n = 20.0', "precompression is built for flat-walled basins"),

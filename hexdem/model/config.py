@@ -273,8 +273,8 @@ class RunConfig:
             "half-disc": lambda: half_disc(self.radius_beads, self.diameter_m, struck),
             "triangle": lambda: triangle(self.edge_beads, self.diameter_m, struck),
             "disc": lambda: disc(self.radius_beads, self.diameter_m, struck),
-            "parallelogram": lambda: parallelogram(self.edge_beads, self.depth_beads or self.edge_beads,
-                                                   self.diameter_m, struck),
+            "parallelogram": lambda: parallelogram(self.edge_beads, self.edge_beads if self.depth_beads is None
+                                                   else self.depth_beads, self.diameter_m, struck),
             "sites": lambda: read_sites(self.sites, self.sites_file, self.diameter_m, self.site_walls_deg, struck),
         }
         if self.shape != "sites" and (self.sites or self.sites_file or self.site_walls_deg):
