@@ -169,3 +169,16 @@ def test_bad_tolerance_is_a_one_line_error(tmp_path, small_toml, capsys):
     assert main(["compare", "--config", str(small_toml), "--out", str(tmp_path), "--arrival-tol", "-1"]) == 2
     assert capsys.readouterr().err.strip() == "hexdem: error: tolerance arrival_s must be a number >= 0, got -1.0"
     assert not any(tmp_path.glob("compare*"))
+
+
+def test_the_smallest_peak_checked_scales_with_the_impacts_own_speed(tmp_path):
+    """An impact of its own 0.05 m/s under the config's default v0 = 0.4: compare checks the beads
+    whose peak exceeds the minimum fraction (here 30 %) of 0.05 m/s, the speed that struck, not of
+    0.4 (which would leave out beads it should check)."""
+    comparison = run_comparison(SMALL.replace(impacts=[{"site": [0, 0], "v0": 0.05}]), tmp_path, log=lambda message: None,
+                                tolerances=Tolerances(min_peak_fraction=0.3))
+    peaks = np.array([max(row[COMPARE_COLUMNS.index("peak_lammps")], row[COMPARE_COLUMNS.index("peak_reference")])
+                      for row in comparison.rows])
+    fraction = comparison.tolerances.min_peak_fraction
+    assert comparison.n_checked == np.count_nonzero(peaks > fraction * 0.05) > np.count_nonzero(peaks > fraction * 0.4)
+    assert comparison.agree, comparison.verdict()

@@ -103,6 +103,11 @@ class ImpactAnalysis:
             raise HexdemError(f"line {line} was not traced in this run; pass trace_lines=[{line!r}]")
         return self.tracked.trace_times, self.tracked.trace_speeds[:, [traced[int(b)] for b in beads]]
 
+    @property
+    def v0(self) -> float:
+        """The fastest impact's speed in the run's units: the scale of the run's peaks."""
+        return max(impact.speed_m_s for impact in self.model.impacts) / self.settings.units.velocity_m_s
+
     def line_rows(self) -> list[tuple]:
         """Rows of ``peaks.csv``: one per bead on each observation line (the paper's three first,
         then the extra ones), n from 0."""

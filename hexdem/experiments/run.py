@@ -153,7 +153,7 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
     write_csv(out / "beads.csv", BEAD_COLUMNS, bead_rows(analysis))
     write_json(out / "summary.json", summary(config, analysis, wall_time_s))
     r, model = analysis.results, analysis.model
-    v0 = max(impact.speed_m_s for impact in model.impacts) / analysis.settings.units.velocity_m_s  # the fastest's
+    v0 = analysis.v0
     plots.arrival_map(r, model, out / "arrival_map.png", title=f"Arrival time, {model.lattice.shape}, V0 = {v0:g}")
     plots.peak_map(r, model, v0, out / "peak_map.png", title=f"Peak speed, {model.lattice.shape}")
     by_line = {name: (np.arange(len(beads)), r.peak_speed[beads]) for name, beads in r.lines.items()}
