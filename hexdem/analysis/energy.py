@@ -89,13 +89,9 @@ def contact_energy_j(positions_m, model: GranularModel) -> float:
     return hertz_energy_j(*pairs[2:]) + _wall_energy_j(_wall_contacts(positions_m, _wall_constants(model)))
 
 
-def _kinetic_j(velocities_m_s, masses_kg) -> float:
-    return float(0.5 * np.sum(masses_kg * np.sum(np.asarray(velocities_m_s) ** 2, axis=1)))
-
-
 def kinetic_energy_j(velocities_m_s, model: GranularModel) -> float:
-    """Translational kinetic energy Σ ½ M v² [J] (no torques act, so no rotation)."""
-    return _kinetic_j(velocities_m_s, model.masses_kg)
+    """Translational kinetic energy Σ ½ M v² [J]."""
+    return float(0.5 * np.sum(model.masses_kg * np.sum(np.asarray(velocities_m_s) ** 2, axis=1)))
 
 
 def inertia_kg_m2(model: GranularModel) -> np.ndarray:
@@ -149,14 +145,19 @@ class EnergyAudit:
             return np.zeros(len(self.masses_kg))
         return 0.5 * self.inertia_kg_m2 * np.asarray(angular_velocities_s, float) ** 2
 
-    def _total(self, positions_m, velocities_m_s, angular_velocities_s, pairs, walls) -> float:
-        energy = (_kinetic_j(velocities_m_s, self.masses_kg) + float(np.sum(self.rotational_j(angular_velocities_s)))
-                  + hertz_energy_j(*pairs[2:]) + _wall_energy_j(walls))
+    def _kinetic_j(self, velocities_m_s, angular_velocities_s) -> np.ndarray:
+        """(n_bodies,) ½ M v² + ½ I ω² [J] of each body."""
+        translational = 0.5 * self.masses_kg * np.sum(np.asarray(velocities_m_s, float) ** 2, axis=1)
+        return translational + self.rotational_j(angular_velocities_s)
+
+    def _total(self, positions_m, kinetic_j, pairs, walls) -> float:
+        energy = float(np.sum(kinetic_j)) + hertz_energy_j(*pairs[2:]) + _wall_energy_j(walls)
         return energy - float(np.sum((positions_m - self.start_m) * self.external_n))
 
     def __call__(self, positions_m, velocities_m_s, angular_velocities_s=None) -> float:
         positions_m = np.asarray(positions_m, float)
-        return self._total(positions_m, velocities_m_s, angular_velocities_s, *self._contacts(positions_m))
+        return self._total(positions_m, self._kinetic_j(velocities_m_s, angular_velocities_s),
+                           *self._contacts(positions_m))
 
     def measure(self, positions_m, velocities_m_s, angular_velocities_s=None) -> tuple[float, np.ndarray]:
         """(the total energy [J] as :meth:`__call__` gives it, (R, 2) kinetic (translational and
@@ -164,9 +165,8 @@ class EnergyAudit:
         of the contacts."""
         positions_m = np.asarray(positions_m, float)
         pairs, walls = self._contacts(positions_m)
-        kinetic = 0.5 * self.masses_kg * np.sum(np.asarray(velocities_m_s, float) ** 2, axis=1)
-        kinetic = kinetic + self.rotational_j(angular_velocities_s)
-        return (self._total(positions_m, velocities_m_s, angular_velocities_s, pairs, walls),
+        kinetic = self._kinetic_j(velocities_m_s, angular_velocities_s)
+        return (self._total(positions_m, kinetic, pairs, walls),
                 _region_energies_j(kinetic, self.regions, len(self.region_names), pairs, walls))
 
 

@@ -23,7 +23,8 @@ state arrays for all beads but updates only its own; the state of a bead is exac
 rank that owns it. When atoms change ranks (LAMMPS migrates them when it rebuilds its
 neighbour lists) each migrated bead's state is handed from its previous owner to its new one
 before the new sample is taken (only those beads' rows travel); :meth:`finish` brings every
-bead's state from its owner onto rank 0, which alone returns the results. The energy audit and the snapshot fields gather whole states onto rank 0.
+bead's state from its owner onto rank 0, which alone returns the results. The energy audit and
+the snapshot fields gather whole states onto rank 0.
 """
 
 from __future__ import annotations
