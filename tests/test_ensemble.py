@@ -20,7 +20,7 @@ from hexdem.cli.main import main
 from hexdem.disorder.ensemble import Ensemble, EnsembleConfig
 from hexdem.disorder.preparation import Preparation
 from hexdem.disorder.runner import run_ensemble
-from hexdem.disorder.sharing import adopt_compaction, adopt_ideal_impacts
+from hexdem.disorder.sharing import adopt_preparation, adopt_ideal_impacts
 from hexdem.disorder.stats import STATS_COLUMNS
 from hexdem.engines.lammps.partitions import DONE_MARKER, run_partitioned
 from hexdem.errors import HexdemError
@@ -120,9 +120,28 @@ def test_adopting_another_ensembles_identical_runs_gives_what_running_them_gives
             (ensemble.stage_dir(k, "compact") / "log.lammps").read_bytes()
         assert not np.array_equal(results(adopted, k)["wall_offsets_m"], results(ensemble, k)["wall_offsets_m"])
     seeded = Ensemble(EnsembleConfig(**SMALL, seed=1), tmp_path / "seed")
-    assert adopt_compaction(seeded, ensemble) == 0 and adopt_ideal_impacts(seeded, ensemble) == 2
+    assert adopt_preparation(seeded, ensemble) == 0 and adopt_ideal_impacts(seeded, ensemble) == 2
     larger = Ensemble(EnsembleConfig(**{**SMALL, "edge_beads": 5}), tmp_path / "larger")
-    assert adopt_compaction(larger, ensemble) == 0 and adopt_ideal_impacts(larger, ensemble) == 0
+    assert adopt_preparation(larger, ensemble) == 0 and adopt_ideal_impacts(larger, ensemble) == 0
+
+
+def test_a_frictional_ensemble_strikes_the_frictionless_preparation(reference, tmp_path):
+    """Friction acts in the impacts only: the whole preparation (compaction and settling) is
+    adopted from the frictionless ensemble, byte for byte, while every impact is run anew and
+    the struck bead's neighbours, met at 30° to the strike, now turn."""
+    ensemble, _ = reference
+    rough = EnsembleConfig(**SMALL, friction=0.3)
+    run_ensemble(rough, tmp_path, workers=2, log=quiet, share_from=(ensemble,))
+    adopted = Ensemble(rough, tmp_path)
+    for k in range(3):
+        for stage in ("compact", "settle"):
+            assert (adopted.stage_dir(k, stage) / "log.lammps").read_bytes() == \
+                (ensemble.stage_dir(k, stage) / "log.lammps").read_bytes()
+        np.testing.assert_array_equal(results(adopted, k)["positions_m"], results(ensemble, k)["positions_m"])
+        assert not np.array_equal(results(adopted, k)["peak_speed"], results(ensemble, k)["peak_speed"])
+    assert "nve/sphere" in (adopted.impact_dir(0, 0.4) / "in.hexdem").read_text()
+    assert "nve/sphere" not in (adopted.stage_dir(0, "settle") / "in.hexdem").read_text()
+    assert not np.array_equal(results(adopted, None)["peak_speed"], results(ensemble, None)["peak_speed"])
 
 
 def wait_for_unlock(out, timeout_s=60):

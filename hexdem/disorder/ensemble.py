@@ -85,7 +85,11 @@ class EnsembleConfig:
     ``duration_factor``: 1.5 lets the slower disordered wave reach the lines' far beads,
     while the far wall's reflection has not yet changed the ideal lattice's peaks, which it
     does at 1.75); ``reference_bead`` {m, n} the bead whose arrival is t = 0 in the maps
-    (Fig. 8's white x; default: bead 1 of the 0° line, the sensor nearest the impact).
+    (Fig. 8's white x; default: bead 1 of the 0° line, the sensor nearest the impact);
+    ``friction`` Coulomb's μ of the impacts' contacts, beads and walls alike
+    (:mod:`hexdem.model.contact_law`; 0: the paper's frictionless spheres). The preparation is
+    frictionless whatever ``friction`` is: every ensemble of the same diameters starts its
+    impacts from the same settled packing, whose contacts carry no tangential load.
     """
 
     realizations: int = 20
@@ -98,6 +102,7 @@ class EnsembleConfig:
     duration_s: float | None = None
     duration_factor: float = 1.5
     reference_bead: tuple[int, int] = (0, 2)
+    friction: float = 0.0
 
     def __post_init__(self):
         positive_int("the number of realizations", self.realizations)
@@ -122,7 +127,7 @@ class EnsembleConfig:
         """The ideal-lattice striker run at ``v_striker`` (also sets every run's dt and length)."""
         base = RunConfig(shape="hexagon", edge_beads=self.edge_beads, diameter_m=self.disorder.diameter_m,
                          impact="striker", v0=float(v_striker), steps_per_contact=self.steps_per_contact,
-                         dump_every=self.steps_per_contact // IMPACT_SAMPLES_PER_CONTACT)
+                         dump_every=self.steps_per_contact // IMPACT_SAMPLES_PER_CONTACT, friction=self.friction)
         if self.duration_s is not None:
             return base.replace(duration=self.duration_s)
         return base.replace(duration=self.duration_factor * base.settings().duration_s)
@@ -143,6 +148,7 @@ class EnsembleConfig:
     def identity_of(config: dict) -> dict:
         identity = json.loads(json.dumps(config))
         del identity["realizations"], identity["preparation"]["max_steps"]
+        identity.setdefault("friction", 0.0)  # ensembles run before friction existed were frictionless
         return identity
 
 
@@ -157,7 +163,7 @@ class Ensemble:
     def __init__(self, config: EnsembleConfig, out):
         self.config, self.out = config, Path(out)
         self.ideal = config.ideal_lattice()
-        self._base_model = config.run_config(config.velocities_m_s[0]).model()
+        self._base_model = config.run_config(config.velocities_m_s[0]).replace(friction=0.0).model()
 
     # ---- layout
     def realization_dir(self, k: int) -> Path:

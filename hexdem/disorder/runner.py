@@ -22,7 +22,7 @@ from hexdem.disorder.ensemble import MANIFEST_NAME, PHASE_LABELS, Ensemble, Ense
 from hexdem.disorder.figures import fitted_laws
 from hexdem.disorder.impacts import ImpactTasks, impact_done, publish_result
 from hexdem.disorder.preparation import STAGES, write_stage_deck
-from hexdem.disorder.sharing import adopt_compaction, adopt_ideal_impacts
+from hexdem.disorder.sharing import adopt_preparation, adopt_ideal_impacts
 from hexdem.disorder.stats import write_statistics
 from hexdem.engines.lammps.partitions import is_done, run_partitioned
 from hexdem.errors import HexdemError
@@ -77,7 +77,7 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
                 leftover.unlink(missing_ok=True)
         for source in share_from:
             adopt_ideal_impacts(ensemble, source)
-            adopt_compaction(ensemble, source)
+            adopt_preparation(ensemble, source)
         todo = [k for k in range(config.realizations) if not ensemble.result_path(k).exists()]
         ideal_todo = not ensemble.result_path(None).exists()
         log(f"{config.realizations} realizations x {len(config.velocities_m_s)} striker velocities, "

@@ -1,5 +1,5 @@
-"""Work that two ensembles have in common, done once: the ideal lattice's impacts and
-compaction decks that are the same to the byte.
+"""Work that two ensembles have in common, done once: the ideal lattice's impacts and the
+preparation decks that are the same to the byte.
 
 A study that runs several ensembles (``hexdem paper``: one per disorder strength and
 preparation) would otherwise strike the same ideal lattice at the same speed in every one,
@@ -11,7 +11,9 @@ its finished files are copied from the ensemble that has them:
   (:meth:`~hexdem.disorder.ensemble.EnsembleConfig.run_config`) and the source's
   ``impact.npz`` exists;
 * a realization's compaction, when both render the same deck and data file and the
-  source's stage is finished (its done marker).
+  source's stage is finished (its done marker); then its settling, on the same condition
+  (ensembles that differ only in their impacts, such as their friction, share the whole
+  preparation).
 
 Copies are made by the ensemble's run, under its lock, before anything runs
 (:func:`~hexdem.disorder.runner.run_ensemble`, ``share_from``); it then resumes as if it had
@@ -52,22 +54,33 @@ def _same_deck(a: Path, b: Path) -> bool:
     return all((a / name).read_bytes() == (b / name).read_bytes() for name in (DECK_NAME, DATA_NAME))
 
 
-def adopt_compaction(ensemble: Ensemble, source: Ensemble) -> int:
-    """Copy ``source``'s finished compaction of every realization whose compaction deck
-    ``ensemble`` would render identically; how many."""
+def _adopt_stage(ensemble: Ensemble, source: Ensemble, k: int, stage: str, scratch: Path) -> bool:
+    """Copy ``source``'s finished ``stage`` of realization k if ``ensemble`` would render the
+    same deck and data file and has not finished it; whether it was copied."""
+    theirs, ours = source.stage_dir(k, stage), ensemble.stage_dir(k, stage)
+    if not is_done(theirs) or is_done(ours):
+        return False
+    rendered = write_stage_deck(ensemble.stage_model(k, stage), stage, ensemble.config.preparation,
+                                scratch / f"r{k}-{stage}")
+    if not _same_deck(rendered, theirs):
+        return False
+    shutil.rmtree(ours, ignore_errors=True)
+    partial = ours.with_name(f".{ours.name}.part")
+    shutil.rmtree(partial, ignore_errors=True)
+    shutil.copytree(theirs, partial)
+    os.replace(partial, ours)
+    return True
+
+
+def adopt_preparation(ensemble: Ensemble, source: Ensemble) -> int:
+    """Copy ``source``'s finished preparation stages of every realization whose decks
+    ``ensemble`` would render identically, compaction first (the settling deck is rendered
+    from the compacted packing, so it is compared only where that is the same); how many."""
     adopted = 0
-    with tempfile.TemporaryDirectory(prefix="hexdem-compact-") as scratch:
+    with tempfile.TemporaryDirectory(prefix="hexdem-prepare-") as scratch:
         for k in range(min(ensemble.config.realizations, source.config.realizations)):
-            theirs, ours = source.stage_dir(k, "compact"), ensemble.stage_dir(k, "compact")
-            if not is_done(theirs) or is_done(ours):
-                continue
-            rendered = write_stage_deck(ensemble.stage_model(k, "compact"), "compact", ensemble.config.preparation,
-                                        Path(scratch) / f"r{k}")
-            if _same_deck(rendered, theirs):
-                shutil.rmtree(ours, ignore_errors=True)
-                partial = ours.with_name(f".{ours.name}.part")
-                shutil.rmtree(partial, ignore_errors=True)
-                shutil.copytree(theirs, partial)
-                os.replace(partial, ours)
-                adopted += 1
+            adopted += _adopt_stage(ensemble, source, k, "compact", Path(scratch))
+            if is_done(ensemble.stage_dir(k, "compact")) and _same_deck(ensemble.stage_dir(k, "compact"),
+                                                                        source.stage_dir(k, "compact")):
+                adopted += _adopt_stage(ensemble, source, k, "settle", Path(scratch))
     return adopted
