@@ -40,21 +40,26 @@ def test_the_tracker_reports_the_spin_and_rotational_share_of_gross_sliding(tmp_
     hertz = (4 / 3) * effective_modulus(model.bead, model.wall) * np.sqrt(D / 2)  # F = A δ^{3/2} against a plane
     tau = float(contact_time(model.masses_kg[0], hertz, v_n))
     settings = RunSettings(dt_s=tau / 2000, n_steps=4000, dump_every=20, contact_time_s=tau)
-    analysis = track_impact(ImpactJob(model, settings, engine, tmp_path, show_progress=False))
+    last = settings.n_samples - 1
+    analysis = track_impact(ImpactJob(model, settings, engine, tmp_path, show_progress=False, field_samples=(0, last)))
     omega, share = gross_sliding()
     assert analysis.results.peak_angular_speed[0] == pytest.approx(omega, rel=1e-5)
     assert analysis.results.rotational_energy_fraction == pytest.approx(share, rel=1e-4)
     assert share > 0.01
+    rim = analysis.tracked.field_rim_speeds[:, 0]  # the spin movie's frames: at rest, then ω r
+    assert rim[0] == 0.0 and rim[1] == pytest.approx(omega * D / 2, rel=1e-5)
 
 
 def test_frictionless_spheres_report_no_spin_and_frictional_ones_do(tmp_path):
     """beads.csv's last column and summary.json's share: 0 without friction; with μ = 0.3 the
-    struck bead turns and rotation holds a share of the energy (the default experiment, 4 per edge)."""
+    struck bead turns and rotation holds a share of the energy (the default experiment, 4 per edge);
+    a movie of the spin comes with the movie of the speeds where the spheres turn."""
     for friction in (0.0, 0.3):
         out = tmp_path / str(friction)
         config = tmp_path / f"{friction}.toml"
         config.write_text(f"edge_beads = 4\nstrike_angle_deg = 20.0\nfriction = {friction}\n")
-        assert main(["run", "--config", str(config), "--out", str(out)]) == 0
+        assert main(["run", "--config", str(config), "--out", str(out), "--movie"]) == 0
+        assert (out / "movie.gif").exists() and (out / "spin_movie.gif").exists() == (friction > 0)
         _, beads = read_csv(out / "beads.csv")
         spins = np.array([float(row["peak_angular_speed"]) for row in beads])
         share = json.loads((out / "summary.json").read_text())["rotational_energy_fraction"]

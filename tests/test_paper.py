@@ -12,6 +12,7 @@ import pytest
 from hexdem.cli.main import main
 from hexdem.paper.comparison import COMPARISON_COLUMNS
 from hexdem.paper.disorder_study import STUDY_COLUMNS, change, verdict
+from hexdem.paper.friction_study import EFFECT_COLUMNS, FRICTIONS, arrival_verdict
 from hexdem.paper.published import PUBLISHED
 from hexdem.paper.settings import SIGMA_PER_TOL
 from hexdem.theory.outputs import read_sweep_peaks
@@ -96,7 +97,8 @@ def test_the_html_report_is_self_contained_with_every_figure(quick):
 
 def test_a_rerun_resumes_without_recomputing(quick, capsys):
     markers = sorted((quick / "parts").glob("*.json"))
-    assert {"tca", "fig3", "fig4", "scaling", "fit_protocols", "disorder", "crossover"} <= {p.stem for p in markers}
+    assert {"tca", "fig3", "fig4", "scaling", "fit_protocols", "disorder", "crossover", "friction"} \
+        <= {p.stem for p in markers}
     before = {p.name: p.stat().st_mtime_ns for p in markers}
     assert main(["paper", "--out", str(quick), "--quick"]) == 0
     err = capsys.readouterr().err
@@ -113,6 +115,63 @@ def test_every_mpi_job_of_the_paper_went_through_the_launcher(quick, launcher):
         assert [job.split()[:2] for job in jobs if f"{quick}/{folder}/" in job] == [["-n", str(ranks)]], folder
     assert any("hexdem-sweep-" in job for job in jobs), "the V0 sweep"
     assert any("-partition 2x1 -in run.in" in job for job in jobs), "the ensembles' preparation"
+
+
+def test_the_friction_study_covers_every_friction_speed_and_line(quick):
+    with open(quick / "friction" / "friction_effect.csv", newline="") as fh:
+        assert tuple(next(csv.reader(fh))) == EFFECT_COLUMNS
+    rows = table(quick / "friction" / "friction_effect.csv")
+    keys = {(float(r["friction"]), float(r["v_striker"]), float(r["sigma_tol"]), r["line"]) for r in rows}
+    assert keys == {(mu, v, s, line) for mu in (0.0, *FRICTIONS) for v in (0.25, 0.40, 0.70) for s in (0.0, 6.0)
+                    for line in ("0", "±30")} and len(rows) == len(keys)
+    study = json.loads((quick / "friction" / "friction_study.json").read_text())
+    report = (quick / "report.md").read_text()
+    assert "Friction and rotation" in report and "friction/friction_effect.png" in report
+    assert study["arrival_verdict"] in report and study["disorder_verdict"] in report
+
+
+def test_friction_strikes_the_papers_packings_and_only_the_impacts_differ(quick):
+    """The frictional ensembles adopt the σ = 6 tol ensemble's settled packings (not prepared
+    again) and strike them with nve/sphere."""
+    for mu in FRICTIONS:
+        for k in range(2):
+            ours = np.load(quick / "friction" / f"friction{mu:g}" / "realizations" / f"r{k:04d}" / "result.npz")
+            paper = np.load(quick / "disorder" / "sigma6tol" / "realizations" / f"r{k:04d}" / "result.npz")
+            np.testing.assert_array_equal(ours["positions_m"], paper["positions_m"])
+            assert not np.array_equal(ours["lead_speed"], paper["lead_speed"], equal_nan=True)
+
+
+def test_friction_in_the_ideal_lattice_does_not_depend_on_the_speed(quick):
+    """Hertz–Mindlin–Coulomb is homogeneous: F_n ∝ δ^(3/2), F_t ∝ a ξ ∝ δ^(1/2) ξ, and the cap μ F_n
+    scales with F_n, so x → λx, t → λ^(−1/4) t maps a run at one striker speed onto another's
+    (the frictionless one too). Ratios to the frictionless run, and Sec. V's decay rates, are then
+    the same at every speed, up to the geometric nonlinearity δ/d ≤ 8e-4 (δ = 15 µm at 0.70 m/s)
+    and the arrival shifts scale as V^(−1/5)."""
+    rows = table(quick / "friction" / "friction_effect.csv")
+    ideal = {(float(r["friction"]), float(r["v_striker"]), r["line"]): r for r in rows if float(r["sigma_tol"]) == 0}
+    for mu in FRICTIONS:
+        for line in ("0", "±30"):
+            ratios = [float(ideal[mu, v, line]["mean_peak_ratio"]) for v in (0.25, 0.40, 0.70)]
+            assert max(ratios) - min(ratios) < 1e-3 * max(ratios)
+            assert abs(ratios[0] - 1) > 1e-2, "friction changes the leading pulse"
+            shifts = [float(ideal[mu, v, line]["mean_arrival_shift_us"]) * v ** 0.2 for v in (0.25, 0.40, 0.70)]
+            assert max(shifts) - min(shifts) < 1e-2 * max(abs(s) for s in shifts)
+    decay = table(quick / "friction" / "friction_decay.csv")
+    for mu in (0.0, *FRICTIONS):
+        for combination in ("0/0", "0/30"):
+            rates = [float(r["decay_rate"]) for r in decay if float(r["friction"]) == mu and r["combination"] == combination]
+            assert len(rates) == 3 and max(rates) - min(rates) < 1e-3 * max(rates)
+
+
+def test_the_arrival_verdict_names_the_lines_friction_delays():
+    def row(mu, line, shift):
+        return (mu, 0.40, 0.0, line, 0.9, float("nan"), shift)
+
+    mixed = arrival_verdict([row(0.1, "0", -3.0), row(0.1, "±30", 2.0), row(0.5, "0", -20.0), row(0.5, "±30", 9.0)])
+    assert "delays the arrivals along ±30° but brings them forward along 0°" in mixed
+    assert "μ = 0.5: 0° -20.00 µs, ±30° +9.00 µs" in mixed
+    later = arrival_verdict([row(0.1, "0", 1.0), row(0.1, "±30", 2.0)])
+    assert "in the direction of the experiment's longer arrival times" in later
 
 
 def test_other_settings_in_the_same_directory_are_refused(quick, capsys):

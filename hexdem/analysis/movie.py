@@ -4,6 +4,8 @@ The frames are the speeds of every bead that the tracker kept at evenly spaced s
 run (``field_samples``, no dump needed): :func:`movie_samples` picks them, :func:`speed_movie`
 draws each as the packing's beads coloured by |v|/V0 on a logarithmic scale (a solitary
 front decays by orders of magnitude as it spreads) and writes an animated GIF atomically.
+Frictional spheres also turn: the same drawing of their rims' speed |ω_z| r / V0 shows the
+spin on the same scale as the motion (:data:`SPIN_LABEL`).
 """
 
 from __future__ import annotations
@@ -19,6 +21,9 @@ FRAME_MS = 100
 PALETTE_COLOURS = 192
 #: The colour scale spans this many decades below V0.
 DECADES = 3.0
+#: Colour-bar labels of the speed movie and of the spin movie.
+SPEED_LABEL = "speed $|v| / V_0$"
+SPIN_LABEL = r"spin: rim speed $|\omega_z| r / V_0$"
 
 
 def movie_samples(n_samples: int, frames: int = MOVIE_FRAMES) -> tuple[int, ...]:
@@ -26,10 +31,10 @@ def movie_samples(n_samples: int, frames: int = MOVIE_FRAMES) -> tuple[int, ...]
     return tuple(int(k) for k in np.unique(np.linspace(0, n_samples - 1, min(frames, n_samples)).round()))
 
 
-def speed_movie(results, model, times, speeds, v0: float, path, title: str = "") -> None:
+def speed_movie(results, model, times, speeds, v0: float, path, title: str = "", label: str = SPEED_LABEL) -> None:
     """Write ``path`` (GIF): one frame per row of ``speeds`` (F, N), the beads coloured by
-    |v|/``v0``, the frame's time from ``times`` (F,) in the run's units, walls and the struck
-    beads drawn."""
+    speed/``v0`` (``label`` on the colour bar), the frame's time from ``times`` (F,) in the
+    run's units, walls and the struck beads drawn."""
     from matplotlib.colors import LogNorm  # (drawing only: a run picks its frames without matplotlib)
     from PIL import Image
 
@@ -39,7 +44,7 @@ def speed_movie(results, model, times, speeds, v0: float, path, title: str = "")
     fig, ax = subplots(figsize=(6.4, 5.4))
     fig.subplots_adjust(left=0.1, right=0.97, bottom=0.09, top=0.92)
     floor = 10.0 ** -DECADES
-    circles = draw_lattice(ax, results, model, np.full(len(model.lattice), floor), "speed $|v| / V_0$",
+    circles = draw_lattice(ax, results, model, np.full(len(model.lattice), floor), label,
                            cmap="inferno", norm=LogNorm(floor, 1.0), marker_colour="c")
     clock = ax.text(0.5, 1.01, "", transform=ax.transAxes, ha="center", va="bottom", fontsize=12)
     for artist in (circles, clock):  # drawn on a background of everything else, rendered once

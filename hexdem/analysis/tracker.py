@@ -60,7 +60,9 @@ class TrackedPulses:
     energy [J] of each region (:func:`~hexdem.analysis.energy.energy_regions`) at those times;
     ``n_samples``;
     ``trace_times`` (S,) and ``trace_speeds`` (S, len(trace_beads)); ``field_times`` (F,) and
-    ``field_speeds`` (F, N) at the requested snapshot samples; ``sensor_times`` (K,) and
+    ``field_speeds`` (F, N) at the requested snapshot samples, and ``field_rim_speeds`` (F, N)
+    there, each bead's |ω_z| r, the speed its rim turns at (empty, (0, N), for spheres that do
+    not turn); ``sensor_times`` (K,) and
     ``sensor_states`` (K, n_sensors, 4): vx, vy, ax, ay of the model's sensor beads every
     ``settings.sensor_every`` steps. ``peak_angular_speed`` (N,) each bead's largest |ω_z| (0 for
     spheres that do not turn); ``rotational_energy_fraction`` the largest share of the kinetic and
@@ -81,6 +83,7 @@ class TrackedPulses:
     trace_speeds: np.ndarray
     field_times: np.ndarray
     field_speeds: np.ndarray
+    field_rim_speeds: np.ndarray
     sensor_times: np.ndarray
     sensor_states: np.ndarray
     peak_angular_speed: np.ndarray
@@ -113,6 +116,8 @@ class PulseTracker:
         self.sensors = np.full((n_sensed, len(self.sensor_beads), 4), np.nan)
         self.field_samples = np.asarray(sorted(field_samples), dtype=np.int64)
         self.fields = np.full((len(self.field_samples), n), np.nan)
+        self.rim_fields = np.full((len(self.field_samples) if model.laws.tangential else 0, n), np.nan)
+        self.radii = model.lattice.diameters_m[:n] / 2 / settings.units.length_m
         self.energy_every = max(1, (total - 1) // ENERGY_SAMPLES)
         self.audit = EnergyAudit(model, gravity_m_s2) if self.root else None
         self.energies, self.energy_times, self.impact_energy, self.region_energies = [], [], None, []
@@ -146,7 +151,7 @@ class PulseTracker:
         for beads, rows in parts if self.root else ():
             for array, values in zip(arrays, rows):
                 array[beads] = values
-        for array in (self.traces, self.fields, self.sensors):
+        for array in (self.traces, self.fields, self.rim_fields, self.sensors):
             taken = np.isfinite(array).astype(np.int64)
             counts = np.empty_like(taken) if self.root else None
             self.comm.Reduce(taken, counts, op=MPI.SUM, root=0)
@@ -189,6 +194,9 @@ class PulseTracker:
             self._sense(sample)
         if s in self.field_samples:
             self.fields[np.searchsorted(self.field_samples, s), index] = speeds
+            if len(self.rim_fields):
+                self.rim_fields[np.searchsorted(self.field_samples, s), index] = (
+                    np.abs(sample.angular_velocities[beads]) * self.radii[index])
         if s % self.energy_every == 0 or s == self.n_samples_expected - 1:
             self._audit(sample)
         self.count = s + 1
@@ -255,6 +263,7 @@ class PulseTracker:
                              n_samples=self.count, trace_beads=self.trace_beads,
                              trace_times=np.arange(self.count) * interval, trace_speeds=self.traces[:self.count],
                              field_times=self.field_samples * interval, field_speeds=self.fields,
+                             field_rim_speeds=self.rim_fields,
                              sensor_times=np.arange(len(self.sensors)) * self.sensor_every * self.settings.dt_s
                              / self.settings.units.time_s, sensor_states=self.sensors,
                              peak_angular_speed=self.peak_spin,

@@ -8,6 +8,7 @@ import json
 import math
 import os
 import tempfile
+import tomllib
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -45,6 +46,18 @@ def locked_directory(out: Path, holder: str):
         yield fd
     finally:
         os.close(fd)
+
+
+def read_toml(path, what: str = "config") -> dict:
+    """The table of the TOML file at ``path``; an unreadable or invalid file is one clear line
+    naming it as ``what``."""
+    path = Path(path)
+    try:
+        return tomllib.loads(path.read_text())
+    except OSError as exc:
+        raise HexdemError(f"cannot read {what} {path}: {exc.strerror}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise HexdemError(f"{what} {path} is not valid TOML: {exc}") from None
 
 
 def write_text(path, text: str) -> None:

@@ -5,7 +5,8 @@
 ``OUT/deck`` (inputs, log, the dump if asked for) and :data:`RESULT_FILES` (``peaks.csv``
 along the observation lines, ``beads.csv`` of every bead, ``summary.json``, the arrival and
 peak maps, ``peak_decay.png``, ``front_shape.csv`` and ``.png``, ``energy_regions.csv``), with
-``energy_regions.png`` when the beads are of several materials and ``movie.gif`` on request,
+``energy_regions.png`` when the beads are of several materials and ``movie.gif`` on request
+(with ``spin_movie.gif`` for frictional spheres, which turn),
 each written atomically. A failed run leaves its inputs and log in
 ``OUT/deck.failed`` for inspection and no result files.
 """
@@ -146,7 +147,7 @@ def summary(config: RunConfig, analysis: ImpactAnalysis, wall_time_s: float) -> 
 def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_time_s: float) -> None:
     """Every result file of the run (see the module docstring), each written atomically."""
     from hexdem.analysis import figures as plots  # matplotlib: only where figures are drawn
-    from hexdem.analysis.movie import speed_movie
+    from hexdem.analysis.movie import SPIN_LABEL, speed_movie
 
     rows = analysis.line_rows()
     write_csv(out / "peaks.csv", PEAK_COLUMNS, rows)
@@ -170,6 +171,9 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
     tracked = analysis.tracked
     if config.movie and tracked is not None and len(tracked.field_times):  # (a dump read back has no fields)
         speed_movie(r, model, tracked.field_times, tracked.field_speeds, v0, out / "movie.gif", title=model.lattice.shape)
+        if len(tracked.field_rim_speeds):
+            speed_movie(r, model, tracked.field_times, tracked.field_rim_speeds, v0, out / "spin_movie.gif",
+                        title=model.lattice.shape, label=SPIN_LABEL)
 
 
 def bead_rows(analysis: ImpactAnalysis) -> list[tuple]:
@@ -213,8 +217,9 @@ def measure_front_shape(analysis: ImpactAnalysis, count: int = 8, geometric: boo
     return front_shape(positions, r.arrival_time, origin, times, wall_margin=wall_margin_d, window_deg=window_deg)
 
 
-def run_experiment(config: RunConfig, out, log=None) -> ImpactAnalysis:
-    """Run ``config`` and publish its result files in ``out`` (see module docstring)."""
+def run_experiment(config: RunConfig, out, log=None, comm=None) -> ImpactAnalysis:
+    """Run ``config`` and publish its result files in ``out`` (see module docstring); ``comm`` as
+    for :func:`simulate`."""
     log = log or (lambda message: print(f"hexdem: {message}", file=sys.stderr))
     out = ensure_writable_dir(out)
     check_dump_space(config, out)
@@ -223,7 +228,7 @@ def run_experiment(config: RunConfig, out, log=None) -> ImpactAnalysis:
     if workdir.exists():
         shutil.rmtree(workdir)
     try:
-        analysis = simulate(config, workdir, log)
+        analysis = simulate(config, workdir, log, comm=comm)
     except HexdemError as exc:
         if workdir.exists():
             _replace_dir(workdir, out / "deck.failed")

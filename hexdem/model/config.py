@@ -11,11 +11,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import tomllib
 from dataclasses import dataclass
-from pathlib import Path
 
 from hexdem.common.checks import is_number, positive_int
+from hexdem.common.io import read_toml
 from hexdem.common.machine import available_memory_bytes
 from hexdem.errors import HexdemError
 from hexdem.model.contact_law import Friction
@@ -226,14 +225,7 @@ class RunConfig:
     @classmethod
     def from_toml(cls, path) -> "RunConfig":
         """Read a TOML file whose keys are :class:`RunConfig` field names."""
-        path = Path(path)
-        try:
-            data = tomllib.loads(path.read_text())
-        except OSError as exc:
-            raise HexdemError(f"cannot read config {path}: {exc.strerror}") from None
-        except tomllib.TOMLDecodeError as exc:
-            raise HexdemError(f"config {path} is not valid TOML: {exc}") from None
-        return cls.from_dict(data, source=str(path))
+        return cls.from_dict(read_toml(path), source=str(path))
 
     @classmethod
     def from_dict(cls, data: dict, source: str = "config") -> "RunConfig":

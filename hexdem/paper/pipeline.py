@@ -11,6 +11,10 @@ The parts, each writing into its own folder of ``DIR``:
                        ``sigma6tol`` holds Figs. 8 and 9
 ``disorder/``          the study's tables, figure and verdict; the crossover sweep's
                        ``disorder_crossover.csv``, ``.json`` and ``.png``
+``friction/<name>/``   the σ = 6 tol ensemble struck with friction μ, on the paper's packings
+``friction/``          the friction study (:mod:`hexdem.paper.friction_study`):
+                       ``friction_effect.csv``, ``friction_decay.csv``, ``friction_effect.png``,
+                       ``friction_study.json``
 =====================  =====================================================================
 
 then ``report.html``, ``report.md`` and ``published_vs_computed.csv`` (:mod:`hexdem.paper.report`).
@@ -41,6 +45,7 @@ from hexdem.paper.disorder_study import (
     study_rows,
     verdict,
 )
+from hexdem.paper.friction_study import FRICTIONS, friction_name, run_friction_ensemble
 from hexdem.paper.settings import SIGMA_PER_TOL, PaperSettings
 
 SETTINGS_NAME = "paper.json"
@@ -129,6 +134,30 @@ def _crossover(summaries: list[dict], out: Path) -> dict:
     return result
 
 
+def _friction_summary(settings: PaperSettings, summaries: dict, out: Path) -> dict:
+    from hexdem.common.io import write_csv
+    from hexdem.paper.friction_figure import friction_figure
+    from hexdem.paper.friction_study import (
+        DECAY_COLUMNS,
+        EFFECT_COLUMNS,
+        arrival_verdict,
+        disorder_verdict,
+        friction_tables,
+    )
+
+    rows, decay, conditions = friction_tables(out, settings, summaries)
+    folder = out / "friction"
+    write_csv(folder / "friction_effect.csv", EFFECT_COLUMNS, rows)
+    write_csv(folder / "friction_decay.csv", DECAY_COLUMNS, decay)
+    friction_figure(rows, decay, conditions, folder / "friction_effect.png")
+    result = {"rows": [dict(zip(EFFECT_COLUMNS, row)) for row in rows],
+              "decay": [dict(zip(DECAY_COLUMNS, row)) for row in decay], "disorder": conditions,
+              "realizations": settings.friction_realizations, "paper_realizations": settings.realizations,
+              "arrival_verdict": arrival_verdict(rows), "disorder_verdict": disorder_verdict(conditions)}
+    write_json(folder / "friction_study.json", result)
+    return result
+
+
 def _quiet(message: str) -> None:
     """The parts' own logs: the paper's progress display replaces them."""
 
@@ -180,6 +209,15 @@ def _run_parts(settings: PaperSettings, out: Path) -> tuple[dict, float]:
                   lambda: _disorder_summary([summaries[name] for name in study_parts], out)))
     parts.append(("crossover", "disorder crossover sweep", tuple(ensemble_parts),
                   lambda: _crossover([summaries[name] for name in ensemble_parts], out)))
+    paper_part = f"disorder-{FIGURES_ENSEMBLE}"
+    friction_parts = [f"friction-{friction_name(mu)}" for mu in FRICTIONS]
+    parts += [(name, f"ensemble with friction μ = {mu:g}", (paper_part,),
+               lambda mu=mu: run_friction_ensemble(mu, settings, out, scaling_json))
+              for name, mu in zip(friction_parts, FRICTIONS)]
+    parts.append(("friction", "friction and rotation study", (paper_part, *friction_parts),
+                  lambda: _friction_summary(settings, {0.0: summaries[paper_part],
+                                                       **{mu: summaries[name] for name, mu in
+                                                          zip(friction_parts, FRICTIONS)}}, out)))
     summaries: dict = {}
     computed: set = set()
     bar = progress_bar(len(parts), "hexdem paper", unit="part")

@@ -25,6 +25,8 @@ CROSSOVER_SIGMA_PER_TOL = (0.001, 0.003, 0.01, 0.03, 0.1, 0.3, 1.0, 3.0, 6.0)
 QUICK_CROSSOVER_SIGMA_PER_TOL = (0.01, 0.1, 1.0, 6.0)
 #: Striker speeds of the crossover sweep [m/s]: every prestressed ensemble is struck at these.
 CROSSOVER_VELOCITIES_M_S = FIG9_VELOCITIES_M_S
+#: Packings of the full run's friction study (:mod:`hexdem.paper.friction_study`).
+FULL_FRICTION_REALIZATIONS = 5
 #: σ / tol at which the preparation is also run without prestress.
 RELAXED_SIGMA_PER_TOL = (0.0, 6.0)
 #: Slack of the walls in the preparation without prestress [m]: one diameter tolerance,
@@ -64,6 +66,12 @@ class PaperSettings:
         return 2 if self.quick else 20
 
     @property
+    def friction_realizations(self) -> int:
+        """Packings of the friction study: the first of the σ = 6 tol ensemble's, fewer than its
+        realizations so that the whole paper stays within ten minutes on two workers."""
+        return 2 if self.quick else FULL_FRICTION_REALIZATIONS
+
+    @property
     def crossover_sigma_per_tol(self) -> tuple[float, ...]:
         return QUICK_CROSSOVER_SIGMA_PER_TOL if self.quick else CROSSOVER_SIGMA_PER_TOL
 
@@ -81,4 +89,5 @@ class PaperSettings:
                 "study_velocity_m_s": STUDY_VELOCITY_M_S, "fig9_velocities_m_s": list(FIG9_VELOCITIES_M_S),
                 "relaxed_sigma_per_tol": list(RELAXED_SIGMA_PER_TOL), "relaxed_wall_slack_m": RELAXED_WALL_SLACK_M,
                 "crossover_sigma_per_tol": list(self.crossover_sigma_per_tol),
-                "crossover_velocities_m_s": list(CROSSOVER_VELOCITIES_M_S)}
+                "crossover_velocities_m_s": list(CROSSOVER_VELOCITIES_M_S),
+                "friction_realizations": self.friction_realizations}
