@@ -23,6 +23,7 @@ COMMANDS = {
     "scaling": ("hexdem.cli.scaling", "velocity-decay scaling laws over a V0 sweep (Sec. V)"),
     "ensemble": ("hexdem.cli.ensemble", "weakly disordered ensembles with striker impacts (Sec. VI)"),
     "snapshots": ("hexdem.cli.snapshots", "wavefront speed maps at chosen times (Figs. 3 and 4)"),
+    "sweep": ("hexdem.cli.sweep", "a study of any run-config keys, each run a full result directory"),
     "paper": ("hexdem.cli.paper", "the whole paper: every published number beside hexdem's, in one report"),
 }
 

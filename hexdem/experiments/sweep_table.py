@@ -1,0 +1,124 @@
+"""``sweep.csv`` and ``sweep.png`` of ``hexdem sweep``, read from the runs' own result files.
+
+One row per run, in the plan's order:
+
+* the varied keys, one column each, headed by the key as given (``regions.0.material``);
+* ``run``: the run's directory, relative to the sweep's;
+* :data:`SUMMARY_COLUMNS`, the scalar figures of the run's ``summary.json`` (``n_beads`` is its
+  ``lattice.n_beads``);
+* ``energy_share_<region>``: each material region's share of the energy (kinetic and contact)
+  at the end of the run, from its ``energy_regions.csv``; empty where a run has no such region;
+* ``decay_exponent_<line>``: the power law V_n ∝ n^(−p) fitted to the peak speeds of each
+  observation line in ``peaks.csv`` (least squares of log V_n on log n) over the beads
+  :data:`DECAY_FIRST_N` ≤ n ≤ N − 2 of a line of N beads: n = 0 and 1 are set by the impact,
+  and the last bead meets the far wall; empty with fewer than three beads in that range.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+
+from hexdem.common.io import write_csv
+from hexdem.experiments.sweep_plan import SweepRun
+
+#: Scalar figures of a run's ``summary.json`` in the table, in this order.
+SUMMARY_COLUMNS = ("n_beads", "n_samples", "energy_drift", "energy_lost", "rotational_energy_fraction",
+                   "far_wall_reached", "engine_wall_time_s", "wall_time_s")
+#: The first bead of a line in the decay fit.
+DECAY_FIRST_N = 2
+
+
+def _rows_of(path: Path) -> list[dict]:
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def final_energy_shares(path: Path) -> dict[str, float]:
+    """{region: share of the energy} at the last audited time of an ``energy_regions.csv``."""
+    rows = _rows_of(path)
+    last = max(float(row["time"]) for row in rows)
+    return {row["region"]: float(row["energy_fraction"]) for row in rows if float(row["time"]) == last}
+
+
+def decay_exponent(n, peak_speed) -> float:
+    """p of V_n ∝ n^(−p) over DECAY_FIRST_N ≤ n ≤ N − 2 (see the module docstring); NaN if
+    fewer than three beads there have a peak."""
+    n, v = np.asarray(n, float), np.asarray(peak_speed, float)
+    chosen = (n >= DECAY_FIRST_N) & (n <= len(n) - 2) & np.isfinite(v) & (v > 0)
+    if np.count_nonzero(chosen) < 3:
+        return float("nan")
+    slope, _ = np.polyfit(np.log(n[chosen]), np.log(v[chosen]), 1)
+    return float(-slope)
+
+
+def decay_exponents(path: Path) -> dict[str, float]:
+    """{line: its decay exponent} from a run's ``peaks.csv``."""
+    lines: dict[str, list] = {}
+    for row in _rows_of(path):
+        lines.setdefault(row["line"], []).append((int(row["n"]), float(row["peak_speed"] or "nan")))
+    return {line: decay_exponent(*zip(*sorted(pairs))) for line, pairs in lines.items()}
+
+
+def _run_figures(directory: Path) -> tuple[dict, dict, dict]:
+    summary = json.loads((directory / "summary.json").read_text())
+    scalars = {key: summary["lattice"]["n_beads"] if key == "n_beads" else summary[key] for key in SUMMARY_COLUMNS}
+    return (scalars, final_energy_shares(directory / "energy_regions.csv"),
+            decay_exponents(directory / "peaks.csv"))
+
+
+def _first_seen(keys_per_run) -> list[str]:
+    seen: dict[str, None] = {}
+    for keys in keys_per_run:
+        seen.update(dict.fromkeys(keys))
+    return list(seen)
+
+
+def write_table(out: Path, runs: list[SweepRun], variations) -> list[tuple]:
+    """Write ``out / sweep.csv`` (see the module docstring); its rows."""
+    figures = [_run_figures(out / "runs" / run.name) for run in runs]
+    regions = _first_seen(shares for _, shares, _ in figures)
+    lines = _first_seen(exponents for _, _, exponents in figures)
+    header = (*(v.key for v in variations), "run", *SUMMARY_COLUMNS, *(f"energy_share_{r}" for r in regions),
+              *(f"decay_exponent_{line}" for line in lines))
+    rows = [(*run.values.values(), f"runs/{run.name}", *scalars.values(), *(shares.get(r, "") for r in regions),
+             *(exponents.get(line, "") for line in lines))
+            for run, (scalars, shares, exponents) in zip(runs, figures)]
+    write_csv(out / "sweep.csv", header, rows)
+    return [header, *rows]
+
+
+def sweep_figure(out: Path, runs: list[SweepRun], variations, rows: list[tuple]) -> None:
+    """``out / sweep.png``: the energy lost, the energy drift and each line's decay exponent
+    against the first varied key, one curve per combination of the others (categories, such as
+    materials, spread evenly along the axis)."""
+    from hexdem.analysis import figures as plots
+
+    header, body = rows[0], rows[1:]
+    panels = ["energy_lost", "energy_drift", *(name for name in header if name.startswith("decay_exponent_"))]
+    first = variations[0]
+    numeric = all(isinstance(value, (int, float)) and not isinstance(value, bool) for value in first.values)
+    position = {value: (value if numeric else i) for i, value in enumerate(first.values)}
+    fig, axes = plots.subplots(1, len(panels), figsize=(4.2 * len(panels), 3.8), squeeze=False)
+    groups: dict[tuple, list] = {}
+    for run, row in zip(runs, body):
+        others = tuple((key, value) for key, value in run.values.items() if key != first.key)
+        groups.setdefault(others, []).append((position[run.values[first.key]], dict(zip(header, row))))
+    for ax, panel in zip(axes[0], panels):
+        for others, points in groups.items():
+            label = ", ".join(f"{key} = {value}" for key, value in others) or None
+            ax.plot([x for x, _ in points], [float(r[panel]) if r[panel] != "" else np.nan for _, r in points],
+                    "o-", label=label)
+        ax.set_xlabel(first.key)
+        ax.set_title(panel.replace("_", " "), fontsize=10)
+        ax.grid(True, alpha=0.3)
+        if not numeric:
+            ax.set_xticks(range(len(first.values)), [str(v) for v in first.values])
+    if len(groups) > 1:
+        axes[0][0].legend(fontsize=7)
+    fig.suptitle(f"hexdem sweep: {len(runs)} runs")
+    fig.tight_layout()
+    plots.save(fig, out / "sweep.png")
