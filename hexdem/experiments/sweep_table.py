@@ -92,33 +92,37 @@ def write_table(out: Path, runs: list[SweepRun], variations) -> list[tuple]:
 
 
 def sweep_figure(out: Path, runs: list[SweepRun], variations, rows: list[tuple]) -> None:
-    """``out / sweep.png``: the energy lost, the energy drift and each line's decay exponent
-    against the first varied key, one curve per combination of the others (categories, such as
-    materials, spread evenly along the axis)."""
+    """``out / sweep.png``: one column of panels per varied key, that key along the x axis and,
+    one row each, the energy lost and the decay exponent of the first observation line; one
+    curve per combination of the other keys (categories, such as materials, are spread evenly
+    along the axis)."""
     from hexdem.analysis import figures as plots
 
     header, body = rows[0], rows[1:]
-    panels = ["energy_lost", "energy_drift", *(name for name in header if name.startswith("decay_exponent_"))]
-    first = variations[0]
-    numeric = all(isinstance(value, (int, float)) and not isinstance(value, bool) for value in first.values)
-    position = {value: (value if numeric else i) for i, value in enumerate(first.values)}
-    fig, axes = plots.subplots(1, len(panels), figsize=(4.2 * len(panels), 3.8), squeeze=False)
-    groups: dict[tuple, list] = {}
-    for run, row in zip(runs, body):
-        others = tuple((key, value) for key, value in run.values.items() if key != first.key)
-        groups.setdefault(others, []).append((position[run.values[first.key]], dict(zip(header, row))))
-    for ax, panel in zip(axes[0], panels):
-        for others, points in groups.items():
-            label = ", ".join(f"{key} = {value}" for key, value in others) or None
-            ax.plot([x for x, _ in points], [float(r[panel]) if r[panel] != "" else np.nan for _, r in points],
-                    "o-", label=label)
-        ax.set_xlabel(first.key)
-        ax.set_title(panel.replace("_", " "), fontsize=10)
-        ax.grid(True, alpha=0.3)
-        if not numeric:
-            ax.set_xticks(range(len(first.values)), [str(v) for v in first.values])
-    if len(groups) > 1:
-        axes[0][0].legend(fontsize=7)
+    shown = ["energy_lost", *[name for name in header if name.startswith("decay_exponent_")][:1]]
+    fig, axes = plots.subplots(len(shown), len(variations), figsize=(4.6 * len(variations), 3.4 * len(shown)),
+                               squeeze=False, layout="constrained")
+    table = [dict(zip(header, row)) for row in body]
+    for j, variation in enumerate(variations):
+        numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in variation.values)
+        position = {text: (value if numeric else i)
+                    for i, (value, text) in enumerate(zip(variation.values, variation.texts))}
+        groups: dict[tuple, list] = {}
+        for run, row in zip(runs, table):
+            others = tuple((key, value) for key, value in run.values.items() if key != variation.key)
+            text = variation.texts[variation.values.index(run.values[variation.key])]
+            groups.setdefault(others, []).append((position[text], row))
+        for i, name in enumerate(shown):
+            ax = axes[i, j]
+            for others, points in groups.items():
+                ax.plot([x for x, _ in points], [float(r[name]) if r[name] != "" else np.nan for _, r in points],
+                        "o-", label=", ".join(f"{key} = {value}" for key, value in others) or None)
+            ax.set_xlabel(variation.key)
+            ax.set_ylabel(name.replace("_", " "))
+            ax.grid(True, alpha=0.3)
+            if not numeric:
+                ax.set_xticks(range(len(variation.texts)), variation.texts)
+            if len(groups) > 1 and i == 0:
+                ax.legend(fontsize=7)
     fig.suptitle(f"hexdem sweep: {len(runs)} runs")
-    fig.tight_layout()
     plots.save(fig, out / "sweep.png")
