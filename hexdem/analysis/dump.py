@@ -52,7 +52,7 @@ class BeadRecord(_analysis_base()):
     """Per-frame speeds and displacements of every body in a hexdem dump.
 
     ``results.times`` (n_frames,) in the dump's units; ``results.speeds`` (n_frames, n_atoms)
-    |v| in the plane; ``results.velocities`` and ``results.displacements`` (n_frames,
+    the speed in the plane; ``results.velocities`` and ``results.displacements`` (n_frames,
     n_atoms, 2). Atoms are ordered by id (hexdem dumps are sorted by id).
     """
 

@@ -45,7 +45,7 @@ MIN_BINS = 13
 RAY_SAMPLES = 1024
 #: A regular hexagon's relative sixfold amplitude, 2 − 32 / (15 ln 3), from the Fourier
 #: coefficients of R(θ) = R_in / cos φ over φ in [−30°, 30°]: a0 = (3/π) ln 3 · R_in and
-#: |a6| = (6/π) (ln 3 − 16/15) · R_in.
+#: abs(a6) = (6/π) (ln 3 − 16/15) · R_in.
 HEXAGON_SIXFOLD = 2.0 - 32.0 / (15.0 * np.log(3.0))
 #: Header of the front-shape table (mean radius in bead diameters).
 FRONT_SHAPE_COLUMNS = ("time", "mean_radius_d", "sixfold_amplitude", "bins_used")

@@ -1,10 +1,14 @@
 """Analytic Hertz two-body collision (Johnson 1987), the yardstick for contact times.
 
 Two bodies with reduced mass μ approaching at relative speed v with a contact force
-F = A δ^{3/2} (A = k_n sqrt(R_eff)) stop approaching at the maximum overlap
+F = A δ^{3/2} (A = k_n sqrt(R_eff)) stop approaching at the maximum overlap ::
+
     δ_max = (5 μ v² / (4 A))^{2/5}
-and separate, undamped, after the contact time
+
+and separate, undamped, after the contact time ::
+
     τ = 2 (δ_max / v) ∫₀¹ (1 − x^{5/2})^{−1/2} dx = (4/5) B(2/5, 1/2) δ_max / v ≈ 2.9432 δ_max / v.
+
 A sphere against a flat wall is the case μ = M, R_eff = R.
 """
 

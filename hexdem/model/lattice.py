@@ -1,7 +1,9 @@
 """Geometry of 2D hexagonal (triangular) packings of touching beads, indexed as in the paper.
 
-Bead {m, n} (m + n even) of an ideal packing with diameter d sits at
+Bead {m, n} (m + n even) of an ideal packing with diameter d sits at ::
+
     x = (√3/2) d n,   y = (d/2) m,
+
 so its six touching neighbours are {m ± 2, n} and {m ± 1, n ± 1} (the paper's e₁, e₂, e₃,
 Sec. III, rotated so that the struck edge is vertical). The struck bead is the centre bead
 {0, 0} of the left edge n = 0; the wave runs towards +x.

@@ -1,4 +1,5 @@
-"""README.md's Python example runs verbatim and its packing configs build, so the documentation cannot rot."""
+"""The user guide's Python example runs verbatim and its configs build what they say, so the
+documentation cannot rot."""
 
 import re
 import subprocess
@@ -10,13 +11,12 @@ import numpy as np
 
 from hexdem.model.config import RunConfig
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+GUIDE = Path(__file__).resolve().parents[1] / "docs" / "guide"
 
 
 def python_api_example() -> str:
-    section = README.read_text().split("## Python API", 1)[1].split("\n## ", 1)[0]
-    blocks = re.findall(r"```python\n(.*?)```", section, flags=re.DOTALL)
-    assert len(blocks) == 1, "the Python API section holds one example"
+    blocks = re.findall(r"```python\n(.*?)```", (GUIDE / "python-api.md").read_text(), flags=re.DOTALL)
+    assert len(blocks) == 1, "the Python API page holds one example"
     return blocks[0]
 
 
@@ -31,8 +31,8 @@ def test_the_python_api_example_runs(tmp_path):
     assert sorted(path.name for path in tmp_path.iterdir()) == ["example.py"], "no files unless asked for"
 
 
-def test_every_packing_config_of_the_readme_builds_the_packing_its_comment_names():
-    section = README.read_text().split("#### Packings", 1)[1].split("#### Impacts", 1)[0]
+def test_every_packing_config_of_the_guide_builds_the_packing_its_comment_names():
+    section = (GUIDE / "packings.md").read_text()
     blocks = re.findall(r"```toml\n(.*?)```", section, flags=re.DOTALL)
     assert len(blocks) == 5
     lattices = [RunConfig(**tomllib.loads(block)).lattice() for block in blocks]
@@ -40,8 +40,8 @@ def test_every_packing_config_of_the_readme_builds_the_packing_its_comment_names
     assert [len(lattice.walls) for lattice in lattices] == [3, 4, 1, 6, 1]
 
 
-def test_the_readme_interface_config_builds_its_materials():
-    section = README.read_text().split("#### Materials", 1)[1].split("#### Packings", 1)[0]
+def test_the_guides_interface_config_builds_its_materials():
+    section = (GUIDE / "materials.md").read_text()
     (block,) = re.findall(r"```toml\n(.*?)```", section, flags=re.DOTALL)
     model = RunConfig(**tomllib.loads(block)).model()
     assert [m.name for m in model.materials] == ["steel316", "brass", "ptfe", "glass"]
@@ -50,8 +50,8 @@ def test_the_readme_interface_config_builds_its_materials():
     assert list(np.bincount(model.material_ids)) == [331 - brass - 2, brass, 2, 1] and model.diameters_m[-1] == 0.012
 
 
-def test_the_readme_impact_configs_build_their_impacts_and_lines():
-    section = README.read_text().split("#### Impacts", 1)[1].split("\n## ", 1)[0]
+def test_the_guides_impact_configs_build_their_impacts_and_lines():
+    section = (GUIDE / "impacts.md").read_text()
     blocks = re.findall(r"```toml\n(.*?)```", section, flags=re.DOTALL)
     assert len(blocks) == 4
     *impacts, lines = [RunConfig(**tomllib.loads(block)) for block in blocks]

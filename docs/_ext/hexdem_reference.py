@@ -1,0 +1,94 @@
+"""Sphinx extension: the CLI, configuration and API references, generated from the code at
+build time into ``reference/_generated/`` (never edited by hand, never committed).
+
+* ``cli.md``: every ``hexdem`` subcommand's ``--help``, from the argparse parser itself;
+* ``config.md``: every run-configuration key with its default, from :class:`RunConfig`'s fields,
+  and the class's docstring;
+* ``api.md``: every module of the package, by subpackage, through autodoc.
+
+hexdem's docstrings write magnitudes the physicist's way, |v| or |ω_z|, which reStructuredText
+would read as substitutions: :func:`escape_bars` escapes every bar outside a grid table's rows.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import pkgutil
+from pathlib import Path
+
+import hexdem
+from hexdem.cli.main import COMMANDS, build_parser
+from hexdem.model.config import RunConfig
+
+#: Width of the help texts (argparse reads COLUMNS).
+HELP_COLUMNS = "100"
+
+
+def _write(path: Path, text: str) -> None:
+    """Write ``text`` only if it changed (an unchanged file keeps Sphinx's cache valid)."""
+    if not path.exists() or path.read_text() != text:
+        path.write_text(text)
+
+
+def cli_page() -> str:
+    os.environ["COLUMNS"] = HELP_COLUMNS
+    lines = ["# Command line", "", "Every subcommand's `--help`, as `hexdem` prints it.", ""]
+    for name, (_, summary) in COMMANDS.items():
+        parser = build_parser([name])
+        subcommand = parser._subparsers._group_actions[0].choices[name]
+        lines += [f"## hexdem {name}", "", summary[0].upper() + summary[1:] + ".", "", "```text",
+                  subcommand.format_help().rstrip(), "```", ""]
+    return "\n".join(lines)
+
+
+def _default(field: dataclasses.Field) -> str:
+    if field.default is not dataclasses.MISSING:
+        value = field.default
+    elif field.default_factory is not dataclasses.MISSING:
+        value = field.default_factory()
+    else:
+        return "(required)"
+    return "(none)" if value is None else f"`{value!r}`"
+
+
+def config_page() -> str:
+    rows = [f"| `{f.name}` | {_default(f)} | `{f.type}` |" for f in dataclasses.fields(RunConfig)]
+    return "\n".join(["# Run configuration keys", "",
+                      "The keys of a `hexdem run --config FILE.toml` file (and of `hexdem sweep --vary`), with "
+                      "their defaults; a file sets any of them, the rest keep these.", "",
+                      "| key | default | type |", "|---|---|---|", *rows, "",
+                      "```{eval-rst}", ".. autoclass:: hexdem.model.config.RunConfig", "   :no-members:",
+                      "   :no-index:", "```", ""])
+
+
+def api_page() -> str:
+    modules = sorted(info.name for info in pkgutil.walk_packages(hexdem.__path__, "hexdem.")
+                     if not info.name.endswith("__main__"))
+    lines = ["# API", "", "Every module of the package, from its docstrings.", ""]
+    for package in sorted({m.split(".")[1] for m in modules}):
+        members = [m for m in modules if m.split(".")[1] == package]
+        lines += [f"## hexdem.{package}", ""]
+        for module in members:
+            lines += ["```{eval-rst}", f".. automodule:: {module}", "   :members:", "```", ""]
+    return "\n".join(lines)
+
+
+def escape_bars(app, what, name, obj, options, lines) -> None:
+    """Escape the bars of |v| and the like in a docstring (not a grid table's row or border)."""
+    for i, line in enumerate(lines):
+        if not line.lstrip().startswith(("|", "+")):
+            lines[i] = line.replace("|", "\\|")
+
+
+def generate(app) -> None:
+    folder = Path(app.srcdir) / "reference" / "_generated"
+    folder.mkdir(exist_ok=True)
+    for name, page in (("cli.md", cli_page), ("config.md", config_page), ("api.md", api_page)):
+        _write(folder / name, page())
+
+
+def setup(app):
+    app.connect("builder-inited", generate)
+    app.connect("autodoc-process-docstring", escape_bars)
+    return {"parallel_read_safe": True, "parallel_write_safe": True}

@@ -1,0 +1,28 @@
+"""Sphinx configuration of hexdem's documentation (``sphinx-build -W -b html docs OUT``).
+
+The pages are Markdown (MyST). The CLI and configuration references are generated from the
+code at build time (``_ext/hexdem_reference.py``), the API reference from the docstrings
+(autodoc). Nothing is simulated during a build: the gallery's figures are files that
+``gallery/make_gallery.py`` regenerates.
+"""
+
+import sys
+from importlib.metadata import version as installed_version
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).parent / "_ext"))
+
+project = "hexdem"
+author = "the hexdem developers"
+copyright = "2026, the hexdem developers"
+release = installed_version("hexdem")
+extensions = ["myst_parser", "sphinx.ext.autodoc", "sphinx.ext.napoleon", "hexdem_reference"]
+myst_enable_extensions = ["dollarmath"]
+myst_heading_anchors = 3
+source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
+exclude_patterns = ["_build", "gallery/configs"]
+autodoc_member_order = "bysource"
+autodoc_typehints = "none"
+html_theme = "alabaster"
+html_theme_options = {"description": "Impulses in 2D hexagonal granular crystals", "page_width": "1100px"}
+suppress_warnings = ["myst.header", "myst.xref_missing"]

@@ -1,0 +1,75 @@
+"""The documentation site builds with warnings as errors, its generated references cover the
+code, its gallery covers every packing and impact kind, and the README is a front page whose
+set-up commands are those CI runs."""
+
+import re
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from hexdem.cli.main import COMMANDS
+from hexdem.model.config import SHAPES, RunConfig
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    """The HTML site, built from scratch (-E) with every warning an error (-W)."""
+    out = tmp_path_factory.mktemp("docs") / "html"
+    done = subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-E", "-q", "-b", "html",
+                           str(DOCS), str(out)], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    return out
+
+
+def test_the_cli_reference_holds_every_subcommands_help(built):
+    page = (built / "reference" / "_generated" / "cli.html").read_text()
+    for name in COMMANDS:
+        assert f"hexdem {name}" in page
+    assert "--vary KEY=V1,V2,..." in page and "--steps-per-contact" in page
+
+
+def test_the_config_reference_lists_every_key(built):
+    page = (built / "reference" / "_generated" / "config.html").read_text()
+    import dataclasses
+
+    missing = [f.name for f in dataclasses.fields(RunConfig) if f"<code class=\"docutils literal notranslate\"><span class=\"pre\">{f.name}</span>" not in page]
+    assert not missing
+
+
+def test_the_api_reference_documents_the_modules(built):
+    page = (built / "reference" / "_generated" / "api.html").read_text()
+    for name in ("hexdem.model.contact_law", "hexdem.experiments.sweep", "hexdem.paper.friction_study"):
+        assert f'id="module-{name}"' in page
+
+
+def test_the_gallery_shows_every_shape_and_impact_kind():
+    configs = {path.stem: RunConfig(**tomllib.loads(path.read_text()))
+               for path in sorted((DOCS / "gallery" / "configs").glob("*.toml"))}
+    assert {config.shape for config in configs.values()} == set(SHAPES)
+    models = {name: config.model() for name, config in configs.items()}
+    kinds = {"velocity": any(not m.strikers for m in models.values()),
+             "striker": any(len(m.strikers) == 1 for m in models.values()),
+             "several impacts": any(len(m.impacts) > 1 and not m.strikers for m in models.values()),
+             "a flat striker": any(len(m.strikers) > 1 for m in models.values()),
+             "an interior impact": any(config.precompression_n > 0 for config in configs.values())}
+    assert all(kinds.values()), kinds
+    page = (DOCS / "gallery" / "index.md").read_text()
+    for name in configs:
+        assert f"configs/{name}.toml" in page and (DOCS / "gallery" / "images" / f"{name}.png").exists()
+
+
+def test_the_readme_is_a_front_page_with_the_commands_ci_runs():
+    readme = (ROOT / "README.md").read_text()
+    assert len(readme.splitlines()) <= 200
+    ci = (ROOT / ".ci" / "run").read_text().splitlines()[-1]
+    assert ci in readme, "the README's test command is the one .ci/run calls"
+    assert "python3 -m venv .venv && .venv/bin/pip install -q . && .venv/bin/hexdem run" in readme
+    for link in re.findall(r"\]\((docs/[^)#]+)", readme):
+        assert (ROOT / link).exists(), link
+    assert re.search(r"!\[[^]]*\]\(docs/gallery/images/\w+\.png\)", readme), "one picture"
