@@ -38,7 +38,7 @@ PEAK_DIFF, ARRIVAL_DIFF, CHECKED = (COMPARE_COLUMNS.index(key) for key in ("peak
 
 
 #: LAMMPS's measured error at N steps per contact time τ, against the converged answer, over the
-#: lines' beads above 1 % of V0 (``benchmarks/bench_accuracy.py``, README "Time step"): velocity
+#: lines' beads above 1 % of V0 (``benchmarks/bench_accuracy.py``, docs/validation/convergence.md): velocity
 #: Verlet's peak-speed error is at most 0.77/N² relative and its arrival-time error 3.9 τ/N² (the
 #: coefficients below round them up). With Tsuji damping α LAMMPS evaluates the damping force at
 #: the half-step velocity, an error of first order: measured at most 1.43 α/N in peak and
