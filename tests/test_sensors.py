@@ -41,6 +41,18 @@ def test_bad_sensors_are_refused(sensors, message):
         RunConfig(edge_beads=7, sensors=sensors)
 
 
+def test_sensors_may_name_the_extra_lines():
+    """A sensor on bead 3 of an extra line up the middle column: the bead {−20 + 2·3, 10}; a
+    misspelt line is refused with the extra line among the known ones."""
+    lines = [{"name": "across", "site": [-20, 10], "angle_deg": 90}]
+    config = RunConfig(lines=lines, sensors=["across:3", "0:1"])
+    lattice = config.lattice()
+    beads = config.sensor_beads(lattice)
+    assert list(beads) == ["across:3", "0:1"] and tuple(lattice.indices[beads["across:3"]]) == (-14, 10)
+    with pytest.raises(HexdemError, match="line one of 0, [+]30, -30, across"):
+        RunConfig(lines=lines, sensors=["acros:3"])
+
+
 def test_sensor_files_follow_the_run(sensor_run):
     out, analysis = sensor_run
     header, rows = read_csv(out / "sensors.csv")

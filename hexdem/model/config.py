@@ -21,7 +21,7 @@ from hexdem.model.contact_law import Friction
 from hexdem.model.dissipation import damping_coefficient, lammps_tsuji_coefficient
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.impacts import ImpactSpec, cut_holes, impact_specs, resolve_impacts, struck_site
-from hexdem.model.lattice import (LINE_STEPS, Lattice, disc, half_disc, half_hexagon, hexagon, parallelogram, triangle,
+from hexdem.model.lattice import (Lattice, disc, half_disc, half_hexagon, hexagon, parallelogram, triangle,
                                    without_hole, without_sites)
 from hexdem.model.lines import with_lines
 from hexdem.model.sites import read_sites
@@ -321,8 +321,9 @@ class RunConfig:
         return resolve_impacts(self.impact_specs(), lattice, self.unit_system.velocity_m_s, self.material)
 
     def sensor_beads(self, lattice: Lattice) -> dict[str, int]:
-        """{label: bead index} of the ``sensors``, in the order given ("line:n" or a bead id)."""
-        beads = {}
+        """{label: bead index} of the ``sensors``, in the order given ("line:n", the line one of the
+        paper's three or of the extra ``lines``, or a bead id)."""
+        beads, lines = {}, lattice.lines()
         for sensor in self.sensors:
             if isinstance(sensor, int) and not isinstance(sensor, bool):
                 if not 1 <= sensor <= len(lattice):
@@ -330,10 +331,10 @@ class RunConfig:
                 beads[str(sensor)] = sensor - 1
                 continue
             name, _, n = str(sensor).partition(":")
-            if name not in LINE_STEPS or not n.isdigit():
+            if name not in lines or not n.isdigit():
                 raise HexdemError(f"sensor {sensor!r} is neither a bead id nor 'line:n' with line one of "
-                                  f"{', '.join(LINE_STEPS)}")
-            line = lattice.line(name)
+                                  f"{', '.join(lines)}")
+            line = lines[name]
             if int(n) >= len(line):
                 raise HexdemError(f"sensor {sensor!r}: line {name} has beads 0 to {len(line) - 1}")
             beads[str(sensor)] = int(line[int(n)])
