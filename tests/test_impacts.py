@@ -152,3 +152,28 @@ def test_bad_impacts_and_lines_get_one_line_errors(changes, message):
     with pytest.raises(HexdemError, match=None) as error:
         RunConfig(**changes)
     assert message in str(error.value) and "\n" not in str(error.value)
+
+
+def test_the_far_wall_of_every_impact_must_be_reached():
+    """A double strike from both ends of the hexagon's middle row: each impact's far wall is the
+    other's struck wall, so a run in which the left wall's beads are reached only at the very
+    end (the second impact's wave still crossing) has not reached its far walls, whatever the
+    first impact's far wall says."""
+    from hexdem.analysis.impact import ImpactAnalysis
+    from hexdem.analysis.energy import energy_regions
+
+    config = RunConfig(impacts=[{"site": [0, 0]}, {"site": [0, 20], "angle_deg": 180.0}])
+    model = config.model()
+    settings = config.settings(model)
+    n = len(model.lattice)
+    left = next(w for w in model.walls if w.normal[0] > 0.99)
+
+    def far_wall_reached(reach_time):
+        regions = len(energy_regions(model)[0])
+        return ImpactAnalysis(model, settings, {}, np.ones(n), np.zeros(n), np.zeros(n), reach_time, 0.0,
+                              (np.zeros(1), np.zeros((1, regions, 2)))).results.far_wall_reached
+
+    reach = np.zeros(n)
+    assert far_wall_reached(reach)
+    reach[left.members] = settings.duration_s / settings.units.time_s
+    assert not far_wall_reached(reach)

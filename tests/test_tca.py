@@ -160,3 +160,16 @@ def test_tca_figures_compare_favourably_with_the_lattice(tmp_path):
         assert result[figure]["max_relative_deviation_tca"] < 0.15
     for name in ("fig5a_pulse_speed", "fig5b_arrival_time"):
         assert (tmp_path / f"{name}.png").stat().st_size > 0 and (tmp_path / f"{name}.csv").stat().st_size > 0
+
+
+@pytest.mark.parametrize("table", [tca.pulse_speed_table, tca.arrival_time_table])
+def test_the_tca_comparison_refuses_a_run_of_several_impacts(tmp_path, table):
+    """A double strike: the second front crosses the line the TCA follows (it used to be
+    compared with the first impact's speed alone)."""
+    from hexdem.experiments.run import simulate
+    from hexdem.model.config import RunConfig
+
+    config = RunConfig(edge_beads=5, engine="reference", impacts=[{"site": [0, 0]}, {"site": [0, 8], "angle_deg": 180.0}])
+    analysis = simulate(config, tmp_path, log=lambda message: None, trace_lines=["+30"])
+    with pytest.raises(HexdemError, match="single impact; this run has 2"):
+        table(analysis)

@@ -75,21 +75,25 @@ class ImpactAnalysis:
                    pulses.reach_time, trajectory.energy_drift(model), (times_s / units.time_s, energies))
 
     def _far_wall_reached(self) -> bool:
-        """Did the leading wave reach every bead at the walls facing the strike within the run?
-        Those are the wall beads whose inward normal points against the strike within 30° as
-        much as the most-facing one's does (the far wall of a hexagon, both far walls of a
-        triangle, the far arc of a disc); without such a wall (no walls, or only the struck
-        edge's) every bead counts. A bead counts as reached when its speed rose to
+        """Did the leading waves reach every bead at the walls facing the strikes within the run?
+        For each impact, those are the wall beads whose inward normal points against its
+        direction within 30° as much as the most-facing one's does (the far wall of a hexagon,
+        both far walls of a triangle, the far arc of a disc; a double strike's two far walls);
+        without such a wall (no walls, or only the struck edge's) every bead counts. A bead counts as reached when its speed rose to
         half of its largest value at least one impact time scale (``settings.contact_time_s``)
         before the run ended: a bead still on its first rise at the end has not been passed by
         the front, while one whose speed keeps growing under reflections (a precompressed box
         rings) has."""
         r = self.results
-        beads = np.arange(len(r.reach_time))
         members, normals = wall_normals(self.model.walls, self.model.lattice.positions_m)
-        against = -normals @ self.model.impact.direction
-        if len(against) and against.max() > 1e-9:
-            beads = np.unique(members[against >= against.max() * FAR_WALL_COSINE - 1e-9])
+        facing = []
+        for impact in self.model.impacts:
+            against = -normals @ impact.direction
+            if not (len(against) and against.max() > 1e-9):
+                facing = [np.arange(len(r.reach_time))]
+                break
+            facing.append(members[against >= against.max() * FAR_WALL_COSINE - 1e-9])
+        beads = np.unique(np.concatenate(facing))
         units = self.settings.units
         latest = (self.settings.duration_s - self.settings.contact_time_s) / units.time_s
         return bool(np.all(r.reach_time[beads] <= latest))

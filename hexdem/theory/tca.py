@@ -290,6 +290,15 @@ def lattice_pulses(analysis, line: str) -> LatticePulses:
     return LatticePulses(np.arange(len(crossing)), crossing, np.diff(np.concatenate([[0.0], crossing])))
 
 
+def _impact_speed_m_s(analysis) -> float:
+    """The speed of the run's impact [m/s]: the TCA follows the pulse of a single impact, which
+    other fronts crossing the line would distort (a run of several is refused)."""
+    impacts = analysis.model.impacts
+    if len(impacts) != 1:
+        raise HexdemError(f"the TCA comparison follows the pulse of a single impact; this run has {len(impacts)}")
+    return impacts[0].speed_m_s
+
+
 def _nondimensional_units(analysis):
     from hexdem.model.units import nondimensional
 
@@ -299,11 +308,12 @@ def _nondimensional_units(analysis):
 def pulse_speed_table(analysis, line: str = "+30") -> dict:
     """Fig. 5a: c_n = 1/T_n along ``line`` of a 30°-strike run against the TCA started with the
     run's V₀ at n = 0. Arrays ``n``, ``lattice``, ``tca``, ``hyperg`` (nondimensional), NaN-free."""
+    v0_m_s = _impact_speed_m_s(analysis)
     units = _nondimensional_units(analysis)
     measured = lattice_pulses(analysis, line)
     keep = np.isfinite(measured.residence_time)
     n = measured.n[keep]
-    v0 = analysis.model.impact.speed_m_s / units.velocity_m_s
+    v0 = v0_m_s / units.velocity_m_s
     prediction = predict_pulses(v0, 0, int(n.max()))
     speed = measured.pulse_speed[keep] * units.time_s / analysis.settings.units.time_s
     return {"n": n, "lattice": speed, "tca": prediction.pulse_speed[n], "hyperg": prediction.pulse_speed_hyperg[n]}
@@ -314,11 +324,12 @@ def arrival_time_table(analysis, line: str = "+30") -> dict:
     run's time unit. The lattice's arrival at n is when beads n − 1 and n move equally fast;
     the TCA's is the lattice's arrival at bead 1 (the anchor, as the paper anchors the
     experiment at its first sensor) plus the TCA residence times from V₁ = V₀/2 on."""
+    v0_m_s = _impact_speed_m_s(analysis)
     units = _nondimensional_units(analysis)
     scale = analysis.settings.units.time_s / units.time_s
     lattice = lattice_pulses(analysis, line).crossing_time
     lattice = lattice[:np.flatnonzero(np.isfinite(lattice))[-1] + 1]
-    v1 = 0.5 * analysis.model.impact.speed_m_s / units.velocity_m_s
+    v1 = 0.5 * v0_m_s / units.velocity_m_s
     prediction = predict_pulses(v1, 1, len(lattice) - 1)
     tca, hyperg = prediction.arrival_times(t_first=lattice[0] * scale)
     return {"n": np.arange(1, len(lattice) + 1), "lattice": lattice,
