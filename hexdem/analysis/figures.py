@@ -14,17 +14,38 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import EllipseCollection
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
+from matplotlib.ticker import FuncFormatter, LogFormatter
 
 from hexdem.analysis.front_shape import HEXAGON_SIXFOLD
 from hexdem.common.io import atomic_path
 from hexdem.model.walls import CurvedWall
 
 UNIT_LABELS = {"si": {"length": "m", "speed": "m/s", "time": "ms", "time_scale": 1e3},
-               "nondimensional": {"length": "d", "speed": "$\\sqrt{A/M}\\,d^{5/4}$", "time": "T", "time_scale": 1.0}}
+               "nondimensional": {"length": "d", "speed": "√(A/M) d^(5/4)", "time": "T", "time_scale": 1.0}}
 
 #: Fixed margins of the one-panel figures every run writes: a constrained layout would cost
 #: about a tenth of a second per figure, measured on the default run.
 SINGLE_PLOT_MARGINS = {"left": 0.13, "right": 0.97, "bottom": 0.12, "top": 0.92}
+
+
+#: Digits as superscripts, for the decades of a logarithmic axis (10⁻²).
+SUPERSCRIPTS = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+
+
+def decade_label(value: float, position=None) -> str:
+    """A major tick of a logarithmic axis in plain text: 10⁻² at a decade, else the number."""
+    exponent = np.log10(value)
+    if np.isclose(exponent, round(exponent)):
+        return "10" + str(int(round(exponent))).translate(SUPERSCRIPTS)
+    return f"{value:g}"
+
+
+def plain_log_ticks(axis) -> None:
+    """Label a logarithmic axis in plain text (10⁻², and 2e−02 where minor ticks are labelled),
+    at the ticks matplotlib itself picks: its default labels are mathtext, whose parser costs
+    about a third of a second on a run's first figure (the run's figures carry no other mathtext)."""
+    axis.set_major_formatter(FuncFormatter(decade_label))
+    axis.set_minor_formatter(LogFormatter(labelOnlyBase=False))
 
 
 def set_title(ax, title: str) -> None:
@@ -66,7 +87,9 @@ def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=No
     ax.update_datalim(np.vstack([positions.min(axis=0) - radius, positions.max(axis=0) + radius]))
     ax.set_aspect("equal")
     ax.autoscale_view()
-    ax.figure.colorbar(circles, ax=ax, label=label, shrink=0.8)
+    bar = ax.figure.colorbar(circles, ax=ax, label=label, shrink=0.8)
+    if isinstance(norm, LogNorm):
+        plain_log_ticks(bar.ax.yaxis)
     return circles
 
 
@@ -126,7 +149,7 @@ def peak_map(results, model, v0: float, path, title="Peak speed") -> None:
     by decades as they spread)."""
     ratio = results.peak_speed / v0
     floor = max(float(np.nanmin(ratio[ratio > 0])) if np.any(ratio > 0) else 1e-3, 1e-3)
-    lattice_map(results, model, ratio, path, "peak speed $V_{max} / V_0$", title, cmap="magma",
+    lattice_map(results, model, ratio, path, "peak speed V_max / V₀", title, cmap="magma",
                 norm=LogNorm(floor, max(float(np.nanmax(ratio)), floor * 10)))
 
 
@@ -139,7 +162,8 @@ def peak_decay(rows_by_line: dict, path, units_name: str, v0: float, title="Peak
     for line, (n, peak) in rows_by_line.items():
         ax.semilogy(n, np.asarray(peak) / v0, marker=markers.get(line, "o"), linestyle="-", label=f"{line}°")
     ax.set_xlabel("bead n along the line")
-    ax.set_ylabel(f"$V_n / V_0$   ($V_0$ = {v0:.4g} {units['speed']})")
+    ax.set_ylabel(f"Vₙ / V₀   (V₀ = {v0:.4g} {units['speed']})")
+    plain_log_ticks(ax.yaxis)
     set_title(ax, title)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(title="observation line")
@@ -191,12 +215,13 @@ def front_shape_figure(curves: dict, path, title="Roundness of the wavefront", f
             ax.axhline(fit.a_inf, color=line.get_color(), linestyle=":", linewidth=1)
     if fits:
         ax.set_xscale("log")
+        plain_log_ticks(ax.xaxis)
     ax.axhline(HEXAGON_SIXFOLD, color="k", linestyle="--", linewidth=1, label=f"regular hexagon ({HEXAGON_SIXFOLD:.4f})")
     if signed:
         ax.axhline(-HEXAGON_SIXFOLD, color="k", linestyle="--", linewidth=1)
     ax.axhline(0.0, color="grey", linestyle="-", linewidth=1, label="circle (0)")
-    ax.set_xlabel("mean front radius $a_0$ [d]")
-    ax.set_ylabel("sixfold component $a_6/a_0$  [–]" if signed else "sixfold amplitude $\\sqrt{a_6^2 + b_6^2}\\,/\\,a_0$  [–]")
+    ax.set_xlabel("mean front radius a₀ [d]")
+    ax.set_ylabel("sixfold component a₆/a₀  [–]" if signed else "sixfold amplitude √(a₆² + b₆²) / a₀  [–]")
     set_title(ax, title)
     ax.grid(True, alpha=0.3)
     ax.legend()

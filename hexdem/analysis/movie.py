@@ -22,8 +22,8 @@ PALETTE_COLOURS = 192
 #: The colour scale spans this many decades below V0.
 DECADES = 3.0
 #: Colour-bar labels of the speed movie and of the spin movie.
-SPEED_LABEL = "speed $|v| / V_0$"
-SPIN_LABEL = r"spin: rim speed $|\omega_z| r / V_0$"
+SPEED_LABEL = "speed |v| / V₀"
+SPIN_LABEL = "spin: rim speed |ω_z| r / V₀"
 
 
 def movie_samples(n_samples: int, frames: int = MOVIE_FRAMES) -> tuple[int, ...]:
