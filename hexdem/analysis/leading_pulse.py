@@ -26,11 +26,28 @@ LEAD_THRESHOLD = 0.2
 LEAD_FALL = 0.8
 
 
-def _parabola_vertex(before: float, peak: float, after: float) -> float:
+def parabola_vertex(before: float, peak: float, after: float) -> float:
+    """The largest value of the parabola through three evenly spaced samples, the middle one
+    the highest (the sample itself where they do not curve down)."""
     curvature = before - 2 * peak + after
     if curvature >= 0:
         return peak
     return peak - (after - before) ** 2 / (8 * curvature)
+
+
+def leading_maximum(signal, threshold: float = LEAD_THRESHOLD, fall: float = LEAD_FALL) -> int:
+    """Index of the highest sample of the leading pulse of one speed signal (see the module
+    docstring), −1 if it has none."""
+    largest = np.nanmax(signal) if np.any(np.isfinite(signal)) else 0.0
+    if not largest > 0:
+        return -1
+    best, index = -np.inf, -1
+    for k in range(np.flatnonzero(signal >= threshold * largest)[0], len(signal)):
+        if signal[k] > best:
+            best, index = signal[k], k
+        elif signal[k] < fall * best:
+            return index if 0 < index < len(signal) - 1 else -1
+    return -1
 
 
 def leading_pulse_amplitude(speeds, threshold: float = LEAD_THRESHOLD, fall: float = LEAD_FALL) -> np.ndarray:
@@ -38,18 +55,7 @@ def leading_pulse_amplitude(speeds, threshold: float = LEAD_THRESHOLD, fall: flo
     speeds = np.asarray(speeds, float)
     amplitudes = np.full(speeds.shape[1], np.nan)
     for bead, signal in enumerate(speeds.T):
-        largest = np.nanmax(signal) if np.any(np.isfinite(signal)) else 0.0
-        if not largest > 0:
-            continue
-        above = np.flatnonzero(signal >= threshold * largest)
-        best, index = -np.inf, -1
-        for k in range(above[0], len(signal)):
-            if signal[k] > best:
-                best, index = signal[k], k
-            elif signal[k] < fall * best:
-                break
-        else:
-            continue
-        if 0 < index < len(signal) - 1:
-            amplitudes[bead] = _parabola_vertex(signal[index - 1], best, signal[index + 1])
+        index = leading_maximum(signal, threshold, fall)
+        if index >= 0:
+            amplitudes[bead] = parabola_vertex(signal[index - 1], signal[index], signal[index + 1])
     return amplitudes

@@ -55,14 +55,15 @@ def _replace_dir(source: Path, target: Path) -> None:
     source.rename(target)
 
 
-def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples=(), comm=None) -> ImpactAnalysis:
+def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples=(), comm=None,
+             trace_beads=()) -> ImpactAnalysis:
     """Run ``config`` with its engine in ``workdir``, analysed while it runs (no result files).
 
     ``comm``: a one-rank mpi4py communicator when this runs inside an MPI job of several
     independent runs (see :func:`~hexdem.experiments.parallel.spread_tasks`), else None.
 
     ``trace_lines`` (observation line names) keep the speeds of those lines' beads at every
-    sample, ``field_samples`` every bead's speed at those samples (see
+    sample, and so do ``trace_beads`` (bead indices) for theirs; ``field_samples`` every bead's speed at those samples (see
     :class:`~hexdem.analysis.tracker.PulseTracker`), and those of the movie's frames
     (:func:`~hexdem.analysis.movie.movie_samples`) with ``config.movie``. A LAMMPS deck directory also gets
     ``hexdem.json`` (the configuration), which ``hexdem analyse`` reads.
@@ -77,7 +78,8 @@ def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples
     log(f"running {config.engine}: {model.lattice.shape}, {model.n_bodies} bodies, "
         f"{settings.n_steps} steps of {settings.dt_s:.4g} s ({settings.duration_s * 1e3:.4g} ms), "
         f"{config.ranks if config.engine == 'lammps' else 1} rank(s), {settings.n_samples} samples analysed in the run")
-    traced = tuple(int(bead) for line in trace_lines for bead in model.lattice.line(line))
+    traced = tuple(dict.fromkeys([*(int(bead) for line in trace_lines for bead in model.lattice.line(line)),
+                                  *(int(bead) for bead in trace_beads)]))
     frames = movie_samples(settings.n_samples) if config.movie else ()
     job = ImpactJob(model, settings, config.engine, workdir, dump=config.dump, trace_beads=traced,
                     field_samples=tuple(sorted(set(field_samples) | set(frames))))
