@@ -98,7 +98,8 @@ class MigratingBeads:
         n, ranks = len(model.lattice), 1 if comm is None else comm.Get_size()
         speeds = _synthetic_speeds(times, n, rng)
         owners = np.repeat(rng.integers(0, ranks, (self.n_samples // self.every + 1, n)), self.every, axis=0)
-        tracker = PulseTracker(model, RunSettings(dt_s=times[1], n_steps=self.n_samples - 1, dump_every=1), comm)
+        tracker = PulseTracker(model, RunSettings(dt_s=times[1], n_steps=self.n_samples - 1, dump_every=1), comm,
+                               threshold_speed=0.05)
         if tracker.root:
             tracker.audit = NoAudit()
         rank = 0 if comm is None else comm.Get_rank()
@@ -115,9 +116,23 @@ def test_beads_that_change_ranks_keep_their_pulses(tmp_path, monkeypatch):
     one, _ = MigratingBeads()(None)
     two, handed_over = run_on_ranks(MigratingBeads(), 2, tmp_path)
     assert handed_over > 500  # about half of 37 beads at each of 42 draws
-    assert np.isfinite(one.arrival_time).sum() > 20
-    for name in ("peak_speed", "t_peak", "arrival_time", "reach_time"):
+    assert np.isfinite(one.arrival_time).sum() > 20 and np.isfinite(one.threshold_time).sum() > 20
+    for name in ("peak_speed", "t_peak", "arrival_time", "reach_time", "threshold_time"):
         np.testing.assert_array_equal(getattr(two, name), getattr(one, name), err_msg=name)
+
+
+def test_the_tracker_records_when_each_bead_first_reaches_a_fixed_speed(tmp_path):
+    """The threshold's first crossing, from the whole trace of the 0° line, interpolated by hand
+    between the samples around it: the same time to round-off (the struck bead: 0)."""
+    threshold = 0.01
+    analysis = simulate(RunConfig(edge_beads=5, engine="reference"), tmp_path, trace_lines=["0"],
+                        threshold_speed=threshold)
+    times, speeds = analysis.line_trace("0")
+    for k, bead in enumerate(analysis.results.lines["0"]):
+        i = int(np.argmax(speeds[:, k] >= threshold))
+        expected = 0.0 if i == 0 else np.interp(threshold, speeds[i - 1:i + 1, k], times[i - 1:i + 1])
+        assert analysis.tracked.threshold_time[bead] == pytest.approx(expected, rel=1e-12, abs=1e-15)
+    assert analysis.tracked.threshold_time[analysis.results.lines["0"][-1]] > 0
 
 
 def test_memory_does_not_grow_with_the_run_length(tmp_path):

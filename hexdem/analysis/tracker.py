@@ -15,8 +15,9 @@ definitions of :mod:`hexdem.analysis.peaks`:
 
 It also audits the energy (kinetic + Hertz, minus the work of gravity if any) at about
 :data:`ENERGY_SAMPLES` evenly spaced samples, records the speed of a few ``trace_beads`` at
-every sample (pulse shapes for the theory), and the speed of every bead at the samples
-``field_samples`` (wavefront snapshots).
+every sample (pulse shapes for the theory), the speed of every bead at the samples
+``field_samples`` (wavefront snapshots), and, given a ``threshold_speed``, the first time each
+bead's speed reaches it (a second measure of the front, interpolated linearly between samples).
 
 **Several ranks.** Under MPI every rank owns some atoms and sees only those. Each rank keeps
 state arrays for all beads but updates only its own; the state of a bead is exact on the
@@ -60,6 +61,8 @@ class TrackedPulses:
     energy [J] of each region (:func:`~hexdem.analysis.energy.energy_regions`) at those times;
     ``n_samples``;
     ``trace_times`` (S,) and ``trace_speeds`` (S, len(trace_beads)); ``field_times`` (F,) and
+    ``threshold_time`` (N,) when each bead's speed first reached the tracker's ``threshold_speed``
+    (NaN: never, or no threshold asked for);
     ``field_speeds`` (F, N) at the requested snapshot samples, and ``field_rim_speeds`` (F, N)
     there, each bead's |ω_z| r, the speed its rim turns at (empty, (0, N), for spheres that do
     not turn); ``sensor_times`` (K,) and
@@ -84,6 +87,7 @@ class TrackedPulses:
     field_times: np.ndarray
     field_speeds: np.ndarray
     field_rim_speeds: np.ndarray
+    threshold_time: np.ndarray
     sensor_times: np.ndarray
     sensor_states: np.ndarray
     peak_angular_speed: np.ndarray
@@ -96,17 +100,20 @@ class PulseTracker:
     ``model`` and ``settings`` are the run's (SI model, run units from ``settings.units``);
     ``comm`` the mpi4py communicator of the ranks that share the run (None: one rank);
     ``trace_beads`` bead indices whose every sample is kept; ``field_samples`` sample
-    indices at which every bead's speed is kept; ``gravity_m_s2`` the run's uniform gravity.
+    indices at which every bead's speed is kept; ``gravity_m_s2`` the run's uniform gravity;
+    ``threshold_speed`` (run units) a speed whose first crossing by each bead is recorded.
     """
 
     def __init__(self, model: GranularModel, settings: RunSettings, comm=None, trace_beads=(),
-                 field_samples=(), gravity_m_s2=None):
+                 field_samples=(), gravity_m_s2=None, threshold_speed: float | None = None):
         self.model, self.settings, self.comm = model, settings, comm
         self.root = comm is None or comm.Get_rank() == 0
         n, total = len(model.lattice), settings.n_samples
         self.n_beads, self.n_bodies, self.n_samples_expected = n, model.n_bodies, total
         self.pulses = PulseState(n, RECORD_CAPACITY)
         self.peak_spin = np.zeros(n)
+        self.threshold_speed = threshold_speed
+        self.threshold_index, self.previous_speed = np.full(n, np.nan), np.zeros(n)
         self.owned = np.zeros(n, dtype=np.bool_)
         self.trace_beads = np.asarray(trace_beads, dtype=np.int64)
         self.traces = np.full((total, len(self.trace_beads)), np.nan)
@@ -127,7 +134,7 @@ class PulseTracker:
     # ---- state shared across ranks
     def _bead_state(self) -> list[np.ndarray]:
         """Every per-bead array that the bead's owner keeps up to date."""
-        return [*self.pulses.arrays(), self.peak_spin]
+        return [*self.pulses.arrays(), self.peak_spin, self.threshold_index, self.previous_speed]
 
     def _hand_over(self, owned: np.ndarray) -> None:
         """Give each bead that changed ranks since the last sample (``owned``: this rank's beads
@@ -185,6 +192,8 @@ class PulseTracker:
         else:
             self.owned[index] = True
         self.pulses.update(index, speeds, s)
+        if self.threshold_speed is not None:
+            self._cross_threshold(index, speeds, s)
         if sample.angular_velocities is not None:
             self.peak_spin[index] = np.maximum(self.peak_spin[index], np.abs(sample.angular_velocities[beads]))
         if len(self.trace_beads):
@@ -200,6 +209,16 @@ class PulseTracker:
         if s % self.energy_every == 0 or s == self.n_samples_expected - 1:
             self._audit(sample)
         self.count = s + 1
+
+    def _cross_threshold(self, index: np.ndarray, speeds: np.ndarray, s: int) -> None:
+        """Record, as a fractional sample index, where each bead's speed first reached the
+        threshold (linear between its previous sample and this one; 0 for a bead at it from the start)."""
+        fresh = np.isnan(self.threshold_index[index]) & (speeds >= self.threshold_speed)
+        if fresh.any():
+            beads, now = index[fresh], speeds[fresh]
+            before = self.previous_speed[beads]
+            self.threshold_index[beads] = np.maximum(s - (now - self.threshold_speed) / (now - before), 0.0)
+        self.previous_speed[index] = speeds
 
     def _rows(self, sample: Sample, beads: np.ndarray):
         """(mask of ``beads`` this rank owns, their rows in ``sample``)."""
@@ -263,7 +282,7 @@ class PulseTracker:
                              n_samples=self.count, trace_beads=self.trace_beads,
                              trace_times=np.arange(self.count) * interval, trace_speeds=self.traces[:self.count],
                              field_times=self.field_samples * interval, field_speeds=self.fields,
-                             field_rim_speeds=self.rim_fields,
+                             field_rim_speeds=self.rim_fields, threshold_time=self.threshold_index * interval,
                              sensor_times=np.arange(len(self.sensors)) * self.sensor_every * self.settings.dt_s
                              / self.settings.units.time_s, sensor_states=self.sensors,
                              peak_angular_speed=self.peak_spin,

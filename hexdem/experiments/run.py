@@ -56,14 +56,15 @@ def _replace_dir(source: Path, target: Path) -> None:
 
 
 def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples=(), comm=None,
-             trace_beads=()) -> ImpactAnalysis:
+             trace_beads=(), threshold_speed: float | None = None) -> ImpactAnalysis:
     """Run ``config`` with its engine in ``workdir``, analysed while it runs (no result files).
 
     ``comm``: a one-rank mpi4py communicator when this runs inside an MPI job of several
     independent runs (see :func:`~hexdem.experiments.parallel.spread_tasks`), else None.
 
     ``trace_lines`` (observation line names) keep the speeds of those lines' beads at every
-    sample, and so do ``trace_beads`` (bead indices) for theirs; ``field_samples`` every bead's speed at those samples (see
+    sample, and so do ``trace_beads`` (bead indices) for theirs; ``threshold_speed`` (run units)
+    records when each bead's speed first reaches it; ``field_samples`` every bead's speed at those samples (see
     :class:`~hexdem.analysis.tracker.PulseTracker`), and those of the movie's frames
     (:func:`~hexdem.analysis.movie.movie_samples`) with ``config.movie``. A LAMMPS deck directory also gets
     ``hexdem.json`` (the configuration), which ``hexdem analyse`` reads.
@@ -82,7 +83,7 @@ def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples
                                   *(int(bead) for bead in trace_beads)]))
     frames = movie_samples(settings.n_samples) if config.movie else ()
     job = ImpactJob(model, settings, config.engine, workdir, dump=config.dump, trace_beads=traced,
-                    field_samples=tuple(sorted(set(field_samples) | set(frames))))
+                    field_samples=tuple(sorted(set(field_samples) | set(frames))), threshold_speed=threshold_speed)
     analysis = track_impact(job, config.ranks, comm, config.launcher)
     check_energy(analysis, workdir)
     return analysis
@@ -201,22 +202,24 @@ def energy_region_rows(results) -> list[tuple]:
 
 def measure_front_shape(analysis: ImpactAnalysis, count: int = 8, geometric: bool = False,
                         window_deg: float | None = None, start_quantile: float = 0.05,
-                        wall_margin_d: float = FRONT_WALL_MARGIN_D) -> FrontShape:
+                        wall_margin_d: float = FRONT_WALL_MARGIN_D, arrival_times=None) -> FrontShape:
     """Roundness of the half-maximum arrival front about the struck bead against its mean radius
     in bead diameters at ``count`` times (:func:`~hexdem.analysis.front_shape.front_times`), each
     direction read until the front comes within ``wall_margin_d`` of the packing's edge there
     (``window_deg``: only the rays of that window about +x), from the
     ``start_quantile`` of the arrival times on; no rows when the packing is too small for the
-    front to grow before it meets one."""
+    front to grow before it meets one. ``arrival_times`` (run units; default the half-maximum
+    arrivals) defines the front otherwise, for example by a fixed speed's first crossing."""
     model, r = analysis.model, analysis.results
+    arrivals = r.arrival_time if arrival_times is None else np.asarray(arrival_times, float)
     positions = model.lattice.positions_m / model.lattice.diameter_m
     origin = positions[model.lattice.struck]
     try:
-        times = front_times(positions, r.arrival_time, origin, count, start_quantile, wall_margin=wall_margin_d,
+        times = front_times(positions, arrivals, origin, count, start_quantile, wall_margin=wall_margin_d,
                             geometric=geometric, window_deg=window_deg)
     except HexdemError:
         times = []
-    return front_shape(positions, r.arrival_time, origin, times, wall_margin=wall_margin_d, window_deg=window_deg)
+    return front_shape(positions, arrivals, origin, times, wall_margin=wall_margin_d, window_deg=window_deg)
 
 
 def run_experiment(config: RunConfig, out, log=None, comm=None) -> ImpactAnalysis:

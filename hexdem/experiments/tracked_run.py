@@ -23,8 +23,8 @@ class ImpactJob:
 
     ``engine``: "lammps" or "reference"; ``dump``: LAMMPS also writes its full dump;
     ``gravity_m_s2``: uniform in-plane gravity (gx, gy) [m/s²] or None; ``trace_beads`` and
-    ``field_samples``: what the tracker keeps besides the pulses; ``show_progress``: a bar on
-    a terminal.
+    ``field_samples``: what the tracker keeps besides the pulses; ``threshold_speed`` (run units):
+    a speed whose first crossing by each bead it records; ``show_progress``: a bar on a terminal.
     """
 
     model: GranularModel
@@ -36,10 +36,11 @@ class ImpactJob:
     trace_beads: tuple[int, ...] = ()
     field_samples: tuple[int, ...] = ()
     show_progress: bool = True
+    threshold_speed: float | None = None
 
     def __call__(self, comm):
         tracker = PulseTracker(self.model, self.settings, comm, self.trace_beads, self.field_samples,
-                               self.gravity_m_s2)
+                               self.gravity_m_s2, self.threshold_speed)
         if self.engine == "reference":  # numba and its compiled kernels: only for the runs that use them
             from hexdem.engines.reference.engine import ReferenceEngine
 
