@@ -1,8 +1,9 @@
-"""The self-similarity workflow (``--quick``): its files, and the physics its measurements must
-show: Hertz's time scale in the uncompressed pulse, the sound speed in the linear control,
-Nesterenko's law in the chain; and the pulse-shape analysis on signals built by hand."""
+"""The self-similarity workflow (``--quick``): its files (the late rise's included), and the
+physics its measurements must show: Hertz's time scale in the uncompressed pulse, the sound
+speed in the linear control; and the pulse-shape analysis on signals built by hand."""
 
 import csv
+import html
 import json
 import math
 import subprocess
@@ -50,8 +51,14 @@ def test_the_workflow_writes_its_files(quick):
             assert len(entry["fit_range_d"]) == 2 and entry["energy_verdict"]
     chain = json.loads((quick / "chain.json").read_text())
     assert {"front_speed_m_s", "nesterenko_speed_m_s", "relative_deviation", "peak_ratio"} <= set(chain)
+    rise = json.loads((quick / "late_rise.json").read_text())
+    assert set(rise["fits"]) == set(rise["rises"]) == {"baseline", "finer_sampling", "finer_step", "fixed_speed"}
+    assert rise["kind"] in ("artefact of the sampling", "artefact of the time step", "of the half-maximum measure",
+                            "the front's own", "undetermined") and rise["verdict"]
+    with open(quick / "late_rise.csv", newline="") as fh:
+        assert {row["variant"] for row in csv.DictReader(fh)} == set(rise["fits"])
     page = (quick / "self_similarity.html").read_text()
-    assert page.count("data:image/png;base64,") == 3 and "self-similar" in page
+    assert page.count("data:image/png;base64,") == 4 and "self-similar" in page and html.escape(rise["verdict"]) in page
 
 
 @pytest.mark.slow

@@ -11,8 +11,10 @@ test suite's) uses a half-disc of 40 d and a hexagon of 30 per edge. Writes into
 ``self_similarity.json`` (per study and line the exponents with their standard errors, the fit
 range, ``self_similar`` and its criterion, the energy budget), ``chain.json``
 (``front_speed_m_s``, ``nesterenko_speed_m_s``, ``relative_deviation``, ``peak_ratio``, ...),
-``self_similarity.png``, ``profiles.png``, ``chain.png``, ``self_similarity.html``, the runs'
-decks under ``runs/`` and ``workflow.json``.
+``self_similarity.png``, ``profiles.png``, ``chain.png``; the late rise of the front's anisotropy
+measured four ways (:mod:`hexdem.paper.late_rise`: ``late_rise.csv``
+``variant,time,mean_radius_d,sixfold_cos``, ``late_rise.json`` with its verdict, ``late_rise.png``);
+``self_similarity.html``, the runs' decks under ``runs/`` and ``workflow.json``.
 """
 
 from __future__ import annotations
@@ -26,10 +28,11 @@ from pathlib import Path
 import numpy as np
 
 from hexdem.cli.options import add_launcher
-from hexdem.common.io import ensure_writable_dir, write_json
+from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.errors import HexdemError
 from hexdem.experiments.run import simulate
 from hexdem.model.config import RunConfig
+from hexdem.paper import late_rise
 from hexdem.paper.self_similarity import STUDIES, SelfSimilarityStudy, run_study_packing
 from hexdem.paper.self_similarity_outputs import chain_figure, verdict, write_outputs, write_page
 from hexdem.theory.chain_wave import CHAIN_LINE, chain_config, measure_chain
@@ -69,7 +72,12 @@ def run(argv=None) -> int:
         measured = {name: run_study_packing(study, name, out / "runs" / name, log) for name in STUDIES}
         chain = chain_comparison(out, log)
         result = write_outputs(out, measured, chain)
-        write_page(out, result, chain)
+        rise = late_rise.run_late_rise(study.front, out / "runs" / "late_rise", log)
+        write_csv(out / "late_rise.csv", late_rise.COLUMNS, late_rise.rows(rise))
+        rise_verdict = late_rise.verdict(rise)
+        write_json(out / "late_rise.json", rise_verdict)
+        late_rise.late_rise_figure(rise, out / "late_rise.png")
+        write_page(out, result, chain, rise_verdict)
     except HexdemError as exc:
         print(f"self_similarity: error: {exc}", file=sys.stderr)
         return 2
@@ -78,6 +86,7 @@ def run(argv=None) -> int:
         sys.argv[1:] if argv is None else argv), "wall_time_s": wall, "study": study.as_dict()})
     for name in STUDIES:
         log(verdict(result, name))
+    log(rise_verdict["verdict"])
     log(f"chain: {100 * chain['relative_deviation']:+.2f} % from Nesterenko's law; {wall:.0f} s in all")
     return 0
 

@@ -92,6 +92,17 @@ class FrontStudy:
                                               duration=self.control_crossings * far_m / c_l)}
 
 
+def study_front_shape(study: FrontStudy, analysis, arrival_times=None):
+    """The front's shape in a run of the study (:func:`~hexdem.experiments.run.measure_front_shape`
+    with the study's fronts, window and margin, from the radius ``radius_min_d`` on), by the
+    half-maximum arrivals or by ``arrival_times``."""
+    lattice = analysis.model.lattice
+    distance_d = np.hypot(*(lattice.positions_m - lattice.positions_m[lattice.struck]).T) / lattice.diameter_m
+    start = float(np.mean(distance_d <= START_RADIUS_FRACTION * study.radius_min_d))  # fronts from there on
+    return measure_front_shape(analysis, study.fronts, geometric=True, window_deg=study.window_deg,
+                               start_quantile=start, wall_margin_d=study.wall_margin_d, arrival_times=arrival_times)
+
+
 def run_front_study(study: FrontStudy, out, log=None) -> dict:
     """Run both packings into ``out``, fit their roundness and write ``front_shape.csv``
     (columns :data:`STUDY_COLUMNS`), ``front_shape_fit.json`` and ``front_shape.png``; returns
@@ -100,12 +111,7 @@ def run_front_study(study: FrontStudy, out, log=None) -> dict:
     shapes, fits, rows = {}, {}, []
     for name, config in study.configs().items():
         analysis = run_experiment(config, out / name, log)
-        lattice = analysis.model.lattice
-        distance_d = np.hypot(*(lattice.positions_m - lattice.positions_m[lattice.struck]).T) / lattice.diameter_m
-        start = float(np.mean(distance_d <= START_RADIUS_FRACTION * study.radius_min_d))  # fronts from there on
-        shape = measure_front_shape(analysis, study.fronts, geometric=True, window_deg=study.window_deg,
-                                    start_quantile=start, wall_margin_d=study.wall_margin_d)
-        shapes[name] = shape
+        shapes[name] = shape = study_front_shape(study, analysis)
         rows += [(name, *row, float(cos6), float(sin6))
                  for row, cos6, sin6 in zip(shape.rows(), shape.sixfold_cos, shape.sixfold_sin)]
     write_csv(out / "front_shape.csv", STUDY_COLUMNS, rows)  # the measurement stays if a fit fails

@@ -238,7 +238,7 @@ def render_markdown(blocks: list) -> str:
     return "\n".join(lines)
 
 
-def render_html(blocks: list, out: Path) -> str:
+def render_html(blocks: list, out: Path, title: str = "hexdem paper report") -> str:
     body = []
     for block in blocks:
         kind = block[0]
@@ -256,7 +256,7 @@ def render_html(blocks: list, out: Path) -> str:
     style = ("body{font-family:sans-serif;max-width:70em;margin:2em auto;line-height:1.4}"
              "table{border-collapse:collapse;margin:1em 0;font-size:90%}td,th{border:1px solid #bbb;padding:3px 6px}"
              "th{background:#eee}img{max-width:100%}figcaption{font-style:italic}")
-    return (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>hexdem paper report</title>"
+    return (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{html.escape(title)}</title>"
             f"<style>{style}</style></head><body>\n" + "\n".join(body) + "\n</body></html>\n")
 
 

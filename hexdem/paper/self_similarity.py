@@ -60,7 +60,7 @@ class SelfSimilarityStudy:
     @classmethod
     def quick(cls) -> "SelfSimilarityStudy":
         """The test suite's version: a half-disc of 40 d and a hexagon of 30 per edge."""
-        return cls(FrontStudy(edge_beads=30, radius_beads=40), radius_max_d={"uncompressed": 35.0, "precompressed": 24.0},
+        return cls(FrontStudy(edge_beads=30, radius_beads=40, fit_range_d=(8.0, 35.0)), radius_max_d={"uncompressed": 35.0, "precompressed": 24.0},
                    fit_range_d={"uncompressed": (8.0, 35.0), "precompressed": (8.0, 24.0)})
 
     def as_dict(self) -> dict:

@@ -25,13 +25,14 @@ def rows(measured: dict[str, dict[str, Ray]]) -> list[tuple]:
 
 
 def energy_verdict(value: float, stderr: float) -> str:
-    """Does the leading pulse keep the energy it carries across a ring (r^e, e = 0 within two
-    standard errors), or leak it into its tail?"""
+    """Does the leading pulse keep the energy it carries across a ring along this ray (r^e, e = 0
+    within two standard errors), leak it into its tail, or gain it from the neighbouring
+    directions (the budget is per unit angle)?"""
     if abs(value) <= 2 * stderr:
         return "keeps its energy"
     if value < 0:
         return f"leaks energy into its tail: what it carries falls as r^{value:.2f}"
-    return f"gains energy: what it carries grows as r^{value:.2f}"
+    return f"draws energy from the neighbouring directions: what it carries grows as r^{value:.2f}"
 
 
 def summary(measured: dict[str, dict[str, Ray]]) -> dict:
@@ -147,7 +148,7 @@ def write_page(out: Path, result: dict, chain: dict, late_rise: dict | None = No
     if late_rise:
         blocks += [("h2", "The late rise of the front's anisotropy"), ("p", late_rise["verdict"]),
                    ("figure", "late_rise.png", "a6/a0 against the front's radius, as measured four ways")]
-    write_text(out / "self_similarity.html", render_html(blocks, out))
+    write_text(out / "self_similarity.html", render_html(blocks, out, "hexdem: self-similarity of the decaying pulse"))
 
 
 def write_outputs(out: Path, measured: dict, chain: dict) -> dict:
