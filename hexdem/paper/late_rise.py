@@ -114,10 +114,26 @@ def rows(measured: dict) -> list[tuple]:
 
 
 def late_rise_figure(measured: dict, path) -> None:
-    """a6/a0 against the front's radius, the four measurements, with their fitted laws."""
+    """a6/a0 against the front's radius beyond the fit range's start, the four measurements
+    with their fitted laws (dotted: A∞), zoomed on the late rise."""
     from hexdem.analysis import figures as plots
 
-    plots.front_shape_figure({name.replace("_", " "): entry["shape"] for name, entry in measured.items()}, path,
-                             title="The late rise, measured four ways",
-                             fits={name.replace("_", " "): entry["fit"] for name, entry in measured.items()}, signed=True)
+    fig, ax = plots.subplots(figsize=(7, 4.8), layout="constrained")
+    for k, (name, entry) in enumerate(measured.items()):
+        shape, fit = entry["shape"], entry["fit"]
+        keep = shape.mean_radius >= fit.radius_min_d
+        ax.plot(shape.mean_radius[keep], shape.sixfold_cos[keep], "o", color=f"C{k}", markersize=4 - 0.6 * k,
+                label=f"{name.replace('_', ' ')}: A∞ = {fit.a_inf:+.4f} ± {fit.a_inf_se:.4f}, late rise {entry['rise']:+.4f}")
+        radius = np.linspace(fit.radius_min_d, fit.radius_max_d, 100)
+        ax.plot(radius, fit(radius), color=f"C{k}", lw=1)
+        ax.axhline(fit.a_inf, color=f"C{k}", ls=":", lw=1)
+    for fraction in (*PLATEAU, OUTER[0]):
+        ax.axvline(fraction * max(float(np.nanmax(e["shape"].mean_radius)) for e in measured.values()),
+                   color="grey", lw=0.6, ls="--")
+    ax.set_xlabel("mean front radius a₀ [d]")
+    ax.set_ylabel("sixfold component a₆/a₀")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, loc="lower left")
+    ax.set_title("The late rise, measured four ways (dashed: the plateau and the outer fronts)", fontsize=10)
+    plots.save(fig, path)
 
