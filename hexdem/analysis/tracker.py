@@ -241,12 +241,24 @@ class PulseTracker:
             velocities = state[:, 2:4] * units.velocity_m_s
             angular = state[:, 4] / units.time_s if spins else None
             if self.impact_energy is None:
-                self.impact_energy = kinetic_energy_j(velocities, self.model)
+                self.impact_energy = kinetic_energy_j(velocities, self.model) + self._displacement_energy_j(angular)
             energy, by_region = self.audit.measure(state[:, :2] * units.length_m, velocities, angular)
             self.energies.append(energy)
             self.region_energies.append(by_region)
             self.rotational_energies.append(float(np.sum(self.audit.rotational_j(angular))))
             self.energy_times.append(sample.time)
+
+    def _displacement_energy_j(self, angular) -> float:
+        """The contact energy [J] the initial state's displacements add to the packed state's:
+        with the kinetic energy, what the run was given (0 without displacements)."""
+        state = self.model.initial_state
+        if state is None or not state.displacements_m.any():
+            return 0.0
+        moved = self.model.initial_positions_m()
+        packed = moved.copy()
+        packed[:len(state.displacements_m)] -= state.displacements_m
+        still, spins = np.zeros_like(moved), None if angular is None else np.zeros_like(angular)
+        return self.audit.measure(moved, still, spins)[0] - self.audit.measure(packed, still, spins)[0]
 
     # ---- results
     def finish(self) -> TrackedPulses | None:

@@ -21,6 +21,7 @@ from hexdem.model.contact_law import Friction
 from hexdem.model.dissipation import damping_coefficient, lammps_tsuji_coefficient
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.impacts import ImpactSpec, cut_holes, impact_specs, resolve_impacts, struck_site
+from hexdem.model.initial_state import read_initial_state
 from hexdem.model.lattice import (Lattice, disc, half_disc, half_hexagon, hexagon, parallelogram, triangle,
                                    without_hole, without_sites)
 from hexdem.model.lines import with_lines
@@ -75,7 +76,8 @@ class RunConfig:
     bead–wall (None: ``restitution``). ``friction``, ``wall_friction`` (None: ``friction``), ``rolling_friction``:
     Coulomb μ between bodies and against walls, rolling resistance (:mod:`hexdem.model.contact_law`).
     ``precompression_n``: static force per bead–bead contact [N] (0: uncompressed; see
-    :mod:`hexdem.model.precompression`).
+    :mod:`hexdem.model.precompression`). ``initial_state_file``: a CSV ``m,n,vx,vy[,dx,dy]`` of
+    initial velocities and displacements [SI] (:mod:`hexdem.model.initial_state`).
     ``sensors``: sensor particles, each ``"line:n"`` (e.g. ``"0:1"``, ``"+30:6"``) or a bead id;
     sampled at ``sensor_rate_hz`` (the paper's 500 kS/s); ``sensor_mass_factor``: a sensor
     bead's mass relative to a plain bead's.
@@ -145,6 +147,7 @@ class RunConfig:
     wall_friction: float | None = None
     rolling_friction: float = 0.0
     precompression_n: float = 0.0
+    initial_state_file: str | None = None
     sensors: tuple = ()
     sensor_rate_hz: float = 500e3
     sensor_mass_factor: float = 1.0
@@ -308,9 +311,11 @@ class RunConfig:
                                       "wall; strike the other beads inside the packing")
                 held = held if lattice.struck in opened else (0.0, 0.0)
             lattice = holed
+        state = None if self.initial_state_file is None else read_initial_state(self.initial_state_file, lattice)
         return GranularModel(lattice, impacts[0], bead, wall, self.restitution, wall_restitution, held,
                              tuple(self.sensor_beads(lattice).values()), self.sensor_mass_factor, extra,
-                             tuple(impacts[1:]), Friction.of(self.friction, self.wall_friction, self.rolling_friction))
+                             tuple(impacts[1:]), Friction.of(self.friction, self.wall_friction, self.rolling_friction),
+                             state)
 
     def _impacts(self, lattice: Lattice) -> list[Impact]:
         """The model's impacts: the paper's single one on the struck bead, or those of ``impacts``."""

@@ -18,6 +18,7 @@ from hexdem.common.checks import is_number
 from hexdem.errors import HexdemError
 from hexdem.model.contact_law import NO_FRICTION, ContactLaws, Friction
 from hexdem.model.dissipation import check_restitution, damping_coefficient
+from hexdem.model.initial_state import InitialState
 from hexdem.model.lattice import Lattice, strike_direction, unit_vector
 from hexdem.model.materials import DELRIN, STEEL_316, Material
 from hexdem.model.units import SI, UnitSystem
@@ -81,7 +82,8 @@ class GranularModel:
     ``friction`` adds Mindlin's tangential force and the bodies' rotation (:attr:`laws`).
 
     Impacts: ``impact`` (the paper's single impact by default) and ``more_impacts``, each on
-    its own bead (:attr:`impacts`).
+    its own bead (:attr:`impacts`); ``initial_state`` per-bead velocities and displacements at
+    t = 0 besides them (:mod:`hexdem.model.initial_state`; None: at rest where packed).
     """
 
     lattice: Lattice
@@ -96,6 +98,7 @@ class GranularModel:
     extra_materials: tuple[Material, ...] = ()
     more_impacts: tuple[Impact, ...] = ()
     friction: Friction = NO_FRICTION
+    initial_state: InitialState | None = None
 
     def __post_init__(self):
         check_restitution("restitution", self.restitution)
@@ -267,18 +270,23 @@ class GranularModel:
         return bodies
 
     def initial_positions_m(self) -> np.ndarray:
-        """(n_bodies, 2) positions at t = 0; each striker touches its bead from outside."""
+        """(n_bodies, 2) positions at t = 0 (the packed ones, moved by the initial state's
+        displacements); each striker touches its bead, as packed, from outside."""
         pos = self.lattice.positions_m
         beads, diameters = self.struck_beads, self.diameters_m
         strikers = [pos[beads[k]] - (diameters[beads[k]] + diameters[body]) / 2 * self.impacts[k].direction
                     for body, k in enumerate(self._striker_impacts, start=len(self.lattice))]
-        return np.vstack([pos, *strikers]) if strikers else pos.copy()
+        moved = pos if self.initial_state is None else pos + self.initial_state.displacements_m
+        return np.vstack([moved, *strikers]) if strikers else moved.copy()
 
     def initial_velocities_m_s(self) -> np.ndarray:
-        """(n_bodies, 2) velocities at t = 0: each impact's V0 on its striker, or on its bead."""
+        """(n_bodies, 2) velocities at t = 0: the initial state's, plus each impact's V0 on its
+        striker, or on its bead."""
         vel = np.zeros((self.n_bodies, 2))
+        if self.initial_state is not None:
+            vel[:len(self.lattice)] = self.initial_state.velocities_m_s
         for impact, body in zip(self.impacts, self.impact_bodies()):
-            vel[body] = impact.speed_m_s * impact.direction
+            vel[body] += impact.speed_m_s * impact.direction
         return vel
 
 

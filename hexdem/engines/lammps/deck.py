@@ -81,7 +81,9 @@ def type_materials(model: GranularModel) -> list[int]:
 
 
 def data_file(model: GranularModel, units: UnitSystem) -> str:
-    """The text of ``data.hexdem``: every body of ``model`` at its initial position."""
+    """The text of ``data.hexdem``: every body of ``model`` at its initial position, and, with an
+    initial state (:mod:`hexdem.model.initial_state`), every body's initial velocity (the
+    impacts' ``velocity`` commands then set their bodies to the same sums)."""
     pos = model.initial_positions_m() / units.length_m
     diam = model.diameters_m / units.length_m
     densities = model.densities_kg_m3 * model.mass_factors / units.density_kg_m3
@@ -94,6 +96,10 @@ def data_file(model: GranularModel, units: UnitSystem) -> str:
              f"{_fmt(-diam.max())} {_fmt(diam.max())} zlo zhi", "", "Atoms # sphere", ""]
     lines += [f"{i + 1} {t} {_fmt(d)} {_fmt(rho)} {_fmt(x)} {_fmt(y)} 0.0"
               for i, (t, d, rho, (x, y)) in enumerate(zip(types, diam, densities, pos))]
+    if model.initial_state is not None:
+        velocities = model.initial_velocities_m_s() / units.velocity_m_s
+        lines += ["", "Velocities", ""]
+        lines += [f"{i + 1} {_fmt(vx)} {_fmt(vy)} 0.0 0.0 0.0 0.0" for i, (vx, vy) in enumerate(velocities)]
     return "\n".join(lines) + "\n"
 
 

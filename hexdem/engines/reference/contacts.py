@@ -45,10 +45,11 @@ def striker_bodies(model: GranularModel) -> tuple[np.ndarray, np.ndarray]:
 
 def wall_geometry(model: GranularModel):
     """(beads, inward normals (K, 2), rest gaps [m], curvatures [1/m], R_eff [m]) of every wall
-    member: n the inward normal at the bead's rest position, curvature 1/ρ with ρ the distance from
-    the rest position to a curved wall's centre (0 for a plane), R_eff the Hertz contact radius."""
+    member: n the inward normal at the bead's rest position (its position at t = 0), curvature 1/ρ
+    with ρ the distance from there to a curved wall's centre (0 for a plane), R_eff the Hertz
+    contact radius."""
     lattice, walls = model.lattice, model.walls
-    positions, radii = lattice.positions_m, lattice.radii_m
+    positions, radii = model.initial_positions_m()[:len(lattice)], lattice.radii_m
     beads, normals = wall_normals(walls, positions)
     gaps = np.concatenate([np.zeros(0)] + [wall.gaps_m(positions[wall.members], radii[wall.members]) for wall in walls])
     curvature = np.concatenate([np.zeros(0)] + [wall.curvatures_at(positions[wall.members]) for wall in walls])

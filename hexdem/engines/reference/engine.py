@@ -87,7 +87,8 @@ class Grid:
 
 
 def _lattice_bonds(model: GranularModel, grid: Grid, units: UnitSystem):
-    """(rest_x, rest_y, contact, stiffness, damping), each (3, hi), of the lattice's fixed bonds."""
+    """(rest_x, rest_y, contact, stiffness, damping), each (3, hi), of the lattice's fixed bonds,
+    their rest vectors those of the beads' positions at t = 0 (displacements q are from there)."""
     lattice = model.lattice
     shape = (len(BOND_STEPS), grid.hi)
     # Empty slots keep a rest vector of bond length, so r > 0 and their force is exactly 0.
@@ -97,8 +98,8 @@ def _lattice_bonds(model: GranularModel, grid: Grid, units: UnitSystem):
     i, j = lattice.bonds().T
     direction = {grid.offset(step): d for d, step in enumerate(BOND_STEPS)}
     d = np.array([direction[o] for o in grid.cells[j] - grid.cells[i]], dtype=int)
-    cell, radii = grid.cells[i], lattice.radii_m
-    rest_x[d, cell], rest_y[d, cell] = (lattice.positions_m[j] - lattice.positions_m[i]).T / units.length_m
+    cell, radii, start = grid.cells[i], lattice.radii_m, model.initial_positions_m()
+    rest_x[d, cell], rest_y[d, cell] = (start[j] - start[i]).T / units.length_m
     contact[d, cell] = (radii[i] + radii[j]) / units.length_m
     stiffness[d, cell] = coefficient(model.contact_stiffness_pa(i, j), reduced(radii[i], radii[j]), units)
     masses = model.masses_kg / units.mass_kg

@@ -1,0 +1,76 @@
+"""Any initial state: per-bead velocities, and displacements from the packed positions.
+
+``initial_state_file`` is a CSV whose header is ``m,n,vx,vy`` or ``m,n,vx,vy,dx,dy``: one bead
+per line, by its label {m, n}, its initial velocity [m/s] and optionally its displacement [m]
+from where the packing (precompressed or not) puts it. Beads not listed start at rest where the
+packing puts them. The impacts add their speeds on top (:meth:`~hexdem.model.granular.GranularModel.initial_velocities_m_s`).
+Both engines start from :meth:`~hexdem.model.granular.GranularModel.initial_positions_m` and
+that method, so they read the state alike.
+
+A displacement of half a diameter or more would put a bead inside its neighbours and is refused,
+as are unknown or repeated sites and values that are not finite numbers.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from hexdem.errors import HexdemError
+from hexdem.model.lattice import Lattice
+
+#: The accepted headers.
+HEADERS = (("m", "n", "vx", "vy"), ("m", "n", "vx", "vy", "dx", "dy"))
+
+
+@dataclass(frozen=True, eq=False)
+class InitialState:
+    """(N, 2) ``velocities_m_s`` and ``displacements_m`` of the packing's N beads."""
+
+    velocities_m_s: np.ndarray
+    displacements_m: np.ndarray
+
+
+def read_initial_state(path, lattice: Lattice) -> InitialState:
+    """The state in the CSV at ``path`` for the beads of ``lattice`` (see the module docstring)."""
+    path = Path(path)
+    name = f"initial_state_file {path}"
+    try:
+        lines = [line for line in path.read_text().splitlines() if line.strip()]
+    except OSError as exc:
+        raise HexdemError(f"cannot read {name}: {exc.strerror}") from None
+    except UnicodeDecodeError:
+        raise HexdemError(f"{name} is not a text file") from None
+    rows = list(csv.reader(lines))
+    header = tuple(cell.strip() for cell in rows[0]) if rows else ()
+    if header not in HEADERS:
+        raise HexdemError(f"{name}: the header must be m,n,vx,vy or m,n,vx,vy,dx,dy, got {','.join(header) or 'nothing'}")
+    n = len(lattice)
+    velocities, displacements, seen = np.zeros((n, 2)), np.zeros((n, 2)), set()
+    for number, row in enumerate(rows[1:], start=2):
+        if len(row) != len(header):
+            raise HexdemError(f"{name}, line {number}: {len(row)} values, the header has {len(header)}")
+        try:
+            m, k = int(row[0]), int(row[1])
+            values = [float(cell) for cell in row[2:]]
+        except ValueError:
+            raise HexdemError(f"{name}, line {number}: m and n must be integers and the rest numbers") from None
+        if not all(math.isfinite(v) for v in values):
+            raise HexdemError(f"{name}, line {number}: the values must be finite numbers")
+        bead = lattice.index_of(m, k)
+        if bead is None:
+            raise HexdemError(f"{name}, line {number}: site {{{m}, {k}}} is not a bead of the packing")
+        if bead in seen:
+            raise HexdemError(f"{name}, line {number}: site {{{m}, {k}}} is listed twice")
+        seen.add(bead)
+        velocities[bead] = values[:2]
+        if len(values) == 4:
+            if math.hypot(*values[2:]) >= lattice.diameters_m[bead] / 2:
+                raise HexdemError(f"{name}, line {number}: a displacement of half a diameter or more would put "
+                                  f"bead {{{m}, {k}}} inside its neighbours")
+            displacements[bead] = values[2:]
+    return InitialState(velocities, displacements)
