@@ -125,6 +125,7 @@ def test_another_plan_in_the_same_directory_is_refused(swept, tmp_path, capsys):
     (["--vary", "friction="], "no empty value"),
     (["--vary", "friction=0,rough"], "run friction=rough: friction must be a coefficient >= 0, got 'rough'"),
     (["--vary", "friction=0.1,0.1"], "a value is listed twice"),
+    (["--vary", "v0=0.4,0.40"], "two values are the same once read"),
     (["--vary", "friction=0,-0.2"], "run friction=-0.2: friction must be a coefficient >= 0"),
     (["--vary", "v0=0.4", "--vary", "v0=0.2"], "a key is varied twice"),
     (["--vary", "regions.1.material=brass"], "the base configuration has no item 1"),

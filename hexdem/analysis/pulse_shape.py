@@ -32,9 +32,9 @@ PROFILE_GRID = np.linspace(-1.0, 3.0, 81)
 
 @dataclass(frozen=True)
 class PulseShapes:
-    """(B,) arrays of B beads: ``peak`` v_m, ``arrival`` t_a, ``width`` w, ``peak_time`` (NaN
-    where a bead has no clear leading pulse, or its half-maximum crossings are not both in the
-    signal), in the signal's units."""
+    """(B,) arrays of B beads: ``peak`` v_m, ``arrival`` t_a, ``width`` w, ``peak_time``, in the
+    signal's units. All four are NaN where a bead has no clear leading pulse; ``arrival`` is NaN
+    where the rise through v_m/2 is not in the signal, ``width`` where either crossing is not."""
 
     peak: np.ndarray
     arrival: np.ndarray

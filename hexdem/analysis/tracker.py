@@ -38,6 +38,7 @@ from hexdem.analysis.energy import EnergyAudit, energy_error, energy_regions, en
 from hexdem.analysis.peaks import refine_peak, refine_peaks
 from hexdem.analysis.tracker_kernel import PulseState
 from hexdem.engines.sampling import Sample
+from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel, RunSettings
 
 #: About this many evenly spaced samples enter the energy audit (the first and last always).
@@ -60,9 +61,9 @@ class TrackedPulses:
     impact's kinetic energy; ``region_energies`` (len(energy_times), R, 2) the kinetic and contact
     energy [J] of each region (:func:`~hexdem.analysis.energy.energy_regions`) at those times;
     ``n_samples``;
-    ``trace_times`` (S,) and ``trace_speeds`` (S, len(trace_beads)); ``field_times`` (F,) and
+    ``trace_times`` (S,) and ``trace_speeds`` (S, len(trace_beads));
     ``threshold_time`` (N,) when each bead's speed first reached the tracker's ``threshold_speed``
-    (NaN: never, or no threshold asked for);
+    (NaN: never, or no threshold asked for); ``field_times`` (F,) and
     ``field_speeds`` (F, N) at the requested snapshot samples, and ``field_rim_speeds`` (F, N)
     there, each bead's |ω_z| r, the speed its rim turns at (empty, (0, N), for spheres that do
     not turn); ``sensor_times`` (K,) and
@@ -112,6 +113,8 @@ class PulseTracker:
         self.n_beads, self.n_bodies, self.n_samples_expected = n, model.n_bodies, total
         self.pulses = PulseState(n, RECORD_CAPACITY)
         self.peak_spin = np.zeros(n)
+        if threshold_speed is not None and not threshold_speed > 0:
+            raise HexdemError(f"the threshold speed must be > 0, got {threshold_speed!r}")
         self.threshold_speed = threshold_speed
         self.threshold_index, self.previous_speed = np.full(n, np.nan), np.zeros(n)
         self.owned = np.zeros(n, dtype=np.bool_)

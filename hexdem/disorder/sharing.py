@@ -80,7 +80,7 @@ def adopt_preparation(ensemble: Ensemble, source: Ensemble) -> int:
     with tempfile.TemporaryDirectory(prefix="hexdem-prepare-") as scratch:
         for k in range(min(ensemble.config.realizations, source.config.realizations)):
             adopted += _adopt_stage(ensemble, source, k, "compact", Path(scratch))
-            if is_done(ensemble.stage_dir(k, "compact")) and _same_deck(ensemble.stage_dir(k, "compact"),
-                                                                        source.stage_dir(k, "compact")):
+            ours, theirs = ensemble.stage_dir(k, "compact"), source.stage_dir(k, "compact")
+            if is_done(ours) and is_done(theirs) and _same_deck(ours, theirs):
                 adopted += _adopt_stage(ensemble, source, k, "settle", Path(scratch))
     return adopted

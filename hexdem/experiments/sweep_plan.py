@@ -52,7 +52,10 @@ class Variation:
         known = {f.name for f in fields(RunConfig)}
         if top not in known:
             raise HexdemError(f"--vary {key}: {top!r} is not a run-config key; known: {', '.join(sorted(known))}")
-        return cls(key, tuple(toml_value(text) for text in texts), texts)
+        values = tuple(toml_value(text) for text in texts)
+        if any(a == b and type(a) is type(b) for i, a in enumerate(values) for b in values[i + 1:]):
+            raise HexdemError(f"--vary {key}: two values are the same once read ({listed})")
+        return cls(key, values, texts)
 
 
 def toml_value(text: str):
@@ -65,7 +68,7 @@ def toml_value(text: str):
 
 def _step(container, step: str, path: str):
     if isinstance(container, list):
-        if not step.isdigit() or int(step) >= len(container):
+        if not re.fullmatch(r"[0-9]+", step) or int(step) >= len(container):
             raise HexdemError(f"--vary {path}: the base configuration has no item {step} "
                               f"(it has {len(container)})")
         return int(step)

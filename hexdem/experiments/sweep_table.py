@@ -84,8 +84,11 @@ def write_table(out: Path, runs: list[SweepRun], variations) -> list[tuple]:
     lines = _first_seen(exponents for _, _, exponents in figures)
     header = (*(v.key for v in variations), "run", *SUMMARY_COLUMNS, *(f"energy_share_{r}" for r in regions),
               *(f"decay_exponent_{line}" for line in lines))
+    def cell(value):
+        return "" if value == "" or not np.isfinite(value) else value
+
     rows = [(*run.values.values(), f"runs/{run.name}", *scalars.values(), *(shares.get(r, "") for r in regions),
-             *(exponents.get(line, "") for line in lines))
+             *(cell(exponents.get(line, "")) for line in lines))
             for run, (scalars, shares, exponents) in zip(runs, figures)]
     write_csv(out / "sweep.csv", header, rows)
     return [header, *rows]

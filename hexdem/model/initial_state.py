@@ -7,8 +7,9 @@ packing puts them. The impacts add their speeds on top (:meth:`~hexdem.model.gra
 Both engines start from :meth:`~hexdem.model.granular.GranularModel.initial_positions_m` and
 that method, so they read the state alike.
 
-A displacement of half a diameter or more would put a bead inside its neighbours and is refused,
-as are unknown or repeated sites and values that are not finite numbers.
+A displacement of half a diameter or more is refused (it would put the bead inside its
+neighbours; beads displaced towards each other may still overlap, which is the state asked
+for), as are unknown or repeated sites and values that are not finite numbers.
 """
 
 from __future__ import annotations

@@ -36,7 +36,8 @@ import numpy as np
 
 from hexdem.disorder.ensemble import Ensemble, EnsembleConfig
 from hexdem.disorder.runner import run_ensemble
-from hexdem.disorder.stats import EFFECT_FIRST_N, load_results
+from hexdem.disorder.stats import EFFECT_COLUMNS as ENSEMBLE_EFFECT_COLUMNS
+from hexdem.disorder.stats import EFFECT_FIRST_N, disorder_effect, load_results
 from hexdem.errors import HexdemError
 from hexdem.paper.disorder_study import FIGURES_ENSEMBLE, MEASURES, StudyEnsemble, change, json_number
 from hexdem.paper.settings import FIG9_VELOCITIES_M_S, STUDY_VELOCITY_M_S, PaperSettings
@@ -215,11 +216,14 @@ def disorder_verdict(conditions: list[dict]) -> str:
 
 def friction_tables(out: Path, settings: PaperSettings, summaries: dict) -> tuple[list, list, list]:
     """(rows of ``friction_effect.csv``, rows of ``friction_decay.csv``, disorder conditions) of
-    the finished ensembles in ``out``; ``summaries`` {μ: summary}, μ = 0 the paper's σ = 6 tol
-    ensemble's."""
+    the finished ensembles in ``out``; ``summaries`` {μ: summary} of the frictional ensembles.
+    μ = 0's disorder condition is measured on the same packings as theirs, the paper's first."""
     ensembles = {0.0: Ensemble(friction_config(0.0, settings), out / "disorder" / FIGURES_ENSEMBLE)}
     ensembles |= {mu: Ensemble(friction_config(mu, settings), out / "friction" / friction_name(mu))
                   for mu in FRICTIONS}
     results = {mu: load_results(ensemble) for mu, ensemble in ensembles.items()}
     lattice = ensembles[0.0].ideal
-    return effect_rows(results, lattice), decay_rows(results, lattice), disorder_conditions(summaries)
+    frictionless = {key: [dict(zip(ENSEMBLE_EFFECT_COLUMNS, row)) for row in disorder_effect(results[0.0], lattice, measure)]
+                    for measure, key in MEASURES.items()}
+    return (effect_rows(results, lattice), decay_rows(results, lattice),
+            disorder_conditions({0.0: frictionless, **summaries}))

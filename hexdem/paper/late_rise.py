@@ -18,9 +18,11 @@ range, and the **late rise**: the mean a6/a0 of the fronts beyond :data:`OUTER` 
 radius measured (within that range) minus the mean over :data:`PLATEAU` of it (negative: the
 anisotropy grows again).
 
-**Verdict** (:func:`verdict`): the rise is a sampling or time-step artefact if refining either
-changes it by more than :data:`RISE_AGREEMENT` of itself; it belongs to the half-maximum measure
-if the fixed-speed front's rise is less than that fraction of it; else it is the front's own.
+**Verdict** (:func:`verdict`): there is no late rise if the baseline's is not negative by more
+than twice its fitted A∞'s standard error; otherwise the rise is a sampling or time-step
+artefact if refining either changes it by more than :data:`RISE_AGREEMENT` of itself; it belongs
+to the half-maximum measure if the fixed-speed front's rise is less than that fraction of it or
+of the other sign; else it is the front's own.
 """
 
 from __future__ import annotations
@@ -77,8 +79,8 @@ def run_late_rise(study: FrontStudy, out: Path, log=None) -> dict:
 
 
 def verdict(measured: dict) -> dict:
-    """What the four measurements say of the rise: ``kind`` ("artefact of the sampling",
-    "artefact of the time step", "of the half-maximum measure", "the front's own", or
+    """What the four measurements say of the rise: ``kind`` ("no late rise", "artefact of the
+    sampling", "artefact of the time step", "of the half-maximum measure", "the front's own", or
     "undetermined" where a window holds no front) and one sentence, with A∞ of each."""
     rise = {name: entry["rise"] for name, entry in measured.items()}
     base = rise["baseline"]
@@ -88,15 +90,19 @@ def verdict(measured: dict) -> dict:
                      f"(p = {entry['fit'].p:.2f}), late rise {entry['rise']:+.4f}" for name, entry in measured.items())
     if not all(np.isfinite(list(rise.values()))):
         kind = "undetermined"
+    elif not base < -2 * measured["baseline"]["fit"].a_inf_se:
+        kind = "no late rise"
     elif changed("finer_sampling"):
         kind = "artefact of the sampling"
     elif changed("finer_step"):
         kind = "artefact of the time step"
-    elif abs(rise["fixed_speed"]) < RISE_AGREEMENT * abs(base):
+    elif not rise["fixed_speed"] < -RISE_AGREEMENT * abs(base):
         kind = "of the half-maximum measure"
     else:
         kind = "the front's own"
     sentences = {"undetermined": "The packing is too small for fronts in both windows of the late rise: undetermined.",
+                 "no late rise": ("The anisotropy does not grow again beyond the plateau by more than twice the "
+                                  "fit's error: there is no late rise here."),
                  "artefact of the sampling": "The late rise changes when the sampling is refined: it is an artefact of the sampling.",
                  "artefact of the time step": "The late rise changes with the time step: it is an artefact of the discretization.",
                  "of the half-maximum measure": ("The late rise stays under finer sampling and a finer time step, but the front "

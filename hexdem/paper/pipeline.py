@@ -215,9 +215,8 @@ def _run_parts(settings: PaperSettings, out: Path) -> tuple[dict, float]:
                lambda mu=mu: run_friction_ensemble(mu, settings, out, scaling_json))
               for name, mu in zip(friction_parts, FRICTIONS)]
     parts.append(("friction", "friction and rotation study", (paper_part, *friction_parts),
-                  lambda: _friction_summary(settings, {0.0: summaries[paper_part],
-                                                       **{mu: summaries[name] for name, mu in
-                                                          zip(friction_parts, FRICTIONS)}}, out)))
+                  lambda: _friction_summary(settings, {mu: summaries[name] for name, mu in
+                                                       zip(friction_parts, FRICTIONS)}, out)))
     summaries: dict = {}
     computed: set = set()
     bar = progress_bar(len(parts), "hexdem paper", unit="part")

@@ -181,7 +181,8 @@ def _friction_blocks(friction: dict) -> list:
                   "about z as solid spheres, the walls with the same law and their own E* and G*. The preparation "
                   "stays frictionless, so each μ strikes the very packings the paper's σ = 6 tol ensemble "
                   f"strikes: the first {friction['realizations']} of its {friction['paper_realizations']} "
-                  "(fewer, to keep the whole paper within ten minutes on two workers). Ratios and shifts are "
+                  "(fewer, to keep the whole paper within ten minutes on two workers; μ = 0 is read on the "
+                  "same packings). Ratios and shifts are "
                   "to the frictionless run of the same packing and speed, averaged over the line's beads "
                   "n ≥ 2 (± standard error over packings); the leading pulse's amplitude is the measure."),
             ("p", f"Arrival times: {friction['arrival_verdict']}"),

@@ -103,7 +103,8 @@ class Ray:
         return bool(self.middle_residual < COLLAPSE_TOLERANCE)
 
     def energy_exponent(self) -> tuple[float, float]:
-        """(e, its standard error) of the energy crossing a ring, r v_m² w c ∝ r^e."""
+        """(e, its standard error) of the energy crossing a ring, r v_m² w c ∝ r^e; the error
+        treats the three fitted exponents as independent, though they come from the same beads."""
         (a, sa), (b, sb), (s, ss) = (self.exponents[k] for k in ("amplitude", "width", "speed"))
         return 1 + 2 * a + b + s, float(np.sqrt(4 * sa**2 + sb**2 + ss**2))
 

@@ -84,7 +84,9 @@ def half_maximum_duration(times, speeds) -> float:
 
 def measure_chain(analysis, window: tuple[int, int] = WINDOW) -> ChainWave:
     """The chain's pulse (see the module docstring) from a run of :func:`chain_config` that
-    traced :data:`CHAIN_LINE`."""
+    traced :data:`CHAIN_LINE`, in SI units."""
+    if analysis.settings.units.name != "si":
+        raise HexdemError("the chain's pulse is measured in SI units; run the chain with units = \"si\"")
     r = analysis.results
     beads = r.lines[CHAIN_LINE]
     first, last = window

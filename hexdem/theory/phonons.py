@@ -62,7 +62,7 @@ class Lattice2D:
         return math.sqrt(self.stiffness_n_m / self.mass_kg)
 
     def high_symmetry_points(self) -> dict[str, np.ndarray]:
-        """Γ, K and M [1/m] of the Brillouin zone: K = (0, 4π/(3a)), where q·a e_j = 2π/3 (mod 2π,
+        """Γ, K and M [1/m] of the Brillouin zone: K = (0, 4π/(3a)), where q·a e_j = ±2π/3 (mod 2π,
         cos = −1/2) for every bond; M = (2π/(√3 a), 0), half the reciprocal vector
         perpendicular to the 90° bonds."""
         a = self.spacing_m
