@@ -12,7 +12,8 @@ the beads of :data:`WINDOW`, where it has formed and the free end is still far.
   first's (1 for a pulse that keeps its amplitude);
 * ``nesterenko_speed_m_s``: the continuum law at that V_m (:func:`~hexdem.theory.solitary.solitary_speed_m_s`),
   ``relative_deviation`` the measured speed's from it;
-* ``half_maximum_width_d``: the time the middle bead's speed stays above half its peak, times
+* ``half_maximum_width_d``: the time the middle bead's speed stays above half its peak
+  (:func:`~hexdem.analysis.pulse_shape.pulse_shapes`), times
   the front speed, in diameters, beside the continuum's (:data:`~hexdem.theory.solitary.HALF_MAXIMUM_WIDTH_D`,
   of a pulse spanning :data:`~hexdem.theory.solitary.SUPPORT_WIDTH_D` ≈ 5 d).
 """
@@ -23,6 +24,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from hexdem.analysis.pulse_shape import pulse_shapes
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
 from hexdem.theory.solitary import (
@@ -68,20 +70,6 @@ class ChainWave:
         return asdict(self)
 
 
-def half_maximum_duration(times, speeds) -> float:
-    """How long ``speeds`` (one bead's, sampled at ``times``) stay above half their largest value,
-    the crossings interpolated linearly between samples."""
-    times, speeds = np.asarray(times, float), np.asarray(speeds, float)
-    half = speeds.max() / 2
-    above = np.flatnonzero(speeds >= half)
-    first, last = above[0], above[-1]
-    if first == 0 or last == len(speeds) - 1:
-        raise HexdemError("the pulse is cut by the run's start or end: no width at half maximum")
-    rise = np.interp(half, speeds[first - 1:first + 1], times[first - 1:first + 1])
-    fall = np.interp(half, speeds[last:last + 2][::-1], times[last:last + 2][::-1])
-    return float(fall - rise)
-
-
 def measure_chain(analysis, window: tuple[int, int] = WINDOW) -> ChainWave:
     """The chain's pulse (see the module docstring) from a run of :func:`chain_config` that
     traced :data:`CHAIN_LINE`, in SI units."""
@@ -101,5 +89,8 @@ def measure_chain(analysis, window: tuple[int, int] = WINDOW) -> ChainWave:
     peak_velocity = float(np.mean(peak))
     law = solitary_speed_m_s(chain_speed_scale_m_s(analysis.model.bead), peak_velocity)
     times, speeds = analysis.line_trace(CHAIN_LINE)
-    width = half_maximum_duration(times, speeds[:, (first + last) // 2]) * speed / diameter
+    duration = pulse_shapes(times, speeds[:, [(first + last) // 2]]).width[0]
+    if not np.isfinite(duration):
+        raise HexdemError("the pulse is cut by the run's start or end: no width at half maximum")
+    width = float(duration) * speed / diameter
     return ChainWave(speed, law, speed / law - 1, peak_velocity, float(peak[-1] / peak[0]), width)
