@@ -91,6 +91,12 @@ def _mean_std_count(values: np.ndarray, axis: int = 0):
     return mean, std, count
 
 
+def mean_and_sem(values) -> tuple[float, float]:
+    """(mean, standard error of the mean) of the finite ``values`` (1D); no error from fewer than two."""
+    mean, std, count = _mean_std_count(np.asarray(values, float))
+    return float(mean), float(std / np.sqrt(count)) if count > 1 else float("nan")
+
+
 def peak_statistics(results: EnsembleResults, lattice: Lattice) -> list[tuple]:
     """Rows of ``peaks_stats.csv``: mean and sample standard deviation over realizations of
     the peak speed of bead n of each line, for each striker velocity."""

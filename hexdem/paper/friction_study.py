@@ -37,7 +37,7 @@ import numpy as np
 from hexdem.disorder.ensemble import Ensemble, EnsembleConfig
 from hexdem.disorder.runner import run_ensemble
 from hexdem.disorder.stats import EFFECT_COLUMNS as ENSEMBLE_EFFECT_COLUMNS
-from hexdem.disorder.stats import EFFECT_FIRST_N, disorder_effect, load_results
+from hexdem.disorder.stats import EFFECT_FIRST_N, disorder_effect, load_results, mean_and_sem
 from hexdem.errors import HexdemError
 from hexdem.paper.disorder_study import FIGURES_ENSEMBLE, MEASURES, StudyEnsemble, change, json_number
 from hexdem.paper.settings import FIG9_VELOCITIES_M_S, STUDY_VELOCITY_M_S, PaperSettings
@@ -92,14 +92,6 @@ def _line_beads(lattice) -> dict[str, np.ndarray]:
     return {"0": lines["0"], "±30": np.concatenate([lines["+30"], lines["-30"]])}
 
 
-def _per_packing(values: np.ndarray) -> tuple[float, float]:
-    """(mean, standard error) over packings of per-packing values; no error from one."""
-    values = values[np.isfinite(values)]
-    if len(values) < 2:
-        return (float(values[0]) if len(values) else float("nan")), float("nan")
-    return float(values.mean()), float(values.std(ddof=1) / np.sqrt(len(values)))
-
-
 def effect_rows(results: dict, lattice) -> list[tuple]:
     """Rows of ``friction_effect.csv`` from {μ: EnsembleResults} (μ = 0 included) of ``lattice``."""
     base = results[0.0]
@@ -114,9 +106,9 @@ def effect_rows(results: dict, lattice) -> list[tuple]:
                 shift = (r.arrival_time[:, iv, beads] - base.arrival_time[:, iv, beads]) * 1e6
                 rows.append((mu, float(v), 0.0, line, float(np.nanmean(ideal_ratio)), float("nan"),
                              float(np.nanmean(ideal_shift))))
-                mean, sem = _per_packing(np.nanmean(ratio, axis=1))
+                mean, sem = mean_and_sem(np.nanmean(ratio, axis=1))
                 rows.append((mu, float(v), FRICTION_SIGMA_PER_TOL, line, mean, sem,
-                             _per_packing(np.nanmean(shift, axis=1))[0]))
+                             mean_and_sem(np.nanmean(shift, axis=1))[0]))
     return rows
 
 
