@@ -36,7 +36,6 @@ def speed_movie(results, model, times, speeds, v0: float, path, title: str = "",
     speed/``v0`` (``label`` on the colour bar), the frame's time from ``times`` (F,) in the
     run's units, walls and the struck beads drawn."""
     from matplotlib.colors import LogNorm  # (drawing only: a run picks its frames without matplotlib)
-    from PIL import Image
 
     from hexdem.analysis.figures import UNIT_LABELS, draw_lattice, subplots
 
@@ -47,17 +46,29 @@ def speed_movie(results, model, times, speeds, v0: float, path, title: str = "",
     circles = draw_lattice(ax, results, model, np.full(len(model.lattice), floor), label,
                            cmap="inferno", norm=LogNorm(floor, 1.0), marker_colour="c")
     clock = ax.text(0.5, 1.01, "", transform=ax.transAxes, ha="center", va="bottom", fontsize=12)
-    for artist in (circles, clock):  # drawn on a background of everything else, rendered once
+
+    def show(frame: int) -> None:
+        circles.set_array(np.clip(np.nan_to_num(np.asarray(speeds[frame]) / v0, nan=floor), floor, None))
+        clock.set_text(f"{title}   t = {times[frame] * units['time_scale']:.3g} {units['time']}")
+
+    write_gif(fig, (circles, clock), len(times), show, path)
+
+
+def write_gif(fig, artists, count: int, show, path) -> None:
+    """Write ``path`` (GIF) of ``count`` frames of ``fig``: ``show(frame)`` updates ``artists``
+    for each, which alone are redrawn on a background of everything else, rendered once."""
+    from PIL import Image
+
+    for artist in artists:
         artist.set_animated(True)
     fig.canvas.draw()
     background = fig.canvas.copy_from_bbox(fig.bbox)
     frames, palette = [], None
-    for time, field in zip(times, speeds):
+    for frame in range(count):
         fig.canvas.restore_region(background)
-        circles.set_array(np.clip(np.nan_to_num(np.asarray(field) / v0, nan=floor), floor, None))
-        clock.set_text(f"{title}   t = {time * units['time_scale']:.3g} {units['time']}")
-        ax.draw_artist(circles)
-        ax.draw_artist(clock)
+        show(frame)
+        for artist in artists:
+            artist.axes.draw_artist(artist)
         image = Image.fromarray(np.asarray(fig.canvas.buffer_rgba())[..., :3])
         # one palette for the movie, from the first frame (its colour bar holds the whole scale)
         palette = palette or image.quantize(colors=PALETTE_COLOURS)

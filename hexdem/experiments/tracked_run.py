@@ -41,15 +41,19 @@ class ImpactJob:
     def __call__(self, comm):
         tracker = PulseTracker(self.model, self.settings, comm, self.trace_beads, self.field_samples,
                                self.gravity_m_s2, self.threshold_speed)
-        if self.engine == "reference":  # numba and its compiled kernels: only for the runs that use them
-            from hexdem.engines.reference.engine import ReferenceEngine
-
-            engine = ReferenceEngine()
-        else:
-            engine = LammpsEngine(dump=self.dump, gravity_m_s2=self.gravity_m_s2)
+        engine = make_engine(self.engine, self.dump, self.gravity_m_s2)
         description = engine.run(self.model, self.settings, self.directory, tracker, comm, self.show_progress)
         tracked = tracker.finish()
         return None if tracked is None else (tracked, description)
+
+
+def make_engine(name: str, dump: bool = False, gravity_m_s2=None):
+    """The engine called ``name`` ("lammps" or "reference"); ``dump`` and ``gravity_m_s2`` are LAMMPS's."""
+    if name == "reference":  # numba and its compiled kernels: only for the runs that use them
+        from hexdem.engines.reference.engine import ReferenceEngine
+
+        return ReferenceEngine()
+    return LammpsEngine(dump=dump, gravity_m_s2=gravity_m_s2)
 
 
 def track_impact(job: ImpactJob, ranks: int = 1, comm=None, launcher: str | None = None) -> ImpactAnalysis | None:

@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from hexdem.common.io import write_csv
 from hexdem.errors import HexdemError
 from hexdem.model.lattice import Lattice
 
@@ -75,3 +76,15 @@ def read_initial_state(path, lattice: Lattice) -> InitialState:
                                   f"bead {{{m}, {k}}} inside its neighbours")
             displacements[bead] = values[2:]
     return InitialState(velocities, displacements)
+
+
+def write_initial_state(path, lattice: Lattice, velocities_m_s, displacements_m=None) -> None:
+    """Write (N, 2) ``velocities_m_s`` and optionally ``displacements_m`` of ``lattice``'s beads
+    as an ``initial_state_file`` (atomically), every bead on its own line, full precision."""
+    columns = [np.asarray(velocities_m_s, float)]
+    if displacements_m is not None:
+        columns.append(np.asarray(displacements_m, float))
+    header = HEADERS[len(columns) - 1]
+    rows = [[m, n, *(repr(float(value)) for value in values)]
+            for (m, n), values in zip(lattice.indices.tolist(), np.hstack(columns))]
+    write_csv(path, header, rows)

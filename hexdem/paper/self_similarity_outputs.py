@@ -133,7 +133,7 @@ def chain_figure(chain_rows: dict, hexagon_rows: dict, path) -> None:
 
 def write_page(out: Path, result: dict, chain: dict, late_rise: dict | None = None) -> None:
     """``self_similarity.html``, one self-contained page with the verdicts and figures."""
-    from hexdem.paper.report import render_html
+    from hexdem.common.html_page import render_html
 
     blocks = [("h1", "Does the decaying pulse become self-similar?"),
               *[("p", verdict(result, study)) for study in result if study not in ("criterion", "collapse_tolerance")],

@@ -1,0 +1,55 @@
+"""One run whose velocity field is recorded for linear-wave analysis: engine → samples →
+:class:`~hexdem.analysis.wave_recorder.WaveRecorder` (no pulse tracking, no dump).
+
+The linear-wave studies (:mod:`hexdem.waves`) set their excitation through the configuration's
+``initial_state_file`` and read the plane-wave components and energy blocks back, on one rank
+in-process or on several under MPI like every other run (:mod:`hexdem.experiments.parallel`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from hexdem.analysis.wave_recorder import RecordedWaves, WaveRecorder
+from hexdem.experiments.parallel import run_on_ranks
+from hexdem.experiments.tracked_run import make_engine
+from hexdem.model.config import RunConfig
+from hexdem.model.granular import GranularModel, RunSettings
+
+
+@dataclass(frozen=True)
+class WaveJob:
+    """What every rank of one recorded run does (picklable): ``wave_vectors_m`` (Q, 2) [1/m]
+    and ``block`` samples per energy block as :class:`WaveRecorder` takes them."""
+
+    model: GranularModel
+    settings: RunSettings
+    engine: str
+    directory: Path
+    wave_vectors_m: tuple = ()
+    block: int = 0
+    show_progress: bool = True
+
+    def __call__(self, comm):
+        recorder = WaveRecorder(self.model, self.settings, np.asarray(self.wave_vectors_m, float), self.block, comm)
+        make_engine(self.engine).run(self.model, self.settings, self.directory, recorder, comm, self.show_progress)
+        return recorder.finish()
+
+
+def record_waves(config: RunConfig, workdir, wave_vectors_m=(), block: int = 0, log=None,
+                 show_progress: bool = True) -> RecordedWaves:
+    """Run ``config`` in ``workdir`` on its engine and ranks, recording the plane-wave components
+    at ``wave_vectors_m`` [1/m] and the energy blocks of ``block`` samples."""
+    model = config.model()
+    settings = config.settings(model)
+    workdir = Path(workdir)
+    workdir.mkdir(parents=True, exist_ok=True)
+    if log is not None:
+        log(f"running {config.engine}: {len(model.lattice)} beads, {settings.n_steps} steps of "
+            f"{settings.dt_s:.4g} s, {settings.n_samples} samples recorded")
+    job = WaveJob(model, settings, config.engine, workdir, tuple(map(tuple, np.asarray(wave_vectors_m, float).reshape(-1, 2))),
+                  block, show_progress)
+    return run_on_ranks(job, config.ranks if config.engine == "lammps" else 1, workdir, config.launcher)

@@ -1,0 +1,218 @@
+"""Conical diffraction in the precompressed packing (issue part 4): a Gaussian packet built at
+the Dirac point K opens into a ring at the cone's slope; a control packet built away from K
+keeps its shape and drifts at its group velocity.
+
+**Set-up.** A hexagon precompressed to f0, at rest, is given at t = 0 the packet of
+:func:`~hexdem.waves.states.bloch_packet` (through ``initial_state_file``): envelope width σ
+(``width_d`` diameters), peak speed ``speed_m_s`` (displacements a per cent of δ0 at 20 N, so
+linear). At K it is circularly polarized (:data:`~hexdem.theory.conical.CIRCULAR`) and centred;
+the control, on the lower band at ``control_fraction`` K, starts behind the centre by half the
+way its group velocity takes it. The run lasts until v_D t = ``reach`` σ, and the hexagon is
+sized to keep the ring (or the drifting packet) three widths clear of the walls.
+
+**Measurement.** The run records each bead's kinetic energy averaged over blocks of
+``block_periods`` periods at ω_K (:mod:`hexdem.analysis.wave_recorder`); half the wave's
+energy, without its oscillation. The ring radius is R(t) = sqrt(⟨r²⟩(t) − ⟨r²⟩(0)) about the
+packet's centre, the mean with those energies as weights, ⟨r²⟩(0) that of the packet's own
+envelope G² on the beads (:mod:`hexdem.analysis.packet`). The cone's R(t) for the same σ and χ
+(:func:`~hexdem.theory.conical.cone_ring_radius`) is the theory; fitting it to the measured R with
+the slope v as its one parameter gives the growth rate, which must be v_D.
+
+**Why not a straight line.** R grows as v_D t only slowly: the cone's apex leaves a diffuse
+interior (measured at σ = 8 d: the slope of R over the last half of a run to 5σ is 0.96 v_D,
+while the cone's whole R(t) fits it with v = 1.004 v_D).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from hexdem.analysis.packet import energy_centroid, energy_spread, ring_radius
+from hexdem.analysis.wave_recorder import RecordedWaves
+from hexdem.experiments.wave_run import record_waves
+from hexdem.model.config import RunConfig
+from hexdem.model.initial_state import write_initial_state
+from hexdem.theory.conical import CIRCULAR, cone_ring_radius
+from hexdem.theory.phonons import Lattice2D, cone_slope, dynamical_matrix, frequencies
+from hexdem.waves.states import bloch_packet
+
+#: conical.csv's columns.
+COLUMNS = ("time_s", "ring_radius_d", "theory_radius_d")
+#: control.csv's columns: the control's centroid along its group velocity from where it started,
+#: where the group velocity takes it, and its rms width, all in bead diameters.
+CONTROL_COLUMNS = ("time_s", "centroid_along_d", "group_path_d", "width_d")
+#: Widths σ between the packet's outermost extent and the walls.
+CLEARANCE_WIDTHS = 3.0
+
+
+@dataclass(frozen=True)
+class ConicalSettings:
+    """The packets' runs (see the module docstring): ``precompression_n`` [N] per contact,
+    envelope width ``width_d`` σ [bead diameters], run until v_D t = ``reach`` σ, peak speed
+    ``speed_m_s``; the control on the lower band at ``control_fraction`` K; sampled
+    ``samples_per_period`` times per period at ω_K, energies averaged over ``block_periods``
+    periods; ``engine``, ``ranks`` and ``steps_per_contact`` as in
+    :class:`~hexdem.model.config.RunConfig`."""
+
+    precompression_n: float = 20.0
+    width_d: float = 12.0
+    reach: float = 5.0
+    speed_m_s: float = 5e-4
+    control_fraction: float = 0.5
+    samples_per_period: int = 8
+    block_periods: int = 4
+    engine: str = "lammps"
+    ranks: int = 1
+    steps_per_contact: int = 40
+
+    def edge_beads(self) -> int:
+        """Beads per edge of a hexagon whose apothem, (E − 1) √3/2 d, is (reach + clearance) σ."""
+        return math.ceil((self.reach + CLEARANCE_WIDTHS) * self.width_d / (math.sqrt(3) / 2)) + 1
+
+    def config(self) -> RunConfig:
+        return RunConfig(edge_beads=self.edge_beads(), precompression_n=self.precompression_n, v0=1e-6,
+                         steps_per_contact=self.steps_per_contact, engine=self.engine, ranks=self.ranks)
+
+    def theory(self) -> Lattice2D:
+        config = self.config()
+        return Lattice2D.precompressed(self.precompression_n, config.diameter_m, config.material(config.bead_material))
+
+
+@dataclass(frozen=True)
+class PacketRun:
+    """One packet's run: its ``centre_m`` and ``width_m``, and what was recorded."""
+
+    centre_m: np.ndarray
+    width_m: float
+    recorded: RecordedWaves = field(repr=False)
+
+    @property
+    def times_s(self) -> np.ndarray:
+        return self.recorded.block_times_s
+
+    def ring_radius_m(self) -> np.ndarray:
+        return ring_radius(self.recorded.positions_m, self.recorded.block_kinetic_j, self.centre_m, self.width_m)
+
+
+@dataclass(frozen=True)
+class Conical:
+    """Both packets measured, SI: ``cone_slope_m_s`` v_D, ``fitted_slope_m_s`` the growth rate;
+    ``theory_radius_m`` the cone's R(t) at the K packet's block times; the control's
+    ``group_velocity_m_s`` (2,) from the bands and ``drift_velocity_m_s`` (2,) fitted to its
+    centroid, its width (rms distance from the centroid) ``control_width_m`` (F,)."""
+
+    dirac: PacketRun
+    control: PacketRun
+    theory_radius_m: np.ndarray
+    cone_slope_m_s: float
+    fitted_slope_m_s: float
+    group_velocity_m_s: np.ndarray
+    drift_velocity_m_s: np.ndarray
+    control_width_m: np.ndarray
+    diameter_m: float
+    omega_k_rad_s: float
+    settings: ConicalSettings = field(repr=False)
+
+    @property
+    def slope_deviation(self) -> float:
+        """The growth rate's relative deviation from v_D, abs(v − v_D) / v_D."""
+        return abs(self.fitted_slope_m_s / self.cone_slope_m_s - 1.0)
+
+    @property
+    def drift_deviation(self) -> float:
+        """The control's drift velocity's relative deviation from its group velocity (vector norms)."""
+        return float(np.linalg.norm(self.drift_velocity_m_s - self.group_velocity_m_s)
+                     / np.linalg.norm(self.group_velocity_m_s))
+
+    def rows(self) -> list[list]:
+        """conical.csv's rows (:data:`COLUMNS`)."""
+        d = self.diameter_m
+        return [[repr(float(t)), repr(float(r / d)), repr(float(theory / d))]
+                for t, r, theory in zip(self.dirac.times_s, self.dirac.ring_radius_m(), self.theory_radius_m)]
+
+
+    def control_path_m(self) -> np.ndarray:
+        """(F,) the control's centroid's distance from its start along its group velocity."""
+        run = self.control
+        centroids = energy_centroid(run.recorded.positions_m, run.recorded.block_kinetic_j)
+        return (centroids - run.centre_m) @ (self.group_velocity_m_s / np.linalg.norm(self.group_velocity_m_s))
+
+    def control_rows(self) -> list[list]:
+        """control.csv's rows (:data:`CONTROL_COLUMNS`)."""
+        d, speed = self.diameter_m, np.linalg.norm(self.group_velocity_m_s)
+        return [[repr(float(t)), repr(float(along / d)), repr(float(speed * t / d)), repr(float(width / d))]
+                for t, along, width in zip(self.control.times_s, self.control_path_m(), self.control_width_m)]
+
+
+def group_velocity(theory: Lattice2D, wave_vector, branch: int) -> np.ndarray:
+    """∇ω of ``branch`` (0 lower) at ``wave_vector`` [m/s], by central differences."""
+    step = 1e-6 / theory.spacing_m
+    return np.array([(frequencies(theory, wave_vector + step * unit)[branch]
+                      - frequencies(theory, wave_vector - step * unit)[branch]) / (2 * step) for unit in np.eye(2)])
+
+
+def _run_packet(settings: ConicalSettings, workdir: Path, wave_vector, polarization, omega: float, centre,
+                log, show_progress) -> PacketRun:
+    """Write the packet's state, run it and record its energy blocks."""
+    config = settings.config()
+    lattice, theory = config.lattice(), settings.theory()
+    width = settings.width_d * config.diameter_m
+    velocities, displacements = bloch_packet(lattice.positions_m, centre, width, wave_vector, polarization,
+                                             omega, settings.speed_m_s)
+    workdir.mkdir(parents=True, exist_ok=True)
+    write_initial_state(workdir / "initial_state.csv", lattice, velocities, displacements)
+    duration = settings.reach * width / cone_slope(theory)
+    config = config.replace(initial_state_file=str(workdir / "initial_state.csv"), duration=duration)
+    dt_s = config.settings(config.model()).dt_s
+    period = 2 * math.pi / (math.sqrt(4.5) * theory.frequency_scale)
+    every = max(1, int(period / settings.samples_per_period / dt_s))
+    block = max(1, round(settings.block_periods * period / (every * dt_s)))
+    recorded = record_waves(config.replace(dump_every=every), workdir / "run", block=block, log=log,
+                            show_progress=show_progress)
+    return PacketRun(np.asarray(centre, float), width, recorded)
+
+
+def _block_cone(theory: Lattice2D, run: PacketRun):
+    """speed ↦ the cone's R at ``run``'s blocks for that slope, measured as the run measures it:
+    R² averaged over each block's samples. R = σ F(v t/σ) (:mod:`hexdem.theory.conical`): F is
+    integrated once, at 301 values of v t/σ up to twice the run's reach."""
+    width, times = run.width_m, run.recorded.block_sample_times_s()
+    v_d = cone_slope(theory)
+    scaled = np.linspace(0.0, 2.0 * v_d * times.max() / width, 301)
+    profile_squared = (cone_ring_radius(theory, width, scaled * width / v_d) / width) ** 2
+
+    def radius(speed):
+        return width * np.sqrt(np.mean(np.interp(speed * times / width, scaled, profile_squared), axis=1))
+
+    return radius
+
+
+def measure_conical(settings: ConicalSettings, workdir, log=None, show_progress: bool = True) -> Conical:
+    """Run both packets of the module docstring in ``workdir`` and measure them."""
+    workdir = Path(workdir)
+    theory, config = settings.theory(), settings.config()
+    centre = config.lattice().positions_m.mean(axis=0)
+    k_point = theory.high_symmetry_points()["K"]
+    omega_k = math.sqrt(4.5) * theory.frequency_scale
+    dirac = _run_packet(settings, workdir / "dirac", k_point, CIRCULAR, omega_k, centre, log, show_progress)
+    measured = dirac.ring_radius_m()
+    v_d = cone_slope(theory)
+    cone = _block_cone(theory, dirac)
+    fitted = minimize_scalar(lambda speed: float(np.sum((cone(speed) - measured) ** 2)), bounds=(0.5 * v_d, 1.5 * v_d),
+                             method="bounded", options={"xatol": 1e-6 * v_d}).x
+    q = settings.control_fraction * k_point
+    omega2, vectors = np.linalg.eigh(dynamical_matrix(theory, q))
+    velocity = group_velocity(theory, q, 0)
+    duration = settings.reach * dirac.width_m / v_d
+    control = _run_packet(settings, workdir / "control", q, vectors[:, 0], math.sqrt(omega2[0]),
+                          centre - velocity * duration / 2, log, show_progress)
+    centroids = energy_centroid(control.recorded.positions_m, control.recorded.block_kinetic_j)
+    drift = np.polyfit(control.times_s, centroids, 1)[0]
+    spread = energy_spread(control.recorded.positions_m, control.recorded.block_kinetic_j, centroids)
+    return Conical(dirac, control, cone(v_d), v_d, float(fitted),
+                   velocity, drift, spread, config.diameter_m, omega_k, settings)

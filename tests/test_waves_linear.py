@@ -1,0 +1,119 @@
+"""The linear-wave study's pieces against what can be worked out by hand: spectra of known
+signals, the lattice Fourier sum, a packet's energy moments, the cone's ring and its limits;
+then both engines' measured dispersion and conical diffraction against the theory."""
+
+import math
+
+import numpy as np
+import pytest
+
+from hexdem.analysis.packet import energy_centroid, energy_spread, ring_radius
+from hexdem.analysis.spectrum import peak_frequency, power_spectrum
+from hexdem.analysis.wave_recorder import WaveRecorder
+from hexdem.engines.sampling import Sample
+from hexdem.model.config import RunConfig
+from hexdem.theory.conical import CIRCULAR, cone_ring_radius, dirac_matrix
+from hexdem.theory.phonons import Lattice2D, cone_slope
+from hexdem.waves.conical import ConicalSettings, measure_conical
+from hexdem.waves.dispersion import DispersionSettings, measure_dispersion
+from hexdem.waves.states import bloch_packet
+
+STEEL_20N = Lattice2D.precompressed(20.0, 0.01905)
+
+
+def test_the_spectral_peaks_of_two_tones_are_their_frequencies():
+    """cos(ω1 t) + 0.5 sin(ω2 t), sampled 2000 times: the folded, windowed spectrum peaks at ω1
+    and ω2, off the bins, to far below a bin (Hann's main lobe is nearly Gaussian in log)."""
+    times = np.arange(2000) * 1e-5
+    omegas = np.array([12345.0, 23456.0])
+    signals = np.column_stack([np.cos(omegas[0] * times), 0.5 * np.sin(omegas[1] * times + 0.3)])
+    omega, power = power_spectrum(times, signals)
+    bin_width = omega[1] - omega[0]
+    np.testing.assert_allclose(peak_frequency(omega, power), omegas, atol=0.05 * bin_width)
+
+
+def test_a_complex_signal_is_folded_onto_positive_frequencies():
+    """exp(−iωt) has all its power at −ω; folded, its peak is at +ω."""
+    times = np.arange(1000) * 1e-5
+    omega, power = power_spectrum(times, np.exp(-1j * 20000.0 * times))
+    assert peak_frequency(omega, power) == pytest.approx(20000.0, rel=1e-3)
+
+
+def test_the_recorder_keeps_the_lattice_fourier_sum_and_the_block_energies():
+    """Two samples of a 3-bead model split over two 'ranks' (two calls with the beads apart):
+    V(q) = Σ v_j exp(−i q·r_j) by hand, and each block's mean ½ m v²."""
+    config = RunConfig(shape="sites", sites=[[0, 0], [1, 1], [2, 0]], site_walls_deg=[], duration=1e-4, dump_every=1)
+    model = config.model()
+    settings = config.settings(model)
+    q = np.array([[30.0, -12.0]])
+    recorder = WaveRecorder(model, settings, q, block=2)
+    velocities = np.array([[0.1, 0.0], [0.0, -0.2], [0.3, 0.1]])
+    for index in (0, 1):
+        scaled = velocities * (index + 1)
+        recorder(Sample(index, index, 0.0, np.array([1, 3]), np.zeros((2, 2)), scaled[[0, 2]]))
+        recorder(Sample(index, index, 0.0, np.array([2]), np.zeros((1, 2)), scaled[[1]]))
+    waves = recorder.finish()
+    phases = np.exp(-1j * model.lattice.positions_m @ q[0])
+    np.testing.assert_allclose(waves.components[1, 0], 2 * phases @ velocities)
+    kinetic = 0.5 * model.masses_kg[:3] * np.sum(velocities**2, axis=1)
+    np.testing.assert_allclose(waves.block_kinetic_j[0], kinetic * (1 + 4) / 2)
+
+
+def test_a_thin_ring_of_energy_has_its_radius_and_a_shifted_one_its_centroid():
+    angle = np.linspace(0, 2 * np.pi, 360, endpoint=False)
+    ring = np.column_stack([7.0 * np.cos(angle), 7.0 * np.sin(angle)])
+    points = np.vstack([ring, [[0.0, 0.0]]])  # a centre bead without energy
+    energies = np.append(np.ones(360), 0.0)[None, :]
+    # ⟨r²⟩(0) of a Gaussian of width σ on these points is ~0 for σ → 0: only the centre counts
+    assert ring_radius(points, energies, [0.0, 0.0], 1e-3)[0] == pytest.approx(7.0)
+    shifted = points + [2.0, -1.0]
+    np.testing.assert_allclose(energy_centroid(shifted, energies)[0], [2.0, -1.0], atol=1e-12)
+    assert energy_spread(shifted, energies, energy_centroid(shifted, energies))[0] == pytest.approx(7.0)
+
+
+def test_the_dirac_matrix_has_eigenvalues_one_and_minus_one_and_the_circular_packet_no_drift():
+    for angle in np.linspace(0, 2 * np.pi, 13):
+        matrix = dirac_matrix(STEEL_20N, angle)
+        np.testing.assert_allclose(np.linalg.eigvalsh(matrix), [-1.0, 1.0], atol=1e-6)
+        assert abs(np.vdot(CIRCULAR, matrix @ CIRCULAR)) < 1e-6  # ⟨χ|M(θ)|χ⟩ = 0: no direction favoured
+
+
+def test_the_cone_ring_starts_at_zero_and_grows_at_the_cone_slope():
+    """R(0) = 0; far out, R/(v_D t) → 1 (at v_D t = 40 σ within 0.5 %; the apex's diffuse
+    interior makes it approach from above)."""
+    width, speed = 8 * 0.01905, cone_slope(STEEL_20N)
+    assert cone_ring_radius(STEEL_20N, width, [0.0])[0] == pytest.approx(0.0, abs=1e-6 * width)
+    far = cone_ring_radius(STEEL_20N, width, [40 * width / speed], radial_points=4000)[0] / (40 * width)
+    assert 1.0 < far < 1.005
+
+
+def test_a_bloch_packet_at_its_centre_is_all_velocity_along_the_polarization():
+    positions = np.array([[0.0, 0.0], [0.3, 0.1]])
+    velocities, displacements = bloch_packet(positions, [0.0, 0.0], 1.0, [math.pi / 0.6, 0.0], [0.0, 1.0], 50.0, 2.0)
+    np.testing.assert_allclose(velocities[0], 0.0)  # sin 0
+    np.testing.assert_allclose(displacements[0], [0.0, 2.0 / 50.0])  # V/ω cos 0
+    envelope = math.exp(-0.1 / 2)
+    np.testing.assert_allclose(velocities[1], [0.0, 2.0 * envelope * math.sin(math.pi / 2)])
+
+
+@pytest.mark.parametrize("engine", ["lammps", "reference"])
+def test_the_measured_dispersion_lies_on_the_bands(engine, tmp_path):
+    """20 per edge under 20 N, random velocities for 10 ms: the spectral peaks along Γ–K–M–Γ
+    are within 2 % of the bands (median; measured 1.0 % in both engines)."""
+    measured = measure_dispersion(DispersionSettings(edge_beads=20, duration_s=0.01, points_per_segment=12,
+                                                     engine=engine), tmp_path, show_progress=False)
+    assert measured.median_deviation < 0.02
+    assert len(measured.rows()) == 2 * (3 * 12 - 1) and measured.rows()[0][3] == "lower"  # both Γ left out
+
+
+@pytest.mark.parametrize("engine", ["lammps", "reference"])
+def test_a_packet_at_the_dirac_point_opens_into_a_ring_at_the_cone_slope(engine, tmp_path):
+    """σ = 8 d to 3σ: the ring's growth rate is v_D within 3 % (measured 0.26 % LAMMPS, 0.08 %
+    reference), and the control away from K drifts at its group velocity within 2 % and widens
+    by less than 10 %."""
+    packets = measure_conical(ConicalSettings(width_d=8.0, reach=3.0, engine=engine), tmp_path, show_progress=False)
+    assert packets.slope_deviation < 0.03
+    assert packets.drift_deviation < 0.02
+    assert packets.control_width_m[-1] / packets.control_width_m[0] < 1.1
+    radius = packets.dirac.ring_radius_m()
+    assert radius[-1] > 2.5 * packets.dirac.width_m  # it did open
