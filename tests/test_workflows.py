@@ -1,6 +1,8 @@
-"""The basins-and-interfaces workflow runs in one command and writes its page, tables and movies."""
+"""The workflows run in one command and write their pages, tables and movies: basins and
+interfaces, and the Dirac point."""
 
 import csv
+import html
 import json
 import subprocess
 import sys
@@ -33,3 +35,33 @@ def test_the_basins_and_interfaces_workflow_runs_in_one_command(tmp_path):
     trapping = json.loads((tmp_path / "trapping.json").read_text())
     assert set(trapping) == {"steel_brass", "steel_ptfe"}, "one entry per interface case"
     assert all(0.0 < t["far_side_fraction_end"] <= t["far_side_fraction_max"] < 1.0 for t in trapping.values())
+
+
+DIRAC_WORKFLOW = WORKFLOW.parent / "dirac_point.py"
+
+
+@pytest.mark.slow
+def test_the_dirac_point_workflow_writes_its_tables_within_the_bounds(tmp_path):
+    """``--quick`` (20 per edge, σ = 8 d, the small sweep) from another directory: the contract's
+    files and columns, the dispersion within 2 % and the ring's growth within 3 % of v_D."""
+    done = subprocess.run([sys.executable, str(DIRAC_WORKFLOW), "--out", str(tmp_path / "out"), "--quick"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    out = tmp_path / "out"
+    result = json.loads((out / "dirac_point.json").read_text())
+    assert result["dispersion"]["median_relative_deviation"] <= 0.02
+    assert result["conical"]["slope_relative_deviation"] <= 0.03
+    headers = {name: next(csv.reader(open(out / name))) for name in ("dispersion.csv", "conical.csv", "transition.csv")}
+    assert headers["dispersion.csv"] == ["path_position", "kx", "ky", "branch", "omega_theory", "omega_measured"]
+    assert headers["conical.csv"] == ["time_s", "ring_radius_d", "theory_radius_d"]
+    assert headers["transition.csv"][:2] == ["precompression_n", "v0_m_s"]
+    assert (out / "conical.gif").read_bytes()[:6] == b"GIF89a"
+    page = (out / "dirac_point.html").read_text()
+    assert page.count("data:image/png;base64,") == 4 and html.escape(result["transition"]["finding"]) in page
+
+
+def test_the_dirac_point_workflow_refuses_an_unwritable_out_in_one_line(tmp_path):
+    (tmp_path / "file").write_text("")
+    done = subprocess.run([sys.executable, str(DIRAC_WORKFLOW), "--out", str(tmp_path / "file" / "out"), "--quick"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1, done.stderr

@@ -56,6 +56,12 @@ class Lattice2D:
         return cls(diameter_m - static_overlap(force_n, coefficient), spring_stiffness(force_n, coefficient),
                    float(sphere_mass(diameter_m, material)))
 
+    @classmethod
+    def of(cls, config) -> "Lattice2D":
+        """The packing of a :class:`~hexdem.model.config.RunConfig` (its beads' material and size,
+        its ``precompression_n``, which must be > 0)."""
+        return cls.precompressed(config.precompression_n, config.diameter_m, config.material(config.bead_material))
+
     @property
     def frequency_scale(self) -> float:
         """sqrt(k/m) [rad/s]."""

@@ -79,8 +79,7 @@ class ConicalSettings:
                          steps_per_contact=self.steps_per_contact, engine=self.engine, ranks=self.ranks)
 
     def theory(self) -> Lattice2D:
-        config = self.config()
-        return Lattice2D.precompressed(self.precompression_n, config.diameter_m, config.material(config.bead_material))
+        return Lattice2D.of(self.config())
 
 
 @dataclass(frozen=True)

@@ -67,8 +67,7 @@ class DispersionSettings:
                          ranks=self.ranks, initial_state_file=None if state_file is None else str(state_file))
 
     def theory(self) -> Lattice2D:
-        config = self.config()
-        return Lattice2D.precompressed(self.precompression_n, config.diameter_m, config.material(config.bead_material))
+        return Lattice2D.of(self.config())
 
 
 @dataclass(frozen=True)

@@ -41,7 +41,7 @@ def bands_figure(dispersion: Dispersion, path) -> None:
         ax.plot(position * a, _kilohertz(omega[:, branch]), color="c", linewidth=1.2,
                 label="theory: linearized Hertz, k = (3/2) A^(2/3) f₀^(1/3)" if branch == 0 else None)
         ax.plot(dispersion.path_position * a, _kilohertz(dispersion.omega_measured[:, branch]), linestyle="",
-                marker="o", markersize=3.5, markerfacecolor="none", markeredgecolor="w",
+                marker="o", markersize=3.5, markerfacecolor="k", markeredgecolor="w",
                 label="measured spectral peak" if branch == 0 else None)
     corners = position[::120] * a
     ax.set_xticks(corners, PATH)
@@ -49,7 +49,7 @@ def bands_figure(dispersion: Dispersion, path) -> None:
         ax.axvline(corner, color="0.6", linewidth=0.6)
     ax.set_xlim(position[0] * a, position[-1] * a)
     ax.set_ylim(0, 1.1 * _kilohertz(omega.max()))
-    ax.set_xlabel("wave vector along the path (path length × a)")
+    ax.set_xlabel("wave vector q along Γ–K–M–Γ (distance travelled in q, times a)")
     ax.set_ylabel("frequency ω/2π [kHz]")
     settings = dispersion.settings
     ax.set_title(f"Phonon bands of the hexagon precompressed at {settings.precompression_n:g} N "

@@ -1,0 +1,133 @@
+"""The precompressed lattice's linear waves in one study: its Dirac point, measured.
+
+:func:`run_dirac_study` measures the dispersion (:mod:`hexdem.waves.dispersion`), conical
+diffraction and its control (:mod:`hexdem.waves.conical`) and the transition from the nonlinear
+front to the linear regime (:mod:`hexdem.waves.transition`), and writes into ``out``:
+
+* ``dispersion.csv`` (``path_position,kx,ky,branch,omega_theory,omega_measured``: 1/m, 1/m, 1/m,
+  lower/upper, rad/s, rad/s) and ``bands.png``;
+* ``conical.csv`` (``time_s,ring_radius_d,theory_radius_d``), ``control.csv``
+  (``time_s,centroid_along_d,group_path_d,width_d``), ``conical.png``, ``snapshots.png`` and
+  ``conical.gif``;
+* ``transition.csv`` and ``transition_map.png``;
+* ``dirac_point.json`` (the theory's numbers, the deviations against their bounds, the
+  transition's finding) and ``dirac_point.html``, one page with all of it.
+
+The runs' decks and initial states stay under ``runs/``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, replace
+
+from hexdem.common.html_page import render_html
+from hexdem.common.io import ensure_writable_dir, write_csv, write_json, write_text
+from hexdem.theory.phonons import sound_speeds
+from hexdem.waves import conical, dispersion, transition
+from hexdem.waves.figures import bands_figure, conical_figure, conical_movie, snapshots_figure
+
+#: The issue's bounds: the dispersion's median relative deviation, the ring's growth rate against v_D.
+DISPERSION_BOUND = 0.02
+SLOPE_BOUND = 0.03
+
+
+@dataclass(frozen=True)
+class DiracStudy:
+    """The three parts' settings; :meth:`quick` the test suite's smaller case."""
+
+    dispersion: dispersion.DispersionSettings = dispersion.DispersionSettings()
+    conical: conical.ConicalSettings = conical.ConicalSettings()
+    transition: transition.TransitionSettings = transition.TransitionSettings()
+
+    @classmethod
+    def quick(cls) -> "DiracStudy":
+        """20 per edge for 10 ms (1,141 beads), a packet of σ = 8 d to 3σ (9,577 beads), the
+        transition's small sweep."""
+        return cls(dispersion.DispersionSettings(edge_beads=20, duration_s=0.01, points_per_segment=12),
+                   conical.ConicalSettings(width_d=8.0, reach=3.0), transition.QUICK)
+
+    def on(self, engine: str, ranks: int) -> "DiracStudy":
+        """Every run on ``engine`` with ``ranks`` ranks."""
+        return DiracStudy(*(replace(part, engine=engine, ranks=ranks)
+                            for part in (self.dispersion, self.conical, self.transition)))
+
+
+def summary(measured: dispersion.Dispersion, packets: conical.Conical, sweep) -> dict:
+    """dirac_point.json's contents."""
+    theory = measured.theory
+    c_l, c_t = sound_speeds(theory)
+    omega_k = math.sqrt(4.5) * theory.frequency_scale
+    return {
+        "precompression_n": measured.settings.precompression_n,
+        "theory": {"spacing_m": theory.spacing_m, "stiffness_n_m": theory.stiffness_n_m, "mass_kg": theory.mass_kg,
+                   "dirac_omega_rad_s": omega_k, "dirac_frequency_hz": omega_k / (2 * math.pi),
+                   "cone_slope_m_s": packets.cone_slope_m_s, "sound_speed_longitudinal_m_s": c_l,
+                   "sound_speed_transverse_m_s": c_t},
+        "dispersion": {"median_relative_deviation": measured.median_deviation,
+                       "largest_relative_deviation": float(measured.relative_deviation.max()),
+                       "bound": DISPERSION_BOUND, "within_bound": measured.median_deviation <= DISPERSION_BOUND,
+                       "settings": asdict(measured.settings)},
+        "conical": {"fitted_slope_m_s": packets.fitted_slope_m_s, "slope_relative_deviation": packets.slope_deviation,
+                    "bound": SLOPE_BOUND, "within_bound": packets.slope_deviation <= SLOPE_BOUND,
+                    "control_group_velocity_m_s": packets.group_velocity_m_s,
+                    "control_drift_velocity_m_s": packets.drift_velocity_m_s,
+                    "control_drift_relative_deviation": packets.drift_deviation,
+                    "control_width_growth": float(packets.control_width_m[-1] / packets.control_width_m[0]),
+                    "settings": asdict(packets.settings)},
+        "transition": {"finding": sweep.finding(), "settings": asdict(sweep.settings)},
+    }
+
+
+def _page(result: dict) -> list:
+    """The HTML page's blocks."""
+    theory, spread, ring = result["theory"], result["dispersion"], result["conical"]
+    return [
+        ("h1", f"The Dirac point of the hexagonal packing precompressed at {result['precompression_n']:g} N"),
+        ("p", f"Linearized about the static force, every contact is a spring of {theory['stiffness_n_m'] / 1e6:.2f} MN/m. "
+              f"The two bands meet at K at ω_K/2π = {theory['dirac_frequency_hz']:.1f} Hz in a cone of slope "
+              f"v_D = {theory['cone_slope_m_s']:.2f} m/s; the long waves travel at c_L = "
+              f"{theory['sound_speed_longitudinal_m_s']:.1f} and c_T = {theory['sound_speed_transverse_m_s']:.1f} m/s."),
+        ("h2", "The measured dispersion"),
+        ("p", f"Random velocities of every bead light up all the modes; the spectral peaks lie on the bands with a median "
+              f"relative deviation of {100 * spread['median_relative_deviation']:.2f} % (bound "
+              f"{100 * spread['bound']:g} %; largest {100 * spread['largest_relative_deviation']:.1f} %, near Γ)."),
+        ("figure", "bands.png", "The measured spectrum along Γ–K–M–Γ with the theory's bands drawn over it"),
+        ("h2", "Conical diffraction at K"),
+        ("p", f"A Gaussian packet of circularly polarized waves at K opens into a ring. Fitted with the cone's own R(t), "
+              f"its growth rate is {ring['fitted_slope_m_s']:.2f} m/s, {100 * ring['slope_relative_deviation']:.2f} % from "
+              f"v_D (bound {100 * ring['bound']:g} %). The control packet away from K drifts "
+              f"{100 * ring['control_drift_relative_deviation']:.2f} % from its group velocity and widens by "
+              f"{100 * (ring['control_width_growth'] - 1):.1f} %: it keeps its shape."),
+        ("figure", "conical.png", "The ring's radius against the cone, and the control's drift"),
+        ("figure", "snapshots.png", "Kinetic energy of the packet at K, and of the control at the end (log scale)"),
+        ("h2", "From the nonlinear front to the linear regime"),
+        ("p", result["transition"]["finding"]),
+        ("figure", "transition_map.png", "The front's shape and speed over precompression and impact speed"),
+    ]
+
+
+def run_dirac_study(study: DiracStudy, out, log=None, show_progress: bool = True) -> dict:
+    """Run the study into ``out`` (see the module docstring); returns dirac_point.json's contents."""
+    out = ensure_writable_dir(out)
+    log = log or (lambda message: None)
+    log("dispersion: a precompressed hexagon under random velocities")
+    measured = dispersion.measure_dispersion(study.dispersion, out / "runs" / "dispersion", log, show_progress)
+    write_csv(out / "dispersion.csv", dispersion.COLUMNS, measured.rows())
+    bands_figure(measured, out / "bands.png")
+    log("conical diffraction: a packet at K and a control")
+    packets = conical.measure_conical(study.conical, out / "runs" / "conical", log, show_progress)
+    write_csv(out / "conical.csv", conical.COLUMNS, packets.rows())
+    write_csv(out / "control.csv", conical.CONTROL_COLUMNS, packets.control_rows())
+    conical_figure(packets, out / "conical.png")
+    snapshots_figure(packets, out / "snapshots.png")
+    conical_movie(packets, out / "conical.gif")
+    log("transition: precompression against impact speed")
+    sweep = transition.run_transition(study.transition, out / "runs" / "transition", log)
+    write_csv(out / "transition.csv", transition.COLUMNS, sweep.rows())
+    transition.transition_figure(sweep, out / "transition_map.png")
+    result = summary(measured, packets, sweep)
+    write_json(out / "dirac_point.json", result)
+    write_text(out / "dirac_point.html", render_html(_page(result), out, "hexdem: the Dirac point"))
+    return result
+
