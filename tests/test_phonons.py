@@ -6,6 +6,7 @@ import math
 import numpy as np
 import pytest
 
+from hexdem.errors import HexdemError
 from hexdem.model.materials import hertz_coefficient, sphere_mass
 from hexdem.model.precompression import longitudinal_sound_speed, spring_stiffness, static_overlap
 from hexdem.theory.phonons import Lattice2D, band_path, cone_slope, dynamical_matrix, frequencies, sound_speeds
@@ -67,3 +68,18 @@ def test_the_band_path_runs_gamma_k_m_gamma():
     np.testing.assert_allclose(vectors[[0, 30, 60, 90]], [points["Γ"], points["K"], points["M"], points["Γ"]], atol=1e-9)
     np.testing.assert_allclose(omega[30], [math.sqrt(4.5) * SCALE] * 2, rtol=1e-12)
     assert np.all(omega[:, 1] >= omega[:, 0])
+
+
+def test_the_path_runs_along_the_zone_edge_from_k_to_m():
+    """K and M are neighbours on the zone's edge: |K − M| = 2π/(3a), half an edge of the
+    hexagonal zone whose corners lie 4π/(3a) from Γ, and M is at distance 2π/(√3 a) = the
+    zone's inradius."""
+    points = LATTICE.high_symmetry_points()
+    a = LATTICE.spacing_m
+    assert np.linalg.norm(points["K"] - points["M"]) == pytest.approx(2 * math.pi / (3 * a), rel=1e-12)
+    assert np.linalg.norm(points["M"]) == pytest.approx(2 * math.pi / (math.sqrt(3) * a), rel=1e-12)
+
+
+def test_an_uncompressed_packing_has_no_linear_lattice():
+    with pytest.raises(HexdemError, match="precompression > 0"):
+        Lattice2D.precompressed(0.0, 0.01905)

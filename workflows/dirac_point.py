@@ -32,13 +32,14 @@ def run(argv=None) -> int:
     parser.add_argument("--engine", choices=("lammps", "reference"), default="lammps",
                         help="the engine of every run (default lammps; the reference runs on one rank)")
     args = parser.parse_args(argv)
-    study = (DiracStudy.quick() if args.quick else DiracStudy()).on(args.engine, args.ranks if args.engine == "lammps" else 1)
 
     def log(message):
         print(f"dirac_point: {message}", file=sys.stderr, flush=True)
 
     start = time.perf_counter()
     try:
+        study = (DiracStudy.quick() if args.quick else DiracStudy()).on(args.engine,
+                                                                         args.ranks if args.engine == "lammps" else 1)
         out = ensure_writable_dir(args.out)
         result = run_dirac_study(study, out, log)
     except HexdemError as exc:

@@ -32,7 +32,9 @@ def power_spectrum(times_s, signals, pad: int = 4) -> tuple[np.ndarray, np.ndarr
     """(ω [rad/s] (W,), power (W, ...)) of ``signals`` (S, ...) sampled evenly at ``times_s``
     (see the module docstring); ω runs from 0 to the Nyquist frequency."""
     times_s, signals = np.asarray(times_s, float), np.asarray(signals)
-    if len(times_s) < 8 or len(signals) != len(times_s):
+    if len(signals) != len(times_s):
+        raise HexdemError(f"a spectrum needs one signal row per time, got {len(signals)} rows for {len(times_s)} times")
+    if len(times_s) < 8:
         raise HexdemError(f"a spectrum needs at least 8 evenly spaced samples, got {len(times_s)}")
     interval = times_s[1] - times_s[0]
     window = np.hanning(len(times_s)).reshape((-1,) + (1,) * (signals.ndim - 1))
@@ -53,6 +55,8 @@ def peak_frequency(omega, power, lowest: float = 0.0) -> np.ndarray:
     columns = power.reshape(len(omega), -1)
     allowed = np.flatnonzero(omega > lowest)
     allowed = allowed[(allowed > 0) & (allowed < len(omega) - 1)]
+    if not len(allowed):
+        raise HexdemError(f"no frequency of the spectrum lies above {lowest:g} rad/s and below its last")
     peaks = allowed[np.argmax(columns[allowed], axis=0)]
     span = np.arange(columns.shape[1])
     left, middle, right = (np.log(np.maximum(columns[peaks + shift, span], np.finfo(float).tiny)) for shift in (-1, 0, 1))

@@ -47,8 +47,9 @@ class RecordedWaves:
 
     def block_sample_times_s(self) -> np.ndarray:
         """(F, B) the times of each block's samples."""
+        interval = self.times_s[1] - self.times_s[0] if len(self.times_s) > 1 else 0.0
         index = np.arange(len(self.block_times_s))[:, None] * self.block_samples + np.arange(self.block_samples)
-        return index * (self.times_s[1] - self.times_s[0])
+        return index * interval
 
 
 class WaveRecorder:

@@ -12,7 +12,8 @@ import html
 from pathlib import Path
 
 
-def render_html(blocks: list, out: Path, title: str = "hexdem paper report") -> str:
+def render_html(blocks: list, out: Path, title: str) -> str:
+    """The page of ``blocks`` (module docstring) titled ``title``, its figures read from ``out``."""
     body = []
     for block in blocks:
         kind = block[0]

@@ -84,6 +84,9 @@ def write_initial_state(path, lattice: Lattice, velocities_m_s, displacements_m=
     columns = [np.asarray(velocities_m_s, float)]
     if displacements_m is not None:
         columns.append(np.asarray(displacements_m, float))
+    if any(column.shape != (len(lattice), 2) for column in columns):
+        raise HexdemError(f"an initial state needs ({len(lattice)}, 2) arrays for the packing's beads, got "
+                          f"{' and '.join(str(column.shape) for column in columns)}")
     header = HEADERS[len(columns) - 1]
     rows = [[m, n, *(repr(float(value)) for value in values)]
             for (m, n), values in zip(lattice.indices.tolist(), np.hstack(columns))]

@@ -243,6 +243,6 @@ def write_report(out: Path, settings, summaries: dict, wall_time_s: float) -> li
     blocks, rows = build_report(out, settings, summaries, wall_time_s)
     write_csv(out / "published_vs_computed.csv", COMPARISON_COLUMNS, rows)
     write_text(out / "report.md", render_markdown(blocks))
-    write_text(out / "report.html", render_html(blocks, out))
+    write_text(out / "report.html", render_html(blocks, out, "hexdem paper report"))
     return rows
 

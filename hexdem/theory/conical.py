@@ -41,7 +41,7 @@ def dirac_matrix(lattice: Lattice2D, angle_rad: float) -> np.ndarray:
     dynamical matrix's part odd in q about K, taken at |q| = 1e-6 / a (first order)."""
     k_point = lattice.high_symmetry_points()["K"]
     step = 1e-6 / lattice.spacing_m * np.array([math.cos(angle_rad), math.sin(angle_rad)])
-    omega_k = math.sqrt(4.5) * lattice.frequency_scale
+    omega_k = lattice.dirac_frequency()
     odd = dynamical_matrix(lattice, k_point + step) - dynamical_matrix(lattice, k_point - step)
     return odd / (4 * omega_k * cone_slope(lattice) * np.linalg.norm(step))
 
@@ -58,7 +58,8 @@ def cone_ring_radius(lattice: Lattice2D, width_m: float, times_s, polarization=C
     q = (np.arange(radial_points) + 0.5) * 6.0 / width_m / radial_points
     dq = q[1] - q[0]
     m_chi = np.array([dirac_matrix(lattice, angle) @ chi for angle in theta])  # (A, 2)
-    dm_chi = (np.roll(m_chi, -1, axis=0) - np.roll(m_chi, 1, axis=0)) / (2 * dtheta)
+    # M is linear in (cos θ, sin θ), so dM/dθ = M(θ + π/2) exactly
+    dm_chi = np.array([dirac_matrix(lattice, angle + np.pi / 2) @ chi for angle in theta])
     g = np.exp(-(width_m * q) ** 2 / 2)
     dg = -width_m**2 * q * g
     weight = q[:, None] * dq * dtheta

@@ -21,7 +21,7 @@ paper's labels). The static force's transverse (geometric) stiffness, −f0/a, i
   and 270°), is traceless with eigenvalues
   ±(3/4)(k/m) √3 a |q| in every direction: the bands meet in a cone,
   ω = ω_K ± v_D |q − K|, v_D = (√6/8) a sqrt(k/m) (:func:`cone_slope`).
-* M (the middle of a zone edge): two bond directions have q·a_j = π, the third 0, so
+* M (the middle of a zone edge, next to K): two bond directions have q·a_j = π, the third 0, so
   D = 4 (k/m)(e_A e_Aᵀ + e_B e_Bᵀ) with e_A, e_B 60° apart: ω_M = sqrt(6 k/m) and sqrt(2 k/m).
 """
 
@@ -32,6 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hexdem.errors import HexdemError
 from hexdem.model.materials import STEEL_316, Material, hertz_coefficient, sphere_mass
 from hexdem.model.precompression import spring_stiffness, static_overlap
 
@@ -51,7 +52,10 @@ class Lattice2D:
 
     @classmethod
     def precompressed(cls, force_n: float, diameter_m: float, material: Material = STEEL_316) -> "Lattice2D":
-        """The packing of ``material`` spheres of ``diameter_m`` with every contact at ``force_n``."""
+        """The packing of ``material`` spheres of ``diameter_m`` with every contact at ``force_n`` > 0
+        (an uncompressed packing has no linear waves)."""
+        if not force_n > 0:
+            raise HexdemError(f"linear waves need a precompression > 0 N per contact, got {force_n!r}")
         coefficient = float(hertz_coefficient(diameter_m, material))
         return cls(diameter_m - static_overlap(force_n, coefficient), spring_stiffness(force_n, coefficient),
                    float(sphere_mass(diameter_m, material)))
@@ -59,7 +63,7 @@ class Lattice2D:
     @classmethod
     def of(cls, config) -> "Lattice2D":
         """The packing of a :class:`~hexdem.model.config.RunConfig` (its beads' material and size,
-        its ``precompression_n``, which must be > 0)."""
+        its ``precompression_n``)."""
         return cls.precompressed(config.precompression_n, config.diameter_m, config.material(config.bead_material))
 
     @property
@@ -68,12 +72,17 @@ class Lattice2D:
         return math.sqrt(self.stiffness_n_m / self.mass_kg)
 
     def high_symmetry_points(self) -> dict[str, np.ndarray]:
-        """Γ, K and M [1/m] of the Brillouin zone: K = (0, 4π/(3a)), where q·a e_j = ±2π/3 (mod 2π,
-        cos = −1/2) for every bond; M = (2π/(√3 a), 0), half the reciprocal vector
-        perpendicular to the 90° bonds."""
+        """Γ, K and M [1/m] of the Brillouin zone: K = (0, 4π/(3a)), at 90°, where q·a e_j = ±2π/3
+        (mod 2π, cos = −1/2) for every bond; M = (π/(√3 a), π/a), at 60°, the middle of the zone
+        edge next to K (|K − M| = 2π/(3a)): half the reciprocal vector perpendicular to the
+        150° bonds."""
         a = self.spacing_m
         return {"Γ": np.zeros(2), "K": np.array([0.0, 4 * math.pi / (3 * a)]),
-                "M": np.array([2 * math.pi / (math.sqrt(3) * a), 0.0])}
+                "M": np.array([math.pi / (math.sqrt(3) * a), math.pi / a])}
+
+    def dirac_frequency(self) -> float:
+        """ω_K = sqrt(9/2) sqrt(k/m) [rad/s], where the two bands meet (module docstring)."""
+        return math.sqrt(4.5) * self.frequency_scale
 
 
 def dynamical_matrix(lattice: Lattice2D, q) -> np.ndarray:

@@ -19,8 +19,9 @@ envelope G² on the beads (:mod:`hexdem.analysis.packet`). The cone's R(t) for t
 the slope v as its one parameter gives the growth rate, which must be v_D.
 
 **Why not a straight line.** R grows as v_D t only slowly: the cone's apex leaves a diffuse
-interior (measured at σ = 8 d: the slope of R over the last half of a run to 5σ is 0.96 v_D,
-while the cone's whole R(t) fits it with v = 1.004 v_D).
+interior. Measured at σ = 8 d in a run to 5σ: a straight line through R over the last half of
+the run has the slope 0.961 v_D, and the cone's own R(t) for v_D has 0.959 over the same window;
+the cone's whole R(t) fits the measured R with v = 1.002 v_D.
 """
 
 from __future__ import annotations
@@ -34,7 +35,9 @@ from scipy.optimize import minimize_scalar
 
 from hexdem.analysis.packet import energy_centroid, energy_spread, ring_radius
 from hexdem.analysis.wave_recorder import RecordedWaves
-from hexdem.experiments.wave_run import record_waves
+from hexdem.common.checks import is_number, positive_int
+from hexdem.errors import HexdemError
+from hexdem.experiments.wave_run import record_waves, sampled_per_period
 from hexdem.model.config import RunConfig
 from hexdem.model.initial_state import write_initial_state
 from hexdem.theory.conical import CIRCULAR, cone_ring_radius
@@ -48,6 +51,11 @@ COLUMNS = ("time_s", "ring_radius_d", "theory_radius_d")
 CONTROL_COLUMNS = ("time_s", "centroid_along_d", "group_path_d", "width_d")
 #: Widths σ between the packet's outermost extent and the walls.
 CLEARANCE_WIDTHS = 3.0
+#: The control keeps its shape and drifts if its drift velocity is within this of its group
+#: velocity and its width grows by less than this share over the run (measured: 0.12 % and 3.8 %
+#: at σ = 12 d to 5σ, 0.4 % and 6.5 % at σ = 8 d to 3σ).
+CONTROL_DRIFT_BOUND = 0.02
+CONTROL_WIDENING_BOUND = 0.10
 
 
 @dataclass(frozen=True)
@@ -70,16 +78,44 @@ class ConicalSettings:
     ranks: int = 1
     steps_per_contact: int = 40
 
+    def __post_init__(self):
+        for name in ("samples_per_period", "block_periods", "ranks", "steps_per_contact"):
+            positive_int(name, getattr(self, name))
+        if self.samples_per_period < 3:
+            raise HexdemError(f"samples_per_period must be at least 3, got {self.samples_per_period}")
+        for name in ("precompression_n", "width_d", "reach", "speed_m_s"):
+            if not (is_number(getattr(self, name)) and getattr(self, name) > 0):
+                raise HexdemError(f"{name} must be a number > 0, got {getattr(self, name)!r}")
+        if not (is_number(self.control_fraction) and 0 < self.control_fraction < 1):
+            raise HexdemError(f"control_fraction must lie between 0 and 1 (of K), got {self.control_fraction!r}")
+        theory = self.theory()
+        blocks = self.reach * self.width_d * theory.spacing_m / cone_slope(theory) * theory.dirac_frequency() / (
+            2 * math.pi * self.block_periods)
+        if blocks < 4:
+            raise HexdemError(f"a reach of {self.reach:g} widths lasts {blocks:.1f} energy blocks of {self.block_periods} "
+                              "periods; the ring needs at least 4: widen the packet or reach farther")
+        self.config()  # its own checks, worded there
+
+    def control_wave_vector(self) -> np.ndarray:
+        """The control's wave vector [1/m]: ``control_fraction`` of K."""
+        return self.control_fraction * self.theory().high_symmetry_points()["K"]
+
     def edge_beads(self) -> int:
-        """Beads per edge of a hexagon whose apothem, (E − 1) √3/2 d, is (reach + clearance) σ."""
-        return math.ceil((self.reach + CLEARANCE_WIDTHS) * self.width_d / (math.sqrt(3) / 2)) + 1
+        """Beads per edge of a hexagon whose apothem, (E − 1) √3/2 d, is ``clearance`` widths σ
+        beyond the farthest the packets go: the ring to ``reach`` σ, the control (which starts
+        behind the centre by half its path) to half its path, |v_g| / v_D ``reach`` σ."""
+        theory = self.theory()
+        speed = np.linalg.norm(group_velocity(theory, self.control_wave_vector(), 0))
+        farthest = max(1.0, 0.5 * speed / cone_slope(theory)) * self.reach
+        return math.ceil((farthest + CLEARANCE_WIDTHS) * self.width_d / (math.sqrt(3) / 2)) + 1
 
     def config(self) -> RunConfig:
         return RunConfig(edge_beads=self.edge_beads(), precompression_n=self.precompression_n, v0=1e-6,
                          steps_per_contact=self.steps_per_contact, engine=self.engine, ranks=self.ranks)
 
     def theory(self) -> Lattice2D:
-        return Lattice2D.of(self.config())
+        """The linear lattice (its size does not matter)."""
+        return Lattice2D.of(RunConfig(precompression_n=self.precompression_n))
 
 
 @dataclass(frozen=True)
@@ -128,12 +164,21 @@ class Conical:
         return float(np.linalg.norm(self.drift_velocity_m_s - self.group_velocity_m_s)
                      / np.linalg.norm(self.group_velocity_m_s))
 
+    @property
+    def control_widening(self) -> float:
+        """The control's width at the end over its width at the first block, minus 1."""
+        return float(self.control_width_m[-1] / self.control_width_m[0] - 1.0)
+
+    @property
+    def control_keeps_shape(self) -> bool:
+        """Whether the control drifts at its group velocity and keeps its width (the bounds above)."""
+        return self.drift_deviation <= CONTROL_DRIFT_BOUND and self.control_widening <= CONTROL_WIDENING_BOUND
+
     def rows(self) -> list[list]:
         """conical.csv's rows (:data:`COLUMNS`)."""
         d = self.diameter_m
         return [[repr(float(t)), repr(float(r / d)), repr(float(theory / d))]
                 for t, r, theory in zip(self.dirac.times_s, self.dirac.ring_radius_m(), self.theory_radius_m)]
-
 
     def control_path_m(self) -> np.ndarray:
         """(F,) the control's centroid's distance from its start along its group velocity."""
@@ -159,7 +204,7 @@ def _run_packet(settings: ConicalSettings, workdir: Path, wave_vector, polarizat
                 log, show_progress) -> PacketRun:
     """Write the packet's state, run it and record its energy blocks."""
     config = settings.config()
-    lattice, theory = config.lattice(), settings.theory()
+    lattice, theory = config.model().lattice, settings.theory()  # the precompressed positions
     width = settings.width_d * config.diameter_m
     velocities, displacements = bloch_packet(lattice.positions_m, centre, width, wave_vector, polarization,
                                              omega, settings.speed_m_s)
@@ -167,12 +212,11 @@ def _run_packet(settings: ConicalSettings, workdir: Path, wave_vector, polarizat
     write_initial_state(workdir / "initial_state.csv", lattice, velocities, displacements)
     duration = settings.reach * width / cone_slope(theory)
     config = config.replace(initial_state_file=str(workdir / "initial_state.csv"), duration=duration)
-    dt_s = config.settings(config.model()).dt_s
-    period = 2 * math.pi / (math.sqrt(4.5) * theory.frequency_scale)
-    every = max(1, int(period / settings.samples_per_period / dt_s))
-    block = max(1, round(settings.block_periods * period / (every * dt_s)))
-    recorded = record_waves(config.replace(dump_every=every), workdir / "run", block=block, log=log,
-                            show_progress=show_progress)
+    period = 2 * math.pi / theory.dirac_frequency()
+    config = sampled_per_period(config, period, settings.samples_per_period)
+    interval = config.dump_every * config.settings(config.model()).dt_s
+    recorded = record_waves(config, workdir / "run", block=max(1, round(settings.block_periods * period / interval)),
+                            log=log, show_progress=show_progress)
     return PacketRun(np.asarray(centre, float), width, recorded)
 
 
@@ -195,16 +239,16 @@ def measure_conical(settings: ConicalSettings, workdir, log=None, show_progress:
     """Run both packets of the module docstring in ``workdir`` and measure them."""
     workdir = Path(workdir)
     theory, config = settings.theory(), settings.config()
-    centre = config.lattice().positions_m.mean(axis=0)
+    centre = config.model().lattice.positions_m.mean(axis=0)
     k_point = theory.high_symmetry_points()["K"]
-    omega_k = math.sqrt(4.5) * theory.frequency_scale
+    omega_k = theory.dirac_frequency()
     dirac = _run_packet(settings, workdir / "dirac", k_point, CIRCULAR, omega_k, centre, log, show_progress)
     measured = dirac.ring_radius_m()
     v_d = cone_slope(theory)
     cone = _block_cone(theory, dirac)
     fitted = minimize_scalar(lambda speed: float(np.sum((cone(speed) - measured) ** 2)), bounds=(0.5 * v_d, 1.5 * v_d),
                              method="bounded", options={"xatol": 1e-6 * v_d}).x
-    q = settings.control_fraction * k_point
+    q = settings.control_wave_vector()
     omega2, vectors = np.linalg.eigh(dynamical_matrix(theory, q))
     velocity = group_velocity(theory, q, 0)
     duration = settings.reach * dirac.width_m / v_d

@@ -60,9 +60,9 @@ def bands_figure(dispersion: Dispersion, path) -> None:
 
 
 def conical_figure(conical: Conical, path) -> None:
-    """(a) The K packet's ring radius against time, the cone's R(t) for v_D and for the fitted
-    slope, and v_D t; (b) the control: its centroid's path along its group velocity against
-    the bands' prediction, and its width."""
+    """(a) The K packet's ring radius against time, the cone's R(t) for v_D, and v_D t (the
+    fitted slope in the title); (b) the control: its centroid's path along its group velocity
+    against the bands' prediction, and its width."""
     from hexdem.analysis.figures import save, subplots
 
     d = conical.diameter_m

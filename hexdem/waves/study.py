@@ -57,7 +57,7 @@ def summary(measured: dispersion.Dispersion, packets: conical.Conical, sweep) ->
     """dirac_point.json's contents."""
     theory = measured.theory
     c_l, c_t = sound_speeds(theory)
-    omega_k = math.sqrt(4.5) * theory.frequency_scale
+    omega_k = theory.dirac_frequency()
     return {
         "precompression_n": measured.settings.precompression_n,
         "theory": {"spacing_m": theory.spacing_m, "stiffness_n_m": theory.stiffness_n_m, "mass_kg": theory.mass_kg,
@@ -66,6 +66,7 @@ def summary(measured: dispersion.Dispersion, packets: conical.Conical, sweep) ->
                    "sound_speed_transverse_m_s": c_t},
         "dispersion": {"median_relative_deviation": measured.median_deviation,
                        "largest_relative_deviation": float(measured.relative_deviation.max()),
+                       "largest_deviation_from_gamma_per_m": measured.largest_deviation_distance_from_gamma(),
                        "bound": DISPERSION_BOUND, "within_bound": measured.median_deviation <= DISPERSION_BOUND,
                        "settings": asdict(measured.settings)},
         "conical": {"fitted_slope_m_s": packets.fitted_slope_m_s, "slope_relative_deviation": packets.slope_deviation,
@@ -73,7 +74,10 @@ def summary(measured: dispersion.Dispersion, packets: conical.Conical, sweep) ->
                     "control_group_velocity_m_s": packets.group_velocity_m_s,
                     "control_drift_velocity_m_s": packets.drift_velocity_m_s,
                     "control_drift_relative_deviation": packets.drift_deviation,
-                    "control_width_growth": float(packets.control_width_m[-1] / packets.control_width_m[0]),
+                    "control_drift_bound": conical.CONTROL_DRIFT_BOUND,
+                    "control_widening": packets.control_widening,
+                    "control_widening_bound": conical.CONTROL_WIDENING_BOUND,
+                    "control_keeps_shape": packets.control_keeps_shape,
                     "settings": asdict(packets.settings)},
         "transition": {"finding": sweep.finding(), "settings": asdict(sweep.settings)},
     }
@@ -91,14 +95,19 @@ def _page(result: dict) -> list:
         ("h2", "The measured dispersion"),
         ("p", f"Random velocities of every bead light up all the modes; the spectral peaks lie on the bands with a median "
               f"relative deviation of {100 * spread['median_relative_deviation']:.2f} % (bound "
-              f"{100 * spread['bound']:g} %; largest {100 * spread['largest_relative_deviation']:.1f} %, near Γ)."),
+              f"{100 * spread['bound']:g} %; the largest, {100 * spread['largest_relative_deviation']:.1f} %, at "
+              f"|q| a = {spread['largest_deviation_from_gamma_per_m'] * theory['spacing_m']:.2f} from Γ, where the "
+              f"packing's size resolves q least well against ω)."),
         ("figure", "bands.png", "The measured spectrum along Γ–K–M–Γ with the theory's bands drawn over it"),
         ("h2", "Conical diffraction at K"),
         ("p", f"A Gaussian packet of circularly polarized waves at K opens into a ring. Fitted with the cone's own R(t), "
               f"its growth rate is {ring['fitted_slope_m_s']:.2f} m/s, {100 * ring['slope_relative_deviation']:.2f} % from "
               f"v_D (bound {100 * ring['bound']:g} %). The control packet away from K drifts "
               f"{100 * ring['control_drift_relative_deviation']:.2f} % from its group velocity and widens by "
-              f"{100 * (ring['control_width_growth'] - 1):.1f} %: it keeps its shape."),
+              f"{100 * ring['control_widening']:.1f} %: "
+              + ("it keeps its shape." if ring["control_keeps_shape"] else
+                 f"beyond the bounds ({100 * ring['control_drift_bound']:g} % and "
+                 f"{100 * ring['control_widening_bound']:g} %), it does not keep its shape.")),
         ("figure", "conical.png", "The ring's radius against the cone, and the control's drift"),
         ("figure", "snapshots.png", "Kinetic energy of the packet at K, and of the control at the end (log scale)"),
         ("h2", "From the nonlinear front to the linear regime"),

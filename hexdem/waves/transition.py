@@ -204,7 +204,7 @@ class TransitionMap:
             return "The sweep needs uncompressed and precompressed runs to place the transition."
         order = np.flatnonzero(pressed)[np.argsort(self.overlap_ratio[pressed], kind="stable")]
         ratio, speed, shape = self.overlap_ratio[order], self.speed_ratio[order], self.sixfold_amplitude[order]
-        off = np.abs(speed - 1) > LINEAR_SPEED_TOLERANCE
+        off = ~(np.abs(speed - 1) <= LINEAR_SPEED_TOLERANCE)  # a speed not measured (NaN) is not at c_L
         linear = int(np.argmax(off)) if off.any() else len(order)
         tolerance = f"{100 * LINEAR_SPEED_TOLERANCE:g} %"
         speeds = (f"travel at c_L within {tolerance} up to δ_impact/δ0 = {_short(ratio[linear - 1])}" if linear else
