@@ -88,11 +88,10 @@ class WaveRecorder:
         if self.comm is not None and self.comm.Get_size() > 1:
             from mpi4py import MPI
 
+            root = self.comm.Get_rank() == 0
             for array in (self.components, self.kinetic):
-                total = np.empty_like(array) if self.comm.Get_rank() == 0 else None
-                self.comm.Reduce(array, total, op=MPI.SUM, root=0)
-                array[...] = total if total is not None else 0.0
-            if self.comm.Get_rank() != 0:
+                self.comm.Reduce(MPI.IN_PLACE if root else array, array if root else None, op=MPI.SUM, root=0)
+            if not root:
                 return None
         interval = self.settings.dump_every * self.settings.dt_s
         n_blocks = min(len(self.kinetic), self.count // self.block) if self.block else 0

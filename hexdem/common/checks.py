@@ -17,6 +17,13 @@ def is_number(value) -> bool:
     return isinstance(value, numbers.Real) and not isinstance(value, bool) and math.isfinite(value)
 
 
+def positive_number(name: str, value) -> float:
+    """``value`` as a float if it is a finite number > 0, else a HexdemError naming ``name``."""
+    if not (is_number(value) and value > 0):
+        raise HexdemError(f"{name} must be a number > 0, got {value!r}")
+    return float(value)
+
+
 def positive_int(name: str, value) -> int:
     """``value`` as an int if it is an integer ≥ 1, else a HexdemError naming ``name``."""
     if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1:

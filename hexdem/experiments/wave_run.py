@@ -39,11 +39,10 @@ class WaveJob:
         return recorder.finish()
 
 
-def sampled_per_period(config: RunConfig, period_s: float, samples_per_period: int) -> RunConfig:
-    """``config`` sampled about ``samples_per_period`` times per ``period_s`` (at least every
-    step): ``dump_every`` = the whole steps of its time step in period / samples."""
-    dt_s = config.settings(config.model()).dt_s
-    return config.replace(dump_every=max(1, int(period_s / samples_per_period / dt_s)))
+def steps_per_sample(dt_s: float, period_s: float, samples_per_period: int) -> int:
+    """The ``dump_every`` that samples about ``samples_per_period`` times per ``period_s`` with
+    the time step ``dt_s``: the whole steps in period / samples, at least one."""
+    return max(1, int(period_s / samples_per_period / dt_s))
 
 
 def record_waves(config: RunConfig, workdir, wave_vectors_m=(), block: int = 0, log=None,

@@ -35,10 +35,11 @@ from scipy.optimize import minimize_scalar
 
 from hexdem.analysis.packet import energy_centroid, energy_spread, ring_radius
 from hexdem.analysis.wave_recorder import RecordedWaves
-from hexdem.common.checks import is_number, positive_int
+from hexdem.common.checks import is_number, positive_int, positive_number
 from hexdem.errors import HexdemError
-from hexdem.experiments.wave_run import record_waves, sampled_per_period
+from hexdem.experiments.wave_run import record_waves, steps_per_sample
 from hexdem.model.config import RunConfig
+from hexdem.model.granular import GranularModel
 from hexdem.model.initial_state import write_initial_state
 from hexdem.theory.conical import CIRCULAR, cone_ring_radius
 from hexdem.theory.phonons import Lattice2D, cone_slope, dynamical_matrix, frequencies
@@ -84,8 +85,7 @@ class ConicalSettings:
         if self.samples_per_period < 3:
             raise HexdemError(f"samples_per_period must be at least 3, got {self.samples_per_period}")
         for name in ("precompression_n", "width_d", "reach", "speed_m_s"):
-            if not (is_number(getattr(self, name)) and getattr(self, name) > 0):
-                raise HexdemError(f"{name} must be a number > 0, got {getattr(self, name)!r}")
+            positive_number(name, getattr(self, name))
         if not (is_number(self.control_fraction) and 0 < self.control_fraction < 1):
             raise HexdemError(f"control_fraction must lie between 0 and 1 (of K), got {self.control_fraction!r}")
         theory = self.theory()
@@ -139,7 +139,8 @@ class Conical:
     """Both packets measured, SI: ``cone_slope_m_s`` v_D, ``fitted_slope_m_s`` the growth rate;
     ``theory_radius_m`` the cone's R(t) at the K packet's block times; the control's
     ``group_velocity_m_s`` (2,) from the bands and ``drift_velocity_m_s`` (2,) fitted to its
-    centroid, its width (rms distance from the centroid) ``control_width_m`` (F,)."""
+    centroid, its width (rms distance from the centroid) ``control_width_m`` (F,); the beads'
+    ``diameter_m``, the unit of the CSVs."""
 
     dirac: PacketRun
     control: PacketRun
@@ -150,7 +151,6 @@ class Conical:
     drift_velocity_m_s: np.ndarray
     control_width_m: np.ndarray
     diameter_m: float
-    omega_k_rad_s: float
     settings: ConicalSettings = field(repr=False)
 
     @property
@@ -200,22 +200,21 @@ def group_velocity(theory: Lattice2D, wave_vector, branch: int) -> np.ndarray:
                       - frequencies(theory, wave_vector - step * unit)[branch]) / (2 * step) for unit in np.eye(2)])
 
 
-def _run_packet(settings: ConicalSettings, workdir: Path, wave_vector, polarization, omega: float, centre,
-                log, show_progress) -> PacketRun:
-    """Write the packet's state, run it and record its energy blocks."""
-    config = settings.config()
-    lattice, theory = config.model().lattice, settings.theory()  # the precompressed positions
+def _run_packet(settings: ConicalSettings, config: RunConfig, model: GranularModel, workdir: Path, wave_vector, polarization,
+                omega: float, centre, log, show_progress) -> PacketRun:
+    """Write the packet's state on ``model``'s (precompressed) positions, run ``config`` from it
+    and record its energy blocks."""
+    lattice, theory = model.lattice, settings.theory()
     width = settings.width_d * config.diameter_m
     velocities, displacements = bloch_packet(lattice.positions_m, centre, width, wave_vector, polarization,
                                              omega, settings.speed_m_s)
     workdir.mkdir(parents=True, exist_ok=True)
     write_initial_state(workdir / "initial_state.csv", lattice, velocities, displacements)
-    duration = settings.reach * width / cone_slope(theory)
-    config = config.replace(initial_state_file=str(workdir / "initial_state.csv"), duration=duration)
-    period = 2 * math.pi / theory.dirac_frequency()
-    config = sampled_per_period(config, period, settings.samples_per_period)
-    interval = config.dump_every * config.settings(config.model()).dt_s
-    recorded = record_waves(config, workdir / "run", block=max(1, round(settings.block_periods * period / interval)),
+    period, dt_s = 2 * math.pi / theory.dirac_frequency(), config.settings(model).dt_s
+    every = steps_per_sample(dt_s, period, settings.samples_per_period)
+    config = config.replace(initial_state_file=str(workdir / "initial_state.csv"),
+                            duration=settings.reach * width / cone_slope(theory), dump_every=every)
+    recorded = record_waves(config, workdir / "run", block=max(1, round(settings.block_periods * period / (every * dt_s))),
                             log=log, show_progress=show_progress)
     return PacketRun(np.asarray(centre, float), width, recorded)
 
@@ -239,10 +238,11 @@ def measure_conical(settings: ConicalSettings, workdir, log=None, show_progress:
     """Run both packets of the module docstring in ``workdir`` and measure them."""
     workdir = Path(workdir)
     theory, config = settings.theory(), settings.config()
-    centre = config.model().lattice.positions_m.mean(axis=0)
+    model = config.model()
+    centre = model.lattice.positions_m.mean(axis=0)
     k_point = theory.high_symmetry_points()["K"]
-    omega_k = theory.dirac_frequency()
-    dirac = _run_packet(settings, workdir / "dirac", k_point, CIRCULAR, omega_k, centre, log, show_progress)
+    dirac = _run_packet(settings, config, model, workdir / "dirac", k_point, CIRCULAR, theory.dirac_frequency(), centre,
+                        log, show_progress)
     measured = dirac.ring_radius_m()
     v_d = cone_slope(theory)
     cone = _block_cone(theory, dirac)
@@ -252,10 +252,10 @@ def measure_conical(settings: ConicalSettings, workdir, log=None, show_progress:
     omega2, vectors = np.linalg.eigh(dynamical_matrix(theory, q))
     velocity = group_velocity(theory, q, 0)
     duration = settings.reach * dirac.width_m / v_d
-    control = _run_packet(settings, workdir / "control", q, vectors[:, 0], math.sqrt(omega2[0]),
+    control = _run_packet(settings, config, model, workdir / "control", q, vectors[:, 0], math.sqrt(omega2[0]),
                           centre - velocity * duration / 2, log, show_progress)
     centroids = energy_centroid(control.recorded.positions_m, control.recorded.block_kinetic_j)
     drift = np.polyfit(control.times_s, centroids, 1)[0]
     spread = energy_spread(control.recorded.positions_m, control.recorded.block_kinetic_j, centroids)
     return Conical(dirac, control, cone(v_d), v_d, float(fitted),
-                   velocity, drift, spread, config.diameter_m, omega_k, settings)
+                   velocity, drift, spread, config.diameter_m, settings)

@@ -30,9 +30,9 @@ from pathlib import Path
 import numpy as np
 
 from hexdem.analysis.spectrum import branch_signals, peak_frequency, power_spectrum
-from hexdem.common.checks import is_number, positive_int
+from hexdem.common.checks import positive_int, positive_number
 from hexdem.errors import HexdemError
-from hexdem.experiments.wave_run import record_waves, sampled_per_period
+from hexdem.experiments.wave_run import record_waves, steps_per_sample
 from hexdem.model.config import RunConfig
 from hexdem.model.initial_state import write_initial_state
 from hexdem.theory.phonons import Lattice2D, band_path, dynamical_matrix
@@ -73,15 +73,14 @@ class DispersionSettings:
             raise HexdemError(f"samples_per_period must be at least 3 (the highest band's Nyquist limit is 2), "
                               f"got {self.samples_per_period}")
         for name in ("precompression_n", "speed_m_s", "duration_s"):
-            if not (is_number(getattr(self, name)) and getattr(self, name) > 0):
-                raise HexdemError(f"{name} must be a number > 0, got {getattr(self, name)!r}")
+            positive_number(name, getattr(self, name))
         self.config()  # its own checks, worded there
 
-    def config(self, state_file=None) -> RunConfig:
-        """The run's configuration (the state file set once written)."""
+    def config(self) -> RunConfig:
+        """The run's configuration, before its initial state and sampling are set."""
         return RunConfig(edge_beads=self.edge_beads, precompression_n=self.precompression_n, v0=1e-6,
                          steps_per_contact=self.steps_per_contact, duration=self.duration_s, engine=self.engine,
-                         ranks=self.ranks, initial_state_file=None if state_file is None else str(state_file))
+                         ranks=self.ranks)
 
     def theory(self) -> Lattice2D:
         return Lattice2D.of(self.config())
@@ -136,12 +135,13 @@ def measure_dispersion(settings: DispersionSettings, workdir, log=None, show_pro
     """Run the set-up of the module docstring in ``workdir`` and measure its dispersion."""
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
-    theory = settings.theory()
-    lattice = settings.config().lattice()
+    theory, config = settings.theory(), settings.config()
+    model = config.model()
     state = workdir / "initial_state.csv"
-    write_initial_state(state, lattice, broadband_state(len(lattice), settings.speed_m_s, settings.seed))
+    write_initial_state(state, model.lattice, broadband_state(len(model.lattice), settings.speed_m_s, settings.seed))
     position, vectors, omega = band_path(theory, settings.points_per_segment)
-    config = sampled_per_period(settings.config(state), 2 * math.pi / omega.max(), settings.samples_per_period)
+    every = steps_per_sample(config.settings(model).dt_s, 2 * math.pi / omega.max(), settings.samples_per_period)
+    config = config.replace(initial_state_file=str(state), dump_every=every)
     inside = np.linalg.norm(vectors, axis=1) > 0
     position, vectors, omega = position[inside], vectors[inside], omega[inside]
     recorded = record_waves(config, workdir / "run", vectors, log=log, show_progress=show_progress)

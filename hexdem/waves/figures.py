@@ -89,17 +89,21 @@ def conical_figure(conical: Conical, path) -> None:
     save(fig, path)
 
 
+def _energy_share(run: PacketRun, frame: int) -> np.ndarray:
+    """Each bead's energy over the frame's largest, floored :data:`ENERGY_DECADES` below."""
+    energies = run.recorded.block_kinetic_j[frame]
+    return np.maximum(energies / energies.max(), 10.0 ** -ENERGY_DECADES)
+
+
 def _energy_axes(ax, run: PacketRun, frame: int, diameter_m: float):
     """Beads coloured by their share of the frame's largest energy, log scale; the mappable."""
     from matplotlib.colors import LogNorm
 
     from hexdem.analysis.figures import bead_map
 
-    energies = run.recorded.block_kinetic_j[frame]
-    floor = 10.0 ** -ENERGY_DECADES
     positions = (run.recorded.positions_m - run.centre_m) / diameter_m
-    circles = bead_map(ax, positions, np.ones(len(positions)), np.maximum(energies / energies.max(), floor),
-                       cmap="inferno", label="kinetic energy / largest", norm=LogNorm(floor, 1.0))
+    circles = bead_map(ax, positions, np.ones(len(positions)), _energy_share(run, frame), cmap="inferno",
+                       label="kinetic energy / largest", norm=LogNorm(10.0 ** -ENERGY_DECADES, 1.0))
     circles.set_edgecolor("none")
     ax.set_xlabel("x [d]")
     ax.set_ylabel("y [d]")
@@ -130,11 +134,9 @@ def conical_movie(conical: Conical, path) -> None:
     fig.subplots_adjust(left=0.1, right=0.97, bottom=0.09, top=0.92)
     circles = _energy_axes(ax, run, 0, conical.diameter_m)
     clock = ax.text(0.5, 1.01, "", transform=ax.transAxes, ha="center", va="bottom", fontsize=12)
-    energies = run.recorded.block_kinetic_j
-    floor = 10.0 ** -ENERGY_DECADES
 
     def show(frame: int) -> None:
-        circles.set_array(np.maximum(energies[frame] / energies[frame].max(), floor))
+        circles.set_array(_energy_share(run, frame))
         clock.set_text(f"conical diffraction at K   t = {run.times_s[frame] * 1e3:.2f} ms")
 
     write_gif(fig, (circles, clock), len(run.times_s), show, path)
