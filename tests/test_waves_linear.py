@@ -82,10 +82,15 @@ def test_the_dirac_matrix_has_eigenvalues_one_and_minus_one_and_the_circular_pac
 
 
 def test_the_cone_ring_starts_at_zero_and_grows_at_the_cone_slope():
-    """R(0) = 0; far out, R/(v_D t) → 1 (at v_D t = 40 σ within 0.5 %; the apex's diffuse
-    interior makes it approach from above)."""
+    """R(0) = 0. Early, R = √2 v_D t: to second order in t the density |∇_q ψ|² is
+    |g'|² + 2 v_D² t² g² (the radial term gives v_D² t² |Mχ|² g², the angular one v_D² t² |M'χ|² g²,
+    both unit vectors as M² = M'² = I; the cross terms cancel), so ⟨r²⟩ − σ² = 2 v_D² t² (at
+    v_D t = 0.03 σ within 1e-3; the next order is (v_D t/σ)²). Far out, R/(v_D t) → 1 (at
+    v_D t = 40 σ within 0.5 %; the apex's diffuse interior makes it approach from above)."""
     width, speed = 8 * 0.01905, cone_slope(STEEL_20N)
     assert cone_ring_radius(STEEL_20N, width, [0.0])[0] == pytest.approx(0.0, abs=1e-6 * width)
+    early = cone_ring_radius(STEEL_20N, width, [0.03 * width / speed])[0] / (0.03 * width)
+    assert early == pytest.approx(math.sqrt(2), rel=1e-3)
     far = cone_ring_radius(STEEL_20N, width, [40 * width / speed], radial_points=4000)[0] / (40 * width)
     assert 1.0 < far < 1.005
 

@@ -13,7 +13,8 @@ packet of width σ becomes a ring (Berry's conical diffraction).
 
 **The ring's radius.** With the energy density |ψ(r)|² as weight, the packet's mean square
 distance from its centre is ⟨r²⟩ = ∫|∇_q ψ|² / ∫|ψ|² (Parseval). The ring radius
-R(t) = sqrt(⟨r²⟩(t) − ⟨r²⟩(0)) grows as v_D t only asymptotically: the cone's apex, where M turns
+R(t) = sqrt(⟨r²⟩(t) − ⟨r²⟩(0)) starts as √2 v_D t (both the radial and the angular part of
+∇_q ψ gain v_D t |ψ|) and grows as v_D t only asymptotically: the cone's apex, where M turns
 with θ, leaves a diffuse interior whose share of ⟨r²⟩ grows like log t. :func:`cone_ring_radius`
 therefore integrates the whole R(t) of the cone for ψ(q, 0) = exp(−σ² q²/2) χ, in polar
 coordinates, |∇ψ|² = |∂_q ψ|² + |∂_θ ψ|²/q². By dimensional analysis R = σ F(v t / σ) with F
