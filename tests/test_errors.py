@@ -1,6 +1,8 @@
 """Bad input gets one clear line from the CLI, exit status 2, and no partial result files."""
 
 import functools
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,7 +15,6 @@ from hexdem.engines.lammps.driver import run_streaming
 from hexdem.engines.lammps.runner import run_bare
 from hexdem.errors import HexdemError
 from hexdem.experiments.parallel import run_on_ranks
-from hexdem.experiments.run import RESULT_FILES
 from hexdem.model.config import RunConfig
 
 
@@ -30,10 +31,15 @@ def run_cli(tmp_path, capsys, config_text=None, out=None):
 
 
 def assert_no_results(directory):
-    if directory.exists():
-        assert not [name for name in RESULT_FILES if (directory / name).exists()]
-        assert not (directory / "deck").exists()
-        assert not list(directory.glob("*.part"))
+    """A failed run leaves nothing in its --out: not a result, not a deck, not a hidden folder."""
+    assert not directory.exists() or not any(directory.iterdir())
+
+
+def kept_deck(message: str) -> Path:
+    """The folder outside --out where a failed run's message says its deck is kept."""
+    kept = Path(re.search(r"(\S*hexdem-failed-\w+/deck)", message).group(1))
+    assert kept.is_dir()
+    return kept
 
 
 @pytest.mark.parametrize("config_text, message", [
@@ -80,8 +86,7 @@ def test_lammps_failure_names_lammps_message_and_the_kept_deck(tmp_path, capsys,
     out = tmp_path / "out"
     assert code == 2 and len(err) == 1
     assert "LAMMPS failed on" in err[0] and "ERROR: Unknown command: timestpe" in err[0]
-    assert str(out / "deck.failed" / "in.hexdem") in err[0]
-    assert (out / "deck.failed" / "log.lammps").exists()
+    assert "in.hexdem" in err[0] and (kept_deck(err[0]) / "log.lammps").exists()
     assert_no_results(out)
 
 
@@ -89,7 +94,7 @@ def test_time_step_not_small_against_the_contact_is_refused_before_running(tmp_p
     """dt = 2e-5 s against the 71.7 µs two-bead contact at 0.4 m/s: fewer than 20 steps per contact."""
     code, err = run_cli(tmp_path, capsys, "edge_beads = 5\ndt = 2e-5\nduration = 1e-3")
     assert code == 2 and len(err) == 1 and "not small against the Hertz contact time 7.17e-05" in err[0]
-    assert not (tmp_path / "out" / "deck.failed").exists()
+    assert "hexdem-failed-" not in err[0]
     assert_no_results(tmp_path / "out")
 
 
@@ -97,7 +102,7 @@ def test_run_whose_energy_drifts_is_refused(tmp_path, capsys):
     """dt = τ/24 passes the step check, but its energy drift (≈ 2e-6 · (700/24)² ≈ 2e-3) does not."""
     code, err = run_cli(tmp_path, capsys, "edge_beads = 5\ndt = 3e-6\nduration = 1e-3\ndump_every = 2")
     assert code == 2 and len(err) == 1 and "energy drift" in err[0] and "time step" in err[0]
-    assert str(tmp_path / "out" / "deck.failed") in err[0]
+    assert (kept_deck(err[0]) / "in.hexdem").exists()
     assert_no_results(tmp_path / "out")
 
 

@@ -171,7 +171,9 @@ def test_a_ray_is_read_only_until_the_front_nears_the_packings_edge():
     (lambda: front_radius(np.zeros((5, 2)), np.zeros(4), ORIGIN, 1.0), "arrival times"),
     (lambda: front_radius(triangular_disc(5), np.zeros(len(triangular_disc(5))), ORIGIN, 1.0, n_bins=6), "n_bins"),
     (lambda: front_radius(np.zeros((3, 3)), np.zeros(3), ORIGIN, 1.0), "positions"),
-    (lambda: front_radius(np.eye(2), np.zeros(2), ORIGIN, 1.0), "too few"),
+    (lambda: front_radius(np.eye(2), np.zeros(2), ORIGIN, 1.0), "3 beads or more"),
+    (lambda: front_radius(np.outer(np.arange(5.0), [np.cos(0.5), np.sin(0.5)]), np.arange(5.0), ORIGIN, 1.0),
+     "one line"),
     (lambda: sixfold_roundness(np.zeros(5), np.zeros(4)), "matching"),
 ])
 def test_bad_input_is_a_one_line_hexdem_error(call, message):

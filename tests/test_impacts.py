@@ -171,7 +171,7 @@ def test_the_far_wall_of_every_impact_must_be_reached():
     def far_wall_reached(reach_time):
         regions = len(energy_regions(model)[0])
         return ImpactAnalysis(model, settings, {}, np.ones(n), np.zeros(n), np.zeros(n), reach_time, 0.0,
-                              (np.zeros(1), np.zeros((1, regions, 2)))).results.far_wall_reached
+                              (np.zeros(1), np.zeros((1, regions, 2))), np.zeros((n, 2))).results.far_wall_reached
 
     reach = np.zeros(n)
     assert far_wall_reached(reach)

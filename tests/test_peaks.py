@@ -25,11 +25,13 @@ def test_peak_and_half_maximum_between_samples(step):
     np.testing.assert_allclose(result.arrival_time, half, atol=0.05 * step)
 
 
-def test_record_ending_before_the_peak_and_silent_beads_are_nan():
+def test_record_ending_before_the_peak_is_nan_and_a_silent_bead_peaks_at_zero():
+    """Still rising at the end: no peak is known. Never moved: the peak is 0, and it has no time."""
     times = np.linspace(0, 1e-4, 101)
     rising = hertz_like_pulse(times, 1.2e-4, 6e-5, 0.1)
     result = pulse_times(times, np.column_stack([rising, np.zeros_like(times)]))
-    assert np.all(np.isnan([result.peak_speed, result.t_peak, result.arrival_time]))
+    assert np.all(np.isnan([result.peak_speed[0], result.t_peak[0], result.arrival_time[0]]))
+    assert result.peak_speed[1] == 0.0 and np.isnan(result.t_peak[1]) and np.isnan(result.arrival_time[1])
 
 
 def test_initial_velocity_is_its_own_peak_at_time_zero():

@@ -43,6 +43,9 @@ DEFAULT_BINS = 144
 MIN_BINS = 13
 #: Samples along each ray; the crossing is interpolated between them.
 RAY_SAMPLES = 1024
+#: Beads lie on one line when their positions' second principal spread is below this fraction of
+#: the first (round-off of the packed positions is ~1e-16 of it).
+COLLINEAR_TOLERANCE = 1e-9
 #: A regular hexagon's relative sixfold amplitude, 2 − 32 / (15 ln 3), from the Fourier
 #: coefficients of R(θ) = R_in / cos φ over φ in [−30°, 30°]: a0 = (3/π) ln 3 · R_in and
 #: abs(a6) = (6/π) (ln 3 − 16/15) · R_in.
@@ -120,15 +123,30 @@ def linear_field(points, values):
     return field
 
 
+def front_unmeasurable(positions, arrival_times) -> str | None:
+    """Why no front can be read from these arrivals, or None when it can: the front is a curve in
+    the plane, interpolated over the triangles of the beads whose arrival is known, so it needs
+    three of them or more, not all on one line (a chain, a single bead or a pair has none)."""
+    known = np.asarray(positions, float)[np.isfinite(np.asarray(arrival_times, float))]
+    if len(known) < 3:
+        return f"a 2D front needs arrival times at 3 beads or more, not on one line; known at {len(known)}"
+    spread = np.linalg.svd(known - known.mean(axis=0), compute_uv=False)
+    if spread[1] <= COLLINEAR_TOLERANCE * spread[0]:
+        return f"a 2D front needs arrival times at beads not all on one line; the {len(known)} known lie on one"
+    return None
+
+
 def _rays(positions, arrival_times, origin, n_bins) -> _Rays:
     if int(n_bins) != n_bins or n_bins < MIN_BINS:
         raise HexdemError(f"n_bins must be an integer >= {MIN_BINS} to resolve a sixfold shape, got {n_bins}")
     relative, arrival_times = _checked(positions, arrival_times, origin)
+    if (reason := front_unmeasurable(relative, arrival_times)) is not None:
+        raise HexdemError(reason)
     known = np.isfinite(arrival_times)
     try:
         field = linear_field(relative[known], arrival_times[known])
     except (QhullError, ValueError):
-        raise HexdemError(f"arrival times known at only {known.sum()} beads, too few or collinear for a front") from None
+        raise HexdemError(f"arrival times known at {known.sum()} beads do not span a triangle: no front") from None
     theta = -np.pi + (np.arange(int(n_bins)) + 0.5) * 2 * np.pi / n_bins
     radius = np.linspace(0.0, np.hypot(*relative[known].T).max(), RAY_SAMPLES)
     directions = np.column_stack([np.cos(theta), np.sin(theta)])

@@ -33,7 +33,7 @@ class ImpactAnalysis:
 
     ``results``: ``units``, ``length_unit_m``, ``positions`` (N, 2), ``peak_speed``, ``t_peak``,
     ``arrival_time``, ``reach_time`` (N,), ``lines`` {name: bead indices}, ``energy_drift``,
-    ``far_wall_reached``, ``region_names``, ``region_times`` (T,) and ``region_energies`` (T, R, 2)
+    ``far_wall_reached``, ``end_velocity`` (N, 2) each bead's velocity at the last sample, ``region_names``, ``region_times`` (T,) and ``region_energies`` (T, R, 2)
     [J] (:func:`~hexdem.analysis.energy.energy_regions`), ``peak_angular_speed`` (N,) each bead's
     largest |ω_z| and ``rotational_energy_fraction`` the largest share of the energy held in
     rotation (0 for spheres that do not turn; NaN for a frictional run read from a dump, which
@@ -42,7 +42,7 @@ class ImpactAnalysis:
     """
 
     def __init__(self, model: GranularModel, settings: RunSettings, engine: dict, peak_speed, t_peak, arrival_time,
-                 reach_time, energy_drift: float, region_energies, tracked: TrackedPulses | None = None):
+                 reach_time, energy_drift: float, region_energies, end_velocity, tracked: TrackedPulses | None = None):
         self.model, self.settings, self.engine, self.tracked = model, settings, engine, tracked
         units = settings.units
         self.results = r = SimpleNamespace()
@@ -50,6 +50,7 @@ class ImpactAnalysis:
         r.length_unit_m = units.length_m
         r.positions = model.lattice.positions_m / units.length_m
         r.peak_speed, r.t_peak, r.arrival_time, r.reach_time = peak_speed, t_peak, arrival_time, reach_time
+        r.end_velocity = np.asarray(end_velocity, float)
         r.lines = model.lattice.lines()
         r.energy_drift = energy_drift
         r.region_names = energy_regions(model)[0]
@@ -63,7 +64,8 @@ class ImpactAnalysis:
     def from_tracker(cls, model: GranularModel, settings: RunSettings, tracked: TrackedPulses,
                      engine: dict) -> "ImpactAnalysis":
         return cls(model, settings, engine, tracked.peak_speed, tracked.t_peak, tracked.arrival_time,
-                   tracked.reach_time, tracked.energy_drift, (tracked.energy_times, tracked.region_energies), tracked)
+                   tracked.reach_time, tracked.energy_drift, (tracked.energy_times, tracked.region_energies),
+                   tracked.end_velocity, tracked)
 
     @classmethod
     def from_trajectory(cls, model: GranularModel, settings: RunSettings, trajectory: Trajectory) -> "ImpactAnalysis":
@@ -72,7 +74,8 @@ class ImpactAnalysis:
                              trajectory.speeds_m_s[:, :len(model.lattice)] / units.velocity_m_s)
         times_s, energies = trajectory.region_energies_j(model, ENERGY_SAMPLES)
         return cls(model, settings, trajectory.engine, pulses.peak_speed, pulses.t_peak, pulses.arrival_time,
-                   pulses.reach_time, trajectory.energy_drift(model), (times_s / units.time_s, energies))
+                   pulses.reach_time, trajectory.energy_drift(model), (times_s / units.time_s, energies),
+                   trajectory.velocities_m_s[-1, :len(model.lattice)] / units.velocity_m_s)
 
     def _far_wall_reached(self) -> bool:
         """Did the leading waves reach every bead at the walls facing the strikes within the run?

@@ -12,7 +12,8 @@ Definitions (used for LAMMPS dumps and for the reference integrator alike):
 
 A bead whose largest sample is among the last two of the record has not yet been passed
 by its pulse: its three values are NaN (the run was too short to see its peak). A bead
-that never moved (peak exactly 0) also gets NaN.
+that never moved (|v| exactly 0 throughout) has peak speed 0, a measured value, and NaN time
+of peak and arrival: no pulse passed it.
 
 * **reach time**: when |v| first reached half of its largest sample of the record: the
   arrival time where that is defined, and also for beads whose speed is largest at the end of
@@ -128,6 +129,7 @@ def pulse_times(times, speeds) -> PulseTimes:
         series = speeds[:, bead]
         k = int(np.argmax(series))
         if series[k] <= 0.0:
+            peak[bead] = 0.0
             continue
         if k > last_complete:
             reach[bead] = rising_crossing(times, series, 0.5 * series[k])

@@ -70,7 +70,8 @@ class TrackedPulses:
     ``sensor_states`` (K, n_sensors, 4): vx, vy, ax, ay of the model's sensor beads every
     ``settings.sensor_every`` steps. ``peak_angular_speed`` (N,) each bead's largest |ω_z| (0 for
     spheres that do not turn); ``rotational_energy_fraction`` the largest share of the kinetic and
-    contact energy held in rotation at the audited times.
+    contact energy held in rotation at the audited times; ``end_velocity`` (N, 2) each bead's
+    velocity at the last sample (a rebound's outgoing velocity).
     """
 
     peak_speed: np.ndarray
@@ -93,6 +94,7 @@ class TrackedPulses:
     sensor_states: np.ndarray
     peak_angular_speed: np.ndarray
     rotational_energy_fraction: float
+    end_velocity: np.ndarray
 
 
 class PulseTracker:
@@ -113,6 +115,7 @@ class PulseTracker:
         self.n_beads, self.n_bodies, self.n_samples_expected = n, model.n_bodies, total
         self.pulses = PulseState(n, RECORD_CAPACITY)
         self.peak_spin = np.zeros(n)
+        self.end_velocity = np.zeros((n, 2))
         if threshold_speed is not None and not threshold_speed > 0:
             raise HexdemError(f"the threshold speed must be > 0, got {threshold_speed!r}")
         self.threshold_speed = threshold_speed
@@ -137,7 +140,7 @@ class PulseTracker:
     # ---- state shared across ranks
     def _bead_state(self) -> list[np.ndarray]:
         """Every per-bead array that the bead's owner keeps up to date."""
-        return [*self.pulses.arrays(), self.peak_spin, self.threshold_index, self.previous_speed]
+        return [*self.pulses.arrays(), self.peak_spin, self.threshold_index, self.previous_speed, self.end_velocity]
 
     def _hand_over(self, owned: np.ndarray) -> None:
         """Give each bead that changed ranks since the last sample (``owned``: this rank's beads
@@ -195,6 +198,7 @@ class PulseTracker:
         else:
             self.owned[index] = True
         self.pulses.update(index, speeds, s)
+        self.end_velocity[index] = sample.velocities[beads]
         if self.threshold_speed is not None:
             self._cross_threshold(index, speeds, s)
         if sample.angular_velocities is not None:
@@ -274,6 +278,7 @@ class PulseTracker:
         peak, t_peak, arrival, reach = (np.full(self.n_beads, np.nan) for _ in range(4))
         state = self.pulses
         moved = state.peak > 0.0
+        peak[~moved] = 0.0
         complete = moved & (state.peak_index <= self.count - 3)
         full = complete & np.isfinite(state.window).all(axis=1)  # the 7 samples: one refinement for all
         offset, peak[full] = refine_peaks(state.window[full], interval)
@@ -300,7 +305,7 @@ class PulseTracker:
                              field_rim_speeds=self.rim_fields, threshold_time=self.threshold_index * interval,
                              sensor_times=np.arange(len(self.sensors)) * self.sensor_every * self.settings.dt_s
                              / self.settings.units.time_s, sensor_states=self.sensors,
-                             peak_angular_speed=self.peak_spin,
+                             peak_angular_speed=self.peak_spin, end_velocity=self.end_velocity,
                              rotational_energy_fraction=rotational_share(self.rotational_energies, self.region_energies))
 
 

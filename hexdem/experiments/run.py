@@ -1,27 +1,32 @@
 """One impact simulation end to end: config → engine → analysis → result files.
 
-:func:`run_experiment` validates everything before it touches the disk, runs the engine in
-``OUT/deck.inprogress`` and, only when the run and its analysis succeeded, publishes
-``OUT/deck`` (inputs, log, the dump if asked for) and :data:`RESULT_FILES` (``peaks.csv``
+:func:`run_experiment` validates everything before it touches the disk, runs the engine and
+writes every result into a fresh hidden folder of ``OUT`` and, only when the run and its analysis
+succeeded, moves into ``OUT`` the deck ``OUT/deck`` (inputs, log, the dump if asked for) and
+:data:`RESULT_FILES` (``peaks.csv``
 along the observation lines, ``beads.csv`` of every bead, ``summary.json``, the arrival and
 peak maps, ``peak_decay.png``, ``front_shape.csv`` and ``.png``, ``energy_regions.csv``), with
 ``energy_regions.png`` when the beads are of several materials and ``movie.gif`` on request
 (with ``spin_movie.gif`` for frictional spheres, which turn),
-each written atomically. A failed run leaves its inputs and log in
-``OUT/deck.failed`` for inspection and no result files.
+each written atomically. An output that cannot be measured on the packing (a chain has no 2D
+front; a single bead no decay along a line) is skipped, and ``summary.json`` says which and why
+(:func:`unmeasurable_outputs`). A failed run leaves nothing in ``OUT`` (an ``OUT`` it created is
+removed again); its inputs and log are kept in a ``hexdem-failed-*`` folder of the system's
+temporary directory, which the error message names.
 """
 
 from __future__ import annotations
 
 import shutil
 import sys
+import tempfile
 import time
 from importlib.metadata import version
 from pathlib import Path
 
 import numpy as np
 
-from hexdem.analysis.front_shape import FRONT_SHAPE_COLUMNS, FrontShape, front_shape, front_times
+from hexdem.analysis.front_shape import FRONT_SHAPE_COLUMNS, FrontShape, front_shape, front_times, front_unmeasurable
 from hexdem.analysis.impact import PEAK_COLUMNS, ImpactAnalysis
 from hexdem.analysis.movie import movie_samples
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json
@@ -35,24 +40,22 @@ from hexdem.model.config import RunConfig
 CONFIG_NAME = "hexdem.json"
 RESULT_FILES = ("peaks.csv", "summary.json", "arrival_map.png", "peak_decay.png", "front_shape.csv",
                 "front_shape.png", "energy_regions.csv", "beads.csv", "peak_map.png")
-#: Columns of ``beads.csv``: every bead's label, position, material and pulse, and its largest
-#: spin |ω_z| (run's units: rad/s in SI; 0 for frictionless spheres, which never turn).
-BEAD_COLUMNS = ("bead_id", "m", "n", "x", "y", "material", "peak_speed", "t_peak", "arrival_time", "peak_angular_speed")
+#: Columns of ``beads.csv``: every bead's label, position, material and pulse, its largest
+#: spin |ω_z| (run's units: rad/s in SI; 0 for frictionless spheres, which never turn) and its
+#: velocity at the run's last sample (a rebound's outgoing velocity).
+BEAD_COLUMNS = ("bead_id", "m", "n", "x", "y", "material", "peak_speed", "t_peak", "arrival_time", "peak_angular_speed",
+                "vx_end", "vy_end")
 #: Columns of ``energy_regions.csv``: time in the run's units, energies in J, share of the total.
 ENERGY_REGION_COLUMNS = ("time", "region", "kinetic_energy_j", "contact_energy_j", "energy_fraction")
 #: Bytes per atom and frame of a full-precision dump (measured: 30 MB for 331 atoms x 701 frames).
 DUMP_BYTES_PER_ATOM_FRAME = 150
 #: A conservative model whose energy wanders more than this was integrated too coarsely.
 MAX_ENERGY_DRIFT = 1e-3
+#: A run writes everything into a fresh ``OUT/.hexdem-run-*`` folder and moves it into ``OUT`` at the end.
+STAGING_PREFIX = ".hexdem-run-"
 #: The front is read along each direction until it comes this close to the packing's edge [d]:
 #: the last bead before a wall moves as the wall lets it.
 FRONT_WALL_MARGIN_D = 2.0
-
-
-def _replace_dir(source: Path, target: Path) -> None:
-    if target.exists():
-        shutil.rmtree(target)
-    source.rename(target)
 
 
 def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples=(), comm=None,
@@ -147,26 +150,48 @@ def summary(config: RunConfig, analysis: ImpactAnalysis, wall_time_s: float) -> 
     }
 
 
-def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_time_s: float) -> None:
-    """Every result file of the run (see the module docstring), each written atomically."""
+def unmeasurable_outputs(analysis: ImpactAnalysis) -> dict[str, str]:
+    """{result file: why it cannot be measured on this run's packing}: the front's shape needs
+    arrivals spread over the plane (:func:`~hexdem.analysis.front_shape.front_unmeasurable`), and a
+    decay along the observation lines needs a line of two beads or more."""
+    r = analysis.results
+    skipped = {}
+    front = front_unmeasurable(r.positions, r.arrival_time)
+    if front is not None:
+        skipped.update({"front_shape.csv": front, "front_shape.png": front})
+    if max(len(beads) for beads in r.lines.values()) < 2:
+        skipped["peak_decay.png"] = "no observation line holds two beads or more: there is no decay to draw"
+    return skipped
+
+
+def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_time_s: float, log=None) -> None:
+    """Every result file of the run (see the module docstring), each written atomically; those
+    that cannot be measured on the packing are skipped, named with their reason in
+    ``summary.json``'s ``skipped_outputs`` and in the ``log``."""
     from hexdem.analysis import figures as plots  # matplotlib: only where figures are drawn
     from hexdem.analysis.movie import SPIN_LABEL, speed_movie
 
+    log = log or (lambda message: None)
+    skipped = unmeasurable_outputs(analysis)
+    for name, reason in skipped.items():
+        log(f"skipped {name}: {reason}")
     rows = analysis.line_rows()
     write_csv(out / "peaks.csv", PEAK_COLUMNS, rows)
     write_csv(out / "beads.csv", BEAD_COLUMNS, bead_rows(analysis))
-    write_json(out / "summary.json", summary(config, analysis, wall_time_s))
+    write_json(out / "summary.json", {**summary(config, analysis, wall_time_s), "skipped_outputs": skipped})
     r, model = analysis.results, analysis.model
     v0 = analysis.v0
     plots.arrival_map(r, model, out / "arrival_map.png", title=f"Arrival time, {model.lattice.shape}, V0 = {v0:g}")
     plots.peak_map(r, model, v0, out / "peak_map.png", title=f"Peak speed, {model.lattice.shape}")
-    by_line = {name: (np.arange(len(beads)), r.peak_speed[beads]) for name, beads in r.lines.items()}
-    plots.peak_decay(by_line, out / "peak_decay.png", r.units, v0)
+    if "peak_decay.png" not in skipped:
+        by_line = {name: (np.arange(len(beads)), r.peak_speed[beads]) for name, beads in r.lines.items()}
+        plots.peak_decay(by_line, out / "peak_decay.png", r.units, v0)
     if config.sensors:
         write_sensor_files(analysis, list(config.sensor_beads(analysis.model.lattice)), out)
-    shape = measure_front_shape(analysis)
-    write_csv(out / "front_shape.csv", FRONT_SHAPE_COLUMNS, shape.rows())
-    plots.front_shape_figure({analysis.model.lattice.shape: shape}, out / "front_shape.png")
+    if "front_shape.csv" not in skipped:
+        shape = measure_front_shape(analysis)
+        write_csv(out / "front_shape.csv", FRONT_SHAPE_COLUMNS, shape.rows())
+        plots.front_shape_figure({analysis.model.lattice.shape: shape}, out / "front_shape.png")
     write_csv(out / "energy_regions.csv", ENERGY_REGION_COLUMNS, energy_region_rows(r))
     if analysis.model.extra_materials:
         plots.energy_regions_figure(r, out / "energy_regions.png",
@@ -180,15 +205,15 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
 
 
 def bead_rows(analysis: ImpactAnalysis) -> list[tuple]:
-    """Rows of ``beads.csv``: every bead, id from 1, with its label {m, n}, position, material
-    and pulse."""
+    """Rows of ``beads.csv``: every bead, id from 1, with its label {m, n}, position, material,
+    pulse and final velocity."""
     r, model = analysis.results, analysis.model
     names = [material.name for material in model.materials]
     return [(b + 1, int(m), int(n), float(x), float(y), names[material], float(peak), float(t_peak), float(arrival),
-             float(spin))
-            for b, ((m, n), (x, y), material, peak, t_peak, arrival, spin)
+             float(spin), float(vx), float(vy))
+            for b, ((m, n), (x, y), material, peak, t_peak, arrival, spin, (vx, vy))
             in enumerate(zip(model.lattice.indices, r.positions, model.lattice.material_ids, r.peak_speed, r.t_peak,
-                             r.arrival_time, r.peak_angular_speed))]
+                             r.arrival_time, r.peak_angular_speed, r.end_velocity))]
 
 
 def energy_region_rows(results) -> list[tuple]:
@@ -226,25 +251,47 @@ def run_experiment(config: RunConfig, out, log=None, comm=None) -> ImpactAnalysi
     """Run ``config`` and publish its result files in ``out`` (see module docstring); ``comm`` as
     for :func:`simulate`."""
     log = log or (lambda message: print(f"hexdem: {message}", file=sys.stderr))
+    out = Path(out)
+    created = not out.exists()
     out = ensure_writable_dir(out)
-    check_dump_space(config, out)
-    start = time.perf_counter()
-    workdir = out / "deck.inprogress"
-    if workdir.exists():
-        shutil.rmtree(workdir)
+    staging = Path(tempfile.mkdtemp(dir=out, prefix=STAGING_PREFIX))
     try:
-        analysis = simulate(config, workdir, log, comm=comm)
-    except HexdemError as exc:
-        if workdir.exists():
-            _replace_dir(workdir, out / "deck.failed")
-        raise HexdemError(str(exc).replace(str(workdir), str(out / "deck.failed"))) from None
-    except BaseException:
-        shutil.rmtree(workdir, ignore_errors=True)
-        raise
-    _replace_dir(workdir, out / "deck")
-    write_results(config, analysis, out, time.perf_counter() - start)
+        check_dump_space(config, out)
+        start = time.perf_counter()
+        analysis = simulate(config, staging / "deck", log, comm=comm)
+        write_results(config, analysis, staging, time.perf_counter() - start, log)
+    except BaseException as exc:
+        kept = _keep_failed_deck(staging / "deck") if isinstance(exc, HexdemError) else None
+        shutil.rmtree(staging, ignore_errors=True)
+        if created and not any(out.iterdir()):
+            out.rmdir()
+        if kept is None:
+            raise
+        raise HexdemError(str(exc).replace(str(staging / "deck"), str(kept))) from None
+    _publish(staging, out)
     log(f"energy drift {analysis.results.energy_drift:.2e}; results in {out}")
     if not analysis.results.far_wall_reached:
         log("warning: the leading wave had not reached every bead at the far wall one contact time before the run "
             "ended; increase 'duration'")
     return analysis
+
+
+def _keep_failed_deck(deck: Path) -> Path | None:
+    """Move a failed run's deck (inputs and log) out of ``--out`` into a fresh folder of the system's
+    temporary directory, for inspection; None if the run failed before writing one."""
+    if not deck.exists():
+        return None
+    kept = Path(tempfile.mkdtemp(prefix="hexdem-failed-")) / "deck"
+    shutil.move(str(deck), kept)
+    return kept
+
+
+def _publish(staging: Path, out: Path) -> None:
+    """Move every entry of ``staging`` into ``out`` (replacing older ones of the same name), then
+    remove ``staging``: each entry appears whole, and only once the run and all its results are done."""
+    for entry in sorted(staging.iterdir()):
+        target = out / entry.name
+        if target.is_dir() and not target.is_symlink():
+            shutil.rmtree(target)
+        entry.replace(target)
+    staging.rmdir()

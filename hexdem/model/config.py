@@ -20,6 +20,7 @@ from hexdem.errors import HexdemError
 from hexdem.model.contact_law import Friction
 from hexdem.model.dissipation import damping_coefficient, lammps_tsuji_coefficient
 from hexdem.model.granular import GranularModel, Impact, RunSettings
+from hexdem.model.hertz import contact_time
 from hexdem.model.impacts import ImpactSpec, cut_holes, impact_specs, resolve_impacts, struck_site
 from hexdem.model.initial_state import read_initial_state
 from hexdem.model.lattice import (Lattice, disc, half_disc, half_hexagon, hexagon, parallelogram, triangle,
@@ -359,6 +360,19 @@ class RunConfig:
                                      [self.material(r["material"]) for r in self.regions], strikers,
                                      self.precompression_n)
 
+    def _rebound_time_s(self, model: GranularModel) -> float:
+        """The default duration [s] when nothing lies ahead of the struck beads (a single bead, a
+        row struck along its normal): the longest of each struck bead's head-on Hertz contacts
+        with the walls at its impact's speed (mass m against a rigid body, A = k_n sqrt(r)), plus one
+        contact time, so that the run holds the whole rebound and the bead's flight after it."""
+        walls = [0.0]
+        if model.walls:
+            masses, radii = model.masses_kg, model.lattice.radii_m
+            for bead, impact in zip(model.struck_beads, model.impacts):
+                coefficient = float(model.wall_stiffness_pa([bead])[0]) * math.sqrt(radii[bead])
+                walls.append(float(contact_time(masses[bead], coefficient, impact.speed_m_s)))
+        return self.contact_time_s() + max(walls)
+
     def _step_and_sampling(self) -> tuple[float, int]:
         """(dt [s], steps between samples): ``dt`` or the contact time over ``steps_per_contact``,
         and ``dump_every`` or the steps of one default sampling interval (1/20 of the contact
@@ -387,7 +401,7 @@ class RunConfig:
             reach = max(float(((lattice.positions_m - lattice.positions_m[bead]) @ impact.direction).max())
                         for bead, impact in zip(model.struck_beads, model.impacts))
             layers = math.ceil(reach / (math.sqrt(3) / 2 * lattice.diameter_m))
-            duration_s = layers * self.contact_time_s()
+            duration_s = layers * self.contact_time_s() if layers else self._rebound_time_s(model)
         sensor_every = 0
         if self.sensors:
             samples = math.ceil(1.0 / self.sensor_rate_hz / (dt_s * every) - 1e-9)

@@ -160,8 +160,8 @@ def from_sites(labels, diameter_m: float = 1.0, wall_angles_deg=(), shape: str =
     if np.any(counts > 1):
         m, n = unique[np.argmax(counts > 1)]
         raise HexdemError(f"{shape}: site {{{m}, {n}}} is listed twice")
-    if len(labels) < 2:
-        raise HexdemError(f"{shape}: a packing needs at least 2 beads, got {len(labels)}")
+    if len(labels) < 1:
+        raise HexdemError(f"{shape}: a packing needs at least 1 bead, got none")
     hit = np.flatnonzero((labels[:, 0] == struck[0]) & (labels[:, 1] == struck[1]))
     if not len(hit):
         raise HexdemError(f"{shape}: the struck site {{{struck[0]}, {struck[1]}}} is not in the packing")

@@ -138,7 +138,7 @@ def fit_decay(n, v, start: int, last: int, kind: str = "loglinear", anchored: bo
         raise HexdemError(f"the window {start}..{last} needs at least two beads after the start bead")
     k, vk = n[window] - start, v[window]
     anchor = v[n == start][0]
-    if not np.all(np.isfinite(vk)) or not np.isfinite(anchor):
+    if not (np.all(vk > 0) and anchor > 0):  # (NaN: still rising at the end; 0: never reached)
         raise HexdemError(f"peak speeds missing in the window {start}..{last}: the run was too short")
     if anchored:
         y, design = np.log(vk / anchor), k[:, None].astype(float)
