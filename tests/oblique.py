@@ -3,10 +3,12 @@ a sphere on a flat wall and two spheres, built as hexdem models; LAMMPS run on t
 spins read; and an independent solution of the one-contact Hertz–Mindlin problem.
 
 The independent solution integrates, with SciPy, the contact's relative motion: the overlap δ
-and its rate w, F_n = k_n sqrt(R δ) δ, m_n ẇ = −F_n; the tangential displacement ξ of the contact
-points, driven by their relative slip velocity v_c, ξ' = v_c, and F_t = −k_t a ξ with
-a = sqrt(R δ), capped by Coulomb: |ξ| ≤ μ F_n/(k_t a) = μ k_n δ/k_t (at the cap, ξ' is the
-smaller of v_c and the cap's rate, outwards); v_c' = F_t c(δ) with c the tangential compliance of the bodies at the
+and its rate w, F_n = k_n sqrt(R δ) δ, with Tsuji's damping α (Tsuji et al. 1992) F_n =
+max(A δ^{3/2} + α sqrt(m_n A) δ^{1/4} w, 0), A = k_n sqrt(R), clipped at zero as it opens;
+m_n ẇ = −F_n; the tangential displacement ξ of the contact points, driven by their relative slip
+velocity v_c, ξ' = v_c, and F_t = −k_t a ξ with a = sqrt(R δ), capped by Coulomb:
+|ξ| ≤ μ F_n/(k_t a) (μ k_n δ/k_t undamped; at the cap, ξ' is the smaller of v_c and the cap's
+rate, outwards); v_c' = F_t c(δ) with c the tangential compliance of the bodies at the
 contact (1/m + r²/I for a sphere on a wall, I = (2/5) m r²; for two spheres LAMMPS's lever arms
 r_i − δ/2, see ``granular_model.cpp``). It returns the tangential impulse J_t = ∫F_t dt and the
 rebound rates.
@@ -64,7 +66,8 @@ def sphere_pair(incidence_deg: float, friction: float, speed: float = V0) -> Gra
 @dataclass(frozen=True)
 class Contact:
     """One contact's parameters for :func:`solve_contact`: Hertz k_n and Mindlin k_t [Pa], R_eff [m],
-    μ, normal mass m_n [kg], the bodies' radii, masses and whether the contact is with a wall."""
+    μ, normal mass m_n [kg], the bodies' radii, masses, whether the contact is with a wall, and Tsuji's
+    damping α."""
 
     k_n: float
     k_t: float
@@ -74,6 +77,7 @@ class Contact:
     radii: tuple
     masses: tuple
     wall: bool
+    damping: float = 0.0
 
     @classmethod
     def of(cls, model: GranularModel) -> "Contact":
@@ -81,10 +85,10 @@ class Contact:
         if model.walls:
             law = model.laws.walls[0]
             return cls(law.normal_stiffness_pa, law.tangential_stiffness_pa, radii[0], law.friction, masses[0],
-                       radii, masses, True)
+                       radii, masses, True, law.damping)
         law = model.laws.pairs[0][0]
         return cls(law.normal_stiffness_pa, law.tangential_stiffness_pa, radii[0] * radii[1] / (radii[0] + radii[1]),
-                   law.friction, masses[0] * masses[1] / (masses[0] + masses[1]), radii, masses, False)
+                   law.friction, masses[0] * masses[1] / (masses[0] + masses[1]), radii, masses, False, law.damping)
 
     def compliance(self, overlap: float) -> float:
         """dv_c/dF_t: 1/m + r²/I against a wall (LAMMPS's lever r), Σ 1/m_i + r_i (r_i − δ/2)/I_i for two
@@ -108,21 +112,36 @@ def solve_contact(contact: Contact, normal_speed: float, slip_speed: float, capp
 
     c = contact
     stiffness = c.k_n * math.sqrt(c.r_eff)
+    eta = c.damping * math.sqrt(c.m_n * stiffness)
+    per_force = c.mu / (c.k_t * math.sqrt(c.r_eff))  # the cap on ξ per unit F_n/sqrt(δ)
 
-    def limit(overlap):
-        return c.mu * c.k_n * overlap / c.k_t if capped else math.inf
+    def normal(overlap, rate):
+        return max(stiffness * overlap**1.5 + eta * overlap**0.25 * rate, 0.0)
+
+    def limit(overlap, rate):
+        """The cap on |ξ|, μ F_n/(k_t a) (none before the bodies touch)."""
+        return per_force * normal(overlap, rate) / math.sqrt(overlap) if capped and overlap > 0 else math.inf
+
+    def limit_rate(overlap, rate):
+        """d/dt of :func:`limit` (0 where the clipped F_n is 0)."""
+        force = normal(overlap, rate)
+        if force == 0.0:
+            return 0.0
+        force_rate = (1.5 * stiffness * math.sqrt(overlap) * rate
+                      + eta * (0.25 * overlap**-0.75 * rate**2 - overlap**0.25 * force / c.m_n))
+        return per_force * (force_rate / math.sqrt(overlap) - 0.5 * force * rate / overlap**1.5)
 
     def rhs(t, y):
         overlap, rate, xi, slip, impulse = y
         overlap = max(overlap, 0.0)
-        bound = limit(overlap)
+        bound = limit(overlap, rate)
         force = -c.k_t * math.sqrt(c.r_eff * overlap) * min(max(xi, -bound), bound)
         if abs(xi) < bound:
             growth = slip
         else:  # at the cap: ξ moves with the contact points only as far as the cap lets it
             sign = 1.0 if xi > 0 else -1.0
-            growth = sign * min(sign * slip, limit(rate))
-        return [rate, -stiffness * overlap**1.5 / c.m_n, growth, force * c.compliance(overlap), force]
+            growth = sign * min(sign * slip, limit_rate(overlap, rate))
+        return [rate, -normal(overlap, rate) / c.m_n, growth, force * c.compliance(overlap), force]
 
     def separated(t, y):
         return y[0]
@@ -132,9 +151,10 @@ def solve_contact(contact: Contact, normal_speed: float, slip_speed: float, capp
     solution = solve_ivp(rhs, (0.0, 2 * tau), [0.0, normal_speed, 0.0, slip_speed, 0.0], method="DOP853",
                          events=separated, rtol=1e-11, atol=1e-16, max_step=tau / steps, dense_output=True)
     end = solution.y_events[0][0]
-    overlap, _, xi, _, _ = solution.sol(np.linspace(0, solution.t_events[0][0], 2001)[1:-1])
-    bound = np.minimum(limit(overlap), np.abs(xi))
-    return end[4], -end[1], end[3], float((c.k_t * bound / (c.k_n * overlap)).max())
+    samples = solution.sol(np.linspace(0, solution.t_events[0][0], 2001)[1:-1]).T
+    ratios = [c.k_t * math.sqrt(c.r_eff * overlap) * min(limit(overlap, rate), abs(xi)) / normal(overlap, rate)
+              for overlap, rate, xi, _, _ in samples if normal(overlap, rate) > 0]
+    return end[4], -end[1], end[3], float(max(ratios))
 
 
 @dataclass(frozen=True)

@@ -1,5 +1,5 @@
-"""Dissipative contacts (restitution < 1): Tsuji damping calibrated to the requested
-coefficient of restitution, in LAMMPS and in the reference integrator alike."""
+"""Dissipative contacts (restitution < 1): Tsuji damping, its force clipped at zero, calibrated to the
+requested coefficient of restitution, in LAMMPS and in the reference integrator alike."""
 
 from dataclasses import replace
 
@@ -35,6 +35,48 @@ def test_weak_damping_loses_the_energy_of_first_order_perturbation_theory():
     alphas = [damping_coefficient(e) for e in (0.99, 0.9, 0.7, 0.4)]
     assert np.all(np.diff(alphas) > 0), "more damping, less restitution"
     assert damping_coefficient(1.0) == 0.0
+
+
+def unclipped_restitution(alpha):
+    """The rebound speed of x'' = −x^{3/2} − α x^{1/4} x' (x(0) = 0, x'(0) = 1) where x returns to 0:
+    Tsuji's law without the clip, its force allowed to pull as the contact opens."""
+    from scipy.integrate import solve_ivp
+
+    def parted(t, state):
+        return state[0]
+
+    parted.terminal, parted.direction = True, -1
+    solution = solve_ivp(lambda t, s: [s[1], -max(s[0], 0.0) ** 1.5 - alpha * max(s[0], 0.0) ** 0.25 * s[1]],
+                         (0.0, 100.0), [0.0, 1.0], events=parted, rtol=1e-12, atol=1e-14, first_step=1e-6)
+    return -solution.y_events[0][0][1]
+
+
+@pytest.mark.parametrize("alpha", [0.01, 0.03])
+def test_the_clip_gives_back_the_work_of_the_tensile_phase(alpha):
+    """Unclipped, the force x^{1/4} (x^{5/4} + α x') pulls once x^{5/4} < α |x'| ≈ α e: over that last
+    stretch the bodies lose ∫₀^{x_c} (α e x^{1/4} − x^{3/2}) dx = (2/5) α² e² of kinetic energy (½ e²),
+    which the clipped law keeps: e_clip² − e² = (4/5) α² e² to leading order (relative corrections
+    O(α²))."""
+    clipped, unclipped = restitution_of(alpha), unclipped_restitution(alpha)
+    assert (clipped**2 - unclipped**2) / (alpha * clipped) ** 2 == pytest.approx(0.8, rel=alpha**2)
+
+
+@pytest.mark.parametrize("engine", ENGINES, ids=lambda e: e.name)
+def test_a_damped_contact_never_pulls(tmp_path, engine):
+    """A steel sphere striking a steel wall with e = 0.8: the contact force only pushes the sphere out,
+    so its outward speed never falls, step after step, and it leaves at e V0. Without the clip the
+    damping force pulls at the end of the contact, down to −4.8 % of the peak force (measured in both
+    engines), and the outward speed falls over the last steps."""
+    wall = Wall("wall_180", (-1.0, 0.0), -D / 2, np.array([0]))
+    model = GranularModel(replace(single_bead(D), walls=(wall,)), Impact(V0), STEEL_316, wall=STEEL_316,
+                          wall_restitution=0.8)
+    mass = float(sphere_mass(D, STEEL_316))
+    duration = 1.3 * contact_time(mass, hertz_stiffness(STEEL_316, STEEL_316) * np.sqrt(D / 2), V0)
+    outward = -record(engine, model, RunSettings(duration / 2000, 2000, 1), tmp_path).velocities_m_s[:, 0, 0]
+    kicks = np.diff(outward)
+    assert kicks.max() > 1e-3 * V0, "the wall pushes"
+    assert kicks.min() >= -1e-12 * V0, "and never pulls"
+    assert outward[-1] == pytest.approx(0.8 * V0, rel=RESTITUTION_RTOL)
 
 
 @pytest.mark.parametrize("c", [0.95, 0.8])

@@ -4,19 +4,37 @@ The paper's model is conservative (Sec. III); its experiments arrive later and w
 it puts down to dissipation (Sec. VI-B). hexdem adds Tsuji's viscous damping to the Hertz law,
 for an overlap δ and its rate δ̇ (positive while the bodies approach):
 
-    F = A δ^{3/2} + η δ̇,   η = α sqrt(m_eff A) δ^{1/4},
+    F = max(A δ^{3/2} + η δ̇, 0),   η = α sqrt(m_eff A) δ^{1/4},
 
-with A = k_n sqrt(R_eff) and m_eff the reduced mass (the body's own mass against a wall).
-The force is applied while δ > 0 and may turn slightly attractive at the very end of a
-contact, as in LAMMPS's ``damping tsuji``. In the units m_eff = A = 1 and with the impact
-speed v as velocity unit, x = δ/δ_v obeys x'' = −x^{3/2} − α x^{1/4} x' (δ_v = (m v²/A)^{2/5}):
-both forces scale as v^{6/5}, so the restitution e = −x'(end)/x'(0) depends on α only, not on
-the speed. :func:`damping_coefficient` inverts e(α) by integrating that equation.
+with A = k_n sqrt(R_eff) and m_eff the reduced mass. The same law holds for a bead–bead contact
+(m_eff = m_i m_j/(m_i + m_j), R_eff = R_i R_j/(R_i + R_j)) and a bead–wall contact (the wall does not
+move: m_eff = m, the bead's own mass, and R_eff its radius, or LAMMPS's radius for a curved wall):
+in both the overlap obeys m_eff δ̈ = −F. The force is applied while δ > 0 and clipped at zero: as the
+contact opens (δ̇ < 0) the damping term would otherwise exceed the elastic one near its end and pull
+(−4.8 % of the peak force at e = 0.8), and a Coulomb cap μ |F_n| would keep acting in that phase.
+LAMMPS clips the same way with the keyword ``limit_damping`` (``pair_style granular`` and the wall
+fixes: its normal force F_ntot set to 0 when negative, before the friction limit is taken from it).
+
+**Restitution of the clipped law.** In the units m_eff = A = 1, with the impact speed v as velocity
+unit, x = δ/δ_v (δ_v = (m_eff v²/A)^{2/5}) obeys
+
+    x'' = −x^{1/4} max(x^{5/4} + α x', 0),   x(0) = 0, x'(0) = 1:
+
+both forces scale as v^{6/5}, so the restitution depends on α only, not on the speed, and is the same
+map for bead–bead and bead–wall contacts. The bracket is positive while the bodies approach and
+first vanishes on the way out, at x_c > 0 where x_c^{5/4} = −α x'. From there the force is zero and
+stays zero: x' no longer changes while x^{5/4} falls, so the bracket stays negative until the
+bodies part. The rebound speed is therefore the speed at the clip, e = −x'(t_c).
+:func:`restitution_of` integrates the equation up to that event and :func:`damping_coefficient`
+inverts e(α). Against the unclipped law, the clip gives back the work of the tensile phase: with
+x' ≈ −e there, ∫₀^{x_c} (x^{3/2} − α e x^{1/4}) dx = −(2/5) α² e², so e_clip² − e² = (4/5) α² e² to
+leading order (for e = 0.8 the clipped law needs α = 0.1663 instead of 0.1584; the same α would give
+e = 0.808). At weak damping 1 − e² = 2π α/√5 + O(α²) either way (first-order perturbation theory).
 
 LAMMPS's ``damping tsuji`` takes a coefficient c and applies α = P(c), Marshall's (2009)
-polynomial fit. The fit is approximate: measured with the installed LAMMPS (22 Jul 2025),
-c = 0.95 gives e = 0.965 and c = 0.8 gives e = 0.853, exactly the e(α) of the equation above
-with α = P(c) (newer LAMMPS sources multiply by √2; hexdem's restitution tests on real LAMMPS
+polynomial fit. The fit is approximate: with the installed LAMMPS (22 Jul 2025) and
+``limit_damping``, c = 0.95 gives e = 0.9654 and c = 0.8 gives e = 0.8577, the e(α) of the equation
+above with α = P(c) (newer LAMMPS sources multiply by √2; hexdem's restitution tests on real LAMMPS
 would catch that change). hexdem therefore hands LAMMPS the c whose α gives the requested e
 (:func:`lammps_tsuji_coefficient`).
 """
@@ -37,22 +55,24 @@ TSUJI_POLYNOMIAL = (1.2728, -4.2783, 11.087, -22.348, 27.467, -18.022, 4.8218)
 
 
 def restitution_of(alpha: float) -> float:
-    """The coefficient of restitution of a head-on Tsuji-damped Hertz collision with damping α."""
+    """The coefficient of restitution of a head-on Tsuji-damped Hertz collision with damping α, its
+    force clipped at zero (module docstring): the speed at which the force first vanishes."""
     from scipy.integrate import solve_ivp
 
     def rhs(t, state):
         x, v = state
         x = max(x, 0.0)
-        return [v, -x**1.5 - alpha * x**0.25 * v]
+        return [v, -x**0.25 * max(x**1.25 + alpha * v, 0.0)]
 
-    def separated(t, state):
-        return state[0]
+    def released(t, state):  # x^{5/4} + α x', signed so that α = 0 ends where the bodies part
+        x, v = state
+        return x * abs(x) ** 0.25 + alpha * v
 
-    separated.terminal, separated.direction = True, -1
-    solution = solve_ivp(rhs, (0.0, 100.0), [0.0, 1.0], events=separated, rtol=1e-11, atol=1e-13,
+    released.terminal, released.direction = True, -1
+    solution = solve_ivp(rhs, (0.0, 100.0), [0.0, 1.0], events=released, rtol=1e-11, atol=1e-13,
                          first_step=1e-6)
     if not solution.t_events[0].size:
-        return 0.0  # the bodies stay together: all the approach energy is dissipated
+        return 0.0  # the force never lets go: all the approach energy is dissipated
     return float(-solution.y_events[0][0][1])
 
 

@@ -6,8 +6,9 @@ by hand. Quantities are written in the chosen :class:`~hexdem.model.units.UnitSy
 (``units si``) or the paper's A = d = M = 1 (``units lj``). Contacts use the ``hertz k_n``
 model, F = k_n sqrt(R_eff δ) δ, for bead pairs and for the walls alike, so the walls carry
 their own modulus (the wall fix's ``hertz/material`` cannot mix materials, LAMMPS issue 4141);
-with friction, Mindlin's ``tangential mindlin`` with each contact's own k_t = 8 G* (given, as
-LAMMPS cannot derive it from ``hertz k_n``), and ``fix nve/sphere`` turns the spheres.
+Tsuji's damping with ``limit_damping`` (the normal force clipped at zero); with friction,
+Mindlin's ``tangential mindlin`` with each contact's own k_t = 8 G* (given, as LAMMPS cannot
+derive it from ``hertz k_n``), and ``fix nve/sphere`` turns the spheres.
 An optional uniform in-plane gravity (the tilted set-up of Sec. VI-A) adds ``fix gravity``.
 """
 
@@ -143,10 +144,13 @@ def template(name: str) -> Template:
 
 def damping_model(alpha: float) -> str:
     """The damping of a ``hertz`` contact: none (α = 0), or Tsuji's with damping α
-    (:mod:`hexdem.model.dissipation`), as LAMMPS's ``damp`` value and model name."""
+    (:mod:`hexdem.model.dissipation`), as LAMMPS's ``damp`` value and model name, with
+    ``limit_damping``: the damped normal force clipped at zero, so that it never pulls as the
+    contact opens (nor lets the Coulomb cap act there). ``pair_coeff`` and the wall fixes read it
+    alike among the sub-models."""
     if alpha == 0.0:
         return "0.0 damping viscoelastic"
-    return f"{_fmt(lammps_tsuji_coefficient(alpha))} damping tsuji"
+    return f"{_fmt(lammps_tsuji_coefficient(alpha))} damping tsuji limit_damping"
 
 
 def contact_model(law: ContactLaw, units: UnitSystem) -> str:

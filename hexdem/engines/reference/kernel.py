@@ -41,7 +41,7 @@ class KernelArrays(NamedTuple):
     ``pair_rest_x``, ``pair_rest_y``, ``pair_contact``, ``pair_stiffness``. Wall contacts:
     ``wall_cell``, inward normal ``wall_nx``, ``wall_ny`` at rest, rest gap ``wall_gap``,
     ``wall_curvature`` 1/ρ (0: a plane), ``wall_stiffness`` A_w = k_n,wall sqrt(R_eff). Tsuji damping (:mod:`hexdem.model.dissipation`)
-    η = α sqrt(m_eff A) of each lattice bond (3, hi), explicit pair and wall contact:
+    η = α sqrt(m_eff A) of each lattice bond (3, hi), explicit pair and wall contact, the damped force clipped at zero:
     ``damping``, ``pair_damping``, ``wall_damping``; ``damped`` whether any is non-zero. Per cell: ``external_x``, ``external_y`` constant
     forces (the held force of a precompressed packing's struck bead).
     """
@@ -89,7 +89,8 @@ def _hertz_bonds(xi, yi, xj, yj, rest_x, rest_y, contact, stiffness, fx, fy):
 
 @_jit
 def _damped_bonds(xi, yi, xj, yj, ui, wi, uj, wj, rest_x, rest_y, contact, stiffness, damping, fx, fy):
-    """As :func:`_hertz_bonds` plus Tsuji's damping η δ^{1/4} δ̇ (δ̇ > 0 while compressing)."""
+    """As :func:`_hertz_bonds` plus Tsuji's damping η δ^{1/4} δ̇ (δ̇ > 0 while compressing), the sum
+    clipped at zero (it never pulls: :mod:`hexdem.model.dissipation`)."""
     for p in range(fx.shape[0]):
         dx = rest_x[p] + xj[p] - xi[p]
         dy = rest_y[p] + yj[p] - yi[p]
@@ -97,7 +98,7 @@ def _damped_bonds(xi, yi, xj, yj, ui, wi, uj, wj, rest_x, rest_y, contact, stiff
         overlap = max(contact[p] - r, 0.0)
         rate = -(dx * (uj[p] - ui[p]) + dy * (wj[p] - wi[p])) / r
         root = np.sqrt(overlap)
-        f = (stiffness[p] * overlap * root + damping[p] * np.sqrt(root) * rate) / r
+        f = max(stiffness[p] * overlap * root + damping[p] * np.sqrt(root) * rate, 0.0) / r
         fx[p] = f * dx
         fy[p] = f * dy
 
@@ -120,7 +121,7 @@ def _pair_forces(k, x, y, u, w, scale, fx, fy):
         if overlap > 0.0:
             rate = -(dx * (u[j] - u[i]) + dy * (w[j] - w[i])) / r
             root = np.sqrt(overlap)
-            f = (k.pair_stiffness[b] * overlap * root + k.pair_damping[b] * np.sqrt(root) * rate) / r
+            f = max(k.pair_stiffness[b] * overlap * root + k.pair_damping[b] * np.sqrt(root) * rate, 0.0) / r
             fx[i] -= f * dx * scale[i]
             fy[i] -= f * dy * scale[i]
             fx[j] += f * dx * scale[j]
@@ -143,7 +144,7 @@ def _wall_forces(k, x, y, u, v, scale, fx, fy):
         if depth > 0.0:
             rate = -(u[c] * nx + v[c] * ny)
             root = np.sqrt(depth)
-            f = (k.wall_stiffness[w] * depth * root + k.wall_damping[w] * np.sqrt(root) * rate) * scale[c]
+            f = max(k.wall_stiffness[w] * depth * root + k.wall_damping[w] * np.sqrt(root) * rate, 0.0) * scale[c]
             fx[c] += f * nx
             fy[c] += f * ny
 
