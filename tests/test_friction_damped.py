@@ -3,8 +3,9 @@ the normal damping and cap the tangential force at μ |F_n| with F_n the damped 
 ``fncrit``), so they must agree, within their convergence in the time step, on the rebound and spin.
 
 LAMMPS converges slowly here (its damping force takes half-step velocities: at 10° its ω r moves by
-1.4e-3 and 1.1e-3 of itself from τ/400 to τ/800 to τ/1600), the reference engine fast; the bound is
-the sum of each engine's change over its last halving, doubled (``oblique.convergence_bound``)."""
+2.0e-3 and 1.0e-3 of itself from τ/400 to τ/800 to τ/1600, first order), the reference engine fast
+(3e-5 and 7e-6); the normal force is clipped at zero in both (:mod:`hexdem.model.dissipation`). The
+bound is the sum of each engine's change over its last halving, doubled (``oblique.convergence_bound``)."""
 
 from dataclasses import replace
 
