@@ -13,9 +13,11 @@ from hexdem.errors import HexdemError
 from hexdem.experiments.compare import compare_analyses
 from hexdem.experiments.run import simulate
 from hexdem.model.config import RunConfig
+from hexdem.model.contact_law import Friction
 from hexdem.model.dissipation import TSUJI_POLYNOMIAL, damping_coefficient, lammps_tsuji_coefficient, restitution_of
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time
+from hexdem.model.lattice import Lattice
 from hexdem.model.walls import Wall
 from hexdem.model.materials import DELRIN, STEEL_316, hertz_stiffness, sphere_mass
 
@@ -61,22 +63,43 @@ def test_the_clip_gives_back_the_work_of_the_tensile_phase(alpha):
     assert (clipped**2 - unclipped**2) / (alpha * clipped) ** 2 == pytest.approx(0.8, rel=alpha**2)
 
 
+def steel_contacts(kind: str, mu: float) -> tuple[GranularModel, float, float]:
+    """(model, reduced mass [kg], A [N/m^1.5]) of a steel sphere struck at V0 along +x, restitution 0.8,
+    Coulomb μ: against a steel wall (``wall``), on a resting sphere of the packing (``pair``: a lattice
+    bond) or by a striker (``striker``: an explicit pair)."""
+    mass, friction = float(sphere_mass(D, STEEL_316)), Friction(mu, mu)
+    if kind == "wall":
+        lattice = replace(single_bead(D), walls=(Wall("wall_180", (-1.0, 0.0), -D / 2, np.array([0])),))
+        model = GranularModel(lattice, Impact(V0), STEEL_316, STEEL_316, wall_restitution=0.8, friction=friction)
+        return model, mass, hertz_stiffness(STEEL_316, STEEL_316) * np.sqrt(D / 2)
+    if kind == "pair":
+        lattice = Lattice(np.array([[0, 0], [2, 0]]), np.array([[0.0, 0.0], [D, 0.0]]), np.full(2, D), D, 0, (), "pair")
+        model = GranularModel(lattice, Impact(V0, bead=0), STEEL_316, None, restitution=0.8, friction=friction)
+    else:
+        model = GranularModel(single_bead(D), Impact(V0, striker=True), STEEL_316, None, restitution=0.8,
+                              friction=friction)
+    return model, mass / 2, hertz_stiffness(STEEL_316, STEEL_316) * np.sqrt(D / 4)
+
+
 @pytest.mark.parametrize("engine", ENGINES, ids=lambda e: e.name)
-def test_a_damped_contact_never_pulls(tmp_path, engine):
-    """A steel sphere striking a steel wall with e = 0.8: the contact force only pushes the sphere out,
-    so its outward speed never falls, step after step, and it leaves at e V0. Without the clip the
-    damping force pulls at the end of the contact, down to −4.8 % of the peak force (measured in both
-    engines), and the outward speed falls over the last steps."""
-    wall = Wall("wall_180", (-1.0, 0.0), -D / 2, np.array([0]))
-    model = GranularModel(replace(single_bead(D), walls=(wall,)), Impact(V0), STEEL_316, wall=STEEL_316,
-                          wall_restitution=0.8)
-    mass = float(sphere_mass(D, STEEL_316))
-    duration = 1.3 * contact_time(mass, hertz_stiffness(STEEL_316, STEEL_316) * np.sqrt(D / 2), V0)
-    outward = -record(engine, model, RunSettings(duration / 2000, 2000, 1), tmp_path).velocities_m_s[:, 0, 0]
-    kicks = np.diff(outward)
-    assert kicks.max() > 1e-3 * V0, "the wall pushes"
+@pytest.mark.parametrize("kind", ["wall", "pair", "striker"])
+@pytest.mark.parametrize("mu", [0.0, 0.1])
+def test_a_damped_contact_never_pulls(tmp_path, engine, kind, mu):
+    """A steel sphere struck head-on, e = 0.8, against a wall or another sphere, frictionless or not:
+    the contact force only pushes the bodies apart, so their separation speed never falls, step after
+    step, and ends at e V0. Without the clip the damping force pulls at the end of the contact, down
+    to −4.8 % of the peak force (measured in both engines), and the separation speed falls over the
+    last steps."""
+    model, reduced_mass, stiffness = steel_contacts(kind, mu)
+    duration = 1.3 * contact_time(reduced_mass, stiffness, V0)
+    velocities = record(engine, model, RunSettings(duration / 2000, 2000, 1), tmp_path).velocities_m_s[:, :, 0]
+    apart = -velocities[:, 0] if kind == "wall" else velocities[:, 1] - velocities[:, 0]  # first body struck
+    if kind == "striker":
+        apart = -apart  # the striker (body 1) strikes the bead (body 0)
+    kicks = np.diff(apart)
+    assert kicks.max() > 1e-3 * V0, "the contact pushes"
     assert kicks.min() >= -1e-12 * V0, "and never pulls"
-    assert outward[-1] == pytest.approx(0.8 * V0, rel=RESTITUTION_RTOL)
+    assert apart[-1] == pytest.approx(0.8 * V0, rel=RESTITUTION_RTOL)
 
 
 @pytest.mark.parametrize("c", [0.95, 0.8])
