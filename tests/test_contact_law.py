@@ -51,9 +51,9 @@ def test_config_friction_keys_default_to_the_frictionless_model_and_wall_frictio
 
 @pytest.mark.parametrize("keys, message", [
     ({"friction": -0.1}, "friction must be a coefficient >= 0"),
-    ({"friction": "rough"}, "friction must be a coefficient >= 0"),
-    ({"friction": float("nan")}, "friction must be a coefficient >= 0"),
-    ({"friction": True}, "friction must be a coefficient >= 0"),
+    ({"friction": "rough"}, "friction must be a number, got 'rough'"),
+    ({"friction": float("nan")}, "friction must be a number, got nan"),
+    ({"friction": True}, "friction must be a number, got True"),
     ({"friction": 0.3, "wall_friction": -1}, "wall_friction must be a coefficient >= 0"),
     ({"rolling_friction": 0.01}, "rolling_friction needs friction > 0"),
     ({"rolling_friction": -0.01}, "rolling_friction must be a coefficient >= 0"),

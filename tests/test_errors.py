@@ -1,6 +1,8 @@
 """Bad input gets one clear line from the CLI, exit status 2, and no partial result files."""
 
+import dataclasses
 import functools
+import json
 import re
 from pathlib import Path
 
@@ -15,6 +17,7 @@ from hexdem.engines.lammps.driver import run_streaming
 from hexdem.engines.lammps.runner import run_bare
 from hexdem.errors import HexdemError
 from hexdem.experiments.parallel import run_on_ranks
+from hexdem.experiments.run import run_experiment
 from hexdem.model.config import RunConfig
 
 
@@ -64,12 +67,77 @@ def kept_deck(message: str) -> Path:
     ('bead_material = "unobtainium"', "unobtainium"),
     ('shape = "disc"\nradius_beads = 1', "a disc needs a radius of at least 2 bead diameters"),
     ('shape = "disc"\nradius_beads = 5\nprecompression_n = 20.0', "precompression is built for flat-walled basins"),
+    ('edge_beads = "abc"', "edge_beads must be an integer, got 'abc'"),
+    ("edge_beads = 5.0", "edge_beads must be an integer, got 5.0"),
+    ("initial_state_file = 3", "initial_state_file must be a string, got 3"),
+    ('initial_state_file = {path = "state.csv"}', "initial_state_file must be a string, got {'path': 'state.csv'}"),
+    ("dump = 1", "dump must be true or false, got 1"),
+    ("v0 = nan", "v0 must be a number, got nan"),
+    ('sensors = ["0:1", 1.5]', "sensors.1 must be a string or an integer, got 1.5"),
+    ("vacancies = [[1, 1, 1]]", "vacancies.0 must be a list of 2 integers, got [1, 1, 1]"),
+    ('[[regions]]\nmaterial = "brass"\nx_min_d = "far"', "regions.0.x_min_d must be a number, got 'far'"),
+    ('[[impacts]]\nsite = [0, 0]\nkind = 1', "impacts.0.kind must be a string, got 1"),
+    ('[materials.bronze]\nyoungs_modulus_pa = "stiff"', "materials.bronze.youngs_modulus_pa must be a number"),
 ])
 def test_bad_config_is_one_line_and_writes_nothing(tmp_path, capsys, config_text, message):
     code, err = run_cli(tmp_path, capsys, config_text)
     assert code == 2
     assert len(err) == 1 and err[0].startswith("hexdem: error:") and message in err[0]
     assert_no_results(tmp_path / "out")
+
+
+@pytest.mark.parametrize("name", [field.name for field in dataclasses.fields(RunConfig)])
+def test_every_key_is_checked_against_its_declared_type(name):
+    """A table where any other value belongs (a list for ``materials``, itself a table) is
+    refused in one line naming the key, the type and the value."""
+    wrong = [1] if name == "materials" else {"a": 1}
+    with pytest.raises(HexdemError) as error:
+        RunConfig(**{name: wrong})
+    assert str(error.value).startswith(f"{name} must be ") and str(error.value).endswith(f", got {wrong!r}")
+
+
+def test_input_files_that_are_not_utf8_are_one_line(tmp_path, capsys):
+    """A configuration and a sites file saved in Latin-1 (the ® is byte 0xae, the 33rd)."""
+    latin = tmp_path / "latin.toml"
+    latin.write_bytes('bead_material = "ptfe"  # Teflon®\n'.encode("latin-1"))
+    (tmp_path / "sites.csv").write_bytes("m,n\n0,0\n2,0  # ®\n".encode("latin-1"))
+    (tmp_path / "sites.toml").write_text(f'shape = "sites"\nsites_file = "{tmp_path / "sites.csv"}"\n')
+    for config, message in ((latin, f"config {latin} is not UTF-8 text (byte 32: {bytes([0xae])!r})"),
+                            (tmp_path / "sites.toml", f"sites_file {tmp_path / 'sites.csv'} is not UTF-8 text")):
+        assert main(["run", "--config", str(config), "--out", str(tmp_path / "out")]) == 2
+        lines = capsys.readouterr().err.strip().splitlines()
+        assert len(lines) == 1 and message in lines[0], lines
+        assert_no_results(tmp_path / "out")
+
+
+@pytest.fixture(scope="module")
+def small_deck(tmp_path_factory):
+    """The deck of a 4-per-edge hexagon's run with its dump (37 beads, 1 ms)."""
+    out = tmp_path_factory.mktemp("small") / "out"
+    run_experiment(RunConfig(edge_beads=4, duration=1e-3, dump=True), out, log=lambda message: None)
+    return out / "deck"
+
+
+@pytest.mark.parametrize("text, message", [
+    ("[1, 2]", "hexdem.json holds [1, 2] where a table of run-config keys belongs"),
+    ("null", "hexdem.json holds null where a table of run-config keys belongs"),
+    ('{"edge_beads": "four"}', "edge_beads must be an integer, got 'four'"),
+    (json.dumps(RunConfig(edge_beads=5, duration=1e-3, dump=True).as_dict()),
+     "holds 37 atoms, the packing of"),
+])
+def test_analyse_refuses_a_damaged_deck_in_one_line(small_deck, tmp_path, capsys, text, message):
+    """``hexdem.json`` of the wrong shape, of wrong types, or of another packing than the dump's
+    (61 beads for the dump's 37, the same frames)."""
+    deck = tmp_path / "deck"
+    deck.mkdir()
+    for entry in small_deck.iterdir():
+        (deck / entry.name).symlink_to(entry)
+    (deck / "hexdem.json").unlink()
+    (deck / "hexdem.json").write_text(text)
+    assert main(["analyse", str(deck), "--out", str(tmp_path / "analysed")]) == 2
+    lines = [line for line in capsys.readouterr().err.strip().splitlines() if not line.startswith("hexdem analyse: ")]
+    assert len(lines) == 1 and message in lines[0], lines
+    assert not (tmp_path / "analysed" / "summary.json").exists()
 
 
 def test_unwritable_output_directory(tmp_path, capsys):

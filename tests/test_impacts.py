@@ -144,7 +144,7 @@ def test_extra_observation_lines_follow_the_lattice_from_any_bead(tmp_path):
     ({"lines": [{"name": "0", "site": [0, 0], "angle_deg": 90}]}, "must be a new"),
     ({"lines": [{"name": "up", "site": [0, 0], "angle_deg": 45}]}, "not a lattice direction"),
     ({"lines": [{"name": "up", "site": [1, 0], "angle_deg": 90}]}, "is not a bead"),
-    ({"lines": [{"name": "up", "site": [[0], 0], "angle_deg": 90}]}, "is not a bead"),
+    ({"lines": [{"name": "up", "site": [[0], 0], "angle_deg": 90}]}, "lines.0.site must be a list of 2 integers"),
     ({"impacts": [{"edge_deg": 30.0}]}, "no flat edge"),
     ({"impacts": [{"site": [0, 0], "angle_deg": 150.0}]}, "points out of the packing through wall_000"),
 ])

@@ -1,11 +1,14 @@
 """Any initial state (``initial_state_file``): two spheres set against each other by it, in both
-engines, against momentum and energy conservation worked out by hand; bad files refused in one
-line before anything is written."""
+engines, against momentum and energy conservation worked out by hand; the time step set by the
+state's fastest approach, a state too fast for Hertz contacts refused; the state copied into
+the deck; bad files refused in one line before anything is written."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import read_csv
 
 from hexdem.cli.main import main
 from hexdem.experiments.run import simulate
@@ -70,6 +73,61 @@ def test_bad_initial_state_files_are_one_line_and_write_nothing(tmp_path, capsys
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], lines
     assert not (tmp_path / "out").exists()
+
+
+def test_the_time_step_follows_the_fastest_bead_of_the_state(tmp_path):
+    """The step resolves the shortest contact, t_c ∝ V^(-1/5) at the fastest approach V. A bead
+    of the struck edge given 100 m/s (250 V0) into the packing approaches its neighbours and the
+    walls at 100 m/s, so the step is 250^(1/5) = 3.02 times shorter than at V0 and the run as
+    long in steps. With as many steps per contact as the default experiment, LAMMPS keeps the
+    energy as well as there (drift 4.8e-5; 4.2e-4 at the step of V0, which scales as dt²)."""
+    (tmp_path / "state.csv").write_text("m,n,vx,vy\n4,0,100.0,0\n")
+    base = RunConfig(edge_beads=5)
+    fast = base.replace(initial_state_file=str(tmp_path / "state.csv"))
+    assert base.settings().dt_s / fast.settings().dt_s == pytest.approx(250 ** 0.2, rel=1e-12)
+    assert fast.settings().n_steps == base.settings().n_steps
+    assert simulate(fast, tmp_path / "run").results.energy_drift < 1e-4
+
+
+def test_the_fastest_approach_is_that_of_two_beads_meeting(tmp_path):
+    """Bead 1 of the pair set at 0.2 m/s towards bead 0, struck at 0.4: they close at 0.6 m/s,
+    the contact is (0.6/0.4)^(-1/5) of the impact's alone. A free pair has no wall at rest to
+    measure against."""
+    state = tmp_path / "state.csv"
+    vx, vy = (float(v) for v in -0.2 * ALONG)
+    state.write_text(f"m,n,vx,vy\n1,1,{vx!r},{vy!r}\n")
+    alone = RunConfig(**PAIR).contact_time_s()
+    assert RunConfig(**PAIR, initial_state_file=str(state)).contact_time_s() == pytest.approx(alone * 1.5 ** -0.2,
+                                                                                              rel=1e-12)
+
+
+def test_a_state_too_fast_for_hertz_contacts_is_refused_in_one_line(tmp_path, capsys):
+    """A bead given 1e6 m/s would press 67 diameters into its neighbour: Hertz's law, and the
+    packing, end at half a diameter."""
+    (tmp_path / "state.csv").write_text("m,n,vx,vy\n4,0,1e6,0\n")
+    (tmp_path / "run.toml").write_text(f'edge_beads = 5\ninitial_state_file = "{tmp_path / "state.csv"}"\n')
+    assert main(["run", "--config", str(tmp_path / "run.toml"), "--out", str(tmp_path / "out")]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and "at 1e+06 m/s, two steel316 beads meeting head on would overlap by 67.2 diameters" \
+        in lines[0], lines
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_deck_with_a_relative_initial_state_is_analysed_from_inside(tmp_path, monkeypatch):
+    """The run copies the state into its deck, so ``hexdem analyse .`` inside the deck (the
+    state's relative path no longer leads to it) reads the same packing and finds the run's own
+    peaks (as the analysis of a dump does, test_streaming.py)."""
+    monkeypatch.chdir(tmp_path)
+    Path("state.csv").write_text("m,n,vx,vy\n1,1,0.1,0.05\n")
+    Path("run.toml").write_text('edge_beads = 4\nduration = 1e-3\ninitial_state_file = "state.csv"\n')
+    assert main(["run", "--config", "run.toml", "--out", "out", "--dump"]) == 0
+    monkeypatch.chdir(tmp_path / "out" / "deck")
+    assert Path("initial_state_file.csv").read_text() == (tmp_path / "state.csv").read_text()
+    assert main(["analyse", ".", "--out", str(tmp_path / "analysed")]) == 0
+    _, ran = read_csv(tmp_path / "out" / "peaks.csv")
+    _, analysed = read_csv(tmp_path / "analysed" / "peaks.csv")
+    np.testing.assert_allclose([float(row["peak_speed"]) for row in analysed],
+                               [float(row["peak_speed"]) for row in ran], rtol=1e-4)
 
 
 def test_a_missing_initial_state_file_is_one_line(tmp_path):

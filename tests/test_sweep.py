@@ -123,7 +123,15 @@ def test_another_plan_in_the_same_directory_is_refused(swept, tmp_path, capsys):
     (["--vary", "friction"], "expected KEY=V1,V2,..."),
     (["--vary", "friction=0,,0.1"], "no empty value"),
     (["--vary", "friction="], "no empty value"),
-    (["--vary", "friction=0,rough"], "run friction=rough: friction must be a coefficient >= 0, got 'rough'"),
+    (["--vary", "friction=0,rough"], "--vary friction must be a number, got 'rough'"),
+    (["--vary", "edge_beads=abc,5"], "--vary edge_beads must be an integer, got 'abc'"),
+    (["--vary", "initial_state_file=3"], "--vary initial_state_file must be a string, got 3"),
+    (["--vary", "dump=yes"], "--vary dump must be true or false, got 'yes'"),
+    (["--vary", "regions.0.x_min_d=far"], "--vary regions.0.x_min_d must be a number, got 'far'"),
+    (["--vary", "materials.bronze.density_kg_m3=heavy"], "--vary materials.bronze.density_kg_m3 must be a number"),
+    (["--vary", "vacancies.0.1=x"], "--vary vacancies.0.1 must be an integer, got 'x'"),
+    (["--vary", "friction=0,0.1", "--launcher", "/nonexistent/mpiexec"],
+     "cannot start the MPI launcher '/nonexistent/mpiexec': no such executable"),
     (["--vary", "friction=0.1,0.1"], "a value is listed twice"),
     (["--vary", "v0=0.4,0.40"], "two values are the same once read"),
     (["--vary", "friction=0,-0.2"], "run friction=-0.2: friction must be a coefficient >= 0"),
@@ -133,6 +141,7 @@ def test_another_plan_in_the_same_directory_is_refused(swept, tmp_path, capsys):
     (["--vary", "friction=0", "--workers", "0"], "--workers must be a positive integer"),
 ])
 def test_bad_plans_are_one_line_before_any_run(tmp_path, capsys, options, message):
+    """Refused before anything is written: a corrected command may then use the same --out."""
     assert sweep(tmp_path, *options, "--out", str(tmp_path / "out")) == 2
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], lines

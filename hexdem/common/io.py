@@ -48,14 +48,23 @@ def locked_directory(out: Path, holder: str):
         os.close(fd)
 
 
+def read_text(path, what: str) -> str:
+    """The text of the UTF-8 file at ``path``; an unreadable file, or one that is not UTF-8 text,
+    is one clear line naming it as ``what``."""
+    try:
+        return Path(path).read_text(encoding="utf-8")
+    except OSError as exc:
+        raise HexdemError(f"cannot read {what} {path}: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise HexdemError(f"{what} {path} is not UTF-8 text (byte {exc.start}: {exc.object[exc.start:exc.start + 1]!r})") from None
+
+
 def read_toml(path, what: str = "config") -> dict:
     """The table of the TOML file at ``path``; an unreadable or invalid file is one clear line
     naming it as ``what``."""
     path = Path(path)
     try:
-        return tomllib.loads(path.read_text())
-    except OSError as exc:
-        raise HexdemError(f"cannot read {what} {path}: {exc.strerror}") from None
+        return tomllib.loads(read_text(path, what))
     except tomllib.TOMLDecodeError as exc:
         raise HexdemError(f"{what} {path} is not valid TOML: {exc}") from None
 

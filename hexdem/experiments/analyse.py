@@ -6,12 +6,13 @@ ranks, by any LAMMPS with the GRANULAR package) it writes ``dump.lammpstrj``;
 :func:`analyse_deck` reads that dump through MDAnalysis (:mod:`hexdem.analysis.dump`) and
 writes the same ``peaks.csv``, ``summary.json``, ``arrival_map.png`` and ``peak_decay.png``
 as ``hexdem run``, with the definitions of :mod:`hexdem.analysis.peaks`. Unlike hexdem's own
-runs, this path holds the whole trajectory in memory.
+runs, this path holds the whole trajectory in memory. The deck stands alone
+(:mod:`hexdem.experiments.deck_config`); a dump of another packing than ``hexdem.json``'s is
+refused in one line.
 """
 
 from __future__ import annotations
 
-import json
 import sys
 import time
 from pathlib import Path
@@ -22,25 +23,8 @@ from hexdem.common.io import ensure_writable_dir
 from hexdem.engines.lammps.deck import DUMP_NAME
 from hexdem.engines.lammps.runner import log_version
 from hexdem.errors import HexdemError
-from hexdem.experiments.run import CONFIG_NAME, write_results
-from hexdem.model.config import RunConfig
-
-
-#: The time step of decks written before ``steps_per_contact`` existed: τ/700.
-LEGACY_STEPS_PER_CONTACT = 700
-
-
-def deck_config(deck_dir: Path) -> RunConfig:
-    """The :class:`RunConfig` a ``hexdem run`` deck directory was written for."""
-    path = deck_dir / CONFIG_NAME
-    try:
-        data = json.loads(path.read_text())
-    except OSError:
-        raise HexdemError(f"{deck_dir} has no {CONFIG_NAME}: it is not a deck directory written by hexdem run") from None
-    except ValueError:
-        raise HexdemError(f"{path} is not valid JSON") from None
-    data.setdefault("steps_per_contact", LEGACY_STEPS_PER_CONTACT)  # a deck written before the key existed
-    return RunConfig.from_dict(data, source=str(path))
+from hexdem.experiments.deck_config import CONFIG_NAME, read_deck_config
+from hexdem.experiments.run import write_results
 
 
 def analyse_deck(deck_dir, out=None, log=None) -> ImpactAnalysis:
@@ -49,7 +33,7 @@ def analyse_deck(deck_dir, out=None, log=None) -> ImpactAnalysis:
     log = log or (lambda message: print(f"hexdem analyse: {message}", file=sys.stderr, flush=True))
     start = time.perf_counter()
     deck_dir = Path(deck_dir)
-    config = deck_config(deck_dir)
+    config = read_deck_config(deck_dir)
     dump = deck_dir / DUMP_NAME
     if not dump.exists():
         raise HexdemError(f"{deck_dir} has no {DUMP_NAME}: run the deck by hand first "
@@ -60,7 +44,12 @@ def analyse_deck(deck_dir, out=None, log=None) -> ImpactAnalysis:
     log(f"reading {dump} ({settings.n_samples} frames of {model.n_bodies} atoms) through MDAnalysis")
     engine = {"name": "lammps", "version": log_version(deck_dir / "log.lammps"), "ranks": None,
               "wall_time_s": None, "deck": str(deck_dir / "in.hexdem")}
-    analysis = ImpactAnalysis.from_trajectory(model, settings, read_trajectory(dump, settings, engine))
+    trajectory = read_trajectory(dump, settings, engine)
+    atoms = trajectory.velocities_m_s.shape[1]
+    if atoms != model.n_bodies:
+        raise HexdemError(f"{dump} holds {atoms} atoms, the packing of {deck_dir / CONFIG_NAME} {model.n_bodies}: "
+                          "the dump is another packing's")
+    analysis = ImpactAnalysis.from_trajectory(model, settings, trajectory)
     write_results(config, analysis, out, time.perf_counter() - start)
     log(f"energy drift {analysis.results.energy_drift:.2e}; results in {out}")
     return analysis

@@ -16,7 +16,6 @@ from __future__ import annotations
 import functools
 import os
 import pickle
-import shlex
 import subprocess
 import sys
 import threading
@@ -27,8 +26,8 @@ from hexdem.common.checks import positive_int
 from hexdem.common.io import atomic_path
 from hexdem.common.job_failure import ERROR_FILE_VARIABLE, abort_job
 from hexdem.common.progress import progress_bar
-from hexdem.engines.lammps.library import environment_command, load_lammps
-from hexdem.engines.lammps.partitions import die_with_parent
+from hexdem.engines.lammps.library import load_lammps
+from hexdem.engines.lammps.partitions import die_with_parent, launcher_command
 from hexdem.errors import HexdemError
 
 JOB_NAME, RESULT_NAME, ERROR_NAME = "job.pickle", "job.result.pickle", "job.error"
@@ -74,13 +73,13 @@ def run_on_ranks(job, ranks: int, directory, launcher: str | None = None, progre
     if ranks == 1 and launcher is None:
         with _progress(progress):
             return job(None)
+    prefix = launcher_command(launcher)
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     paths = {name: directory / name for name in (JOB_NAME, RESULT_NAME, ERROR_NAME)}
     for path in paths.values():
         path.unlink(missing_ok=True)
     paths[JOB_NAME].write_bytes(pickle.dumps(job))
-    prefix = shlex.split(launcher) if launcher else [environment_command("mpiexec")]
     command = [*prefix, "-n", str(ranks), sys.executable, "-P", "-m", __name__, str(paths[JOB_NAME].resolve())]
     with _progress(progress):
         try:

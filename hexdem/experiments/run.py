@@ -32,12 +32,11 @@ from hexdem.analysis.movie import movie_samples
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.common.machine import free_disk_bytes
 from hexdem.errors import HexdemError
+from hexdem.experiments.deck_config import write_deck_config
 from hexdem.experiments.sensors import write_sensor_files
 from hexdem.experiments.tracked_run import ImpactJob, track_impact
 from hexdem.model.config import RunConfig
 
-#: The configuration of a LAMMPS deck, in its directory (read by ``hexdem analyse``).
-CONFIG_NAME = "hexdem.json"
 RESULT_FILES = ("peaks.csv", "summary.json", "arrival_map.png", "peak_decay.png", "front_shape.csv",
                 "front_shape.png", "energy_regions.csv", "beads.csv", "peak_map.png")
 #: Columns of ``beads.csv``: every bead's label, position, material and pulse, its largest
@@ -70,7 +69,8 @@ def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples
     records when each bead's speed first reaches it; ``field_samples`` every bead's speed at those samples (see
     :class:`~hexdem.analysis.tracker.PulseTracker`), and those of the movie's frames
     (:func:`~hexdem.analysis.movie.movie_samples`) with ``config.movie``. A LAMMPS deck directory also gets
-    ``hexdem.json`` (the configuration), which ``hexdem analyse`` reads.
+    ``hexdem.json`` (the configuration) and a copy of its input files, which ``hexdem analyse`` reads
+    (:mod:`~hexdem.experiments.deck_config`).
     """
     log = log or (lambda message: None)
     model = config.model()
@@ -78,7 +78,7 @@ def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
     if config.engine == "lammps":
-        write_json(workdir / CONFIG_NAME, config.as_dict())
+        write_deck_config(config, workdir)
     log(f"running {config.engine}: {model.lattice.shape}, {model.n_bodies} bodies, "
         f"{settings.n_steps} steps of {settings.dt_s:.4g} s ({settings.duration_s * 1e3:.4g} ms), "
         f"{config.ranks if config.engine == 'lammps' else 1} rank(s), {settings.n_samples} samples analysed in the run")

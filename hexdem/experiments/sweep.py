@@ -6,7 +6,8 @@
 **Running.** ``workers`` runs at once, each on a one-rank communicator of its own: a LAMMPS
 instance, or the reference engine's process (:func:`~hexdem.experiments.parallel.spread_tasks`
 inside :func:`~hexdem.experiments.parallel.run_on_ranks`, whose MPI ranks ``launcher`` may start
-on other machines). A progress bar counts the runs done.
+on other machines). A progress bar counts the runs done. A launcher whose program cannot be
+found is refused before anything is written.
 
 **Layout of DIR.** ``sweep.json`` (the plan: the base configuration, the varied keys and their
 values), ``runs/<name>/`` (each run's full result directory, as ``hexdem run --out`` leaves it),
@@ -29,6 +30,7 @@ from pathlib import Path
 
 from hexdem.common.checks import positive_int
 from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
+from hexdem.engines.lammps.partitions import launcher_command
 from hexdem.errors import HexdemError
 from hexdem.experiments.parallel import run_on_ranks, spread_tasks
 from hexdem.experiments.sweep_plan import SweepRun, Variation, plan_sweep
@@ -87,6 +89,8 @@ def run_sweep(base: dict, variations: list[Variation], out, workers: int = 1, la
     log = log or (lambda message: print(f"hexdem sweep: {message}", file=sys.stderr, flush=True))
     positive_int("--workers", workers)
     runs = plan_sweep(base, variations, source)
+    if launcher is not None or workers > 1:
+        launcher_command(launcher)  # refused before anything is written into out
     out = ensure_writable_dir(out)
     with locked_directory(out, "another hexdem sweep"):
         _check_plan(out, {"base": base, "vary": {v.key: list(v.texts) for v in variations}})

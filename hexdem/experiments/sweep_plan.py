@@ -7,8 +7,10 @@ through its tables and lists: ``regions.0.material`` (the first region's materia
 ``impacts.1.v0`` (the second impact's speed). The path's last step may add a key the base
 configuration leaves at its default; the steps before it must exist there. Values are read as
 TOML values (``0.4``, ``1e-3``, ``true``, ``"brass"``); a bare word is a string
-(``brass``). Every run's configuration is built and validated by :class:`RunConfig` itself
-before anything runs, so a bad key or value is one line naming the run.
+(``brass``). Each value is checked against its key's declared type as it is read
+(:func:`~hexdem.common.typecheck.type_at`), and every run's configuration is built and
+validated by :class:`RunConfig` itself before anything runs, so a bad key or value is one line
+naming the key or the run.
 
 A run's name, its directory under ``DIR/runs/``, is its ``key=value`` pairs joined by commas,
 as given on the command line (characters a file name cannot hold become ``_``).
@@ -23,6 +25,7 @@ import tomllib
 from dataclasses import dataclass, fields
 
 from hexdem.common.io import read_toml
+from hexdem.common.typecheck import check_type, type_at
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
 
@@ -53,6 +56,9 @@ class Variation:
         if top not in known:
             raise HexdemError(f"--vary {key}: {top!r} is not a run-config key; known: {', '.join(sorted(known))}")
         values = tuple(toml_value(text) for text in texts)
+        if (kind := type_at(RunConfig, key)) is not None:
+            for value in values:
+                check_type(f"--vary {key}", value, kind)
         if any(a == b and type(a) is type(b) for i, a in enumerate(values) for b in values[i + 1:]):
             raise HexdemError(f"--vary {key}: two values are the same once read ({listed})")
         return cls(key, values, texts)
@@ -124,7 +130,7 @@ def plan_sweep(base: dict, variations: list[Variation], source: str = "the base 
         name = run_name(pairs)
         try:
             config = RunConfig.from_dict(data, source=f"run {name}")
-        except (HexdemError, TypeError) as exc:
+        except HexdemError as exc:
             message = str(exc)
             raise HexdemError(message if message.startswith(f"run {name}") else f"run {name}: {message}") from None
         if config.ranks != 1:

@@ -13,25 +13,26 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
-from hexdem.common.checks import is_number, positive_int
+from hexdem.common.checks import positive_int
 from hexdem.common.io import read_toml
 from hexdem.common.machine import available_memory_bytes
+from hexdem.common.typecheck import check_fields
 from hexdem.errors import HexdemError
 from hexdem.model.contact_law import Friction
 from hexdem.model.dissipation import damping_coefficient, lammps_tsuji_coefficient
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time
-from hexdem.model.impacts import ImpactSpec, cut_holes, impact_specs, resolve_impacts, struck_site
+from hexdem.model.impacts import ImpactSpec, ImpactTable, cut_holes, impact_specs, resolve_impacts, struck_site
 from hexdem.model.initial_state import read_initial_state
 from hexdem.model.lattice import (Lattice, disc, half_disc, half_hexagon, hexagon, parallelogram, triangle,
                                    without_hole, without_sites)
-from hexdem.model.lines import with_lines
+from hexdem.model.lines import LineTable, with_lines
 from hexdem.model.sites import read_sites
-from hexdem.model.materials import (PAPER_DIAMETER_M, Material, custom_materials, hertz_coefficient, hertz_stiffness,
-                                     material)
+from hexdem.model.materials import (PAPER_DIAMETER_M, Material, MaterialTable, custom_materials, hertz_coefficient,
+                                     hertz_stiffness, material)
 from hexdem.model.precompression import hole_force, precompressed_lattice
-from hexdem.model.regions import assign_materials
-from hexdem.model.timescale import impact_contact_time_s
+from hexdem.model.regions import RegionTable, assign_materials
+from hexdem.model.timescale import fastest_approach_m_s, impact_contact_time_s
 from hexdem.model.units import SI, UnitSystem, nondimensional
 
 SHAPES = ("hexagon", "half-hexagon", "half-disc", "triangle", "parallelogram", "disc", "sites")
@@ -117,19 +118,19 @@ class RunConfig:
     short_edge: int = 46
     radius_beads: int = 100
     depth_beads: int | None = None
-    sites: tuple = ()
+    sites: tuple[tuple[int, int], ...] = ()
     sites_file: str | None = None
-    site_walls_deg: tuple = ()
-    vacancies: tuple = ()
+    site_walls_deg: tuple[float, ...] = ()
+    vacancies: tuple[tuple[int, int], ...] = ()
     diameter_m: float = PAPER_DIAMETER_M
     bead_material: str = "steel316"
     wall_material: str = "delrin"
-    materials: dict = dataclasses.field(default_factory=dict)
-    regions: tuple = ()
+    materials: dict[str, MaterialTable] = dataclasses.field(default_factory=dict)
+    regions: tuple[RegionTable, ...] = ()
     striker_material: str | None = None
     striker_diameter_m: float | None = None
-    impacts: tuple = ()
-    lines: tuple = ()
+    impacts: tuple[ImpactTable, ...] = ()
+    lines: tuple[LineTable, ...] = ()
     movie: bool = False
     units: str = "si"
     v0: float = 0.4
@@ -149,12 +150,13 @@ class RunConfig:
     rolling_friction: float = 0.0
     precompression_n: float = 0.0
     initial_state_file: str | None = None
-    sensors: tuple = ()
+    sensors: tuple[str | int, ...] = ()
     sensor_rate_hz: float = 500e3
     sensor_mass_factor: float = 1.0
     launcher: str | None = None
 
     def __post_init__(self):
+        check_fields(self)
         for name, allowed in (("shape", SHAPES), ("impact", IMPACTS), ("units", UNITS), ("engine", ENGINES)):
             if getattr(self, name) not in allowed:
                 raise HexdemError(f"unknown {name} {getattr(self, name)!r}; use one of: {', '.join(allowed)}")
@@ -165,21 +167,16 @@ class RunConfig:
             raise HexdemError(f"steps_per_contact must be at least {MIN_STEPS_PER_CONTACT} (the Hertz contact "
                               f"needs them), got {self.steps_per_contact}")
         for name in ("sensors", "sites", "site_walls_deg", "vacancies", "regions", "impacts", "lines"):
-            if not isinstance(getattr(self, name), (list, tuple)):
-                raise HexdemError(f"{name} must be a list, got {getattr(self, name)!r}")
             object.__setattr__(self, name, tuple(tuple(v) if isinstance(v, list) else v for v in getattr(self, name)))
-        if not (is_number(self.sensor_rate_hz) and self.sensor_rate_hz > 0):
+        if not self.sensor_rate_hz > 0:
             raise HexdemError(f"sensor_rate_hz must be > 0, got {self.sensor_rate_hz!r}")
-        if not (is_number(self.precompression_n) and self.precompression_n >= 0):
+        if not self.precompression_n >= 0:
             raise HexdemError(f"precompression_n must be a force >= 0 N, got {self.precompression_n!r}")
-        if self.launcher is not None and not (isinstance(self.launcher, str) and self.launcher.split()):
+        if self.launcher is not None and not self.launcher.split():
             raise HexdemError(f"launcher must be a command such as \"mpiexec -f hosts\", got {self.launcher!r}")
-        for name in ("dump", "movie"):
-            if not isinstance(getattr(self, name), bool):
-                raise HexdemError(f"{name} must be true or false, got {getattr(self, name)!r}")
         for name in ("dt", "duration"):
             value = getattr(self, name)
-            if value is not None and not (is_number(value) and value > 0):
+            if value is not None and not value > 0:
                 raise HexdemError(f"{name} must be a positive number of {self.units} time units, got {value!r}")
         self._check_size()
         self._check_sampling(self.settings(self.model()))
@@ -202,7 +199,7 @@ class RunConfig:
         # the packings counted without building them (n_beads) need sizes the count holds for;
         # the others are built, and their builders word any error
         counted = {"hexagon": (self.edge_beads,), "half-hexagon": (self.short_edge, self.long_edge)}
-        if not all(isinstance(n, int) and not isinstance(n, bool) and n >= 2 for n in counted.get(self.shape, ())):
+        if not all(n >= 2 for n in counted.get(self.shape, ())):
             return  # the lattice builder words the error
         needed = self.memory_estimate_bytes() * (self.ranks if self.engine == "lammps" else 1)
         available = available_memory_bytes()
@@ -213,7 +210,7 @@ class RunConfig:
 
     def _check_sampling(self, settings: RunSettings) -> None:
         """Refuse a time step that does not resolve the Hertz contact, or too few samples."""
-        contact_s = self.contact_time_s()
+        contact_s = settings.contact_time_s
         scale = self.unit_system.time_s
         if settings.dt_s > contact_s / MIN_STEPS_PER_CONTACT:
             raise HexdemError(f"time step {settings.dt_s / scale:.3g} is not small against the Hertz contact time "
@@ -282,7 +279,7 @@ class RunConfig:
 
     def model(self) -> GranularModel:
         """The SI :class:`GranularModel` this configuration describes."""
-        if not (is_number(self.v0) and self.v0 > 0):
+        if not self.v0 > 0:
             raise HexdemError(f"v0 must be > 0 (the impact moves into the packing), got {self.v0!r}")
         wall = None if self.wall_material == "none" else self.material(self.wall_material)
         wall_restitution = self.restitution if self.wall_restitution is None else self.wall_restitution
@@ -348,14 +345,18 @@ class RunConfig:
             raise HexdemError(f"sensors {list(self.sensors)} name the same bead twice")
         return beads
 
-    def contact_time_s(self) -> float:
+    def contact_time_s(self, model: GranularModel | None = None) -> float:
         """The natural time scale of the impacts [s] (:func:`~hexdem.model.timescale.impact_contact_time_s`):
-        the shortest two-body Hertz contact time at an impact's V0, or, if shorter, half the
-        period of two beads on the linearized precompressed contact."""
+        the shortest two-body Hertz contact time at an impact's V0 or at the initial state's fastest
+        approach (read on ``model``, built if not given), or, if shorter, half the period of two
+        beads on the linearized precompressed contact."""
         strikers = [(spec.v0 * self.unit_system.velocity_m_s,
                      (self.material(spec.striker_material or self.bead_material), spec.striker_diameter_m or self.diameter_m)
                      if spec.striker and (spec.striker_material is not None or spec.striker_diameter_m is not None)
                      else None) for spec in self.impact_specs()]
+        if self.initial_state_file is not None:
+            fastest = fastest_approach_m_s(model or self.model())
+            strikers += [(fastest, striker) for _, striker in strikers]
         return impact_contact_time_s(self.material(self.bead_material), self.diameter_m,
                                      [self.material(r["material"]) for r in self.regions], strikers,
                                      self.precompression_n)
@@ -371,13 +372,12 @@ class RunConfig:
             for bead, impact in zip(model.struck_beads, model.impacts):
                 coefficient = float(model.wall_stiffness_pa([bead])[0]) * math.sqrt(radii[bead])
                 walls.append(float(contact_time(masses[bead], coefficient, impact.speed_m_s)))
-        return self.contact_time_s() + max(walls)
+        return self.contact_time_s(model) + max(walls)
 
-    def _step_and_sampling(self) -> tuple[float, int]:
-        """(dt [s], steps between samples): ``dt`` or the contact time over ``steps_per_contact``,
+    def _step_and_sampling(self, contact_s: float) -> tuple[float, int]:
+        """(dt [s], steps between samples): ``dt`` or the contact time ``contact_s`` over ``steps_per_contact``,
         and ``dump_every`` or the steps of one default sampling interval (1/20 of the contact
         time), the default step shortened so that this interval is a whole number of steps."""
-        contact_s = self.contact_time_s()
         interval_s = contact_s / SAMPLES_PER_CONTACT
         if self.dt is not None:
             dt_s = self.dt * self.unit_system.time_s
@@ -393,7 +393,8 @@ class RunConfig:
         whole number of analysis samples of ``dump_every`` steps."""
         model = model or self.model()
         scale = self.unit_system.time_s
-        dt_s, every = self._step_and_sampling()
+        contact_s = self.contact_time_s(model)
+        dt_s, every = self._step_and_sampling(contact_s)
         if self.duration is not None:
             duration_s = self.duration * scale
         else:
@@ -401,7 +402,7 @@ class RunConfig:
             reach = max(float(((lattice.positions_m - lattice.positions_m[bead]) @ impact.direction).max())
                         for bead, impact in zip(model.struck_beads, model.impacts))
             layers = math.ceil(reach / (math.sqrt(3) / 2 * lattice.diameter_m))
-            duration_s = layers * self.contact_time_s() if layers else self._rebound_time_s(model)
+            duration_s = layers * contact_s if layers else self._rebound_time_s(model)
         sensor_every = 0
         if self.sensors:
             samples = math.ceil(1.0 / self.sensor_rate_hz / (dt_s * every) - 1e-9)
@@ -409,4 +410,4 @@ class RunConfig:
             dt_s = 1.0 / self.sensor_rate_hz / sensor_every
         n_steps = max(1, round(duration_s / dt_s))
         return RunSettings(dt_s=dt_s, n_steps=n_steps, dump_every=every, units=self.unit_system,
-                           sensor_every=sensor_every, contact_time_s=self.contact_time_s())
+                           sensor_every=sensor_every, contact_time_s=contact_s)

@@ -22,16 +22,28 @@ nothing strikes sits in none, {0, 0} included. An edge must be flat (two beads a
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TypedDict
 
-import numpy as np
-
-from hexdem.common.checks import is_number
 from hexdem.errors import HexdemError
 from hexdem.model.granular import Impact
 from hexdem.model.lattice import HOLE_COSINE, Lattice, facing_edge, unit_vector, with_holes
 
+
+
+class ImpactTable(TypedDict, total=False):
+    """An impact's keys and their types (checked by :class:`~hexdem.model.config.RunConfig`)."""
+
+    site: tuple[int, int]
+    edge_deg: float
+    v0: float
+    angle_deg: float
+    kind: str
+    striker_material: str
+    striker_diameter_m: float
+
+
 #: The keys of one impact's table.
-IMPACT_KEYS = ("site", "edge_deg", "v0", "angle_deg", "kind", "striker_material", "striker_diameter_m")
+IMPACT_KEYS = tuple(ImpactTable.__annotations__)
 KINDS = ("velocity", "striker")
 
 
@@ -61,22 +73,13 @@ def impact_specs(entries, v0, angle_deg, kind, striker_material, striker_diamete
         return [ImpactSpec((0, 0), None, v0, angle_deg, kind, striker_material, striker_diameter_m)]
     specs = []
     for k, entry in enumerate(entries):
-        if not isinstance(entry, dict):
-            raise HexdemError(f"impact {k} must be a table such as {{site = [0, 0], v0 = 0.4}}")
         unknown = sorted(set(entry) - set(IMPACT_KEYS))
         if unknown:
             raise HexdemError(f"impact {k}: unknown key(s) {', '.join(unknown)}; known: {', '.join(IMPACT_KEYS)}")
         if ("site" in entry) == ("edge_deg" in entry):
             raise HexdemError(f"impact {k}: give exactly one of site = [m, n] (one bead) and edge_deg (a whole edge)")
         site = entry.get("site")
-        if site is not None:
-            if not (isinstance(site, (list, tuple)) and len(site) == 2
-                    and all(isinstance(v, int) and not isinstance(v, bool) for v in site)):
-                raise HexdemError(f"impact {k}: site must be a pair of integers [m, n], got {site!r}")
-            site = (int(site[0]), int(site[1]))
-        for key in ("edge_deg", "v0", "angle_deg"):
-            if key in entry and not (is_number(entry[key]) and np.isfinite(entry[key])):
-                raise HexdemError(f"impact {k}: {key} must be a number, got {entry[key]!r}")
+        site = None if site is None else (int(site[0]), int(site[1]))
         if "v0" in entry and not entry["v0"] > 0:
             raise HexdemError(f"impact {k}: v0 must be > 0, got {entry['v0']!r}")
         chosen_kind = entry.get("kind", kind)

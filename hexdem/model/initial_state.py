@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.common.io import write_csv
+from hexdem.common.io import read_text, write_csv
 from hexdem.errors import HexdemError
 from hexdem.model.lattice import Lattice
 
@@ -41,12 +41,7 @@ def read_initial_state(path, lattice: Lattice) -> InitialState:
     """The state in the CSV at ``path`` for the beads of ``lattice`` (see the module docstring)."""
     path = Path(path)
     name = f"initial_state_file {path}"
-    try:
-        lines = [line for line in path.read_text().splitlines() if line.strip()]
-    except OSError as exc:
-        raise HexdemError(f"cannot read {name}: {exc.strerror}") from None
-    except UnicodeDecodeError:
-        raise HexdemError(f"{name} is not a text file") from None
+    lines = [line for line in read_text(path, "initial_state_file").splitlines() if line.strip()]
     rows = list(csv.reader(lines))
     header = tuple(cell.strip() for cell in rows[0]) if rows else ()
     if header not in HEADERS:

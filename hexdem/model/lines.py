@@ -9,29 +9,36 @@ the beads from site {m, n} on, one lattice step at a time along ``angle_deg`` (a
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import TypedDict
 
-from hexdem.common.checks import is_number
 from hexdem.errors import HexdemError
 from hexdem.model.lattice import DIRECTION_STEPS, LINE_STEPS, Lattice
 
-LINE_KEYS = ("name", "site", "angle_deg")
+
+class LineTable(TypedDict, total=False):
+    """A line's keys and their types (checked by :class:`~hexdem.model.config.RunConfig`)."""
+
+    name: str
+    site: tuple[int, int]
+    angle_deg: float
+
+
+LINE_KEYS = tuple(LineTable.__annotations__)
 
 
 def with_lines(lattice: Lattice, entries) -> Lattice:
     """``lattice`` with the observation lines of ``entries`` (tables of :data:`LINE_KEYS`)."""
     lines, names = [], set(LINE_STEPS)
     for k, entry in enumerate(entries):
-        if not isinstance(entry, dict) or sorted(entry) != sorted(LINE_KEYS):
+        if sorted(entry) != sorted(LINE_KEYS):
             raise HexdemError(f"line {k} must be a table {{name = \"up\", site = [m, n], angle_deg = 90}} with "
                               f"exactly the keys {', '.join(LINE_KEYS)}")
         name, site, angle = entry["name"], entry["site"], entry["angle_deg"]
-        if not (isinstance(name, str) and name) or name in names:
+        if not name or name in names:
             raise HexdemError(f"line {k}: name {name!r} must be a new, non-empty string (taken: {', '.join(sorted(names))})")
-        if not (isinstance(site, (list, tuple)) and len(site) == 2
-                and all(isinstance(v, int) and not isinstance(v, bool) for v in site)
-                and lattice.index_of(*site) is not None):
+        if lattice.index_of(*site) is None:
             raise HexdemError(f"line {name}: site {site!r} is not a bead [m, n] of the packing")
-        if not (is_number(angle) and angle in DIRECTION_STEPS):
+        if angle not in DIRECTION_STEPS:
             raise HexdemError(f"line {name}: angle_deg {angle!r} is not a lattice direction; use one of "
                               f"{', '.join(str(a) for a in DIRECTION_STEPS)}")
         names.add(name)

@@ -11,14 +11,27 @@ delrin-lined walls as "spheres with an infinite radius").
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TypedDict
 
 import numpy as np
 
 from hexdem.errors import HexdemError
 
 
+
+
+class MaterialTable(TypedDict, total=False):
+    """A configuration's own material: its keys and their types (checked by
+    :class:`~hexdem.model.config.RunConfig`)."""
+
+    youngs_modulus_pa: float
+    poisson_ratio: float
+    density_kg_m3: float
+    source: str
+
+
 #: The numbers a material is made of; a configuration's own material gives them (and may add a ``source``).
-MATERIAL_KEYS = ("youngs_modulus_pa", "poisson_ratio", "density_kg_m3")
+MATERIAL_KEYS = tuple(key for key in MaterialTable.__annotations__ if key != "source")
 
 
 @dataclass(frozen=True)
@@ -96,14 +109,10 @@ def material(name: str, custom: dict | None = None) -> Material:
 def custom_materials(table) -> dict[str, Material]:
     """{name: Material} of a configuration's ``materials`` table, {name: {youngs_modulus_pa,
     poisson_ratio, density_kg_m3[, source]}}; a preset's name cannot be redefined."""
-    if not isinstance(table, dict):
-        raise HexdemError(f"materials must be a table of named materials, got {table!r}")
     materials = {}
     for name, values in table.items():
         if name in MATERIALS or name == "none":
             raise HexdemError(f"material {name!r} is built in; give your own material another name")
-        if not isinstance(values, dict):
-            raise HexdemError(f"material {name!r} must be a table of {', '.join(MATERIAL_KEYS)}")
         missing = sorted(set(MATERIAL_KEYS) - set(values))
         unknown = sorted(set(values) - {*MATERIAL_KEYS, "source"})
         if missing or unknown:

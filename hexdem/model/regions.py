@@ -10,6 +10,7 @@ strip two, intruders a list of sites (Leonard et al., PRE 86, 031305; Tichler et
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import TypedDict
 
 import numpy as np
 
@@ -17,9 +18,22 @@ from hexdem.errors import HexdemError
 from hexdem.model.lattice import Lattice
 from hexdem.model.materials import Material
 
+
+
+class RegionTable(TypedDict, total=False):
+    """A region's keys and their types (checked by :class:`~hexdem.model.config.RunConfig`)."""
+
+    material: str
+    sites: tuple[tuple[int, int], ...]
+    x_min_d: float
+    x_max_d: float
+    y_min_d: float
+    y_max_d: float
+
+
 #: A region's bounds: key → (coordinate, whether it is a lower bound).
 BOUNDS = {"x_min_d": (0, True), "x_max_d": (0, False), "y_min_d": (1, True), "y_max_d": (1, False)}
-KEYS = {"material", "sites", *BOUNDS}
+KEYS = set(RegionTable.__annotations__)
 
 
 def _selected(lattice: Lattice, region: dict, k: int) -> np.ndarray:
@@ -33,8 +47,6 @@ def _selected(lattice: Lattice, region: dict, k: int) -> np.ndarray:
     chosen = np.ones(len(lattice), dtype=bool)
     if "sites" in region:
         sites = region["sites"]
-        if not isinstance(sites, (list, tuple)) or not all(isinstance(s, (list, tuple)) and len(s) == 2 for s in sites):
-            raise HexdemError(f"region {k}: sites must be pairs [m, n]")
         missing = [tuple(s) for s in sites if lattice.index_of(*s) is None]
         if missing:
             raise HexdemError(f"region {k}: site {{{missing[0][0]}, {missing[0][1]}}} is not in the packing")
@@ -45,8 +57,6 @@ def _selected(lattice: Lattice, region: dict, k: int) -> np.ndarray:
     for key, (axis, lower) in BOUNDS.items():
         if key in region:
             value = region[key]
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise HexdemError(f"region {k}: {key} must be a number of bead diameters, got {value!r}")
             chosen &= relative[:, axis] >= value - 1e-9 if lower else relative[:, axis] <= value + 1e-9
     if not chosen.any():
         raise HexdemError(f"region {k} ({region['material']}) selects no bead of the packing")
@@ -59,8 +69,6 @@ def assign_materials(lattice: Lattice, regions, bead: Material, lookup) -> tuple
     extra: list[Material] = []
     ids = lattice.material_ids.copy()
     for k, region in enumerate(regions):
-        if not isinstance(region, dict):
-            raise HexdemError(f"region {k} must be a table such as {{material = \"brass\", x_min_d = 10.0}}")
         chosen = _selected(lattice, region, k)
         material = lookup(region["material"])
         if material != bead and material not in extra:

@@ -11,15 +11,13 @@ import csv
 import tomllib
 from pathlib import Path
 
+from hexdem.common.io import read_text
 from hexdem.errors import HexdemError
 from hexdem.model.lattice import Lattice, from_sites
 
 
 def _sites_from_file(path: Path) -> list:
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise HexdemError(f"cannot read sites_file {path}: {exc.strerror}") from None
+    text = read_text(path, "sites_file")
     if path.suffix == ".toml":
         try:
             sites = tomllib.loads(text).get("sites")

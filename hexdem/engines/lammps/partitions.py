@@ -23,6 +23,7 @@ import functools
 import os
 import re
 import shlex
+import shutil
 import signal
 import subprocess
 import sys
@@ -102,6 +103,18 @@ def _failure(directories, run_dir: Path, output: str) -> HexdemError:
     return HexdemError(f"LAMMPS partitions failed in {run_dir}: {error_line(output)}")
 
 
+def launcher_command(launcher: str | None) -> list[str]:
+    """The words of the MPI launcher command ``launcher`` (None: this environment's ``mpiexec``),
+    refused in one line if its program is not an executable that can be found."""
+    try:
+        prefix = shlex.split(launcher) if launcher else [environment_command("mpiexec")]
+    except ValueError as exc:
+        raise HexdemError(f"launcher {launcher!r} is not a command: {exc}") from None
+    if shutil.which(prefix[0]) is None:
+        raise HexdemError(f"cannot start the MPI launcher {prefix[0]!r}: no such executable")
+    return prefix
+
+
 def run_partitioned(directories, workers: int, run_dir, description: str = "LAMMPS", launcher: str | None = None,
                     on_done=None, pass_fds=()) -> dict[Path, RunInfo]:
     """Run the decks in ``directories`` (each holding ``in.hexdem``) on ``workers`` partitions.
@@ -115,12 +128,12 @@ def run_partitioned(directories, workers: int, run_dir, description: str = "LAMM
     workers = positive_int("--workers", workers)
     if not directories:
         return {}
+    prefix = launcher_command(launcher)
     run_dir = Path(run_dir)
     for directory in directories:
         (directory / DONE_MARKER).unlink(missing_ok=True)
     partitions = min(workers, len(directories))
     driver = write_driver(directories, run_dir, partitions)
-    prefix = shlex.split(launcher) if launcher else [environment_command("mpiexec")]
     command = [*prefix, "-n", str(partitions), environment_command("lmp"), "-partition", f"{partitions}x1",
                "-in", driver.name, "-screen", "none", "-nocite"]
     output = run_dir / "launcher.out"
