@@ -32,6 +32,7 @@ from hexdem.model.materials import (PAPER_DIAMETER_M, Material, MaterialTable, c
                                      hertz_stiffness, material)
 from hexdem.model.precompression import hole_force, precompressed_lattice
 from hexdem.model.regions import RegionTable, assign_materials
+from hexdem.model.sensors import sensor_beads
 from hexdem.model.timescale import fastest_approach_m_s, impact_contact_time_s
 from hexdem.model.units import SI, UnitSystem, nondimensional
 
@@ -324,26 +325,8 @@ class RunConfig:
         return resolve_impacts(self.impact_specs(), lattice, self.unit_system.velocity_m_s, self.material)
 
     def sensor_beads(self, lattice: Lattice) -> dict[str, int]:
-        """{label: bead index} of the ``sensors``, in the order given ("line:n", the line one of the
-        paper's three or of the extra ``lines``, or a bead id)."""
-        beads, lines = {}, lattice.lines()
-        for sensor in self.sensors:
-            if isinstance(sensor, int) and not isinstance(sensor, bool):
-                if not 1 <= sensor <= len(lattice):
-                    raise HexdemError(f"sensor bead id {sensor} is not in the packing (ids 1 to {len(lattice)})")
-                beads[str(sensor)] = sensor - 1
-                continue
-            name, _, n = str(sensor).partition(":")
-            if name not in lines or not n.isdigit():
-                raise HexdemError(f"sensor {sensor!r} is neither a bead id nor 'line:n' with line one of "
-                                  f"{', '.join(lines)}")
-            line = lines[name]
-            if int(n) >= len(line):
-                raise HexdemError(f"sensor {sensor!r}: line {name} has beads 0 to {len(line) - 1}")
-            beads[str(sensor)] = int(line[int(n)])
-        if len(set(beads.values())) != len(self.sensors):
-            raise HexdemError(f"sensors {list(self.sensors)} name the same bead twice")
-        return beads
+        """{label: bead index} of the ``sensors`` on ``lattice`` (:func:`~hexdem.model.sensors.sensor_beads`)."""
+        return sensor_beads(self.sensors, lattice)
 
     def contact_time_s(self, model: GranularModel | None = None) -> float:
         """The natural time scale of the impacts [s] (:func:`~hexdem.model.timescale.impact_contact_time_s`):
