@@ -51,7 +51,7 @@ def test_the_tracker_reports_the_spin_and_rotational_share_of_gross_sliding(tmp_
 
 
 def test_frictionless_spheres_report_no_spin_and_frictional_ones_do(tmp_path):
-    """beads.csv's last column and summary.json's share: 0 without friction; with μ = 0.3 the
+    """beads.csv's peak_angular_speed and summary.json's share: 0 without friction; with μ = 0.3 the
     struck bead turns and rotation holds a share of the energy (the default experiment, 4 per edge);
     a movie of the spin comes with the movie of the speeds where the spheres turn."""
     for friction in (0.0, 0.3):

@@ -145,7 +145,7 @@ def test_listed_sites_are_the_packing_and_their_walls_touch_it():
 @pytest.mark.parametrize("sites, message", [([(0, 0), (2, 0), (0, 0)], "listed twice"),
                                             ([(0, 0), (1, 0)], "m [+] n odd"),
                                             ([(2, 0), (4, 0)], "struck site"),
-                                            ([(0, 0)], "at least 2 beads")])
+                                            ([], "at least 1 bead")])
 def test_bad_site_lists_are_refused(sites, message):
     with pytest.raises(HexdemError, match=message):
         from_sites(sites, D)
