@@ -137,7 +137,7 @@ def test_analyse_refuses_a_damaged_deck_in_one_line(small_deck, tmp_path, capsys
     assert main(["analyse", str(deck), "--out", str(tmp_path / "analysed")]) == 2
     lines = [line for line in capsys.readouterr().err.strip().splitlines() if not line.startswith("hexdem analyse: ")]
     assert len(lines) == 1 and message in lines[0], lines
-    assert not (tmp_path / "analysed" / "summary.json").exists()
+    assert_no_results(tmp_path / "analysed")
 
 
 def test_unwritable_output_directory(tmp_path, capsys):

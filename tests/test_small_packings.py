@@ -97,3 +97,18 @@ def test_a_bead_that_never_moved_has_peak_speed_zero(tmp_path):
     r = simulate(config, tmp_path / "deck").results
     assert r.peak_speed[1] == 0.0 and np.isnan(r.arrival_time[1]) and np.isnan(r.t_peak[1])
     assert r.peak_speed[0] == pytest.approx(V0, rel=1e-12)
+
+
+def test_a_rerun_replaces_the_results_and_keeps_the_users_files(tmp_path):
+    """Results move into --out only once complete: a second run replaces the first's files and
+    deck, leaves the user's own files, and no staging folder stays behind."""
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    for v0 in (0.4, 0.2):
+        (tmp_path / "run.toml").write_text(f'shape = "sites"\nsites = [[0, 0]]\nsite_walls_deg = [180]\nv0 = {v0}\n')
+        assert main(["run", "--config", str(tmp_path / "run.toml"), "--out", str(out)]) == 0
+    assert float(read_csv(out / "beads.csv")[1][0]["vx_end"]) == pytest.approx(-0.2, rel=1e-6)
+    assert json.loads((out / "deck" / "hexdem.json").read_text())["v0"] == 0.2
+    assert (out / "notes.txt").read_text() == "mine"
+    assert not [entry.name for entry in out.iterdir() if entry.name.startswith(".")]

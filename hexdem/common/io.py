@@ -7,6 +7,7 @@ import fcntl
 import json
 import math
 import os
+import shutil
 import tempfile
 import tomllib
 from contextlib import contextmanager
@@ -97,6 +98,31 @@ def write_csv(path, header, rows) -> None:
         writer = csv.writer(fh)
         writer.writerow(header)
         writer.writerows(rows)
+
+
+@contextmanager
+def staged_directory(out, prefix: str = ".hexdem-staging-"):
+    """Yield a fresh hidden folder inside ``out`` (created if needed) to write results into. When
+    the block succeeds, its entries move into ``out``, each replacing an older one of its name; when
+    it fails, the folder is removed, and so is ``out`` if this created it and it is empty: a failed
+    run leaves nothing in ``out``."""
+    out = Path(out)
+    created = not out.exists()
+    out = ensure_writable_dir(out)
+    staging = Path(tempfile.mkdtemp(dir=out, prefix=prefix))
+    try:
+        yield staging
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        if created and not any(out.iterdir()):
+            out.rmdir()
+        raise
+    for entry in sorted(staging.iterdir()):
+        target = out / entry.name
+        if target.is_dir() and not target.is_symlink():
+            shutil.rmtree(target)
+        entry.replace(target)
+    staging.rmdir()
 
 
 def ensure_writable_dir(directory) -> Path:

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from hexdem.analysis.dump import read_trajectory
 from hexdem.analysis.impact import ImpactAnalysis
-from hexdem.common.io import ensure_writable_dir
+from hexdem.common.io import staged_directory
 from hexdem.engines.lammps.deck import DUMP_NAME
 from hexdem.engines.lammps.runner import log_version
 from hexdem.errors import HexdemError
@@ -38,7 +38,6 @@ def analyse_deck(deck_dir, out=None, log=None) -> ImpactAnalysis:
     if not dump.exists():
         raise HexdemError(f"{deck_dir} has no {DUMP_NAME}: run the deck by hand first "
                           f"(cd {deck_dir} && lmp -in in.hexdem), or use hexdem run --dump")
-    out = ensure_writable_dir(out if out is not None else deck_dir.parent)
     model = config.model()
     settings = config.settings(model)
     log(f"reading {dump} ({settings.n_samples} frames of {model.n_bodies} atoms) through MDAnalysis")
@@ -50,6 +49,8 @@ def analyse_deck(deck_dir, out=None, log=None) -> ImpactAnalysis:
         raise HexdemError(f"{dump} holds {atoms} atoms, the packing of {deck_dir / CONFIG_NAME} {model.n_bodies}: "
                           "the dump is another packing's")
     analysis = ImpactAnalysis.from_trajectory(model, settings, trajectory)
-    write_results(config, analysis, out, time.perf_counter() - start)
+    out = Path(out if out is not None else deck_dir.parent)
+    with staged_directory(out) as staging:
+        write_results(config, analysis, staging, time.perf_counter() - start, log)
     log(f"energy drift {analysis.results.energy_drift:.2e}; results in {out}")
     return analysis

@@ -29,7 +29,7 @@ import numpy as np
 from hexdem.analysis.front_shape import FRONT_SHAPE_COLUMNS, FrontShape, front_shape, front_times, front_unmeasurable
 from hexdem.analysis.impact import PEAK_COLUMNS, ImpactAnalysis
 from hexdem.analysis.movie import movie_samples
-from hexdem.common.io import ensure_writable_dir, write_csv, write_json
+from hexdem.common.io import staged_directory, write_csv, write_json
 from hexdem.common.machine import free_disk_bytes
 from hexdem.errors import HexdemError
 from hexdem.experiments.deck_config import write_deck_config
@@ -251,24 +251,17 @@ def run_experiment(config: RunConfig, out, log=None, comm=None) -> ImpactAnalysi
     """Run ``config`` and publish its result files in ``out`` (see module docstring); ``comm`` as
     for :func:`simulate`."""
     log = log or (lambda message: print(f"hexdem: {message}", file=sys.stderr))
-    out = Path(out)
-    created = not out.exists()
-    out = ensure_writable_dir(out)
-    staging = Path(tempfile.mkdtemp(dir=out, prefix=STAGING_PREFIX))
-    try:
-        check_dump_space(config, out)
-        start = time.perf_counter()
-        analysis = simulate(config, staging / "deck", log, comm=comm)
-        write_results(config, analysis, staging, time.perf_counter() - start, log)
-    except BaseException as exc:
-        kept = _keep_failed_deck(staging / "deck") if isinstance(exc, HexdemError) else None
-        shutil.rmtree(staging, ignore_errors=True)
-        if created and not any(out.iterdir()):
-            out.rmdir()
-        if kept is None:
-            raise
-        raise HexdemError(str(exc).replace(str(staging / "deck"), str(kept))) from None
-    _publish(staging, out)
+    with staged_directory(out, STAGING_PREFIX) as staging:
+        try:
+            check_dump_space(config, Path(out))
+            start = time.perf_counter()
+            analysis = simulate(config, staging / "deck", log, comm=comm)
+            write_results(config, analysis, staging, time.perf_counter() - start, log)
+        except HexdemError as exc:
+            kept = _keep_failed_deck(staging / "deck")
+            if kept is None:
+                raise
+            raise HexdemError(str(exc).replace(str(staging / "deck"), str(kept))) from None
     log(f"energy drift {analysis.results.energy_drift:.2e}; results in {out}")
     if not analysis.results.far_wall_reached:
         log("warning: the leading wave had not reached every bead at the far wall one contact time before the run "
@@ -284,14 +277,3 @@ def _keep_failed_deck(deck: Path) -> Path | None:
     kept = Path(tempfile.mkdtemp(prefix="hexdem-failed-")) / "deck"
     shutil.move(str(deck), kept)
     return kept
-
-
-def _publish(staging: Path, out: Path) -> None:
-    """Move every entry of ``staging`` into ``out`` (replacing older ones of the same name), then
-    remove ``staging``: each entry appears whole, and only once the run and all its results are done."""
-    for entry in sorted(staging.iterdir()):
-        target = out / entry.name
-        if target.is_dir() and not target.is_symlink():
-            shutil.rmtree(target)
-        entry.replace(target)
-    staging.rmdir()
