@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from hexdem.analysis.packet import energy_centroid, energy_spread, ring_radius
-from hexdem.analysis.spectrum import peak_frequency, power_spectrum
+from hexdem.analysis.spectrum import band_peaks, branch_signals, peak_frequency, power_spectrum
 from hexdem.analysis.wave_recorder import WaveRecorder
 from hexdem.engines.sampling import Sample
 from hexdem.errors import HexdemError
@@ -16,9 +16,9 @@ from hexdem.experiments.wave_run import record_waves
 from hexdem.model.config import RunConfig
 from hexdem.model.initial_state import read_initial_state, write_initial_state
 from hexdem.theory.conical import CIRCULAR, cone_ring_radius, dirac_matrix
-from hexdem.theory.phonons import Lattice2D, cone_slope
+from hexdem.theory.phonons import Lattice2D, cone_slope, sound_speeds
 from hexdem.waves.conical import ConicalSettings, measure_conical
-from hexdem.waves.dispersion import DispersionSettings, measure_dispersion
+from hexdem.waves.dispersion import DispersionSettings, band_spread, measure_dispersion, packing_width, taper
 from hexdem.waves.states import bloch_packet, broadband_state
 
 STEEL_20N = Lattice2D.precompressed(20.0, 0.01905)
@@ -40,6 +40,42 @@ def test_a_complex_signal_is_folded_onto_positive_frequencies():
     times = np.arange(1000) * 1e-5
     omega, power = power_spectrum(times, np.exp(-1j * 20000.0 * times))
     assert peak_frequency(omega, power) == pytest.approx(20000.0, rel=1e-3)
+
+
+def test_each_band_takes_the_peak_its_polarization_matches():
+    """A weak lower-band line at ω1 along e_lower and a twice stronger upper-band line at ω2
+    whose polarization is 35° off e_upper: projected on e_lower, the upper line keeps
+    4 sin²35° = 1.3 times the lower line's power, so the projection's largest peak is ω2. Each
+    bin goes to the band holding the larger share of it (cos²35° = 0.67 at ω2 for the upper
+    one), so the lower band is measured at ω1 and the upper one at ω2."""
+    times = np.arange(2000) * 1e-5
+    omega1, omega2, tilt = 12345.0, 23456.0, math.radians(35.0)
+    lower, upper = np.array([1.0, 0.0]), np.array([0.0, 1.0])
+    line = np.array([math.sin(tilt), math.cos(tilt)])
+    components = (np.exp(-1j * omega1 * times)[:, None] * lower + 2 * np.exp(-1j * omega2 * times)[:, None] * line)
+    polarization = np.column_stack([lower, upper])[None]
+    omega, power = power_spectrum(times, branch_signals(components[:, None, :], polarization))
+    assert peak_frequency(omega, power)[0, 0] == pytest.approx(omega2, rel=1e-3)  # by projection alone
+    np.testing.assert_allclose(band_peaks(omega, power)[0], [omega1, omega2], rtol=1e-3)
+
+
+def test_the_resolution_of_a_packing_by_hand():
+    """A 20-per-edge hexagon is √3 · 19 a wide across its flats. The window is 1 at the centre,
+    falls with the distance from it and is 0 from the inscribed circle's rim on. Near Γ the
+    bands are ω = c q, so over a disc of radius r about q the spread is c r for each band."""
+    config = DispersionSettings(edge_beads=20).config()
+    positions = config.model().lattice.positions_m[:config.n_beads()]
+    a = Lattice2D.of(config).spacing_m
+    width = packing_width(positions)
+    assert width == pytest.approx(math.sqrt(3) * 19 * a, rel=1e-9)
+    radius = np.linalg.norm(positions - positions.mean(axis=0), axis=1)
+    weights = taper(positions)
+    assert weights[np.argmin(radius)] == pytest.approx(1.0, abs=1e-3)
+    np.testing.assert_allclose(weights[radius >= width / 2], 0.0, atol=1e-30)
+    assert np.all(np.diff(weights[np.argsort(radius)]) <= 1e-12)
+    spread = band_spread(STEEL_20N, [[0.01 / STEEL_20N.spacing_m, 0.0]], 0.001 / STEEL_20N.spacing_m)
+    np.testing.assert_allclose(spread[0], np.array(sound_speeds(STEEL_20N))[::-1] * 0.001 / STEEL_20N.spacing_m,
+                               rtol=1e-3)
 
 
 def test_the_recorder_keeps_the_lattice_fourier_sum_and_the_block_energies():
@@ -107,11 +143,22 @@ def test_a_bloch_packet_at_its_centre_is_all_velocity_along_the_polarization():
 @pytest.mark.parametrize("engine", ["lammps", "reference"])
 def test_the_measured_dispersion_lies_on_the_bands(engine, tmp_path):
     """20 per edge under 20 N, random velocities for 10 ms: the spectral peaks along Γ–K–M–Γ
-    are within 2 % of the bands (median; measured 0.83 % in LAMMPS, 0.85 % in the reference)."""
+    are within 2 % of the bands (median; measured 0.97 % in both engines), and every point beyond
+    the resolution limit |q| = 2 · 2π/L (|q| a = 0.38) within its own bound (the worst 12.5 % at
+    |q| a = 0.91 against 22.9 %; without the window and the polarizations, 9.3 % at |q| a = 3.49
+    against 5.4 %). The points nearest Γ on Γ–K (|q| a = 0.35) and on M–Γ (0.30) are short of
+    the limit."""
     measured = measure_dispersion(DispersionSettings(edge_beads=20, duration_s=0.01, points_per_segment=12,
                                                      engine=engine), tmp_path, show_progress=False)
     assert measured.median_deviation < 0.02
-    assert len(measured.rows()) == 2 * (3 * 12 - 1) and measured.rows()[0][3] == "lower"  # both Γ left out
+    assert measured.smallest_resolved_per_m * measured.theory.spacing_m == pytest.approx(
+        4 * math.pi / (math.sqrt(3) * 19), rel=1e-6)
+    assert measured.resolved.tolist() == [False] + [True] * 33 + [False]
+    assert measured.within_bound[measured.resolved].all()
+    rows = measured.rows()
+    assert len(rows) == 2 * (3 * 12 - 1) and rows[0][3] == "lower"  # both Γ left out
+    assert [row[8] for row in rows] == (["false"] + ["true"] * 33 + ["false"]) * 2
+    assert all(row[9] == "true" for row in rows if row[8] == "true")
 
 
 @pytest.mark.parametrize("engine", ["lammps", "reference"])

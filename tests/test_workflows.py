@@ -43,16 +43,21 @@ DIRAC_WORKFLOW = WORKFLOW.parent / "dirac_point.py"
 @pytest.mark.slow
 def test_the_dirac_point_workflow_writes_its_tables_within_the_bounds(tmp_path):
     """``--quick`` (20 per edge, σ = 8 d, the small sweep) from another directory: the contract's
-    files and columns, the dispersion within 2 % and the ring's growth within 3 % of v_D."""
+    files and columns (the dispersion's first six as before, each point's verdict after them), the
+    dispersion within 2 % (median) and every point beyond the resolution limit within its bound,
+    and the ring's growth within 3 % of v_D."""
     done = subprocess.run([sys.executable, str(DIRAC_WORKFLOW), "--out", str(tmp_path / "out"), "--quick"],
                           cwd=tmp_path, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr
     out = tmp_path / "out"
     result = json.loads((out / "dirac_point.json").read_text())
     assert result["dispersion"]["median_relative_deviation"] <= 0.02
+    assert result["dispersion"]["within_bound"] and result["dispersion"]["every_resolved_point_within_bound"]
+    assert result["dispersion"]["largest_resolved_relative_deviation"] <= result["dispersion"]["largest_resolved_bound"]
     assert result["conical"]["slope_relative_deviation"] <= 0.03
     headers = {name: next(csv.reader(open(out / name))) for name in ("dispersion.csv", "conical.csv", "transition.csv")}
-    assert headers["dispersion.csv"] == ["path_position", "kx", "ky", "branch", "omega_theory", "omega_measured"]
+    assert headers["dispersion.csv"] == ["path_position", "kx", "ky", "branch", "omega_theory", "omega_measured",
+                                         "relative_deviation", "bound", "resolved", "within_bound"]
     assert headers["conical.csv"] == ["time_s", "ring_radius_d", "theory_radius_d"]
     assert headers["transition.csv"][:2] == ["precompression_n", "v0_m_s"]
     assert (out / "conical.gif").read_bytes()[:6] == b"GIF89a"

@@ -6,8 +6,9 @@ pulse tracker, and keeps two things, both linear in the samples so that under MP
 adds what its own beads give and one sum at the end merges them:
 
 * **Plane-wave components.** At every sample and for each wave vector q of ``wave_vectors_m``,
-  the lattice Fourier sum V(q, t) = Σ_j v_j(t) exp(−i q·r_j) over the beads' packed positions
-  r_j [m] (a complex 2-vector per q, in m/s). Its spectrum in time is the measured dispersion
+  the lattice Fourier sum V(q, t) = Σ_j w_j v_j(t) exp(−i q·r_j) over the beads' packed positions
+  r_j [m] (a complex 2-vector per q, in m/s), each bead weighted by ``weights`` w_j (1 unless
+  given: a spatial window). Its spectrum in time is the measured dispersion
   (:mod:`hexdem.analysis.spectrum`).
 * **Energy blocks.** Every ``block`` samples, each bead's kinetic energy ½ m |v|² [J] averaged
   over those samples: over whole periods of a wave, half its energy, without the oscillation at
@@ -56,15 +57,19 @@ class WaveRecorder:
     """Observer of one run's samples (see the module docstring).
 
     ``wave_vectors_m`` (Q, 2) [1/m] (may be empty); ``block`` samples per energy block (0: no
-    energies); ``comm`` the mpi4py communicator of the ranks that share the run (None: one rank).
+    energies); ``comm`` the mpi4py communicator of the ranks that share the run (None: one rank);
+    ``weights`` (N,) each bead's weight in the plane-wave components (None: all 1).
     """
 
-    def __init__(self, model: GranularModel, settings: RunSettings, wave_vectors_m=(), block: int = 0, comm=None):
+    def __init__(self, model: GranularModel, settings: RunSettings, wave_vectors_m=(), block: int = 0, comm=None,
+                 weights=None):
         self.settings, self.comm = settings, comm
         self.n_beads = len(model.lattice)
         self.positions_m = model.lattice.positions_m[:self.n_beads].copy()
         vectors = np.asarray(wave_vectors_m, float).reshape(-1, 2)
         self.phases = np.exp(-1j * self.positions_m @ vectors.T)  # (N, Q)
+        if weights is not None:
+            self.phases *= np.asarray(weights, float)[:, None]
         self.components = np.zeros((settings.n_samples, len(vectors), 2), complex)
         self.block = block
         n_blocks = settings.n_samples // block if block else 0

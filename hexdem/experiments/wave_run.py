@@ -22,8 +22,9 @@ from hexdem.model.granular import GranularModel, RunSettings
 
 @dataclass(frozen=True)
 class WaveJob:
-    """What every rank of one recorded run does (picklable): ``wave_vectors_m`` (Q, 2) [1/m]
-    and ``block`` samples per energy block as :class:`WaveRecorder` takes them."""
+    """What every rank of one recorded run does (picklable): ``wave_vectors_m`` (Q, 2) [1/m],
+    ``block`` samples per energy block and the beads' ``weights`` (empty: all 1) as
+    :class:`WaveRecorder` takes them."""
 
     model: GranularModel
     settings: RunSettings
@@ -32,9 +33,11 @@ class WaveJob:
     wave_vectors_m: tuple = ()
     block: int = 0
     show_progress: bool = True
+    weights: tuple = ()
 
     def __call__(self, comm):
-        recorder = WaveRecorder(self.model, self.settings, np.asarray(self.wave_vectors_m, float), self.block, comm)
+        recorder = WaveRecorder(self.model, self.settings, np.asarray(self.wave_vectors_m, float), self.block, comm,
+                                self.weights or None)
         make_engine(self.engine).run(self.model, self.settings, self.directory, recorder, comm, self.show_progress)
         return recorder.finish()
 
@@ -46,9 +49,10 @@ def steps_per_sample(dt_s: float, period_s: float, samples_per_period: int) -> i
 
 
 def record_waves(config: RunConfig, workdir, wave_vectors_m=(), block: int = 0, log=None,
-                 show_progress: bool = True) -> RecordedWaves:
+                 show_progress: bool = True, weights=()) -> RecordedWaves:
     """Run ``config`` in ``workdir`` on its engine and ranks, recording the plane-wave components
-    at ``wave_vectors_m`` [1/m] and the energy blocks of ``block`` samples."""
+    at ``wave_vectors_m`` [1/m], each bead weighted by ``weights`` (N,) (empty: all 1), and the
+    energy blocks of ``block`` samples."""
     model = config.model()
     settings = config.settings(model)
     workdir = Path(workdir)
@@ -57,5 +61,5 @@ def record_waves(config: RunConfig, workdir, wave_vectors_m=(), block: int = 0, 
         log(f"running {config.engine}: {len(model.lattice)} beads, {settings.n_steps} steps of "
             f"{settings.dt_s:.4g} s, {settings.n_samples} samples recorded")
     job = WaveJob(model, settings, config.engine, workdir, tuple(map(tuple, np.asarray(wave_vectors_m, float).reshape(-1, 2))),
-                  block, show_progress)
+                  block, show_progress, tuple(map(float, weights)))
     return run_on_ranks(job, config.ranks if config.engine == "lammps" else 1, workdir, config.launcher)

@@ -86,15 +86,15 @@ class Lattice2D:
 
 
 def dynamical_matrix(lattice: Lattice2D, q) -> np.ndarray:
-    """D(q) [rad²/s²] (2, 2) of the module docstring."""
+    """D(q) [rad²/s²] (..., 2, 2) of the module docstring at the wave vectors ``q`` (..., 2)."""
     q = np.asarray(q, float)
-    phases = lattice.spacing_m * BOND_DIRECTIONS @ q
+    phases = lattice.spacing_m * q @ BOND_DIRECTIONS.T
     weights = 4 * np.sin(phases / 2) ** 2  # 2 (1 − cos): each direction and its opposite, exact at small q
-    return lattice.frequency_scale**2 * np.einsum("j,ja,jb->ab", weights, BOND_DIRECTIONS, BOND_DIRECTIONS)
+    return lattice.frequency_scale**2 * np.einsum("...j,ja,jb->...ab", weights, BOND_DIRECTIONS, BOND_DIRECTIONS)
 
 
 def frequencies(lattice: Lattice2D, q) -> np.ndarray:
-    """The two band frequencies ω [rad/s] at ``q``, ascending."""
+    """The two band frequencies ω [rad/s] (..., 2) at the wave vectors ``q`` (..., 2), ascending."""
     return np.sqrt(np.clip(np.linalg.eigvalsh(dynamical_matrix(lattice, q)), 0.0, None))
 
 

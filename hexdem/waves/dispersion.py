@@ -9,16 +9,36 @@ under 20 N). The struck bead's impact is a token 1 µm/s (a run needs one).
 
 **Measurement.** The run records, at every sample, the lattice Fourier sums V(q, t) at the wave
 vectors of the path Γ–K–M–Γ (:mod:`hexdem.analysis.wave_recorder`), sampled ``samples_per_period``
-times per period of the highest band. Each is projected on the theory's two polarizations at q,
-and each branch's spectrum peaks at its measured ω (:mod:`hexdem.analysis.spectrum`). Γ itself is
-left out: its ω = 0 is a rigid translation, which the walls forbid.
+times per period of the highest band, each bead weighted by a spatial window (:func:`taper`: 1
+over the inner half of the packing's inscribed circle, falling as cos² to 0 at its rim). Each
+sum is projected on the theory's two polarizations at q, every frequency bin goes to the band
+whose polarization holds the larger share of its power, and each band's peak among its own bins
+is its measured ω (:func:`~hexdem.analysis.spectrum.band_peaks`). Γ itself is left out: its
+ω = 0 is a rigid translation, which the walls forbid.
 
-**Why it agrees, and how well.** A finite packing L beads across resolves wave vectors to about
-2π/(L a), so a spectrum at q gathers the modes within that distance, spread in frequency by the
-group velocity: the deviation falls as 1/L (measured, seed 1, 20 N: median 0.83 % at 20 per edge,
-0.52 % at 30, 0.40 % at 40), largest near Γ where ω itself is small. A faint band near
-4.5 kHz, below the bulk bands between K and M, is the walls': the experiment's delrin walls are
-soft, and with steel ones its power falls 15-fold.
+**Resolution, and the bound on every point.** The packing is L wide (its smallest width, bead
+centre to bead centre: √3 (n − 1) a for n per edge), so it has no plane waves, only its own
+modes, each a mixture of the wave vectors within about δq = 2π/L of its own; and a record T
+long separates frequencies to 2π/T. The spectrum at q thus gathers the modes of the disc of
+radius δq about q, each with the random energy the initial state gave it, and its peak is the
+strongest of them: anywhere in the band's range over that disc. Each point's bound is that
+range plus 2π/T (:func:`band_spread`), relative to ω_b(q): it falls as 1/L. Below |q| = 2δq
+(fewer than two wavelengths across the packing) the disc reaches the packing's lowest modes,
+set by its walls and shape rather than by the bulk bands; those points are reported, but not
+resolved and not judged.
+
+**Why the window and the polarization.** Without them, one random state at 20 per edge put the
+worst point 94 % off: the lower band at |q| a = 0.30 measured on the upper band's line, whose
+polarization only partly follows e_upper there. Beyond 2δq it was still 12 % at |q| a = 0.91
+(upper band, inside its bound) and 9 % at |q| a = 3.49, where a single mode at 6.87 kHz outshone
+the bulk modes; in other seeds the worst point came from the walls' modes (4.75 kHz at the
+lower band's |q| a = 3.33, 16 %) or from the abrupt edge's side lobes at K, where the cone's density of
+states vanishes and few modes lie inside the disc (7.9 kHz, 7.7 %). The soft delrin walls hold
+a band of their own near 4.5 kHz, in the outer rows of beads (with steel walls its power falls
+15-fold): the window gives those rows no weight (the band's share of the power between K and M,
+4.3–4.9 kHz, falls from 1.9 % to 1.5e-5), and its smooth edge keeps the side lobes down. With
+it, six seeds at 20 per edge put every resolved point within its bound (at most 0.78 of it),
+at a median of 0.9–1.4 %, and three at 40 per edge (at most 0.95 of it, at K), at 0.6–0.7 %.
 """
 
 from __future__ import annotations
@@ -29,19 +49,22 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.analysis.spectrum import branch_signals, peak_frequency, power_spectrum
+from hexdem.analysis.spectrum import band_peaks, branch_signals, power_spectrum
 from hexdem.common.checks import positive_int, positive_number
 from hexdem.errors import HexdemError
 from hexdem.experiments.wave_run import record_waves, steps_per_sample
 from hexdem.model.config import RunConfig
 from hexdem.model.initial_state import write_initial_state
-from hexdem.theory.phonons import Lattice2D, band_path, dynamical_matrix
+from hexdem.theory.phonons import Lattice2D, band_path, dynamical_matrix, frequencies
 from hexdem.waves.states import broadband_state
 
 #: Branch names of dispersion.csv, the lower band first.
 BRANCHES = ("lower", "upper")
-#: dispersion.csv's columns.
-COLUMNS = ("path_position", "kx", "ky", "branch", "omega_theory", "omega_measured")
+#: dispersion.csv's columns: a point's verdict after its wave vector and frequencies.
+COLUMNS = ("path_position", "kx", "ky", "branch", "omega_theory", "omega_measured", "relative_deviation",
+           "bound", "resolved", "within_bound")
+#: Rings and directions that sample the disc of :func:`band_spread`.
+SPREAD_RINGS, SPREAD_DIRECTIONS = 8, 48
 
 
 @dataclass(frozen=True)
@@ -93,7 +116,9 @@ class Dispersion:
     ``path_position`` (P,) [1/m]; ``wave_vectors`` (P, 2) [1/m]; ``omega_theory`` and
     ``omega_measured`` (P, 2) [rad/s], the lower band first; ``spectrum_omega`` (W,) [rad/s] and
     ``spectrum_power`` (W, P): both polarizations' power, each column scaled to its largest value;
-    ``theory`` the linear lattice; ``settings``.
+    ``packing_width_m`` L and ``frequency_resolution_rad_s`` 2π/T (module docstring);
+    ``bound`` (P, 2) each point's bound on its relative deviation (:func:`band_spread` plus
+    2π/T, over ω_theory); ``theory`` the linear lattice; ``settings``.
     """
 
     path_position: np.ndarray
@@ -102,6 +127,9 @@ class Dispersion:
     omega_measured: np.ndarray
     spectrum_omega: np.ndarray
     spectrum_power: np.ndarray
+    packing_width_m: float
+    frequency_resolution_rad_s: float
+    bound: np.ndarray
     theory: Lattice2D
     settings: DispersionSettings = field(repr=False)
 
@@ -114,21 +142,78 @@ class Dispersion:
     def median_deviation(self) -> float:
         return float(np.median(self.relative_deviation))
 
+    @property
+    def resolution_per_m(self) -> float:
+        """δq = 2π/L [1/m], the packing's resolution in wave vector."""
+        return 2 * math.pi / self.packing_width_m
+
+    @property
+    def smallest_resolved_per_m(self) -> float:
+        """2δq [1/m]: the resolution limit, two wavelengths across the packing."""
+        return 2 * self.resolution_per_m
+
+    @property
+    def resolved(self) -> np.ndarray:
+        """(P,) whether the wave vector lies beyond the resolution limit."""
+        return np.linalg.norm(self.wave_vectors, axis=1) >= self.smallest_resolved_per_m
+
+    @property
+    def within_bound(self) -> np.ndarray:
+        """(P, 2) whether each point's relative deviation is at most its bound."""
+        return self.relative_deviation <= self.bound
+
     def largest_deviation_distance_from_gamma(self) -> float:
         """The length [1/m] of the wave vector with the largest relative deviation (either branch)."""
         return float(np.linalg.norm(self.wave_vectors[np.argmax(self.relative_deviation.max(axis=1))]))
 
+    def largest_resolved(self) -> tuple[int, int]:
+        """(point, branch) of the largest relative deviation beyond the resolution limit."""
+        deviation = np.where(self.resolved[:, None], self.relative_deviation, -np.inf)
+        point, branch = np.unravel_index(np.argmax(deviation), deviation.shape)
+        return int(point), int(branch)
+
     def rows(self) -> list[list]:
         """dispersion.csv's rows (:data:`COLUMNS`), branch by branch along the path."""
+        deviation, resolved, within = self.relative_deviation, self.resolved, self.within_bound
         return [[repr(float(self.path_position[p])), repr(float(self.wave_vectors[p, 0])),
                  repr(float(self.wave_vectors[p, 1])), name, repr(float(self.omega_theory[p, b])),
-                 repr(float(self.omega_measured[p, b]))]
+                 repr(float(self.omega_measured[p, b])), repr(float(deviation[p, b])), repr(float(self.bound[p, b])),
+                 str(bool(resolved[p])).lower(), str(bool(within[p, b])).lower()]
                 for b, name in enumerate(BRANCHES) for p in range(len(self.path_position))]
 
 
 def polarizations(theory: Lattice2D, wave_vectors) -> np.ndarray:
     """(Q, 2, 2) the theory's unit eigenvectors at each wave vector, the lower band's first."""
-    return np.array([np.linalg.eigh(dynamical_matrix(theory, q))[1] for q in wave_vectors])
+    return np.linalg.eigh(dynamical_matrix(theory, wave_vectors))[1]
+
+
+def packing_width(positions_m) -> float:
+    """L [m]: the smallest width of the beads' centres ``positions_m`` (N, 2), over directions
+    every half degree."""
+    angles = np.radians(np.arange(0.0, 180.0, 0.5))
+    extent = np.asarray(positions_m, float) @ np.array([np.cos(angles), np.sin(angles)])
+    return float(np.min(extent.max(axis=0) - extent.min(axis=0)))
+
+
+def taper(positions_m) -> np.ndarray:
+    """(N,) the spatial window of the module docstring: about the centres' mean, radius r, in the
+    inscribed circle of radius R = L/2: 1 for r ≤ R/2, cos²(π (r − R/2)/R) up to R, 0 beyond."""
+    positions_m = np.asarray(positions_m, float)
+    radius = packing_width(positions_m) / 2
+    r = np.linalg.norm(positions_m - positions_m.mean(axis=0), axis=1)
+    return np.cos(0.5 * math.pi * np.clip(2 * r / radius - 1, 0.0, 1.0)) ** 2
+
+
+def band_spread(theory: Lattice2D, wave_vectors, radius_per_m: float) -> np.ndarray:
+    """(Q, 2) each band's largest |ω_b(q') − ω_b(q)| [rad/s] over the disc |q' − q| ≤
+    ``radius_per_m`` about each of ``wave_vectors`` (Q, 2) [1/m], sampled on
+    :data:`SPREAD_RINGS` rings of :data:`SPREAD_DIRECTIONS` directions."""
+    wave_vectors = np.asarray(wave_vectors, float)
+    angles = np.linspace(0.0, 2 * math.pi, SPREAD_DIRECTIONS, endpoint=False)
+    rings = radius_per_m * np.arange(1, SPREAD_RINGS + 1) / SPREAD_RINGS
+    disc = (rings[:, None, None] * np.stack([np.cos(angles), np.sin(angles)], axis=-1)).reshape(-1, 2)
+    spread = frequencies(theory, wave_vectors[:, None, :] + disc) - frequencies(theory, wave_vectors)[:, None, :]
+    return np.abs(spread).max(axis=1)
 
 
 def measure_dispersion(settings: DispersionSettings, workdir, log=None, show_progress: bool = True) -> Dispersion:
@@ -144,9 +229,14 @@ def measure_dispersion(settings: DispersionSettings, workdir, log=None, show_pro
     config = config.replace(initial_state_file=str(state), dump_every=every)
     inside = np.linalg.norm(vectors, axis=1) > 0
     position, vectors, omega = position[inside], vectors[inside], omega[inside]
-    recorded = record_waves(config, workdir / "run", vectors, log=log, show_progress=show_progress)
+    positions = model.lattice.positions_m[:len(model.lattice)]
+    recorded = record_waves(config, workdir / "run", vectors, log=log, show_progress=show_progress,
+                            weights=taper(positions))
     spectrum_omega, power = power_spectrum(recorded.times_s, branch_signals(recorded.components,
                                                                              polarizations(theory, vectors)))
     total = power.sum(axis=2)
-    return Dispersion(position, vectors, omega, peak_frequency(spectrum_omega, power), spectrum_omega,
-                      total / total.max(axis=0), theory, settings)
+    width = packing_width(positions)
+    resolution = 2 * math.pi / (len(recorded.times_s) * (recorded.times_s[1] - recorded.times_s[0]))
+    bound = (band_spread(theory, vectors, 2 * math.pi / width) + resolution) / omega
+    return Dispersion(position, vectors, omega, band_peaks(spectrum_omega, power), spectrum_omega,
+                      total / total.max(axis=0), width, resolution, bound, theory, settings)

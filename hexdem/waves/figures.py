@@ -23,7 +23,8 @@ def _kilohertz(omega) -> np.ndarray:
 
 def bands_figure(dispersion: Dispersion, path) -> None:
     """The measured spectrum (each wave vector's power, scaled to its largest, on a log colour
-    scale) along Γ–K–M–Γ, the theory's two bands over it, the measured peaks as dots."""
+    scale) along Γ–K–M–Γ, the theory's two bands over it, the measured peaks as dots (open short
+    of the resolution limit)."""
     from matplotlib.colors import LogNorm
 
     from hexdem.analysis.figures import plain_log_ticks, save, subplots
@@ -37,12 +38,17 @@ def bands_figure(dispersion: Dispersion, path) -> None:
                           norm=LogNorm(1e-4, 1.0), rasterized=True)
     bar = fig.colorbar(image, ax=ax, label="spectral power (each q scaled to its largest)")
     plain_log_ticks(bar.ax.yaxis)
+    resolved = dispersion.resolved
     for branch in range(2):
         ax.plot(position * a, _kilohertz(omega[:, branch]), color="c", linewidth=1.2,
                 label="theory: linearized Hertz, k = (3/2) A^(2/3) f₀^(1/3)" if branch == 0 else None)
-        ax.plot(dispersion.path_position * a, _kilohertz(dispersion.omega_measured[:, branch]), linestyle="",
-                marker="o", markersize=3.5, markerfacecolor="k", markeredgecolor="w",
-                label="measured spectral peak" if branch == 0 else None)
+        for kept, face, edge, label in ((resolved, "k", "w", "measured spectral peak"),
+                                        (~resolved, "w", "k", "short of the resolution limit |q| a = "
+                                                              f"{dispersion.smallest_resolved_per_m * a:.2f}")):
+            if kept.any():
+                ax.plot(dispersion.path_position[kept] * a, _kilohertz(dispersion.omega_measured[kept, branch]),
+                        linestyle="", marker="o", markersize=3.5, markerfacecolor=face, markeredgecolor=edge,
+                        label=label if branch == 0 else None)
     corners = position[::120] * a
     ax.set_xticks(corners, PATH)
     for corner in corners[1:-1]:
@@ -52,10 +58,12 @@ def bands_figure(dispersion: Dispersion, path) -> None:
     ax.set_xlabel("wave vector q along Γ–K–M–Γ (distance travelled in q, times a)")
     ax.set_ylabel("frequency ω/2π [kHz]")
     settings = dispersion.settings
+    point, branch = dispersion.largest_resolved()
     ax.set_title(f"Phonon bands of the hexagon precompressed at {settings.precompression_n:g} N "
-                 f"({settings.edge_beads} per edge); median deviation {100 * dispersion.median_deviation:.2f} %",
-                 fontsize=10)
-    fig.legend(loc="outside lower center", ncols=2, fontsize=8)
+                 f"({settings.edge_beads} per edge)\ndeviation: median {100 * dispersion.median_deviation:.2f} %, "
+                 f"worst resolved {100 * dispersion.relative_deviation[point, branch]:.1f} % "
+                 f"(bound {100 * dispersion.bound[point, branch]:.1f} %)", fontsize=9)
+    fig.legend(loc="outside lower center", ncols=3, fontsize=8)
     save(fig, path)
 
 
