@@ -11,7 +11,12 @@ energy drift, the observed order of the peak error, and the run's wall time. Cas
 * the paper's experiment (11 per edge, 0.4 m/s, delrin walls), LAMMPS (velocity Verlet) and the
   reference integrator (RK4);
 * the V0 sweep's runs (nondimensional, no walls) at its smallest and largest V0, 0.01 and 0.30,
-  LAMMPS.
+  LAMMPS;
+* and, for the growth of the arrival-time error with the time t the pulse has travelled, a 150-bead
+  chain struck along its axis (``convergence.CHAIN``, the fastest growth), LAMMPS. For it and every
+  LAMMPS case the bound |error| <= (floor τ + rate t)/N²
+  (:func:`~hexdem.experiments.convergence.arrival_growth`) is printed beside the constants of
+  ``hexdem compare``'s tolerances.
 
 Target: at the default steps per contact, peaks within 1e-4 and arrival times within 0.05 µs
 (in contact times: 7e-4 τ, the same share of the contact at every V0) of the converged answer,
@@ -27,7 +32,8 @@ import tempfile
 
 from machine import describe
 
-from hexdem.experiments.convergence import sampling_error, study_time_step
+from hexdem.experiments.compare import ARRIVAL_ERROR_N2, ARRIVAL_GROWTH_N2
+from hexdem.experiments.convergence import CHAIN, arrival_growth, sampling_error, study_time_step
 from hexdem.model.config import STEPS_PER_CONTACT, RunConfig
 
 PEAK_TARGET = 1e-4
@@ -43,6 +49,14 @@ def cases(quick: bool) -> list[tuple[str, RunConfig, tuple[int, ...]]]:
             ("experiment", RunConfig(engine="reference"), (40, 80, 100, STEPS_PER_CONTACT, 200, 400, 800)),
             ("sweep, V0 = 0.01", sweep.replace(v0=0.01), (40, 80, STEPS_PER_CONTACT, 280, 560)),
             ("sweep, V0 = 0.30", sweep.replace(v0=0.30), (40, 80, STEPS_PER_CONTACT, 280, 560))]
+
+
+def growth_verdict(name: str, study) -> str:
+    """The study's bound on the arrival-time error as the pulse travels, beside hexdem compare's."""
+    growth = arrival_growth(study)
+    return (f"{name}, {study.engine}: arrival error <= ({growth.floor:.3f} τ + {growth.rate:.3f} t)/N² over "
+            f"t <= {study.arrivals.max():.0f} τ (hexdem compare's tolerances: {ARRIVAL_ERROR_N2} and "
+            f"{ARRIVAL_GROWTH_N2})")
 
 
 def main() -> int:
@@ -73,6 +87,10 @@ def main() -> int:
             verdicts.append(f"{name}, {config.engine}: step + sampling every {sampled.dump_every} steps: peak "
                             f"{default.peak_error:.1e} + {sampled.peak_error:.1e}, arrival "
                             f"{default.arrival_error_contacts:.1e} + {sampled_contacts:.1e} τ: {'met' if met else 'NOT met'}")
+            if study.order == 2:
+                verdicts.append(growth_verdict(name, study))
+        verdicts.append(growth_verdict("chain, 150 beads", study_time_step(CHAIN, (80, STEPS_PER_CONTACT, 280, 560),
+                                                                           f"{scratch}/chain")))
     print(f"target at {STEPS_PER_CONTACT} steps per contact: peaks within {PEAK_TARGET:g}, arrival within "
           f"{ARRIVAL_TARGET_S * 1e6:g} µs ({arrival_target:.1e} τ), the step's error and the sampling's "
           f"(against sampling every step) together")

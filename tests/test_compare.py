@@ -14,8 +14,9 @@ from hexdem.engines.reference.engine import PARAMETERS_NAME, ReferenceEngine
 from hexdem.errors import HexdemError
 from hexdem.experiments.compare import (COMPARE_COLUMNS, MARGIN, Tolerances, compare_analyses, expected_error,
                                          run_comparison)
+from hexdem.experiments.convergence import CHAIN
 from hexdem.experiments.run import RESULT_FILES, simulate
-from hexdem.model.config import RunConfig
+from hexdem.model.config import STEPS_PER_CONTACT, RunConfig
 from hexdem.model.granular import RunSettings
 
 SMALL = RunConfig(edge_beads=4)
@@ -23,7 +24,8 @@ SMALL = RunConfig(edge_beads=4)
 
 def test_reference_agrees_with_lammps_on_the_default_experiment(default_run, tmp_path):
     """On the paper's experiment every line's bead agrees within the default tolerances (4 times
-    LAMMPS's expected error at 140 steps per contact: 1.6e-4 in peak, 0.059 µs in arrival)."""
+    LAMMPS's expected error at 140 steps per contact: 1.6e-4 in peak, 0.0066 µs + 5.3e-5 of the
+    arrival time in arrival)."""
     lammps = default_run[1]
     reference = simulate(RunConfig(engine="reference"), tmp_path)
     assert reference.tracked.n_samples == lammps.tracked.n_samples == lammps.settings.n_samples
@@ -81,46 +83,74 @@ def test_engines_agree_with_per_bead_diameters(tmp_path):
     moving = np.nan_to_num(lammps.peak_speed) > tolerances.min_peak_fraction * V0
     assert moving.sum() > 20
     np.testing.assert_allclose(reference.peak_speed[moving], lammps.peak_speed[moving], rtol=tolerances.peak_rel)
-    np.testing.assert_allclose(reference.arrival_time[moving], lammps.arrival_time[moving],
-                               rtol=0, atol=tolerances.arrival_s)
+    difference = np.abs(reference.arrival_time[moving] - lammps.arrival_time[moving])
+    assert np.all(difference <= tolerances.arrival(lammps.arrival_time[moving])), difference.max()
 
 
 def test_default_tolerances_follow_lammps_expected_error_at_the_runs_steps_per_contact():
     """MARGIN times LAMMPS's expected error: a quarter at twice the steps (velocity Verlet is second
-    order), the arrival in contact times whatever the units, larger with bead-bead damping; given values stay."""
+    order), the arrival in contact times whatever the units, growing with the bead's arrival time,
+    larger with bead-bead damping; given values stay, a given arrival tolerance constant."""
     def defaults(config):
         return Tolerances().for_run(config.model(), config.settings())
 
     coarse, fine = (defaults(SMALL.replace(steps_per_contact=n)) for n in (140, 280))
     assert coarse.peak_rel == pytest.approx(MARGIN * expected_error(140)[0]) == pytest.approx(4 * fine.peak_rel)
     assert coarse.arrival_s == pytest.approx(4 * fine.arrival_s)
+    assert coarse.arrival_rate == pytest.approx(MARGIN * expected_error(140)[2]) == pytest.approx(4 * fine.arrival_rate)
     for config in (SMALL, SMALL.replace(units="nondimensional", v0=0.05)):
         contact = config.contact_time_s()
         assert defaults(config).arrival_s / contact == pytest.approx(MARGIN * expected_error(140)[1])
+        assert defaults(config).arrival(10 * contact) / contact == pytest.approx(
+            MARGIN * (expected_error(140)[1] + 10 * expected_error(140)[2]))
     damped = defaults(SMALL.replace(restitution=0.9))
     assert damped.peak_rel > coarse.peak_rel and damped.arrival_s > coarse.arrival_s
     assert defaults(SMALL.replace(wall_restitution=0.9)) == coarse, "bead-wall damping costs LAMMPS little"
+    bare = RunSettings(dt_s=1e-7, n_steps=10, dump_every=1)
     given = Tolerances(peak_rel=0.01, arrival_s=1e-6)
-    assert given.for_run(SMALL.model(), RunSettings(dt_s=1e-7, n_steps=10, dump_every=1)) == given
+    assert given.for_run(SMALL.model(), bare) == replace(given, arrival_rate=0.0)
+    assert replace(given, arrival_rate=1e-3).for_run(SMALL.model(), bare).arrival(1e-3) == pytest.approx(2e-6)
+    assert Tolerances(arrival_rate=0.0).for_run(SMALL.model(), SMALL.settings()).arrival_s == coarse.arrival_s
     with pytest.raises(HexdemError, match="the default tolerances need the run's contact time"):
-        Tolerances(peak_rel=0.01).for_run(SMALL.model(), RunSettings(dt_s=1e-7, n_steps=10, dump_every=1))
+        Tolerances(peak_rel=0.01).for_run(SMALL.model(), bare)
 
 
-def test_a_bead_stiffness_off_by_0_3_percent_in_one_engine_is_caught(tmp_path):
+def test_the_arrival_tolerance_grows_with_the_distance_the_pulse_has_travelled(tmp_path):
+    """LAMMPS's arrival error grows with the time the pulse has travelled (velocity Verlet's error
+    in its speed accumulates): along a 150-bead chain the engines differ by 0.068 µs at the far
+    end, beyond the former constant tolerance (16 τ/N², 0.059 µs, calibrated on the 11-per-edge
+    hexagon), and well within each bead's own, which compare.csv lists."""
+    comparison = run_comparison(CHAIN, tmp_path, log=lambda message: None)
+    assert comparison.agree and comparison.max_arrival_share < 0.5, comparison.verdict()
+    contact = CHAIN.contact_time_s()
+    assert comparison.max_arrival_diff > MARGIN * 4.0 * contact / STEPS_PER_CONTACT**2
+    column = {key: np.array([float(row[key]) for row in read_csv(tmp_path / "compare.csv")[1] if row["line"] == "+30"])
+              for key in ("arrival_lammps", "arrival_diff", "arrival_tolerance")}
+    expected = comparison.tolerances.arrival_s + comparison.tolerances.arrival_rate * column["arrival_lammps"]
+    np.testing.assert_allclose(column["arrival_tolerance"], expected, rtol=1e-9)
+    assert column["arrival_tolerance"][-1] > 30 * column["arrival_tolerance"][0]
+    assert np.all(np.abs(column["arrival_diff"]) <= column["arrival_tolerance"])
+    saved = json.loads((tmp_path / "compare.json").read_text())
+    assert saved["tolerances"]["arrival_rate"] == comparison.tolerances.arrival_rate
+    assert saved["max_arrival_share"] == comparison.max_arrival_share
+
+
+@pytest.mark.parametrize("config", [SMALL, RunConfig()], ids=["4 per edge", "default experiment"])
+def test_a_bead_stiffness_off_by_0_3_percent_in_one_engine_is_caught(tmp_path, config):
     """The bias the cross-check exists for (a wrong E* or G* in one engine): the reference run on
     beads 0.3 % stiffer, same step and samples, arrives 0.12 % early (times go as A^(−2/5)),
     beyond the default tolerances, where the same run on the true beads agrees."""
-    model, settings = SMALL.model(), SMALL.settings()
+    model, settings = config.model(), config.settings()
     stiffer = replace(model, bead=replace(model.bead, youngs_modulus_pa=1.003 * model.bead.youngs_modulus_pa))
     runs = (("lammps", LammpsEngine(), model), ("true", ReferenceEngine(), model),
             ("biased", ReferenceEngine(), stiffer))
     lammps, true, biased = (ImpactAnalysis.from_trajectory(beads, settings,
                                                            record(engine, beads, settings, tmp_path / name))
                             for name, engine, beads in runs)
-    assert compare_analyses(lammps, true, SMALL.v0).agree
-    comparison = compare_analyses(lammps, biased, SMALL.v0)
+    assert compare_analyses(lammps, true, config.v0).agree
+    comparison = compare_analyses(lammps, biased, config.v0)
     assert not comparison.agree
-    assert comparison.max_arrival_diff > 2 * comparison.arrival_tolerance, comparison.verdict()
+    assert comparison.max_arrival_share > 5, comparison.verdict()
 
 
 def test_a_difference_beyond_tolerance_is_detected(tmp_path):
@@ -166,6 +196,8 @@ def test_compare_cli_reports_agreement_and_fails_on_disagreement(tmp_path, small
 def test_bad_tolerance_is_a_one_line_error(tmp_path, small_toml, capsys):
     with pytest.raises(HexdemError, match="peak_rel"):
         Tolerances(peak_rel=float("nan"))
+    with pytest.raises(HexdemError, match="tolerance arrival_rate must be a number >= 0, got -0.1"):
+        Tolerances(arrival_rate=-0.1)
     assert main(["compare", "--config", str(small_toml), "--out", str(tmp_path), "--arrival-tol", "-1"]) == 2
     assert capsys.readouterr().err.strip() == "hexdem: error: tolerance arrival_s must be a number >= 0, got -1.0"
     assert not any(tmp_path.glob("compare*"))

@@ -11,13 +11,16 @@ the default interval and at every step.
 
 Measured quantities, over the observation lines' beads whose peak exceeds ``threshold`` V0:
 the largest relative peak-speed error, the largest arrival-time error (in the run's time unit
-and in contact times), and the energy drift (:mod:`hexdem.analysis.energy`).
+and in contact times), each bead's arrival-time error, and the energy drift
+(:mod:`hexdem.analysis.energy`). :func:`arrival_growth` bounds the arrival-time errors by a
+straight line in the time the pulse has travelled: a second-order integrator's error in the
+pulse's speed accumulates along its path.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -29,13 +32,17 @@ from hexdem.model.config import SAMPLES_PER_CONTACT, RunConfig
 ORDERS = {"lammps": 2, "reference": 4}
 #: Beads with a peak above this fraction of V0 are measured (as in ``hexdem compare``).
 THRESHOLD = 0.01
+#: A chain of 150 beads struck along its axis: its solitary wave keeps the struck bead's contact
+#: time, so its arrival errors grow fastest (:func:`arrival_growth`); a LAMMPS study takes seconds.
+CHAIN = RunConfig(shape="sites", site_walls_deg=[], strike_angle_deg=30.0, sites=[[k, k] for k in range(150)])
 
 
 @dataclass(frozen=True)
 class StepError:
     """One run of a convergence study: ``steps_per_contact``, ``dt`` (run units), the largest
     relative ``peak_error``, the largest ``arrival_error`` (run units) and ``arrival_error_contacts``
-    (in contact times at V0), ``energy_drift``, and the run's ``wall_time_s``."""
+    (in contact times at V0), ``energy_drift``, the run's ``wall_time_s``, and ``arrival_errors``:
+    each measured bead's arrival minus the extrapolated one, in contact times."""
 
     steps_per_contact: int
     dt: float
@@ -44,18 +51,21 @@ class StepError:
     arrival_error_contacts: float
     energy_drift: float
     wall_time_s: float
+    arrival_errors: np.ndarray = field(repr=False, compare=False)
 
 
 @dataclass(frozen=True)
 class Convergence:
     """A study's runs (coarse to fine), the engine's ``order``, the observed orders of the
-    peak error between successive runs, and the number of beads measured."""
+    peak error between successive runs, the number of beads measured, and ``arrivals``: their
+    extrapolated arrival times in contact times."""
 
     engine: str
     order: int
     runs: tuple[StepError, ...]
     observed_orders: tuple[float, ...]
     n_beads: int
+    arrivals: np.ndarray = field(repr=False, compare=False)
 
     def at(self, steps_per_contact: int) -> StepError:
         return next(run for run in self.runs if run.steps_per_contact == steps_per_contact)
@@ -112,10 +122,33 @@ def study_time_step(config: RunConfig, steps, workdir, log=None) -> Convergence:
         arrival_error = float(np.max(np.abs(arrival - exact_arrival)))
         runs.append(StepError(n, analysis.settings.dt_s / analysis.settings.units.time_s,
                               float(np.max(np.abs(peak / exact_peak - 1.0))), arrival_error,
-                              arrival_error / contact, float(analysis.results.energy_drift), wall))
+                              arrival_error / contact, float(analysis.results.energy_drift), wall,
+                              (arrival - exact_arrival) / contact))
     observed = tuple(float(np.log(a.peak_error / b.peak_error) / np.log(b.steps_per_contact / a.steps_per_contact))
                      for a, b in zip(runs[:-2], runs[1:-1]))
-    return Convergence(config.engine, order, tuple(runs), observed, len(beads))
+    return Convergence(config.engine, order, tuple(runs), observed, len(beads), exact_arrival / contact)
+
+
+@dataclass(frozen=True)
+class ArrivalGrowth:
+    """A bound on a second-order study's arrival-time errors as the pulse travels: at N steps per
+    contact time τ, a bead reached at t has |error| <= (``floor`` τ + ``rate`` t) / N² [-, both].
+    ``rate`` is the least-squares slope of |error| N² against t over the study's beads and runs,
+    ``floor`` the smallest intercept that bounds them all."""
+
+    floor: float
+    rate: float
+
+
+def arrival_growth(study: Convergence) -> ArrivalGrowth:
+    """The :class:`ArrivalGrowth` of ``study``'s arrival-time errors (of an engine of order 2)."""
+    if study.order != 2:
+        raise HexdemError(f"the arrival errors' growth is scaled for a second-order engine, not {study.engine}'s "
+                          f"order {study.order}")
+    scaled = np.abs([run.arrival_errors * run.steps_per_contact**2 for run in study.runs])
+    arrivals = np.broadcast_to(study.arrivals, scaled.shape)
+    rate = float(np.polyfit(arrivals.ravel(), scaled.ravel(), 1)[0])
+    return ArrivalGrowth(float(np.max(scaled - rate * arrivals)), rate)
 
 
 @dataclass(frozen=True)
