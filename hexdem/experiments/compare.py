@@ -17,6 +17,7 @@ larger than that.
 
 from __future__ import annotations
 
+import textwrap
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -219,7 +220,7 @@ def comparison_plot(comparison: EngineComparison, v0: float, path) -> None:
         ax.legend(fontsize=7)
     for ax in axes[1]:
         ax.set_xlabel("bead n along the line")
-    fig.suptitle(comparison.verdict(), fontsize=9)
+    fig.suptitle(textwrap.fill(comparison.verdict(), 150), fontsize=9)
     fig.tight_layout()
     save(fig, path)
 
