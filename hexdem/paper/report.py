@@ -205,7 +205,7 @@ def _header_blocks(out: Path, settings, wall_time_s: float) -> list:
                   f"{platform.machine()} ({platform.node()}), "
                   f"{datetime.now(timezone.utc).strftime('%Y-%m-%d %H:%M UTC')}. "
                   f"{'Quick run (thinned sweep and ensembles: rough numbers)' if settings.quick else 'Full run'}, "
-                  f"{settings.workers} workers; this invocation {wall_time_s:.0f} s. Parts (s, when computed): "
+                  f"{settings.workers} worker{'s' if settings.workers != 1 else ''}; this invocation {wall_time_s:.0f} s. Parts (s, when computed): "
                   + ", ".join(f"{name} {t}" for name, t in times) + ".")]
 
 
