@@ -149,7 +149,7 @@ def peak_map(results, model, v0: float, path, title="Peak speed") -> None:
     by decades as they spread)."""
     ratio = results.peak_speed / v0
     floor = max(float(np.nanmin(ratio[ratio > 0])) if np.any(ratio > 0) else 1e-3, 1e-3)
-    lattice_map(results, model, ratio, path, "peak speed V_max / V₀", title, cmap="magma",
+    lattice_map(results, model, ratio, path, "peak speed Vₘₐₓ / V₀", title, cmap="magma",
                 norm=LogNorm(floor, max(float(np.nanmax(ratio)), floor * 10)))
 
 
@@ -158,9 +158,12 @@ def peak_decay(rows_by_line: dict, path, units_name: str, v0: float, title="Peak
     units = UNIT_LABELS[units_name]
     fig, ax = subplots(figsize=(6, 4.5))
     fig.subplots_adjust(**SINGLE_PLOT_MARGINS)
-    markers = {"0": "o", "+30": "^", "-30": "v"}
+    # the ±30° lines of a symmetric strike coincide: −30° is drawn open and dashed over +30°'s filled markers
+    styles = {"0": {"marker": "o"}, "+30": {"marker": "^", "markersize": 7},
+              "-30": {"marker": "v", "markerfacecolor": "none", "linestyle": "--", "markersize": 9}}
     for line, (n, peak) in rows_by_line.items():
-        ax.semilogy(n, np.asarray(peak) / v0, marker=markers.get(line, "o"), linestyle="-", label=f"{line}°")
+        style = {"marker": "o", "linestyle": "-", **styles.get(line, {})}
+        ax.semilogy(n, np.asarray(peak) / v0, label=f"{line}°", **style)
     ax.set_xlabel("bead n along the line")
     ax.set_ylabel(f"Vₙ / V₀   (V₀ = {v0:.4g} {units['speed']})")
     plain_log_ticks(ax.yaxis)

@@ -181,8 +181,9 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
     write_json(out / "summary.json", {**summary(config, analysis, wall_time_s), "skipped_outputs": skipped})
     r, model = analysis.results, analysis.model
     v0 = analysis.v0
-    plots.arrival_map(r, model, out / "arrival_map.png", title=f"Arrival time, {model.lattice.shape}, V0 = {v0:g}")
-    plots.peak_map(r, model, v0, out / "peak_map.png", title=f"Peak speed, {model.lattice.shape}")
+    impact = f"V₀ = {v0:g} {plots.UNIT_LABELS[r.units]['speed']}"
+    plots.arrival_map(r, model, out / "arrival_map.png", title=f"Arrival time, {model.lattice.shape}, {impact}")
+    plots.peak_map(r, model, v0, out / "peak_map.png", title=f"Peak speed, {model.lattice.shape}, {impact}")
     if "peak_decay.png" not in skipped:
         by_line = {name: (np.arange(len(beads)), r.peak_speed[beads]) for name, beads in r.lines.items()}
         plots.peak_decay(by_line, out / "peak_decay.png", r.units, v0)
