@@ -5,7 +5,6 @@ set-up commands are those CI runs."""
 import re
 import subprocess
 import sys
-import tomllib
 from pathlib import Path
 
 import pytest
@@ -49,8 +48,7 @@ def test_the_api_reference_documents_the_modules(built):
 
 
 def test_the_gallery_shows_every_shape_and_impact_kind():
-    configs = {path.stem: RunConfig(**tomllib.loads(path.read_text()))
-               for path in sorted((DOCS / "gallery" / "configs").glob("*.toml"))}
+    configs = {path.stem: RunConfig.from_toml(path) for path in sorted((DOCS / "gallery" / "configs").glob("*.toml"))}
     assert {config.shape for config in configs.values()} == set(SHAPES)
     models = {name: config.model() for name, config in configs.items()}
     kinds = {"velocity": any(not m.strikers for m in models.values()),

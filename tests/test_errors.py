@@ -50,7 +50,7 @@ def kept_deck(message: str) -> Path:
     ("v0 = 0.0", "v0 must be > 0"),
     ("v0 = -0.4", "v0 must be > 0"),
     ("strike_angle_deg = 95", "strike angle 95"),
-    ('shape = "square"', "unknown shape 'square'"),
+    ('shape = "pentagon"', "unknown shape 'pentagon'"),
     ("diameter_m = -0.01", "bead diameter must be > 0"),
     ("ranks = 0", "ranks must be a positive integer"),
     ("velocity = 0.4", "unknown parameter(s) velocity"),
@@ -88,9 +88,9 @@ def test_bad_config_is_one_line_and_writes_nothing(tmp_path, capsys, config_text
 
 @pytest.mark.parametrize("name", [field.name for field in dataclasses.fields(RunConfig)])
 def test_every_key_is_checked_against_its_declared_type(name):
-    """A table where any other value belongs (a list for ``materials``, itself a table) is
-    refused in one line naming the key, the type and the value."""
-    wrong = [1] if name == "materials" else {"a": 1}
+    """A table where any other value belongs (a number for ``materials``, which takes a table or a
+    list of names) is refused in one line naming the key, the type and the value."""
+    wrong = 3 if name == "materials" else {"a": 1}
     with pytest.raises(HexdemError) as error:
         RunConfig(**{name: wrong})
     assert str(error.value).startswith(f"{name} must be ") and str(error.value).endswith(f", got {wrong!r}")

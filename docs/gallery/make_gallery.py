@@ -68,6 +68,25 @@ ENTRIES = (
     ("interior_precompressed", "An interior impact in a precompressed hexagon",
      "Bead {0, 14} struck at 0.01 m/s in a hexagon of 15 per edge under 20 N: the ring front of Chong et al.",
      "edge_beads = 15\nprecompression_n = 20.0\n\n[[impacts]]\nsite = [0, 14]\nv0 = 0.01\n", "arrival_map.png"),
+    ("square", "Square crystal",
+     "15 × 15 steel beads on a square grid in a square basin: the struck row carries a chain's solitary wave "
+     "and no other bead moves, the seed paper's contrast to the hexagon.",
+     'shape = "square"\nrows = 15\ncolumns = 15\n', "peak_map.png"),
+    ("centered_square", "Centered-square crystal with interstitials",
+     "A 9 × 12 square of steel beads with a brass interstitial in every cell, sized to touch its four "
+     "corners (Leonard & Daraio): the pulse leaks off the struck row through the interstitials.",
+     'shape = "centered-square"\nrows = 9\ncolumns = 12\ninterstitial_material = "brass"\nduration = 1.2e-3\n',
+     "peak_map.png"),
+    ("chain", "A chain with a light intruder",
+     "Forty steel beads in a free chain, bead 20 half their diameter: most of the solitary wave passes it, "
+     "part comes back.",
+     'shape = "chain"\nbeads = 40\ndiameters_m = [' + ", ".join(["0.01905"] * 20 + ["0.009525"] + ["0.01905"] * 19)
+     + ']\nduration = 2e-3\n', "peak_decay.png"),
+    ("packing", "Measured positions: a packing file",
+     "Beads read from packing.csv (x, y, diameter in metres and material, one per line; here a hexagon of "
+     "8 per edge with five undersized rattlers and five brass beads, written by this script), in flat walls "
+     "along the convex hull.",
+     'shape = "packing"\npacking_file = "packing.csv"\nwalls = "hull"\nstruck_bead = 3\n', "peak_map.png"),
     ("friction", "Spheres that rub and roll",
      "The experiment with Coulomb friction μ = 0.3 (Mindlin's tangential force, beads turning); "
      "the movie shows the spin, each bead coloured by its rim's speed.",
@@ -80,6 +99,24 @@ def shrink(source: Path, target: Path) -> None:
         image = image.convert("RGB")
         image.thumbnail((WIDTH, WIDTH * 4))
         image.quantize(colors=PALETTE_COLOURS).save(target, optimize=True)
+
+
+def write_packing_file(path: Path, seed: int = 1) -> None:
+    """A hexagon of 8 per edge written bead by bead, as measured positions would be: five beads
+    undersized by 10 % (rattlers that touch no one until the pulse shakes them) and five of brass."""
+    import numpy as np
+
+    from hexdem.model.lattice import hexagon
+
+    rng = np.random.default_rng(seed)
+    lattice = hexagon(8, 0.01905)
+    others = rng.choice(np.setdiff1d(np.arange(len(lattice)), [lattice.struck]), 10, replace=False)
+    diameters = lattice.diameters_m.copy()
+    diameters[others[:5]] *= 0.9
+    materials = np.full(len(lattice), "steel316", dtype=object)
+    materials[others[5:]] = "brass"
+    rows = [f"{x!r},{y!r},{d!r},{m}" for (x, y), d, m in zip(lattice.positions_m.tolist(), diameters.tolist(), materials)]
+    path.write_text("x,y,diameter,material\n" + "\n".join(rows) + "\n")
 
 
 def run_entry(name: str, config: str, figure: str, scratch: Path) -> None:
@@ -110,6 +147,7 @@ def page() -> str:
 def main() -> int:
     for folder in ("configs", "images"):
         (HERE / folder).mkdir(exist_ok=True)
+    write_packing_file(HERE / "configs" / "packing.csv")
     with tempfile.TemporaryDirectory(prefix="hexdem-gallery-") as scratch:
         for name, _, _, config, figure in ENTRIES:
             print(f"gallery: {name}", file=sys.stderr, flush=True)

@@ -29,14 +29,6 @@ def declared_types(cls) -> dict:
     return typing.get_type_hints(cls)
 
 
-def _optional(kind):
-    """``kind`` without its ``| None``; None if that leaves several types."""
-    if typing.get_origin(kind) not in (typing.Union, types.UnionType):
-        return kind
-    rest = [arg for arg in typing.get_args(kind) if arg is not type(None)]
-    return rest[0] if len(rest) == 1 else None
-
-
 def _is_list(args) -> bool:
     """Whether a tuple type's ``args`` are ``(X, ...)``: a list of any length."""
     return len(args) == 2 and args[1] is Ellipsis
@@ -119,13 +111,24 @@ def check_fields(obj) -> None:
         check_type(name, getattr(obj, name), kind)
 
 
+def _arm_for(kind, step: str):
+    """The part of the union ``kind`` that a path can step into with ``step``: a list for an
+    index, a table for a key (``materials``: a table of materials or a list of names)."""
+    if typing.get_origin(kind) not in (typing.Union, types.UnionType):
+        return kind
+    for arm in typing.get_args(kind):
+        if (typing.get_origin(arm) is tuple) == step.isdigit() and arm is not type(None):
+            return arm
+    return None
+
+
 def type_at(cls, path: str):
     """The declared type of the dotted ``path`` into ``cls``'s keys, tables and lists
     (``regions.0.material``: ``str``), or None where the path leaves what is declared."""
     steps = path.split(".")
     kind = declared_types(cls).get(steps[0])
     for step in steps[1:]:
-        kind = _optional(kind)
+        kind = _arm_for(kind, step)
         args = typing.get_args(kind)
         if typing.is_typeddict(kind):
             kind = declared_types(kind).get(step)

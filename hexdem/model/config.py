@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 from dataclasses import dataclass
 
 from hexdem.common.checks import positive_int
@@ -24,19 +25,17 @@ from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time
 from hexdem.model.impacts import ImpactSpec, ImpactTable, cut_holes, impact_specs, resolve_impacts, struck_site
 from hexdem.model.initial_state import read_initial_state
-from hexdem.model.lattice import (Lattice, disc, half_disc, half_hexagon, hexagon, parallelogram, triangle,
-                                   without_hole, without_sites)
+from hexdem.model.lattice import Lattice, without_hole, without_sites
 from hexdem.model.lines import LineTable, with_lines
-from hexdem.model.sites import read_sites
+from hexdem.model.packing_builders import PLACED_SHAPES, SHAPES, BuiltPacking, build_packing
 from hexdem.model.materials import (PAPER_DIAMETER_M, Material, MaterialTable, custom_materials, hertz_coefficient,
                                      hertz_stiffness, material)
 from hexdem.model.precompression import hole_force, precompressed_lattice
 from hexdem.model.regions import RegionTable, assign_materials
 from hexdem.model.sensors import sensor_beads
-from hexdem.model.timescale import fastest_approach_m_s, impact_contact_time_s
+from hexdem.model.timescale import fastest_approach_m_s, impact_contact_time_s, sized_bodies
 from hexdem.model.units import SI, UnitSystem, nondimensional
 
-SHAPES = ("hexagon", "half-hexagon", "half-disc", "triangle", "parallelogram", "disc", "sites")
 IMPACTS = ("velocity", "striker")
 UNITS = ("si", "nondimensional")
 ENGINES = ("lammps", "reference")
@@ -69,12 +68,9 @@ class RunConfig:
     """One simulation. Lengths in m; ``v0``, ``dt``, ``duration`` in ``units``.
 
     ``steps_per_contact``: the default time step is the contact time (:meth:`contact_time_s`)
-    over this (at least 20), shortened if need be so that the default sampling interval, 1/20
-    of the contact time, is a whole number of steps.
-    ``dump_every`` steps between samples (None: the steps of 1/20 of the contact time, fixed in
-    time whatever the step): the analysis inside the run takes one every ``dump_every``
-    steps, and so does the full LAMMPS dump, written only with ``dump = true`` (the deck's
-    ``in.hexdem`` always writes it when rerun by hand).
+    over this (at least 20), shortened so that 1/20 of the contact time is whole steps.
+    ``dump_every`` steps between samples of the analysis and of the dump (None: 1/20 of the
+    contact time); the dump is written with ``dump = true`` (and by the deck when rerun by hand).
     ``restitution``: bead–bead coefficient of restitution (1.0: the paper's ideal model); ``wall_restitution``:
     bead–wall (None: ``restitution``). ``friction``, ``wall_friction`` (None: ``friction``), ``rolling_friction``:
     Coulomb μ between bodies and against walls, rolling resistance (:mod:`hexdem.model.contact_law`).
@@ -84,14 +80,13 @@ class RunConfig:
     ``sensors``: sensor particles, each ``"line:n"`` (e.g. ``"0:1"``, ``"+30:6"``) or a bead id;
     sampled at ``sensor_rate_hz`` (the paper's 500 kS/s); ``sensor_mass_factor``: a sensor
     bead's mass relative to a plain bead's.
-    Packings (``shape``): ``hexagon`` (``edge_beads`` per edge), ``half-hexagon`` (``long_edge``,
-    ``short_edge``), ``half-disc`` (``radius_beads``), ``triangle`` (``edge_beads``),
-    ``parallelogram`` (``edge_beads`` along the struck edge, ``depth_beads`` layers, None: as
-    many), ``disc`` (``radius_beads``, a curved wall), each with the walls of its basin; ``sites``: the sites listed in ``sites`` (pairs
-    [m, n]) or in ``sites_file`` (CSV with columns m,n, or TOML with ``sites = [[m, n], …]``),
-    struck at {0, 0}, with flat walls touching it whose inward normals point at the angles
-    ``site_walls_deg`` (none: a free packing). ``vacancies``: sites [m, n] left out of any
-    packing (the walls stay).
+    Packings (``shape``, :mod:`hexdem.model.packing_builders`): ``hexagon`` (``edge_beads``),
+    ``half-hexagon`` (``long_edge``, ``short_edge``), ``half-disc`` and ``disc`` (``radius_beads``),
+    ``triangle`` (``edge_beads``), ``parallelogram`` (``edge_beads``, ``depth_beads``), ``sites``
+    (``sites`` [m, n] or ``sites_file``, walls at ``site_walls_deg``), ``square`` and
+    ``centered-square`` (``rows``, ``columns``, ``interstitial_diameter_m``, ``interstitial_material``),
+    ``chain`` (``beads``, ``angle_deg``, ``diameters_m``, ``materials`` as a list of names),
+    ``packing`` (``packing_file``, ``struck_bead``, ``walls``). ``vacancies``: labels left out.
     ``bead_material``, ``wall_material``: a preset (steel316, delrin, brass, aluminium, glass,
     ptfe; :mod:`hexdem.model.materials`) or a material of ``materials``, this configuration's own
     table {name: {youngs_modulus_pa, poisson_ratio, density_kg_m3[, source]}}.
@@ -126,7 +121,7 @@ class RunConfig:
     diameter_m: float = PAPER_DIAMETER_M
     bead_material: str = "steel316"
     wall_material: str = "delrin"
-    materials: dict[str, MaterialTable] = dataclasses.field(default_factory=dict)
+    materials: dict[str, MaterialTable] | tuple[str, ...] = dataclasses.field(default_factory=dict)
     regions: tuple[RegionTable, ...] = ()
     striker_material: str | None = None
     striker_diameter_m: float | None = None
@@ -155,6 +150,16 @@ class RunConfig:
     sensor_rate_hz: float = 500e3
     sensor_mass_factor: float = 1.0
     launcher: str | None = None
+    rows: int = 15
+    columns: int = 15
+    interstitial_diameter_m: float | None = None
+    interstitial_material: str | None = None
+    beads: int = 20
+    angle_deg: float = 0.0
+    diameters_m: tuple[float, ...] = ()
+    packing_file: str | None = None
+    walls: str = "none"
+    struck_bead: int = 0
 
     def __post_init__(self):
         check_fields(self)
@@ -167,7 +172,7 @@ class RunConfig:
         if positive_int("steps_per_contact", self.steps_per_contact) < MIN_STEPS_PER_CONTACT:
             raise HexdemError(f"steps_per_contact must be at least {MIN_STEPS_PER_CONTACT} (the Hertz contact "
                               f"needs them), got {self.steps_per_contact}")
-        for name in ("sensors", "sites", "site_walls_deg", "vacancies", "regions", "impacts", "lines"):
+        for name in ("sensors", "sites", "site_walls_deg", "vacancies", "regions", "impacts", "lines", "diameters_m"):
             object.__setattr__(self, name, tuple(tuple(v) if isinstance(v, list) else v for v in getattr(self, name)))
         if not self.sensor_rate_hz > 0:
             raise HexdemError(f"sensor_rate_hz must be > 0, got {self.sensor_rate_hz!r}")
@@ -226,8 +231,12 @@ class RunConfig:
 
     @classmethod
     def from_toml(cls, path) -> "RunConfig":
-        """Read a TOML file whose keys are :class:`RunConfig` field names."""
-        return cls.from_dict(read_toml(path), source=str(path))
+        """Read a TOML file whose keys are :class:`RunConfig` field names; a relative ``packing_file``
+        is read from the TOML file's folder."""
+        data = read_toml(path)
+        if isinstance(data.get("packing_file"), str) and not Path(data["packing_file"]).is_absolute():
+            data["packing_file"] = str(Path(path).parent / data["packing_file"])
+        return cls.from_dict(data, source=str(path))
 
     @classmethod
     def from_dict(cls, data: dict, source: str = "config") -> "RunConfig":
@@ -245,7 +254,7 @@ class RunConfig:
 
     def material(self, name: str) -> Material:
         """The material called ``name``: a preset or one of this configuration's ``materials``."""
-        return material(name, custom_materials(self.materials))
+        return material(name, custom_materials(self.materials if isinstance(self.materials, dict) else {}))
 
     @property
     def unit_system(self) -> UnitSystem:
@@ -257,26 +266,18 @@ class RunConfig:
         return impact_specs(self.impacts, self.v0, self.strike_angle_deg, self.impact, self.striker_material,
                             self.striker_diameter_m)
 
-    def lattice(self) -> Lattice:
-        """The packing: the ``shape``'s sites less the ``vacancies``, with its walls, struck at the
-        first impact's site, with the extra observation ``lines``."""
-        struck = struck_site(self.impact_specs())
-        builders = {
-            "hexagon": lambda: hexagon(self.edge_beads, self.diameter_m, struck),
-            "half-hexagon": lambda: half_hexagon(self.long_edge, self.short_edge, self.diameter_m, struck),
-            "half-disc": lambda: half_disc(self.radius_beads, self.diameter_m, struck),
-            "triangle": lambda: triangle(self.edge_beads, self.diameter_m, struck),
-            "disc": lambda: disc(self.radius_beads, self.diameter_m, struck),
-            "parallelogram": lambda: parallelogram(self.edge_beads, self.edge_beads if self.depth_beads is None
-                                                   else self.depth_beads, self.diameter_m, struck),
-            "sites": lambda: read_sites(self.sites, self.sites_file, self.diameter_m, self.site_walls_deg, struck),
-        }
-        if self.shape != "sites" and (self.sites or self.sites_file or self.site_walls_deg):
-            raise HexdemError(f"sites, sites_file and site_walls_deg describe shape = \"sites\", not {self.shape!r}")
-        lattice = builders[self.shape]()
-        lattice = without_hole(lattice) if self.impacts else lattice  # each impact cuts its own
+    def packing(self) -> BuiltPacking:
+        """The ``shape``'s packing (:func:`~hexdem.model.packing_builders.build_packing`) less the
+        ``vacancies``, struck at the first impact's site, with the extra observation ``lines``,
+        and the material regions of its builder."""
+        built = build_packing(self, struck_site(self.impact_specs()))
+        lattice = without_hole(built.lattice) if self.impacts else built.lattice  # each impact cuts its own
         lattice = without_sites(lattice, self.vacancies) if self.vacancies else lattice
-        return with_lines(lattice, self.lines) if self.lines else lattice
+        return BuiltPacking(with_lines(lattice, self.lines) if self.lines else lattice, built.regions)
+
+    def lattice(self) -> Lattice:
+        """The packing of :meth:`packing`."""
+        return self.packing().lattice
 
     def model(self) -> GranularModel:
         """The SI :class:`GranularModel` this configuration describes."""
@@ -287,7 +288,8 @@ class RunConfig:
         for alpha in {damping_coefficient(self.restitution), damping_coefficient(wall_restitution)} - {0.0}:
             lammps_tsuji_coefficient(alpha)
         bead, held = self.material(self.bead_material), (0.0, 0.0)
-        lattice, extra = assign_materials(self.lattice(), self.regions, bead, self.material)
+        built = self.packing()
+        lattice, extra = assign_materials(built.lattice, built.regions + self.regions, bead, self.material)
         if self.precompression_n > 0:
             if extra:
                 raise HexdemError("precompression is built for a packing of one material; drop the regions")
@@ -295,7 +297,7 @@ class RunConfig:
                 raise HexdemError("a precompressed packing needs walls to hold it (wall_material = \"none\")")
             if self.shape == "half-disc":
                 raise HexdemError("a precompressed packing needs walls all round; the half-disc's arc is free")
-            if self.shape in ("disc", "sites"):
+            if self.shape in ("disc", "sites") + PLACED_SHAPES:
                 raise HexdemError(f"precompression is built for flat-walled basins (hexagon, half-hexagon, triangle, "
                                   f"parallelogram), not shape = {self.shape!r}")
             coefficient = float(hertz_coefficient(self.diameter_m, bead))
@@ -340,9 +342,10 @@ class RunConfig:
         if self.initial_state_file is not None:
             fastest = fastest_approach_m_s(model or self.model())
             strikers += [(fastest, striker) for _, striker in strikers]
+        sized = () if self.shape not in PLACED_SHAPES else sized_bodies(model or self.model())
         return impact_contact_time_s(self.material(self.bead_material), self.diameter_m,
                                      [self.material(r["material"]) for r in self.regions], strikers,
-                                     self.precompression_n)
+                                     self.precompression_n, sized)
 
     def _rebound_time_s(self, model: GranularModel) -> float:
         """The default duration [s] when nothing lies ahead of the struck beads (a single bead, a

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from hexdem.errors import HexdemError
+from hexdem.model.rays import ray_beads, ray_name
 from hexdem.model.walls import CurvedWall, Wall
 
 #: The step in (m, n) between consecutive sites along each of the lattice's twelve directions, by
@@ -57,7 +58,10 @@ class Lattice:
     ``walls`` the confining walls; ``shape`` a readable description; ``material_ids`` (N,)
     each bead's material, an index into the model's materials (None: all 0, the bead material);
     ``extra_lines`` observation lines besides the paper's three, each (name, start site (m, n),
-    step (dm, dn)).
+    step (dm, dn)). ``ray_angles_deg``: None for the triangular lattice, whose labels are the
+    paper's {m, n} and whose lines step along it; for any other packing (square, centered-square,
+    chain, measured positions), whose ``indices`` are its builder's integer labels, the angles
+    from +x of its observation lines, rays from the struck bead (:mod:`hexdem.model.rays`).
     """
 
     indices: np.ndarray
@@ -69,6 +73,7 @@ class Lattice:
     shape: str
     material_ids: np.ndarray | None = None
     extra_lines: tuple = ()
+    ray_angles_deg: tuple[float, ...] | None = None
     _lookup: dict = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
@@ -103,7 +108,12 @@ class Lattice:
 
     def line(self, name: str) -> np.ndarray:
         """Bead indices on observation line ``name`` ("0", "+30", "-30" from the struck bead, or an
-        extra line from its own start), from its start on."""
+        extra line from its own start; a ray's name on other packings), from its start on."""
+        if self.ray_angles_deg is not None:
+            rays = {ray_name(angle): angle for angle in self.ray_angles_deg}
+            if name not in rays:
+                raise HexdemError(f"unknown observation line {name!r}; known: {', '.join(rays)}")
+            return ray_beads(self.positions_m, self.struck, rays[name], self.diameter_m)
         starts = self._line_starts()
         if name not in starts:
             raise HexdemError(f"unknown observation line {name!r}; known: {', '.join(starts)}")
@@ -115,7 +125,9 @@ class Lattice:
         return np.array(beads, dtype=int)
 
     def lines(self) -> dict[str, np.ndarray]:
-        return {name: self.line(name) for name in self._line_starts()}
+        names = (self._line_starts() if self.ray_angles_deg is None
+                 else [ray_name(angle) for angle in self.ray_angles_deg])
+        return {name: self.line(name) for name in names}
 
     def with_geometry(self, positions_m, diameters_m) -> "Lattice":
         """The same labels with new positions and diameters, walls re-placed to touch them."""

@@ -61,19 +61,28 @@ def pair_contact_time_s(a: Material, da: float, b: Material, db: float, speed_m_
     return _contact_time_s(ma * mb / (ma + mb), coefficient, speed_m_s, f"{a.name} and {b.name}", min(da, db))
 
 
+def sized_bodies(model) -> tuple[tuple[Material, float], ...]:
+    """(material, smallest diameter [m]) of each bead material of the :class:`~hexdem.model.granular.GranularModel`
+    ``model``: the smallest beads of a material touch the shortest (t_c ∝ d at a given speed)."""
+    diameters, ids = model.lattice.diameters_m, model.material_ids[:len(model.lattice)]
+    return tuple((model.materials[k], float(diameters[ids == k].min())) for k in np.unique(ids))
+
+
 def impact_contact_time_s(bead: Material, diameter_m: float, region_materials, impacts,
-                          precompression_n: float = 0.0) -> float:
+                          precompression_n: float = 0.0, sized=()) -> float:
     """The shortest contact time [s] of the pairs the impacts set moving.
 
     ``region_materials``: the other bead materials of the packing; ``impacts``: per impact (and
     per fastest approach of an initial state), (speed [m/s], its striker (material, diameter [m])
     when of its own material or size, else None). At each impact's speed: two beads (the paper's pair, computed as always), every
-    other pair of bead materials, and the striker with each bead material. With
+    other pair of bead materials, and the striker with each bead material; ``sized`` adds bodies
+    (material, diameter [m]) of other sizes (:func:`sized_bodies`). With
     ``precompression_n`` > 0 [N], also half the period of two beads on the linearized
     contact, π sqrt(m/2k)."""
     mass = float(sphere_mass(diameter_m, bead))
     coefficient = float(hertz_coefficient(diameter_m, bead))
     bodies = [(bead, diameter_m)] + [(m, diameter_m) for m in dict.fromkeys(region_materials) if m != bead]
+    bodies += [body for body in dict.fromkeys(sized) if body not in bodies]
     times = []
     for speed, striker in impacts:
         pairs = list(itertools.combinations_with_replacement(bodies, 2))[1:]

@@ -1,0 +1,58 @@
+"""A packing from placed beads: labels, positions and diameters given, walls found from them.
+
+The triangular shapes place their beads on the paper's lattice (:func:`~hexdem.model.lattice.from_sites`);
+every other builder (square and centered-square crystals, chains, measured positions) places them
+itself and calls :func:`placed_packing`, which checks them, finds the struck bead by its label
+and puts flat walls touching the packing. Contacts are not stored: both engines find them from
+the geometry (beads touch when their gap is below zero).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from hexdem.errors import HexdemError
+from hexdem.model.lattice import Lattice, touching_walls, unit_vector
+
+#: Beads may overlap by at most this fraction of the smaller diameter at rest (round-off of
+#: measured or computed positions); more is a packing that would explode.
+MAX_REST_OVERLAP = 1e-6
+
+
+def check_no_overlap(positions_m, diameters_m, what: str) -> None:
+    """Refuse beads that overlap at rest by more than :data:`MAX_REST_OVERLAP` of the smaller one."""
+    from scipy.spatial import cKDTree
+
+    positions, diameters = np.asarray(positions_m, float), np.asarray(diameters_m, float)
+    pairs = cKDTree(positions).query_pairs(float(diameters.max()), output_type="ndarray")
+    if not len(pairs):
+        return
+    i, j = pairs.T
+    overlap = (diameters[i] + diameters[j]) / 2 - np.linalg.norm(positions[j] - positions[i], axis=1)
+    worst = int(np.argmax(overlap / np.minimum(diameters[i], diameters[j])))
+    if overlap[worst] > MAX_REST_OVERLAP * min(diameters[i[worst]], diameters[j[worst]]):
+        raise HexdemError(f"{what}: beads {i[worst]} and {j[worst]} overlap by {overlap[worst]:.3g} m at rest; "
+                          "a packing's beads may touch but not overlap")
+
+
+def placed_packing(labels, positions_m, diameters_m, diameter_m: float, wall_angles_deg, shape: str, struck,
+                   ray_angles_deg) -> Lattice:
+    """The packing of beads labelled ``labels`` (N, 2) int at ``positions_m`` (N, 2) [m] with
+    ``diameters_m`` (N,) [m] (nominal ``diameter_m``), struck at the bead labelled ``struck``,
+    inside flat walls touching it whose inward normals point at ``wall_angles_deg`` (the one at
+    0° has the struck bead's hole), its lines the rays at ``ray_angles_deg``."""
+    labels = np.asarray(labels, dtype=int).reshape(-1, 2)
+    positions, diameters = np.asarray(positions_m, float).reshape(-1, 2), np.asarray(diameters_m, float)
+    if not len(labels):
+        raise HexdemError(f"{shape}: a packing needs at least 1 bead, got none")
+    if not (np.all(np.isfinite(positions)) and np.all(diameters > 0) and len(diameters) == len(labels)):
+        raise HexdemError(f"{shape}: every bead needs a finite position and a diameter > 0")
+    check_no_overlap(positions, diameters, shape)
+    hit = np.flatnonzero(np.all(labels == np.asarray(struck, dtype=int), axis=1))
+    if not len(hit):
+        raise HexdemError(f"{shape}: the struck bead {tuple(int(v) for v in struck)} is not in the packing")
+    lattice = Lattice(indices=labels, positions_m=positions, diameters_m=diameters, diameter_m=float(diameter_m),
+                      struck=int(hit[0]), walls=(), shape=shape, ray_angles_deg=tuple(float(a) for a in ray_angles_deg))
+    return replace(lattice, walls=touching_walls(lattice, [unit_vector(a) for a in wall_angles_deg]))
