@@ -72,7 +72,7 @@ def test_engines_agree_on_small_lattices(tmp_path, changes):
 
 
 def test_engines_agree_with_per_bead_diameters(tmp_path):
-    """Fixed bonds with per-pair contact distances (reference) vs every overlap (LAMMPS), on every bead."""
+    """Per-pair contact distances in both engines' neighbour lists, on every bead."""
     model = disordered_model(seed=3, edge_beads=5)
     settings = RunSettings(dt_s=1e-7, n_steps=8000, dump_every=20, contact_time_s=RunConfig().contact_time_s())
     tolerances = Tolerances().for_run(model, settings)

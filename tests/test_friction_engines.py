@@ -112,15 +112,15 @@ def test_free_packing_keeps_its_angular_momentum_in_the_reference_engine():
 
 def test_frictionless_models_keep_the_frictionless_kernel_and_frictional_ones_spin(tmp_path):
     """The engine picks its kernel from the contact law: a frictionless model runs the kernel of
-    before (``reference.json`` counts its lattice bonds) and its samples carry no spins, a frictional
-    one the frictional kernel, whose samples carry the spheres' spins."""
+    before (``reference.json`` counts the pairs of its neighbour list) and its samples carry no spins,
+    a frictional one the frictional kernel, whose samples carry the spheres' spins."""
     config = RunConfig(edge_beads=4, impact="striker", strike_angle_deg=20.0, engine="reference")
     for friction, system in ((0.0, ReferenceSystem), (0.4, FrictionalSystem)):
         model = config.replace(friction=friction).model()
         samples = []
         engine = ReferenceEngine().run(model, config.settings(model), tmp_path / str(friction), samples.append,
                                        show_progress=False)
-        assert engine["n_bonds"] == system.from_model(model, SI).n_bonds
+        assert engine["n_pairs"] == system.from_model(model, SI).pairs.n_pairs
         assert np.isfinite(samples[-1].velocities).all()
         spins = samples[-1].angular_velocities
         assert (spins is None) if friction == 0 else (np.isfinite(spins).all() and np.abs(spins).max() > 0)

@@ -1,1 +1,2 @@
-"""The reference integrator of the paper's fixed-neighbour Hamiltonian: engine (:mod:`.engine`) and compiled kernel (:mod:`.kernel`)."""
+"""The reference integrator of the paper's Hamiltonian: engine (:mod:`.engine`), neighbour search
+(:mod:`.neighbours`) and compiled kernels (:mod:`.kernel`, :mod:`.friction_kernel`)."""

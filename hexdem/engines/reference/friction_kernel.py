@@ -2,9 +2,12 @@
 
 Selected by the contact law's data (:mod:`hexdem.model.contact_law`) when any contact has a
 tangential force; the frictionless kernel (:mod:`hexdem.engines.reference.kernel`) is untouched.
-Every contact is in an explicit list: a pair of bodies (i, j) with rest vector, contact distance
-c = R_i + R_j, A = k_n sqrt(R_eff), Tsuji's η, K = k_t sqrt(R_eff) (Mindlin's k_t a = K sqrt(δ)), μ and
-the radii; or a body on a wall, with the wall's geometry as in the frictionless kernel.
+Every contact is in an explicit list: a pair of bodies (i, j) of the neighbour list
+(:mod:`hexdem.engines.reference.neighbours`) with rest vector, contact distance c = R_i + R_j,
+A = k_n sqrt(R_eff), Tsuji's η, K = k_t sqrt(R_eff) (Mindlin's k_t a = K sqrt(δ)), μ and the radii;
+or a body on a wall, with the wall's geometry as in the frictionless kernel. As there,
+:func:`integrate_frictional` stops before a step where the list has gone stale, for the engine
+to rebuild it; the histories ξ of the pairs in both lists are carried over by their (i, j) keys.
 
 The law is LAMMPS's ``tangential mindlin`` in 2D. With n the unit vector from i to j (a wall's
 inward normal) and t = ẑ × n, the contact points slip at
@@ -30,18 +33,19 @@ from typing import NamedTuple
 
 import numpy as np
 
-from hexdem.engines.reference.kernel import _advance, _jit, _shifted
+from hexdem.engines.reference.kernel import _advance, _jit, _shifted, stale
 
 
 class FrictionArrays(NamedTuple):
     """One frictional model laid out for the kernel, in the run's unit system.
 
-    Pairs (b = 0 … P−1): ``pair_i``, ``pair_j`` cells, ``pair_rest_x``, ``pair_rest_y`` rest vector
+    Pairs (b = 0 … P−1): ``pair_i``, ``pair_j`` bodies, ``pair_rest_x``, ``pair_rest_y`` rest vector
     i → j, ``pair_contact`` c, ``pair_stiffness`` A, ``pair_damping`` η, ``pair_tangential`` K,
     ``pair_mu`` μ, ``pair_radius_i``, ``pair_radius_j``. Walls: ``wall_cell``, ``wall_nx``, ``wall_ny``,
     ``wall_gap``, ``wall_curvature`` (as in :class:`~hexdem.engines.reference.kernel.KernelArrays`),
-    ``wall_stiffness``, ``wall_damping``, ``wall_tangential``, ``wall_mu``, ``wall_radius``. Per cell:
-    ``inv_mass`` 1/m, ``inv_inertia`` 1/I (0 for padding), ``external_x``, ``external_y``.
+    ``wall_stiffness``, ``wall_damping``, ``wall_tangential``, ``wall_mu``, ``wall_radius``. Per body:
+    ``inv_mass`` 1/m, ``inv_inertia`` 1/I, ``external_x``, ``external_y``, ``built_x``, ``built_y``
+    (the displacements at the list's build) and ``reach``, as in the frictionless kernel.
     """
 
     pair_i: np.ndarray
@@ -69,6 +73,9 @@ class FrictionArrays(NamedTuple):
     inv_inertia: np.ndarray
     external_x: np.ndarray
     external_y: np.ndarray
+    built_x: np.ndarray
+    built_y: np.ndarray
+    reach: float
 
 
 @_jit
@@ -151,7 +158,7 @@ def _walls(k, x, y, u, v, spin, xi, cap, fx, fy, torque, slip):
 
 @_jit
 def frictional_forces(k, x, y, u, w, spin, pair_xi, wall_xi, cap, fx, fy, torque, pair_slip, wall_slip):
-    """Forces (fx, fy) and torques on every cell, and the slip rates of every contact, at the state
+    """Forces (fx, fy) and torques on every body, and the slip rates of every contact, at the state
     (q, v, ω, ξ); ``cap``: also set the histories ξ back to the Coulomb cap in place."""
     for c in range(fx.shape[0]):
         fx[c] = k.external_x[c]
@@ -186,14 +193,17 @@ def _first_order(z, h, k1, k2, k3, k4):
 @_jit
 def integrate_frictional(k, x, y, u, w, spin, pair_xi, wall_xi, h, n_steps):
     """Advance displacements (x, y), velocities (u, w), spins ω and the contacts' histories ξ in place
-    by ``n_steps`` RK4 steps of ``h``."""
+    by up to ``n_steps`` RK4 steps of ``h``; returns the steps done, fewer when the neighbour list went
+    :func:`~hexdem.engines.reference.kernel.stale` first."""
     n, p, m = x.shape[0], pair_xi.shape[0], wall_xi.shape[0]
     a = np.zeros((4, 3, n))
     ps, ws = np.zeros((4, p)), np.zeros((4, m))
     tx, ty, tu, tw, ts = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
     tp, tq = np.zeros(p), np.zeros(m)
     steps, shifts = (0.5 * h, 0.5 * h, h), (0.0, 0.25 * h * h, 0.5 * h * h)
-    for _ in range(n_steps):
+    for step in range(n_steps):
+        if stale(k, x, y):
+            return step
         _rates(k, x, y, u, w, spin, pair_xi, wall_xi, True, a[0], ps[0], ws[0])
         for s in range(3):  # stages 2-4: q + cv v + ca a, and z + cv z' for v, ω and ξ
             cv, ca = steps[s], shifts[s]
@@ -212,3 +222,4 @@ def integrate_frictional(k, x, y, u, w, spin, pair_xi, wall_xi, h, n_steps):
         _first_order(spin, h, a[0, 2], a[1, 2], a[2, 2], a[3, 2])
         _first_order(pair_xi, h, ps[0], ps[1], ps[2], ps[3])
         _first_order(wall_xi, h, ws[0], ws[1], ws[2], ws[3])
+    return n_steps

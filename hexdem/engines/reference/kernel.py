@@ -1,20 +1,18 @@
 """Compiled kernel of the reference integrator: the forces of eq. (model) and classical RK4.
 
 The paper's equations of motion (Sec. III, eq. (model)) with V(r) = (2/5) A [c − r]_+^{5/2}
-give each fixed bond a repulsive force A [c − r]_+^{3/2} along the current line of centres,
-where r = |rest + q_j − q_i| is the current distance of the bond's beads (rest vector
-``rest`` plus displacements q) and c their contact distance. A bead touching a flat wall
-with normal n feels A_w [−(g₀ + q·n)]_+^{3/2} along n (g₀ its gap at rest). Inside a curved
-wall (a circle whose centre is ρ from the bead's rest position along n) the depth is exact,
+give each pair of bodies a repulsive force A [c − r]_+^{3/2} along the current line of centres,
+where r = |rest + q_j − q_i| is the current distance of the pair (rest vector ``rest`` between
+their positions at t = 0 plus displacements q) and c their contact distance. A bead touching a
+flat wall with normal n feels A_w [−(g₀ + q·n)]_+^{3/2} along n (g₀ its gap at rest). Inside a
+curved wall (a circle whose centre is ρ from the bead's rest position along n) the depth is exact,
 −(g₀ + q·n) + (|ρn − q| − (ρ − q·n)), and the force acts along the current radius.
 
-Layout (built by :mod:`hexdem.engines.reference.engine`): every body owns a *cell* of flat arrays. Lattice
-bead {m, n} sits in the padded grid cell (n + 1)·C + (m + n)/2 + 1, so the paper's three
-bond directions e₁, e₂, e₃ become three constant cell offsets and a bond's partner is a
-shifted slice: the bond loop is a straight, branch-free pass over contiguous arrays that
-the compiler vectorises. Cells without a bead (padding) carry bonds of stiffness 0 and
-zero inverse mass. Bodies off the grid (the striker) follow the grid and are bonded
-through a short explicit pair list.
+The pairs are the neighbour list's (:mod:`hexdem.engines.reference.neighbours`): every pair whose
+gap was below the skin at the list's build, sorted by i, then j. A listed pair that does not touch
+adds nothing, so the forces do not depend on when the list was built. :func:`integrate` checks
+before every step whether a body has moved more than ``reach`` since the build and stops there,
+for the engine to rebuild the list.
 
 Compiled with numba (``error_model="numpy"`` lets divisions vectorise) and without
 fast-math, so results are IEEE-exact and reproducible.
@@ -31,87 +29,60 @@ _jit = njit(cache=True, error_model="numpy")
 
 
 class KernelArrays(NamedTuple):
-    """One model laid out for the kernel, in the run's unit system.
+    """One model and its neighbour list laid out for the kernel, in the run's unit system.
 
-    ``offsets`` (3,) cell offsets of the bond directions; lattice bonds start at cells
-    [0, ``hi``) and beads lie in [``lo``, ``hi``). Per bond direction, (3, hi):
-    ``rest_x``, ``rest_y`` rest vector from a cell to its partner, ``contact`` contact
-    distance c = R_i + R_j, ``stiffness`` A = k_n sqrt(R_eff) (0: no bond). Per cell:
-    ``inv_mass`` 1/M (0 for padding). Explicit pairs (i → j): ``pair_i``, ``pair_j``,
-    ``pair_rest_x``, ``pair_rest_y``, ``pair_contact``, ``pair_stiffness``. Wall contacts:
-    ``wall_cell``, inward normal ``wall_nx``, ``wall_ny`` at rest, rest gap ``wall_gap``,
-    ``wall_curvature`` 1/ρ (0: a plane), ``wall_stiffness`` A_w = k_n,wall sqrt(R_eff). Tsuji damping (:mod:`hexdem.model.dissipation`)
-    η = α sqrt(m_eff A) of each lattice bond (3, hi), explicit pair and wall contact, the damped force clipped at zero:
-    ``damping``, ``pair_damping``, ``wall_damping``; ``damped`` whether any is non-zero. Per cell: ``external_x``, ``external_y`` constant
-    forces (the held force of a precompressed packing's struck bead).
+    Listed pairs (i → j, b = 0 … P−1): ``pair_i``, ``pair_j`` bodies, ``pair_rest_x``,
+    ``pair_rest_y`` rest vector i → j (of their positions at t = 0), ``pair_contact`` contact
+    distance c = R_i + R_j, ``pair_stiffness`` A = k_n sqrt(R_eff). Wall contacts: ``wall_cell``
+    the body, inward normal ``wall_nx``, ``wall_ny`` at rest, rest gap ``wall_gap``,
+    ``wall_curvature`` 1/ρ (0: a plane), ``wall_stiffness`` A_w = k_n,wall sqrt(R_eff). Tsuji damping
+    (:mod:`hexdem.model.dissipation`) η = α sqrt(m_eff A) of each pair and wall contact, the damped
+    force clipped at zero: ``pair_damping``, ``wall_damping``; ``damped`` whether any is non-zero.
+    Per body: ``inv_mass`` 1/M, ``external_x``, ``external_y`` constant forces (the held force of a
+    precompressed packing's struck bead), ``built_x``, ``built_y`` its displacement at the list's
+    build; ``reach`` how far a body may move from there before the list must be rebuilt.
     """
 
-    offsets: np.ndarray
-    lo: int
-    hi: int
-    rest_x: np.ndarray
-    rest_y: np.ndarray
-    contact: np.ndarray
-    stiffness: np.ndarray
-    inv_mass: np.ndarray
     pair_i: np.ndarray
     pair_j: np.ndarray
     pair_rest_x: np.ndarray
     pair_rest_y: np.ndarray
     pair_contact: np.ndarray
     pair_stiffness: np.ndarray
+    pair_damping: np.ndarray
     wall_cell: np.ndarray
     wall_nx: np.ndarray
     wall_ny: np.ndarray
     wall_gap: np.ndarray
     wall_curvature: np.ndarray
     wall_stiffness: np.ndarray
-    damping: np.ndarray
-    pair_damping: np.ndarray
     wall_damping: np.ndarray
     damped: bool
+    inv_mass: np.ndarray
     external_x: np.ndarray
     external_y: np.ndarray
+    built_x: np.ndarray
+    built_y: np.ndarray
+    reach: float
 
 
 @_jit
-def _hertz_bonds(xi, yi, xj, yj, rest_x, rest_y, contact, stiffness, fx, fy):
-    """Force on bead j of each bond (i, j): A [c − r]_+^{3/2} along the line of centres."""
-    for p in range(fx.shape[0]):
-        dx = rest_x[p] + xj[p] - xi[p]
-        dy = rest_y[p] + yj[p] - yi[p]
-        r = np.sqrt(dx * dx + dy * dy)
-        overlap = max(contact[p] - r, 0.0)
-        f = stiffness[p] * overlap * np.sqrt(overlap) / r
-        fx[p] = f * dx
-        fy[p] = f * dy
+def stale(k, x, y):
+    """Whether a body at displacements (x, y) has moved more than ``k.reach`` since the neighbour
+    list's build (at ``k.built_x``, ``k.built_y``): the list must be rebuilt."""
+    limit = k.reach * k.reach
+    for c in range(x.shape[0]):
+        dx = x[c] - k.built_x[c]
+        dy = y[c] - k.built_y[c]
+        if dx * dx + dy * dy > limit:
+            return True
+    return False
 
 
 @_jit
-def _damped_bonds(xi, yi, xj, yj, ui, wi, uj, wj, rest_x, rest_y, contact, stiffness, damping, fx, fy):
-    """As :func:`_hertz_bonds` plus Tsuji's damping η δ^{1/4} δ̇ (δ̇ > 0 while compressing), the sum
-    clipped at zero (it never pulls: :mod:`hexdem.model.dissipation`)."""
-    for p in range(fx.shape[0]):
-        dx = rest_x[p] + xj[p] - xi[p]
-        dy = rest_y[p] + yj[p] - yi[p]
-        r = np.sqrt(dx * dx + dy * dy)
-        overlap = max(contact[p] - r, 0.0)
-        rate = -(dx * (uj[p] - ui[p]) + dy * (wj[p] - wi[p])) / r
-        root = np.sqrt(overlap)
-        f = max(stiffness[p] * overlap * root + damping[p] * np.sqrt(root) * rate, 0.0) / r
-        fx[p] = f * dx
-        fy[p] = f * dy
-
-
-@_jit
-def _net_bond_force(in0, in1, in2, out0, out1, out2, scale, net):
-    """Net force on each cell, times ``scale``: its bonds as partner j (+) minus as origin i (−)."""
-    for p in range(net.shape[0]):
-        net[p] = (in0[p] + in1[p] + in2[p] - out0[p] - out1[p] - out2[p]) * scale[p]
-
-
-@_jit
-def _pair_forces(k, x, y, u, w, scale, fx, fy):
+def _pair_forces(k, x, y, u, w, fx, fy):
+    """Add the force of every touching listed pair: A δ^{3/2}, plus Tsuji's η δ^{1/4} δ̇ (δ̇ > 0 while
+    compressing) in a damped model, the sum clipped at zero (it never pulls)."""
     for b in range(k.pair_i.shape[0]):
         i, j = k.pair_i[b], k.pair_j[b]
         dx = k.pair_rest_x[b] + x[j] - x[i]
@@ -119,17 +90,20 @@ def _pair_forces(k, x, y, u, w, scale, fx, fy):
         r = np.sqrt(dx * dx + dy * dy)
         overlap = k.pair_contact[b] - r
         if overlap > 0.0:
-            rate = -(dx * (u[j] - u[i]) + dy * (w[j] - w[i])) / r
             root = np.sqrt(overlap)
-            f = max(k.pair_stiffness[b] * overlap * root + k.pair_damping[b] * np.sqrt(root) * rate, 0.0) / r
-            fx[i] -= f * dx * scale[i]
-            fy[i] -= f * dy * scale[i]
-            fx[j] += f * dx * scale[j]
-            fy[j] += f * dy * scale[j]
+            if k.damped:
+                rate = -(dx * (u[j] - u[i]) + dy * (w[j] - w[i])) / r
+                f = max(k.pair_stiffness[b] * overlap * root + k.pair_damping[b] * np.sqrt(root) * rate, 0.0) / r
+            else:
+                f = k.pair_stiffness[b] * overlap * root / r
+            fx[i] -= f * dx
+            fy[i] -= f * dy
+            fx[j] += f * dx
+            fy[j] += f * dy
 
 
 @_jit
-def _wall_forces(k, x, y, u, v, scale, fx, fy):
+def _wall_forces(k, x, y, u, v, fx, fy):
     for w in range(k.wall_cell.shape[0]):
         c = k.wall_cell[w]
         nx, ny = k.wall_nx[w], k.wall_ny[w]
@@ -144,36 +118,23 @@ def _wall_forces(k, x, y, u, v, scale, fx, fy):
         if depth > 0.0:
             rate = -(u[c] * nx + v[c] * ny)
             root = np.sqrt(depth)
-            f = max(k.wall_stiffness[w] * depth * root + k.wall_damping[w] * np.sqrt(root) * rate, 0.0) * scale[c]
+            f = max(k.wall_stiffness[w] * depth * root + k.wall_damping[w] * np.sqrt(root) * rate, 0.0)
             fx[c] += f * nx
             fy[c] += f * ny
 
 
 @_jit
-def forces(k, x, y, u, w, scale, bond_fx, bond_fy, fx, fy):
-    """Net force on every cell at displacements (x, y) and velocities (u, w), times ``scale``
-    (1: forces; 1/M: accelerations), into (fx, fy); ``bond_fx``, ``bond_fy`` are (3, hi) scratch."""
-    lo, hi = k.lo, k.hi
-    for d in range(3):
-        o = k.offsets[d]
-        if k.damped:
-            _damped_bonds(x[:hi], y[:hi], x[o:o + hi], y[o:o + hi], u[:hi], w[:hi], u[o:o + hi], w[o:o + hi],
-                          k.rest_x[d], k.rest_y[d], k.contact[d], k.stiffness[d], k.damping[d],
-                          bond_fx[d], bond_fy[d])
-        else:
-            _hertz_bonds(x[:hi], y[:hi], x[o:o + hi], y[o:o + hi], k.rest_x[d], k.rest_y[d],
-                         k.contact[d], k.stiffness[d], bond_fx[d], bond_fy[d])
-    o0, o1, o2 = k.offsets[0], k.offsets[1], k.offsets[2]
-    for bond, net in ((bond_fx, fx), (bond_fy, fy)):
-        net[:lo] = 0.0
-        net[hi:] = 0.0
-        _net_bond_force(bond[0, lo - o0:hi - o0], bond[1, lo - o1:hi - o1], bond[2, lo - o2:hi - o2],
-                        bond[0, lo:hi], bond[1, lo:hi], bond[2, lo:hi], scale[lo:hi], net[lo:hi])
-    _pair_forces(k, x, y, u, w, scale, fx, fy)
-    _wall_forces(k, x, y, u, w, scale, fx, fy)
+def forces(k, x, y, u, w, scale, fx, fy):
+    """Net force on every body at displacements (x, y) and velocities (u, w), times ``scale``
+    (1: forces; 1/M: accelerations), into (fx, fy)."""
     for c in range(fx.shape[0]):
-        fx[c] += k.external_x[c] * scale[c]
-        fy[c] += k.external_y[c] * scale[c]
+        fx[c] = k.external_x[c]
+        fy[c] = k.external_y[c]
+    _pair_forces(k, x, y, u, w, fx, fy)
+    _wall_forces(k, x, y, u, w, fx, fy)
+    for c in range(fx.shape[0]):
+        fx[c] *= scale[c]
+        fy[c] *= scale[c]
 
 
 @_jit
@@ -204,7 +165,8 @@ def _advance(q, v, h, a1, a2, a3, a4):
 
 @_jit
 def integrate(k, x, y, u, w, h, n_steps):
-    """Advance displacements (x, y) and velocities (u, w) in place by ``n_steps`` RK4 steps of ``h``.
+    """Advance displacements (x, y) and velocities (u, w) in place by up to ``n_steps`` RK4 steps
+    of ``h``; returns the steps done, fewer when the neighbour list went :func:`stale` first.
 
     Stage velocities (v + h/2 a₁, v + h/2 a₂, v + h a₃ of classical RK4) are formed only for a
     damped model; without damping the forces depend on positions alone.
@@ -213,15 +175,17 @@ def integrate(k, x, y, u, w, h, n_steps):
     a = np.zeros((8, n))
     tx, ty = np.zeros(n), np.zeros(n)
     tu, tw = (np.zeros(n), np.zeros(n)) if k.damped else (u, w)
-    bond_fx, bond_fy = np.zeros((3, k.hi)), np.zeros((3, k.hi))
     half, sq = 0.5 * h, h * h
-    for _ in range(n_steps):
-        forces(k, x, y, u, w, k.inv_mass, bond_fx, bond_fy, a[0], a[1])
+    for step in range(n_steps):
+        if stale(k, x, y):
+            return step
+        forces(k, x, y, u, w, k.inv_mass, a[0], a[1])
         _stage(k, x, y, u, w, half, 0.0, a[0], a[1], a[0], a[1], tx, ty, tu, tw)
-        forces(k, tx, ty, tu, tw, k.inv_mass, bond_fx, bond_fy, a[2], a[3])
+        forces(k, tx, ty, tu, tw, k.inv_mass, a[2], a[3])
         _stage(k, x, y, u, w, half, 0.25 * sq, a[0], a[1], a[2], a[3], tx, ty, tu, tw)
-        forces(k, tx, ty, tu, tw, k.inv_mass, bond_fx, bond_fy, a[4], a[5])
+        forces(k, tx, ty, tu, tw, k.inv_mass, a[4], a[5])
         _stage(k, x, y, u, w, h, 0.5 * sq, a[2], a[3], a[4], a[5], tx, ty, tu, tw)
-        forces(k, tx, ty, tu, tw, k.inv_mass, bond_fx, bond_fy, a[6], a[7])
+        forces(k, tx, ty, tu, tw, k.inv_mass, a[6], a[7])
         _advance(x, u, h, a[0], a[2], a[4], a[6])
         _advance(y, w, h, a[1], a[3], a[5], a[7])
+    return n_steps
