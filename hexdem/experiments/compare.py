@@ -2,7 +2,7 @@
 
 :func:`run_comparison` runs ``config`` once with each engine (each run published as by
 ``hexdem run``, in ``OUT/lammps`` and ``OUT/reference``), then compares peak speed and
-arrival time bead by bead along the three observation lines and writes
+arrival time bead by bead along every observation line of the packing and writes
 ``compare.csv`` (one row per bead), ``compare.json`` (largest differences, tolerances,
 verdict) and ``compare.png``. Values are in the run's units (SI or A = d = M = 1).
 
@@ -17,6 +17,7 @@ larger than that.
 
 from __future__ import annotations
 
+import itertools
 import textwrap
 from dataclasses import dataclass, replace
 
@@ -31,9 +32,10 @@ from hexdem.experiments.run import run_experiment
 from hexdem.model.config import RunConfig
 from hexdem.model.dissipation import damping_coefficient
 from hexdem.model.granular import GranularModel, RunSettings
-from hexdem.model.lattice import LINE_STEPS
 
 ENGINE_NAMES = ("lammps", "reference")
+#: Markers of the lines in the figure, in the order of the packing's lines.
+LINE_MARKERS = "o^v<>sD"
 #: Columns of ``compare.csv``; differences are reference − LAMMPS (relative to LAMMPS for peaks).
 #: ``arrival_tolerance`` is the bead's own: the tolerance's floor plus its rate times the bead's arrival.
 COMPARE_COLUMNS = ("line", "n", "bead_id", "peak_lammps", "peak_reference", "peak_rel_diff",
@@ -171,8 +173,8 @@ def compare_analyses(lammps: ImpactAnalysis, reference: ImpactAnalysis, v0: floa
     time_s = lammps.settings.units.time_s
     a, b = lammps.results, reference.results
     rows = []
-    for name in LINE_STEPS:
-        for n, bead in enumerate(a.lines[name]):
+    for name, beads in a.lines.items():
+        for n, bead in enumerate(beads):
             pa, pb, ta, tb = (float(v) for v in (a.peak_speed[bead], b.peak_speed[bead],
                                                   a.arrival_time[bead], b.arrival_time[bead]))
             checked = bool(np.nanmax([pa, pb, -np.inf]) > tolerances.min_peak_fraction * v0)
@@ -194,7 +196,8 @@ def comparison_plot(comparison: EngineComparison, v0: float, path) -> None:
     units = UNIT_LABELS[comparison.units]
     scale = units["time_scale"]
     fig, axes = subplots(2, 2, figsize=(11, 7.5), sharex=True)
-    for k, (name, marker) in enumerate(zip(LINE_STEPS, "o^v")):
+    lines = dict.fromkeys(row[0] for row in comparison.rows)
+    for k, (name, marker) in enumerate(zip(lines, itertools.cycle(LINE_MARKERS))):
         rows = [row for row in comparison.rows if row[0] == name]
         n = np.array([row[1] for row in rows])
         column = {key: np.array([row[COMPARE_COLUMNS.index(key)] for row in rows], float)
