@@ -156,3 +156,18 @@ def test_both_engines_agree_on_a_random_initial_state_in_a_precompressed_packing
         assert np.array_equal(np.isnan(lammps.peak_speed), np.isnan(reference.peak_speed))
         errors.append(np.nanmax(np.abs(lammps.peak_speed - reference.peak_speed)) / scale)
     assert errors[0] < 1e-3 and 3 < errors[0] / errors[1] < 5, errors
+
+
+def test_beads_csv_places_the_beads_where_the_state_starts_them(tmp_path):
+    """A displacement of the state moves the bead's x, y in beads.csv: the table shows where the
+    beads are at t = 0, not the packed sites."""
+    state = tmp_path / "state.csv"
+    state.write_text("m,n,vx,vy,dx,dy\n1,1,0,0,0.001,-0.002\n")
+    config = tmp_path / "run.toml"
+    config.write_text('shape = "sites"\nsites = [[0, 0], [1, 1], [0, 4]]\nsite_walls_deg = []\nduration = 2e-4\n'
+                      f'initial_state_file = "{state}"\n')
+    assert main(["run", "--config", str(config), "--out", str(tmp_path / "out")]) == 0
+    packed = RunConfig(shape="sites", sites=[[0, 0], [1, 1], [0, 4]]).lattice().positions_m
+    rows = read_csv(tmp_path / "out" / "beads.csv")[1]
+    placed = np.array([[float(row["x"]), float(row["y"])] for row in rows])
+    np.testing.assert_allclose(placed - packed, [[0, 0], [0.001, -0.002], [0, 0]], atol=1e-15)

@@ -48,7 +48,7 @@ class ImpactAnalysis:
         self.results = r = SimpleNamespace()
         r.units = units.name
         r.length_unit_m = units.length_m
-        r.positions = model.lattice.positions_m / units.length_m
+        r.positions = model.initial_positions_m()[:len(model.lattice)] / units.length_m  # where the beads start
         r.peak_speed, r.t_peak, r.arrival_time, r.reach_time = peak_speed, t_peak, arrival_time, reach_time
         r.end_velocity = np.asarray(end_velocity, float)
         r.lines = model.lattice.lines()
