@@ -3,10 +3,13 @@ row is a chain carrying Nesterenko's solitary wave, the centered-square crystal 
 about its strike, an intruder in a chain splits the wave while momentum and energy are kept,
 and a packing read from a file is the packing it was written from."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from hexdem.errors import HexdemError
+from hexdem.experiments.compare import MARGIN, PEAK_ERROR_N2, PLACED_PEAK_ERROR_N2, Tolerances, run_comparison
 from hexdem.experiments.run import simulate
 from hexdem.model.config import RunConfig
 from hexdem.model.materials import sphere_mass
@@ -14,6 +17,7 @@ from hexdem.model.square_crystals import interstitial_fit_m
 from hexdem.theory.solitary import chain_speed_scale_m_s, solitary_speed_m_s
 
 V0 = 0.4
+GALLERY = Path(__file__).resolve().parent.parent / "docs" / "gallery" / "configs"
 #: The square's struck row is read over these beads: the pulse has formed, the far wall is 2 beads on.
 SQUARE_WINDOW = (5, 12)
 
@@ -135,3 +139,37 @@ def test_a_chains_intruder_mass_follows_its_diameter():
     model = config.model()
     assert model.masses_kg[1] == pytest.approx(sphere_mass(0.01, model.bead))
     np.testing.assert_allclose(model.lattice.positions_m[:, 0], [0.0, 0.015, 0.03])
+
+
+@pytest.mark.parametrize("changes", [
+    {"shape": "square", "rows": 7, "columns": 9, "strike_angle_deg": 5.0},
+    {"shape": "square", "rows": 7, "columns": 9, "strike_angle_deg": 20.0, "friction": 0.3},
+    {"shape": "centered-square", "rows": 7, "columns": 9, "interstitial_material": "brass"},
+    {"shape": "centered-square", "rows": 5, "columns": 7, "restitution": 0.9},
+    {"shape": "chain", "beads": 30, "diameters_m": [0.01905] * 15 + [0.009525] + [0.01905] * 14, "duration": 1.5e-3},
+], ids=["square-oblique", "square-friction", "centered-square", "centered-square-damped", "chain-intruder"])
+def test_both_engines_agree_on_every_packing(tmp_path, changes):
+    """LAMMPS and the reference integrator, each finding its contacts from the geometry, agree at
+    ``hexdem compare``'s default tolerances on every line of the packing (their peak tolerance
+    from :data:`~hexdem.experiments.compare.PLACED_PEAK_ERROR_N2`)."""
+    comparison = run_comparison(RunConfig(**changes), tmp_path, log=lambda message: None)
+    assert comparison.agree, comparison.verdict()
+    assert comparison.n_checked >= 10
+
+
+def test_both_engines_agree_on_a_packing_file_with_rattlers_and_hull_walls(tmp_path):
+    """The gallery's measured hexagon: five undersized rattlers, five brass beads, walls along its hull."""
+    config = RunConfig.from_toml(GALLERY / "packing.toml")
+    comparison = run_comparison(config, tmp_path, log=lambda message: None)
+    assert comparison.agree, comparison.verdict()
+    assert {row[0] for row in comparison.rows} == {"0", "+30", "-30"}
+
+
+def test_compares_peak_tolerance_off_the_triangular_lattice_is_the_measured_one():
+    """MARGIN times 5.0/N² on a square (the largest error measured off the lattice), 0.8/N² on the hexagon."""
+    for config, coefficient in ((RunConfig(shape="square", rows=5, columns=5), PLACED_PEAK_ERROR_N2),
+                                (RunConfig(edge_beads=4), PEAK_ERROR_N2)):
+        model = config.model()
+        settings = config.settings(model)
+        steps = settings.contact_time_s / settings.dt_s
+        assert Tolerances().for_run(model, settings).peak_rel == pytest.approx(MARGIN * coefficient / steps**2)
