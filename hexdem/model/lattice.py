@@ -95,7 +95,10 @@ class Lattice:
         return self._lookup.get((m, n))
 
     def bonds(self) -> np.ndarray:
-        """(B, 2) index pairs of touching neighbours, each bond once (the paper's fixed bonds)."""
+        """(B, 2) index pairs of touching neighbours of a triangular packing, each pair once (the
+        paper's e₁, e₂, e₃); other packings' contacts come from their geometry alone."""
+        if self.ray_angles_deg is not None:
+            raise HexdemError(f"{self.shape} is not a triangular packing: its contacts come from the geometry")
         pairs = [(i, j) for i, (m, n) in enumerate(self.indices.tolist())
                  for dm, dn in BOND_STEPS if (j := self.index_of(m + dm, n + dn)) is not None]
         return np.array(pairs, dtype=int).reshape(-1, 2)
