@@ -1,4 +1,4 @@
-"""Packings beyond the triangular lattice, checked by their physics: the square crystal's struck
+"""Packings beyond the triangular lattice, checked by their physics in both engines: the square crystal's struck
 row is a chain carrying Nesterenko's solitary wave, the centered-square crystal is symmetric
 about its strike, an intruder in a chain splits the wave while momentum and energy are kept,
 and a packing read from a file is the packing it was written from."""
@@ -22,9 +22,10 @@ GALLERY = Path(__file__).resolve().parent.parent / "docs" / "gallery" / "configs
 SQUARE_WINDOW = (5, 12)
 
 
-@pytest.fixture(scope="module")
-def square_run(tmp_path_factory):
-    return simulate(RunConfig(shape="square", rows=15, columns=15), tmp_path_factory.mktemp("square"))
+@pytest.fixture(scope="module", params=["lammps", "reference"])
+def square_run(request, tmp_path_factory):
+    return simulate(RunConfig(shape="square", rows=15, columns=15, engine=request.param),
+                    tmp_path_factory.mktemp("square"))
 
 
 def test_the_square_crystals_struck_row_carries_nesterenkos_solitary_wave(square_run):
@@ -46,16 +47,18 @@ def test_the_square_crystals_struck_row_carries_nesterenkos_solitary_wave(square
 def test_an_oblique_strike_sends_motion_up_the_struck_column(tmp_path, square_run):
     """At 5° the struck bead pushes the bead above it head-on with its V0 sin 5° (no bead above
     moves at 0°): that bead takes at least half of it."""
-    tilted = simulate(RunConfig(shape="square", rows=15, columns=15, strike_angle_deg=5.0), tmp_path)
+    tilted = simulate(RunConfig(shape="square", rows=15, columns=15, strike_angle_deg=5.0,
+                                engine=square_run.engine["name"]), tmp_path)
     above = tilted.results.lines["+90"][1]
     assert tilted.results.peak_speed[above] > 0.5 * V0 * np.sin(np.radians(5.0))
     assert square_run.results.peak_speed[above] == 0.0
 
 
-def test_the_centered_square_crystal_is_symmetric_about_its_strike(tmp_path):
+@pytest.mark.parametrize("engine", ["lammps", "reference"])
+def test_the_centered_square_crystal_is_symmetric_about_its_strike(tmp_path, engine):
     """Mirrored in the strike axis (label {m, n} to {−m, n}), every bead peaks and arrives as its image."""
-    analysis = simulate(RunConfig(shape="centered-square", rows=7, columns=7, interstitial_material="brass"),
-                        tmp_path)
+    analysis = simulate(RunConfig(shape="centered-square", rows=7, columns=7, interstitial_material="brass",
+                                  engine=engine), tmp_path)
     r, labels = analysis.results, analysis.model.lattice.indices
     image = [analysis.model.lattice.index_of(-m, n) for m, n in labels.tolist()]
     np.testing.assert_allclose(r.peak_speed[image], r.peak_speed, rtol=1e-9, atol=1e-12)
@@ -67,14 +70,16 @@ def test_the_centered_square_crystal_is_symmetric_about_its_strike(tmp_path):
     assert {m.name for m in analysis.model.materials} == {"steel316", "brass"}
 
 
-def test_a_light_intruder_splits_the_chains_wave_and_keeps_momentum_and_energy(tmp_path):
+@pytest.mark.parametrize("engine", ["lammps", "reference"])
+def test_a_light_intruder_splits_the_chains_wave_and_keeps_momentum_and_energy(tmp_path, engine):
     """A bead of half the diameter (an eighth of the mass) in the middle of a free chain: most of the
     solitary wave's energy goes on past it (measured: 94 %), part comes back, and the chain's
     momentum m V0 and energy are those the impact gave it."""
     beads, intruder, d = 40, 20, 0.01905
     sizes = np.full(beads, d)
     sizes[intruder] = d / 2
-    analysis = simulate(RunConfig(shape="chain", beads=beads, diameters_m=sizes.tolist(), duration=2.0e-3), tmp_path)
+    analysis = simulate(RunConfig(shape="chain", beads=beads, diameters_m=sizes.tolist(), duration=2.0e-3,
+                                  engine=engine), tmp_path)
     r, model = analysis.results, analysis.model
     masses = model.masses_kg[:beads]
     np.testing.assert_allclose(masses @ r.end_velocity, [masses[0] * V0, 0.0], atol=1e-9 * masses[0] * V0)
