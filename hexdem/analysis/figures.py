@@ -12,6 +12,7 @@ import numpy as np
 from matplotlib import colormaps
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import EllipseCollection
+from matplotlib.patches import Patch
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, LogFormatter
@@ -73,16 +74,44 @@ def save(fig, path) -> None:
         fig.savefig(tmp, format="png", dpi=150, pil_kwargs={"compress_level": PNG_COMPRESSION})
 
 
-def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=None, norm=None):
+#: How beads without a value are drawn, outside every colour scale (a colour scale never hatches),
+#: with their legend entry: white, striped for a bead whose pulse was still rising when the run
+#: ended, dotted for one that never moved, crossed for any other bead without a value.
+UNMEASURED_STYLES = {
+    "still rising at the run's end": {"facecolor": "white", "hatch": "////", "edgecolor": "0.45"},
+    "never moved": {"facecolor": "white", "hatch": "..", "edgecolor": "0.45"},
+    "no value": {"facecolor": "white", "hatch": "xx", "edgecolor": "0.45"},
+}
+
+
+def _circles(ax, positions, diameters, **style) -> EllipseCollection:
+    return EllipseCollection(diameters, diameters, np.zeros(len(diameters)), units="xy", offsets=positions,
+                             offset_transform=ax.transData, linewidth=0.2, **style)
+
+
+def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=None, norm=None, unmeasured=None):
     """Beads as true-size circles (one collection, sized in data units) coloured by ``values``
-    (NaN drawn grey) through ``norm`` (None: linear); returns the mappable."""
-    circles = EllipseCollection(diameters, diameters, np.zeros(len(diameters)), units="xy", offsets=positions,
-                                offset_transform=ax.transData, norm=norm,
-                                cmap=colormaps[cmap].with_extremes(bad="lightgrey"), edgecolor="k", linewidth=0.2)
-    circles.set_array(np.ma.masked_invalid(values))
+    through ``norm`` (None: linear); returns the mappable. ``unmeasured``: {name in
+    :data:`UNMEASURED_STYLES`: mask of the beads it describes}, drawn in that style outside the
+    colour scale and named in a legend; any other NaN is drawn as "no value"."""
+    values = np.asarray(values, float)
+    groups = {name: np.asarray(beads, bool) for name, beads in (unmeasured or {}).items()}
+    flagged = np.any([np.zeros(len(values), bool), *groups.values()], axis=0)
+    groups["no value"] = ~np.isfinite(values) & ~flagged
+    coloured = ~np.any(list(groups.values()), axis=0)
+    circles = _circles(ax, positions[coloured], diameters[coloured], norm=norm, cmap=colormaps[cmap], edgecolor="k")
+    circles.set_array(values[coloured])
     if clim is not None:
         circles.set_clim(*clim)
     ax.add_collection(circles)
+    legend = []
+    for name, beads in groups.items():
+        if np.any(beads):
+            ax.add_collection(_circles(ax, positions[beads], diameters[beads], **UNMEASURED_STYLES[name]))
+            legend.append(Patch(label=name, **UNMEASURED_STYLES[name]))
+    if legend:
+        ax.legend(handles=legend, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=len(legend), frameon=False,
+                  fontsize="small")
     radius = np.max(diameters) / 2
     ax.update_datalim(np.vstack([positions.min(axis=0) - radius, positions.max(axis=0) + radius]))
     ax.set_aspect("equal")
@@ -111,15 +140,23 @@ def draw_walls(ax, walls, positions, radii, scale=1.0, **style):
         ax.plot(ends[:, 0], ends[:, 1], **{"color": "k", "linewidth": 2, **style})
 
 
-def draw_lattice(ax, results, model, values, label: str, cmap="viridis", norm=None, marker_colour="w"):
+def unmeasured_beads(results) -> dict:
+    """{name: mask} of the beads without a peak (:data:`UNMEASURED_STYLES`): still rising when
+    the run ended (peak NaN), or never moved (peak 0)."""
+    peaks = results.peak_speed
+    return {"still rising at the run's end": np.isnan(peaks), "never moved": peaks == 0}
+
+
+def draw_lattice(ax, results, model, values, label: str, cmap="viridis", norm=None, marker_colour="w",
+                 unmeasured=None):
     """The packing's beads coloured by ``values`` (one per bead, in the run's units), its walls,
     its struck beads marked with crosses of ``marker_colour``, axes labelled; returns the beads'
-    mappable."""
+    mappable. ``unmeasured`` as for :func:`bead_map`."""
     units = UNIT_LABELS[results.units]
     scale = 1.0 / results.length_unit_m
     positions = results.positions
     diameters = model.lattice.diameters_m * scale
-    circles = bead_map(ax, positions, diameters, values, cmap=cmap, label=label, norm=norm)
+    circles = bead_map(ax, positions, diameters, values, cmap=cmap, label=label, norm=norm, unmeasured=unmeasured)
     draw_walls(ax, model.walls, positions, diameters / 2, scale=scale)
     struck = positions[np.unique(model.struck_beads)]
     ax.plot(struck[:, 0], struck[:, 1], linestyle="", marker="x", color=marker_colour, markersize=8, mew=2)
@@ -132,7 +169,7 @@ def lattice_map(results, model, values, path, label: str, title: str, cmap="viri
     """One value per bead drawn on the lattice (like Fig. 8a), walls drawn, struck beads marked."""
     fig, ax = subplots(figsize=(7, 6))
     fig.subplots_adjust(left=0.12, right=0.98, bottom=0.09, top=0.94)
-    draw_lattice(ax, results, model, values, label, cmap, norm)
+    draw_lattice(ax, results, model, values, label, cmap, norm, unmeasured=unmeasured_beads(results))
     set_title(ax, title)
     save(fig, path)
 
