@@ -20,4 +20,4 @@ def test_beads_without_a_peak_are_drawn_outside_the_scale_and_named_in_the_legen
     assert all(collection.get_hatch() for collection in others), "outside the scale: hatched"
     assert len({collection.get_hatch() for collection in others}) == 3, "told apart"
     assert not coloured.get_hatch()
-    assert {text.get_text() for text in ax.get_legend().get_texts()} == set(UNMEASURED_STYLES)
+    assert {text.get_text() for text in fig.legends[0].get_texts()} == set(UNMEASURED_STYLES)

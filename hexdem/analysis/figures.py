@@ -110,8 +110,7 @@ def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=No
             ax.add_collection(_circles(ax, positions[beads], diameters[beads], **UNMEASURED_STYLES[name]))
             legend.append(Patch(label=name, **UNMEASURED_STYLES[name]))
     if legend:
-        ax.legend(handles=legend, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=len(legend), frameon=False,
-                  fontsize="small")
+        ax.figure.legend(handles=legend, loc="lower center", ncol=len(legend), frameon=False, fontsize="small")
     radius = np.max(diameters) / 2
     ax.update_datalim(np.vstack([positions.min(axis=0) - radius, positions.max(axis=0) + radius]))
     ax.set_aspect("equal")
@@ -167,8 +166,8 @@ def draw_lattice(ax, results, model, values, label: str, cmap="viridis", norm=No
 
 def lattice_map(results, model, values, path, label: str, title: str, cmap="viridis", norm=None) -> None:
     """One value per bead drawn on the lattice (like Fig. 8a), walls drawn, struck beads marked."""
-    fig, ax = subplots(figsize=(7, 6))
-    fig.subplots_adjust(left=0.12, right=0.98, bottom=0.09, top=0.94)
+    fig, ax = subplots(figsize=(7, 6.3))
+    fig.subplots_adjust(left=0.12, right=0.98, bottom=0.13, top=0.94)  # room for the legend below
     draw_lattice(ax, results, model, values, label, cmap, norm, unmeasured=unmeasured_beads(results))
     set_title(ax, title)
     save(fig, path)
