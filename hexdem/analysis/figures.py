@@ -21,8 +21,10 @@ from hexdem.analysis.front_shape import HEXAGON_SIXFOLD
 from hexdem.common.io import atomic_path
 from hexdem.model.walls import CurvedWall
 
+#: Axis units of the run's unit systems: SI, or the paper's (eq. 3): lengths in d, times in
+#: T = sqrt(M / (A d^½)), so speeds in d/T = sqrt(A/M) d^(5/4).
 UNIT_LABELS = {"si": {"length": "m", "speed": "m/s", "time": "ms", "time_scale": 1e3},
-               "nondimensional": {"length": "d", "speed": "√(A/M) d^(5/4)", "time": "T", "time_scale": 1.0}}
+               "nondimensional": {"length": "d", "speed": "d/T", "time": "T", "time_scale": 1.0}}
 
 #: Fixed margins of the one-panel figures every run writes: a constrained layout would cost
 #: about a tenth of a second per figure, measured on the default run.
