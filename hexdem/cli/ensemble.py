@@ -46,13 +46,19 @@ def add_arguments(parser) -> None:
     parser.add_argument("--workers", type=int, default=os.cpu_count() or 1, metavar="N",
                         help="LAMMPS partitions (processes) at once (default: the number of cores)")
     add_launcher(parser, "-n N lmp -partition Nx1 -in run.in")
+    parser.add_argument("--shape", default="hexagon", help="packing: hexagon, square or centered-square "
+                        "(default hexagon)")
     parser.add_argument("--edge-beads", type=int, default=11, help="beads per hexagon edge (default 11)")
+    parser.add_argument("--rows", type=int, default=15, help="rows of a square or centered-square crystal (default 15)")
+    parser.add_argument("--columns", type=int, default=15,
+                        help="columns of a square or centered-square crystal (default 15)")
     parser.add_argument("--tol-mm", type=float, help="diameter tolerance tol in mm (default 0.0127)")
     parser.add_argument("--sigma-mm", type=float, help="standard deviation of the diameters in mm (default 6 tol)")
     parser.add_argument("--tilt-deg", type=float, default=5.0,
                         help="tilt of the set-up: gravity g sin(tilt) along the strike (default 5)")
-    parser.add_argument("--push-force", type=float, default=5.0, metavar="NEWTON",
-                        help="inward force on the edge beads while compacting (default 5)")
+    parser.add_argument("--push-force", type=float, metavar="NEWTON",
+                        help="inward force on the edge beads while compacting (default 5 on the hexagon, "
+                        "0.05 on the crystals, whose rows buckle at 5)")
     parser.add_argument("--max-settle-steps", type=int, default=1_000_000, metavar="N",
                         help="steps after which a preparation stage that has not settled is an error (default 1e6)")
     parser.add_argument("--duration-ms", type=float, help="length of every impact run in ms "
@@ -65,15 +71,19 @@ def add_arguments(parser) -> None:
 
 def config_from_args(args):
     from hexdem.disorder.ensemble import EnsembleConfig
-    from hexdem.disorder.preparation import Disorder, Preparation
+    from hexdem.disorder.preparation import CRYSTAL_PUSH_FORCE_N, Disorder, Preparation
     from hexdem.model.materials import PAPER_DIAMETER_M
 
     sizes = {name: value * 1e-3 for name, value in (("tol_m", args.tol_mm), ("sigma_m", args.sigma_mm))
              if value is not None}
     disorder = Disorder(PAPER_DIAMETER_M, **sizes)
-    preparation = Preparation(push_force_n=args.push_force, tilt_deg=args.tilt_deg, max_steps=args.max_settle_steps)
+    push = args.push_force
+    if push is None:
+        push = Preparation.push_force_n if args.shape == "hexagon" else CRYSTAL_PUSH_FORCE_N
+    preparation = Preparation(push_force_n=push, tilt_deg=args.tilt_deg, max_steps=args.max_settle_steps)
     return EnsembleConfig(realizations=args.realizations, velocities_m_s=parse_numbers(args.velocities),
-                          seed=args.seed, edge_beads=args.edge_beads, disorder=disorder, preparation=preparation,
+                          seed=args.seed, shape=args.shape, edge_beads=args.edge_beads, rows=args.rows,
+                          columns=args.columns, disorder=disorder, preparation=preparation,
                           duration_s=None if args.duration_ms is None else args.duration_ms * 1e-3,
                           reference_bead=parse_bead(args.reference_bead))
 

@@ -55,6 +55,10 @@ RESULT_NAME = "result.npz"
 MANIFEST_NAME = "ensemble.json"
 #: An impact is sampled this many times per contact time (every 10 steps of the default τ/140).
 IMPACT_SAMPLES_PER_CONTACT = 14
+#: The packings an ensemble can be built on.
+ENSEMBLE_SHAPES = ("hexagon", "square", "centered-square")
+#: The shape keys of an ensemble and their values in ensembles made before they existed.
+SHAPE_DEFAULTS = {"shape": "hexagon", "rows": 15, "columns": 15}
 #: Progress-bar labels of the phases.
 PHASE_LABELS = {"compact": "compacting", "settle": "settling", "impacts": "impacts"}
 
@@ -73,8 +77,10 @@ def check_impact_steps(name: str, steps_per_contact) -> int:
 
 @dataclass(frozen=True)
 class EnsembleConfig:
-    """An ensemble: ``realizations`` packings of a hexagon with ``edge_beads`` per edge,
-    each struck at every striker speed of ``velocities_m_s`` [m/s].
+    """An ensemble: ``realizations`` packings of ``shape`` (:data:`ENSEMBLE_SHAPES`): a hexagon with
+    ``edge_beads`` per edge, or a square or centered-square crystal of ``rows`` × ``columns``
+    (:mod:`hexdem.model.square_crystals`), each struck at every striker speed of
+    ``velocities_m_s`` [m/s].
 
     ``seed`` seeds every realization's diameters; ``disorder`` and ``preparation`` are Sec.
     VI-A; ``steps_per_contact`` the impacts' time step, τ/this (τ the two-bead Hertz contact
@@ -85,7 +91,8 @@ class EnsembleConfig:
     ``duration_factor``: 1.5 lets the slower disordered wave reach the lines' far beads,
     while the far wall's reflection has not yet changed the ideal lattice's peaks, which it
     does at 1.75); ``reference_bead`` {m, n} the bead whose arrival is t = 0 in the maps
-    (Fig. 8's white x; default: bead 1 of the 0° line, the sensor nearest the impact);
+    (Fig. 8's white x; default {0, 2}: bead 1 of the 0° line, the sensor nearest the impact, on
+    the hexagon and the centered square; bead 2 on the square, whose labels are row and column);
     ``friction`` Coulomb's μ of the impacts' contacts, beads and walls alike
     (:mod:`hexdem.model.contact_law`; 0: the paper's frictionless spheres). The preparation is
     frictionless whatever ``friction`` is: every ensemble of the same diameters starts its
@@ -103,9 +110,14 @@ class EnsembleConfig:
     duration_factor: float = 1.5
     reference_bead: tuple[int, int] = (0, 2)
     friction: float = 0.0
+    shape: str = "hexagon"
+    rows: int = 15
+    columns: int = 15
 
     def __post_init__(self):
         positive_int("the number of realizations", self.realizations)
+        if self.shape not in ENSEMBLE_SHAPES:
+            raise HexdemError(f"ensembles are built on shape {', '.join(ENSEMBLE_SHAPES)}, not {self.shape!r}")
         check_impact_steps("steps_per_contact", self.steps_per_contact)
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
             raise HexdemError(f"the seed must be a non-negative integer, got {self.seed!r}")
@@ -125,7 +137,8 @@ class EnsembleConfig:
 
     def run_config(self, v_striker: float) -> RunConfig:
         """The ideal-lattice striker run at ``v_striker`` (also sets every run's dt and length)."""
-        base = RunConfig(shape="hexagon", edge_beads=self.edge_beads, diameter_m=self.disorder.diameter_m,
+        base = RunConfig(shape=self.shape, edge_beads=self.edge_beads, rows=self.rows, columns=self.columns,
+                         diameter_m=self.disorder.diameter_m,
                          impact="striker", v0=float(v_striker), steps_per_contact=self.steps_per_contact,
                          dump_every=self.steps_per_contact // IMPACT_SAMPLES_PER_CONTACT, friction=self.friction)
         if self.duration_s is not None:
@@ -149,6 +162,8 @@ class EnsembleConfig:
         identity = json.loads(json.dumps(config))
         del identity["realizations"], identity["preparation"]["max_steps"]
         identity.setdefault("friction", 0.0)  # ensembles run before friction existed were frictionless
+        for name, default in SHAPE_DEFAULTS.items():  # and before other shapes, hexagons
+            identity.setdefault(name, default)
         return identity
 
 
@@ -189,7 +204,10 @@ class Ensemble:
         return self.config.run_config(v).settings()
 
     def diameters_m(self, k: int) -> np.ndarray:
-        return self.config.disorder.diameters_m(len(self.ideal), self.config.seed, k)
+        """Realization k's diameters: each bead's nominal one (d, or a centered square's
+        interstitial size) plus its draw's deviation from d."""
+        draws = self.config.disorder.diameters_m(len(self.ideal), self.config.seed, k)
+        return draws + (self.ideal.diameters_m - self.ideal.diameter_m)
 
     def stage_model(self, k: int, stage: str) -> GranularModel:
         """The packing a preparation stage starts from: spaced (compact) or compacted with walls

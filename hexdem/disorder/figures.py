@@ -52,8 +52,16 @@ def _by_velocity_line(rows, value_columns: slice):
     return {key: np.array(sorted(values), dtype=float) for key, values in table.items()}
 
 
-def all_directions(stats_rows, ideal_rows, laws: dict, path) -> None:
-    """Fig. 9: peak speed against n along the 0° and −30° lines, one row per striker speed.
+def fig9_lines(lattice) -> tuple[str, str]:
+    """The lines of Fig. 9: :data:`FIG9_LINES` on the triangular lattice; elsewhere the 0° ray and
+    the first ray below it (a square's −45°)."""
+    if lattice.ray_angles_deg is None:
+        return FIG9_LINES
+    return "0", next(name for name in lattice.lines() if name.startswith("-"))
+
+
+def all_directions(stats_rows, ideal_rows, laws: dict, path, lines=FIG9_LINES) -> None:
+    """Fig. 9: peak speed against n along the 0° and −30° ``lines``, one row per striker speed.
 
     Grey band: mean ± σ over the disordered realizations (dotted: the mean); black dots:
     the ideal lattice struck by the same striker; red: the fitted law, if any.
@@ -66,7 +74,7 @@ def all_directions(stats_rows, ideal_rows, laws: dict, path) -> None:
     fig, axes = plots.subplots(len(velocities), 2, figsize=(10, 3.2 * len(velocities)), squeeze=False,
                                sharex="col")
     for row, v in enumerate(velocities):
-        for col, line in enumerate(FIG9_LINES):
+        for col, line in enumerate(lines):
             ax = axes[row, col]
             n, mean, std = stats[(v, line)].T
             ax.fill_between(n, mean - std, mean + std, color="0.8", label=r"disordered $\mu \pm \sigma$")

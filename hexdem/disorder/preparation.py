@@ -9,11 +9,23 @@ random numbers would depend on the rank count).
 **Preparation**, two damped LAMMPS runs rendered from ``lammps_inputs/settle.in``:
 
 1. ``compact``: the lattice is spaced for its largest diameter (at least d + tol), so that
-   nothing overlaps. A constant force of 5 N pushes every edge bead (a bead with fewer than
-   six neighbours) inward, perpendicular to its edge (along the bisector at a corner). There
-   are no walls yet, so nothing resists a rigid drift or spin of the whole packing:
-   ``fix momentum`` removes both (fixed-direction forces on a rotated hexagon would drive
-   the spin further). Artificial viscous drag F = −γ v settles the packing.
+   nothing overlaps. A constant force of 5 N pushes every edge bead (a bead with fewer
+   neighbours than the bulk's) inward, perpendicular to its edge (along the bisector at a
+   corner). There are no walls yet, so nothing resists a rigid drift or spin of the whole
+   packing: ``fix momentum`` removes both (fixed-direction forces on a rotated hexagon would
+   drive the spin further). Artificial viscous drag F = −γ v settles the packing.
+
+   Square and centered-square crystals (:mod:`hexdem.model.square_crystals`; spaced about the
+   struck bead, a bead's growth taken relative to its own nominal diameter) are compacted
+   inside the frame of their four walls touching the spaced crystal, with pushes perpendicular
+   to their own edges. A frictionless crystal with disordered diameters has gaps between some
+   neighbours, and its compressed rows buckle sideways into them: at 5 N (and at 0.5 N) a
+   5 × 6 square's rows bent into a zigzag of ±1.6 mm (0.09 d, a step towards the triangular
+   packing), and a centered square did not settle in 10⁶ steps. At
+   :data:`CRYSTAL_PUSH_FORCE_N` = 0.05 N both keep their geometry within the disorder (rows and
+   columns straight to 0.2–0.3 mm, 3–4 σ, on a 5 × 6 square and a 9 × 12 centered square): use
+   that force on them. The settle's gravity loads a square's rows too: a 15 × 15 square's bend
+   to 0.78 mm (10 σ) in stage 2.
 2. ``settle``: the walls are placed touching the compacted packing
    (:meth:`~hexdem.model.lattice.Lattice.with_geometry`; or ``wall_slack_m`` further out, a
    variant without prestress), the 5 N forces are removed, gravity
@@ -73,6 +85,9 @@ from hexdem.model.units import SI
 TOLERANCE_M = 0.0127e-3
 #: σ / tol of the paper's diameter distribution.
 SIGMA_PER_TOLERANCE = 6.0
+#: Push force [N] that compacts a square or centered-square crystal without buckling its rows
+#: (see the module docstring); the hexagon takes the paper's 5 N.
+CRYSTAL_PUSH_FORCE_N = 0.05
 #: Standard gravity [m/s²].
 STANDARD_GRAVITY_M_S2 = 9.80665
 #: The two preparation stages, in order.
@@ -83,6 +98,12 @@ STATS_NAME = "settle.txt"
 SETTLED_NAME = "settled.data"
 #: Neighbour offsets {Δm, Δn} of a bead in the paper's labels: the bond steps and their opposites.
 NEIGHBOURS = BOND_STEPS + tuple((-dm, -dn) for dm, dn in BOND_STEPS)
+#: Off the triangular lattice, beads are neighbours when their centres are closer than this
+#: times the sum of their radii.
+NEIGHBOUR_REACH = 1.1
+#: A bead whose neighbours' unit vectors sum to more than this is an edge bead (the bulk's sum
+#: is zero to round-off; an edge bead's is at least 1).
+EDGE_SUM_THRESHOLD = 1e-6
 
 
 @dataclass(frozen=True)
@@ -180,30 +201,62 @@ def walls_for_settling(compacted: Lattice, preparation: Preparation) -> Lattice:
 def edge_directions(lattice: Lattice) -> np.ndarray:
     """(N, 2) inward unit vectors of the edge beads (zero for interior beads).
 
-    An edge bead misses some of its six neighbours; it is pushed away from the missing
-    ones: perpendicular to a straight edge, along the bisector at a corner.
+    An edge bead misses some of the neighbours a bead of the bulk has; it is pushed away from
+    the missing ones, along the sum of the unit vectors to the neighbours it has: perpendicular
+    to a straight edge, along the bisector at a corner. The triangular lattice reads its six
+    neighbours from the labels; any other packing (square, centered-square) from the geometry
+    (:func:`geometric_neighbour_sums`).
     """
-    unit = {step: np.array([np.sqrt(3) / 2 * step[1], step[0] / 2]) for step in NEIGHBOURS}
-    directions = np.zeros((len(lattice), 2))
-    for i, (m, n) in enumerate(lattice.indices.tolist()):
-        for dm, dn in NEIGHBOURS:
-            if lattice.index_of(m + dm, n + dn) is None:
-                directions[i] -= unit[(dm, dn)]
+    if lattice.ray_angles_deg is None:
+        unit = {step: np.array([np.sqrt(3) / 2 * step[1], step[0] / 2]) for step in NEIGHBOURS}
+        directions = np.zeros((len(lattice), 2))
+        for i, (m, n) in enumerate(lattice.indices.tolist()):
+            for dm, dn in NEIGHBOURS:
+                if lattice.index_of(m + dm, n + dn) is None:
+                    directions[i] -= unit[(dm, dn)]
+    else:
+        directions = geometric_neighbour_sums(lattice.positions_m, lattice.diameters_m)
     norms = np.linalg.norm(directions, axis=1)
-    edge = norms > 1e-12
+    edge = norms > EDGE_SUM_THRESHOLD
     directions[edge] /= norms[edge, None]
     directions[~edge] = 0.0
     return directions
 
 
+def geometric_neighbour_sums(positions_m, diameters_m) -> np.ndarray:
+    """(N, 2) sum over each bead's neighbours of the unit vectors towards them: zero in the bulk of
+    a crystal, pointing inward at its edges. Neighbours: centres closer than
+    :data:`NEIGHBOUR_REACH` times the sum of the radii (a lattice spaced for its largest diameter
+    keeps its neighbours; a square's diagonal, √2 d away, is none)."""
+    from scipy.spatial import cKDTree
+
+    positions, diameters = np.asarray(positions_m, float), np.asarray(diameters_m, float)
+    pairs = cKDTree(positions).query_pairs(NEIGHBOUR_REACH * float(diameters.max()), output_type="ndarray")
+    i, j = pairs.T if len(pairs) else (np.zeros(0, int), np.zeros(0, int))
+    offsets = positions[j] - positions[i]
+    distances = np.linalg.norm(offsets, axis=1)
+    near = distances < NEIGHBOUR_REACH * (diameters[i] + diameters[j]) / 2
+    units = offsets[near] / distances[near, None]
+    sums = np.zeros_like(positions)
+    np.add.at(sums, i[near], units)
+    np.add.at(sums, j[near], -units)
+    return sums
+
+
 def spaced_lattice(lattice: Lattice, diameters_m, disorder: Disorder) -> Lattice:
-    """``lattice`` with the given diameters, spaced by :meth:`Disorder.spacing_m` (no overlap)."""
-    scale = disorder.spacing_m(diameters_m) / lattice.diameter_m
-    return lattice.with_geometry(lattice.positions_m * scale, diameters_m)
+    """``lattice`` with the given diameters, its positions scaled about the struck bead so that
+    nothing overlaps: by :meth:`Disorder.spacing_m` over d, or more where a bead grew by a larger
+    share of its own nominal diameter (a centered-square's small interstitials)."""
+    diameters_m = np.asarray(diameters_m, float)
+    scale = max(disorder.spacing_m(diameters_m) / lattice.diameter_m,
+                float(np.max(diameters_m / lattice.diameters_m)))
+    origin = lattice.positions_m[lattice.struck]
+    return lattice.with_geometry(origin + (lattice.positions_m - origin) * scale, diameters_m)
 
 
-def _push_block(model: GranularModel, preparation: Preparation) -> str:
-    """Constant inward forces on the edge beads, grouped by direction, and fix momentum."""
+def _push_block(model: GranularModel, preparation: Preparation, framed: bool) -> str:
+    """Constant inward forces on the edge beads, grouped by direction, and (when no frame holds
+    the packing, ``framed`` False) fix momentum."""
     directions = edge_directions(model.lattice)
     groups: dict[tuple[float, float], list[int]] = {}
     for i in np.flatnonzero(np.any(directions != 0, axis=1)):
@@ -214,16 +267,20 @@ def _push_block(model: GranularModel, preparation: Preparation) -> str:
         ids = [i + 1 for i in members]
         lines += [f"group           push_{k} id {' '.join(map(str, ids))}",
                   f"fix             push_{k} push_{k} addforce {float(force[0])!r} {float(force[1])!r} 0.0"]
-    lines.append("fix             rigid_modes all momentum 10 linear 1 1 0 angular")
+    if not framed:
+        lines.append("fix             rigid_modes all momentum 10 linear 1 1 0 angular")
     return "\n".join(lines) + "\n"
 
 
 def _stage_blocks(model: GranularModel, stage: str, preparation: Preparation) -> dict:
     """What differs between the stages: walls, loads, damping time, force criterion (None: none)."""
     if stage == "compact":
-        return {"walls": "# (none yet: they are placed touching the compacted packing)\n",
-                "loads": _push_block(model, preparation), "damping_s": preparation.compact_damping_s,
-                "loads_note": f"{preparation.push_force_n:g} N inward on every edge bead; rigid drift and spin removed",
+        framed = model.lattice.ray_angles_deg is not None
+        return {"walls": walls_block(model, SI) if framed else
+                "# (none yet: they are placed touching the compacted packing)\n",
+                "loads": _push_block(model, preparation, framed), "damping_s": preparation.compact_damping_s,
+                "loads_note": f"{preparation.push_force_n:g} N inward on every edge bead; " +
+                ("the frame of walls touching the spaced crystal holds it" if framed else "rigid drift and spin removed"),
                 "force_tolerance": None}
     return {"walls": walls_block(model, SI),
             "loads": gravity_block(preparation.gravity_vector_m_s2(model.impact.direction), SI),

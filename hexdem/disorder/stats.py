@@ -127,12 +127,19 @@ def arrival_rows(results: EnsembleResults, lattice: Lattice, reference: int) -> 
             for bead, ((m, n), (x, y)) in enumerate(zip(lattice.indices, lattice.positions_m))]
 
 
+def mirror_lines(lines) -> list[tuple[str, str]]:
+    """(``"+a"``, ``"-a"``) for every pair of lines mirrored about the 0° strike: the hexagon's ±30°,
+    a square's ±45° and ±90°."""
+    return [(name, "-" + name[1:]) for name in lines if name.startswith("+") and "-" + name[1:] in lines]
+
+
 def disorder_effect(results: EnsembleResults, lattice: Lattice, measure: str = "peak") -> list[tuple]:
     """Transmission along each line, disordered / ideal (the paper's claim of Sec. VI-B).
 
     For each realization, the ratio V_n / V_n(ideal) averaged over beads n ≥ 2 of the line
-    whose ideal speed was seen; then the mean, sample standard deviation and standard error
-    over realizations. "±30" pools both 30° lines of each realization. ``measure``: V_n is the
+    whose ideal speed was seen (a square's beads off the struck row stay at rest); then the mean, sample standard deviation and standard error
+    over realizations. "±30" pools both 30° lines of each realization (on a square, "±45" and "±90"
+    pool its mirrored rays). ``measure``: V_n is the
     peak speed over the run ("peak") or the leading pulse's amplitude ("lead").
     """
     rows = []
@@ -142,13 +149,14 @@ def disorder_effect(results: EnsembleResults, lattice: Lattice, measure: str = "
         ratios = {}
         for line, beads in lines.items():
             beads = beads[EFFECT_FIRST_N:]
-            beads = beads[np.isfinite(ideal_speeds[iv, beads])]
+            beads = beads[np.isfinite(ideal_speeds[iv, beads]) & (ideal_speeds[iv, beads] > 0)]
             with np.errstate(invalid="ignore"):
                 ratios[line] = (speeds[:, iv, beads] / ideal_speeds[iv, beads], beads)
-        longer = max(ratios["+30"][1], ratios["-30"][1], key=len)
-        ratios["±30"] = (np.concatenate([ratios["+30"][0], ratios["-30"][0]], axis=1), longer)
+        for plus, minus in mirror_lines(lines):
+            longer = max(ratios[plus][1], ratios[minus][1], key=len)
+            ratios[f"±{plus[1:]}"] = (np.concatenate([ratios[plus][0], ratios[minus][0]], axis=1), longer)
         for line, (ratio, beads) in ratios.items():
-            per_realization = np.nanmean(ratio, axis=1)
+            per_realization = np.nanmean(ratio, axis=1) if ratio.shape[1] else np.full(len(ratio), np.nan)
             mean, std, count = _mean_std_count(per_realization)
             last_n = EFFECT_FIRST_N + len(beads) - 1
             rows.append((float(v), line, EFFECT_FIRST_N, int(last_n), float(mean), float(std),
@@ -175,7 +183,8 @@ def write_statistics(ensemble: Ensemble, laws: dict | None = None) -> dict:
     write_csv(out / "arrival_map.csv", ARRIVAL_COLUMNS, arrival_rows(results, lattice, reference))
     write_csv(out / "disorder_effect.csv", EFFECT_COLUMNS, effect)
     write_csv(out / "leading_pulse_effect.csv", EFFECT_COLUMNS, lead_effect)
-    ensemble_plots.all_directions(stats, ideal, laws or {}, out / "fig9_all_directions.png")
+    ensemble_plots.all_directions(stats, ideal, laws or {}, out / "fig9_all_directions.png",
+                                  ensemble_plots.fig9_lines(lattice))
     ideal_rel, disordered_rel = relative_arrivals(results, reference)
     for iv, v in enumerate(results.velocities_m_s):
         mean, _, _ = _mean_std_count(disordered_rel[:, iv])
