@@ -11,6 +11,7 @@ import pytest
 
 from hexdem.cli.main import COMMANDS
 from hexdem.model.config import SHAPES, RunConfig
+from hexdem.model.config_keys import KEY_DESCRIPTIONS
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
@@ -39,6 +40,11 @@ def test_the_config_reference_lists_every_key(built):
 
     missing = [f.name for f in dataclasses.fields(RunConfig) if f"<code class=\"docutils literal notranslate\"><span class=\"pre\">{f.name}</span>" not in page]
     assert not missing
+    assert set(KEY_DESCRIPTIONS) == {f.name for f in dataclasses.fields(RunConfig)}, "every key says what it means"
+    rows = re.findall(r"<tr class=\"row-(?:odd|even)\">(.*?)</tr>", page.split("</thead>")[1], flags=re.DOTALL)
+    assert len(rows) == len(dataclasses.fields(RunConfig))
+    assert all(row.count("<td>") == 4 for row in rows), "an optional type's bar no longer splits its cell"
+    assert "int or None" in page
 
 
 def test_the_api_reference_documents_the_modules(built):

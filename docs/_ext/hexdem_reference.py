@@ -2,8 +2,8 @@
 build time into ``reference/_generated/`` (never edited by hand, never committed).
 
 * ``cli.md``: every ``hexdem`` subcommand's ``--help``, from the argparse parser itself;
-* ``config.md``: every run-configuration key with its default, from :class:`RunConfig`'s fields,
-  and the class's docstring;
+* ``config.md``: every run-configuration key with its default and type, from :class:`RunConfig`'s
+  fields, and its meaning (:data:`~hexdem.model.config_keys.KEY_DESCRIPTIONS`);
 * ``api.md``: every module of the package, by subpackage, through autodoc.
 
 hexdem's docstrings write magnitudes the physicist's way, |v| or |ω_z|, which reStructuredText
@@ -20,6 +20,7 @@ from pathlib import Path
 import hexdem
 from hexdem.cli.main import COMMANDS, build_parser
 from hexdem.model.config import RunConfig
+from hexdem.model.config_keys import KEY_DESCRIPTIONS
 
 #: Width of the help texts (argparse reads COLUMNS).
 HELP_COLUMNS = "100"
@@ -53,11 +54,13 @@ def _default(field: dataclasses.Field) -> str:
 
 
 def config_page() -> str:
-    rows = [f"| `{f.name}` | {_default(f)} | `{f.type}` |" for f in dataclasses.fields(RunConfig)]
+    rows = [f"| `{f.name}` | {_default(f)} | {str(f.type).replace(' | ', ' or ')} | {KEY_DESCRIPTIONS[f.name]} |"
+            for f in dataclasses.fields(RunConfig)]
     return "\n".join(["# Run configuration keys", "",
                       "The keys of a `hexdem run --config FILE.toml` file (and of `hexdem sweep --vary`), with "
-                      "their defaults; a file sets any of them, the rest keep these.", "",
-                      "| key | default | type |", "|---|---|---|", *rows, "",
+                      "their defaults and what they mean; a file sets any of them, the rest keep these. "
+                      "Lengths are in metres; `v0`, `dt` and `duration` in the run's `units`.", "",
+                      "| key | default | type | meaning |", "|---|---|---|---|", *rows, "",
                       "```{eval-rst}", ".. autoclass:: hexdem.model.config.RunConfig", "   :no-members:",
                       "   :no-index:", "```", ""])
 

@@ -65,47 +65,14 @@ MEMORY_PER_BEAD_BYTES = 8e3
 
 @dataclass(frozen=True)
 class RunConfig:
-    """One simulation. Lengths in m; ``v0``, ``dt``, ``duration`` in ``units``.
-
-    ``steps_per_contact``: the default time step is the contact time (:meth:`contact_time_s`)
-    over this (at least 20), shortened so that 1/20 of the contact time is whole steps.
-    ``dump_every`` steps between samples of the analysis and of the dump (None: 1/20 of the
-    contact time); the dump is written with ``dump = true`` (and by the deck when rerun by hand).
-    ``restitution``: bead–bead coefficient of restitution (1.0: the paper's ideal model); ``wall_restitution``:
-    bead–wall (None: ``restitution``). ``friction``, ``wall_friction`` (None: ``friction``), ``rolling_friction``:
-    Coulomb μ between bodies and against walls, rolling resistance (:mod:`hexdem.model.contact_law`).
-    ``precompression_n``: static force per bead–bead contact [N] (0: uncompressed; see
-    :mod:`hexdem.model.precompression`). ``initial_state_file``: a CSV ``m,n,vx,vy[,dx,dy]`` of
-    initial velocities and displacements [SI] (:mod:`hexdem.model.initial_state`).
-    ``sensors``: sensor particles, each ``"line:n"`` (e.g. ``"0:1"``, ``"+30:6"``) or a bead id;
-    sampled at ``sensor_rate_hz`` (the paper's 500 kS/s); ``sensor_mass_factor``: a sensor
-    bead's mass relative to a plain bead's.
-    Packings (``shape``, :mod:`hexdem.model.packing_builders`): ``hexagon`` (``edge_beads``),
-    ``half-hexagon`` (``long_edge``, ``short_edge``), ``half-disc`` and ``disc`` (``radius_beads``),
-    ``triangle`` (``edge_beads``), ``parallelogram`` (``edge_beads``, ``depth_beads``), ``sites``
-    (``sites`` [m, n] or ``sites_file``, walls at ``site_walls_deg``), ``square`` and
-    ``centered-square`` (``rows``, ``columns``, ``interstitial_diameter_m``, ``interstitial_material``),
-    ``chain`` (``beads``, ``angle_deg``, ``diameters_m``, ``materials`` as a list of names),
-    ``packing`` (``packing_file``, ``struck_bead``, ``walls``). ``vacancies``: labels left out.
-    ``bead_material``, ``wall_material``: a preset (steel316, delrin, brass, aluminium, glass,
-    ptfe; :mod:`hexdem.model.materials`) or a material of ``materials``, this configuration's own
-    table {name: {youngs_modulus_pa, poisson_ratio, density_kg_m3[, source]}}.
-    ``regions``: tables {material, sites, x_min_d, x_max_d, y_min_d, y_max_d} giving the beads
-    they select another material (:mod:`hexdem.model.regions`): interfaces, strips, intruders.
-    ``striker_material``, ``striker_diameter_m``: the striker's (None: the beads' material and
-    the nominal diameter).
-    ``impacts``: several impacts, or one elsewhere than {0, 0}: tables {site = [m, n] or
-    edge_deg, v0, angle_deg, kind, striker_material, striker_diameter_m}, each defaulting to the
-    run's own (:mod:`hexdem.model.impacts`); empty: the paper's single impact (``v0``,
-    ``strike_angle_deg``, ``impact`` on {0, 0}).
-    ``lines``: observation lines besides the paper's, tables {name, site, angle_deg}
-    (:mod:`hexdem.model.lines`). ``movie``: ``hexdem run`` also writes ``movie.gif``.
-    ``launcher``: the MPI launcher command that starts the ranks (None: this environment's
-    ``mpiexec``; e.g. ``"mpiexec -f hosts"`` or ``"srun"`` to span machines); given, the run goes
-    through it even on one rank.
-    ``dt = None`` takes the step that ``steps_per_contact`` gives; ``duration = None`` runs until the leading
-    wave has crossed the packing: one contact time per layer between the struck bead and the far wall (the pulse
-    resides less than that on each layer: 0.82 ms are needed, 1.43 ms are run for the default experiment).
+    """One simulation: every key a configuration file may set, each checked against its declared
+    type (:mod:`hexdem.common.typecheck`) and its meaning in
+    :data:`~hexdem.model.config_keys.KEY_DESCRIPTIONS`. Lengths in m; ``v0``, ``dt``, ``duration``
+    in ``units``. ``dt = None`` takes the contact time (:meth:`contact_time_s`) over
+    ``steps_per_contact``, shortened so that the default sampling interval, 1/20 of the contact
+    time, is whole steps; ``duration = None`` runs one contact time per layer between the struck
+    bead and the far wall (the pulse resides less than that on each: 0.82 ms are needed, 1.43 ms
+    are run for the default experiment).
     """
 
     shape: str = "hexagon"
