@@ -26,3 +26,7 @@ autodoc_typehints = "none"
 html_theme = "alabaster"
 html_theme_options = {"description": "Impulses in 2D hexagonal granular crystals", "page_width": "1100px"}
 suppress_warnings = ["myst.header", "myst.xref_missing"]
+#: The page's own headings below the site's navigation: an API page lists its modules there.
+html_sidebars = {"**": ["about.html", "searchfield.html", "navigation.html", "localtoc.html"]}
+#: Module headings in that table of contents, not every function (their names would be cut off).
+toc_object_entries = False

@@ -47,10 +47,13 @@ def test_the_config_reference_lists_every_key(built):
     assert "int or None" in page
 
 
-def test_the_api_reference_documents_the_modules(built):
-    page = (built / "reference" / "_generated" / "api.html").read_text()
+def test_the_api_reference_documents_the_modules_a_page_per_subpackage(built):
+    """Each subpackage on its own page (the whole API was one 1.1 MB page), each module a heading."""
+    folder = built / "reference" / "_generated"
     for name in ("hexdem.model.contact_law", "hexdem.experiments.sweep", "hexdem.paper.friction_study"):
-        assert f'id="module-{name}"' in page
+        page = (folder / f"api_{name.split('.')[1]}.html").read_text()
+        assert f'id="module-{name}"' in page and f"<h2>{name}" in page
+    assert max(path.stat().st_size for path in folder.glob("api_*.html")) < 600e3
 
 
 def test_the_gallery_shows_every_shape_and_impact_kind():

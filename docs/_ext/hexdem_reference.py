@@ -4,7 +4,8 @@ build time into ``reference/_generated/`` (never edited by hand, never committed
 * ``cli.md``: every ``hexdem`` subcommand's ``--help``, from the argparse parser itself;
 * ``config.md``: every run-configuration key with its default and type, from :class:`RunConfig`'s
   fields, and its meaning (:data:`~hexdem.model.config_keys.KEY_DESCRIPTIONS`);
-* ``api.md``: every module of the package, by subpackage, through autodoc.
+* ``api.md`` and ``api_<subpackage>.md``: every module of the package, a page per subpackage and a
+  heading per module, through autodoc.
 
 hexdem's docstrings write magnitudes the physicist's way, |v| or |ω_z|, which reStructuredText
 would read as substitutions: :func:`escape_bars` escapes every bar outside a grid table's rows.
@@ -65,16 +66,21 @@ def config_page() -> str:
                       "   :no-index:", "```", ""])
 
 
-def api_page() -> str:
+def api_pages() -> dict[str, str]:
+    """{page name: text}: an index of the subpackages, and one page per subpackage with a heading
+    per module (so that the sidebar lists them)."""
     modules = sorted(info.name for info in pkgutil.walk_packages(hexdem.__path__, "hexdem.")
                      if not info.name.endswith("__main__"))
-    lines = ["# API", "", "Every module of the package, from its docstrings.", ""]
-    for package in sorted({m.split(".")[1] for m in modules}):
-        members = [m for m in modules if m.split(".")[1] == package]
-        lines += [f"## hexdem.{package}", ""]
-        for module in members:
-            lines += ["```{eval-rst}", f".. automodule:: {module}", "   :members:", "```", ""]
-    return "\n".join(lines)
+    packages = sorted({m.split(".")[1] for m in modules})
+    pages = {"api": "\n".join(["# API", "", "Every module of the package, from its docstrings, one page per "
+                               "subpackage.", "", "```{toctree}", ":maxdepth: 2", "",
+                               *(f"api_{package}" for package in packages), "```", ""])}
+    for package in packages:
+        lines = [f"# hexdem.{package}", ""]
+        for module in (m for m in modules if m.split(".")[1] == package):
+            lines += [f"## {module}", "", "```{eval-rst}", f".. automodule:: {module}", "   :members:", "```", ""]
+        pages[f"api_{package}"] = "\n".join(lines)
+    return pages
 
 
 def escape_bars(app, what, name, obj, options, lines) -> None:
@@ -87,8 +93,8 @@ def escape_bars(app, what, name, obj, options, lines) -> None:
 def generate(app) -> None:
     folder = Path(app.srcdir) / "reference" / "_generated"
     folder.mkdir(exist_ok=True)
-    for name, page in (("cli.md", cli_page), ("config.md", config_page), ("api.md", api_page)):
-        _write(folder / name, page())
+    for name, text in {"cli": cli_page(), "config": config_page(), **api_pages()}.items():
+        _write(folder / f"{name}.md", text)
 
 
 def setup(app):
