@@ -5,7 +5,7 @@
   time along each observation line, energy drift), writing files only if asked;
 * :func:`tca` — ω and c of the ternary collision approximation (Sec. IV);
 * :class:`SweepSettings` and :func:`scaling_laws` — the V₀ sweep of Sec. V and the fitted
-  laws (v30), (v0), (veq0) of the four strike/observation combinations.
+  laws (9), (10), (11) of the four strike/observation combinations.
 """
 
 from __future__ import annotations
@@ -80,7 +80,7 @@ def simulate_impact(config: RunConfig | None = None, out=None, verbose: bool = F
 
 
 def tca() -> dict:
-    """ω, c and the TCA's residence time at V₀ = 1 (nondimensional; Sec. IV, eq. (hyperg))."""
+    """ω, c and the TCA's residence time at V₀ = 1 (nondimensional; Sec. IV, eq. (6))."""
     return _tca.summary()
 
 

@@ -80,3 +80,11 @@ def test_the_readme_is_a_front_page_with_the_commands_ci_runs():
     for link in re.findall(r"\]\((docs/[^)#]+)", readme):
         assert (ROOT / link).exists(), link
     assert re.search(r"!\[[^]]*\]\(docs/gallery/images/\w+\.png\)", readme), "one picture"
+
+
+def test_equations_are_cited_by_the_papers_numbers(built):
+    """'eq. (4)', as the paper numbers them, never the LaTeX source's labels ('eq. (v30)', '(TCA_decay)')."""
+    label = re.compile(r"[Ee]qs?\. \([A-Za-z_]\w*\)|\((?:v30|v0|veq0|hyperg|TCA_strain|TCA_decay|BCA_decay)\)")
+    pages = [path for path in built.rglob("*.html") if "_static" not in path.parts]
+    raw = [(path.name, hit) for path in pages for hit in label.findall(path.read_text())]
+    assert not raw, raw[:5]

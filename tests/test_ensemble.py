@@ -235,7 +235,7 @@ def test_a_failing_deck_is_named_with_lammps_error(tmp_path):
 
 
 def test_fitted_laws_follow_the_papers_rule_for_physical_units(tmp_path):
-    """eq. (v0) with nondimensional coefficients, evaluated in m/s: every V becomes V/U."""
+    """eq. (10) with nondimensional coefficients, evaluated in m/s: every V becomes V/U."""
     from hexdem.disorder.figures import fitted_laws
     from hexdem.model.materials import PAPER_DIAMETER_M
     from hexdem.model.units import nondimensional

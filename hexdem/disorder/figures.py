@@ -1,7 +1,7 @@
 """Figures of a disorder ensemble (Sec. VI-B): Fig. 9 (fig:all_directions) and Fig. 8
 (fig:expnumsim), drawn from the tables :mod:`hexdem.disorder.ensemble` writes.
 
-The fitted laws of Fig. 9 are the paper's eqs. (v0) (0° line, n ≥ 2) and (veq0) (±30°
+The fitted laws of Fig. 9 are the paper's eqs. (10) (0° line, n ≥ 2) and (11) (±30°
 lines, n ≥ 1) with the coefficients of a ``scaling.json`` from ``hexdem scaling`` (keys
 "0/0" and "0/30"; nondimensional, turned into m/s by the paper's rule V → V sqrt(M/A)/d^{5/4}).
 """
@@ -25,7 +25,7 @@ LAW_KEYS = {"0": "0/0", "+30": "0/30", "-30": "0/30"}
 
 
 def fitted_laws(path, diameter_m: float) -> dict:
-    """{line: ScalingLaw in m/s} from a ``scaling.json`` (eqs. (v0), (veq0))."""
+    """{line: ScalingLaw in m/s} from a ``scaling.json`` (eqs. (10), (11))."""
     from hexdem.theory.scaling import ScalingLaw
 
     path = Path(path)

@@ -1,4 +1,4 @@
-"""The paper's nondimensional scaling, eq. (scaling), and conversions both ways.
+"""The paper's nondimensional scaling, eq. (3), and conversions both ways.
 
 With A = d = M = 1 inside the theory, lengths are measured in d, masses in M and times in
 T = sqrt(M / (A d^{1/2})); velocities are then measured in d/T = d^{5/4} sqrt(A/M), which is

@@ -1,9 +1,9 @@
 """Every number the paper publishes that hexdem computes, as printed in the paper's text.
 
 Sec. IV (the TCA): ω ≈ 0.382 (compatibility condition) and c ≈ 0.8452 (decay rate,
-eq. TCA_decay). Sec. V (fitted laws, nondimensional A = d = M = 1): m and b of c(V₀) = m V₀ + b
-and α, β, γ of V_s/V₀ for the four strike/observation combinations, eqs. (v30), (v0),
-(veq0). Each value keeps the digits it was printed with, since half a unit of its last
+eq. (8)). Sec. V (fitted laws, nondimensional A = d = M = 1): m and b of c(V₀) = m V₀ + b
+and α, β, γ of V_s/V₀ for the four strike/observation combinations, eqs. (9), (10),
+(11). Each value keeps the digits it was printed with, since half a unit of its last
 digit is as close as it can be compared.
 """
 
@@ -41,11 +41,11 @@ def _law(combination: str, equation: str, **values: str) -> list[Published]:
 #: The paper's numbers, in the order they appear.
 PUBLISHED: tuple[Published, ...] = (
     Published("TCA compatibility condition (Sec. IV)", "omega", "", "0.382"),
-    Published("TCA decay rate, eq. (TCA_decay)", "c", "", "0.8452"),
-    *_law("30/30", "v30", m="0.257", b="0.832", alpha="0.206", beta="0.629"),
-    *_law("30/0", "v0", m="0.3039", b="0.8756", alpha="-0.4788", beta="-0.0256", gamma="0.1936"),
-    *_law("0/0", "v0", m="0.1766", b="0.8878", alpha="-0.2643", beta="-0.0969", gamma="0.2152"),
-    *_law("0/30", "veq0", m="0.1484", b="0.8393", alpha="-0.1182", beta="0.0203", gamma="0.5192"),
+    Published("TCA decay rate, eq. (8)", "c", "", "0.8452"),
+    *_law("30/30", "9", m="0.257", b="0.832", alpha="0.206", beta="0.629"),
+    *_law("30/0", "10", m="0.3039", b="0.8756", alpha="-0.4788", beta="-0.0256", gamma="0.1936"),
+    *_law("0/0", "10", m="0.1766", b="0.8878", alpha="-0.2643", beta="-0.0969", gamma="0.2152"),
+    *_law("0/30", "11", m="0.1484", b="0.8393", alpha="-0.1182", beta="0.0203", gamma="0.5192"),
 )
 
 

@@ -13,11 +13,11 @@ ND_SPEED = UNIT_LABELS["nondimensional"]["speed"]
 
 
 def _lattice_against_tca(n_lattice, lattice, n_tca, tca, hyperg, ylabel, title, path) -> None:
-    """One quantity along the 30° line: lattice vs TCA vs eq. (hyperg)."""
+    """One quantity along the 30° line: lattice vs TCA vs eq. (6)."""
     fig, ax = subplots(figsize=(6, 4.5))
     ax.plot(n_lattice, lattice, "o", color="tab:blue", label="lattice simulation")
-    ax.plot(n_tca, tca, "o", mfc="none", color="tab:red", markersize=9, label="TCA, eq. (TCA_strain)")
-    ax.plot(n_tca, hyperg, "^", color="k", label="TCA closed form, eq. (hyperg)")
+    ax.plot(n_tca, tca, "o", mfc="none", color="tab:red", markersize=9, label="TCA, eq. (5)")
+    ax.plot(n_tca, hyperg, "^", color="k", label="TCA closed form, eq. (6)")
     ax.set_xlabel("bead n on the 30° line")
     ax.set_ylabel(ylabel)
     ax.set_title(title)
@@ -27,7 +27,7 @@ def _lattice_against_tca(n_lattice, lattice, n_tca, tca, hyperg, ylabel, title, 
 
 
 def tca_pulse_speeds(n_lattice, lattice, n_tca, tca, hyperg, v0, path) -> None:
-    """Fig. 5a: pulse speed c_n = 1/T_n against n, lattice vs TCA vs eq. (hyperg)."""
+    """Fig. 5a: pulse speed c_n = 1/T_n against n, lattice vs TCA vs eq. (6)."""
     _lattice_against_tca(n_lattice, lattice, n_tca, tca, hyperg, "pulse speed $c_n = 1/T_n$  [d per time unit]",
                          f"30° strike, 30° observation, $V_0$ = {v0:g} (nondimensional)", path)
 

@@ -10,10 +10,10 @@ the struck lattice. The four strike/observation combinations:
 =========  ============  ========  ==========  ================================
 name       strike, line  start s   law         V_s / V₀
 =========  ============  ========  ==========  ================================
-``30/30``  30°, +30      1         eq. (v30)   α V₀ + β
-``30/0``   30°, 0        2         eq. (v0)    α V₀² + β V₀ + γ
-``0/0``    0°, 0         2         eq. (v0)    α V₀² + β V₀ + γ
-``0/30``   0°, +30       1         eq. (veq0)  α V₀² + β V₀ + γ
+``30/30``  30°, +30      1         eq. (9)     α V₀ + β
+``30/0``   30°, 0        2         eq. (10)    α V₀² + β V₀ + γ
+``0/0``    0°, 0         2         eq. (10)    α V₀² + β V₀ + γ
+``0/30``   0°, +30       1         eq. (11)    α V₀² + β V₀ + γ
 =========  ============  ========  ==========  ================================
 
 **Per-V₀ fit** (:func:`fit_decay`). V_n = V_s c^{n − s} on the window s < n ≤ ``last``, with
@@ -26,7 +26,7 @@ anchored start is conditional on V_s (the measured start bead is taken as exact)
 
 **Laws.** c(V₀) = m V₀ + b and V_s/V₀ = the polynomial above are ordinary least squares
 (:func:`polynomial_fit`), with standard errors from the residual variance. Together:
-V_n = V₀ (V_s/V₀)(V₀) (m V₀ + b)^{n − s}, eqs. (v30), (v0), (veq0).
+V_n = V₀ (V_s/V₀)(V₀) (m V₀ + b)^{n − s}, eqs. (9), (10), (11).
 
 **Why c depends on V₀ at all.** The Hertz lattice with linearised bond directions is scale
 invariant (x → λx, t → λ^{−1/4}t): c would be a constant. V₀ enters only through the
@@ -160,7 +160,7 @@ def fit_decay(n, v, start: int, last: int, kind: str = "loglinear", anchored: bo
 
 @dataclass(frozen=True)
 class ScalingLaw:
-    """V_n = V₀ P(V₀) (m V₀ + b)^{n − start}: eqs. (v30), (v0), (veq0).
+    """V_n = V₀ P(V₀) (m V₀ + b)^{n − start}: eqs. (9), (10), (11).
 
     ``amplitude`` the coefficients of P highest power first: (α, β) or (α, β, γ);
     ``velocity_unit_m_s`` 1 for nondimensional laws, U for laws in m/s.

@@ -12,22 +12,22 @@ displacements x₀, x₁ along the line and x_a = x_b along the a and b bonds,
 Its energy ½ẋ₀² + ½ẋ₁² + ẋ_a² + (2/5)[z]₊^{5/2} + (4/5)[y]₊^{5/2} (both side beads) and its
 momentum ẋ₀ + ẋ₁ + 2 cos θ ẋ_a along the line are conserved.
 
-**Reduced form**, eq. (TCA_strain). With z = x₀ − x₁ and y = cos θ x₀ − x_a,
+**Reduced form**, eq. (5). With z = x₀ − x₁ and y = cos θ x₀ − x_a,
 (z̈, ÿ) = −K (z₊^{3/2}, y₊^{3/2}), K = [[2, 2 cos θ], [cos θ, 2 cos²θ + 1]] = [[2, 1],
 [1/2, 3/2]] at θ = π/3. K = N diag(1, 2) with N = J M⁻¹ Jᵀ the inverse mass matrix of the
-strains, so ½ q̇ᵀ N⁻¹ q̇ + (2/5)z₊^{5/2} + (4/5)y₊^{5/2} is conserved by eq. (TCA_strain).
+strains, so ½ q̇ᵀ N⁻¹ q̇ + (2/5)z₊^{5/2} + (4/5)y₊^{5/2} is conserved by eq. (5).
 
 **ω** solves the compatibility condition 2 + ω^{3/2} = (1/2 + 3/2 ω^{3/2})/ω of the ansatz
 y = ω z (the initial conditions would need ω = cos θ = 1/2). With s = √ω it reads
 2s⁵ − 3s³ + 4s² − 1 = (s² + s − 1)(2s³ − 2s² + s + 1) = 0, so ω = ((√5 − 1)/2)² = (3 − √5)/2.
 
-**c**, eq. (TCA_decay): the common velocity of beads 0 and 1 at the moment they become
+**c**, eq. (8): the common velocity of beads 0 and 1 at the moment they become
 equal (ż = 0), divided by the BCA's V₀/2. It does not depend on V₀: the Hertz system is
 invariant under x → λx, t → λ^{−1/4}t, v → λ^{5/4}v.
 
 **Residence times.** The TCA's T_n is the time from z = 0, ż = V_n, y = 0, ẏ = V_n cos θ to
 ż = 0, with V_n = V₀ cⁿ; the pulse speed is c_n = 1/T_n. Under the ansatz z̈ = −k z^{3/2},
-k = 2 + ω^{3/2}, solved by eq. (hyperg):
+k = 2 + ω^{3/2}, solved by eq. (6):
 
     t(z) = ₂F₁(2/5, 1/2; 7/5; 2 k z^{5/2} / (5E)) z / sqrt(2E),    E = V²/2.
 
@@ -90,20 +90,20 @@ def three_bead_momentum(state, theta: float = THETA) -> float:
 
 
 def strain_matrix(theta: float = THETA) -> np.ndarray:
-    """K of eq. (TCA_strain): (z̈, ÿ) = −K (z₊^{3/2}, y₊^{3/2}); [[2, 1], [1/2, 3/2]] at π/3."""
+    """K of eq. (5): (z̈, ÿ) = −K (z₊^{3/2}, y₊^{3/2}); [[2, 1], [1/2, 3/2]] at π/3."""
     c = np.cos(theta)
     return np.array([[2.0, 2 * c], [c, 2 * c * c + 1.0]])
 
 
 def strain_rhs(t, state, theta: float = THETA):
-    """Right-hand side of eq. (TCA_strain); ``state`` = (z, y, ż, ẏ)."""
+    """Right-hand side of eq. (5); ``state`` = (z, y, ż, ẏ)."""
     z, y, zd, yd = state
     acc = -strain_matrix(theta) @ np.array([_pos32(z), _pos32(y)])
     return np.array([zd, yd, acc[0], acc[1]])
 
 
 def strain_energy(state, theta: float = THETA) -> float:
-    """Conserved quantity of eq. (TCA_strain): ½ q̇ᵀ N⁻¹ q̇ + (2/5)z₊^{5/2} + (4/5)y₊^{5/2}."""
+    """Conserved quantity of eq. (5): ½ q̇ᵀ N⁻¹ q̇ + (2/5)z₊^{5/2} + (4/5)y₊^{5/2}."""
     z, y, zd, yd = np.asarray(state, float)
     inverse_mass = strain_matrix(theta) @ np.diag([1.0, 0.5])
     rates = np.array([zd, yd])
@@ -111,7 +111,7 @@ def strain_energy(state, theta: float = THETA) -> float:
 
 
 def compatibility_residual(omega):
-    """2 + ω^{3/2} − (1/2 + 3/2 ω^{3/2})/ω: zero where y = ω z solves eq. (TCA_strain)."""
+    """2 + ω^{3/2} − (1/2 + 3/2 ω^{3/2})/ω: zero where y = ω z solves eq. (5)."""
     omega = np.asarray(omega, float)
     return 2.0 + omega**1.5 - (0.5 + 1.5 * omega**1.5) / omega
 
@@ -176,19 +176,19 @@ def equal_velocity(v0: float = 1.0, theta: float = THETA) -> EqualVelocity:
 
 
 def decay_factor(theta: float = THETA) -> float:
-    """The TCA's c of eq. (TCA_decay), the same for every V₀."""
+    """The TCA's c of eq. (8), the same for every V₀."""
     return equal_velocity(1.0, theta).decay_factor
 
 
 def residence_time(v: float, theta: float = THETA) -> float:
-    """T(V): eq. (TCA_strain) from z = 0, ż = V, y = 0, ẏ = V cos θ until ż = 0."""
+    """T(V): eq. (5) from z = 0, ż = V, y = 0, ẏ = V cos θ until ż = 0."""
     v = _positive(v)
     state0 = np.array([0.0, 0.0, v, v * np.cos(theta)])
     return _until_rate_vanishes(strain_rhs, state0, lambda s: s[2], theta, v)[0]
 
 
 def hypergeometric_time(z, v: float, omega: float):
-    """Eq. (hyperg): when z(t) of z̈ = −(2 + ω^{3/2}) z^{3/2}, z(0) = 0, ż(0) = v reaches z,
+    """Eq. (6): when z(t) of z̈ = −(2 + ω^{3/2}) z^{3/2}, z(0) = 0, ż(0) = v reaches z,
     for 0 ≤ z ≤ the maximum compression."""
     energy = 0.5 * _positive(v) ** 2
     k = 2.0 + omega**1.5
@@ -198,7 +198,7 @@ def hypergeometric_time(z, v: float, omega: float):
 
 
 def hypergeometric_residence_time(v: float, omega: float) -> float:
-    """Closed-form T(V): eq. (hyperg) at the maximum compression (5E/(2k))^{2/5}, where ż = 0."""
+    """Closed-form T(V): eq. (6) at the maximum compression (5E/(2k))^{2/5}, where ż = 0."""
     energy = 0.5 * _positive(v) ** 2
     z_max = (5.0 * energy / (2.0 * (2.0 + omega**1.5))) ** 0.4
     return float(hypergeometric_time(z_max, v, omega))
@@ -209,7 +209,7 @@ class PulsePrediction:
     """TCA residence times along the 30° line (nondimensional).
 
     ``n`` bead numbers; ``velocity`` V_n = V_first c^{n − n_first}; ``residence_time`` T_n
-    from eq. (TCA_strain); ``residence_time_hyperg`` T_n from eq. (hyperg).
+    from eq. (5); ``residence_time_hyperg`` T_n from eq. (6).
     """
 
     n: np.ndarray
@@ -228,7 +228,7 @@ class PulsePrediction:
 
     def arrival_times(self, t_first: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """Arrival of the pulse at beads n + 1 for each n: ``t_first`` (its arrival at the
-        first bead) plus the summed residence times of eq. (TCA_strain) and of eq. (hyperg)."""
+        first bead) plus the summed residence times of eq. (5) and of eq. (6)."""
         return t_first + np.cumsum(self.residence_time), t_first + np.cumsum(self.residence_time_hyperg)
 
 

@@ -1,6 +1,6 @@
 """Reference integrator of the paper's Hamiltonian (Sec. III): an engine independent of LAMMPS.
 
-It integrates eq. (model) as the paper does, with classical 4th-order Runge–Kutta:
+It integrates eq. (4) as the paper does, with classical 4th-order Runge–Kutta:
 
 * contacts found from the bodies' positions, as in LAMMPS: a neighbour search
   (:mod:`hexdem.engines.reference.neighbours`) lists the pairs whose gap is below a skin, and is
@@ -15,7 +15,7 @@ It integrates eq. (model) as the paper does, with classical 4th-order Runge–Ku
 * each impact's V0 on its bead, or on a striker sphere, a body like the beads for the
   neighbour search.
 
-It works in the run's unit system (SI, or the paper's A = d = M = 1 of eq. (scaling)) and
+It works in the run's unit system (SI, or the paper's A = d = M = 1 of eq. (3)) and
 hands its samples, taken like a LAMMPS dump's, to the same observer as LAMMPS, so the same
 analysis judges both engines. In a triangular packing the list at t = 0 is exactly the lattice's
 six touching neighbours (the paper's e₁, e₂, e₃): its next-nearest neighbours are further apart

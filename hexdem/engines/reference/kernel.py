@@ -1,6 +1,6 @@
-"""Compiled kernel of the reference integrator: the forces of eq. (model) and classical RK4.
+"""Compiled kernel of the reference integrator: the forces of eq. (4) and classical RK4.
 
-The paper's equations of motion (Sec. III, eq. (model)) with V(r) = (2/5) A [c − r]_+^{5/2}
+The paper's equations of motion (Sec. III, eq. (4)) with V(r) = (2/5) A [c − r]_+^{5/2}
 give each pair of bodies a repulsive force A [c − r]_+^{3/2} along the current line of centres,
 where r = |rest + q_j − q_i| is the current distance of the pair (rest vector ``rest`` between
 their positions at t = 0 plus displacements q) and c their contact distance. A bead touching a
