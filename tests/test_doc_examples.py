@@ -63,3 +63,10 @@ def test_the_guides_impact_configs_build_their_impacts_and_lines():
     assert [len(model.strikers) for model in models] == [0, 11, 0]
     assert [list(lattice.indices[b]) for lattice in [models[2].lattice] for b in models[2].struck_beads] == [[0, 14]]
     assert len(lines.lattice().line("across")) == 21  # the middle column of 11 per edge: 2 * 11 - 1 beads
+
+
+def test_the_configuration_pages_file_is_the_built_in_default():
+    """The guide's key-by-key file of the paper's experiment is the default configuration, whatever
+    the defaults become."""
+    (block,) = re.findall(r"```toml\n(.*?)```", (GUIDE / "configuration.md").read_text(), flags=re.DOTALL)
+    assert RunConfig(**tomllib.loads(block)) == RunConfig()

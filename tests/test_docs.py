@@ -88,3 +88,20 @@ def test_equations_are_cited_by_the_papers_numbers(built):
     pages = [path for path in built.rglob("*.html") if "_static" not in path.parts]
     raw = [(path.name, hit) for path in pages for hit in label.findall(path.read_text())]
     assert not raw, raw[:5]
+
+
+#: Characters of a code line that the page shows without clipping (alabaster at 1100 px).
+CODE_COLUMNS = 84
+
+
+def test_no_code_line_is_wider_than_the_page(built):
+    """Every line of every code block, the generated references' included, fits the page, and
+    shows a docstring's |v| as written (no escape)."""
+    import html
+
+    lines = [(path.name, line) for path in built.rglob("*.html") if "_static" not in path.parts
+             for block in re.findall(r"<pre>(.*?)</pre>", path.read_text(), flags=re.DOTALL)
+             for line in html.unescape(re.sub(r"<[^>]+>", "", block)).splitlines()]
+    wide = [(name, line) for name, line in lines if len(line) > CODE_COLUMNS]
+    assert not wide, wide[:5]
+    assert not [line for _, line in lines if "\\|" in line]

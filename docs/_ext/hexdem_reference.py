@@ -24,7 +24,7 @@ from hexdem.model.config import RunConfig
 from hexdem.model.config_keys import KEY_DESCRIPTIONS
 
 #: Width of the help texts (argparse reads COLUMNS).
-HELP_COLUMNS = "100"
+HELP_COLUMNS = "84"
 
 
 def _write(path: Path, text: str) -> None:
@@ -84,8 +84,14 @@ def api_pages() -> dict[str, str]:
 
 
 def escape_bars(app, what, name, obj, options, lines) -> None:
-    """Escape the bars of |v| and the like in a docstring (not a grid table's row or border)."""
+    """Escape the bars of |v| and the like in a docstring: not in a grid table's row or border,
+    nor in a literal block (after ``::``, shown as written, where the escape would show)."""
+    literal = None  # indentation of the paragraph that opened the literal block we are in
     for i, line in enumerate(lines):
+        indent = len(line) - len(line.lstrip())
+        if literal is not None and (not line.strip() or indent > literal):
+            continue
+        literal = indent if line.rstrip().endswith("::") else None
         if not line.lstrip().startswith(("|", "+")):
             lines[i] = line.replace("|", "\\|")
 

@@ -25,6 +25,8 @@ WIDTH = 640
 #: Colours of each image's palette (a tenth of the size of full colour, no visible loss).
 PALETTE_COLOURS = 128
 
+#: The chain's diameters [m]: 40 steel beads, bead 20 of half the diameter (an eighth of the mass).
+CHAIN_DIAMETERS = ["0.01905"] * 20 + ["0.009525"] + ["0.01905"] * 19
 #: (name, title, what it shows, config, figure of the run shown).
 ENTRIES = (
     ("hexagon", "The experiment: hexagon, velocity impact",
@@ -50,7 +52,7 @@ ENTRIES = (
      'shape = "disc"\nradius_beads = 10\n', "peak_map.png"),
     ("sites", "Your own packing: listed sites",
      "Ten sites listed by hand, a flat wall behind the struck bead, the rest free.",
-     'shape = "sites"\nsites = [[0, 0], [2, 0], [-2, 0], [1, 1], [-1, 1], [0, 2], [2, 2], [-2, 2], [1, 3], [-1, 3]]\n'
+     'shape = "sites"\nsites = [[0, 0], [2, 0], [-2, 0], [1, 1], [-1, 1],\n         [0, 2], [2, 2], [-2, 2], [1, 3], [-1, 3]]\n'
      "site_walls_deg = [0]\n", "peak_map.png"),
     ("vacancies", "Vacancies",
      "The experiment's hexagon with two beads missing on the +30° line (the walls stay).",
@@ -80,8 +82,9 @@ ENTRIES = (
     ("chain", "A chain with a light intruder",
      "Forty steel beads in a free chain, bead 20 half their diameter: most of the solitary wave passes it, "
      "part comes back.",
-     'shape = "chain"\nbeads = 40\ndiameters_m = [' + ", ".join(["0.01905"] * 20 + ["0.009525"] + ["0.01905"] * 19)
-     + ']\nduration = 2e-3\n', "peak_decay.png"),
+     'shape = "chain"\nbeads = 40\nduration = 2e-3\n# 40 diameters, bead 20 half the others\ndiameters_m = [\n'
+     + "".join(f"    {', '.join(CHAIN_DIAMETERS[k:k + 6])},\n" for k in range(0, len(CHAIN_DIAMETERS), 6))
+     + ']\n', "peak_decay.png"),
     ("packing", "Measured positions: a packing file",
      "Beads read from packing.csv (x, y, diameter in metres and material, one per line; here a hexagon of "
      "8 per edge with five undersized rattlers and five brass beads, written by this script), in flat walls "

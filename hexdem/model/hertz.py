@@ -7,7 +7,8 @@ F = A δ^{3/2} (A = k_n sqrt(R_eff)) stop approaching at the maximum overlap ::
 
 and separate, undamped, after the contact time ::
 
-    τ = 2 (δ_max / v) ∫₀¹ (1 − x^{5/2})^{−1/2} dx = (4/5) B(2/5, 1/2) δ_max / v ≈ 2.9432 δ_max / v.
+    τ = 2 (δ_max / v) ∫₀¹ (1 − x^{5/2})^{−1/2} dx
+      = (4/5) B(2/5, 1/2) δ_max / v ≈ 2.9432 δ_max / v.
 
 A sphere against a flat wall is the case μ = M, R_eff = R.
 """

@@ -5,11 +5,13 @@ For equal spheres of diameter d, mass m = πρd³/6 and Hertz coefficient
 A = E sqrt(d) / (3(1 − ν²)) (F = A δ^{3/2}), the strain ξ = −∂u/∂x of a long wave obeys
 (Nesterenko, *Dynamics of Heterogeneous Materials*, 2001, Sec. 1.2) ::
 
-    ξ_tt = c² ∂²/∂x² [ ξ^{3/2} + (d²/10) ξ^{1/4} ∂²/∂x² ξ^{5/4} ],   c² = A d^{5/2} / m = 2E / (πρ(1 − ν²)),
+    ξ_tt = c² ∂²/∂x² [ ξ^{3/2} + (d²/10) ξ^{1/4} ∂²/∂x² ξ^{5/4} ],
+    c² = A d^{5/2} / m = 2E / (πρ(1 − ν²)),
 
 whose travelling solution of speed V is ::
 
-    ξ(x − Vt) = (5V² / (4c²))² cos⁴(√10 (x − Vt) / (5d)),   |x − Vt| ≤ 5πd / (2√10) ≈ 2.48 d.
+    ξ(x − Vt) = (5V² / (4c²))² cos⁴(√10 (x − Vt) / (5d)),
+    |x − Vt| ≤ 5πd / (2√10) ≈ 2.48 d.
 
 A bead's velocity in that wave is v = V ξ, so its largest, V_m = V (5V²/(4c²))², gives
 V⁵ = (16/25) c⁴ V_m: the speed law :func:`solitary_speed_m_s`. The pulse spans 5π/√10 ≈ 4.97 d
