@@ -4,9 +4,9 @@ A deck directory written by ``hexdem run`` holds ``in.hexdem``, ``data.hexdem`` 
 ``hexdem.json`` (its configuration). Rerun by hand (``lmp -in in.hexdem``, on any number of
 ranks, by any LAMMPS with the GRANULAR package) it writes ``dump.lammpstrj``;
 :func:`analyse_deck` reads that dump through MDAnalysis (:mod:`hexdem.analysis.dump`) and
-writes the same ``peaks.csv``, ``summary.json``, ``arrival_map.png`` and ``peak_decay.png``
-as ``hexdem run``, with the definitions of :mod:`hexdem.analysis.peaks`. Unlike hexdem's own
-runs, this path holds the whole trajectory in memory. The deck stands alone
+writes the same result files as ``hexdem run`` (:data:`~hexdem.experiments.run.RESULT_FILES`),
+with the definitions of :mod:`hexdem.analysis.peaks`. Unlike hexdem's own runs, this path holds
+the whole trajectory in memory. The deck stands alone
 (:mod:`hexdem.experiments.deck_config`); a dump of another packing than ``hexdem.json``'s is
 refused in one line.
 """
