@@ -108,11 +108,12 @@ def test_no_code_line_is_wider_than_the_page(built):
 
 
 def test_the_development_page_counts_the_slow_tests(request):
-    """The number of `slow` tests the page quotes is the number the session collected."""
-    quoted = re.search(r"(\d+) tests are marked `slow`", (DOCS / "development.md").read_text())
+    """The number of `slow` tests the pages quote is the number the session collected."""
+    quoted = [int(count) for page in ("development.md", "getting-started.md")
+              for count in re.findall(r"(\d+) tests (?:are )?marked\s+`?slow", (DOCS / page).read_text())]
     items = request.session.items
     whole = ({item.path.name for item in items} == {path.name for path in (ROOT / "tests").glob("test_*.py")}
              and not request.config.getoption("-m") and not request.config.getoption("-k"))
     if not whole:
         pytest.skip("only a selection of the tests was collected: the count needs the whole suite")
-    assert quoted and int(quoted.group(1)) == sum(1 for item in items if item.get_closest_marker("slow"))
+    assert len(quoted) == 2 and set(quoted) == {sum(1 for item in items if item.get_closest_marker("slow"))}
