@@ -78,14 +78,15 @@ def test_bad_initial_state_files_are_one_line_and_write_nothing(tmp_path, capsys
 def test_the_time_step_follows_the_fastest_bead_of_the_state(tmp_path):
     """The step resolves the shortest contact, t_c ∝ V^(-1/5) at the fastest approach V. A bead
     of the struck edge given 100 m/s (250 V0) into the packing approaches its neighbours and the
-    walls at 100 m/s, so the step is 250^(1/5) = 3.02 times shorter than at V0 and the run as
-    long in steps. With as many steps per contact as the default experiment, LAMMPS keeps the
-    energy as well as there (drift 4.8e-5; 4.2e-4 at the step of V0, which scales as dt²)."""
+    walls at 100 m/s, so the step is 250^(1/5) = 3.02 times shorter than at V0; the run lasts as
+    long, the time the impact's pulse needs to cross the packing. With as many steps per contact as
+    the default experiment, LAMMPS keeps the energy as well as there (drift 4.8e-5; 4.2e-4 at the
+    step of V0, which scales as dt²)."""
     (tmp_path / "state.csv").write_text("m,n,vx,vy\n4,0,100.0,0\n")
     base = RunConfig(edge_beads=5)
     fast = base.replace(initial_state_file=str(tmp_path / "state.csv"))
     assert base.settings().dt_s / fast.settings().dt_s == pytest.approx(250 ** 0.2, rel=1e-12)
-    assert fast.settings().n_steps == base.settings().n_steps
+    assert fast.settings().duration_s == pytest.approx(base.settings().duration_s, abs=base.settings().dt_s)
     assert simulate(fast, tmp_path / "run").results.energy_drift < 1e-4
 
 

@@ -33,7 +33,8 @@ from hexdem.model.materials import (PAPER_DIAMETER_M, Material, MaterialTable, c
 from hexdem.model.precompression import hole_force, precompressed_lattice
 from hexdem.model.regions import RegionTable, assign_materials
 from hexdem.model.sensors import sensor_beads
-from hexdem.model.timescale import fastest_approach_m_s, impact_contact_time_s, sized_bodies
+from hexdem.model.timescale import (crossing_time_s, fastest_approach_m_s, impact_contact_time_s, sized_bodies,
+                                    striker_launch_s)
 from hexdem.model.units import SI, UnitSystem, nondimensional
 
 IMPACTS = ("velocity", "striker")
@@ -70,9 +71,10 @@ class RunConfig:
     :data:`~hexdem.model.config_keys.KEY_DESCRIPTIONS`. Lengths in m; ``v0``, ``dt``, ``duration``
     in ``units``. ``dt = None`` takes the contact time (:meth:`contact_time_s`) over
     ``steps_per_contact``, shortened so that the default sampling interval, 1/20 of the contact
-    time, is whole steps; ``duration = None`` runs one contact time per layer between the struck
-    bead and the far wall (the pulse resides less than that on each: 0.82 ms are needed, 1.43 ms
-    are run for the default experiment).
+    time, is whole steps; ``duration = None`` follows the pulse layer by layer from the struck
+    bead to the far wall, each layer for the contact time of its quickest material, and a soft
+    striker's longer contact (:func:`~hexdem.model.timescale.crossing_time_s`; the pulse resides
+    less than that on each layer: 0.82 ms are needed, 1.43 ms are run for the default experiment).
     """
 
     shape: str = "hexagon"
@@ -351,11 +353,8 @@ class RunConfig:
         if self.duration is not None:
             duration_s = self.duration * scale
         else:
-            lattice = model.lattice
-            reach = max(float(((lattice.positions_m - lattice.positions_m[bead]) @ impact.direction).max())
-                        for bead, impact in zip(model.struck_beads, model.impacts))
-            layers = math.ceil(reach / (math.sqrt(3) / 2 * lattice.diameter_m))
-            duration_s = layers * contact_s if layers else self._rebound_time_s(model)
+            crossing_s = crossing_time_s(model, contact_s if self.precompression_n > 0 else None)
+            duration_s = crossing_s + striker_launch_s(model) if crossing_s > 0 else self._rebound_time_s(model)
         sensor_every = 0
         if self.sensors:
             samples = math.ceil(1.0 / self.sensor_rate_hz / (dt_s * every) - 1e-9)

@@ -39,7 +39,8 @@ KEY_DESCRIPTIONS = {
     "impact": "velocity (V0 given to the struck bead) or striker (a sphere at V0 hits it)",
     "dt": "time step (none: the contact time over steps_per_contact)",
     "steps_per_contact": "steps per two-body Hertz contact time at the fastest approach (at least 20)",
-    "duration": "length of the run (none: until the leading wave has crossed the packing)",
+    "duration": "length of the run (none: until the leading wave has crossed the packing, layer by layer "
+                "at the pace of each layer's quickest material)",
     "dump_every": "steps between samples of the analysis and of the dump (none: 1/20 of the contact time)",
     "ranks": "MPI ranks for LAMMPS",
     "engine": "lammps, or reference (hexdem's own integrator of the same model)",

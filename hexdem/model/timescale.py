@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections import Counter
 
 import numpy as np
 
@@ -93,3 +94,57 @@ def impact_contact_time_s(bead: Material, diameter_m: float, region_materials, i
     if precompression_n <= 0:
         return hertz
     return min(hertz, math.pi * math.sqrt(mass / 2 / spring_stiffness(precompression_n, coefficient)))
+
+
+#: Round-off, in layers, below which a bead counts as on a layer's line rather than past it.
+LAYER_ROUND_OFF = 1e-9
+
+
+def own_contact_times_s(model) -> dict[int, float]:
+    """{material id: the Hertz contact time [s] of two beads of that material and the nominal
+    diameter meeting at the first impact's speed}, for the packing's bead materials."""
+    lattice, speed, d = model.lattice, model.impacts[0].speed_m_s, model.lattice.diameter_m
+    return {int(k): float(contact_time(float(sphere_mass(d, model.materials[k])) / 2,
+                                       float(hertz_coefficient(d, model.materials[k])), speed))
+            for k in np.unique(model.material_ids[:len(lattice)])}
+
+
+def crossing_time_s(model, linear_contact_s: float | None = None) -> float:
+    """The time [s] the default duration gives the leading pulse to cross the packing: one layer
+    (√3/2 d, the triangular lattice's row spacing) at a time, from each struck bead along its
+    impact to the packing's far side, each layer taking the two-bead Hertz contact time of the
+    quickest material it holds (:func:`own_contact_times_s`): the front runs through the quickest
+    material a layer offers, and through a softer one where a whole layer is of it (brass behind a
+    steel|brass interface: ((ρ_brass E*_steel) / (ρ_steel E*_brass))^(2/5) = 1.26 times longer per
+    layer, as t_c ∝ (m / A)^(2/5) at a given speed). A
+    precompressed packing's ``linear_contact_s`` (its linearized contact's half period) replaces
+    the Hertz time, scaled alike. For a packing of one material this is the layer count times
+    the two-bead contact time. The largest over the impacts."""
+    lattice = model.lattice
+    ids = model.material_ids[:len(lattice)]
+    own = own_contact_times_s(model)
+    scale = 1.0 if linear_contact_s is None else linear_contact_s / min(own.values())
+    layer_m = math.sqrt(3) / 2 * lattice.diameter_m
+    times = []
+    for bead, impact in zip(model.struck_beads, model.impacts):
+        depth = (lattice.positions_m - lattice.positions_m[bead]) @ impact.direction
+        count = math.ceil(float(depth.max()) / layer_m)
+        layers = np.ceil(depth / layer_m - LAYER_ROUND_OFF).astype(int)  # a bead on a layer's line is in it
+        quickest = {}
+        for layer, material in zip(layers[layers > 0].tolist(), ids[layers > 0].tolist()):
+            quickest[layer] = min(quickest.get(layer, np.inf), own[material])
+        paces = Counter(quickest.get(layer, min(own.values())) for layer in range(1, count + 1))
+        times.append(scale * sum(count * pace for pace, count in paces.items()))
+    return max(times)
+
+
+def striker_launch_s(model) -> float:
+    """How much longer [s] the slowest striker touches its bead than two beads of that bead's
+    material touch (0 for strikers no slower: the pulse a soft striker launches needs that much
+    more time to enter the packing)."""
+    own, struck, ids = own_contact_times_s(model), model.struck_beads, model.material_ids
+    extra = [pair_contact_time_s(model.materials[ids[struck[k]]], float(model.lattice.diameters_m[struck[k]]),
+                                 impact.striker_material or model.bead,
+                                 impact.striker_diameter_m or model.lattice.diameter_m, impact.speed_m_s)
+             - own[int(ids[struck[k]])] for k, impact in enumerate(model.impacts) if impact.striker]
+    return max([0.0, *extra])
