@@ -86,16 +86,23 @@ UNMEASURED_STYLES = {
 }
 
 
+#: Ring colours of the beads of other materials, outside every colour map the maps use.
+OUTLINE_COLOURS = ("#00c8ff", "#3cdc3c", "#ff3cc8", "#0050ff")
+
+
 def _circles(ax, positions, diameters, **style) -> EllipseCollection:
     return EllipseCollection(diameters, diameters, np.zeros(len(diameters)), units="xy", offsets=positions,
-                             offset_transform=ax.transData, linewidth=0.2, **style)
+                             offset_transform=ax.transData, **{"linewidths": 0.2, **style})
 
 
-def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=None, norm=None, unmeasured=None):
+def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=None, norm=None, unmeasured=None,
+             outlined=None):
     """Beads as true-size circles (one collection, sized in data units) coloured by ``values``
     through ``norm`` (None: linear); returns the mappable. ``unmeasured``: {name in
     :data:`UNMEASURED_STYLES`: mask of the beads it describes}, drawn in that style outside the
-    colour scale and named in a legend; any other NaN is drawn as "no value"."""
+    colour scale and named in a legend; any other NaN is drawn as "no value". ``outlined``:
+    {name: mask} of beads to ring in a colour of :data:`OUTLINE_COLOURS` (a region of another
+    material: an interface, intruders), named in the same legend."""
     values = np.asarray(values, float)
     groups = {name: np.asarray(beads, bool) for name, beads in (unmeasured or {}).items()}
     flagged = np.any([np.zeros(len(values), bool), *groups.values()], axis=0)
@@ -111,6 +118,10 @@ def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=No
         if np.any(beads):
             ax.add_collection(_circles(ax, positions[beads], diameters[beads], **UNMEASURED_STYLES[name]))
             legend.append(Patch(label=name, **UNMEASURED_STYLES[name]))
+    for (name, beads), colour in zip((outlined or {}).items(), OUTLINE_COLOURS):
+        ring = {"facecolor": "none", "edgecolor": colour}
+        ax.add_collection(_circles(ax, positions[beads], diameters[beads] * 0.9, **ring, linewidths=1.6))
+        legend.append(Patch(label=name, linewidth=1.6, **ring))
     if legend:
         ax.figure.legend(handles=legend, loc="lower center", ncol=len(legend), frameon=False, fontsize="small")
     radius = np.max(diameters) / 2
@@ -157,7 +168,10 @@ def draw_lattice(ax, results, model, values, label: str, cmap="viridis", norm=No
     scale = 1.0 / results.length_unit_m
     positions = results.positions
     diameters = model.lattice.diameters_m * scale
-    circles = bead_map(ax, positions, diameters, values, cmap=cmap, label=label, norm=norm, unmeasured=unmeasured)
+    ids, names = model.lattice.material_ids, [material.name for material in model.materials]
+    others = {f"{names[k]} beads": ids == k for k in np.unique(ids) if k > 0}
+    circles = bead_map(ax, positions, diameters, values, cmap=cmap, label=label, norm=norm, unmeasured=unmeasured,
+                       outlined=others)
     draw_walls(ax, model.walls, positions, diameters / 2, scale=scale)
     struck = positions[np.unique(model.struck_beads)]
     ax.plot(struck[:, 0], struck[:, 1], linestyle="", marker="x", color=marker_colour, markersize=8, mew=2)
