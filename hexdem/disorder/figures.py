@@ -117,5 +117,6 @@ def expnumsim(lattice, walls, ideal_relative, mean_relative, reference: int, v_s
         ax.set_title(title)
         ax.set_xlabel("x [m]")
         ax.set_ylabel("y [m]")
-    fig.suptitle(f"Wavefront arrival relative to the marked bead, $V_{{striker}}$ = {v_striker:g} m/s (Fig. 8)")
+    fig.suptitle(f"Wavefront arrival relative to the marked bead, $V_{{striker}}$ = {v_striker:g} m/s (Fig. 8; "
+                 "its panel (b), the experiments' mean, is measured, not simulated)")
     plots.save(fig, path)
