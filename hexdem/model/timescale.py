@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections import Counter
 
 import numpy as np
 
@@ -121,20 +120,22 @@ def crossing_time_s(model, linear_contact_s: float | None = None) -> float:
     the Hertz time, scaled alike. For a packing of one material this is the layer count times
     the two-bead contact time. The largest over the impacts."""
     lattice = model.lattice
-    ids = model.material_ids[:len(lattice)]
     own = own_contact_times_s(model)
-    scale = 1.0 if linear_contact_s is None else linear_contact_s / min(own.values())
+    fastest = min(own.values())
+    pace = np.vectorize(own.get, otypes=[float])(model.material_ids[:len(lattice)])  # each bead's material's
+    scale = 1.0 if linear_contact_s is None else linear_contact_s / fastest
     layer_m = math.sqrt(3) / 2 * lattice.diameter_m
     times = []
     for bead, impact in zip(model.struck_beads, model.impacts):
         depth = (lattice.positions_m - lattice.positions_m[bead]) @ impact.direction
         count = math.ceil(float(depth.max()) / layer_m)
         layers = np.ceil(depth / layer_m - LAYER_ROUND_OFF).astype(int)  # a bead on a layer's line is in it
-        quickest = {}
-        for layer, material in zip(layers[layers > 0].tolist(), ids[layers > 0].tolist()):
-            quickest[layer] = min(quickest.get(layer, np.inf), own[material])
-        paces = Counter(quickest.get(layer, min(own.values())) for layer in range(1, count + 1))
-        times.append(scale * sum(count * pace for pace, count in paces.items()))
+        ahead = (layers > 0) & (layers <= count)
+        quickest = np.full(count + 1, np.inf)
+        np.minimum.at(quickest, layers[ahead], pace[ahead])
+        quickest[np.isinf(quickest)] = fastest  # a layer no bead's centre falls in
+        paces, counts = np.unique(quickest[1:], return_counts=True)  # count × pace: exact for one material
+        times.append(scale * sum(float(n * p) for p, n in zip(paces, counts)))
     return max(times)
 
 
