@@ -308,10 +308,12 @@ class RunConfig:
                      (self.material(spec.striker_material or self.bead_material), spec.striker_diameter_m or self.diameter_m)
                      if spec.striker and (spec.striker_material is not None or spec.striker_diameter_m is not None)
                      else None) for spec in self.impact_specs()]
+        if model is None and (self.initial_state_file is not None or self.shape in PLACED_SHAPES):
+            model = self.model()
         if self.initial_state_file is not None:
-            fastest = fastest_approach_m_s(model or self.model())
+            fastest = fastest_approach_m_s(model)
             strikers += [(fastest, striker) for _, striker in strikers]
-        sized = () if self.shape not in PLACED_SHAPES else sized_bodies(model or self.model())
+        sized = () if self.shape not in PLACED_SHAPES else sized_bodies(model)
         return impact_contact_time_s(self.material(self.bead_material), self.diameter_m,
                                      [self.material(r["material"]) for r in self.regions], strikers,
                                      self.precompression_n, sized)

@@ -75,9 +75,10 @@ def _centered_square(config, struck) -> BuiltPacking:
 def _packing_file(config) -> BuiltPacking:
     if config.packing_file is None:
         raise HexdemError('shape = "packing" needs packing_file = "beads.csv" (header x,y,diameter[,material])')
-    lattice = packing_from_file(config.packing_file, config.diameter_m, config.struck_bead, config.walls,
+    beads = read_packing_rows(config.packing_file)
+    lattice = packing_from_file(config.packing_file, beads, config.diameter_m, config.struck_bead, config.walls,
                                 strike_direction(config.strike_angle_deg))
-    return BuiltPacking(lattice, material_regions(lattice, read_packing_rows(config.packing_file).materials))
+    return BuiltPacking(lattice, material_regions(lattice, beads.materials))
 
 
 def build_packing(config, struck) -> BuiltPacking:

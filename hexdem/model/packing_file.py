@@ -70,12 +70,13 @@ def hull_normals(positions_m) -> list[np.ndarray]:
     return [-equation[:2] / np.linalg.norm(equation[:2]) for equation in hull.equations]
 
 
-def packing_from_file(path, diameter_m: float, struck_bead: int, walls: str, strike_direction) -> Lattice:
-    """The packing of ``packing_file`` ``path`` (nominal ``diameter_m``), struck at row
-    ``struck_bead`` along the unit vector ``strike_direction``, with ``walls``."""
+def packing_from_file(path, beads: PackingRows, diameter_m: float, struck_bead: int, walls: str,
+                      strike_direction) -> Lattice:
+    """The packing of the ``beads`` read from ``packing_file`` ``path`` (:func:`read_packing_rows`;
+    nominal ``diameter_m``), struck at row ``struck_bead`` along the unit vector
+    ``strike_direction``, with ``walls``."""
     if walls not in WALLS:
         raise HexdemError(f"walls must be one of {', '.join(WALLS)}, got {walls!r}")
-    beads = read_packing_rows(path)
     if not 0 <= struck_bead < len(beads.diameters_m):
         raise HexdemError(f"struck_bead {struck_bead} is not a bead of {path} (rows 0 to {len(beads.diameters_m) - 1})")
     ratio = beads.diameters_m / diameter_m
