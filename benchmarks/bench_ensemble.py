@@ -43,6 +43,8 @@ from hexdem.engines.lammps.partitions import loop_time_s
 from hexdem.engines.lammps.runner import run_bare
 from hexdem.experiments.snapshots import DEFAULT_TIMES_MS, snapshot_config, take_snapshots
 from hexdem.model.config import RunConfig
+from hexdem.model.model_builder import build_model
+from hexdem.model.run_settings import run_settings
 
 ENSEMBLE_TARGET_S = 60.0
 ENSEMBLE_SPEED_UP_TARGET = 1.5
@@ -94,8 +96,8 @@ def bench_ensemble(work: Path, workers: int, options, before: str) -> None:
 
 def bench_ranks(work: Path, repeats: int, base: RunConfig, times_s) -> None:
     config = snapshot_config(base, sorted(times_s))
-    model = config.model()
-    settings = config.settings(model)
+    model = build_model(config)
+    settings = run_settings(config, model)
     atom_steps = model.n_bodies * settings.n_steps
     runners = [(f"hexdem, {ranks} rank{'s' * (ranks > 1)}", "hexdem", ranks) for ranks in (1, 2)]
     runners += [(f"bare lmp, {ranks} rank{'s' * (ranks > 1)}", "bare", ranks) for ranks in (1, 2)]

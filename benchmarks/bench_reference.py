@@ -47,6 +47,8 @@ from hexdem.engines.lammps.runner import run_bare
 from hexdem.engines.reference.engine import ReferenceEngine
 from hexdem.model.config import RunConfig
 from hexdem.model.granular import RunSettings
+from hexdem.model.model_builder import build_model
+from hexdem.model.run_settings import run_settings
 
 #: (config, steps per timed run) of each benchmarked lattice.
 LATTICES = ((RunConfig(shape="hexagon"), 20000), (RunConfig(shape="half-hexagon"), 4000))
@@ -81,8 +83,8 @@ def reference_subprocess(tree: Path | None, config: RunConfig):
 def time_reference(path: str, steps: str, dump_every: str) -> None:
     """Print the reference engine's seconds for ``steps`` steps of the config at ``path``, after a warm-up."""
     config = RunConfig.from_toml(Path(path))
-    model = config.model()
-    settings = RunSettings(config.settings(model).dt_s, int(steps), int(dump_every))
+    model = build_model(config)
+    settings = RunSettings(run_settings(config, model).dt_s, int(steps), int(dump_every))
     work = Path(tempfile.mkdtemp(prefix="hexdem-bench-reference-"))
     try:
         reference_seconds(model, RunSettings(settings.dt_s, 2, 1), work / "warm-up")
@@ -139,8 +141,8 @@ def main() -> None:
     rates = {}
     try:
         for config, steps in lattices:
-            model = config.model()
-            settings = RunSettings(config.settings(model).dt_s, steps, args.dump_every)
+            model = build_model(config)
+            settings = RunSettings(run_settings(config, model).dt_s, steps, args.dump_every)
             reference_seconds(model, RunSettings(settings.dt_s, 2, 1), work / "warm-up")
             references = ([(reference, reference_subprocess(None, config)),
                            (f"reference at {args.before}", reference_subprocess(tree, config))]

@@ -52,6 +52,8 @@ from hexdem.engines.lammps.partitions import loop_time_s
 from hexdem.engines.lammps.runner import run_bare
 from hexdem.experiments.run import run_experiment
 from hexdem.model.config import RunConfig
+from hexdem.model.model_builder import build_model
+from hexdem.model.run_settings import run_settings
 
 QUICK = RunConfig(edge_beads=5, duration=2e-4)
 TARGET_FACTOR, TARGET_OFFSET_S = 1.3, 0.6
@@ -91,8 +93,8 @@ def main() -> None:
     args = parser.parse_args()
     repeats = 1 if args.quick else args.repeats
     config = QUICK if args.quick else RunConfig()
-    model = config.model()
-    settings = config.settings(model)
+    model = build_model(config)
+    settings = run_settings(config, model)
     work = Path(tempfile.mkdtemp(prefix="hexdem-bench-run-"))
     print(f"machine: {describe()}; load average {os.getloadavg()[0]:.2f}", flush=True)
     try:

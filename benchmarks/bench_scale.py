@@ -51,6 +51,8 @@ from hexdem.engines.lammps.driver import split_deck
 from hexdem.engines.lammps.partitions import loop_time_s
 from hexdem.engines.lammps.runner import run_bare
 from hexdem.model.config import STEPS_PER_CONTACT, RunConfig
+from hexdem.model.model_builder import build_model
+from hexdem.model.run_settings import run_settings
 
 SIZES = {331: RunConfig(shape="hexagon", edge_beads=11),
          3151: RunConfig(shape="half-hexagon", long_edge=91, short_edge=46),
@@ -74,8 +76,8 @@ def measure(config: RunConfig, ranks: int, steps: int, work: Path, repeat: int, 
     """hexdem end to end (the version unpacked at ``tree``, None: today's), then bare LAMMPS, on
     ``ranks`` ranks at ``steps`` steps per contact: one row's measurements."""
     config = config.replace(ranks=ranks, steps_per_contact=steps)
-    model = config.model()
-    settings = config.settings(model)
+    model = build_model(config)
+    settings = run_settings(config, model)
     tag = f"{config.n_beads()}-{ranks}-{steps}-{repeat}-{'before' if tree else 'now'}"
     config_path = write_config(config, work / f"{tag}.toml")
     deck = nooutput_deck(model, settings, work / f"bare-{tag}")

@@ -12,6 +12,8 @@ from hexdem.model.config import RunConfig
 from hexdem.model.contact_law import ContactLaws, Friction
 from hexdem.model.materials import BRASS, DELRIN, STEEL_316, hertz_stiffness, mindlin_stiffness
 from hexdem.model.units import SI
+from hexdem.model.model_builder import build_model
+from hexdem.model.run_settings import run_settings
 
 
 def test_mindlin_over_hertz_stiffness_of_like_spheres_is_2_1_minus_nu_over_2_minus_nu():
@@ -44,9 +46,9 @@ def test_laws_of_pairs_and_walls_carry_each_contacts_own_moduli_and_mu():
 
 
 def test_config_friction_keys_default_to_the_frictionless_model_and_wall_friction_to_friction():
-    assert RunConfig(edge_beads=3).model().friction == Friction()
-    assert RunConfig(edge_beads=3, friction=0.2).model().friction == Friction(0.2, 0.2)
-    assert RunConfig(edge_beads=3, friction=0.2, wall_friction=0.0).model().friction == Friction(0.2, 0.0)
+    assert build_model(RunConfig(edge_beads=3)).friction == Friction()
+    assert build_model(RunConfig(edge_beads=3, friction=0.2)).friction == Friction(0.2, 0.2)
+    assert build_model(RunConfig(edge_beads=3, friction=0.2, wall_friction=0.0)).friction == Friction(0.2, 0.0)
 
 
 @pytest.mark.parametrize("keys, message", [
@@ -66,16 +68,16 @@ def test_bad_friction_is_refused_in_one_line(keys, message):
 
 def test_frictionless_decks_keep_fix_nve_and_no_tangential_force():
     config = RunConfig(edge_beads=3)
-    model = config.model()
-    deck = render_input(model, config.settings(model))
+    model = build_model(config)
+    deck = render_input(model, run_settings(config, model))
     assert "fix             integrate all nve\n" in deck
     assert "mindlin" not in deck and deck.count("tangential linear_nohistory 0.0 0.0") == len(model.walls)
 
 
 def test_frictional_deck_gives_every_contact_its_own_mindlin_law_and_turns_the_spheres():
     config = RunConfig(edge_beads=4, impact="striker", striker_material="brass", friction=0.3, wall_friction=0.5)
-    model = config.model()
-    deck = render_input(model, config.settings(model))
+    model = build_model(config)
+    deck = render_input(model, run_settings(config, model))
     assert "fix             integrate all nve/sphere\n" in deck and "enforce2d" in deck
     pairs = [line.split() for line in pair_block(model, SI).splitlines() if line.startswith("pair_coeff")]
     kinds = {"1": STEEL_316, "2": BRASS}
@@ -91,7 +93,7 @@ def test_frictional_deck_gives_every_contact_its_own_mindlin_law_and_turns_the_s
 
 
 def test_one_material_with_friction_takes_one_pair_coeff():
-    model = replace(RunConfig(edge_beads=3).model(), friction=Friction(0.25, 0.25))
+    model = replace(build_model(RunConfig(edge_beads=3)), friction=Friction(0.25, 0.25))
     block = pair_block(model, SI)
     assert block.startswith("pair_style      granular\npair_coeff      * * hertz")
     assert block.endswith(f"tangential mindlin {mindlin_stiffness(STEEL_316, STEEL_316)!r} 0.0 0.25")
@@ -102,7 +104,7 @@ def test_settle_decks_turn_frictional_spheres_too(tmp_path):
     from hexdem.disorder.preparation import Preparation, write_stage_deck
 
     for friction, integrator in ((0.0, "nve"), (0.3, "nve/sphere")):
-        model = RunConfig(edge_beads=3, friction=friction).model()
+        model = build_model(RunConfig(edge_beads=3, friction=friction))
         deck = (write_stage_deck(model, "settle", Preparation(), tmp_path / str(friction)) / DECK_NAME).read_text()
         assert f"fix             integrate all {integrator}\n" in deck
         assert ("tangential mindlin" in deck) == (friction > 0)

@@ -14,13 +14,10 @@ from scipy import stats
 from scipy.spatial import cKDTree
 
 from hexdem.disorder.preparation import (
-    SETTLED_NAME,
     TOLERANCE_M,
     Disorder,
     Preparation,
     edge_directions,
-    read_data_file,
-    read_stage,
     spaced_lattice,
     walls_for_settling,
     write_stage_deck,
@@ -28,10 +25,13 @@ from hexdem.disorder.preparation import (
 from hexdem.disorder.prestress import touching_pairs
 from hexdem.engines.lammps.engine import LammpsEngine
 from hexdem.engines.lammps.partitions import run_partitioned
+from hexdem.engines.lammps.settling import SETTLED_NAME, read_data_file, read_stage
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
 from hexdem.model.lattice import hexagon
 from hexdem.model.materials import PAPER_DIAMETER_M, sphere_mass
+from hexdem.model.model_builder import build_model
+from hexdem.model.run_settings import run_settings
 
 D = PAPER_DIAMETER_M
 EDGE = 4
@@ -120,7 +120,7 @@ def test_the_settling_walls_stand_back_from_every_member_by_the_slack(slack):
 def prepare(directory, sigma_m=None, seed=0) -> SimpleNamespace:
     """Both preparation stages of a 4-per-edge hexagon, chained as the ensemble chains them."""
     disorder, preparation = Disorder(D, sigma_m=sigma_m), Preparation()
-    base = RunConfig(edge_beads=EDGE, impact="striker").model()
+    base = build_model(RunConfig(edge_beads=EDGE, impact="striker"))
     ideal = base.lattice
     spaced = spaced_lattice(ideal, disorder.diameters_m(len(ideal), seed, 0), disorder)
     compact = dataclasses.replace(base, lattice=spaced)
@@ -214,7 +214,7 @@ def test_gravity_acts_during_the_impact_and_the_tilted_audit_conserves_energy(pr
     gravitational potential included the total is conserved to the integrator's accuracy
     (700 steps per contact: about 2e-6, so that the work of gravity stands out by far)."""
     config = RunConfig(edge_beads=EDGE, impact="striker", v0=0.4, duration=3e-4, steps_per_contact=700, dump_every=20)
-    settings = config.settings(prepared.model)
+    settings = run_settings(config, prepared.model)
     plain = record(LammpsEngine(gravity_m_s2=tuple(prepared.gravity)), prepared.model, settings, tmp_path / "impact")
     tilted = replace(plain, gravity_m_s2=tuple(prepared.gravity))
     assert tilted.energy_drift(prepared.model) < 1e-5

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from hexdem.model.config import RunConfig
+from hexdem.model.model_builder import build_lattice, build_model
 
 GUIDE = Path(__file__).resolve().parents[1] / "docs" / "guide"
 
@@ -37,7 +38,7 @@ def test_every_packing_config_of_the_guide_builds_the_packing_its_comment_names(
     assert len(blocks) == 10
     packing = [k for k, block in enumerate(blocks) if "packing_file" in block]
     assert len(packing) == 1, "the packing file's example names a file of the reader's"
-    lattices = [RunConfig(**tomllib.loads(block)).lattice() for k, block in enumerate(blocks) if k not in packing]
+    lattices = [build_lattice(RunConfig(**tomllib.loads(block))) for k, block in enumerate(blocks) if k not in packing]
     # 9 x 12 corners and 8 x 11 interstitials; the chain's 40 beads
     assert [len(lattice) for lattice in lattices] == [28, 30, 514, 329, 10, 225, 9 * 12 + 8 * 11, 40, 1]
     assert [len(lattice.walls) for lattice in lattices] == [3, 4, 1, 6, 1, 4, 4, 0, 1]
@@ -46,7 +47,7 @@ def test_every_packing_config_of_the_guide_builds_the_packing_its_comment_names(
 def test_the_guides_interface_config_builds_its_materials():
     section = (GUIDE / "materials.md").read_text()
     (block,) = re.findall(r"```toml\n(.*?)```", section, flags=re.DOTALL)
-    model = RunConfig(**tomllib.loads(block)).model()
+    model = build_model(RunConfig(**tomllib.loads(block)))
     assert [m.name for m in model.materials] == ["steel316", "brass", "ptfe", "glass"]
     # brass: the layers n with (√3/2) n >= 10, n = 12 … 20, holding 11 + (20 − n) beads each: 135
     brass = sum(11 + 20 - n for n in range(12, 21))
@@ -58,11 +59,11 @@ def test_the_guides_impact_configs_build_their_impacts_and_lines():
     blocks = re.findall(r"```toml\n(.*?)```", section, flags=re.DOTALL)
     assert len(blocks) == 4
     *impacts, lines = [RunConfig(**tomllib.loads(block)) for block in blocks]
-    models = [config.model() for config in impacts]
+    models = [build_model(config) for config in impacts]
     assert [len(model.impacts) for model in models] == [2, 11, 1]  # double strike, the 11 beads of an edge, interior
     assert [len(model.strikers) for model in models] == [0, 11, 0]
     assert [list(lattice.indices[b]) for lattice in [models[2].lattice] for b in models[2].struck_beads] == [[0, 14]]
-    assert len(lines.lattice().line("across")) == 21  # the middle column of 11 per edge: 2 * 11 - 1 beads
+    assert len(build_lattice(lines).line("across")) == 21  # the middle column of 11 per edge: 2 * 11 - 1 beads
 
 
 def test_the_configuration_pages_file_is_the_built_in_default():

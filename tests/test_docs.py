@@ -12,6 +12,7 @@ import pytest
 from hexdem.cli.main import COMMANDS
 from hexdem.model.config import SHAPES, RunConfig
 from hexdem.model.config_keys import KEY_DESCRIPTIONS
+from hexdem.model.model_builder import build_model
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
@@ -59,7 +60,7 @@ def test_the_api_reference_documents_the_modules_a_page_per_subpackage(built):
 def test_the_gallery_shows_every_shape_and_impact_kind():
     configs = {path.stem: RunConfig.from_toml(path) for path in sorted((DOCS / "gallery" / "configs").glob("*.toml"))}
     assert {config.shape for config in configs.values()} == set(SHAPES)
-    models = {name: config.model() for name, config in configs.items()}
+    models = {name: build_model(config) for name, config in configs.items()}
     kinds = {"velocity": any(not m.strikers for m in models.values()),
              "striker": any(len(m.strikers) == 1 for m in models.values()),
              "several impacts": any(len(m.impacts) > 1 and not m.strikers for m in models.values()),

@@ -25,6 +25,8 @@ from hexdem.analysis.peaks import refine_peak
 from hexdem.model.config import RunConfig
 from hexdem.model.granular import RunSettings
 from hexdem.model.materials import STEEL_316
+from hexdem.model.model_builder import build_model
+from hexdem.model.run_settings import run_settings
 
 MU = 0.3
 #: Round-off floor of a rebound velocity compared with an exact one, relative to V0.
@@ -227,8 +229,8 @@ def test_free_packing_with_friction_keeps_its_angular_momentum(tmp_path):
     Verlet keeps it to round-off)."""
     config = RunConfig(shape="sites", sites=[[0, 0], [2, 0], [1, 1], [3, 1], [1, -1], [4, 0], [2, 2]],
                        impact="striker", strike_angle_deg=35.0, friction=0.5, wall_material="none", duration=4e-4)
-    model = config.model()
-    states = lammps_states(model, config.settings(model), tmp_path, every=20)
+    model = build_model(config)
+    states = lammps_states(model, run_settings(config, model), tmp_path, every=20)
     masses, radii = model.masses_kg, model.diameters_m / 2
     orbital = masses * (states.positions[..., 0] * states.velocities[..., 1]
                         - states.positions[..., 1] * states.velocities[..., 0])

@@ -18,6 +18,8 @@ from hexdem.engines.reference.friction import FrictionalSystem
 from hexdem.model.config import RunConfig
 from hexdem.model.materials import STEEL_316
 from hexdem.model.units import SI, nondimensional
+from hexdem.model.model_builder import build_model
+from hexdem.model.run_settings import run_settings
 
 MU = 0.3
 STEPS = 200
@@ -95,11 +97,11 @@ def test_free_packing_keeps_its_angular_momentum_in_the_reference_engine():
     (levers R_i − δ/2), so RK4 keeps it to its truncation error, which halving the step shrinks."""
     config = RunConfig(shape="sites", sites=[[0, 0], [2, 0], [1, 1], [3, 1], [1, -1], [4, 0], [2, 2]],
                        impact="striker", strike_angle_deg=35.0, friction=0.5, wall_material="none", duration=4e-4)
-    model = config.model()
+    model = build_model(config)
     masses, radii = model.masses_kg, model.diameters_m / 2
     drifts = []
     for halving in (1, 2):
-        settings = config.settings(model)
+        settings = run_settings(config, model)
         settings = type(settings)(settings.dt_s / halving, settings.n_steps * halving, 10 * halving)
         states = reference_states(model, settings, every=10 * halving)
         orbital = masses * (states.positions[..., 0] * states.velocities[..., 1]
@@ -116,9 +118,9 @@ def test_frictionless_models_keep_the_frictionless_kernel_and_frictional_ones_sp
     a frictional one the frictional kernel, whose samples carry the spheres' spins."""
     config = RunConfig(edge_beads=4, impact="striker", strike_angle_deg=20.0, engine="reference")
     for friction, system in ((0.0, ReferenceSystem), (0.4, FrictionalSystem)):
-        model = config.replace(friction=friction).model()
+        model = build_model(config.replace(friction=friction))
         samples = []
-        engine = ReferenceEngine().run(model, config.settings(model), tmp_path / str(friction), samples.append,
+        engine = ReferenceEngine().run(model, run_settings(config, model), tmp_path / str(friction), samples.append,
                                        show_progress=False)
         assert engine["n_pairs"] == system.from_model(model, SI).pairs.n_pairs
         assert np.isfinite(samples[-1].velocities).all()
@@ -136,9 +138,9 @@ def test_friction_in_the_papers_units_is_the_si_run_rescaled(tmp_path, engine):
     scaled = si.replace(units="nondimensional", v0=si.v0 / units.velocity_m_s, duration=si.duration / units.time_s)
     finals = []
     for config in (si, scaled):
-        model = config.model()
+        model = build_model(config)
         run = ReferenceEngine() if engine == "reference" else LammpsEngine()
-        trajectory = record(run, model, config.settings(model), tmp_path / config.units)
+        trajectory = record(run, model, run_settings(config, model), tmp_path / config.units)
         finals.append(trajectory.velocities_m_s[-1])
     assert np.abs(finals[0]).max() > 0.05 * V0
     np.testing.assert_allclose(finals[1], finals[0], rtol=0, atol=1e-8 * V0)
@@ -158,10 +160,10 @@ def test_engines_agree_on_a_frictional_packings_peak_speeds(tmp_path, keys):
     peaks = {}
     for steps in (140, 280):
         config = base.replace(steps_per_contact=steps)
-        model = config.model()
+        model = build_model(config)
         for name, engine in (("lammps", LammpsEngine()), ("reference", ReferenceEngine())):
             samples = []
-            engine.run(model, config.settings(model), tmp_path / f"{name}-{steps}", samples.append, show_progress=False)
+            engine.run(model, run_settings(config, model), tmp_path / f"{name}-{steps}", samples.append, show_progress=False)
             speeds = np.array([np.linalg.norm(s.velocities[np.argsort(s.ids)], axis=1) for s in samples])
             peaks[name, steps] = speeds.max(axis=0)  # by body id
         spins = np.abs([s.angular_velocities for s in samples]).max(axis=0)  # the reference engine's

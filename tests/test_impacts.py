@@ -11,6 +11,8 @@ from hexdem.errors import HexdemError
 from hexdem.experiments.run import run_experiment, simulate
 from hexdem.model.config import RunConfig
 from hexdem.model.materials import BRASS, STEEL_316
+from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.run_settings import run_settings
 
 ENGINES = [LammpsEngine(), ReferenceEngine()]
 #: A free hexagon of 5 per edge (sites n = 0..8; {0, 8} is the middle of the right edge, {8, 4}
@@ -30,12 +32,12 @@ def sphere_mass(material, d=0.01905):
 def test_three_strikers_keep_the_momentum_and_energy_they_bring(engine, tmp_path):
     """No walls and no external force: Σ m v stays the strikers' initial momentum, worked out by
     hand, and the energy their kinetic energy, to the integrator's dt² error."""
-    model = THREE_STRIKERS.model()
+    model = build_model(THREE_STRIKERS)
     assert model.n_bodies == 61 + 3 and len(model.strikers) == 3
     steel, brass = sphere_mass(STEEL_316), sphere_mass(BRASS)
     momentum = np.array([steel * 0.4 - brass * 0.3, -steel * 0.4])
     energy = 0.5 * steel * 0.4**2 * 2 + 0.5 * brass * 0.3**2
-    trajectory = record(engine, model, THREE_STRIKERS.settings(model), tmp_path)
+    trajectory = record(engine, model, run_settings(THREE_STRIKERS, model), tmp_path)
     p = np.einsum("b,fbk->fk", model.masses_kg, trajectory.velocities_m_s)
     np.testing.assert_allclose(p, np.tile(momentum, (len(p), 1)), rtol=0, atol=1e-12 * np.abs(momentum).max())
     energies = trajectory.energies_j(model)
@@ -71,7 +73,7 @@ def test_a_symmetric_strike_gives_mirror_symmetric_pulses(engine, case, tmp_path
 
 
 def test_a_flat_striker_is_one_sphere_per_edge_bead_and_replaces_the_wall():
-    model = RunConfig(impact="striker", impacts=[{"edge_deg": 0.0}]).model()
+    model = build_model(RunConfig(impact="striker", impacts=[{"edge_deg": 0.0}]))
     left = np.flatnonzero(model.lattice.indices[:, 1] == 0)
     assert sorted(model.struck_beads) == sorted(left) and len(left) == 11
     assert len(model.strikers) == 11 and "wall_000" not in [w.name for w in model.walls]
@@ -82,25 +84,25 @@ def test_a_flat_striker_is_one_sphere_per_edge_bead_and_replaces_the_wall():
 
 
 def test_every_struck_bead_sits_in_a_hole_of_the_wall_it_is_pushed_through():
-    model = RunConfig(edge_beads=5, impacts=[{"site": [0, 0]}, {"site": [0, 8], "angle_deg": 180.0},
-                                             {"site": [-4, 0], "angle_deg": 0.0}]).model()
+    model = build_model(RunConfig(edge_beads=5, impacts=[{"site": [0, 0]}, {"site": [0, 8], "angle_deg": 180.0},
+                                             {"site": [-4, 0], "angle_deg": 0.0}]))
     members = {w.name: {tuple(model.lattice.indices[b]) for b in w.members} for w in model.walls}
     assert (0, 0) not in members["wall_000"] and (0, 8) not in members["wall_180"]
     assert (-4, 0) not in members["wall_000"] and (-4, 0) in members["wall_060"]  # the corner's other wall stays
 
 
 def test_holes_do_not_depend_on_the_order_of_the_impacts_and_only_struck_beads_sit_in_one():
-    first = RunConfig(edge_beads=4, impacts=[{"site": [0, 0]}, {"site": [2, 6], "angle_deg": -120.0}]).model()
-    second = RunConfig(edge_beads=4, impacts=[{"site": [2, 6], "angle_deg": -120.0}, {"site": [0, 0]}]).model()
+    first = build_model(RunConfig(edge_beads=4, impacts=[{"site": [0, 0]}, {"site": [2, 6], "angle_deg": -120.0}]))
+    second = build_model(RunConfig(edge_beads=4, impacts=[{"site": [2, 6], "angle_deg": -120.0}, {"site": [0, 0]}]))
     assert {w.name: w.members.tolist() for w in first.walls} == {w.name: w.members.tolist() for w in second.walls}
-    far = RunConfig(edge_beads=4, impacts=[{"edge_deg": 180.0}]).model()  # {0, 0} is not struck: no hole there
+    far = build_model(RunConfig(edge_beads=4, impacts=[{"edge_deg": 180.0}]))  # {0, 0} is not struck: no hole there
     assert far.lattice.struck in next(w for w in far.walls if w.name == "wall_000").members
 
 
 def test_the_papers_single_impact_keeps_its_one_hole_in_the_struck_edges_wall():
     """In a hexagon of 2 per edge {0, 0} is also the corner of the lower-left edge: it stays on that wall."""
-    walls = {w.name: w.members for w in RunConfig(edge_beads=2).lattice().walls}
-    struck = RunConfig(edge_beads=2).lattice().struck
+    walls = {w.name: w.members for w in build_lattice(RunConfig(edge_beads=2)).walls}
+    struck = build_lattice(RunConfig(edge_beads=2)).struck
     assert struck not in walls["wall_000"] and struck in walls["wall_060"]
 
 
@@ -109,16 +111,16 @@ def test_a_deck_beyond_lammpss_32_groups_is_refused_before_it_runs(tmp_path):
 
     interior = [[m, n] for n in range(2, 8) for m in range(-4, 5) if (m + n) % 2 == 0][:26]
     config = RunConfig(edge_beads=5, impacts=[{"site": site, "v0": 0.1 + 0.01 * k} for k, site in enumerate(interior)])
-    model = config.model()
+    model = build_model(config)
     with pytest.raises(HexdemError, match="LAMMPS groups"):
-        render_input(model, config.settings(model))
+        render_input(model, run_settings(config, model))
 
 
 def test_extra_observation_lines_follow_the_lattice_from_any_bead(tmp_path):
     config = RunConfig(edge_beads=5, engine="reference",
                        lines=[{"name": "up", "site": [-8, 4], "angle_deg": 90},
                               {"name": "sixty", "site": [0, 0], "angle_deg": 60}])
-    lattice = config.lattice()
+    lattice = build_lattice(config)
     assert [tuple(lattice.indices[b]) for b in lattice.line("up")] == [(m, 4) for m in range(-8, 9, 2)]
     assert [tuple(lattice.indices[b]) for b in lattice.line("sixty")] == [(0, 0), (3, 1), (6, 2)]
     run_experiment(config, tmp_path, log=lambda message: None)
@@ -150,7 +152,7 @@ def test_extra_observation_lines_follow_the_lattice_from_any_bead(tmp_path):
 ])
 def test_bad_impacts_and_lines_get_one_line_errors(changes, message):
     with pytest.raises(HexdemError, match=None) as error:
-        RunConfig(**changes)
+        build_model(RunConfig(**changes))
     assert message in str(error.value) and "\n" not in str(error.value)
 
 
@@ -163,8 +165,8 @@ def test_the_far_wall_of_every_impact_must_be_reached():
     from hexdem.analysis.energy import energy_regions
 
     config = RunConfig(impacts=[{"site": [0, 0]}, {"site": [0, 20], "angle_deg": 180.0}])
-    model = config.model()
-    settings = config.settings(model)
+    model = build_model(config)
+    settings = run_settings(config, model)
     n = len(model.lattice)
     left = next(w for w in model.walls if w.normal[0] > 0.99)
 

@@ -14,6 +14,8 @@ from hexdem.cli.main import main
 from hexdem.experiments.run import simulate
 from hexdem.model.config import RunConfig
 from hexdem.model.materials import hertz_coefficient, sphere_mass
+from hexdem.model.run_settings import contact_time_s, run_settings
+from hexdem.model.model_builder import build_lattice, build_model
 
 #: Two touching spheres on the +30° line, no walls, the first struck along the line.
 PAIR = {"shape": "sites", "sites": [[0, 0], [1, 1]], "site_walls_deg": [], "strike_angle_deg": 30.0}
@@ -85,8 +87,8 @@ def test_the_time_step_follows_the_fastest_bead_of_the_state(tmp_path):
     (tmp_path / "state.csv").write_text("m,n,vx,vy\n4,0,100.0,0\n")
     base = RunConfig(edge_beads=5)
     fast = base.replace(initial_state_file=str(tmp_path / "state.csv"))
-    assert base.settings().dt_s / fast.settings().dt_s == pytest.approx(250 ** 0.2, rel=1e-12)
-    assert fast.settings().duration_s == pytest.approx(base.settings().duration_s, abs=base.settings().dt_s)
+    assert run_settings(base).dt_s / run_settings(fast).dt_s == pytest.approx(250 ** 0.2, rel=1e-12)
+    assert run_settings(fast).duration_s == pytest.approx(run_settings(base).duration_s, abs=run_settings(base).dt_s)
     assert simulate(fast, tmp_path / "run").results.energy_drift < 1e-4
 
 
@@ -97,8 +99,8 @@ def test_the_fastest_approach_is_that_of_two_beads_meeting(tmp_path):
     state = tmp_path / "state.csv"
     vx, vy = (float(v) for v in -0.2 * ALONG)
     state.write_text(f"m,n,vx,vy\n1,1,{vx!r},{vy!r}\n")
-    alone = RunConfig(**PAIR).contact_time_s()
-    assert RunConfig(**PAIR, initial_state_file=str(state)).contact_time_s() == pytest.approx(alone * 1.5 ** -0.2,
+    alone = contact_time_s(RunConfig(**PAIR))
+    assert contact_time_s(RunConfig(**PAIR, initial_state_file=str(state))) == pytest.approx(alone * 1.5 ** -0.2,
                                                                                               rel=1e-12)
 
 
@@ -133,7 +135,7 @@ def test_a_deck_with_a_relative_initial_state_is_analysed_from_inside(tmp_path, 
 
 def test_a_missing_initial_state_file_is_one_line(tmp_path):
     with pytest.raises(Exception, match="cannot read initial_state_file"):
-        RunConfig(**PAIR, initial_state_file=str(tmp_path / "nowhere.csv"))
+        build_model(RunConfig(**PAIR, initial_state_file=str(tmp_path / "nowhere.csv")))
 
 
 def test_both_engines_agree_on_a_random_initial_state_in_a_precompressed_packing(tmp_path):
@@ -146,7 +148,7 @@ def test_both_engines_agree_on_a_random_initial_state_in_a_precompressed_packing
     config = RunConfig(edge_beads=5, precompression_n=20.0, v0=1e-4)
     velocities, displacements = 1e-4 * rng.standard_normal((61, 2)), 1e-8 * rng.standard_normal((61, 2))
     lines = ["m,n,vx,vy,dx,dy"] + [f"{m},{n}," + ",".join(repr(float(v)) for v in (*u, *d))
-                                   for (m, n), u, d in zip(config.lattice().indices.tolist(), velocities, displacements)]
+                                   for (m, n), u, d in zip(build_lattice(config).indices.tolist(), velocities, displacements)]
     (tmp_path / "state.csv").write_text("\n".join(lines) + "\n")
     config = config.replace(initial_state_file=str(tmp_path / "state.csv"), duration=5e-4)
     reference = simulate(config.replace(engine="reference", steps_per_contact=280), tmp_path / "reference").results
@@ -168,7 +170,7 @@ def test_beads_csv_places_the_beads_where_the_state_starts_them(tmp_path):
     config.write_text('shape = "sites"\nsites = [[0, 0], [1, 1], [0, 4]]\nsite_walls_deg = []\nduration = 2e-4\n'
                       f'initial_state_file = "{state}"\n')
     assert main(["run", "--config", str(config), "--out", str(tmp_path / "out")]) == 0
-    packed = RunConfig(shape="sites", sites=[[0, 0], [1, 1], [0, 4]]).lattice().positions_m
+    packed = build_lattice(RunConfig(shape="sites", sites=[[0, 0], [1, 1], [0, 4]])).positions_m
     rows = read_csv(tmp_path / "out" / "beads.csv")[1]
     placed = np.array([[float(row["x"]), float(row["y"])] for row in rows])
     np.testing.assert_allclose(placed - packed, [[0, 0], [0.001, -0.002], [0, 0]], atol=1e-15)

@@ -7,6 +7,7 @@ from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
 from hexdem.model.lattice import (disc, from_sites, half_disc, half_hexagon, hexagon, parallelogram, strike_direction,
                                    triangle, without_sites)
+from hexdem.model.model_builder import build_lattice, build_model
 
 D = 0.01905
 
@@ -173,16 +174,16 @@ def test_config_reads_sites_from_csv_and_toml(tmp_path):
     csv_file, toml_file = tmp_path / "sites.csv", tmp_path / "sites.toml"
     csv_file.write_text("m,n\n0,0\n2,0\n1,1\n")
     toml_file.write_text("sites = [[0, 0], [2, 0], [1, 1]]\n")
-    inline = RunConfig(shape="sites", sites=[[0, 0], [2, 0], [1, 1]]).lattice()
+    inline = build_lattice(RunConfig(shape="sites", sites=[[0, 0], [2, 0], [1, 1]]))
     for path in (csv_file, toml_file):
-        lattice = RunConfig(shape="sites", sites_file=str(path)).lattice()
+        lattice = build_lattice(RunConfig(shape="sites", sites_file=str(path)))
         np.testing.assert_array_equal(lattice.indices, inline.indices)
         assert lattice.walls == ()
     (tmp_path / "bad.csv").write_text("m,n\n0,0\nx,1\n")
     with pytest.raises(HexdemError, match="two integers"):
-        RunConfig(shape="sites", sites_file=str(tmp_path / "bad.csv"))
+        build_model(RunConfig(shape="sites", sites_file=str(tmp_path / "bad.csv")))
     with pytest.raises(HexdemError, match="exactly one of"):
-        RunConfig(shape="sites")
+        build_model(RunConfig(shape="sites"))
 
 
 def test_disc_holds_every_site_within_its_radius_inside_a_touching_circle():

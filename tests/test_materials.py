@@ -17,6 +17,7 @@ from hexdem.experiments.run import ENERGY_REGION_COLUMNS, run_experiment, simula
 from hexdem.model.config import RunConfig
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.materials import BRASS, PTFE, STEEL_316
+from hexdem.model.model_builder import build_model
 
 STRIKER_D = 0.6 * D
 
@@ -55,7 +56,7 @@ def test_regions_give_materials_half_plane_strip_and_intruders():
     config = RunConfig(edge_beads=7, regions=[{"material": "brass", "x_min_d": 5.0},
                                               {"material": "glass", "x_min_d": 2.0, "x_max_d": 3.0},
                                               {"material": "ptfe", "sites": [[0, 6], [1, 7]]}])
-    model = config.model()
+    model = build_model(config)
     assert [m.name for m in model.materials] == ["steel316", "brass", "glass", "ptfe"]
     x_d = (model.lattice.positions_m[:, 0] - model.lattice.positions_m[model.lattice.struck, 0]) / D
     names = np.array([model.materials[k].name for k in model.lattice.material_ids])
@@ -77,7 +78,7 @@ def test_regions_give_materials_half_plane_strip_and_intruders():
 ])
 def test_bad_regions_are_refused(regions, message):
     with pytest.raises(HexdemError, match=message.replace("(", r"\(").replace(")", r"\)").replace("{", r"\{")):
-        RunConfig(edge_beads=4, regions=regions)
+        build_model(RunConfig(edge_beads=4, regions=regions))
 
 
 @pytest.mark.parametrize("engine", ["lammps", "reference"])

@@ -17,6 +17,8 @@ from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time
 from hexdem.model.lattice import Lattice
 from hexdem.model.materials import STEEL_316, hertz_stiffness, sphere_mass
+from hexdem.model.model_builder import build_model
+from hexdem.model.run_settings import run_settings
 
 #: Steel beads of the experiment at V0: the two-bead Hertz contact time [s].
 TAU = contact_time(sphere_mass(D, STEEL_316) / 2, hertz_stiffness(STEEL_316, STEEL_316) * np.sqrt(D / 4), V0)
@@ -91,11 +93,11 @@ def test_rebuilding_the_list_often_changes_nothing(tmp_path, monkeypatch, fricti
     pair that does not touch adds nothing and the tangential histories are carried over by pair, so
     the run is the same to the last bit."""
     config = RunConfig(edge_beads=4, impact="striker", strike_angle_deg=20.0, friction=friction, engine="reference")
-    model = config.model()
+    model = build_model(config)
 
     def run(name):
         samples = []
-        engine = ReferenceEngine().run(model, config.settings(model), tmp_path / name, samples.append,
+        engine = ReferenceEngine().run(model, run_settings(config, model), tmp_path / name, samples.append,
                                        show_progress=False)
         spins = [np.zeros(0) if s.angular_velocities is None else s.angular_velocities for s in samples]
         return engine, np.array([s.velocities for s in samples]), np.array(spins)

@@ -15,6 +15,8 @@ from hexdem.model.config import RunConfig
 from hexdem.model.materials import sphere_mass
 from hexdem.model.square_crystals import interstitial_fit_m
 from hexdem.theory.solitary import chain_speed_scale_m_s, solitary_speed_m_s
+from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.run_settings import run_settings
 
 V0 = 0.4
 GALLERY = Path(__file__).resolve().parent.parent / "docs" / "gallery" / "configs"
@@ -97,12 +99,12 @@ def test_a_packing_file_is_the_packing_it_was_written_from(tmp_path):
     walls and holes, and the same peaks and arrivals on every bead the pulse reaches before it
     could meet a wall (1e-6)."""
     default = RunConfig()
-    lattice = default.lattice()
+    lattice = build_lattice(default)
     rows = "\n".join(f"{float(x)!r},{float(y)!r},{float(d)!r}" for (x, y), d in zip(lattice.positions_m, lattice.diameters_m))
     (tmp_path / "hexagon.csv").write_text("x,y,diameter\n" + rows + "\n")
     from_file = RunConfig(shape="packing", packing_file=str(tmp_path / "hexagon.csv"), walls="hull",
                           struck_bead=int(lattice.struck))
-    packed = from_file.lattice()
+    packed = build_lattice(from_file)
     np.testing.assert_allclose(sorted(np.round(w.normal, 12).tolist() for w in packed.walls),
                                sorted(np.round(w.normal, 12).tolist() for w in lattice.walls), atol=1e-12)
     assert sorted(sorted(w.members.tolist()) for w in packed.walls) == sorted(sorted(w.members.tolist())
@@ -125,7 +127,7 @@ def test_a_packing_file_is_the_packing_it_was_written_from(tmp_path):
 ])
 def test_bad_shapes_are_one_line_errors(changes, message):
     with pytest.raises(HexdemError, match=message) as error:
-        RunConfig(**changes)
+        build_model(RunConfig(**changes))
     assert "\n" not in str(error.value)
 
 
@@ -136,12 +138,12 @@ def test_overlapping_or_badly_written_packing_files_are_refused(tmp_path):
                           ("x,y,diameter\n0,0,0.1\n", "not within a factor 2")):
         path.write_text(text)
         with pytest.raises(HexdemError, match=message):
-            RunConfig(shape="packing", packing_file=str(path))
+            build_model(RunConfig(shape="packing", packing_file=str(path)))
 
 
 def test_a_chains_intruder_mass_follows_its_diameter():
     config = RunConfig(shape="chain", beads=3, diameters_m=[0.02, 0.01, 0.02])
-    model = config.model()
+    model = build_model(config)
     assert model.masses_kg[1] == pytest.approx(sphere_mass(0.01, model.bead))
     np.testing.assert_allclose(model.lattice.positions_m[:, 0], [0.0, 0.015, 0.03])
 
@@ -174,7 +176,7 @@ def test_compares_peak_tolerance_off_the_triangular_lattice_is_the_measured_one(
     """MARGIN times 5.0/N² on a square (the largest error measured off the lattice), 0.8/N² on the hexagon."""
     for config, coefficient in ((RunConfig(shape="square", rows=5, columns=5), PLACED_PEAK_ERROR_N2),
                                 (RunConfig(edge_beads=4), PEAK_ERROR_N2)):
-        model = config.model()
-        settings = config.settings(model)
+        model = build_model(config)
+        settings = run_settings(config, model)
         steps = settings.contact_time_s / settings.dt_s
         assert Tolerances().for_run(model, settings).peak_rel == pytest.approx(MARGIN * coefficient / steps**2)

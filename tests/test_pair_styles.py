@@ -13,6 +13,8 @@ from hexdem.engines.lammps.deck import DECK_NAME, pair_block, write_deck
 from hexdem.engines.lammps.library import load_lammps
 from hexdem.model.config import RunConfig
 from hexdem.model.units import SI
+from hexdem.model.model_builder import build_model
+from hexdem.model.run_settings import run_settings
 
 GRANULAR_PAIR = "pair_style      granular\npair_coeff      * * hertz {k} 0.0 damping viscoelastic tangential linear_nohistory 0.0 0.0"
 
@@ -20,7 +22,7 @@ GRANULAR_PAIR = "pair_style      granular\npair_coeff      * * hertz {k} 0.0 dam
 def compressed_model():
     """The 4-per-edge experiment with diameters 0-0.1 % too large for their sites: every bead
     overlaps its neighbours and the edge beads overlap their walls (by up to 4.8 µm)."""
-    model = RunConfig(edge_beads=4, impact="striker").model()
+    model = build_model(RunConfig(edge_beads=4, impact="striker"))
     lattice = model.lattice
     grown = lattice.diameters_m * (1 + 1e-3 * np.random.default_rng(7).random(len(lattice)))
     return replace(model, lattice=replace(lattice, diameters_m=grown))
@@ -58,7 +60,7 @@ def test_elastic_decks_use_gran_hertz_history_and_damped_ones_granular():
 
 def test_gran_hertz_history_forces_equal_granular_hertz_walls_included(tmp_path):
     model = compressed_model()
-    settings = RunConfig(edge_beads=4, impact="striker").settings(model)
+    settings = run_settings(RunConfig(edge_beads=4, impact="striker"), model)
     k = pair_block(model, SI).split()[2]
     history = write_deck(model, settings, tmp_path / "history").directory
     granular = write_deck(model, settings, tmp_path / "granular").directory

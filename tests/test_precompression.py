@@ -10,6 +10,7 @@ from hexdem.experiments.run import simulate
 from hexdem.model.config import RunConfig
 from hexdem.model.lattice import half_hexagon, hexagon
 from hexdem.model.materials import DELRIN, STEEL_316, hertz_coefficient, hertz_stiffness, sphere_mass
+from hexdem.model.model_builder import build_model
 from hexdem.model.precompression import (
     hole_force,
     longitudinal_sound_speed,
@@ -96,7 +97,7 @@ def test_weak_impulses_travel_at_the_longitudinal_sound_speed(tmp_path, engine):
 ])
 def test_bad_precompression_is_refused(changes, message):
     with pytest.raises(HexdemError, match=message):
-        RunConfig(**changes)
+        build_model(RunConfig(**changes))
 
 
 def test_far_wall_is_reached_when_the_front_has_crossed_although_the_box_keeps_ringing(tmp_path):

@@ -7,10 +7,11 @@ import pytest
 
 from hexdem.disorder.prestress import prestress, touching_pairs
 from hexdem.model.config import RunConfig
+from hexdem.model.model_builder import build_model
 
 
 def test_a_touching_ideal_lattice_carries_no_load():
-    model = RunConfig().model()
+    model = build_model(RunConfig())
     load = prestress(model)
     assert load.contacts == 0 and load.mean_contact_force_n == 0 and load.wall_force_n == 0
 
@@ -18,7 +19,7 @@ def test_a_touching_ideal_lattice_carries_no_load():
 def test_pair_forces_follow_hertz_with_each_contacts_own_radius():
     """Shrink the lattice so that neighbours overlap by δ: every bond carries k sqrt(R_eff) δ^1.5,
     R_eff = r/2 for equal beads."""
-    model = RunConfig().model()
+    model = build_model(RunConfig())
     lattice = model.lattice
     d, delta = lattice.diameter_m, 1e-6
     squeezed = replace(model, lattice=replace(lattice, positions_m=lattice.positions_m * (d - delta) / d))
@@ -34,7 +35,7 @@ def test_pair_forces_follow_hertz_with_each_contacts_own_radius():
 
 
 def test_a_wall_pushed_in_by_delta_loads_each_of_its_beads_by_hertz():
-    model = RunConfig().model()
+    model = build_model(RunConfig())
     lattice = model.lattice
     delta = 2e-6
     wall = lattice.walls[0]

@@ -16,6 +16,8 @@ from hexdem.model.hertz import contact_time, max_overlap
 from hexdem.model.walls import Wall
 from hexdem.model.materials import DELRIN, STEEL_316, hertz_stiffness, sphere_mass
 from hexdem.model.units import SI, nondimensional
+from hexdem.model.model_builder import build_model
+from hexdem.model.run_settings import run_settings
 
 #: A small experiment: 5 beads per edge (61 beads), everything else the paper's defaults.
 SMALL = RunConfig(edge_beads=5, engine="reference")
@@ -94,9 +96,9 @@ def line_peaks(analysis, line):
 
 def test_halving_the_time_step_changes_peaks_by_less_than_1e_4(tmp_path):
     config = SMALL.replace(strike_angle_deg=30.0)
-    dt = config.settings().dt_s
+    dt = run_settings(config).dt_s
     coarse = simulate(config, tmp_path / "dt")
-    fine = simulate(config.replace(dt=dt / 2, dump_every=2 * config.settings().dump_every), tmp_path / "dt2")
+    fine = simulate(config.replace(dt=dt / 2, dump_every=2 * run_settings(config).dump_every), tmp_path / "dt2")
     for line in ("0", "+30", "-30"):
         (p1, t1), (p2, t2) = line_peaks(coarse, line), line_peaks(fine, line)
         moving = p1 > 0.01 * config.v0
@@ -118,7 +120,7 @@ def test_nondimensional_run_is_the_scaled_si_run(tmp_path):
     """Eq. (scaling): in A = d = M = 1 the same impact gives the same V_n/V0 and scaled times."""
     si = SMALL.replace(strike_angle_deg=30.0)
     scale = nondimensional(D)
-    settings = si.settings()
+    settings = run_settings(si)
     nd = si.replace(units="nondimensional", v0=si.v0 / scale.velocity_m_s, dt=settings.dt_s / scale.time_s,
                     duration=settings.duration_s / scale.time_s)
     a, b = simulate(si, tmp_path / "si"), simulate(nd, tmp_path / "nd")
@@ -128,7 +130,7 @@ def test_nondimensional_run_is_the_scaled_si_run(tmp_path):
 
 
 def test_samples_start_at_zero_every_dump_interval_and_the_run_is_described(tmp_path):
-    model = SMALL.model()
+    model = build_model(SMALL)
     trajectory = record(ReferenceEngine(), model, RunSettings(1e-7, 105, 10), tmp_path / "deck")
     np.testing.assert_allclose(trajectory.times_s, np.arange(11) * 1e-6)
     assert trajectory.velocities_m_s.shape == (11, model.n_bodies, 2)
@@ -142,7 +144,7 @@ def test_samples_start_at_zero_every_dump_interval_and_the_run_is_described(tmp_
     (RunSettings(1e-7, 0, 1), "n_steps"), (RunSettings(1e-7, 10, 0), "dump_every")])
 def test_bad_settings_are_one_line_errors(tmp_path, settings, message):
     with pytest.raises(HexdemError, match=message):
-        ReferenceEngine().run(SMALL.model(), settings, tmp_path, lambda sample: None)
+        ReferenceEngine().run(build_model(SMALL), settings, tmp_path, lambda sample: None)
 
 
 def test_divergence_is_reported(tmp_path):

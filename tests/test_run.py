@@ -9,6 +9,7 @@ from conftest import read_csv
 from hexdem.analysis.impact import PEAK_COLUMNS
 from hexdem.experiments.run import BEAD_COLUMNS, RESULT_FILES, simulate
 from hexdem.model.config import RunConfig
+from hexdem.model.model_builder import build_model
 
 
 def test_default_run_writes_the_contracted_files(default_run):
@@ -123,7 +124,7 @@ def test_config_file_sets_parameters(tmp_path):
     path = tmp_path / "run.toml"
     path.write_text('edge_beads = 5\nstrike_angle_deg = 30.0\nimpact = "striker"\nunits = "nondimensional"\nv0 = 0.05\n')
     config = RunConfig.from_toml(path)
-    model = config.model()
+    model = build_model(config)
     assert len(model.lattice) == 61 and model.has_striker
     np.testing.assert_allclose(model.impact.direction, [np.sqrt(3) / 2, 0.5])
     assert model.impact.speed_m_s == pytest.approx(0.05 * config.unit_system.velocity_m_s)

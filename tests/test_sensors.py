@@ -15,6 +15,9 @@ from hexdem.experiments.sensors import SENSOR_COLUMNS, SENSOR_PEAK_COLUMNS
 from hexdem.experiments.signals import SIGNAL_COLUMNS
 from hexdem.model.config import RunConfig
 from hexdem.model.materials import sphere_mass
+from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.run_settings import run_settings
+from hexdem.model.sensors import sensor_beads
 
 SENSORS = ["0:1", "+30:3", "-30:5", "0:4"]
 CONFIG = RunConfig(edge_beads=7, sensors=SENSORS, duration=6e-4)
@@ -27,10 +30,10 @@ def sensor_run(tmp_path_factory):
 
 
 def test_sensors_are_sampled_exactly_at_the_acquisition_rate():
-    settings = CONFIG.settings()
+    settings = run_settings(CONFIG)
     assert settings.dt_s * settings.sensor_every == pytest.approx(1 / 500e3, rel=1e-12)
     assert settings.sensor_every % settings.dump_every == 0
-    assert settings.dt_s <= RunConfig(edge_beads=7).settings().dt_s
+    assert settings.dt_s <= run_settings(RunConfig(edge_beads=7)).dt_s
 
 
 @pytest.mark.parametrize("sensors, message", [
@@ -38,7 +41,7 @@ def test_sensors_are_sampled_exactly_at_the_acquisition_rate():
     ([10_000], "not in the packing"), (["0:1", "0:1"], "the same bead twice")])
 def test_bad_sensors_are_refused(sensors, message):
     with pytest.raises(HexdemError, match=message):
-        RunConfig(edge_beads=7, sensors=sensors)
+        build_model(RunConfig(edge_beads=7, sensors=sensors))
 
 
 def test_sensors_may_name_the_extra_lines():
@@ -46,11 +49,11 @@ def test_sensors_may_name_the_extra_lines():
     misspelt line is refused with the extra line among the known ones."""
     lines = [{"name": "across", "site": [-20, 10], "angle_deg": 90}]
     config = RunConfig(lines=lines, sensors=["across:3", "0:1"])
-    lattice = config.lattice()
-    beads = config.sensor_beads(lattice)
+    lattice = build_lattice(config)
+    beads = sensor_beads(config.sensors, lattice)
     assert list(beads) == ["across:3", "0:1"] and tuple(lattice.indices[beads["across:3"]]) == (-14, 10)
     with pytest.raises(HexdemError, match="line one of 0, [+]30, -30, across"):
-        RunConfig(lines=lines, sensors=["acros:3"])
+        build_model(RunConfig(lines=lines, sensors=["acros:3"]))
 
 
 def test_sensor_files_follow_the_run(sensor_run):
@@ -86,7 +89,7 @@ def test_heavier_sensor_beads_in_both_engines(tmp_path):
     """sensor_mass_factor = 1.5: both engines agree within the default tolerances on every line's
     bead, and the heavier first bead of the 0° line moves slower than a plain one."""
     config = CONFIG.replace(sensor_mass_factor=1.5)
-    model = config.model()
+    model = build_model(config)
     bead = model.sensor_beads[0]
     assert model.masses_kg[bead] == pytest.approx(1.5 * float(sphere_mass(config.diameter_m)))
     lammps, reference = (simulate(config.replace(engine=name), tmp_path / name) for name in ("lammps", "reference"))

@@ -10,6 +10,7 @@ from hexdem.cli.main import main
 from hexdem.errors import HexdemError
 from hexdem.experiments.snapshots import snapshot_config, take_snapshots
 from hexdem.model.config import RunConfig
+from hexdem.model.run_settings import run_settings
 
 TIMES_S = (1e-4, 2e-4, 3e-4)
 #: A half-hexagon small enough for seconds, large enough to split between two ranks.
@@ -20,8 +21,8 @@ SMALL_HALF = RunConfig(shape="half-hexagon", long_edge=21, short_edge=11, impact
 def test_frames_fall_exactly_on_the_requested_times(times_ms):
     config = RunConfig(impact="striker")
     snap = snapshot_config(config, [t * 1e-3 for t in times_ms])
-    settings = snap.settings()
-    assert settings.dt_s <= config.settings().dt_s
+    settings = run_settings(snap)
+    assert settings.dt_s <= run_settings(config).dt_s
     interval = settings.dt_s * settings.dump_every
     for t in times_ms:
         assert t * 1e-3 / interval == pytest.approx(round(t * 1e-3 / interval), abs=1e-9)

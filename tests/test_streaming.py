@@ -16,6 +16,7 @@ from hexdem.experiments.parallel import run_on_ranks
 from hexdem.experiments.run import RESULT_FILES, simulate
 from hexdem.model.config import RunConfig
 from hexdem.model.granular import RunSettings
+from hexdem.model.model_builder import build_model
 
 
 class NoAudit:
@@ -64,7 +65,7 @@ def test_tracker_reproduces_the_whole_record_definitions(n_samples):
     at fine sampling, where the ladder of records brackets the crossing within a rung."""
     rng = np.random.default_rng(7)
     times = np.linspace(0.0, 1.2, n_samples)
-    model = RunConfig(edge_beads=4).model()
+    model = build_model(RunConfig(edge_beads=4))
     n = len(model.lattice)
     speeds = _synthetic_speeds(times, n, rng)
     settings = RunSettings(dt_s=times[1], n_steps=n_samples - 1, dump_every=1)
@@ -94,7 +95,7 @@ class MigratingBeads:
     def __call__(self, comm):
         rng = np.random.default_rng(11)
         times = np.linspace(0.0, 1.2, self.n_samples)
-        model = RunConfig(edge_beads=4).model()
+        model = build_model(RunConfig(edge_beads=4))
         n, ranks = len(model.lattice), 1 if comm is None else comm.Get_size()
         speeds = _synthetic_speeds(times, n, rng)
         owners = np.repeat(rng.integers(0, ranks, (self.n_samples // self.every + 1, n)), self.every, axis=0)
@@ -163,7 +164,7 @@ def test_an_earlier_small_pulse_just_above_half_the_peak_is_the_arrival():
     on the first rise (sample 7.96), although that record lies within a rung of the next; the
     tracker interpolates linearly at the rounded top of the small pulse (7.80), not 20 samples
     later on the main pulse."""
-    model = RunConfig(edge_beads=2).model()
+    model = build_model(RunConfig(edge_beads=2))
     n = len(model.lattice)
     series = np.zeros(60)
     series[5:12] = (0.3, 0.45, 0.498, 0.5005, 0.49, 0.3, 0.1)

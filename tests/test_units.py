@@ -9,6 +9,8 @@ from hexdem.model.hertz import contact_time
 from hexdem.model.materials import (DELRIN, MATERIALS, STEEL_316, Material, effective_modulus, hertz_coefficient,
                                      sphere_mass)
 from hexdem.model.units import nondimensional, to_nondimensional_velocity, to_physical_velocity
+from hexdem.model.model_builder import build_model
+from hexdem.model.run_settings import contact_time_s
 
 D = 0.01905
 
@@ -56,14 +58,14 @@ def test_a_packing_of_another_material_takes_its_hertz_law_and_mass(name):
     mass = mat.density_kg_m3 * np.pi * D**3 / 6
     a = mat.youngs_modulus_pa * np.sqrt(D) / (3 * (1 - mat.poisson_ratio**2))
     config = RunConfig(bead_material=name, edge_beads=3)
-    assert config.contact_time_s() == pytest.approx(contact_time(mass / 2, a, 0.4), rel=1e-12)
-    assert config.contact_time_s() == pytest.approx(2.9432 * (5 * mass / 2 * 0.4**2 / (4 * a)) ** 0.4 / 0.4, rel=1e-4)
-    assert config.model().masses_kg[0] == pytest.approx(mass)
+    assert contact_time_s(config) == pytest.approx(contact_time(mass / 2, a, 0.4), rel=1e-12)
+    assert contact_time_s(config) == pytest.approx(2.9432 * (5 * mass / 2 * 0.4**2 / (4 * a)) ** 0.4 / 0.4, rel=1e-4)
+    assert build_model(config).masses_kg[0] == pytest.approx(mass)
 
 
 def test_a_configuration_defines_its_own_material():
     table = {"bronze": {"youngs_modulus_pa": 1.2e11, "poisson_ratio": 0.34, "density_kg_m3": 8800.0}}
-    model = RunConfig(bead_material="bronze", materials=table, edge_beads=3).model()
+    model = build_model(RunConfig(bead_material="bronze", materials=table, edge_beads=3))
     assert model.bead == Material("bronze", 1.2e11, 0.34, 8800.0, "this configuration")
     with pytest.raises(HexdemError, match="built in"):
         RunConfig(materials={"brass": table["bronze"]})

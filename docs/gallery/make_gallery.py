@@ -90,6 +90,12 @@ ENTRIES = (
      "8 per edge with five undersized rattlers and five brass beads, written by this script), in flat walls "
      "along the convex hull.",
      'shape = "packing"\npacking_file = "packing.csv"\nwalls = "hull"\nstruck_bead = 3\n', "peak_map.png"),
+    ("random", "A random polydisperse disc",
+     "Steel beads with diameters uniform in d (1 ± 0.15), packed into a disc of radius 0.15 m by a "
+     "LAMMPS compaction (pulled to the centre, then released; `OUT/preparation` keeps its decks and "
+     "`packing.csv`) and struck at the middle of the left edge inside walls along its hull: the pulse "
+     "follows the force chains. The same seed packs the same disc.",
+     'shape = "random"\nradius_m = 0.15\nseed = 1\nwalls = "hull"\n', "peak_map.png"),
     ("friction", "Spheres that rub and roll",
      "The experiment with Coulomb friction μ = 0.3 (Mindlin's tangential force, beads turning); "
      "the movie shows the spin, each bead coloured by its rim's speed.",

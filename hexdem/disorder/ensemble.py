@@ -37,19 +37,14 @@ from pathlib import Path
 import numpy as np
 
 from hexdem.common.checks import is_number, positive_int
-from hexdem.disorder.preparation import (
-    SETTLED_NAME,
-    Disorder,
-    Preparation,
-    read_data_file,
-    read_stage,
-    spaced_lattice,
-    walls_for_settling,
-)
+from hexdem.disorder.preparation import Disorder, Preparation, spaced_lattice, walls_for_settling
+from hexdem.engines.lammps.settling import SETTLED_NAME, read_data_file, read_stage
 from hexdem.errors import HexdemError
 from hexdem.model.config import MIN_STEPS_PER_CONTACT, STEPS_PER_CONTACT, RunConfig
 from hexdem.model.granular import GranularModel, RunSettings
 from hexdem.model.lattice import Lattice
+from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.run_settings import run_settings
 
 RESULT_NAME = "result.npz"
 MANIFEST_NAME = "ensemble.json"
@@ -143,10 +138,10 @@ class EnsembleConfig:
                          dump_every=self.steps_per_contact // IMPACT_SAMPLES_PER_CONTACT, friction=self.friction)
         if self.duration_s is not None:
             return base.replace(duration=self.duration_s)
-        return base.replace(duration=self.duration_factor * base.settings().duration_s)
+        return base.replace(duration=self.duration_factor * run_settings(base).duration_s)
 
     def ideal_lattice(self) -> Lattice:
-        return self.run_config(self.velocities_m_s[0]).lattice()
+        return build_lattice(self.run_config(self.velocities_m_s[0]))
 
     def as_dict(self) -> dict:
         return dataclasses.asdict(self)
@@ -178,7 +173,7 @@ class Ensemble:
     def __init__(self, config: EnsembleConfig, out):
         self.config, self.out = config, Path(out)
         self.ideal = config.ideal_lattice()
-        self._base_model = config.run_config(config.velocities_m_s[0]).replace(friction=0.0).model()
+        self._base_model = build_model(config.run_config(config.velocities_m_s[0]).replace(friction=0.0))
 
     # ---- layout
     def realization_dir(self, k: int) -> Path:
@@ -201,7 +196,7 @@ class Ensemble:
 
     # ---- models
     def settings(self, v: float) -> RunSettings:
-        return self.config.run_config(v).settings()
+        return run_settings(self.config.run_config(v))
 
     def diameters_m(self, k: int) -> np.ndarray:
         """Realization k's diameters: each bead's nominal one (d, or a centered square's
@@ -237,7 +232,7 @@ class Ensemble:
 
     def impact_model(self, k: int | None, v: float) -> GranularModel:
         """Realization k (None: the ideal lattice) struck at ``v``."""
-        model = self.config.run_config(v).model()
+        model = build_model(self.config.run_config(v))
         return model if k is None else replace(model, lattice=self.settled_lattice(k))
 
     @property

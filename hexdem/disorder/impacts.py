@@ -21,9 +21,10 @@ from hexdem.analysis.impact import ImpactAnalysis
 from hexdem.analysis.leading_pulse import leading_pulse_amplitude
 from hexdem.common.io import atomic_path
 from hexdem.disorder.ensemble import Ensemble, EnsembleConfig
-from hexdem.disorder.preparation import STAGES, read_stage
+from hexdem.disorder.preparation import STAGES
 from hexdem.disorder.prestress import prestress
 from hexdem.engines.lammps.partitions import loop_time_s
+from hexdem.engines.lammps.settling import read_stage
 from hexdem.experiments.parallel import spread_tasks
 from hexdem.experiments.run import check_energy
 from hexdem.experiments.tracked_run import ImpactJob, track_impact

@@ -66,16 +66,8 @@ from pathlib import Path
 import numpy as np
 
 from hexdem.common.checks import is_number
-from hexdem.engines.lammps.deck import (
-    DATA_NAME,
-    DECK_NAME,
-    data_file,
-    granular_block,
-    gravity_block,
-    integrator,
-    template,
-    walls_block,
-)
+from hexdem.engines.lammps.deck import gravity_block, walls_block
+from hexdem.engines.lammps.settling import SettlingStage, write_settling_deck
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel
 from hexdem.model.lattice import BOND_STEPS, Lattice
@@ -92,10 +84,6 @@ CRYSTAL_PUSH_FORCE_N = 0.05
 STANDARD_GRAVITY_M_S2 = 9.80665
 #: The two preparation stages, in order.
 STAGES = ("compact", "settle")
-#: File in which a stage deck writes its final step, time and kinetic energy.
-STATS_NAME = "settle.txt"
-#: LAMMPS data file with the settled state of a stage.
-SETTLED_NAME = "settled.data"
 #: Neighbour offsets {Δm, Δn} of a bead in the paper's labels: the bond steps and their opposites.
 NEIGHBOURS = BOND_STEPS + tuple((-dm, -dn) for dm, dn in BOND_STEPS)
 #: Off the triangular lattice, beads are neighbours when their centres are closer than this
@@ -290,101 +278,19 @@ def _stage_blocks(model: GranularModel, stage: str, preparation: Preparation) ->
 
 
 def write_stage_deck(model: GranularModel, stage: str, preparation: Preparation, directory) -> Path:
-    """Render the deck of preparation ``stage`` ("compact" or "settle") for ``model``'s lattice.
+    """Render the deck of preparation ``stage`` ("compact" or "settle") for ``model``'s lattice
+    (:func:`~hexdem.engines.lammps.settling.write_settling_deck`).
 
     ``model`` supplies the packing (positions, diameters, walls) and the materials; its
     impact is not part of the deck. Returns the deck directory.
     """
     if stage not in STAGES:
         raise HexdemError(f"unknown preparation stage {stage!r}; known: {', '.join(STAGES)}")
-    directory = Path(directory)
-    directory.mkdir(parents=True, exist_ok=True)
-    lattice = model.lattice
-    masses = model.masses_kg[:len(lattice)]
     blocks = _stage_blocks(model, stage, preparation)
-    kinetic = repr(preparation.kinetic_tolerance_j(masses))
-    condition = f"c_kinetic<{kinetic}"
-    note = f"kinetic energy below {kinetic} J (rms bead speed {preparation.settled_rms_speed_m_s!r} m/s)"
-    force = blocks["force_tolerance"]
-    if force is not None:
-        condition = f"({condition})&&(fmax<{force!r})"
-        note += f"\n# and no net force component above {force!r} N"
-    text = template("settle.in").substitute(
-        stage=stage, title=f"{lattice.shape}, {len(lattice)} beads", loads_note=blocks["loads_note"],
-        granular=granular_block(model, SI), integrator=integrator(model),
-        walls=blocks["walls"], loads=blocks["loads"], damping_time=repr(blocks["damping_s"]),
-        gamma=repr(float(masses.mean()) / blocks["damping_s"]), max_step=repr(preparation.max_step_m),
-        max_dt=repr(preparation.max_dt_s), first_dt=repr(preparation.max_dt_s / 100),
-        thermo_every=10 * preparation.check_every, min_steps=preparation.min_steps,
-        check_every=preparation.check_every, max_steps=preparation.max_steps, settled_condition=condition,
-        settled_note=note, kinetic_tolerance=kinetic, force_tolerance="inf" if force is None else repr(force),
-        stats=STATS_NAME, output=SETTLED_NAME)
-    (directory / DATA_NAME).write_text(data_file(replace(model, impact=replace(model.impact, striker=False)), SI))
-    (directory / DECK_NAME).write_text(text)
-    return directory
-
-
-@dataclass(frozen=True)
-class StageResult:
-    """How a preparation stage ended: ``steps`` taken, simulated ``time_s`` [s], final
-    ``kinetic_energy_j`` [J] and largest net force component ``max_force_n`` [N], against
-    the criteria ``tolerance_j`` and ``force_tolerance_n``."""
-
-    steps: int
-    time_s: float
-    kinetic_energy_j: float
-    tolerance_j: float
-    max_force_n: float
-    force_tolerance_n: float
-
-    @property
-    def settled(self) -> bool:
-        return self.kinetic_energy_j < self.tolerance_j and self.max_force_n < self.force_tolerance_n
-
-
-def read_stage(directory) -> StageResult:
-    """The :class:`StageResult` a finished stage deck wrote into ``directory``."""
-    path = Path(directory) / STATS_NAME
-    try:
-        words = path.read_text().split()
-        values = dict(zip(words[::2], words[1::2]))
-        return StageResult(int(values["steps"]), float(values["time_s"]), float(values["kinetic_energy_j"]),
-                           float(values["tolerance_j"]), float(values["max_force_n"]),
-                           float(values["force_tolerance_n"]))
-    except (OSError, KeyError, ValueError):
-        raise HexdemError(f"{path} is missing or unreadable: the preparation stage did not finish") from None
-
-
-@dataclass(frozen=True)
-class DataFileState:
-    """Bodies of a LAMMPS data file, ordered by atom id: ``diameters_m`` (N,),
-    ``positions_m`` (N, 2), ``velocities_m_s`` (N, 2) (zero when the file has none)."""
-
-    diameters_m: np.ndarray
-    positions_m: np.ndarray
-    velocities_m_s: np.ndarray
-
-
-def _section(lines: list[str], name: str, count: int) -> np.ndarray | None:
-    starts = [i for i, line in enumerate(lines) if line.split("#")[0].strip() == name]
-    if not starts:
-        return None
-    rows = [line.split() for line in lines[starts[0] + 1:] if line.strip()][:count]
-    table = np.array(rows, dtype=float)
-    return table[np.argsort(table[:, 0])]
-
-
-def read_data_file(path) -> DataFileState:
-    """Read an ``atom_style sphere`` data file (as written by ``write_data``), SI units."""
-    path = Path(path)
-    try:
-        lines = path.read_text().splitlines()
-        count = next(int(line.split()[0]) for line in lines if line.strip().endswith(" atoms"))
-        atoms = _section(lines, "Atoms", count)
-        velocities = _section(lines, "Velocities", count)
-        if atoms is None or len(atoms) != count or (velocities is not None and len(velocities) != count):
-            raise ValueError
-    except (OSError, StopIteration, ValueError):
-        raise HexdemError(f"{path} is not a complete LAMMPS data file") from None
-    return DataFileState(diameters_m=atoms[:, 2], positions_m=atoms[:, 4:6],
-                         velocities_m_s=np.zeros((count, 2)) if velocities is None else velocities[:, 1:3])
+    return write_settling_deck(model, SettlingStage(
+        name=stage, purpose="Preparation of a weakly disordered packing (Sec. VI-A).", walls=blocks["walls"],
+        loads=blocks["loads"], loads_note=blocks["loads_note"], damping_s=blocks["damping_s"],
+        kinetic_tolerance_j=preparation.kinetic_tolerance_j(model.masses_kg[:len(model.lattice)]),
+        force_tolerance_n=blocks["force_tolerance"], settled_rms_speed_m_s=preparation.settled_rms_speed_m_s,
+        max_step_m=preparation.max_step_m, max_dt_s=preparation.max_dt_s, check_every=preparation.check_every,
+        min_steps=preparation.min_steps, max_steps=preparation.max_steps), directory)

@@ -25,6 +25,8 @@ from hexdem.engines.lammps.runner import log_version
 from hexdem.errors import HexdemError
 from hexdem.experiments.deck_config import CONFIG_NAME, read_deck_config
 from hexdem.experiments.run import write_results
+from hexdem.model.model_builder import build_model
+from hexdem.model.run_settings import run_settings
 
 
 def analyse_deck(deck_dir, out=None, log=None) -> ImpactAnalysis:
@@ -38,8 +40,8 @@ def analyse_deck(deck_dir, out=None, log=None) -> ImpactAnalysis:
     if not dump.exists():
         raise HexdemError(f"{deck_dir} has no {DUMP_NAME}: run the deck by hand first "
                           f"(cd {deck_dir} && lmp -in in.hexdem), or use hexdem run --dump")
-    model = config.model()
-    settings = config.settings(model)
+    model = build_model(config)
+    settings = run_settings(config, model)
     log(f"reading {dump} ({settings.n_samples} frames of {model.n_bodies} atoms) through MDAnalysis")
     engine = {"name": "lammps", "version": log_version(deck_dir / "log.lammps"), "ranks": None,
               "wall_time_s": None, "deck": str(deck_dir / "in.hexdem")}

@@ -28,6 +28,7 @@ from hexdem.analysis.impact import ImpactAnalysis
 from hexdem.common.checks import is_number
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.errors import HexdemError
+from hexdem.experiments.random_packing import prepare_random_packing
 from hexdem.experiments.run import run_experiment
 from hexdem.model.config import RunConfig
 from hexdem.model.dissipation import damping_coefficient
@@ -245,7 +246,8 @@ def comparison_plot(comparison: EngineComparison, v0: float, path) -> None:
 def run_comparison(config: RunConfig, out, log=None, tolerances: Tolerances = Tolerances()) -> EngineComparison:
     """Run ``config`` with both engines into ``out`` and write the comparison files."""
     out = ensure_writable_dir(out)
-    analyses = {name: run_experiment(config.replace(engine=name), out / name, log) for name in ENGINE_NAMES}
+    prepared = prepare_random_packing(config, out / "preparation", log=log)  # one packing for both engines
+    analyses = {name: run_experiment(prepared.replace(engine=name), out / name, log) for name in ENGINE_NAMES}
     v0 = analyses["lammps"].v0  # the fastest impact's, which may not be config.v0
     comparison = compare_analyses(analyses["lammps"], analyses["reference"], v0, tolerances)
     tolerances = comparison.tolerances

@@ -26,7 +26,8 @@ from pathlib import Path
 import numpy as np
 
 from hexdem.errors import HexdemError
-from hexdem.model.config import SAMPLES_PER_CONTACT, RunConfig
+from hexdem.model.config import RunConfig
+from hexdem.model.run_settings import SAMPLES_PER_CONTACT, run_settings
 
 #: Order of the error in the time step of each engine's integrator.
 ORDERS = {"lammps": 2, "reference": 4}
@@ -167,7 +168,7 @@ def sampling_error(config: RunConfig, workdir) -> SamplingError:
     every step, the same time step and so the same trajectory (see :class:`SamplingError`)."""
     from hexdem.experiments.run import simulate
 
-    settings = config.settings()
+    settings = run_settings(config)
     sampled = simulate(config, Path(workdir) / "sampled").results
     every_step = simulate(config.replace(dt=settings.dt_s / settings.units.time_s, dump_every=1),
                           Path(workdir) / "every-step").results

@@ -2,7 +2,7 @@
 and a copy of each input file it names, so that the deck stands alone.
 
 :func:`write_deck_config` copies the files of :data:`FILE_KEYS` (a ``sites_file``, an
-``initial_state_file``) into the deck as ``<key><suffix>`` and names the copies in
+``initial_state_file``, a ``packing_file``) into the deck as ``<key><suffix>`` and names the copies in
 ``hexdem.json``; :func:`read_deck_config` reads such a name relative to the deck, so the deck
 describes the same packing wherever it is moved and from wherever it is analysed. A
 ``hexdem.json`` that is not a table of run-config keys is refused in one line.
@@ -21,7 +21,7 @@ from hexdem.model.config import RunConfig
 #: The configuration of a LAMMPS deck, in its directory.
 CONFIG_NAME = "hexdem.json"
 #: The run-config keys that name input files, copied into the deck.
-FILE_KEYS = ("sites_file", "initial_state_file")
+FILE_KEYS = ("sites_file", "initial_state_file", "packing_file")
 #: The time step of decks written before ``steps_per_contact`` existed: τ/700.
 LEGACY_STEPS_PER_CONTACT = 700
 

@@ -1,8 +1,10 @@
 """One impact simulation end to end: config → engine → analysis → result files.
 
-:func:`run_experiment` validates everything before it touches the disk, runs the engine and
-writes every result into a fresh hidden folder of ``OUT`` and, only when the run and its analysis
-succeeded, moves into ``OUT`` the deck ``OUT/deck`` (inputs, log, the dump if asked for) and
+:func:`run_experiment` builds and checks the model, runs the engine and writes every result into
+a fresh hidden folder of ``OUT`` and, only when the run and its analysis succeeded, moves into
+``OUT`` the deck ``OUT/deck`` (inputs, log, the dump if asked for), a random disc's packing
+``OUT/preparation`` (its LAMMPS decks and ``packing.csv``,
+:mod:`~hexdem.experiments.random_packing`) and
 :data:`RESULT_FILES` (``peaks.csv``
 along the observation lines, ``beads.csv`` of every bead, ``summary.json``, the arrival and
 peak maps, ``peak_decay.png``, ``front_shape.csv`` and ``.png``, ``energy_regions.csv``), with
@@ -33,9 +35,13 @@ from hexdem.common.io import staged_directory, write_csv, write_json
 from hexdem.common.machine import free_disk_bytes
 from hexdem.errors import HexdemError
 from hexdem.experiments.deck_config import write_deck_config
+from hexdem.experiments.random_packing import prepare_random_packing
 from hexdem.experiments.sensors import write_sensor_files
 from hexdem.experiments.tracked_run import ImpactJob, track_impact
 from hexdem.model.config import RunConfig
+from hexdem.model.model_builder import build_model
+from hexdem.model.run_settings import run_settings
+from hexdem.model.sensors import sensor_beads
 
 RESULT_FILES = ("peaks.csv", "summary.json", "arrival_map.png", "peak_decay.png", "front_shape.csv",
                 "front_shape.png", "energy_regions.csv", "beads.csv", "peak_map.png")
@@ -73,8 +79,8 @@ def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples
     (:mod:`~hexdem.experiments.deck_config`).
     """
     log = log or (lambda message: None)
-    model = config.model()
-    settings = config.settings(model)
+    model = build_model(config)
+    settings = run_settings(config, model)
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
     if config.engine == "lammps":
@@ -96,8 +102,8 @@ def check_dump_space(config: RunConfig, out: Path) -> None:
     """Refuse a run whose requested dump would not fit on the disk of ``out``."""
     if not (config.dump and config.engine == "lammps"):
         return
-    model = config.model()
-    needed = DUMP_BYTES_PER_ATOM_FRAME * config.settings(model).n_samples * model.n_bodies
+    model = build_model(config)
+    needed = DUMP_BYTES_PER_ATOM_FRAME * run_settings(config, model).n_samples * model.n_bodies
     free = free_disk_bytes(out)
     if needed > free:
         raise HexdemError(f"the dump would take about {needed / 1e9:.3g} GB and {out} has {free / 1e9:.3g} GB free; "
@@ -188,7 +194,7 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
         by_line = {name: (np.arange(len(beads)), r.peak_speed[beads]) for name, beads in r.lines.items()}
         plots.peak_decay(by_line, out / "peak_decay.png", r.units, v0)
     if config.sensors:
-        write_sensor_files(analysis, list(config.sensor_beads(analysis.model.lattice)), out)
+        write_sensor_files(analysis, list(sensor_beads(config.sensors, analysis.model.lattice)), out)
     if "front_shape.csv" not in skipped:
         shape = measure_front_shape(analysis)
         write_csv(out / "front_shape.csv", FRONT_SHAPE_COLUMNS, shape.rows())
@@ -254,9 +260,10 @@ def run_experiment(config: RunConfig, out, log=None, comm=None) -> ImpactAnalysi
     log = log or (lambda message: print(f"hexdem: {message}", file=sys.stderr))
     with staged_directory(out, STAGING_PREFIX) as staging:
         try:
-            check_dump_space(config, Path(out))
             start = time.perf_counter()
-            analysis = simulate(config, staging / "deck", log, comm=comm)
+            prepared = prepare_random_packing(config, staging / "preparation", comm, log)
+            check_dump_space(prepared, Path(out))
+            analysis = simulate(prepared, staging / "deck", log, comm=comm)
             write_results(config, analysis, staging, time.perf_counter() - start, log)
         except HexdemError as exc:
             kept = _keep_failed_deck(staging / "deck")

@@ -29,6 +29,8 @@ from hexdem.errors import HexdemError
 from hexdem.experiments.tracked_run import ImpactJob, track_impact
 from hexdem.model.config import RunConfig
 from hexdem.model.lattice import Lattice, hexagon
+from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.run_settings import run_settings
 
 #: Default snapshot times [ms]: at V_striker = 0.4 m/s the leading wave reaches the far wall
 #: of the hexagon after about 0.95 ms, that of the half-hexagon after about 2.5 ms.
@@ -51,7 +53,7 @@ def snapshot_config(config: RunConfig, times_s) -> RunConfig:
     if not micro or min(micro) < 1 or len(set(micro)) != len(micro):
         raise HexdemError(f"snapshot times must be distinct and at least 1 µs, got {list(times_s)}")
     unit_s = math.gcd(*micro) * 1e-6
-    default = config.settings()
+    default = run_settings(config)
     samples = math.ceil(unit_s / (default.dt_s * default.dump_every))
     every = math.ceil(unit_s / samples / default.dt_s)
     return config.replace(dt=unit_s / (samples * every), duration=max(micro) * 1e-6, dump_every=every)
@@ -72,8 +74,8 @@ def take_snapshots(config: RunConfig, times_s, directory) -> Snapshots:
     """Run ``config`` (striker impact, ideal lattice) in LAMMPS on ``config.ranks`` ranks
     and keep every bead's speed at ``times_s``, taken inside the run (no dump)."""
     config = snapshot_config(config, sorted(times_s))
-    model = config.model()
-    settings = config.settings(model)
+    model = build_model(config)
+    settings = run_settings(config, model)
     wanted = np.array([round(t * 1e6) * 1e-6 for t in sorted(times_s)])
     samples = np.rint(wanted / (settings.dump_every * settings.dt_s)).astype(int)
     job = ImpactJob(model, settings, "lammps", Path(directory), dump=config.dump, field_samples=tuple(samples))
@@ -128,13 +130,13 @@ def run_snapshots(config: RunConfig, times_s, out, outline_edge: int | None = No
     outline = hexagon(outline_edge, config.diameter_m) if outline_edge else None
     out = ensure_writable_dir(out)
     start = time.perf_counter()
-    log(f"{config.lattice().shape}, striker at {config.v0:g} m/s, {config.ranks} rank(s), "
+    log(f"{build_lattice(config).shape}, striker at {config.v0:g} m/s, {config.ranks} rank(s), "
         f"{len(times_s)} snapshots up to {max(times_s) * 1e3:g} ms")
     snapshots = take_snapshots(config, times_s, out / "deck")
     name = FIGURE_NAMES.get(config.shape, "snapshots")
     write_csv(out / f"{name}.csv", SNAPSHOT_COLUMNS, snapshot_rows(snapshots))
-    snapshot_figure(snapshots, snapshots.config.model().walls, out / f"{name}.png", outline)
-    settings = snapshots.config.settings()
+    snapshot_figure(snapshots, build_model(snapshots.config).walls, out / f"{name}.png", outline)
+    settings = run_settings(snapshots.config)
     engine = snapshots.engine
     write_json(out / "snapshots.json", {
         "hexdem_version": version("hexdem"), "config": snapshots.config.as_dict(),

@@ -9,8 +9,9 @@ configuration leaves at its default; the steps before it must exist there. Value
 TOML values (``0.4``, ``1e-3``, ``true``, ``"brass"``); a bare word is a string
 (``brass``). Each value is checked against its key's declared type as it is read
 (:func:`~hexdem.common.typecheck.type_at`), and every run's configuration is built and
-validated by :class:`RunConfig` itself before anything runs, so a bad key or value is one line
-naming the key or the run.
+validated (its keys by :class:`RunConfig`, its model and time step by
+:func:`~hexdem.model.run_settings.run_settings`) before anything runs, so a bad key or value is
+one line naming the key or the run.
 
 A run's name, its directory under ``DIR/runs/``, is its ``key=value`` pairs joined by commas,
 as given on the command line (characters a file name cannot hold become ``_``).
@@ -28,6 +29,8 @@ from hexdem.common.io import read_toml
 from hexdem.common.typecheck import check_type, type_at
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
+from hexdem.model.packing_builders import PREPARED_SHAPES
+from hexdem.model.run_settings import run_settings
 
 #: Characters kept as they are in a run's directory name.
 NAME_CHARACTERS = re.compile(r"[^A-Za-z0-9._=,+-]")
@@ -130,6 +133,8 @@ def plan_sweep(base: dict, variations: list[Variation], source: str = "the base 
         name = run_name(pairs)
         try:
             config = RunConfig.from_dict(data, source=f"run {name}")
+            if config.shape not in PREPARED_SHAPES:  # packed by LAMMPS when it runs
+                run_settings(config)
         except HexdemError as exc:
             message = str(exc)
             raise HexdemError(message if message.startswith(f"run {name}") else f"run {name}: {message}") from None

@@ -18,6 +18,8 @@ from hexdem.experiments.parallel import run_on_ranks
 from hexdem.experiments.tracked_run import make_engine
 from hexdem.model.config import RunConfig
 from hexdem.model.granular import GranularModel, RunSettings
+from hexdem.model.model_builder import build_model
+from hexdem.model.run_settings import run_settings
 
 
 @dataclass(frozen=True)
@@ -53,8 +55,8 @@ def record_waves(config: RunConfig, workdir, wave_vectors_m=(), block: int = 0, 
     """Run ``config`` in ``workdir`` on its engine and ranks, recording the plane-wave components
     at ``wave_vectors_m`` [1/m], each bead weighted by ``weights`` (N,) (empty: all 1), and the
     energy blocks of ``block`` samples."""
-    model = config.model()
-    settings = config.settings(model)
+    model = build_model(config)
+    settings = run_settings(config, model)
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
     if log is not None:

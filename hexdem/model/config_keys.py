@@ -7,7 +7,8 @@ Lengths are in metres; ``v0``, ``dt`` and ``duration`` are in the run's ``units`
 
 KEY_DESCRIPTIONS = {
     "shape": "the packing: hexagon, half-hexagon, half-disc, triangle, parallelogram, disc, sites (the "
-             "triangular lattice); square, centered-square, chain, packing (beads placed by their builders)",
+             "triangular lattice); square, centered-square, chain, packing (beads placed by their builders); "
+             "random (a disordered disc packed by a LAMMPS compaction)",
     "edge_beads": "beads per edge of a hexagon or a triangle; along the struck edge of a parallelogram",
     "long_edge": "beads along the struck edge (the long diagonal) of a half-hexagon: 2 short_edge − 1",
     "short_edge": "beads along each short edge of a half-hexagon",
@@ -65,6 +66,9 @@ KEY_DESCRIPTIONS = {
     "angle_deg": "direction of a chain from +x [deg]",
     "diameters_m": "a chain's bead diameters [m], one per bead (empty: all diameter_m)",
     "packing_file": "shape = \"packing\": a CSV x,y,diameter[,material] of measured positions [m]",
-    "walls": "shape = \"packing\": none, or hull (flat walls along the convex hull)",
+    "walls": "shape = \"packing\" or \"random\": none, or hull (flat walls along the convex hull)",
     "struck_bead": "shape = \"packing\": the struck bead, its line in the file from 0",
+    "radius_m": "shape = \"random\": radius of the disc the beads fill [m]",
+    "diameter_spread": "shape = \"random\": the diameters are uniform in d (1 ± diameter_spread), below 0.5",
+    "seed": "shape = \"random\": seed of the diameters and the loose start (the same seed, the same packing)",
 }

@@ -297,7 +297,7 @@ class RunSettings:
     ``sensor_every`` steps between two samples of the sensor particles (0: no sensors), a
     multiple of ``dump_every``; ``contact_time_s`` the impact's time scale [s] (the two-bead
     Hertz contact time at V0, or the precompressed contact's half period: see
-    :meth:`~hexdem.model.config.RunConfig.contact_time_s`; 0 where a run was set up by hand)."""
+    :func:`~hexdem.model.run_settings.contact_time_s`; 0 where a run was set up by hand)."""
 
     dt_s: float
     n_steps: int

@@ -11,7 +11,10 @@ The triangular shapes (``hexagon``, ``half-hexagon``, ``half-disc``, ``triangle`
   ``materials`` is a list, per-bead material names: intruders and dimers), free
   (:mod:`hexdem.model.chain`);
 * ``packing``: the measured positions of ``packing_file``, struck at row ``struck_bead``, with
-  ``walls`` ``"none"`` or ``"hull"`` (:mod:`hexdem.model.packing_file`).
+  ``walls`` ``"none"`` or ``"hull"`` (:mod:`hexdem.model.packing_file`);
+* ``random``: a disordered polydisperse disc (``radius_m``, ``diameter_spread``, ``seed``), whose
+  positions a LAMMPS compaction makes first (:mod:`hexdem.experiments.random_packing`); it is
+  then built as the ``packing`` of those positions.
 
 A builder that gives some beads another material hands them over as material regions, which
 go before the configuration's own ``regions`` (:mod:`hexdem.model.regions`).
@@ -33,7 +36,10 @@ from hexdem.model.square_crystals import centered_square, square
 
 TRIANGULAR_SHAPES = ("hexagon", "half-hexagon", "half-disc", "triangle", "parallelogram", "disc", "sites")
 PLACED_SHAPES = ("square", "centered-square", "chain", "packing")
-SHAPES = TRIANGULAR_SHAPES + PLACED_SHAPES
+#: Shapes whose positions a LAMMPS run makes (:mod:`hexdem.experiments.random_packing`); they are
+#: built as the ``packing`` of that run's positions.
+PREPARED_SHAPES = ("random",)
+SHAPES = TRIANGULAR_SHAPES + PLACED_SHAPES + PREPARED_SHAPES
 
 
 @dataclass(frozen=True)
@@ -105,4 +111,7 @@ def build_packing(config, struck) -> BuiltPacking:
         raise HexdemError(f"sites, sites_file and site_walls_deg describe shape = \"sites\", not {config.shape!r}")
     if config.shape != "packing" and config.packing_file is not None:
         raise HexdemError(f"packing_file describes shape = \"packing\", not {config.shape!r}")
+    if config.shape in PREPARED_SHAPES:
+        raise HexdemError(f"shape = {config.shape!r} is packed by a LAMMPS compaction before it is built: "
+                          "hexdem run, compare and sweep prepare it (hexdem.experiments.random_packing)")
     return builders[config.shape]()

@@ -1,6 +1,6 @@
 """The natural time scale of an impact: the shortest Hertz contact time among the pairs it sets
 moving, from which the time step and the sampling follow (see
-:meth:`~hexdem.model.config.RunConfig.contact_time_s`).
+:func:`~hexdem.model.run_settings.contact_time_s`).
 
 Two spheres meeting at relative speed V touch for t_c = 2.9432 (μ²/(A² V))^{1/5}
 (:func:`~hexdem.model.hertz.contact_time`, μ the reduced mass, A = k_n sqrt(R_eff)). With one

@@ -33,6 +33,7 @@ from hexdem.theory.solitary import (
     chain_speed_scale_m_s,
     solitary_speed_m_s,
 )
+from hexdem.model.model_builder import build_model
 
 #: Beads of the chain.
 CHAIN_BEADS = 80
@@ -48,7 +49,7 @@ def chain_config(v0_m_s: float = 0.4, n_beads: int = CHAIN_BEADS) -> RunConfig:
     than any the impact makes) has crossed it."""
     config = RunConfig(shape="sites", sites=[[k, k] for k in range(n_beads)], site_walls_deg=[],
                        strike_angle_deg=30.0, v0=v0_m_s)
-    slowest = solitary_speed_m_s(chain_speed_scale_m_s(config.model().bead), v0_m_s / 2)
+    slowest = solitary_speed_m_s(chain_speed_scale_m_s(build_model(config).bead), v0_m_s / 2)
     return config.replace(duration=n_beads * config.diameter_m / slowest)
 
 

@@ -29,6 +29,7 @@ import numpy as np
 from hexdem.errors import HexdemError
 from hexdem.experiments.parallel import run_on_ranks, spread_tasks
 from hexdem.theory.scaling import DEFAULT_LAST, Combination, CombinationFit, fit_combination
+from hexdem.model.run_settings import contact_time_s
 
 #: Strike angles of the sweep [deg]: each one serves two combinations.
 STRIKES_DEG = (0.0, 30.0)
@@ -91,7 +92,7 @@ class SweepSettings:
         base = RunConfig(shape="hexagon", edge_beads=self.hexagon_edge, wall_material="none",
                          units="nondimensional", v0=float(v0), strike_angle_deg=float(strike_deg),
                          engine=self.engine, dump_every=self.steps_per_contact // self.samples_per_contact)
-        tau = base.contact_time_s() / base.unit_system.time_s
+        tau = contact_time_s(base) / base.unit_system.time_s
         return base.replace(dt=tau / self.steps_per_contact, duration=self.duration_contacts * tau)
 
 

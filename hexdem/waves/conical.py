@@ -44,6 +44,8 @@ from hexdem.model.initial_state import write_initial_state
 from hexdem.theory.conical import CIRCULAR, cone_ring_radius
 from hexdem.theory.phonons import Lattice2D, cone_slope, dynamical_matrix, frequencies
 from hexdem.waves.states import bloch_packet
+from hexdem.model.model_builder import build_model
+from hexdem.model.run_settings import run_settings
 
 #: conical.csv's columns.
 COLUMNS = ("time_s", "ring_radius_d", "theory_radius_d")
@@ -210,7 +212,7 @@ def _run_packet(settings: ConicalSettings, config: RunConfig, model: GranularMod
                                              omega, settings.speed_m_s)
     workdir.mkdir(parents=True, exist_ok=True)
     write_initial_state(workdir / "initial_state.csv", lattice, velocities, displacements)
-    period, dt_s = 2 * math.pi / theory.dirac_frequency(), config.settings(model).dt_s
+    period, dt_s = 2 * math.pi / theory.dirac_frequency(), run_settings(config, model).dt_s
     every = steps_per_sample(dt_s, period, settings.samples_per_period)
     config = config.replace(initial_state_file=str(workdir / "initial_state.csv"),
                             duration=settings.reach * width / cone_slope(theory), dump_every=every)
@@ -238,7 +240,7 @@ def measure_conical(settings: ConicalSettings, workdir, log=None, show_progress:
     """Run both packets of the module docstring in ``workdir`` and measure them."""
     workdir = Path(workdir)
     theory, config = settings.theory(), settings.config()
-    model = config.model()
+    model = build_model(config)
     centre = model.lattice.positions_m.mean(axis=0)
     k_point = theory.high_symmetry_points()["K"]
     dirac = _run_packet(settings, config, model, workdir / "dirac", k_point, CIRCULAR, theory.dirac_frequency(), centre,

@@ -57,6 +57,8 @@ from hexdem.model.config import RunConfig
 from hexdem.model.initial_state import write_initial_state
 from hexdem.theory.phonons import Lattice2D, band_path, dynamical_matrix, frequencies
 from hexdem.waves.states import broadband_state
+from hexdem.model.model_builder import build_model
+from hexdem.model.run_settings import run_settings
 
 #: Branch names of dispersion.csv, the lower band first.
 BRANCHES = ("lower", "upper")
@@ -221,11 +223,11 @@ def measure_dispersion(settings: DispersionSettings, workdir, log=None, show_pro
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
     theory, config = settings.theory(), settings.config()
-    model = config.model()
+    model = build_model(config)
     state = workdir / "initial_state.csv"
     write_initial_state(state, model.lattice, broadband_state(len(model.lattice), settings.speed_m_s, settings.seed))
     position, vectors, omega = band_path(theory, settings.points_per_segment)
-    every = steps_per_sample(config.settings(model).dt_s, 2 * math.pi / omega.max(), settings.samples_per_period)
+    every = steps_per_sample(run_settings(config, model).dt_s, 2 * math.pi / omega.max(), settings.samples_per_period)
     config = config.replace(initial_state_file=str(state), dump_every=every)
     inside = np.linalg.norm(vectors, axis=1) > 0
     position, vectors, omega = position[inside], vectors[inside], omega[inside]

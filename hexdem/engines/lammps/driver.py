@@ -136,7 +136,7 @@ def _lammps(deck: Deck, call, text: str) -> None:
     try:
         call(text)
     except Exception as exc:
-        raise lammps_failure(deck, str(exc)) from None
+        raise lammps_failure(deck.directory, str(exc)) from None
 
 
 def run_streaming(deck: Deck, on_sample, comm=None, dump: bool = False, show_progress: bool = True,
@@ -157,7 +157,7 @@ def run_streaming(deck: Deck, on_sample, comm=None, dump: bool = False, show_pro
         try:
             lmp = lammps.lammps(cmdargs=args) if comm is None else lammps.lammps(cmdargs=args, comm=comm)
         except Exception as exc:
-            raise lammps_failure(deck, str(exc)) from None
+            raise lammps_failure(deck.directory, str(exc)) from None
         stream = None
         try:
             _lammps(deck, lmp.commands_string, setup + (output if dump else ""))

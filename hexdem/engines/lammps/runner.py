@@ -42,11 +42,13 @@ def error_line(text: str) -> str:
     return re.sub(r"\s*\([^()]*\.cpp:\d+\)", "", line).strip()
 
 
-def lammps_failure(deck: Deck, output: str) -> HexdemError:
-    """The one-line error of a failed run of ``deck``: LAMMPS's ERROR line from its log, or else
-    from ``output`` (what the run printed or raised)."""
-    log = deck.log_path.read_text() if deck.log_path.exists() else ""
-    return HexdemError(f"LAMMPS failed on {deck.input_path}: {error_line(log if 'ERROR' in log else output)}")
+def lammps_failure(directory: Path, output: str) -> HexdemError:
+    """The one-line error of a failed run of the deck in ``directory``: LAMMPS's ERROR line from
+    its log, or else from ``output`` (what the run printed or raised)."""
+    log_path = Path(directory) / "log.lammps"
+    log = log_path.read_text() if log_path.exists() else ""
+    return HexdemError(f"LAMMPS failed on {Path(directory) / DECK_NAME}: "
+                       f"{error_line(log if 'ERROR' in log else output)}")
 
 
 def run_bare(deck: Deck, ranks: int = 1, input_name: str = DECK_NAME) -> RunInfo:
@@ -58,5 +60,5 @@ def run_bare(deck: Deck, ranks: int = 1, input_name: str = DECK_NAME) -> RunInfo
     start = time.perf_counter()
     done = subprocess.run(command, cwd=deck.directory, capture_output=True, text=True)
     if done.returncode != 0:
-        raise lammps_failure(deck, done.stderr + done.stdout)
+        raise lammps_failure(deck.directory, done.stderr + done.stdout)
     return RunInfo(log_version(deck.log_path), ranks, time.perf_counter() - start)

@@ -1,0 +1,90 @@
+"""The model a configuration describes: its packing, materials, walls, impacts and sensors.
+
+:class:`~hexdem.model.config.RunConfig` is the schema: it holds the keys and checks each of
+them. This module builds from it, as ASE's builders make an ``Atoms`` apart from what is done
+with it: the shape's packing (:func:`~hexdem.model.packing_builders.build_packing`), less the
+``vacancies`` and with the extra observation ``lines``; the materials of its regions; the
+precompressed geometry (:mod:`hexdem.model.precompression`); the impacts and the holes they
+cut in the walls; the initial state; and the sensors. The time step and the run's length
+follow from the built model (:mod:`hexdem.model.run_settings`).
+"""
+
+from __future__ import annotations
+
+from hexdem.errors import HexdemError
+from hexdem.model.contact_law import Friction
+from hexdem.model.granular import GranularModel, Impact
+from hexdem.model.impacts import cut_holes, resolve_impacts, struck_site
+from hexdem.model.initial_state import read_initial_state
+from hexdem.model.lattice import Lattice, without_hole, without_sites
+from hexdem.model.lines import with_lines
+from hexdem.model.materials import hertz_coefficient, hertz_stiffness
+from hexdem.model.packing_builders import PLACED_SHAPES, BuiltPacking, build_packing
+from hexdem.model.precompression import hole_force, precompressed_lattice
+from hexdem.model.regions import assign_materials
+from hexdem.model.sensors import sensor_beads
+
+
+def configured_packing(config) -> BuiltPacking:
+    """The packing of ``config`` (a :class:`~hexdem.model.config.RunConfig`): its ``shape``'s,
+    less the ``vacancies``, struck at the first impact's site, with the extra observation
+    ``lines``, and the material regions of its builder."""
+    built = build_packing(config, struck_site(config.impact_specs()))
+    lattice = without_hole(built.lattice) if config.impacts else built.lattice  # each impact cuts its own
+    lattice = without_sites(lattice, config.vacancies) if config.vacancies else lattice
+    return BuiltPacking(with_lines(lattice, config.lines) if config.lines else lattice, built.regions)
+
+
+def build_lattice(config) -> Lattice:
+    """The packing of :func:`configured_packing`, without its material regions."""
+    return configured_packing(config).lattice
+
+
+def _precompressed(config, lattice: Lattice, extra, bead, wall) -> tuple[Lattice, tuple[float, float]]:
+    """The packing squeezed by ``precompression_n`` and the force that holds the struck bead in
+    its hole (:mod:`hexdem.model.precompression`), after checking that the packing allows it."""
+    if extra:
+        raise HexdemError("precompression is built for a packing of one material; drop the regions")
+    if wall is None:
+        raise HexdemError("a precompressed packing needs walls to hold it (wall_material = \"none\")")
+    if config.shape == "half-disc":
+        raise HexdemError("a precompressed packing needs walls all round; the half-disc's arc is free")
+    if config.shape in ("disc", "sites") + PLACED_SHAPES:
+        raise HexdemError(f"precompression is built for flat-walled basins (hexagon, half-hexagon, triangle, "
+                          f"parallelogram), not shape = {config.shape!r}")
+    coefficient = float(hertz_coefficient(config.diameter_m, bead))
+    lattice = precompressed_lattice(lattice, config.precompression_n, coefficient, hertz_stiffness(bead, wall))
+    return lattice, tuple(float(f) for f in hole_force(lattice, config.precompression_n))
+
+
+def build_model(config) -> GranularModel:
+    """The SI :class:`~hexdem.model.granular.GranularModel` that ``config`` describes."""
+    wall = None if config.wall_material == "none" else config.material(config.wall_material)
+    bead, held = config.material(config.bead_material), (0.0, 0.0)
+    built = configured_packing(config)
+    lattice, extra = assign_materials(built.lattice, built.regions + config.regions, bead, config.material)
+    if config.precompression_n > 0:
+        lattice, held = _precompressed(config, lattice, extra, bead, wall)
+    impacts = model_impacts(config, lattice)
+    if config.impacts:
+        holed, opened = cut_holes(lattice, impacts)
+        if config.precompression_n > 0:
+            if opened - {lattice.struck}:
+                raise HexdemError("a precompressed packing holds only the first impact's bead in a hole of its "
+                                  "wall; strike the other beads inside the packing")
+            held = held if lattice.struck in opened else (0.0, 0.0)
+        lattice = holed
+    state = None if config.initial_state_file is None else read_initial_state(config.initial_state_file, lattice)
+    return GranularModel(lattice, impacts[0], bead, wall, config.restitution, config.effective_wall_restitution,
+                         held, tuple(sensor_beads(config.sensors, lattice).values()), config.sensor_mass_factor,
+                         extra, tuple(impacts[1:]),
+                         Friction.of(config.friction, config.wall_friction, config.rolling_friction), state)
+
+
+def model_impacts(config, lattice: Lattice) -> list[Impact]:
+    """The model's impacts: the paper's single one on the struck bead, or those of ``impacts``."""
+    if not config.impacts:
+        striker = None if config.striker_material is None else config.material(config.striker_material)
+        return [Impact(config.v0 * config.unit_system.velocity_m_s, config.strike_angle_deg,
+                       config.impact == "striker", None, striker, config.striker_diameter_m)]
+    return resolve_impacts(config.impact_specs(), lattice, config.unit_system.velocity_m_s, config.material)

@@ -1,0 +1,107 @@
+"""A random polydisperse disc (shape = "random"): drawn reproducibly, packed by LAMMPS until every
+bead rests on its neighbours, then struck, with both engines agreeing."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.spatial import cKDTree
+
+from hexdem.errors import HexdemError
+from hexdem.experiments.compare import run_comparison
+from hexdem.experiments.random_packing import PACKING_NAME, prepare_random_packing
+from hexdem.model.config import RunConfig
+from hexdem.model.model_builder import build_model
+from hexdem.model.placed import MAX_REST_OVERLAP
+from hexdem.model.random_disc import (DENSE_FRACTION, LOOSE_GAP, edge_bead, loose_positions,
+                                      random_diameters)
+
+D = RunConfig().diameter_m
+#: Neighbours closer than this are touching at rest [m]: far below the µm overlaps of a 0.4 m/s impact.
+TOUCHING_M = 1e-6
+SMALL = {"shape": "random", "radius_m": 0.06, "seed": 1}
+
+
+def gaps(positions, diameters):
+    """(i, j, gap [m]) of the pairs of beads closer than two diameters."""
+    i, j = cKDTree(positions).query_pairs(2 * diameters.max(), output_type="ndarray").T
+    return i, j, np.linalg.norm(positions[i] - positions[j], axis=1) - (diameters[i] + diameters[j]) / 2
+
+
+def test_the_diameters_are_seeded_spread_and_fill_the_disc():
+    diameters = random_diameters(0.1, D, 0.15, 7)
+    assert np.array_equal(diameters, random_diameters(0.1, D, 0.15, 7))
+    assert not np.array_equal(diameters[:10], random_diameters(0.1, D, 0.15, 8)[:10])
+    assert D * 0.85 <= diameters.min() and diameters.max() <= D * 1.15
+    assert diameters.std() == pytest.approx(0.15 * D / math.sqrt(3), rel=0.2)  # uniform: half-width / √3
+    area = np.sum(math.pi * diameters**2 / 4)
+    assert DENSE_FRACTION * math.pi * 0.1**2 <= area < DENSE_FRACTION * math.pi * 0.1**2 + math.pi * (1.15 * D) ** 2 / 4
+
+
+def test_the_loose_start_keeps_every_bead_apart():
+    diameters = random_diameters(0.1, D, 0.15, 2)
+    positions = loose_positions(diameters, 2)
+    _, _, gap = gaps(positions, diameters)
+    assert gap.min() >= LOOSE_GAP * 0.85 * D
+
+
+def test_the_struck_bead_is_the_middle_of_the_edge_facing_the_strike():
+    """On a 5 × 5 square grid, a strike along +x meets the middle of the left column first, one
+    along +y the middle of the bottom row; a bead behind another is never chosen."""
+    grid = np.array([(x, y) for x in range(5) for y in range(5)], float) * D
+    diameters = np.full(len(grid), D)
+    assert tuple(grid[edge_bead(grid, diameters, [1.0, 0.0])] / D) == (0, 2)
+    assert tuple(grid[edge_bead(grid, diameters, [0.0, 1.0])] / D) == (2, 0)
+    assert tuple(grid[edge_bead(grid, diameters, [-1.0, 0.0])] / D) == (4, 2)
+
+
+@pytest.mark.parametrize("changes, message", [
+    ({"diameter_spread": 0.5}, "diameter_spread must be at least 0 and below 0.5"),
+    ({"radius_m": 0.01}, "radius_m must be at least diameter_m"),
+    ({"seed": -1}, "seed must be an integer >= 0"),
+    ({"seed": 1.5}, "seed must be an integer"),
+])
+def test_bad_random_discs_are_one_line_errors(changes, message):
+    with pytest.raises(HexdemError, match=message) as error:
+        RunConfig(shape="random", **changes)
+    assert "\n" not in str(error.value)
+
+
+def test_a_random_disc_is_built_only_once_packed():
+    with pytest.raises(HexdemError, match="packed by a LAMMPS compaction"):
+        build_model(RunConfig(**SMALL))
+
+
+@pytest.fixture(scope="module")
+def compared(tmp_path_factory):
+    out = tmp_path_factory.mktemp("random")
+    return out, run_comparison(RunConfig(**SMALL), out, log=lambda message: None)
+
+
+def test_the_packed_disc_rests_bead_on_bead(compared):
+    """Pulled to its centre and released, every bead ends at rest on at least two neighbours (one
+    contact cannot hold a bead against the pull), none overlapping more than a rest overlap;
+    the beads with three contacts or more are jammed, with about the isostatic four each
+    (2 per bead in 2D, frictionless)."""
+    out, _ = compared
+    packing = np.loadtxt(out / "preparation" / PACKING_NAME, delimiter=",", skiprows=1)
+    positions, diameters = packing[:, :2], packing[:, 2]
+    i, j, gap = gaps(positions, diameters)
+    assert -gap.min() < MAX_REST_OVERLAP * diameters.min()
+    touching = gap < TOUCHING_M
+    contacts = np.bincount(np.r_[i[touching], j[touching]], minlength=len(diameters))
+    assert contacts.min() >= 2
+    assert 3.8 < contacts[contacts >= 3].mean() < 5.0
+
+
+def test_the_same_seed_packs_the_same_disc(compared, tmp_path):
+    out, _ = compared
+    again = prepare_random_packing(RunConfig(**SMALL), tmp_path)
+    assert (tmp_path / PACKING_NAME).read_bytes() == (out / "preparation" / PACKING_NAME).read_bytes()
+    assert again.shape == "packing" and again.struck_bead >= 0
+
+
+def test_both_engines_agree_on_a_struck_random_disc(compared):
+    _, comparison = compared
+    assert comparison.agree, comparison.verdict()
+    assert comparison.n_checked >= 8
