@@ -6,7 +6,7 @@ for an overlap δ and its rate δ̇ (positive while the bodies approach):
 
 .. math::
 
-    F = \max(A δ^{3/2} + η \dot δ, 0), \qquad η = α \sqrt{m_\text{eff} A}\, δ^{1/4},
+    F = \operatorname{max}(A δ^{3/2} + η \dot δ, 0), \qquad η = α \sqrt{m_\text{eff} A}\, δ^{1/4},
 
 with :math:`A = k_n \sqrt{R_\text{eff}}` and m_eff the reduced mass. The same law holds for a bead–bead contact
 (m_eff = m_i m_j/(m_i + m_j), R_eff = R_i R_j/(R_i + R_j)) and a bead–wall contact (the wall does not
@@ -22,11 +22,11 @@ unit, x = δ/δ_v (:math:`δ_v = (m_\text{eff} v^2/A)^{2/5}`) obeys
 
 .. math::
 
-    x'' = −x^{1/4} \max(x^{5/4} + α x', 0), \qquad x(0) = 0,\ x'(0) = 1:
+    x′′ = −x^{1/4} \operatorname{max}(x^{5/4} + α x′, 0), \qquad x(0) = 0,\ x′(0) = 1:
 
 both forces scale as :math:`v^{6/5}`, so the restitution depends on α only, not on the speed, and is the same
 map for bead–bead and bead–wall contacts. The bracket is positive while the bodies approach and
-first vanishes on the way out, at x_c > 0 where :math:`x_c^{5/4} = −α x'`. From there the force is zero and
+first vanishes on the way out, at x_c > 0 where :math:`x_c^{5/4} = −α x′`. From there the force is zero and
 stays zero: x' no longer changes while :math:`x^{5/4}` falls, so the bracket stays negative until the
 bodies part. The rebound speed is therefore the speed at the clip, e = −x'(t_c).
 :func:`restitution_of` integrates the equation up to that event and :func:`damping_coefficient`
