@@ -1,4 +1,4 @@
-"""Where a front's roundness is heading: the sixfold amplitude A(R) against the mean radius R.
+r"""Where a front's roundness is heading: the sixfold amplitude A(R) against the mean radius R.
 
 The question (Secs. III and VI-B of the paper) is whether the front of an impulse in the
 uncompressed lattice becomes round as it grows, A → 0, or keeps a finite sixfold anisotropy.
