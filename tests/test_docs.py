@@ -145,3 +145,19 @@ def test_formulas_are_typeset_not_raw_latex(built):
                 raw[module.group(1) if module else path.relative_to(built).as_posix()] = hits
     assert set(raw) <= PLAIN_TEXT_FORMULAS, {name: raw[name] for name in set(raw) - PLAIN_TEXT_FORMULAS}
     assert PLAIN_TEXT_FORMULAS <= set(raw), f"math now, leave the set: {PLAIN_TEXT_FORMULAS - set(raw)}"
+
+
+def test_docstrings_with_backslashes_are_raw_strings():
+    r"""A docstring's LaTeX keeps its backslashes only in a raw string: in a plain one ``\nu``
+    is a newline, ``\frac`` a form feed and ``\sqrt`` an invalid escape."""
+    import ast
+
+    plain = []
+    for path in sorted((ROOT / "hexdem").rglob("*.py")):
+        source = path.read_text()
+        for node in ast.walk(ast.parse(source)):
+            if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef)) and ast.get_docstring(node, clean=False):
+                text = ast.get_source_segment(source, node.body[0].value)
+                if "\\" in text and not text.startswith("r"):
+                    plain.append(f"{path.relative_to(ROOT)}:{node.body[0].lineno}")
+    assert not plain, plain
