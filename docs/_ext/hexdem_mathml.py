@@ -14,12 +14,15 @@ from docutils.utils.math import MathError, latex2mathml, unichar2tex
 from sphinx.util import logging
 
 logger = logging.getLogger(__name__)
+#: A slash as TeX sets it, an ordinary symbol (δ^{3/2} shows 3/2), not an operator with space
+#: either side (3 / 2) as the converter writes it.
+SLASH = '<mo stretchy="false">/</mo>', '<mo stretchy="false" lspace="0" rspace="0">/</mo>'
 
 
 def mathml(translator, node, block: bool) -> str:
     tex = node.astext()
     try:
-        return latex2mathml.tex2mathml(tex.translate(unichar2tex.uni2tex_table), as_block=block)
+        return latex2mathml.tex2mathml(tex.translate(unichar2tex.uni2tex_table), as_block=block).replace(*SLASH)
     except MathError as err:
         logger.warning("math %r cannot be converted to MathML: %s", tex, err, location=node)
         return translator.encode(tex)

@@ -22,7 +22,7 @@ unit, x = δ/δ_v (:math:`δ_v = (m_\text{eff} v^2/A)^{2/5}`) obeys
 
 .. math::
 
-    x′′ = −x^{1/4} \operatorname{max}(x^{5/4} + α x′, 0), \qquad x(0) = 0,\ x′(0) = 1:
+    x′′ = −x^{1/4} \, \operatorname{max}(x^{5/4} + α x′, 0), \qquad x(0) = 0,\ x′(0) = 1:
 
 both forces scale as :math:`v^{6/5}`, so the restitution depends on α only, not on the speed, and is the same
 map for bead–bead and bead–wall contacts. The bracket is positive while the bodies approach and
