@@ -16,8 +16,11 @@ project = "hexdem"
 author = "the hexdem developers"
 copyright = "2026, the hexdem developers"
 release = installed_version("hexdem")
-extensions = ["myst_parser", "sphinx.ext.autodoc", "sphinx.ext.napoleon", "hexdem_reference"]
+extensions = ["myst_parser", "sphinx.ext.autodoc", "sphinx.ext.napoleon", "hexdem_reference",
+              "hexdem_mathml"]
 myst_enable_extensions = ["dollarmath"]
+#: Math as MathML written at build time (``_ext/hexdem_mathml.py``): no script, no network.
+html_math_renderer = "mathml"
 myst_heading_anchors = 3
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
 exclude_patterns = ["_build", "gallery/configs"]

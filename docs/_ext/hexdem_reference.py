@@ -8,7 +8,8 @@ build time into ``reference/_generated/`` (never edited by hand, never committed
   heading per module, through autodoc.
 
 hexdem's docstrings write magnitudes the physicist's way, |v| or |ω_z|, which reStructuredText
-would read as substitutions: :func:`escape_bars` escapes every bar outside a grid table's rows.
+would read as substitutions: :func:`escape_bars` escapes every bar outside a grid table's rows
+and outside math.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from __future__ import annotations
 import dataclasses
 import os
 import pkgutil
+import re
 from pathlib import Path
 
 import hexdem
@@ -25,6 +27,8 @@ from hexdem.model.config_keys import KEY_DESCRIPTIONS
 
 #: Width of the help texts (argparse reads COLUMNS).
 HELP_COLUMNS = "84"
+#: A docstring's inline math, whose bars are LaTeX's and stay as written.
+MATH_ROLE = re.compile(r"(:math:`[^`]*`)")
 
 
 def _write(path: Path, text: str) -> None:
@@ -85,7 +89,8 @@ def api_pages() -> dict[str, str]:
 
 def escape_bars(app, what, name, obj, options, lines) -> None:
     """Escape the bars of |v| and the like in a docstring: not in a grid table's row or border,
-    nor in a literal block (after ``::``, shown as written, where the escape would show)."""
+    nor in a literal block or a math directive (after ``::``, shown as written, where the escape
+    would show), nor in a :math: role."""
     literal = None  # indentation of the paragraph that opened the literal block we are in
     for i, line in enumerate(lines):
         indent = len(line) - len(line.lstrip())
@@ -93,7 +98,8 @@ def escape_bars(app, what, name, obj, options, lines) -> None:
             continue
         literal = indent if line.rstrip().endswith("::") else None
         if not line.lstrip().startswith(("|", "+")):
-            lines[i] = line.replace("|", "\\|")
+            lines[i] = "".join(part if part.startswith(":math:") else part.replace("|", "\\|")
+                               for part in MATH_ROLE.split(line))
 
 
 def generate(app) -> None:

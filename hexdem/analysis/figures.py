@@ -22,7 +22,7 @@ from hexdem.common.io import atomic_path
 from hexdem.model.walls import CurvedWall
 
 #: Axis units of the run's unit systems: SI, or the paper's (eq. 3): lengths in d, times in
-#: T = sqrt(M / (A d^½)), so speeds in d/T = sqrt(A/M) d^(5/4).
+#: :math:`T = \sqrt{M / (A d^{1/2})}`, so speeds in :math:`d/T = \sqrt{A/M}\, d^{5/4}`.
 UNIT_LABELS = {"si": {"length": "m", "speed": "m/s", "time": "ms", "time_scale": 1e3},
                "nondimensional": {"length": "d", "speed": "d/T", "time": "T", "time_scale": 1.0}}
 

@@ -5,7 +5,8 @@ The same curve as ``scipy.interpolate.CubicSpline(t, y)`` with its default not-a
 windows are tiny (at most 7 samples) and every ``hexdem run`` would otherwise import
 ``scipy.interpolate`` (a third of a second) for them.
 
-Each piece is p_i(s) = a_i + b_i s + c_i s² + d_i s³ with s = t − t_i on [t_i, t_{i+1}]:
+Each piece is :math:`p_i(s) = a_i + b_i s + c_i s^2 + d_i s^3` with :math:`s = t − t_i` on
+:math:`[t_i, t_{i+1}]`:
 interpolation at both ends of every piece, continuous first and second derivatives at the
 inner knots, and, with four or more points, continuous third derivatives at the second and
 the second-to-last knots (not-a-knot).

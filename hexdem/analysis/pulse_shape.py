@@ -14,7 +14,7 @@ self-similar if these profiles converge onto one shape as it travels. :func:`col
 measures each profile's RMS distance from a reference shape (the mean profile of the farthest
 beads, :func:`reference_profile`).
 
-**Power laws** (:func:`power_law`): p and its standard error in y ∝ r^p, least squares of
+**Power laws** (:func:`power_law`): p and its standard error in :math:`y ∝ r^p`, least squares of
 log y on log r.
 """
 
@@ -94,7 +94,8 @@ def collapse_residuals(shape_rows: np.ndarray, reference: np.ndarray) -> np.ndar
 
 
 def power_law(r, y) -> tuple[float, float]:
-    """(p, standard error of p) of y ∝ r^p over the finite, positive points (NaN if fewer than four)."""
+    """(p, standard error of p) of :math:`y ∝ r^p` over the finite, positive points (NaN if fewer
+    than four)."""
     r, y = np.asarray(r, float), np.asarray(y, float)
     keep = np.isfinite(r) & np.isfinite(y) & (r > 0) & (y > 0)
     if np.count_nonzero(keep) < 4:

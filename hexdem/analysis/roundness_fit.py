@@ -1,10 +1,12 @@
-"""Where a front's roundness is heading: the sixfold amplitude A(R) against the mean radius R.
+r"""Where a front's roundness is heading: the sixfold amplitude A(R) against the mean radius R.
 
 The question (Secs. III and VI-B of the paper) is whether the front of an impulse in the
 uncompressed lattice becomes round as it grows, A → 0, or keeps a finite sixfold anisotropy.
 :func:`fit_roundness` fits
 
-    A(R) = A∞ + B (R/d)^(−p)
+.. math::
+
+    A(R) = A_∞ + B\, (R/d)^{−p}
 
 by least squares (:func:`scipy.optimize.curve_fit`) and, for comparison and where every A is
 positive, the same law with A∞ = 0. A may be the signed sixfold component a6/a0 (a front whose
@@ -28,7 +30,7 @@ MIN_FRONTS = 6
 
 @dataclass(frozen=True)
 class RoundnessFit:
-    """``a_inf``, ``b``, ``p`` of A = a_inf + b R^−p with standard errors (``*_se``); ``rms`` its
+    r"""``a_inf``, ``b``, ``p`` of :math:`A = a_\text{inf} + b R^{−p}` with standard errors (``*_se``); ``rms`` its
     residual; ``p_zero``, ``b_zero``, ``rms_zero`` of the law with a_inf = 0 (NaN unless every A
     is positive); the fronts used (``n_fronts``) and their radii (``radius_min_d``,
     ``radius_max_d``); ``finite``: a_inf is more than two standard errors from zero."""
@@ -64,7 +66,7 @@ def _power_law(radius, a_inf, b, p):
 
 
 def fit_roundness(radius_d, amplitude, radius_min_d: float = 5.0, radius_max_d: float = np.inf) -> RoundnessFit:
-    """Fit A(R) = A∞ + B R^−p to the fronts with ``radius_min_d`` <= R <= ``radius_max_d`` (see
+    """Fit :math:`A(R) = A_∞ + B R^{−p}` to the fronts with ``radius_min_d`` <= R <= ``radius_max_d`` (see
     the module docstring)."""
     from scipy.optimize import OptimizeWarning, curve_fit
 

@@ -1,9 +1,9 @@
-"""Figures of a disorder ensemble (Sec. VI-B): Fig. 9 (fig:all_directions) and Fig. 8
+r"""Figures of a disorder ensemble (Sec. VI-B): Fig. 9 (fig:all_directions) and Fig. 8
 (fig:expnumsim), drawn from the tables :mod:`hexdem.disorder.ensemble` writes.
 
 The fitted laws of Fig. 9 are the paper's eqs. (10) (0° line, n ≥ 2) and (11) (±30°
 lines, n ≥ 1) with the coefficients of a ``scaling.json`` from ``hexdem scaling`` (keys
-"0/0" and "0/30"; nondimensional, turned into m/s by the paper's rule V → V sqrt(M/A)/d^{5/4}).
+"0/0" and "0/30"; nondimensional, turned into m/s by the paper's rule :math:`V → V \sqrt{M/A} / d^{5/4}`).
 """
 
 from __future__ import annotations

@@ -1,11 +1,11 @@
-"""The prestress a prepared packing keeps: the Hertz forces of its contacts and on its walls.
+r"""The prestress a prepared packing keeps: the Hertz forces of its contacts and on its walls.
 
 Sec. VI-A places the walls touching the packing while 5 N forces still compact it, then
 removes the forces: the packing springs back against the walls and keeps part of its
 compression. That static load is not in the paper's ideal lattice, which is struck
 uncompressed, so it is measured here for every settled packing.
 
-Forces are LAMMPS's ``hertz`` law, F = k_n sqrt(R_eff) δ^{3/2} with the model's k_n: bead
+Forces are LAMMPS's ``hertz`` law, :math:`F = k_n \sqrt{R_\text{eff}}\, δ^{3/2}` with the model's k_n: bead
 pairs with R_eff = r_i r_j / (r_i + r_j), bead–wall contacts with the bead's radius and the
 wall's own E, ν (:class:`~hexdem.model.granular.GranularModel`).
 """

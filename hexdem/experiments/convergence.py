@@ -2,8 +2,9 @@
 against a Richardson-extrapolated answer.
 
 Both integrators converge at a known order p in the step h (velocity Verlet in LAMMPS: 2,
-classical RK4 in the reference engine: 4). For a quantity Q(h) = Q₀ + C h^p + …, the two finest
-runs h and h·r (r the ratio of their steps) give Q₀ ≈ Q(h) + (Q(h) − Q(h r)) / (r^p − 1), and
+classical RK4 in the reference engine: 4). For a quantity :math:`Q(h) = Q_0 + C h^p + …`, the two
+finest runs h and h·r (r the ratio of their steps) give
+:math:`Q_0 ≈ Q(h) + (Q(h) − Q(h r)) / (r^p − 1)`, and
 every run's error is its distance from that. The sampling interval is the same for every run
 (a fixed time, ``dump_every`` scaled with the step), so that only the integration changes.
 The sampling's own error is measured apart (:func:`sampling_error`): the same run sampled at

@@ -7,7 +7,7 @@ uncompressed packing sends nothing back) and follows the half-maximum arrival fr
 sixfold amplitude A against its mean radius R, from a few bead diameters to beyond 150, over
 one sixfold period of rays about the strike direction, each read until the front nears the
 packing's edge (:func:`~hexdem.analysis.front_shape.front_times`); then it fits
-A(R) = A∞ + B (R/d)^−p (:mod:`hexdem.analysis.roundness_fit`) to the signed component a6/a0
+:math:`A(R) = A_∞ + B (R/d)^{−p}` (:mod:`hexdem.analysis.roundness_fit`) to the signed component a6/a0
 (the strike is mirror-symmetric, so b6 vanishes): positive while the front's farthest points lie
 at 0° and ±60°, negative once its faces do, so that a front whose hexagon turns over is seen to.
 

@@ -8,7 +8,7 @@ One row per run, in the plan's order:
   ``lattice.n_beads``);
 * ``energy_share_<region>``: each material region's share of the energy (kinetic and contact)
   at the end of the run, from its ``energy_regions.csv``; empty where a run has no such region;
-* ``decay_exponent_<line>``: the power law V_n ∝ n^(−p) fitted to the peak speeds of each
+* ``decay_exponent_<line>``: the power law :math:`V_n ∝ n^{−p}` fitted to the peak speeds of each
   observation line in ``peaks.csv`` (least squares of log V_n on log n) over the beads
   :data:`DECAY_FIRST_N` ≤ n ≤ N − 2 of a line of N beads: n = 0 and 1 are set by the impact,
   and the last bead meets the far wall; empty with fewer than three beads in that range.
@@ -45,7 +45,7 @@ def final_energy_shares(path: Path) -> dict[str, float]:
 
 
 def decay_exponent(n, peak_speed) -> float:
-    """p of V_n ∝ n^(−p) over DECAY_FIRST_N ≤ n ≤ N − 2 (see the module docstring); NaN if
+    """p of :math:`V_n ∝ n^{−p}` over DECAY_FIRST_N ≤ n ≤ N − 2 (see the module docstring); NaN if
     fewer than three beads there have a peak."""
     n, v = np.asarray(n, float), np.asarray(peak_speed, float)
     chosen = (n >= DECAY_FIRST_N) & (n <= len(n) - 2) & np.isfinite(v) & (v > 0)

@@ -1,7 +1,7 @@
 """A straight chain of touching beads, with intruders and dimers: the 1D granular crystal.
 
 Bead k (label {0, k}) follows bead k − 1 along the chain's direction at ``angle_deg`` from +x,
-touching it: the centres lie (d_{k−1} + d_k)/2 apart, so beads of other sizes (an intruder, a
+touching it: the centres lie :math:`(d_{k−1} + d_k)/2` apart, so beads of other sizes (an intruder, a
 dimer's alternating pair) keep the chain closed. Bead 0 is struck; the chain is free (no walls),
 so its momentum and energy are conserved to the integrator's accuracy.
 """

@@ -1,12 +1,14 @@
-"""Dissipative Hertz contacts with a prescribed coefficient of restitution (Tsuji et al. 1992).
+r"""Dissipative Hertz contacts with a prescribed coefficient of restitution (Tsuji et al. 1992).
 
 The paper's model is conservative (Sec. III); its experiments arrive later and weaker, which
 it puts down to dissipation (Sec. VI-B). hexdem adds Tsuji's viscous damping to the Hertz law,
 for an overlap δ and its rate δ̇ (positive while the bodies approach):
 
-    F = max(A δ^{3/2} + η δ̇, 0),   η = α sqrt(m_eff A) δ^{1/4},
+.. math::
 
-with A = k_n sqrt(R_eff) and m_eff the reduced mass. The same law holds for a bead–bead contact
+    F = \operatorname{max}(A δ^{3/2} + η \dot δ, 0), \qquad η = α \sqrt{m_\text{eff} A}\, δ^{1/4},
+
+with :math:`A = k_n \sqrt{R_\text{eff}}` and m_eff the reduced mass. The same law holds for a bead–bead contact
 (m_eff = m_i m_j/(m_i + m_j), R_eff = R_i R_j/(R_i + R_j)) and a bead–wall contact (the wall does not
 move: m_eff = m, the bead's own mass, and R_eff its radius, or LAMMPS's radius for a curved wall):
 in both the overlap obeys m_eff δ̈ = −F. The force is applied while δ > 0 and clipped at zero: as the
@@ -16,18 +18,21 @@ LAMMPS clips the same way with the keyword ``limit_damping`` (``pair_style granu
 fixes: its normal force F_ntot set to 0 when negative, before the friction limit is taken from it).
 
 **Restitution of the clipped law.** In the units m_eff = A = 1, with the impact speed v as velocity
-unit, x = δ/δ_v (δ_v = (m_eff v²/A)^{2/5}) obeys
+unit, x = δ/δ_v (:math:`δ_v = (m_\text{eff} v^2/A)^{2/5}`) obeys
 
-    x'' = −x^{1/4} max(x^{5/4} + α x', 0),   x(0) = 0, x'(0) = 1:
+.. math::
 
-both forces scale as v^{6/5}, so the restitution depends on α only, not on the speed, and is the same
+    x′′ = −x^{1/4} \, \operatorname{max}(x^{5/4} + α x′, 0), \qquad x(0) = 0,\ x′(0) = 1:
+
+both forces scale as :math:`v^{6/5}`, so the restitution depends on α only, not on the speed, and is the same
 map for bead–bead and bead–wall contacts. The bracket is positive while the bodies approach and
-first vanishes on the way out, at x_c > 0 where x_c^{5/4} = −α x'. From there the force is zero and
-stays zero: x' no longer changes while x^{5/4} falls, so the bracket stays negative until the
+first vanishes on the way out, at x_c > 0 where :math:`x_c^{5/4} = −α x′`. From there the force is zero and
+stays zero: x' no longer changes while :math:`x^{5/4}` falls, so the bracket stays negative until the
 bodies part. The rebound speed is therefore the speed at the clip, e = −x'(t_c).
 :func:`restitution_of` integrates the equation up to that event and :func:`damping_coefficient`
 inverts e(α). Against the unclipped law, the clip gives back the work of the tensile phase: with
-x' ≈ −e there, ∫₀^{x_c} (x^{3/2} − α e x^{1/4}) dx = −(2/5) α² e², so e_clip² − e² = (4/5) α² e² to
+x' ≈ −e there, :math:`\int_0^{x_c} (x^{3/2} − α e x^{1/4})\, dx = −\tfrac{2}{5} α^2 e^2`, so
+:math:`e_\text{clip}^2 − e^2 = \tfrac{4}{5} α^2 e^2` to
 leading order (for e = 0.8 the clipped law needs α = 0.1663 instead of 0.1584; the same α would give
 e = 0.808). At weak damping 1 − e² = 2π α/√5 + O(α²) either way (first-order perturbation theory).
 
@@ -50,7 +55,7 @@ from hexdem.errors import HexdemError
 # scipy's ODE solver and root finder are imported inside the functions that need them: only
 # a damped run does, and importing them costs an undamped run half a second of start-up.
 
-#: Marshall's polynomial P(c) = Σ p_k c^k by which LAMMPS's ``damping tsuji`` sets α = P(c).
+#: Marshall's polynomial :math:`P(c) = \sum_k p_k c^k` by which LAMMPS's ``damping tsuji`` sets α = P(c).
 TSUJI_POLYNOMIAL = (1.2728, -4.2783, 11.087, -22.348, 27.467, -18.022, 4.8218)
 
 

@@ -230,8 +230,8 @@ class GranularModel:
         return self.laws.pair_table("normal_stiffness_pa")
 
     def contact_stiffness_pa(self, i, j) -> np.ndarray:
-        """k_n = (4/3) E* [Pa] of the contacts between bodies ``i`` and ``j`` (arrays of indices):
-        F = k_n sqrt(R_eff) δ^{3/2}."""
+        r""":math:`k_n = \tfrac{4}{3} E^*` [Pa] of the contacts between bodies ``i`` and ``j``
+        (arrays of indices): :math:`F = k_n \sqrt{R_\text{eff}}\, δ^{3/2}`."""
         ids = self.material_ids
         return self.stiffness_table_pa[ids[np.asarray(i, int)], ids[np.asarray(j, int)]]
 

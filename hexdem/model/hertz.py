@@ -1,14 +1,19 @@
-"""Analytic Hertz two-body collision (Johnson 1987), the yardstick for contact times.
+r"""Analytic Hertz two-body collision (Johnson 1987), the yardstick for contact times.
 
 Two bodies with reduced mass μ approaching at relative speed v with a contact force
-F = A δ^{3/2} (A = k_n sqrt(R_eff)) stop approaching at the maximum overlap ::
+:math:`F = A δ^{3/2}` (:math:`A = k_n \sqrt{R_\text{eff}}`) stop approaching at the maximum
+overlap
 
-    δ_max = (5 μ v² / (4 A))^{2/5}
+.. math::
 
-and separate, undamped, after the contact time ::
+    δ_\text{max} = \left(\frac{5 μ v^2}{4 A}\right)^{2/5}
 
-    τ = 2 (δ_max / v) ∫₀¹ (1 − x^{5/2})^{−1/2} dx
-      = (4/5) B(2/5, 1/2) δ_max / v ≈ 2.9432 δ_max / v.
+and separate, undamped, after the contact time
+
+.. math::
+
+    τ = 2 \frac{δ_\text{max}}{v} \int_0^1 (1 − x^{5/2})^{−1/2}\, dx
+      = \tfrac{4}{5} B(\tfrac{2}{5}, \tfrac{1}{2}) \frac{δ_\text{max}}{v} ≈ 2.9432\, \frac{δ_\text{max}}{v}.
 
 A sphere against a flat wall is the case μ = M, R_eff = R.
 """

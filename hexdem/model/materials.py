@@ -1,9 +1,10 @@
-"""Elastic materials and the Hertz contact coefficients built from them (SI units).
+r"""Elastic materials and the Hertz contact coefficients built from them (SI units).
 
 Two spheres of diameter ``d`` and the same material touch with
-F = A δ^{3/2},  A = E sqrt(d) / (3 (1 − ν²))     (paper Sec. III, V(r) = (2/5) A [d − r]_+^{5/2}),
-and, for general radii, F = (4/3) E* sqrt(R_eff) δ^{3/2} with
-1/E* = (1 − ν₁²)/E₁ + (1 − ν₂²)/E₂ and 1/R_eff = 1/R₁ + 1/R₂. A sphere against a flat
+:math:`F = A δ^{3/2}`, :math:`A = E \sqrt{d} / (3 (1 − ν^2))` (paper Sec. III,
+:math:`V(r) = \tfrac{2}{5} A [d − r]_+^{5/2}`), and, for general radii,
+:math:`F = \tfrac{4}{3} E^* \sqrt{R_\text{eff}}\, δ^{3/2}` with
+:math:`1/E^* = (1 − ν_1^2)/E_1 + (1 − ν_2^2)/E_2` and :math:`1/R_\text{eff} = 1/R_1 + 1/R_2`. A sphere against a flat
 wall is the limit R₂ → ∞ (R_eff = R₁), with the wall's own E and ν (the paper models the
 delrin-lined walls as "spheres with an infinite radius").
 """
@@ -140,16 +141,18 @@ def mindlin_stiffness(a: Material, b: Material) -> float:
 
 
 def hertz_stiffness(a: Material, b: Material) -> float:
-    """k_n = (4/3) E* [Pa]: the Hertz prefactor with F = k_n sqrt(R_eff) δ^{3/2}.
+    r""":math:`k_n = \tfrac{4}{3} E^*` [Pa]: the Hertz prefactor with
+    :math:`F = k_n \sqrt{R_\text{eff}}\, δ^{3/2}`.
 
     This is the ``k_n`` of LAMMPS's ``pair_style granular`` / ``fix wall/gran`` ``hertz``
-    model, which computes F = k_n sqrt(R_eff δ) δ.
+    model, which computes :math:`F = k_n \sqrt{R_\text{eff} δ}\, δ`.
     """
     return 4.0 / 3.0 * effective_modulus(a, b)
 
 
 def hertz_coefficient(diameter_m, mat: Material = STEEL_316):
-    """A = E sqrt(d) / (3 (1 − ν²)) [N/m^1.5] for two equal spheres of one material."""
+    r""":math:`A = E \sqrt{d} / (3 (1 − ν^2))` [:math:`\mathrm{N/m^{1.5}}`] for two equal spheres of
+    one material."""
     return hertz_stiffness(mat, mat) * np.sqrt(np.asarray(diameter_m) / 4.0)
 
 

@@ -1,14 +1,16 @@
-"""A statically precompressed packing (the paper's open question, Sec. VII).
+r"""A statically precompressed packing (the paper's open question, Sec. VII).
 
 Every bead–bead contact of the packing is to carry the static force f0 [N]. The packing is
 built in three steps:
 
-1. **Uniform compression.** Each contact overlaps by δ0 = (f0/A)^{2/3} (F = A δ^{3/2}), so
+1. **Uniform compression.** Each contact overlaps by :math:`δ_0 = (f_0/A)^{2/3}`
+   (:math:`F = A δ^{3/2}`), so
    the lattice shrinks about the struck bead by (d − δ0)/d.
 2. **Walls.** Each wall member must receive from its walls the force its missing neighbours'
    contacts would have exerted, f0 Σ (−u) over the unit vectors u towards them. A bead on a
    straight edge misses two neighbours at ±30° from the wall's normal: √3 f0, met when the wall
-   overlaps it by δw = (√3 f0 / A_w)^{2/3} (A_w = k_n,wall sqrt(R)). A bead at a 120° corner
+   overlaps it by :math:`δ_w = (\sqrt{3} f_0 / A_w)^{2/3}`
+   (:math:`A_w = k_{n,\text{wall}} \sqrt{R}`). A bead at a 120° corner
    misses three (2 f0 along the corner's bisector) and touches two walls whose normals are ±30°
    from it, so each must give 2 f0/√3: flat walls at δw would squeeze it with 3 f0 and, relaxed,
    spread errors of several per cent through a hexagon of 21 per edge. Each wall therefore
@@ -21,13 +23,13 @@ built in three steps:
 
 Built this way, the packing is in static equilibrium bead by bead, every contact at f0.
 
-**Linear waves.** About f0 a contact is a spring of stiffness k = dF/dδ = (3/2) A δ0^{1/2} =
-(3/2) A^{2/3} f0^{1/3}. A triangular lattice of beads of mass m joined to their 6 neighbours
+**Linear waves.** About f0 a contact is a spring of stiffness
+:math:`k = dF/dδ = \tfrac{3}{2} A δ_0^{1/2} = \tfrac{3}{2} A^{2/3} f_0^{1/3}`. A triangular lattice of beads of mass m joined to their 6 neighbours
 (spacing a) by such springs stores, under a uniform strain ε, the energy density
 W = (k a²/2A₀) Σ_bonds (n·ε·n)² over its 3 bond directions per bead (A₀ = (√3/2) a² per bead);
 Σ n_i n_j n_k n_l = (3/8)(δ_ij δ_kl + δ_ik δ_jl + δ_il δ_jk) gives Lamé constants λ = μ =
 (√3/4) k, so C₁₁ = λ + 2μ = (3√3/4) k and, with the areal density ρ = m/A₀, the
-long-wavelength longitudinal sound speed c_L = sqrt(C₁₁/ρ) = sqrt(9/8) a sqrt(k/m)
+long-wavelength longitudinal sound speed :math:`c_L = \sqrt{C_{11}/ρ} = \sqrt{9/8}\, a \sqrt{k/m}`
 (:func:`longitudinal_sound_speed`).
 """
 
@@ -52,17 +54,18 @@ def _unit(step) -> np.ndarray:
 
 
 def static_overlap(force_n: float, coefficient: float) -> float:
-    """δ [m] at which a Hertz contact F = A δ^{3/2} carries ``force_n``."""
+    """δ [m] at which a Hertz contact :math:`F = A δ^{3/2}` carries ``force_n``."""
     return (force_n / coefficient) ** (2.0 / 3.0)
 
 
 def spring_stiffness(force_n: float, coefficient: float) -> float:
-    """k = dF/dδ = (3/2) A^{2/3} f0^{1/3} [N/m] of a Hertz contact precompressed by ``force_n``."""
+    r""":math:`k = dF/dδ = \tfrac{3}{2} A^{2/3} f_0^{1/3}` [N/m] of a Hertz contact precompressed
+    by ``force_n``."""
     return 1.5 * coefficient ** (2.0 / 3.0) * force_n ** (1.0 / 3.0)
 
 
 def longitudinal_sound_speed(force_n: float, coefficient: float, mass_kg: float, spacing_m: float) -> float:
-    """c_L = sqrt(9/8) a sqrt(k/m) [m/s] of a triangular spring lattice (module docstring)."""
+    r""":math:`c_L = \sqrt{9/8}\, a \sqrt{k/m}` [m/s] of a triangular spring lattice (module docstring)."""
     return math.sqrt(9.0 / 8.0) * spacing_m * math.sqrt(spring_stiffness(force_n, coefficient) / mass_kg)
 
 
@@ -93,10 +96,11 @@ def _wall_loads(lattice: Lattice, needed: np.ndarray) -> dict[tuple[int, int], f
 
 def precompressed_lattice(lattice: Lattice, force_n: float, pair_coefficient: float,
                           wall_stiffness_pa: float) -> Lattice:
-    """The ideal ``lattice`` (equal beads) in static equilibrium with every contact at ``force_n``
+    r"""The ideal ``lattice`` (equal beads) in static equilibrium with every contact at ``force_n``
     [N] (steps 1 and 2): shrunk about the struck bead, each wall split into planes that meet
     their members at the overlap that gives them their missing contacts' force.
-    ``pair_coefficient`` A [N/m^1.5]; ``wall_stiffness_pa`` k_n,wall (A_w = k_n,wall sqrt(R))."""
+    ``pair_coefficient`` A [:math:`\mathrm{N/m^{1.5}}`]; ``wall_stiffness_pa`` k_n,wall
+    (:math:`A_w = k_{n,\text{wall}} \sqrt{R}`)."""
     d = lattice.diameter_m
     centre = lattice.positions_m[lattice.struck]
     scale = (d - static_overlap(force_n, pair_coefficient)) / d

@@ -1,8 +1,9 @@
-"""The paper's nondimensional scaling, eq. (3), and conversions both ways.
+r"""The paper's nondimensional scaling, eq. (3), and conversions both ways.
 
 With A = d = M = 1 inside the theory, lengths are measured in d, masses in M and times in
-T = sqrt(M / (A d^{1/2})); velocities are then measured in d/T = d^{5/4} sqrt(A/M), which is
-the paper's rule "replace V by V sqrt(M/A) / d^{5/4}" (end of Sec. V).
+:math:`T = \sqrt{M / (A d^{1/2})}`; velocities are then measured in
+:math:`d/T = d^{5/4} \sqrt{A/M}`, which is the paper's rule "replace V by
+:math:`V \sqrt{M/A} / d^{5/4}`" (end of Sec. V).
 """
 
 from __future__ import annotations
@@ -64,7 +65,7 @@ def nondimensional(diameter_m: float, mat: Material = STEEL_316) -> UnitSystem:
 
 
 def to_nondimensional_velocity(v_m_s, diameter_m: float, mat: Material = STEEL_316):
-    """V·sqrt(M/A)/d^{5/4}: a physical velocity in the paper's units."""
+    r""":math:`V \sqrt{M/A} / d^{5/4}`: a physical velocity in the paper's units."""
     return np.asarray(v_m_s) / nondimensional(diameter_m, mat).velocity_m_s
 
 

@@ -1,7 +1,7 @@
-"""Conical diffraction at the Dirac point: how fast a Gaussian packet built at K opens into a ring.
+r"""Conical diffraction at the Dirac point: how fast a Gaussian packet built at K opens into a ring.
 
 Near K both bands of :mod:`hexdem.theory.phonons` meet in a cone. A packet of the waves near
-(K, +ω_K), u = Re[ψ(r, t) e^{i(K·r − ω_K t)}], has an envelope ψ (a complex 2-vector of
+(K, +ω_K), :math:`u = \operatorname{Re}[ψ(r, t)\, e^{i(K \cdot r − ω_K t)}]`, has an envelope ψ (a complex 2-vector of
 polarizations) that obeys, to first order in q = k − K, a Dirac equation
 
     i ∂ψ/∂t = H(q) ψ,   H(q) = (D(K + q) − D(K − q)) / (4 ω_K) = v_D |q| M(θ),

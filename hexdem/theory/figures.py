@@ -39,7 +39,7 @@ def tca_arrival_times(n, lattice_ms, tca_ms, hyperg_ms, v0_m_s, path) -> None:
 
 
 def _traces(ax, trace, fit, title):
-    """|v| of beads 0..last against time at the trace's V₀, their maxima and the fitted V_s c^{n−s}.
+    """|v| of beads 0..last against time at the trace's V₀, their maxima and the fitted :math:`V_s c^{n−s}`.
 
     ``trace`` (times, speeds, peaks, t_peak, v0) of the fit's line; ``title`` without V₀.
     """
@@ -114,7 +114,7 @@ def decay_rates(fits, path) -> None:
 
 
 def decay_form(ratios_by_combination, path) -> None:
-    """Local ratio V_{n+1}/V_n against n: flat for a geometric law, rising to 1 for a power law.
+    """Local ratio :math:`V_{n+1}/V_n` against n: flat for a geometric law, rising to 1 for a power law.
 
     ``ratios_by_combination``: {name: [(v0, n, ratio), ...]}.
     """

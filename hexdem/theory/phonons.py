@@ -1,11 +1,14 @@
-"""Linear waves of the precompressed hexagonal packing: phonon bands, the Dirac point at K.
+r"""Linear waves of the precompressed hexagonal packing: phonon bands, the Dirac point at K.
 
-About a static contact force f0 every contact is a spring of stiffness k = (3/2) A^{2/3} f0^{1/3}
+About a static contact force f0 every contact is a spring of stiffness
+:math:`k = \tfrac{3}{2} A^{2/3} f_0^{1/3}`
 (:func:`~hexdem.model.precompression.spring_stiffness`); the beads of mass m sit on a triangular
 lattice of spacing a = d − δ0. Each bead has two displacement components, so a plane wave
-u ∝ e^{i(q·x − ωt)} gives two bands, the eigenvalues ω² of the dynamical matrix ::
+:math:`u ∝ e^{i(q \cdot x − ωt)}` gives two bands, the eigenvalues ω² of the dynamical matrix
 
-    D(q) = (k/m) Σ_j (1 − cos q·a_j) e_j e_jᵀ,
+.. math::
+
+    D(q) = \frac{k}{m} \sum_j (1 − \cos q \cdot a_j)\, e_j e_j^T,
 
 the sum over the six neighbours at a_j = a e_j (the bonds at 30°, 90°, 150°, … from +x in the
 paper's labels). The static force's transverse (geometric) stiffness, −f0/a, is left out: it is

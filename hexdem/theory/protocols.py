@@ -1,6 +1,6 @@
 """Which fit protocol gives the paper's c(V₀) = m V₀ + b? A search over what Sec. V leaves open.
 
-The paper fits V_n = V_s c^{n − s} per V₀ and then c(V₀) = m V₀ + b, but it does not say over
+The paper fits :math:`V_n = V_s c^{n − s}` per V₀ and then c(V₀) = m V₀ + b, but it does not say over
 which beads, which V₀, nor how. hexdem's m moves with those choices far beyond its standard
 error, so a published (m, b) can only be compared with the protocol that produced it. A
 **protocol** here is one choice of

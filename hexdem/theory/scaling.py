@@ -1,4 +1,4 @@
-"""Velocity-decay scaling laws of Sec. V: per-V₀ decay fits and the laws c(V₀), V_s/V₀.
+r"""Velocity-decay scaling laws of Sec. V: per-V₀ decay fits and the laws c(V₀), V_s/V₀.
 
 Everything is nondimensional (A = d = M = 1, eq. scaling) unless it says otherwise. The
 peak speeds come from a sweep of impact velocities V₀ (:mod:`hexdem.theory.sweep`); the files and
@@ -16,7 +16,7 @@ name       strike, line  start s   law         V_s / V₀
 ``0/30``   0°, +30       1         eq. (11)    α V₀² + β V₀ + γ
 =========  ============  ========  ==========  ================================
 
-**Per-V₀ fit** (:func:`fit_decay`). V_n = V_s c^{n − s} on the window s < n ≤ ``last``, with
+**Per-V₀ fit** (:func:`fit_decay`). :math:`V_n = V_s c^{n − s}` on the window s < n ≤ ``last``, with
 V_s the measured peak of the start bead (the paper's "V₁ is the maximum velocity of the
 first bead"), so c is the only free parameter (a free V_s is the other reading the fit
 protocol search of :mod:`hexdem.theory.protocols` tries). ``kind="loglinear"`` (default) regresses
@@ -26,25 +26,25 @@ anchored start is conditional on V_s (the measured start bead is taken as exact)
 
 **Laws.** c(V₀) = m V₀ + b and V_s/V₀ = the polynomial above are ordinary least squares
 (:func:`polynomial_fit`), with standard errors from the residual variance. Together:
-V_n = V₀ (V_s/V₀)(V₀) (m V₀ + b)^{n − s}, eqs. (9), (10), (11).
+:math:`V_n = V_0\, (V_s/V_0)(V_0)\, (m V_0 + b)^{n − s}`, eqs. (9), (10), (11).
 
 **Why c depends on V₀ at all.** The Hertz lattice with linearised bond directions is scale
-invariant (x → λx, t → λ^{−1/4}t): c would be a constant. V₀ enters only through the
+invariant (:math:`x → λx,\ t → λ^{−1/4} t`): c would be a constant. V₀ enters only through the
 geometric nonlinearity of the bond lengths |d e + q_j − q_i|, whose relative size grows with
-the overlaps δ ∝ V₀^{4/5} (δ ≈ 0.3 d at V₀ = 0.3). So m measures geometric nonlinearity
+the overlaps :math:`δ ∝ V_0^{4/5}` (δ ≈ 0.3 d at V₀ = 0.3). So m measures geometric nonlinearity
 and b is the law's small-amplitude intercept (c(V₀) is slightly convex over the sweep, so b
 lies a little below the measured c at the smallest V₀). The sweep's V₀ = 0.01 … 0.30 are
 41 … 1230 m/s for the paper's steel beads; the experiment's 0.4 m/s is V₀ ≈ 1e−4, where the
 law gives c = b to 4 digits.
 
-**Physical units** (:meth:`ScalingLaw.physical`): replace every V by V/U, U = d^{5/4}
-sqrt(A/M) (end of Sec. V), so m and the V₀-powers of the polynomial pick up powers of 1/U.
+**Physical units** (:meth:`ScalingLaw.physical`): replace every V by V/U, :math:`U = d^{5/4} \sqrt{A/M}`
+(end of Sec. V), so m and the V₀-powers of the polynomial pick up powers of 1/U.
 
 **Beyond the paper** (:func:`decay_form_test`). The paper calls the decay a power law but
 fits a geometric law in n. Both are two-parameter straight lines, log V_n against n or
 against log n, so their residual sums of squares compare directly; the residual curvature
-and the drift of the local ratio V_{n+1}/V_n (constant for a geometric law, rising towards 1
-as (n/(n+1))^p for a power law) say which one the data follow.
+and the drift of the local ratio :math:`V_{n+1}/V_n` (constant for a geometric law, rising
+towards 1 as :math:`(n/(n+1))^p` for a power law) say which one the data follow.
 """
 
 from __future__ import annotations
@@ -109,7 +109,8 @@ class Fit:
 
 
 def polynomial_fit(x, y, degree: int, names) -> Fit:
-    """Ordinary least squares of y = Σ p_k x^{degree−k} (highest power first, as ``np.polyfit``)."""
+    r"""Ordinary least squares of :math:`y = \sum_k p_k x^{\text{degree}−k}` (highest power first,
+    as ``np.polyfit``)."""
     x, y = np.asarray(x, float), np.asarray(y, float)
     design = np.vander(x, degree + 1)
     dof = len(x) - (degree + 1)
@@ -123,7 +124,7 @@ def polynomial_fit(x, y, degree: int, names) -> Fit:
 
 
 def fit_decay(n, v, start: int, last: int, kind: str = "loglinear", anchored: bool = True) -> tuple[float, float]:
-    """(c, stderr of c) of V_n = V_s c^{n − s}, s = ``start``, from one line's peak speeds.
+    """(c, stderr of c) of :math:`V_n = V_s c^{n − s}`, s = ``start``, from one line's peak speeds.
 
     ``n`` bead numbers and ``v`` peak speeds of one line (n ascending from 0). Anchored (the
     paper's reading), V_s = v[start] is the measured peak and the window is s < n ≤ last (the
@@ -160,7 +161,7 @@ def fit_decay(n, v, start: int, last: int, kind: str = "loglinear", anchored: bo
 
 @dataclass(frozen=True)
 class ScalingLaw:
-    """V_n = V₀ P(V₀) (m V₀ + b)^{n − start}: eqs. (9), (10), (11).
+    r""":math:`V_n = V_0 P(V_0)\, (m V_0 + b)^{n − \text{start}}`: eqs. (9), (10), (11).
 
     ``amplitude`` the coefficients of P highest power first: (α, β) or (α, β, γ);
     ``velocity_unit_m_s`` 1 for nondimensional laws, U for laws in m/s.
@@ -294,12 +295,13 @@ GEOMETRIC_BELOW, POWER_ABOVE = 1 / 3, 2 / 3
 
 @dataclass(frozen=True)
 class DecayFormTest:
-    """Geometric V_n = A qⁿ against power V_n = A n^{−p} on one line at one V₀.
+    """Geometric :math:`V_n = A q^n` against power :math:`V_n = A n^{−p}` on one line at one V₀.
 
     Both are straight-line fits in log V (against n, against log n) with two parameters:
     ``rss_geometric`` and ``rss_power`` are their residual sums of squares in log V, directly
-    comparable. ``q`` and ``p`` the fitted ratio and exponent. The local ratio r_n = V_{n+1}/V_n
-    is constant for a geometric law and rises as (n/(n+1))^p for a power law: ``ratio_slope``
+    comparable. ``q`` and ``p`` the fitted ratio and exponent. The local ratio
+    :math:`r_n = V_{n+1}/V_n` is constant for a geometric law and rises as :math:`(n/(n+1))^p` for
+    a power law: ``ratio_slope``
     ± ``ratio_slope_stderr`` is the least-squares trend of the measured r_n per bead,
     ``power_ratio_slope`` the same trend of the fitted power law's r_n, and
     ``drift_fraction`` φ = their quotient (0: geometric, 1: power).

@@ -1,4 +1,4 @@
-"""Ternary collision approximation (TCA) of Sec. IV, and residence times in the full lattice.
+r"""Ternary collision approximation (TCA) of Sec. IV, and residence times in the full lattice.
 
 The TCA lives in the paper's nondimensional units A = d = M = 1 (eq. scaling).
 
@@ -6,33 +6,39 @@ The TCA lives in the paper's nondimensional units A = d = M = 1 (eq. scaling).
 of it on that line, beads a and b beside it at ±θ (θ = π/3 in the hexagonal packing). With
 displacements x₀, x₁ along the line and x_a = x_b along the a and b bonds,
 
-    ẍ₀ = −[x₀ − x₁]₊^{3/2} − 2 cos θ [cos θ x₀ − x_a]₊^{3/2},
-    ẍ₁ =  [x₀ − x₁]₊^{3/2},        ẍ_a = [cos θ x₀ − x_a]₊^{3/2}.
+.. math::
 
-Its energy ½ẋ₀² + ½ẋ₁² + ẋ_a² + (2/5)[z]₊^{5/2} + (4/5)[y]₊^{5/2} (both side beads) and its
-momentum ẋ₀ + ẋ₁ + 2 cos θ ẋ_a along the line are conserved.
+    ẍ_0 = −[x_0 − x_1]_+^{3/2} − 2 \cos θ\, [\cos θ\, x_0 − x_a]_+^{3/2}, \quad
+    ẍ_1 = [x_0 − x_1]_+^{3/2}, \quad ẍ_a = [\cos θ\, x_0 − x_a]_+^{3/2}.
+
+Its energy :math:`\tfrac{1}{2}ẋ_0^2 + \tfrac{1}{2}ẋ_1^2 + ẋ_a^2 + \tfrac{2}{5}[z]_+^{5/2} + \tfrac{4}{5}[y]_+^{5/2}`
+(both side beads) and its momentum ẋ₀ + ẋ₁ + 2 cos θ ẋ_a along the line are conserved.
 
 **Reduced form**, eq. (5). With z = x₀ − x₁ and y = cos θ x₀ − x_a,
-(z̈, ÿ) = −K (z₊^{3/2}, y₊^{3/2}), K = [[2, 2 cos θ], [cos θ, 2 cos²θ + 1]] = [[2, 1],
-[1/2, 3/2]] at θ = π/3. K = N diag(1, 2) with N = J M⁻¹ Jᵀ the inverse mass matrix of the
-strains, so ½ q̇ᵀ N⁻¹ q̇ + (2/5)z₊^{5/2} + (4/5)y₊^{5/2} is conserved by eq. (5).
+:math:`(\ddot z, \ddot y) = −K (z_+^{3/2}, y_+^{3/2})`, K = [[2, 2 cos θ], [cos θ, 2 cos²θ + 1]]
+= [[2, 1], [1/2, 3/2]] at θ = π/3. K = N diag(1, 2) with N = J M⁻¹ Jᵀ the inverse mass matrix of
+the strains, so :math:`\tfrac{1}{2} \dot q^T N^{-1} \dot q + \tfrac{2}{5} z_+^{5/2} + \tfrac{4}{5} y_+^{5/2}`
+is conserved by eq. (5).
 
-**ω** solves the compatibility condition 2 + ω^{3/2} = (1/2 + 3/2 ω^{3/2})/ω of the ansatz
+**ω** solves the compatibility condition :math:`2 + ω^{3/2} = (\tfrac{1}{2} + \tfrac{3}{2} ω^{3/2})/ω` of the ansatz
 y = ω z (the initial conditions would need ω = cos θ = 1/2). With s = √ω it reads
 2s⁵ − 3s³ + 4s² − 1 = (s² + s − 1)(2s³ − 2s² + s + 1) = 0, so ω = ((√5 − 1)/2)² = (3 − √5)/2.
 
 **c**, eq. (8): the common velocity of beads 0 and 1 at the moment they become
 equal (ż = 0), divided by the BCA's V₀/2. It does not depend on V₀: the Hertz system is
-invariant under x → λx, t → λ^{−1/4}t, v → λ^{5/4}v.
+invariant under :math:`x → λx,\ t → λ^{−1/4} t,\ v → λ^{5/4} v`.
 
 **Residence times.** The TCA's T_n is the time from z = 0, ż = V_n, y = 0, ẏ = V_n cos θ to
-ż = 0, with V_n = V₀ cⁿ; the pulse speed is c_n = 1/T_n. Under the ansatz z̈ = −k z^{3/2},
-k = 2 + ω^{3/2}, solved by eq. (6):
+ż = 0, with V_n = V₀ cⁿ; the pulse speed is c_n = 1/T_n. Under the ansatz
+:math:`\ddot z = −k z^{3/2}`, :math:`k = 2 + ω^{3/2}`, solved by eq. (6):
 
-    t(z) = ₂F₁(2/5, 1/2; 7/5; 2 k z^{5/2} / (5E)) z / sqrt(2E),    E = V²/2.
+.. math::
 
-The paper prints sqrt(k) in the argument; k is what energy conservation
-½ż² + (2k/5) z^{5/2} = E gives, and what :func:`hypergeometric_time` uses (the tests check
+    t(z) = {}_2F_1\left(\tfrac{2}{5}, \tfrac{1}{2}; \tfrac{7}{5}; \frac{2 k z^{5/2}}{5E}\right)
+    \frac{z}{\sqrt{2E}}, \qquad E = V^2/2.
+
+The paper prints :math:`\sqrt{k}` in the argument; k is what energy conservation
+:math:`\tfrac{1}{2}\dot z^2 + \tfrac{2k}{5} z^{5/2} = E` gives, and what :func:`hypergeometric_time` uses (the tests check
 it against direct integration).
 
 **Full lattice.** T_n as the paper defines it: t = 0 when the velocities of beads n − 1 and
@@ -90,7 +96,8 @@ def three_bead_momentum(state, theta: float = THETA) -> float:
 
 
 def strain_matrix(theta: float = THETA) -> np.ndarray:
-    """K of eq. (5): (z̈, ÿ) = −K (z₊^{3/2}, y₊^{3/2}); [[2, 1], [1/2, 3/2]] at π/3."""
+    r"""K of eq. (5): :math:`(\ddot z, \ddot y) = −K (z_+^{3/2}, y_+^{3/2})`; [[2, 1], [1/2, 3/2]]
+    at π/3."""
     c = np.cos(theta)
     return np.array([[2.0, 2 * c], [c, 2 * c * c + 1.0]])
 
@@ -103,7 +110,8 @@ def strain_rhs(t, state, theta: float = THETA):
 
 
 def strain_energy(state, theta: float = THETA) -> float:
-    """Conserved quantity of eq. (5): ½ q̇ᵀ N⁻¹ q̇ + (2/5)z₊^{5/2} + (4/5)y₊^{5/2}."""
+    r"""Conserved quantity of eq. (5):
+    :math:`\tfrac{1}{2} \dot q^T N^{-1} \dot q + \tfrac{2}{5} z_+^{5/2} + \tfrac{4}{5} y_+^{5/2}`."""
     z, y, zd, yd = np.asarray(state, float)
     inverse_mass = strain_matrix(theta) @ np.diag([1.0, 0.5])
     rates = np.array([zd, yd])
@@ -111,14 +119,15 @@ def strain_energy(state, theta: float = THETA) -> float:
 
 
 def compatibility_residual(omega):
-    """2 + ω^{3/2} − (1/2 + 3/2 ω^{3/2})/ω: zero where y = ω z solves eq. (5)."""
+    r""":math:`2 + ω^{3/2} − (\tfrac{1}{2} + \tfrac{3}{2} ω^{3/2})/ω`: zero where y = ω z solves
+    eq. (5)."""
     omega = np.asarray(omega, float)
     return 2.0 + omega**1.5 - (0.5 + 1.5 * omega**1.5) / omega
 
 
 def solve_omega() -> float:
     """The sole real root ω of the compatibility condition (the residual increases
-    monotonically from −∞ at ω → 0⁺; ω^{3/2} is not real for ω < 0)."""
+    monotonically from −∞ at ω → 0⁺; :math:`ω^{3/2}` is not real for ω < 0)."""
     return float(brentq(compatibility_residual, 1e-6, 1.0, xtol=1e-15, rtol=4 * np.finfo(float).eps))
 
 
@@ -188,7 +197,7 @@ def residence_time(v: float, theta: float = THETA) -> float:
 
 
 def hypergeometric_time(z, v: float, omega: float):
-    """Eq. (6): when z(t) of z̈ = −(2 + ω^{3/2}) z^{3/2}, z(0) = 0, ż(0) = v reaches z,
+    r"""Eq. (6): when z(t) of :math:`\ddot z = −(2 + ω^{3/2}) z^{3/2}`, z(0) = 0, ż(0) = v reaches z,
     for 0 ≤ z ≤ the maximum compression."""
     energy = 0.5 * _positive(v) ** 2
     k = 2.0 + omega**1.5
@@ -198,7 +207,7 @@ def hypergeometric_time(z, v: float, omega: float):
 
 
 def hypergeometric_residence_time(v: float, omega: float) -> float:
-    """Closed-form T(V): eq. (6) at the maximum compression (5E/(2k))^{2/5}, where ż = 0."""
+    """Closed-form T(V): eq. (6) at the maximum compression :math:`(5E/(2k))^{2/5}`, where ż = 0."""
     energy = 0.5 * _positive(v) ** 2
     z_max = (5.0 * energy / (2.0 * (2.0 + omega**1.5))) ** 0.4
     return float(hypergeometric_time(z_max, v, omega))
@@ -206,10 +215,10 @@ def hypergeometric_residence_time(v: float, omega: float) -> float:
 
 @dataclass(frozen=True)
 class PulsePrediction:
-    """TCA residence times along the 30° line (nondimensional).
+    r"""TCA residence times along the 30° line (nondimensional).
 
-    ``n`` bead numbers; ``velocity`` V_n = V_first c^{n − n_first}; ``residence_time`` T_n
-    from eq. (5); ``residence_time_hyperg`` T_n from eq. (6).
+    ``n`` bead numbers; ``velocity`` :math:`V_n = V_\text{first}\, c^{n − n_\text{first}}`;
+    ``residence_time`` T_n from eq. (5); ``residence_time_hyperg`` T_n from eq. (6).
     """
 
     n: np.ndarray
@@ -233,7 +242,8 @@ class PulsePrediction:
 
 
 def predict_pulses(v_first: float, n_first: int, n_last: int, theta: float = THETA) -> PulsePrediction:
-    """Residence times of beads n_first … n_last for V_n = v_first c^{n − n_first} (eq. TCA_decay).
+    r"""Residence times of beads n_first … n_last for
+    :math:`V_n = v_\text{first}\, c^{n − n_\text{first}}` (eq. TCA_decay).
 
     30° strike: v_first = V₀ at n_first = 0. 0° strike observed at 30°: v_first = V₀/2 at
     n_first = 1 (Sec. IV, last paragraph).
@@ -338,7 +348,7 @@ def arrival_time_table(analysis, line: str = "+30") -> dict:
 
 
 def summary() -> dict:
-    """ω, c and the TCA's timing at V₀ = 1 (T scales as V₀^{-1/5}), nondimensional (``hexdem tca``)."""
+    """ω, c and the TCA's timing at V₀ = 1 (T scales as :math:`V_0^{-1/5}`), nondimensional (``hexdem tca``)."""
     event = equal_velocity(1.0)
     omega = solve_omega()
     return {"omega": omega, "c": event.decay_factor,

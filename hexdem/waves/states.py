@@ -1,11 +1,11 @@
-"""Initial states that excite linear waves, as per-bead velocities and displacements [SI].
+r"""Initial states that excite linear waves, as per-bead velocities and displacements [SI].
 
 * :func:`broadband_state`: independent Gaussian velocities of every bead, white in wave vector
   and polarization: every mode of the packing gets energy, the whole band structure lights up.
 * :func:`bloch_packet`: a Gaussian envelope of width σ on one Bloch mode (q, e, ω) of the
-  theory, u = Re[(V/ω) G(r) e e^{i(q·(r − c) − ωt)}] at t = 0, so
-  u = (V/ω) G Re(e e^{iφ}) and v = V G Im(e e^{iφ}) with φ = q·(r − c),
-  G = exp(−|r − c|²/2σ²): a packet of the waves near (q, +ω) only, its peak speed V. The
+  theory, :math:`u = \operatorname{Re}[(V/ω)\, G(r)\, e\, e^{i(q \cdot (r − c) − ωt)}]` at t = 0, so
+  :math:`u = (V/ω)\, G \operatorname{Re}(e\, e^{iφ})` and :math:`v = V G \operatorname{Im}(e\, e^{iφ})`
+  with φ = q·(r − c), G = exp(−|r − c|²/2σ²): a packet of the waves near (q, +ω) only, its peak speed V. The
   polarization e (a unit 2-vector) may be complex: at the Dirac point, where both polarizations
   share ω_K, the circular e = (1, i)/√2 is the one whose packet does not drift
   (:mod:`hexdem.waves.conical`).

@@ -1,27 +1,28 @@
-"""From the nonlinear front to the linear regime: precompression against impact speed (issue part 5).
+r"""From the nonlinear front to the linear regime: precompression against impact speed (issue part 5).
 
 **Physics.** In the uncompressed packing a contact carries no force until it is squeezed, so
 an impulse travels as a strongly nonlinear front: faceted like the packing early on, at a speed
-set by the impact itself (∝ V0^(1/5), the Hertz lattice having no other scale). Under a static
-force f0 per contact every contact already overlaps by δ0 = (f0/A)^(2/3); when the impact adds
-an overlap small against δ0 the contacts act as springs of stiffness k = (3/2) A^(2/3) f0^(1/3)
-and the front is a linear wave: it travels at the longitudinal sound speed
-c_L = sqrt(9/8) a sqrt(k/m) (a = d − δ0) and is round, the triangular spring lattice being
+set by the impact itself (:math:`∝ V_0^{1/5}`, the Hertz lattice having no other scale). Under a static
+force f0 per contact every contact already overlaps by :math:`δ_0 = (f_0/A)^{2/3}`; when the
+impact adds an overlap small against δ0 the contacts act as springs of stiffness
+:math:`k = \tfrac{3}{2} A^{2/3} f_0^{1/3}` and the front is a linear wave: it travels at the
+longitudinal sound speed :math:`c_L = \sqrt{9/8}\, a \sqrt{k/m}` (a = d − δ0) and is round, the triangular spring lattice being
 isotropic at long wavelengths (:mod:`hexdem.model.precompression`).
 
 **The overlap ratio.** The impact's own overlap is that of the first collision, two equal
 spheres of mass m meeting head-on at V0: with the reduced mass m_eff = m/2, the relative
-motion's energy ½ m_eff V0² is all stored in the Hertz potential (2/5) A δ^(5/2) at the
-largest overlap, so δ_impact = (5 m_eff V0² / (4 A))^(2/5)
+motion's energy :math:`\tfrac{1}{2} m_\text{eff} V_0^2` is all stored in the Hertz potential
+:math:`\tfrac{2}{5} A δ^{5/2}` at the largest overlap, so
+:math:`δ_\text{impact} = (5 m_\text{eff} V_0^2 / (4 A))^{2/5}`
 (:func:`~hexdem.model.hertz.max_overlap`). δ_impact/δ0 ≪ 1 is the linear regime; an
 uncompressed packing (δ0 = 0) has the ratio ∞.
 
 **One parameter.** With overlaps far below d, measuring displacements in δ0, forces in f0 and
-time in sqrt(m δ0 / f0) leaves the impact speed as V0 sqrt(m/A) δ0^(−5/4) ∝ (δ_impact/δ0)^(5/4)
-and nothing else: the front's speed over c_L and its shape at a given R/d depend on
+time in :math:`\sqrt{m δ_0 / f_0}` leaves the impact speed as
+:math:`V_0 \sqrt{m/A}\, δ_0^{−5/4} ∝ (δ_\text{impact}/δ_0)^{5/4}` and nothing else: the front's speed over c_L and its shape at a given R/d depend on
 δ_impact/δ0 alone, whatever f0 (measured: the sweep's forces fall on one curve, see
 ``transition_map.png``). The striker's pulse is part of it: it lasts the Hertz contact time
-t_c = 2.943 δ_impact/V0, a length c_L t_c ≈ 3.0 d (δ0/δ_impact)^(1/4). Below δ_impact/δ0 ≈ 1,
+t_c = 2.943 δ_impact/V0, a length :math:`c_L t_c ≈ 3.0\, d\, (δ_0/δ_\text{impact})^{1/4}`. Below δ_impact/δ0 ≈ 1,
 where the front already travels at c_L, its small sixfold amplitude is the lattice's dispersion
 acting on that pulse (short waves are not isotropic): the amplitude falls as the pulse grows
 longer, seven-fold (0.0014 to 0.0002 at 25 d) between pulses of 10 and 15 d.
@@ -142,7 +143,7 @@ QUICK = TransitionSettings(edge_beads=21, forces_n=(0.0, 20.0), speeds_m_s=(1e-4
 
 
 def _bead(config: RunConfig) -> tuple[float, float, float]:
-    """(d [m], A [N/m^1.5], m [kg]) of the configuration's beads."""
+    r"""(d [m], A [:math:`\mathrm{N/m^{1.5}}`], m [kg]) of the configuration's beads."""
     bead, d = config.material(config.bead_material), config.diameter_m
     return d, float(hertz_coefficient(d, bead)), float(sphere_mass(d, bead))
 
@@ -156,9 +157,9 @@ def sound_speed(config: RunConfig, force_n: float) -> float:
 
 
 def overlap_ratio(force_n: float, speed_m_s: float, coefficient: float, mass_kg: float) -> float:
-    """δ_impact/δ0: the largest overlap of two spheres of ``mass_kg`` meeting head-on at
+    r"""δ_impact/δ0: the largest overlap of two spheres of ``mass_kg`` meeting head-on at
     ``speed_m_s`` [m/s] (m_eff = m/2, module docstring) over the static overlap at ``force_n``
-    [N], for contacts of Hertz coefficient ``coefficient`` A [N/m^1.5]; ∞ for ``force_n`` 0."""
+    [N], for contacts of Hertz coefficient ``coefficient`` A [:math:`\mathrm{N/m^{1.5}}`]; ∞ for ``force_n`` 0."""
     impact = float(max_overlap(mass_kg / 2, coefficient, speed_m_s))
     return math.inf if force_n == 0 else impact / static_overlap(force_n, coefficient)
 
