@@ -70,10 +70,14 @@ def subplots(nrows: int = 1, ncols: int = 1, figsize=None, layout=None, **kwargs
     return fig, fig.subplots(nrows, ncols, **kwargs)
 
 
+#: Pixels per inch of the saved figures.
+DPI = 150
+
+
 def save(fig, path) -> None:
     """``fig`` as PNG at ``path``, written atomically."""
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=150, pil_kwargs={"compress_level": PNG_COMPRESSION})
+        fig.savefig(tmp, format="png", dpi=DPI, pil_kwargs={"compress_level": PNG_COMPRESSION})
 
 
 #: How beads without a value are drawn, outside every colour scale (a colour scale never hatches),

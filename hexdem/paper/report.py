@@ -21,6 +21,7 @@ from hexdem.paper.comparison import (
     comparison_rows,
     largest_differences,
 )
+from hexdem.paper.crossover import CROSSOVER_FIGURES
 from hexdem.paper.settings import STUDY_VELOCITY_M_S
 from hexdem.theory.protocols import CONSISTENT_SIGMAS, MIN_V0, STARTS
 
@@ -162,7 +163,9 @@ def _crossover_blocks(crossover: dict) -> list:
                   "log σ_c against log V, ± its standard error; consistent = within two)."),
             ("table", ("line", "measure", "slope", "consistent with 4/5", "consistent with 0"), tests),
             ("p", f"The paper's ±30° claim in these terms: {crossover['pm30_claim']}"),
-            ("figure", "disorder/disorder_crossover.png", "Transmission against σ and against σ / δ(V)")]
+            ("figure", f"disorder/{CROSSOVER_FIGURES['tol']}", "Transmission against σ"),
+            ("figure", f"disorder/{CROSSOVER_FIGURES['overlap']}",
+             "Transmission against σ / δ(V): if the impact's overlap sets the crossover, the speeds collapse")]
 
 
 def _friction_blocks(friction: dict) -> list:
