@@ -100,9 +100,10 @@ def _circles(ax, positions, diameters, **style) -> EllipseCollection:
 
 
 def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=None, norm=None, unmeasured=None,
-             outlined=None):
+             outlined=None, colorbar=True):
     """Beads as true-size circles (one collection, sized in data units) coloured by ``values``
-    through ``norm`` (None: linear); returns the mappable. ``unmeasured``: {name in
+    through ``norm`` (None: linear), with a colour bar labelled ``label`` unless ``colorbar`` is
+    False (panels that share a scale share one bar); returns the mappable. ``unmeasured``: {name in
     :data:`UNMEASURED_STYLES`: mask of the beads it describes}, drawn in that style outside the
     colour scale and named in a legend; any other NaN is drawn as "no value". ``outlined``:
     {name: mask} of beads to ring in a colour of :data:`OUTLINE_COLOURS` (a region of another
@@ -132,9 +133,10 @@ def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=No
     ax.update_datalim(np.vstack([positions.min(axis=0) - radius, positions.max(axis=0) + radius]))
     ax.set_aspect("equal")
     ax.autoscale_view()
-    bar = ax.figure.colorbar(circles, ax=ax, label=label, shrink=0.8)
-    if isinstance(norm, LogNorm):
-        plain_log_ticks(bar.ax.yaxis)
+    if colorbar:
+        bar = ax.figure.colorbar(circles, ax=ax, label=label, shrink=0.8)
+        if isinstance(norm, LogNorm):
+            plain_log_ticks(bar.ax.yaxis)
     return circles
 
 
