@@ -272,7 +272,7 @@ def front_shape_figure(curves: dict, path, title="Roundness of the wavefront", f
         if fit is not None:
             radius = np.geomspace(fit.radius_min_d, fit.radius_max_d, 100)
             ax.plot(radius, fit(radius), color=line.get_color(),
-                    label=f"A∞ + B R^-p: A∞ = {fit.a_inf:.4f} ± {fit.a_inf_se:.4f}, p = {fit.p:.2f}")
+                    label=f"A∞ + B (R/d)⁻ᵖ: A∞ = {fit.a_inf:.4f} ± {fit.a_inf_se:.4f}, p = {fit.p:.2f}")
             ax.axhline(fit.a_inf, color=line.get_color(), linestyle=":", linewidth=1)
     if fits:
         ax.set_xscale("log")

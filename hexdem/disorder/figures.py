@@ -88,7 +88,7 @@ def all_directions(stats_rows, ideal_rows, laws: dict, path, lines=FIG9_LINES) -
             ax.set_ylim(bottom=0)
             ax.xaxis.set_major_locator(MaxNLocator(integer=True))
             ax.grid(True, alpha=0.3)
-            ax.set_title(f"0° strike, {line}° line, $V_{{striker}}$ = {v:g} m/s", fontsize=10)
+            ax.set_title(f"0° strike, {line}° line, $V_{{\\rm striker}}$ = {v:g} m/s", fontsize=10)
             ax.set_ylabel("peak speed [m/s]")
             if row == len(velocities) - 1:
                 ax.set_xlabel("bead n along the line")
@@ -117,6 +117,6 @@ def expnumsim(lattice, walls, ideal_relative, mean_relative, reference: int, v_s
         ax.set_xlabel("x [m]")
         ax.set_ylabel("y [m]")
     fig.colorbar(circles, ax=list(axes), label="relative arrival time [ms]", shrink=0.8)
-    fig.suptitle(f"Wavefront arrival relative to the marked bead, $V_{{striker}}$ = {v_striker:g} m/s (Fig. 8; "
+    fig.suptitle(f"Wavefront arrival relative to the marked bead, $V_{{\\rm striker}}$ = {v_striker:g} m/s (Fig. 8; "
                  "its panel (b), the experiments' mean, is measured, not simulated)")
     plots.save(fig, path)

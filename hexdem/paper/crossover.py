@@ -167,12 +167,13 @@ def crossover_verdict(fits: list[dict], tests: list[dict]) -> str:
         where = ", ".join(f"σ_c = {f['sigma_c_tol']:.3g} ± {f['sigma_c_se_tol']:.2g} tol "
                           f"({f['sigma_c_over_overlap']:.3g} δ) at {f['v_striker']:.2f} m/s" for f in found)
         if test["consistent_with_overlap"] is None:
-            sentences.append(f"{name}: {where}; too few speeds to test V^(4/5).")
+            sentences.append(f"{name}: {where}; too few speeds to test σ_c ∝ V to the power 4/5.")
             continue
         reading = ("consistent with the overlap's 4/5" if test["consistent_with_overlap"] else
                    "not the overlap's 4/5") + (", and with no dependence on V" if test["consistent_with_constant"]
                                               else "")
-        sentences.append(f"{name}: {where}; σ_c ∝ V^({test['slope']:.2f} ± {test['slope_se']:.2f}), {reading}.")
+        sentences.append(f"{name}: {where}; σ_c ∝ V to the power {test['slope']:.2f} ± {test['slope_se']:.2f}, "
+                         f"{reading}.")
     return " ".join(sentences)
 
 

@@ -154,12 +154,12 @@ def _crossover_blocks(crossover: dict) -> list:
                   + ", ".join(f"{v:.2f}" for v in crossover["velocities_m_s"])
                   + " m/s. δ(V), the largest overlap of two beads meeting at the striker speed, is 0.53, 0.77 and "
                     "1.20 tol at 0.25, 0.40 and 0.70 m/s. Each (speed, line, measure) is fitted with a step in "
-                    "log σ, T = T_∞ + (T_0 − T_∞) / (1 + (σ/σ_c)^p), weighted by the standard errors; σ_c is the "
+                    "log σ, T = T∞ + (T₀ − T∞) / (1 + (σ/σ_c)ᵖ), weighted by the standard errors; σ_c is the "
                     "σ at half the drop, ± its standard error."),
             ("p", f"Verdict: {crossover['verdict']}"),
-            ("table", ("V [m/s]", "line", "measure", "σ_c / tol", "σ_c / δ(V)", "T_0 (small σ)", "T_∞ (large σ)"),
+            ("table", ("V [m/s]", "line", "measure", "σ_c / tol", "σ_c / δ(V)", "T₀ (small σ)", "T∞ (large σ)"),
              fits),
-            ("p", "The overlap hypothesis: σ_c ∝ V^(4/5) if the impact's overlap sets the crossover (slope of "
+            ("p", "The overlap hypothesis: σ_c ∝ V to the power 4/5 if the impact's overlap sets the crossover (slope of "
                   "log σ_c against log V, ± its standard error; consistent = within two)."),
             ("table", ("line", "measure", "slope", "consistent with 4/5", "consistent with 0"), tests),
             ("p", f"The paper's ±30° claim in these terms: {crossover['pm30_claim']}"),
@@ -191,7 +191,7 @@ def _friction_blocks(friction: dict) -> list:
             ("p", f"Disorder: {friction['disorder_verdict']}"),
             ("table", ("μ", "σ / tol", "line", f"leading pulse / frictionless at {STUDY_VELOCITY_M_S:.2f} m/s",
                        "arrival shift [µs]"), effect),
-            ("p", "Sec. V's decay rate c (V_n = V_s c^(n − s), the anchored log-linear fit) of the ideal lattice's "
+            ("p", "Sec. V's decay rate c (Vₙ = Vₛ cⁿ⁻ˢ, the anchored log-linear fit) of the ideal lattice's "
                   "leading pulses, for the 0° strike along 0° (s = 2) and +30° (s = 1), to the last bead no wall "
                   f"touches, at {STUDY_VELOCITY_M_S:.2f} m/s (friction/friction_decay.csv has every speed: "
                   "Hertz–Mindlin–Coulomb contacts are scale invariant, and the rates agree to 1e-4)."),
