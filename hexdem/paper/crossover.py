@@ -177,6 +177,38 @@ def crossover_verdict(fits: list[dict], tests: list[dict]) -> str:
     return " ".join(sentences)
 
 
+#: Headers of the crossover's two tables, in the report (section 3b) and on the crossover page.
+FIT_TABLE_HEADER = ("V [m/s]", "line", "measure", "σ_c / tol", "σ_c / δ(V)", "T₀ (small σ)", "T∞ (large σ)")
+OVERLAP_TABLE_HEADER = ("line", "measure", "slope", "consistent with 4/5", "consistent with 0")
+
+
+def _missing(value) -> bool:
+    """NaN, or null once written to JSON."""
+    return value is None or not np.isfinite(value)
+
+
+def _shown(value, pattern: str) -> str:
+    """``value`` formatted, or "–" where it is missing."""
+    return "–" if _missing(value) else format(value, pattern)
+
+
+def fit_table(fits: list[dict]) -> list[tuple[str, ...]]:
+    """The rows of :data:`FIT_TABLE_HEADER`: each (V, line, measure)'s σ_c ± its standard error,
+    in tol and in δ(V) ("–": no crossover measured), and the step's plateaus."""
+    return [(f"{f['v_striker']:.2f}", f["line"], f["measure"],
+             f"{_shown(f['sigma_c_tol'], '.3g')} ± {_shown(f['sigma_c_se_tol'], '.2g')}" if f["significant"] else "–",
+             f"{_shown(f['sigma_c_over_overlap'], '.3g')} ± {_shown(f['sigma_c_over_overlap_se'], '.2g')}"
+             if f["significant"] else "–", _shown(f["t0"], ".3f"), _shown(f["t_inf"], ".3f")) for f in fits]
+
+
+def overlap_table(tests: list[dict]) -> list[tuple[str, ...]]:
+    """The rows of :data:`OVERLAP_TABLE_HEADER`: the slope of log σ_c against log V per line and measure."""
+    verdicts = {True: "yes", False: "no", None: "–"}
+    return [(t["line"], t["measure"],
+             "–" if _missing(t["slope_se"]) else f"{t['slope']:.2f} ± {t['slope_se']:.2f}",
+             verdicts[t["consistent_with_overlap"]], verdicts[t["consistent_with_constant"]]) for t in tests]
+
+
 #: The crossover's two figures in ``disorder/``: the transmission against σ/tol, and against
 #: σ/δ(V), where the overlap hypothesis collapses the speeds' curves.
 CROSSOVER_FIGURES = {"tol": "disorder_crossover.png", "overlap": "disorder_crossover_overlap.png"}
