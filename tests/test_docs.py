@@ -2,6 +2,7 @@
 code, its gallery covers every packing and impact kind, and the README is a front page whose
 set-up commands are those CI runs."""
 
+import json
 import re
 import subprocess
 import sys
@@ -193,3 +194,33 @@ def test_the_pages_quote_the_numbers_of_their_source():
         if found is None or found.groups() != expected:
             wrong.append((page, pattern[:40], found.groups() if found else "not quoted", expected))
     assert not wrong, wrong
+
+
+def test_the_crossover_page_shows_its_runs_numbers():
+    """The crossover page's tables are those the report draws from the run's
+    ``disorder_crossover.json``, kept beside the page; its σ lists and δ(V) are the code's."""
+    from hexdem.disorder.preparation import TOLERANCE_M
+    from hexdem.paper import settings
+    from hexdem.paper.crossover import (
+        FIT_TABLE_HEADER,
+        OVERLAP_TABLE_HEADER,
+        fit_table,
+        impact_overlap_m,
+        overlap_table,
+    )
+
+    page = (DOCS / "validation" / "crossover.md").read_text()
+    run = json.loads((DOCS / "validation" / "data" / "disorder_crossover.json").read_text())
+    rows = [FIT_TABLE_HEADER, *fit_table(run["fits"]), OVERLAP_TABLE_HEADER, *overlap_table(run["overlap_test"])]
+    missing = [row for row in rows if "| " + " | ".join(row) + " |" not in page]
+    assert not missing, missing
+    assert run["sigma_per_tol"] == sorted({*settings.SIGMA_PER_TOL, *settings.CROSSOVER_SIGMA_PER_TOL} - {0.0})
+    text = " ".join(page.split())
+    sweep = re.search(r"σ/tol ∈ \{([^}]*)\} \(quick: \{([^}]*)\}\)", text)
+    assert sweep and [tuple(float(s) for s in group.split(", ")) for group in sweep.groups()] == \
+        [tuple(s for s in chosen if s not in settings.SIGMA_PER_TOL)
+         for chosen in (settings.CROSSOVER_SIGMA_PER_TOL, settings.QUICK_CROSSOVER_SIGMA_PER_TOL)]
+    overlaps = re.search(r"is ([\d.]+), ([\d.]+) and ([\d.]+) tol at ([\d.]+), ([\d.]+) and ([\d.]+) m/s", text)
+    speeds = settings.CROSSOVER_VELOCITIES_M_S
+    assert overlaps and overlaps.groups() == (*(f"{impact_overlap_m(v) / TOLERANCE_M:.2f}" for v in speeds),
+                                              *(f"{v:.2f}" for v in speeds))
