@@ -8,6 +8,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from hexdem.cli.main import COMMANDS
@@ -126,8 +127,8 @@ def _sci(value: float, digits: int = 2) -> str:
 
 
 def _quoted_numbers() -> list[tuple[str, str, tuple]]:
-    """(page under docs/, pattern, the numbers its groups must read, as the source gives them):
-    every number a page quotes from a constant of the code, the one place it is set."""
+    """(page, pattern, the numbers its groups must read, as the source gives them): every number
+    a page quotes from a constant of the code, or from the theory the code computes, set in one place."""
     sys.path.insert(0, str(ROOT / "benchmarks"))
     import bench_accuracy
     import bench_ensemble
@@ -140,46 +141,61 @@ def _quoted_numbers() -> list[tuple[str, str, tuple]]:
     from hexdem.model import config
     from hexdem.model.dissipation import damping_coefficient
 
+    from hexdem.theory.phonons import Lattice2D, cone_slope, frequencies, sound_speeds
+    from hexdem.waves.conical import ConicalSettings
+
+    force = ConicalSettings().precompression_n
+    lattice_config = config.RunConfig(precompression_n=force)
+    lattice = Lattice2D.of(lattice_config)
+    omega_m = frequencies(lattice, lattice.high_symmetry_points()["M"]) / (2 * np.pi * 1e3)
     n = config.STEPS_PER_CONTACT
     elastic = [(steps, [compare.MARGIN * e for e in compare.expected_error(steps)]) for steps in (n, 2 * n)]
     damped = [compare.MARGIN * e for e in compare.expected_error(n, damping_coefficient(0.95))]
     offsets = {s for beads, s in bench_scale.TARGET_OFFSETS_S.items() if beads != max(bench_scale.TARGET_OFFSETS_S)}
     assert len(offsets) == 1
     return [
-        ("validation/convergence.md", r"`steps_per_contact` = (\d+)", (f"{n}",)),
-        ("validation/convergence.md", r"samples every τ/(\d+) whatever the step \(`dump_every` default: "
+        ("docs/validation/convergence.md", r"`steps_per_contact` = (\d+)", (f"{n}",)),
+        ("docs/validation/convergence.md", r"samples every τ/(\d+) whatever the step \(`dump_every` default: "
          r"steps_per_contact / (\d+); a step count that is not a multiple of (\d+)",
          (f"{config.SAMPLES_PER_CONTACT}",) * 3),
-        ("validation/convergence.md", r"peak speeds within ([\d.e-]+) relative and arrival times within ([\d.]+) µs",
+        ("docs/validation/convergence.md", r"peak speeds within ([\d.e-]+) relative and arrival times within ([\d.]+) µs",
          (_sci(bench_accuracy.PEAK_TARGET, 1), f"{bench_accuracy.ARRIVAL_TARGET_S * 1e6:g}")),
-        ("guide/configuration.md", r"\bsteps_per_contact = (\d+)", (f"{n}",)),
-        ("guide/paper.md", r"\[--steps-per-contact (\d+)\]", (f"{n}",)),
-        ("guide/impacts.md", r"fewer than (\d+) samples or fewer than (\d+) per contact time",
+        ("docs/guide/configuration.md", r"\bsteps_per_contact = (\d+)", (f"{n}",)),
+        ("docs/guide/paper.md", r"\[--steps-per-contact (\d+)\]", (f"{n}",)),
+        ("docs/guide/impacts.md", r"fewer than (\d+) samples or fewer than (\d+) per contact time",
          (f"{config.MIN_SAMPLES}", f"{config.MIN_SAMPLES_PER_CONTACT}")),
-        ("validation/engines.md", r"rounded up to ([\d.]+)/N²\), and in arrival time", (f"{compare.PEAK_ERROR_N2:g}",)),
-        ("validation/engines.md", r"at most \(([\d.]+) τ \+ ([\d.]+) t\)/N²",
+        ("docs/validation/engines.md", r"rounded up to ([\d.]+)/N²\), and in arrival time", (f"{compare.PEAK_ERROR_N2:g}",)),
+        ("docs/validation/engines.md", r"at most \(([\d.]+) τ \+ ([\d.]+) t\)/N²",
          (f"{compare.ARRIVAL_ERROR_N2:g}", f"{compare.ARRIVAL_GROWTH_N2:g}")),
-        ("validation/engines.md", r"rounded up to ([\d.]+) and ([\d.]+)\), halving",
+        ("docs/validation/engines.md", r"rounded up to ([\d.]+) and ([\d.]+)\), halving",
          (f"{compare.PEAK_ERROR_ALPHA_N:g}", f"{compare.ARRIVAL_ERROR_ALPHA_N:g}")),
-        ("validation/engines.md", r"tolerances are (\d+) times that expected error", (f"{compare.MARGIN:g}",)),
-        *[("validation/engines.md", rf"\| elastic, N = {steps}[^|]*\| ([\d.e-]+) \| ([\d.e-]+) τ \+ ([\d.e-]+) t",
+        ("docs/validation/engines.md", r"tolerances are (\d+) times that expected error", (f"{compare.MARGIN:g}",)),
+        *[("docs/validation/engines.md", rf"\| elastic, N = {steps}[^|]*\| ([\d.e-]+) \| ([\d.e-]+) τ \+ ([\d.e-]+) t",
             tuple(map(_sci, tolerance))) for steps, tolerance in elastic],
-        ("validation/engines.md", rf"\| e = 0.95, N = {n} \| ([\d.e-]+) \| ([\d.e-]+) τ \+ ([\d.e-]+) t",
+        ("docs/validation/engines.md", rf"\| e = 0.95, N = {n} \| ([\d.e-]+) \| ([\d.e-]+) τ \+ ([\d.e-]+) t",
          tuple(map(_sci, damped))),
-        ("validation/engines.md", r"the peak tolerance takes ([\d.]+)/N² \(`PLACED_PEAK_ERROR_N2`\): ([\d.e-]+) at "
+        ("docs/validation/engines.md", r"the peak tolerance takes ([\d.]+)/N² \(`PLACED_PEAK_ERROR_N2`\): ([\d.e-]+) at "
          rf"N = {n}", (f"{compare.PLACED_PEAK_ERROR_N2:.1f}", _sci(compare.MARGIN * compare.PLACED_PEAK_ERROR_N2 / n**2))),
-        ("validation/benchmarks.md", r"end to end ≤ floor \+ ([\d.]+) × the LAMMPS loop \+ ([\d.]+) s; the in-run "
+        ("README.md", r"at (\d+) N per contact, \S+ = ([\d.]+) Hz and the cone's slope .*? = ([\d.]+) m/s",
+         (f"{force:g}", f"{lattice.dirac_frequency() / (2 * np.pi):.1f}", f"{cone_slope(lattice):.2f}")),
+        ("docs/guide/dirac-point.md", r"\| at (\d+) N, steel, d = ([\d.]+) mm \|", (f"{force:g}", f"{lattice_config.diameter_m * 1e3:.2f}")),
+        ("docs/guide/dirac-point.md", r"\| \S+ = ([\d.]+) m/s, \S+ = ([\d.]+) m/s \|",
+         tuple(f"{c:.1f}" for c in sound_speeds(lattice))),
+        ("docs/guide/dirac-point.md", r"\| \S+ = ([\d.]+) Hz \|", (f"{lattice.dirac_frequency() / (2 * np.pi):.1f}",)),
+        ("docs/guide/dirac-point.md", r"\| \S+ = ([\d.]+) m/s \|", (f"{cone_slope(lattice):.2f}",)),
+        ("docs/guide/dirac-point.md", r"\| ([\d.]+) and ([\d.]+) kHz \|", tuple(f"{f:.2f}" for f in sorted(omega_m))),
+        ("docs/validation/benchmarks.md", r"end to end ≤ floor \+ ([\d.]+) × the LAMMPS loop \+ ([\d.]+) s; the in-run "
          r"analysis ≤ ([\d.]+) × the loop", (f"{bench_run.TARGET_FACTOR:g}", f"{bench_run.TARGET_OFFSET_S:g}",
                                            f"{bench_run.ANALYSIS_SHARE_TARGET:g}")),
-        ("validation/benchmarks.md", r"end to end ≤ ([\d.]+) × the loop \+ (\d+) s, \+ (\d+) s for the front study's "
+        ("docs/validation/benchmarks.md", r"end to end ≤ ([\d.]+) × the loop \+ (\d+) s, \+ (\d+) s for the front study's "
          r"52,599, ≤ (\d+) MB per process; the analysis ≤ ([\d.]+) × the loop",
          (f"{bench_scale.TARGET_FACTOR:g}", f"{offsets.pop():g}", f"{bench_scale.TARGET_OFFSETS_S[52599]:g}",
           f"{bench_scale.MEMORY_TARGET / 1e6:g}", f"{bench_scale.ANALYSIS_SHARE_TARGET:g}")),
-        ("validation/benchmarks.md", r"target ≥ (\d+) M for (\d+) beads",
+        ("docs/validation/benchmarks.md", r"target ≥ (\d+) M for (\d+) beads",
          (f"{bench_reference.TARGET_M_BEAD_STEPS:g}", f"{bench_reference.TARGET_BEADS}")),
-        ("validation/benchmarks.md", r"\(targets: ≤ (\d+) s, ≥ ([\d.]+) × faster than before\)",
+        ("docs/validation/benchmarks.md", r"\(targets: ≤ (\d+) s, ≥ ([\d.]+) × faster than before\)",
          (f"{bench_ensemble.ENSEMBLE_TARGET_S:g}", f"{bench_ensemble.ENSEMBLE_SPEED_UP_TARGET:g}")),
-        ("validation/benchmarks.md", r"targets: ≤ (\d+) min for the parts .*? `--quick` ≤ (\d+) min; ≥ ([\d.]+) × faster",
+        ("docs/validation/benchmarks.md", r"targets: ≤ (\d+) min for the parts .*? `--quick` ≤ (\d+) min; ≥ ([\d.]+) × faster",
          (f"{bench_paper.TARGETS_S[False] / 60:g}", f"{bench_paper.TARGETS_S[True] / 60:g}",
           f"{bench_paper.SPEED_UP_TARGET:g}")),
     ]
@@ -190,7 +206,7 @@ def test_the_pages_quote_the_numbers_of_their_source():
     the benchmarks' targets) reads what the code sets: change either, and this fails."""
     wrong = []
     for page, pattern, expected in _quoted_numbers():
-        found = re.search(pattern, " ".join((DOCS / page).read_text().split()))
+        found = re.search(pattern, " ".join((ROOT / page).read_text().split()))
         if found is None or found.groups() != expected:
             wrong.append((page, pattern[:40], found.groups() if found else "not quoted", expected))
     assert not wrong, wrong
