@@ -74,7 +74,8 @@ def test_the_command_writes_the_figure_and_its_table(tmp_path):
     assert summary["ranks"] == 1 and summary["n_beads"] == 61
 
 
-@pytest.mark.parametrize("config", [RunConfig(edge_beads=11), RunConfig(shape="half-hexagon", long_edge=41, short_edge=21)])
+@pytest.mark.parametrize("config", [RunConfig(edge_beads=11),
+                                    RunConfig(shape="half-hexagon", long_edge=41, short_edge=21)])
 def test_the_panels_share_one_colour_bar_readable_in_the_report(monkeypatch, config):
     """Six panels, one colour scale from 0 to the median of their largest speeds with one bar
     (Fig. 4 had six bars of 6-point labels), every text at least 10 px where the report shows it."""

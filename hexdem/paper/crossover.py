@@ -196,7 +196,8 @@ def fit_table(fits: list[dict]) -> list[tuple[str, ...]]:
     """The rows of :data:`FIT_TABLE_HEADER`: each (V, line, measure)'s σ_c ± its standard error,
     in tol and in δ(V) ("–": no crossover measured), and the step's plateaus."""
     return [(f"{f['v_striker']:.2f}", f["line"], f["measure"],
-             f"{_shown(f['sigma_c_tol'], '.3g')} ± {_shown(f['sigma_c_se_tol'], '.2g')}" if f["significant"] else "–",
+             f"{_shown(f['sigma_c_tol'], '.3g')} ± {_shown(f['sigma_c_se_tol'], '.2g')}"
+             if f["significant"] else "–",
              f"{_shown(f['sigma_c_over_overlap'], '.3g')} ± {_shown(f['sigma_c_over_overlap_se'], '.2g')}"
              if f["significant"] else "–", _shown(f["t0"], ".3f"), _shown(f["t_inf"], ".3f")) for f in fits]
 

@@ -156,12 +156,12 @@ def _crossover_blocks(crossover: dict) -> list:
                   + " m/s. δ(V), the largest overlap of two beads meeting at the striker speed, is "
                   + ", ".join(f"{impact_overlap_m(v) / TOLERANCE_M:.2f}" for v in crossover["velocities_m_s"])
                   + " tol at these speeds. Each (speed, line, measure) is fitted with a step in "
-                    "log σ, T = T∞ + (T₀ − T∞) / (1 + (σ/σ_c)ᵖ), weighted by the standard errors; σ_c is the "
-                    "σ at half the drop, ± its standard error."),
+                    "log σ, T = T∞ + (T₀ − T∞) / (1 + (σ/σ_c)ᵖ), weighted by the standard errors; σ_c is "
+                    "the σ at half the drop, ± its standard error."),
             ("p", f"Verdict: {crossover['verdict']}"),
             ("table", FIT_TABLE_HEADER, fit_table(crossover["fits"])),
-            ("p", "The overlap hypothesis: σ_c ∝ V to the power 4/5 if the impact's overlap sets the crossover (slope of "
-                  "log σ_c against log V, ± its standard error; consistent = within two)."),
+            ("p", "The overlap hypothesis: σ_c ∝ V to the power 4/5 if the impact's overlap sets the crossover "
+                  "(slope of log σ_c against log V, ± its standard error; consistent = within two)."),
             ("table", OVERLAP_TABLE_HEADER, overlap_table(crossover["overlap_test"])),
             ("p", f"The paper's ±30° claim in these terms: {crossover['pm30_claim']}"),
             ("figure", f"disorder/{CROSSOVER_FIGURES['tol']}", "Transmission against σ"),
