@@ -103,15 +103,20 @@ def _energy_share(run: PacketRun, frame: int) -> np.ndarray:
     return np.maximum(energies / energies.max(), 10.0 ** -ENERGY_DECADES)
 
 
-def _energy_axes(ax, run: PacketRun, frame: int, diameter_m: float):
-    """Beads coloured by their share of the frame's largest energy, log scale; the mappable."""
+#: Colour-bar label of the packets' energy maps.
+ENERGY_LABEL = "kinetic energy / largest"
+
+
+def _energy_axes(ax, run: PacketRun, frame: int, diameter_m: float, colorbar: bool = True):
+    """Beads coloured by their share of the frame's largest energy, log scale, with its colour bar
+    unless ``colorbar`` is False; the mappable."""
     from matplotlib.colors import LogNorm
 
     from hexdem.analysis.figures import bead_map
 
     positions = (run.recorded.positions_m - run.centre_m) / diameter_m
     circles = bead_map(ax, positions, np.ones(len(positions)), _energy_share(run, frame), cmap="inferno",
-                       label="kinetic energy / largest", norm=LogNorm(10.0 ** -ENERGY_DECADES, 1.0))
+                       label=ENERGY_LABEL, norm=LogNorm(10.0 ** -ENERGY_DECADES, 1.0), colorbar=colorbar)
     circles.set_edgecolor("none")
     ax.set_xlabel("x [d]")
     ax.set_ylabel("y [d]")
@@ -119,16 +124,19 @@ def _energy_axes(ax, run: PacketRun, frame: int, diameter_m: float):
 
 
 def snapshots_figure(conical: Conical, path) -> None:
-    """The K packet's energy at the start, midway and at the end, and the control's at the end."""
-    from hexdem.analysis.figures import save, subplots
+    """The K packet's energy at the start, midway and at the end, and the control's at the end:
+    four panels on one colour scale, with one bar."""
+    from hexdem.analysis.figures import plain_log_ticks, save, subplots
 
-    fig, axes = subplots(1, 4, figsize=(17, 4.4), layout="constrained")
+    fig, axes = subplots(2, 2, figsize=(9.5, 8.6), layout="constrained")
     last = len(conical.dirac.times_s) - 1
     shown = [(conical.dirac, 0), (conical.dirac, last // 2), (conical.dirac, last), (conical.control, last)]
-    for ax, (run, frame) in zip(axes, shown):
-        _energy_axes(ax, run, frame, conical.diameter_m)
+    for ax, (run, frame) in zip(axes.flat, shown):
+        circles = _energy_axes(ax, run, frame, conical.diameter_m, colorbar=False)
         name = "control" if run is conical.control else "packet at K"
-        ax.set_title(f"{name}, t = {run.times_s[frame] * 1e3:.2f} ms", fontsize=10)
+        ax.set_title(f"{name}, t = {run.times_s[frame] * 1e3:.2f} ms", fontsize=11)
+    bar = fig.colorbar(circles, ax=axes.ravel().tolist(), label=ENERGY_LABEL, shrink=0.6)
+    plain_log_ticks(bar.ax.yaxis)
     save(fig, path)
 
 
