@@ -10,7 +10,9 @@ import pytest
 from hexdem.disorder.preparation import TOLERANCE_M
 from hexdem.paper.crossover import (
     CROSSOVER_COLUMNS,
+    CROSSOVER_FIGURES,
     _step,
+    crossover_figure,
     crossover_fits,
     crossover_rows,
     fit_crossover,
@@ -18,6 +20,7 @@ from hexdem.paper.crossover import (
     overlap_test,
 )
 from hexdem.paper.settings import PaperSettings
+from readable import saved_figure, smallest_text_px
 
 SIGMA_TOL = np.geomspace(1e-3, 6.0, 9)
 
@@ -69,6 +72,16 @@ def test_the_overlap_test_tells_a_v_to_the_four_fifths_crossover_from_a_fixed_on
         assert test["consistent_with_constant"] is (exponent == 0.0)
 
 
+@pytest.mark.parametrize("against", list(CROSSOVER_FIGURES))
+def test_the_crossover_figures_are_readable_in_the_reports_column(monkeypatch, against):
+    """Four panels a figure, its smallest text at least 10 px where the report shows it (the
+    eight panels of one 16-inch figure had 8-point text shrunk to 7.8 px)."""
+    rows = crossover_rows(summaries_with(lambda v: 0.1 * (v / 0.4) ** 0.8))
+    fig = saved_figure(monkeypatch, lambda: crossover_figure(rows, crossover_fits(rows), "unused.png", against))
+    assert len(fig.axes) == 4
+    assert smallest_text_px(fig) >= 10
+
+
 def test_the_quick_paper_writes_the_crossover_sweep(paper_quick):
     folder = paper_quick / "disorder"
     with open(folder / "disorder_crossover.csv", newline="") as fh:
@@ -80,5 +93,5 @@ def test_the_quick_paper_writes_the_crossover_sweep(paper_quick):
     assert {float(r["v_striker"]) for r in rows} == {0.25, 0.4, 0.7}
     result = json.loads((folder / "disorder_crossover.json").read_text())
     assert len(result["fits"]) == 3 * 2 * 2 and len(result["overlap_test"]) == 4 and result["verdict"]
-    assert (folder / "disorder_crossover.png").stat().st_size > 0
+    assert all((folder / name).stat().st_size > 0 for name in CROSSOVER_FIGURES.values())
     assert result["pm30_claim"] in (paper_quick / "report.md").read_text()

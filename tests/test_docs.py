@@ -2,17 +2,20 @@
 code, its formulas are typeset, its gallery covers every packing and impact kind, and the README
 is a front page whose set-up commands are those CI runs."""
 
+import json
 import re
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from hexdem.cli.main import COMMANDS
 from hexdem.model.config import SHAPES, RunConfig
 from hexdem.model.config_keys import KEY_DESCRIPTIONS
 from hexdem.model.model_builder import build_model
+from hexdem.model.packing_builders import PREPARED_SHAPES
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
@@ -60,7 +63,7 @@ def test_the_api_reference_documents_the_modules_a_page_per_subpackage(built):
 def test_the_gallery_shows_every_shape_and_impact_kind():
     configs = {path.stem: RunConfig.from_toml(path) for path in sorted((DOCS / "gallery" / "configs").glob("*.toml"))}
     assert {config.shape for config in configs.values()} == set(SHAPES)
-    models = {name: build_model(config) for name, config in configs.items()}
+    models = {name: build_model(config) for name, config in configs.items() if config.shape not in PREPARED_SHAPES}
     kinds = {"velocity": any(not m.strikers for m in models.values()),
              "striker": any(len(m.strikers) == 1 for m in models.values()),
              "several impacts": any(len(m.impacts) > 1 and not m.strikers for m in models.values()),
@@ -124,7 +127,7 @@ def test_the_pages_count_the_slow_tests():
 PLAIN_TEXT_FORMULAS = {"hexdem.analysis.energy", "hexdem.analysis.tracker_kernel",
                        "hexdem.engines.lammps.deck", "hexdem.engines.reference.engine",
                        "hexdem.engines.reference.kernel", "hexdem.model.timescale",
-                       "hexdem.paper.crossover", "hexdem.paper.friction_study", "validation/crossover.html"}
+                       "hexdem.paper.crossover", "hexdem.paper.friction_study"}
 
 
 def test_formulas_are_typeset_not_raw_latex(built):
@@ -162,3 +165,132 @@ def test_docstrings_with_backslashes_are_raw_strings():
                 if "\\" in text and not text.startswith("r"):
                     plain.append(f"{path.relative_to(ROOT)}:{node.body[0].lineno}")
     assert not plain, plain
+
+
+def _sci(value: float, digits: int = 2) -> str:
+    """A number as the pages write it: ``digits`` significant digits, 1.6e-4."""
+    mantissa, exponent = f"{value:.{digits - 1}e}".split("e")
+    return f"{mantissa}e{int(exponent)}"
+
+
+def _quoted_numbers() -> list[tuple[str, str, tuple]]:
+    """(page, pattern, the numbers its groups must read, as the source gives them): every number
+    a page quotes from a constant of the code, or from the theory the code computes, set in one place."""
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    import bench_accuracy
+    import bench_ensemble
+    import bench_paper
+    import bench_reference
+    import bench_run
+    import bench_scale
+
+    from hexdem.experiments import compare
+    from hexdem.model import config, run_settings
+    from hexdem.model.dissipation import damping_coefficient
+
+    from hexdem.theory.phonons import Lattice2D, cone_slope, frequencies, sound_speeds
+    from hexdem.waves.conical import ConicalSettings
+
+    force = ConicalSettings().precompression_n
+    lattice_config = config.RunConfig(precompression_n=force)
+    lattice = Lattice2D.of(lattice_config)
+    omega_m = frequencies(lattice, lattice.high_symmetry_points()["M"]) / (2 * np.pi * 1e3)
+    n = config.STEPS_PER_CONTACT
+    elastic = [(steps, [compare.MARGIN * e for e in compare.expected_error(steps)]) for steps in (n, 2 * n)]
+    damped = [compare.MARGIN * e for e in compare.expected_error(n, damping_coefficient(0.95))]
+    offsets = {s for beads, s in bench_scale.TARGET_OFFSETS_S.items() if beads != max(bench_scale.TARGET_OFFSETS_S)}
+    assert len(offsets) == 1
+    return [
+        ("docs/validation/convergence.md", r"`steps_per_contact` = (\d+)", (f"{n}",)),
+        ("docs/validation/convergence.md", r"samples every τ/(\d+) whatever the step \(`dump_every` default: "
+         r"steps_per_contact / (\d+); a step count that is not a multiple of (\d+)",
+         (f"{run_settings.SAMPLES_PER_CONTACT}",) * 3),
+        ("docs/validation/convergence.md",
+         r"peak speeds within ([\d.e-]+) relative and arrival times within ([\d.]+) µs",
+         (_sci(bench_accuracy.PEAK_TARGET, 1), f"{bench_accuracy.ARRIVAL_TARGET_S * 1e6:g}")),
+        ("docs/guide/configuration.md", r"\bsteps_per_contact = (\d+)", (f"{n}",)),
+        ("docs/guide/paper.md", r"\[--steps-per-contact (\d+)\]", (f"{n}",)),
+        ("docs/guide/impacts.md", r"fewer than (\d+) samples or fewer than (\d+) per contact time",
+         (f"{run_settings.MIN_SAMPLES}", f"{run_settings.MIN_SAMPLES_PER_CONTACT}")),
+        ("docs/validation/engines.md", r"rounded up to ([\d.]+)/N²\), and in arrival time",
+         (f"{compare.PEAK_ERROR_N2:g}",)),
+        ("docs/validation/engines.md", r"at most \(([\d.]+) τ \+ ([\d.]+) t\)/N²",
+         (f"{compare.ARRIVAL_ERROR_N2:g}", f"{compare.ARRIVAL_GROWTH_N2:g}")),
+        ("docs/validation/engines.md", r"rounded up to ([\d.]+) and ([\d.]+)\), halving",
+         (f"{compare.PEAK_ERROR_ALPHA_N:g}", f"{compare.ARRIVAL_ERROR_ALPHA_N:g}")),
+        ("docs/validation/engines.md", r"tolerances are (\d+) times that expected error", (f"{compare.MARGIN:g}",)),
+        *[("docs/validation/engines.md", rf"\| elastic, N = {steps}[^|]*\| ([\d.e-]+) \| ([\d.e-]+) τ \+ ([\d.e-]+) t",
+            tuple(map(_sci, tolerance))) for steps, tolerance in elastic],
+        ("docs/validation/engines.md", rf"\| e = 0.95, N = {n} \| ([\d.e-]+) \| ([\d.e-]+) τ \+ ([\d.e-]+) t",
+         tuple(map(_sci, damped))),
+        ("docs/validation/engines.md",
+         rf"the peak tolerance takes ([\d.]+)/N² \(`PLACED_PEAK_ERROR_N2`\): ([\d.e-]+) at N = {n}",
+         (f"{compare.PLACED_PEAK_ERROR_N2:.1f}", _sci(compare.MARGIN * compare.PLACED_PEAK_ERROR_N2 / n**2))),
+        ("README.md", r"at (\d+) N per contact, \S+ = ([\d.]+) Hz and the cone's slope .*? = ([\d.]+) m/s",
+         (f"{force:g}", f"{lattice.dirac_frequency() / (2 * np.pi):.1f}", f"{cone_slope(lattice):.2f}")),
+        ("docs/guide/dirac-point.md", r"\| at (\d+) N, steel, d = ([\d.]+) mm \|",
+         (f"{force:g}", f"{lattice_config.diameter_m * 1e3:.2f}")),
+        ("docs/guide/dirac-point.md", r"\| \S+ = ([\d.]+) m/s, \S+ = ([\d.]+) m/s \|",
+         tuple(f"{c:.1f}" for c in sound_speeds(lattice))),
+        ("docs/guide/dirac-point.md", r"\| \S+ = ([\d.]+) Hz \|", (f"{lattice.dirac_frequency() / (2 * np.pi):.1f}",)),
+        ("docs/guide/dirac-point.md", r"\| \S+ = ([\d.]+) m/s \|", (f"{cone_slope(lattice):.2f}",)),
+        ("docs/guide/dirac-point.md", r"\| ([\d.]+) and ([\d.]+) kHz \|", tuple(f"{f:.2f}" for f in sorted(omega_m))),
+        ("docs/validation/benchmarks.md",
+         r"end to end ≤ floor \+ ([\d.]+) × the LAMMPS loop \+ ([\d.]+) s; the in-run "
+         r"analysis ≤ ([\d.]+) × the loop", (f"{bench_run.TARGET_FACTOR:g}", f"{bench_run.TARGET_OFFSET_S:g}",
+                                           f"{bench_run.ANALYSIS_SHARE_TARGET:g}")),
+        ("docs/validation/benchmarks.md",
+         r"end to end ≤ ([\d.]+) × the loop \+ (\d+) s, \+ (\d+) s for the front study's "
+         r"52,599, ≤ (\d+) MB per process; the analysis ≤ ([\d.]+) × the loop",
+         (f"{bench_scale.TARGET_FACTOR:g}", f"{offsets.pop():g}", f"{bench_scale.TARGET_OFFSETS_S[52599]:g}",
+          f"{bench_scale.MEMORY_TARGET / 1e6:g}", f"{bench_scale.ANALYSIS_SHARE_TARGET:g}")),
+        ("docs/validation/benchmarks.md", r"target ≥ (\d+) M for (\d+) beads",
+         (f"{bench_reference.TARGET_M_BEAD_STEPS:g}", f"{bench_reference.TARGET_BEADS}")),
+        ("docs/validation/benchmarks.md", r"\(targets: ≤ (\d+) s, ≥ ([\d.]+) × faster than before\)",
+         (f"{bench_ensemble.ENSEMBLE_TARGET_S:g}", f"{bench_ensemble.ENSEMBLE_SPEED_UP_TARGET:g}")),
+        ("docs/validation/benchmarks.md",
+         r"targets: ≤ (\d+) min for the parts .*? `--quick` ≤ (\d+) min; ≥ ([\d.]+) × faster",
+         (f"{bench_paper.TARGETS_S[False] / 60:g}", f"{bench_paper.TARGETS_S[True] / 60:g}",
+          f"{bench_paper.SPEED_UP_TARGET:g}")),
+    ]
+
+
+def test_the_pages_quote_the_numbers_of_their_source():
+    """A number a page quotes from the code (the time step, the sampling, the engines' tolerances,
+    the benchmarks' targets) reads what the code sets: change either, and this fails."""
+    wrong = []
+    for page, pattern, expected in _quoted_numbers():
+        found = re.search(pattern, " ".join((ROOT / page).read_text().split()))
+        if found is None or found.groups() != expected:
+            wrong.append((page, pattern[:40], found.groups() if found else "not quoted", expected))
+    assert not wrong, wrong
+
+
+def test_the_crossover_page_shows_its_runs_numbers():
+    """The crossover page's tables are those the report draws from the run's
+    ``disorder_crossover.json``, kept beside the page; its σ lists and δ(V) are the code's."""
+    from hexdem.disorder.preparation import TOLERANCE_M
+    from hexdem.paper import settings
+    from hexdem.paper.crossover import (
+        FIT_TABLE_HEADER,
+        OVERLAP_TABLE_HEADER,
+        fit_table,
+        impact_overlap_m,
+        overlap_table,
+    )
+
+    page = (DOCS / "validation" / "crossover.md").read_text()
+    run = json.loads((DOCS / "validation" / "data" / "disorder_crossover.json").read_text())
+    rows = [FIT_TABLE_HEADER, *fit_table(run["fits"]), OVERLAP_TABLE_HEADER, *overlap_table(run["overlap_test"])]
+    missing = [row for row in rows if "| " + " | ".join(row) + " |" not in page]
+    assert not missing, missing
+    assert run["sigma_per_tol"] == sorted({*settings.SIGMA_PER_TOL, *settings.CROSSOVER_SIGMA_PER_TOL} - {0.0})
+    text = " ".join(page.split())
+    sweep = re.search(r"σ/tol ∈ \{([^}]*)\} \(quick: \{([^}]*)\}\)", text)
+    assert sweep and [tuple(float(s) for s in group.split(", ")) for group in sweep.groups()] == \
+        [tuple(s for s in chosen if s not in settings.SIGMA_PER_TOL)
+         for chosen in (settings.CROSSOVER_SIGMA_PER_TOL, settings.QUICK_CROSSOVER_SIGMA_PER_TOL)]
+    overlaps = re.search(r"is ([\d.]+), ([\d.]+) and ([\d.]+) tol at ([\d.]+), ([\d.]+) and ([\d.]+) m/s", text)
+    speeds = settings.CROSSOVER_VELOCITIES_M_S
+    assert overlaps and overlaps.groups() == (*(f"{impact_overlap_m(v) / TOLERANCE_M:.2f}" for v in speeds),
+                                              *(f"{v:.2f}" for v in speeds))

@@ -1,10 +1,17 @@
 """What a reader sees on a bead map: beads without a value are drawn outside the colour scale, in
-a style its legend names, never in a colour the scale could mean."""
+a style its legend names, never in a colour the scale could mean; and on every figure, text in
+mathtext or Unicode, never raw notation."""
+
+import ast
+import re
+from pathlib import Path
 
 import numpy as np
 from matplotlib.colors import LogNorm
 
 from hexdem.analysis.figures import UNMEASURED_STYLES, bead_map, subplots
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_beads_without_a_peak_are_drawn_outside_the_scale_and_named_in_the_legend():
@@ -34,3 +41,42 @@ def test_beads_of_other_materials_are_ringed_and_named():
     (ring,) = [c for c in ax.collections if c is not coloured]
     assert len(ring.get_offsets()) == 2 and len(ring.get_facecolor()) == 0
     assert [text.get_text() for text in fig.legends[0].get_texts()] == ["brass beads"]
+
+
+#: Modules that draw the report's and the runs' figures.
+FIGURE_MODULES = sorted({*(ROOT / "hexdem" / "paper").glob("*.py"), *(ROOT / "hexdem").glob("*/figures.py"),
+                         ROOT / "hexdem" / "analysis" / "movie.py", ROOT / "hexdem" / "experiments" / "snapshots.py"})
+#: Calls and keywords whose string is text on a figure.
+TEXT_CALLS = {"set_xlabel", "set_ylabel", "set_title", "suptitle", "set_label", "text", "annotate", "legend"}
+TEXT_KEYWORDS = {"label", "title", "xlabel", "ylabel"}
+#: Notation meant for a typesetter: a caret or an underscore before a script ("d^(5/4)", "T_0"),
+#: or V0 for V₀.
+RAW_NOTATION = re.compile(r"\^[-({\w]|_[{\w]|\bV0\b")
+
+
+def _shown(node) -> list[str]:
+    """The texts a string, f-string (placeholders as 0) or conditional node can give."""
+    if isinstance(node, ast.Constant) and isinstance(node.value, str):
+        return [node.value]
+    if isinstance(node, ast.JoinedStr):
+        return ["".join(part.value if isinstance(part, ast.Constant) else "0" for part in node.values)]
+    if isinstance(node, ast.IfExp):
+        return _shown(node.body) + _shown(node.orelse)
+    return []
+
+
+def test_no_figure_text_is_raw_notation():
+    """Axis labels, titles and legends use mathtext ($T_0$, $d^{5/4}$) or Unicode (V₀), never the
+    raw notation a reader would have to decode (issue 35)."""
+    raw = []
+    for path in FIGURE_MODULES:
+        for node in ast.walk(ast.parse(path.read_text())):
+            if not isinstance(node, ast.Call):
+                continue
+            name = node.func.attr if isinstance(node.func, ast.Attribute) else getattr(node.func, "id", "")
+            texts = [*(node.args[:1] if name in TEXT_CALLS else []),
+                     *(k.value for k in node.keywords if k.arg in TEXT_KEYWORDS)]
+            for text in (text for item in texts for text in _shown(item)):
+                if RAW_NOTATION.search(re.sub(r"\$[^$]*\$", "", text)):
+                    raw.append(f"{path.name}:{node.lineno}: {text}")
+    assert len(FIGURE_MODULES) > 15 and not raw, raw

@@ -203,5 +203,8 @@ def test_the_verdict_names_the_conditions_of_the_papers_claim():
     result = verdict(rows)
     assert [(c["sigma_per_tol"], c["preparation"]) for c in result["rises_at"]] == [(6.0, "relaxed")]
     assert result["paper_case"]["pm30"] == "falls" and "relaxed" in result["summary"]
+    assert result["summary"].startswith("At σ = 6 tol (the study's strengths, 0.40 m/s"), "its σ range stated"
+    assert verdict([r for r in rows if r[2] == "prestressed"] + [row(1.0, "prestressed", "±30", 0.9),
+                   row(1.0, "prestressed", "0", 0.9)])["summary"].startswith("At σ = 1, 6 tol")
     assert np.isclose(result["paper_case"]["pm30_ratio"], 0.80)
     assert len(STUDY_COLUMNS) == len(rows[0])

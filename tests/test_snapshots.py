@@ -8,9 +8,12 @@ from conftest import read_csv
 
 from hexdem.cli.main import main
 from hexdem.errors import HexdemError
-from hexdem.experiments.snapshots import snapshot_config, take_snapshots
+from hexdem.experiments.snapshots import Snapshots, snapshot_config, snapshot_figure, take_snapshots
 from hexdem.model.config import RunConfig
+from hexdem.model.lattice import hexagon
+from hexdem.model.model_builder import build_lattice, build_model
 from hexdem.model.run_settings import run_settings
+from readable import saved_figure, smallest_text_px
 
 TIMES_S = (1e-4, 2e-4, 3e-4)
 #: A half-hexagon small enough for seconds, large enough to split between two ranks.
@@ -71,6 +74,22 @@ def test_the_command_writes_the_figure_and_its_table(tmp_path):
     assert (out / "fig3_smallsim.png").stat().st_size > 0
     summary = json.loads((out / "snapshots.json").read_text())
     assert summary["ranks"] == 1 and summary["n_beads"] == 61
+
+
+@pytest.mark.parametrize("config", [RunConfig(edge_beads=11),
+                                    RunConfig(shape="half-hexagon", long_edge=41, short_edge=21)])
+def test_the_panels_share_one_colour_bar_readable_in_the_report(monkeypatch, config):
+    """Six panels, one colour scale from 0 to the median of their largest speeds with one bar
+    (Fig. 4 had six bars of 6-point labels), every text at least 10 px where the report shows it."""
+    lattice = build_lattice(config)
+    speeds = np.random.default_rng(1).uniform(0.0, 0.05, (6, len(lattice))) * np.arange(1, 7)[:, None]
+    snapshots = Snapshots(config, lattice, np.arange(1, 7) * 2e-4, speeds, {})
+    fig = saved_figure(monkeypatch, lambda: snapshot_figure(snapshots, build_model(config).walls, "unused.png",
+                                                            hexagon(11, config.diameter_m)))
+    panels = [ax for ax in fig.axes if ax.get_title().startswith("t = ")]
+    assert len(panels) == 6 and len(fig.axes) == 7, "six panels and one colour bar"
+    assert all(ax.collections[0].get_clim() == (0.0, np.median(speeds.max(axis=1))) for ax in panels)
+    assert smallest_text_px(fig) >= 10
 
 
 def test_bad_times_on_the_command_line_are_one_clear_line(tmp_path, capsys):

@@ -70,10 +70,14 @@ def subplots(nrows: int = 1, ncols: int = 1, figsize=None, layout=None, **kwargs
     return fig, fig.subplots(nrows, ncols, **kwargs)
 
 
+#: Pixels per inch of the saved figures.
+DPI = 150
+
+
 def save(fig, path) -> None:
     """``fig`` as PNG at ``path``, written atomically."""
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=150, pil_kwargs={"compress_level": PNG_COMPRESSION})
+        fig.savefig(tmp, format="png", dpi=DPI, pil_kwargs={"compress_level": PNG_COMPRESSION})
 
 
 #: How beads without a value are drawn, outside every colour scale (a colour scale never hatches),
@@ -96,9 +100,10 @@ def _circles(ax, positions, diameters, **style) -> EllipseCollection:
 
 
 def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=None, norm=None, unmeasured=None,
-             outlined=None):
+             outlined=None, colorbar=True):
     """Beads as true-size circles (one collection, sized in data units) coloured by ``values``
-    through ``norm`` (None: linear); returns the mappable. ``unmeasured``: {name in
+    through ``norm`` (None: linear), with a colour bar labelled ``label`` unless ``colorbar`` is
+    False (panels that share a scale share one bar); returns the mappable. ``unmeasured``: {name in
     :data:`UNMEASURED_STYLES`: mask of the beads it describes}, drawn in that style outside the
     colour scale and named in a legend; any other NaN is drawn as "no value". ``outlined``:
     {name: mask} of beads to ring in a colour of :data:`OUTLINE_COLOURS` (a region of another
@@ -128,9 +133,10 @@ def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=No
     ax.update_datalim(np.vstack([positions.min(axis=0) - radius, positions.max(axis=0) + radius]))
     ax.set_aspect("equal")
     ax.autoscale_view()
-    bar = ax.figure.colorbar(circles, ax=ax, label=label, shrink=0.8)
-    if isinstance(norm, LogNorm):
-        plain_log_ticks(bar.ax.yaxis)
+    if colorbar:
+        bar = ax.figure.colorbar(circles, ax=ax, label=label, shrink=0.8)
+        if isinstance(norm, LogNorm):
+            plain_log_ticks(bar.ax.yaxis)
     return circles
 
 
@@ -266,7 +272,7 @@ def front_shape_figure(curves: dict, path, title="Roundness of the wavefront", f
         if fit is not None:
             radius = np.geomspace(fit.radius_min_d, fit.radius_max_d, 100)
             ax.plot(radius, fit(radius), color=line.get_color(),
-                    label=f"A∞ + B R^-p: A∞ = {fit.a_inf:.4f} ± {fit.a_inf_se:.4f}, p = {fit.p:.2f}")
+                    label=f"A∞ + B (R/d)⁻ᵖ: A∞ = {fit.a_inf:.4f} ± {fit.a_inf_se:.4f}, p = {fit.p:.2f}")
             ax.axhline(fit.a_inf, color=line.get_color(), linestyle=":", linewidth=1)
     if fits:
         ax.set_xscale("log")

@@ -88,7 +88,7 @@ def all_directions(stats_rows, ideal_rows, laws: dict, path, lines=FIG9_LINES) -
             ax.set_ylim(bottom=0)
             ax.xaxis.set_major_locator(MaxNLocator(integer=True))
             ax.grid(True, alpha=0.3)
-            ax.set_title(f"0° strike, {line}° line, $V_{{striker}}$ = {v:g} m/s", fontsize=10)
+            ax.set_title(f"0° strike, {line}° line, $V_{{\\rm striker}}$ = {v:g} m/s", fontsize=10)
             ax.set_ylabel("peak speed [m/s]")
             if row == len(velocities) - 1:
                 ax.set_xlabel("bead n along the line")
@@ -101,7 +101,7 @@ def all_directions(stats_rows, ideal_rows, laws: dict, path, lines=FIG9_LINES) -
 def expnumsim(lattice, walls, ideal_relative, mean_relative, reference: int, v_striker: float,
               realizations: int, path) -> None:
     """Fig. 8 (a), (c): arrival time relative to the reference bead (white x), ideal lattice
-    beside the mean over the disordered realizations, one colour scale [ms]."""
+    beside the mean over the disordered realizations, one colour scale and its one bar [ms]."""
 
     finite = np.concatenate([ideal_relative[np.isfinite(ideal_relative)], mean_relative[np.isfinite(mean_relative)]])
     clim = (float(finite.min()) * 1e3, float(finite.max()) * 1e3)
@@ -110,13 +110,13 @@ def expnumsim(lattice, walls, ideal_relative, mean_relative, reference: int, v_s
     panels = (("(a) ideal lattice", ideal_relative),
               (f"(c) weak disorder, mean of {realizations} realizations", mean_relative))
     for ax, (title, values) in zip(axes, panels):
-        plots.bead_map(ax, positions, diameters, values * 1e3, cmap="viridis_r",
-                       label="relative arrival time [ms]", clim=clim)
+        circles = plots.bead_map(ax, positions, diameters, values * 1e3, cmap="viridis_r", clim=clim, colorbar=False)
         plots.draw_walls(ax, walls, positions, diameters / 2)
         ax.plot(*positions[reference], marker="x", color="w", markersize=8, mew=2)
         ax.set_title(title)
         ax.set_xlabel("x [m]")
         ax.set_ylabel("y [m]")
-    fig.suptitle(f"Wavefront arrival relative to the marked bead, $V_{{striker}}$ = {v_striker:g} m/s (Fig. 8; "
+    fig.colorbar(circles, ax=list(axes), label="relative arrival time [ms]", shrink=0.8)
+    fig.suptitle(f"Wavefront arrival relative to the marked bead, $V_{{\\rm striker}}$ = {v_striker:g} m/s (Fig. 8; "
                  "its panel (b), the experiments' mean, is measured, not simulated)")
     plots.save(fig, path)

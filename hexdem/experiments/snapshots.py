@@ -93,30 +93,38 @@ def snapshot_rows(snapshots: Snapshots) -> list[tuple]:
 
 
 def snapshot_figure(snapshots: Snapshots, walls, path, outline: Lattice | None = None) -> None:
-    """Bead-speed maps, one panel per time (own colour scale), walls drawn; ``outline``: a
-    smaller packing whose walls are drawn dashed (Fig. 4)."""
+    """Bead-speed maps, one panel per time, at most three to a row, walls drawn; ``outline``: a
+    smaller packing whose walls are drawn dashed (Fig. 4). The panels share one colour scale
+    and its one bar, from 0 to the median of the panels' largest speeds: the pulse's slow decay
+    shows, and the few faster beads of the first panels, by the striker, take the top colour
+    (the bar's arrow). Sized so that its smallest text is at least 10 px in the report."""
 
     lattice, config = snapshots.lattice, snapshots.config
     count = len(snapshots.times_s)
     aspect = np.ptp(lattice.positions_m[:, 1]) / max(np.ptp(lattice.positions_m[:, 0]), lattice.diameter_m)
-    tall = aspect > 1.5
-    columns = count if tall else min(3, count)
+    columns = min(3, count)
     rows = math.ceil(count / columns)
-    width = 3.2 if tall else 5.2
-    fig, axes = plots.subplots(rows, columns, figsize=(width * columns, 0.8 * width * aspect * rows + 0.8),
+    width = 3.2 if aspect > 1.5 else 4.0
+    fig, axes = plots.subplots(rows, columns, figsize=(width * columns + 1.0, 0.85 * width * aspect * rows + 0.9),
                                squeeze=False, layout="constrained")
+    top = float(np.median(np.max(snapshots.speeds, axis=1)))
     for ax, t, speeds in zip(axes.flat, snapshots.times_s, snapshots.speeds):
-        plots.bead_map(ax, lattice.positions_m, lattice.diameters_m, speeds, cmap="hot_r", label="speed [m/s]")
+        circles = plots.bead_map(ax, lattice.positions_m, lattice.diameters_m, speeds, cmap="hot_r", clim=(0.0, top),
+                                 colorbar=False)
         plots.draw_walls(ax, walls, lattice.positions_m, lattice.radii_m, linewidth=1)
         if outline is not None:
             plots.draw_walls(ax, outline.walls, outline.positions_m, outline.radii_m, linestyle="--", linewidth=1.2)
-        ax.set_title(f"t = {t * 1e3:.3g} ms")
+        ax.set_title(f"t = {t * 1e3:.3g} ms", fontsize=12)
         ax.set_xticks([])
         ax.set_yticks([])
     for ax in list(axes.flat)[count:]:
         ax.set_visible(False)
+    bar = fig.colorbar(circles, ax=axes.ravel().tolist(), shrink=0.6, extend="max" if snapshots.speeds.max() > top
+                       else "neither")
+    bar.set_label("bead speed [m/s]", fontsize=12)
+    bar.ax.tick_params(labelsize=11)
     fig.suptitle(f"Wavefront, {lattice.shape}, striker at {config.v0:g} m/s"
-                 + (f"; dashed: walls of the {outline.shape}" if outline is not None else ""))
+                 + (f";\ndashed: walls of the {outline.shape}" if outline is not None else ""), fontsize=12)
     plots.save(fig, path)
 
 

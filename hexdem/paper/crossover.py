@@ -25,6 +25,7 @@ that ignores V, set by something the impact does not change, e.g. the static ove
 
 from __future__ import annotations
 
+import itertools
 import warnings
 
 import numpy as np
@@ -166,51 +167,92 @@ def crossover_verdict(fits: list[dict], tests: list[dict]) -> str:
         where = ", ".join(f"σ_c = {f['sigma_c_tol']:.3g} ± {f['sigma_c_se_tol']:.2g} tol "
                           f"({f['sigma_c_over_overlap']:.3g} δ) at {f['v_striker']:.2f} m/s" for f in found)
         if test["consistent_with_overlap"] is None:
-            sentences.append(f"{name}: {where}; too few speeds to test V^(4/5).")
+            sentences.append(f"{name}: {where}; too few speeds to test σ_c ∝ V to the power 4/5.")
             continue
         reading = ("consistent with the overlap's 4/5" if test["consistent_with_overlap"] else
                    "not the overlap's 4/5") + (", and with no dependence on V" if test["consistent_with_constant"]
                                               else "")
-        sentences.append(f"{name}: {where}; σ_c ∝ V^({test['slope']:.2f} ± {test['slope_se']:.2f}), {reading}.")
+        sentences.append(f"{name}: {where}; σ_c ∝ V to the power {test['slope']:.2f} ± {test['slope_se']:.2f}, "
+                         f"{reading}.")
     return " ".join(sentences)
 
 
-def crossover_figure(rows: list[tuple], fits: list[dict], path) -> None:
-    """Transmission against σ/tol (top) and σ/δ(V) (bottom), per line and measure (columns), one
-    colour per striker speed: points ± 2 SEM, the fitted steps and their σ_c (dotted)."""
+#: Headers of the crossover's two tables, in the report (section 3b) and on the crossover page.
+FIT_TABLE_HEADER = ("V [m/s]", "line", "measure", "σ_c / tol", "σ_c / δ(V)", "T₀ (small σ)", "T∞ (large σ)")
+OVERLAP_TABLE_HEADER = ("line", "measure", "slope", "consistent with 4/5", "consistent with 0")
+
+
+def _missing(value) -> bool:
+    """NaN, or null once written to JSON."""
+    return value is None or not np.isfinite(value)
+
+
+def _shown(value, pattern: str) -> str:
+    """``value`` formatted, or "–" where it is missing."""
+    return "–" if _missing(value) else format(value, pattern)
+
+
+def fit_table(fits: list[dict]) -> list[tuple[str, ...]]:
+    """The rows of :data:`FIT_TABLE_HEADER`: each (V, line, measure)'s σ_c ± its standard error,
+    in tol and in δ(V) ("–": no crossover measured), and the step's plateaus."""
+    return [(f"{f['v_striker']:.2f}", f["line"], f["measure"],
+             f"{_shown(f['sigma_c_tol'], '.3g')} ± {_shown(f['sigma_c_se_tol'], '.2g')}"
+             if f["significant"] else "–",
+             f"{_shown(f['sigma_c_over_overlap'], '.3g')} ± {_shown(f['sigma_c_over_overlap_se'], '.2g')}"
+             if f["significant"] else "–", _shown(f["t0"], ".3f"), _shown(f["t_inf"], ".3f")) for f in fits]
+
+
+def overlap_table(tests: list[dict]) -> list[tuple[str, ...]]:
+    """The rows of :data:`OVERLAP_TABLE_HEADER`: the slope of log σ_c against log V per line and measure."""
+    verdicts = {True: "yes", False: "no", None: "–"}
+    return [(t["line"], t["measure"],
+             "–" if _missing(t["slope_se"]) else f"{t['slope']:.2f} ± {t['slope_se']:.2f}",
+             verdicts[t["consistent_with_overlap"]], verdicts[t["consistent_with_constant"]]) for t in tests]
+
+
+#: The crossover's two figures in ``disorder/``: the transmission against σ/tol, and against
+#: σ/δ(V), where the overlap hypothesis collapses the speeds' curves.
+CROSSOVER_FIGURES = {"tol": "disorder_crossover.png", "overlap": "disorder_crossover_overlap.png"}
+
+
+def crossover_figure(rows: list[tuple], fits: list[dict], path, against: str = "tol") -> None:
+    """Transmission against σ/tol (``against`` "tol") or σ/δ(V) ("overlap"): lines 0° and ±30°
+    (columns), peak over the run and leading pulse (rows), one colour per striker speed: points
+    ± 2 SEM, the fitted steps and their σ_c (dotted). Sized to be read in the report's column,
+    about 1100 px wide: its smallest text is 10 px there."""
 
     from hexdem.analysis import figures as plots
 
-    panels = [(line, measure) for measure in MEASURES for line in LINES]
-    fig, axes = plots.subplots(2, len(panels), figsize=(16, 7), sharey=True, layout="constrained")
+    fig, axes = plots.subplots(len(MEASURES), len(LINES), figsize=(10, 7.6), sharex=True, sharey=True,
+                               layout="constrained")
     speeds = sorted({r[0] for r in rows})
-    for j, (line, measure) in enumerate(panels):
+    for (i, measure), (j, line) in itertools.product(enumerate(MEASURES), enumerate(LINES)):
+        ax = axes[i, j]
         for colour, v in zip(("C0", "C1", "C3", "C2"), speeds):
             chosen = [r for r in rows if (r[0], r[1], r[2]) == (v, line, measure)]
             fit = next(f for f in fits if (f["v_striker"], f["line"], f["measure"]) == (v, line, measure))
-            overlap_tol = impact_overlap_m(v) / TOLERANCE_M
+            scale = impact_overlap_m(v) / TOLERANCE_M if against == "overlap" else 1.0
             sigma, t, sem = (np.array([r[k] for r in chosen], float) for k in (3, 5, 6))
+            ax.errorbar(sigma / scale, t, yerr=2 * np.nan_to_num(sem), fmt="o", color=colour, capsize=2,
+                        markersize=5, label=f"{v:.2f} m/s")
             grid = np.geomspace(sigma.min(), sigma.max(), 200)
-            for row, scale in enumerate((1.0, overlap_tol)):
-                ax = axes[row, j]
-                ax.errorbar(sigma / scale, t, yerr=2 * np.nan_to_num(sem), fmt="o", color=colour, capsize=2,
-                            markersize=4, label=f"{v:.2f} m/s")
-                if np.isfinite(fit["t0"]):
-                    ax.plot(grid / scale, _step(np.log10(grid), fit["t0"], fit["t_inf"], fit["log10_sigma_c"]
-                                                if fit["significant"] else np.nan, fit["p"]), color=colour, lw=1)
-                if fit["significant"]:
-                    ax.axvline(fit["sigma_c_tol"] / scale, color=colour, ls=":", lw=1)
-        for row, label in enumerate((r"$\sigma$ / tol", r"$\sigma / \delta(V)$")):
-            ax = axes[row, j]
-            ax.set_xscale("log")
-            ax.axhline(1.0, color="k", lw=0.8)
-            ax.grid(True, which="both", alpha=0.3)
-            ax.set_xlabel(label)
-            ax.set_title(f"{line}°, {'peak over the run' if measure == 'peak' else 'leading pulse'}", fontsize=10)
-        axes[0, 0].set_ylabel("disordered / ideal")
-        axes[1, 0].set_ylabel("disordered / ideal")
-    axes[0, 0].legend(fontsize=8, title="striker")
-    fig.suptitle("Weak disorder across the contact scale: transmission against σ and σ / δ(V) (mean ± 2 SEM)")
+            if fit["significant"]:
+                ax.plot(grid / scale, _step(np.log10(grid), fit["t0"], fit["t_inf"], fit["log10_sigma_c"], fit["p"]),
+                        color=colour, lw=1.2)
+                ax.axvline(fit["sigma_c_tol"] / scale, color=colour, ls=":", lw=1.2)
+        ax.set_xscale("log")
+        ax.axhline(1.0, color="k", lw=0.8)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.set_title(f"{line}°, {'peak over the run' if measure == 'peak' else 'leading pulse'}", fontsize=12)
+        if i == len(MEASURES) - 1:
+            ax.set_xlabel(r"$\sigma / \delta(V)$" if against == "overlap" else r"$\sigma$ / tol", fontsize=12)
+        if j == 0:
+            ax.set_ylabel("disordered / ideal", fontsize=12)
+        ax.tick_params(labelsize=11)
+    axes[0, 0].legend(fontsize=10, title="striker", title_fontsize=10)
+    fig.suptitle("Transmission against " + (r"$\sigma / \delta(V)$, $\delta(V)$ the impact's overlap"
+                                            if against == "overlap" else r"$\sigma$")
+                 + " (mean ± 2 SEM; lines: fitted steps, dotted: $\\sigma_c$)", fontsize=12)
     plots.save(fig, path)
 
 

@@ -10,7 +10,8 @@ The parts, each writing into its own folder of ``DIR``:
 ``disorder/<name>/``   the ensembles of the disorder study and of the crossover sweep;
                        ``sigma6tol`` holds Figs. 8 and 9
 ``disorder/``          the study's tables, figure and verdict; the crossover sweep's
-                       ``disorder_crossover.csv``, ``.json`` and ``.png``
+                       ``disorder_crossover.csv``, ``.json``, ``.png`` and
+                       ``disorder_crossover_overlap.png``
 ``friction/<name>/``   the σ = 6 tol ensemble struck with friction μ, on the paper's packings
 ``friction/``          the friction study (:mod:`hexdem.paper.friction_study`):
                        ``friction_effect.csv``, ``friction_decay.csv``, ``friction_effect.png``,
@@ -113,6 +114,7 @@ def _crossover(summaries: list[dict], out: Path) -> dict:
     from hexdem.common.io import write_csv
     from hexdem.paper.crossover import (
         CROSSOVER_COLUMNS,
+        CROSSOVER_FIGURES,
         crossover_figure,
         crossover_fits,
         crossover_rows,
@@ -126,7 +128,8 @@ def _crossover(summaries: list[dict], out: Path) -> dict:
     tests = overlap_test(fits)
     folder = out / "disorder"
     write_csv(folder / "disorder_crossover.csv", CROSSOVER_COLUMNS, rows)
-    crossover_figure(rows, fits, folder / "disorder_crossover.png")
+    for against, name in CROSSOVER_FIGURES.items():
+        crossover_figure(rows, fits, folder / name, against)
     result = {"fits": fits, "overlap_test": tests, "verdict": crossover_verdict(fits, tests),
               "pm30_claim": pm30_claim(rows),
               "sigma_per_tol": sorted({r[3] for r in rows}), "velocities_m_s": sorted({r[0] for r in rows})}

@@ -16,10 +16,19 @@ from pathlib import Path
 from hexdem.analysis.leading_pulse import LEAD_FALL, LEAD_THRESHOLD
 from hexdem.common.html_page import render_html
 from hexdem.common.io import write_csv, write_text
+from hexdem.disorder.preparation import TOLERANCE_M
 from hexdem.paper.comparison import (
     COMPARISON_COLUMNS,
     comparison_rows,
     largest_differences,
+)
+from hexdem.paper.crossover import (
+    CROSSOVER_FIGURES,
+    FIT_TABLE_HEADER,
+    OVERLAP_TABLE_HEADER,
+    fit_table,
+    impact_overlap_m,
+    overlap_table,
 )
 from hexdem.paper.settings import STUDY_VELOCITY_M_S
 from hexdem.theory.protocols import CONSISTENT_SIGMAS, MIN_V0, STARTS
@@ -140,29 +149,24 @@ def _disorder_blocks(study: dict) -> list:
 
 def _crossover_blocks(crossover: dict) -> list:
     """Section 3b: the crossover sweep's fits, the V^(4/5) test and the ±30° claim in its terms."""
-    fits = [(f"{f['v_striker']:.2f}", f["line"], f["measure"],
-             "–" if not f["significant"] else f"{f['sigma_c_tol']:.3g} ± {f['sigma_c_se_tol']:.2g}",
-             "–" if not f["significant"] else f"{f['sigma_c_over_overlap']:.3g} ± {f['sigma_c_over_overlap_se']:.2g}",
-             _ratio(f["t0"]), _ratio(f["t_inf"])) for f in crossover["fits"]]
-    tests = [(t["line"], t["measure"], "–" if t["slope_se"] is None else f"{t['slope']:.2f} ± {t['slope_se']:.2f}",
-              {True: "yes", False: "no", None: "–"}[t["consistent_with_overlap"]],
-              {True: "yes", False: "no", None: "–"}[t["consistent_with_constant"]]) for t in crossover["overlap_test"]]
     sigmas = ", ".join(f"{s:g}" for s in crossover["sigma_per_tol"])
     return [("h2", "3b. Weak disorder across the contact scale: where the ideal lattice stops"),
             ("p", f"σ / tol = {sigmas}, each ensemble prepared as the paper's and struck at "
                   + ", ".join(f"{v:.2f}" for v in crossover["velocities_m_s"])
-                  + " m/s. δ(V), the largest overlap of two beads meeting at the striker speed, is 0.53, 0.77 and "
-                    "1.20 tol at 0.25, 0.40 and 0.70 m/s. Each (speed, line, measure) is fitted with a step in "
-                    "log σ, T = T_∞ + (T_0 − T_∞) / (1 + (σ/σ_c)^p), weighted by the standard errors; σ_c is the "
-                    "σ at half the drop, ± its standard error."),
+                  + " m/s. δ(V), the largest overlap of two beads meeting at the striker speed, is "
+                  + ", ".join(f"{impact_overlap_m(v) / TOLERANCE_M:.2f}" for v in crossover["velocities_m_s"])
+                  + " tol at these speeds. Each (speed, line, measure) is fitted with a step in "
+                    "log σ, T = T∞ + (T₀ − T∞) / (1 + (σ/σ_c)ᵖ), weighted by the standard errors; σ_c is "
+                    "the σ at half the drop, ± its standard error."),
             ("p", f"Verdict: {crossover['verdict']}"),
-            ("table", ("V [m/s]", "line", "measure", "σ_c / tol", "σ_c / δ(V)", "T_0 (small σ)", "T_∞ (large σ)"),
-             fits),
-            ("p", "The overlap hypothesis: σ_c ∝ V^(4/5) if the impact's overlap sets the crossover (slope of "
-                  "log σ_c against log V, ± its standard error; consistent = within two)."),
-            ("table", ("line", "measure", "slope", "consistent with 4/5", "consistent with 0"), tests),
+            ("table", FIT_TABLE_HEADER, fit_table(crossover["fits"])),
+            ("p", "The overlap hypothesis: σ_c ∝ V to the power 4/5 if the impact's overlap sets the crossover "
+                  "(slope of log σ_c against log V, ± its standard error; consistent = within two)."),
+            ("table", OVERLAP_TABLE_HEADER, overlap_table(crossover["overlap_test"])),
             ("p", f"The paper's ±30° claim in these terms: {crossover['pm30_claim']}"),
-            ("figure", "disorder/disorder_crossover.png", "Transmission against σ and against σ / δ(V)")]
+            ("figure", f"disorder/{CROSSOVER_FIGURES['tol']}", "Transmission against σ"),
+            ("figure", f"disorder/{CROSSOVER_FIGURES['overlap']}",
+             "Transmission against σ / δ(V): if the impact's overlap sets the crossover, the speeds collapse")]
 
 
 def _friction_blocks(friction: dict) -> list:
@@ -188,7 +192,7 @@ def _friction_blocks(friction: dict) -> list:
             ("p", f"Disorder: {friction['disorder_verdict']}"),
             ("table", ("μ", "σ / tol", "line", f"leading pulse / frictionless at {STUDY_VELOCITY_M_S:.2f} m/s",
                        "arrival shift [µs]"), effect),
-            ("p", "Sec. V's decay rate c (V_n = V_s c^(n − s), the anchored log-linear fit) of the ideal lattice's "
+            ("p", "Sec. V's decay rate c (Vₙ = Vₛ cⁿ⁻ˢ, the anchored log-linear fit) of the ideal lattice's "
                   "leading pulses, for the 0° strike along 0° (s = 2) and +30° (s = 1), to the last bead no wall "
                   f"touches, at {STUDY_VELOCITY_M_S:.2f} m/s (friction/friction_decay.csv has every speed: "
                   "Hertz–Mindlin–Coulomb contacts are scale invariant, and the rates agree to 1e-4)."),

@@ -82,8 +82,8 @@ def figures(measured: dict[str, dict[str, Ray]], out: Path) -> None:
     from hexdem.analysis.pulse_shape import PROFILE_GRID
 
     fig, axes = plots.subplots(2, 2, figsize=(11, 8.5), layout="constrained")
-    panels = (("peak_speed", "leading-pulse amplitude v_m [m/s]"), ("width_s", "width at half maximum w [s]"),
-              ("front_speed_m_s", "local front speed c [m/s]"), ("profile_residual", "profile's RMS distance from the outer shape"))
+    panels = (("peak_speed", r"leading-pulse amplitude $v_m$ [m/s]"), ("width_s", "width at half maximum $w$ [s]"),
+              ("front_speed_m_s", "local front speed $c$ [m/s]"), ("profile_residual", "profile's RMS distance from the outer shape"))
     styles = {"uncompressed": "-", "precompressed": "--"}
     for ax, (name, label) in zip(axes.flat, panels):
         for study, rays in measured.items():
@@ -93,7 +93,7 @@ def figures(measured: dict[str, dict[str, Ray]], out: Path) -> None:
         ax.set_yscale("log")
         plots.plain_log_ticks(ax.xaxis)
         plots.plain_log_ticks(ax.yaxis)
-        ax.set_xlabel("distance r [d]")
+        ax.set_xlabel("distance $r$ [d]")
         ax.set_ylabel(label)
         ax.grid(True, which="both", alpha=0.3)
     axes[1, 1].axhline(COLLAPSE_TOLERANCE, color="k", lw=0.8)
@@ -106,8 +106,8 @@ def figures(measured: dict[str, dict[str, Ray]], out: Path) -> None:
         colours = colormaps["viridis"](np.linspace(0, 1, len(ray.distance_d)))
         for profile, colour in zip(ray.profiles, colours):
             ax.plot(PROFILE_GRID, profile, color=colour, lw=0.8)
-        ax.set_xlabel("(t − t_a) / w")
-        ax.set_ylabel("v / v_m")
+        ax.set_xlabel("$(t - t_a)/w$")
+        ax.set_ylabel("$v/v_m$")
         ax.set_title(f"{study}, 0°: {ray.distance_d[0]:.0f} d (purple) to {ray.distance_d[-1]:.0f} d (yellow)", fontsize=9)
         ax.grid(True, alpha=0.3)
     plots.save(fig, out / "profiles.png")

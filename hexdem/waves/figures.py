@@ -41,7 +41,7 @@ def bands_figure(dispersion: Dispersion, path) -> None:
     resolved = dispersion.resolved
     for branch in range(2):
         ax.plot(position * a, _kilohertz(omega[:, branch]), color="c", linewidth=1.2,
-                label="theory: linearized Hertz, k = (3/2) A^(2/3) f₀^(1/3)" if branch == 0 else None)
+                label=r"theory: linearized Hertz, $k = \frac{3}{2} A^{2/3} f_0^{1/3}$" if branch == 0 else None)
         for kept, face, edge, label in ((resolved, "k", "w", "measured spectral peak"),
                                         (~resolved, "w", "k", "short of the resolution limit |q| a = "
                                                               f"{dispersion.smallest_resolved_per_m * a:.2f}")):
@@ -76,23 +76,23 @@ def conical_figure(conical: Conical, path) -> None:
     d = conical.diameter_m
     fig, (left, right) = subplots(1, 2, figsize=(11, 4.4), layout="constrained")
     times_ms = conical.dirac.times_s * 1e3
-    left.plot(times_ms, conical.dirac.ring_radius_m() / d, "o", markersize=4, label="measured R(t)")
-    left.plot(times_ms, conical.theory_radius_m / d, "-", label=f"cone, v_D = {conical.cone_slope_m_s:.1f} m/s")
-    left.plot(times_ms, conical.cone_slope_m_s * conical.dirac.times_s / d, ":", color="0.4", label="v_D t")
+    left.plot(times_ms, conical.dirac.ring_radius_m() / d, "o", markersize=4, label="measured $R(t)$")
+    left.plot(times_ms, conical.theory_radius_m / d, "-", label=f"cone, $v_D$ = {conical.cone_slope_m_s:.1f} m/s")
+    left.plot(times_ms, conical.cone_slope_m_s * conical.dirac.times_s / d, ":", color="0.4", label="$v_D t$")
     left.set_xlabel("time [ms]")
-    left.set_ylabel("ring radius R [d]")
+    left.set_ylabel("ring radius $R$ [d]")
     left.set_title(f"Packet at K (σ = {conical.settings.width_d:g} d): growth rate "
-                   f"{conical.fitted_slope_m_s / conical.cone_slope_m_s:.4f} v_D", fontsize=10)
+                   f"{conical.fitted_slope_m_s / conical.cone_slope_m_s:.4f} $v_D$", fontsize=10)
     left.legend(fontsize=8)
     control = conical.control
     speed = np.linalg.norm(conical.group_velocity_m_s)
-    right.plot(control.times_s * 1e3, conical.control_path_m() / d, "o", markersize=4, label="centroid, along v_g")
-    right.plot(control.times_s * 1e3, speed * control.times_s / d, "-", label=f"|v_g| t, |v_g| = {speed:.1f} m/s")
+    right.plot(control.times_s * 1e3, conical.control_path_m() / d, "o", markersize=4, label="centroid, along $v_g$")
+    right.plot(control.times_s * 1e3, speed * control.times_s / d, "-", label=f"$|v_g|\\,t$, $|v_g|$ = {speed:.1f} m/s")
     right.plot(control.times_s * 1e3, conical.control_width_m / d, "s", markersize=4, label="width (rms) [d]")
     right.set_xlabel("time [ms]")
     right.set_ylabel("distance [d]")
     right.set_title(f"Control at {conical.settings.control_fraction:g} K, lower band: drift "
-                    f"{100 * conical.drift_deviation:.2f} % from v_g", fontsize=10)
+                    f"{100 * conical.drift_deviation:.2f} % from $v_g$", fontsize=10)
     right.legend(fontsize=8)
     save(fig, path)
 
@@ -103,15 +103,20 @@ def _energy_share(run: PacketRun, frame: int) -> np.ndarray:
     return np.maximum(energies / energies.max(), 10.0 ** -ENERGY_DECADES)
 
 
-def _energy_axes(ax, run: PacketRun, frame: int, diameter_m: float):
-    """Beads coloured by their share of the frame's largest energy, log scale; the mappable."""
+#: Colour-bar label of the packets' energy maps.
+ENERGY_LABEL = "kinetic energy / largest"
+
+
+def _energy_axes(ax, run: PacketRun, frame: int, diameter_m: float, colorbar: bool = True):
+    """Beads coloured by their share of the frame's largest energy, log scale, with its colour bar
+    unless ``colorbar`` is False; the mappable."""
     from matplotlib.colors import LogNorm
 
     from hexdem.analysis.figures import bead_map
 
     positions = (run.recorded.positions_m - run.centre_m) / diameter_m
     circles = bead_map(ax, positions, np.ones(len(positions)), _energy_share(run, frame), cmap="inferno",
-                       label="kinetic energy / largest", norm=LogNorm(10.0 ** -ENERGY_DECADES, 1.0))
+                       label=ENERGY_LABEL, norm=LogNorm(10.0 ** -ENERGY_DECADES, 1.0), colorbar=colorbar)
     circles.set_edgecolor("none")
     ax.set_xlabel("x [d]")
     ax.set_ylabel("y [d]")
@@ -119,16 +124,19 @@ def _energy_axes(ax, run: PacketRun, frame: int, diameter_m: float):
 
 
 def snapshots_figure(conical: Conical, path) -> None:
-    """The K packet's energy at the start, midway and at the end, and the control's at the end."""
-    from hexdem.analysis.figures import save, subplots
+    """The K packet's energy at the start, midway and at the end, and the control's at the end:
+    four panels on one colour scale, with one bar."""
+    from hexdem.analysis.figures import plain_log_ticks, save, subplots
 
-    fig, axes = subplots(1, 4, figsize=(17, 4.4), layout="constrained")
+    fig, axes = subplots(2, 2, figsize=(9.5, 8.6), layout="constrained")
     last = len(conical.dirac.times_s) - 1
     shown = [(conical.dirac, 0), (conical.dirac, last // 2), (conical.dirac, last), (conical.control, last)]
-    for ax, (run, frame) in zip(axes, shown):
-        _energy_axes(ax, run, frame, conical.diameter_m)
+    for ax, (run, frame) in zip(axes.flat, shown):
+        circles = _energy_axes(ax, run, frame, conical.diameter_m, colorbar=False)
         name = "control" if run is conical.control else "packet at K"
-        ax.set_title(f"{name}, t = {run.times_s[frame] * 1e3:.2f} ms", fontsize=10)
+        ax.set_title(f"{name}, t = {run.times_s[frame] * 1e3:.2f} ms", fontsize=11)
+    bar = fig.colorbar(circles, ax=axes.ravel().tolist(), label=ENERGY_LABEL, shrink=0.6)
+    plain_log_ticks(bar.ax.yaxis)
     save(fig, path)
 
 
