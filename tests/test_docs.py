@@ -87,8 +87,10 @@ def test_the_readme_is_a_front_page_with_the_commands_ci_runs():
 
 
 def test_equations_are_cited_by_the_papers_numbers(built):
-    """'eq. (4)', as the paper numbers them, never the LaTeX source's labels ('eq. (v30)', '(TCA_decay)')."""
-    label = re.compile(r"[Ee]qs?\. \([A-Za-z_]\w*\)|\((?:v30|v0|veq0|hyperg|TCA_strain|TCA_decay|BCA_decay)\)")
+    """'eq. (4)', as the paper numbers them, never the LaTeX source's labels ('eq. (v30)', '(TCA_decay)',
+    'eq. TCA_decay')."""
+    names = "v30|v0|veq0|hyperg|TCA_strain|TCA_decay|BCA_decay"
+    label = re.compile(rf"[Ee]qs?\. \([A-Za-z_]\w*\)|\((?:{names})\)|[Ee]qs?\. (?:{names})\b")
     pages = [path for path in built.rglob("*.html") if "_static" not in path.parts]
     raw = [(path.name, hit) for path in pages for hit in label.findall(path.read_text())]
     assert not raw, raw[:5]
@@ -124,27 +126,27 @@ def test_the_pages_count_the_slow_tests():
 
 #: Modules and pages whose formulas are still plain text: their files were being rewritten when
 #: the rest became math (issue 35). Each leaves the set as its formulas are converted.
-PLAIN_TEXT_FORMULAS = {"hexdem.analysis.energy", "hexdem.analysis.tracker_kernel",
-                       "hexdem.engines.lammps.deck", "hexdem.engines.reference.engine",
-                       "hexdem.engines.reference.kernel", "hexdem.model.timescale",
-                       "hexdem.paper.crossover", "hexdem.paper.friction_study"}
+PLAIN_TEXT_FORMULAS = {"hexdem.analysis.energy", "hexdem.analysis.tracker_kernel", "hexdem.engines.lammps.deck"}
 
 
 def test_formulas_are_typeset_not_raw_latex(built):
-    """No ``^{``, ``^(`` or ``_{`` in a page's text outside code and math: a formula is math
-    (``$...$`` on a page, ``:math:`` in a docstring), which the page shows typeset (MathML).
-    An API page is read module by module."""
+    """No ``^{``, ``^(`` or ``_{``, nor a bare power such as ``r^a``, ``R^−p`` or ``m^1.5``, in a
+    page's text outside code and math: a formula is math (``$...$`` on a page, ``:math:`` in a
+    docstring), which the page shows typeset (MathML). Code is ``<pre>``, ``<code>`` and the
+    signatures' ``<span class="pre">`` (a value such as ``'o^v<>sD'``). An API page is read
+    module by module."""
     import html
 
     raw = {}
     for path in built.rglob("*.html"):
         if "_static" in path.parts:
             continue
-        page = re.sub(r"<(pre|code|math)\b.*?</\1>", "", path.read_text(), flags=re.DOTALL)
+        page = re.sub(r"<(pre|code|math)\b.*?</\1>|<span class=\"pre\">[^<]*</span>", "", path.read_text(),
+                      flags=re.DOTALL)
         for part in re.split(r'(?=<section id="module-)', page):
             module = re.match(r'<section id="module-([\w.]+)"', part)
             text = html.unescape(re.sub(r"<[^>]+>", "", part))
-            hits = re.findall(r".{0,30}(?:\^[{(]|_\{).{0,30}", text)
+            hits = re.findall(r".{0,30}(?:\^[{(]|_\{|\w\^[−-]?\w).{0,30}", text)
             if hits:
                 raw[module.group(1) if module else path.relative_to(built).as_posix()] = hits
     assert set(raw) <= PLAIN_TEXT_FORMULAS, {name: raw[name] for name in set(raw) - PLAIN_TEXT_FORMULAS}

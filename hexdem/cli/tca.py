@@ -39,4 +39,4 @@ def run(args) -> None:
         print(json.dumps(result, indent=2))
     else:
         print(f"omega = {result['omega']:.12g}   (compatibility condition, Sec. IV)")
-        print(f"c     = {result['c']:.12g}   (eq. TCA_decay: velocity at equal speeds / BCA's V0/2)")
+        print(f"c     = {result['c']:.12g}   (eq. (8): velocity at equal speeds / BCA's V0/2)")

@@ -1,17 +1,17 @@
-"""The natural time scale of an impact: the shortest Hertz contact time among the pairs it sets
+r"""The natural time scale of an impact: the shortest Hertz contact time among the pairs it sets
 moving, from which the time step and the sampling follow (see
 :func:`~hexdem.model.run_settings.contact_time_s`).
 
-Two spheres meeting at relative speed V touch for t_c = 2.9432 (μ²/(A² V))^{1/5}
-(:func:`~hexdem.model.hertz.contact_time`, μ the reduced mass, A = k_n sqrt(R_eff)). With one
+Two spheres meeting at relative speed V touch for :math:`t_c = 2.9432\, (μ^2/(A^2 V))^{1/5}`
+(:func:`~hexdem.model.hertz.contact_time`, μ the reduced mass, :math:`A = k_n \sqrt{R_\text{eff}}`). With one
 material the pair is two equal beads; unlike beads and strikers of their own material or size
 add their pairs, and a precompressed packing its linearized contact's half period.
 
-The contact is shortest at the fastest approach, as V^(-1/5). An impact sets one body moving
+The contact is shortest at the fastest approach, as :math:`V^{−1/5}`. An impact sets one body moving
 at V0 against bodies at rest; an initial state may set any bodies moving, and the fastest
-approach it can make is the largest relative speed |v_i − v_j| of two of its bodies, or of one
+approach it can make is the largest relative speed :math:`\left|v_i − v_j\right|` of two of its bodies, or of one
 against the walls at rest (:func:`fastest_approach_m_s`): a bead given 100 V0 needs a
-step 100^(1/5) = 2.5 times shorter. A speed at which two bodies meeting head on would press
+step :math:`100^{1/5} = 2.5` times shorter. A speed at which two bodies meeting head on would press
 into each other by half the smaller diameter or more is refused: Hertz's law, and the
 packing, no longer hold (the bodies pass through one another).
 """
@@ -109,13 +109,14 @@ def own_contact_times_s(model) -> dict[int, float]:
 
 
 def crossing_time_s(model, linear_contact_s: float | None = None) -> float:
-    """The time [s] the default duration gives the leading pulse to cross the packing: one layer
+    r"""The time [s] the default duration gives the leading pulse to cross the packing: one layer
     (√3/2 d, the triangular lattice's row spacing) at a time, from each struck bead along its
     impact to the packing's far side, each layer taking the two-bead Hertz contact time of the
     quickest material it holds (:func:`own_contact_times_s`): the front runs through the quickest
     material a layer offers, and through a softer one where a whole layer is of it (brass behind a
-    steel|brass interface: ((ρ_brass E*_steel) / (ρ_steel E*_brass))^(2/5) = 1.26 times longer per
-    layer, as t_c ∝ (m / A)^(2/5) at a given speed). A
+    steel|brass interface:
+    :math:`((ρ_\text{brass} E^*_\text{steel}) / (ρ_\text{steel} E^*_\text{brass}))^{2/5} = 1.26` times longer
+    per layer, as :math:`t_c ∝ (m/A)^{2/5}` at a given speed). A
     precompressed packing's ``linear_contact_s`` (its linearized contact's half period) replaces
     the Hertz time, scaled alike. For a packing of one material this is the layer count times
     the two-bead contact time. The largest over the impacts."""

@@ -1,4 +1,4 @@
-"""Weak disorder across the contact scale: where the ideal lattice stops and the disordered one begins.
+r"""Weak disorder across the contact scale: where the ideal lattice stops and the disordered one begins.
 
 The disorder study's σ ∈ {1, …, 6} tol (12.7–76 µm) all lie far above the overlaps in the
 packing, so they cannot say where disorder starts to matter. This sweep adds σ from 1e-3 tol up
@@ -6,19 +6,21 @@ packing, so they cannot say where disorder starts to matter. This sweep adds σ 
 and struck at 0.25, 0.40 and 0.70 m/s, and reads the transmission (disordered / ideal, as the
 study defines it: peak over the run and leading pulse, lines 0° and ±30°) against σ and against
 σ / δ(V), δ(V) the largest overlap of two beads meeting at the striker speed V,
-δ = (5 μ V² / 4A)^{2/5} ∝ V^{4/5} (Hertz; μ = m/2, A the pair's Hertz coefficient).
+:math:`δ = (5 μ V^2 / 4A)^{2/5} ∝ V^{4/5}` (Hertz; μ = m/2, A the pair's Hertz coefficient).
 
 **The crossover** of each (V, line, measure) is fitted (:func:`fit_crossover`) as a step in log σ,
 
-    T(σ) = T_∞ + (T_0 − T_∞) / (1 + (σ/σ_c)^p),
+.. math::
 
-weighted by the realizations' standard errors: σ_c is the σ at half the drop from the small-σ
-plateau T_0 to the large-σ one T_∞, with its standard error from the fit's covariance. A drop
-within two standard errors of zero, or a σ_c outside the sweep or uncertain by more than half a
-decade, is no measured crossover.
+    T(σ) = T_∞ + \frac{T_0 − T_∞}{1 + (σ/σ_c)^p},
+
+weighted by the realizations' standard errors: :math:`σ_c` is the σ at half the drop from the
+small-σ plateau :math:`T_0` to the large-σ one :math:`T_∞`, with its standard error from the
+fit's covariance. A drop within two standard errors of zero, or a σ_c outside the sweep or
+uncertain by more than half a decade, is no measured crossover.
 
 **The overlap hypothesis** (:func:`overlap_test`): if the impact's overlap sets the crossover,
-σ_c ∝ V^{4/5} and the curves against σ/δ(V) collapse. For each line and measure the slope of
+:math:`σ_c ∝ V^{4/5}` and the curves against σ/δ(V) collapse. For each line and measure the slope of
 log σ_c against log V is fitted with its error and compared with 4/5 and with 0 (a crossover
 that ignores V, set by something the impact does not change, e.g. the static overlaps).
 """

@@ -1,4 +1,4 @@
-"""What Mindlin friction and rotation do to the paper's results: the study of ``hexdem paper``.
+r"""What Mindlin friction and rotation do to the paper's results: the study of ``hexdem paper``.
 
 **Set-up.** The disorder study's (:mod:`hexdem.paper.disorder_study`): the experiment's
 11-per-edge hexagon struck by the steel striker at 0.25, 0.40 and 0.70 m/s, as the ideal
@@ -16,7 +16,7 @@ packing, then over packings; ``sem_peak_ratio`` its standard error over packings
 the ideal lattice: one run, exact, LAMMPS being deterministic on one rank);
 ``mean_arrival_shift_us`` is t_n(μ) − t_n(0) averaged the same way [µs] (negative: earlier).
 
-**Decay rates** (``friction_decay.csv``): Sec. V's c of V_n = V_s c^{n − s}
+**Decay rates** (``friction_decay.csv``): Sec. V's c of :math:`V_n = V_s c^{n − s}`
 (:func:`~hexdem.theory.scaling.fit_decay`, the anchored log-linear fit) on the ideal lattice's
 leading pulses, for the 0° strike observed along 0° (``0/0``, s = 2) and along +30° (``0/30``,
 s = 1), up to the last bead of the line that no wall touches.

@@ -2,7 +2,7 @@
 
 The front study (:mod:`hexdem.experiments.front_study`) finds the uncompressed front's a6/a0
 falling to about −0.002 by 80 d and growing again beyond 100 d, to −0.0029 at 159 d, a rise its
-fitted law A∞ + B R^−p does not follow. An artefact of the discretization, of the sampling or
+fitted law :math:`A_∞ + B R^{−p}` does not follow. An artefact of the discretization, of the sampling or
 of the half-maximum measure would change when that is refined or replaced. The same half-disc
 is therefore measured four ways (:data:`VARIANTS`):
 
@@ -13,7 +13,7 @@ is therefore measured four ways (:data:`VARIANTS`):
 * ``fixed_speed``: the baseline run, its front the first crossing of a fixed small speed,
   :data:`THRESHOLD_FRACTION` of V0 (the pulse's very foot rather than its half maximum).
 
-For each: a6/a0 against the front's mean radius R, the fit A∞ + B R^−p over the front study's
+For each: a6/a0 against the front's mean radius R, the fit :math:`A_∞ + B R^{−p}` over the front study's
 range, and the **late rise**: the mean a6/a0 of the fronts beyond :data:`OUTER` of the largest
 radius measured (within that range) minus the mean over :data:`PLATEAU` of it (negative: the
 anisotropy grows again).

@@ -12,18 +12,18 @@ the rays at 0°, 15° and 30° from the struck bead, one every diameter from 5 d
 
 **Per ray** (:func:`measure_ray`, :mod:`hexdem.analysis.pulse_shape`): each bead's leading
 pulse, its amplitude v_m, width w (full width at half maximum) and arrival t_a; the local front
-speed c = dr/dt_a (centred differences over :data:`SPEED_STEP` beads on each side); power laws
-v_m ∝ r^a, w ∝ r^b, c ∝ r^s fitted over ``fit_range_d`` with their standard errors; and each
-profile v/v_m against (t − t_a)/w, with its RMS distance from the mean profile of the beads in
-the outer third of the fit range.
+speed :math:`c = dr/dt_a` (centred differences over :data:`SPEED_STEP` beads on each side); power
+laws :math:`v_m ∝ r^a`, :math:`w ∝ r^b`, :math:`c ∝ r^s` fitted over ``fit_range_d`` with their
+standard errors; and each profile :math:`v/v_m` against :math:`(t − t_a)/w`, with its RMS distance
+from the mean profile of the beads in the outer third of the fit range.
 
 **Verdict.** The pulse is called self-similar along a ray when the profiles of the middle third
 of the fit range lie within :data:`COLLAPSE_TOLERANCE` (RMS, in units of the peak) of that outer
 shape: then amplitude, width and speed are the whole story, with the exponents above.
 
 **Energy budget.** The energy the leading pulse carries across a ring of radius r scales as
-r v_m² w c, that is as r^e with e = 1 + 2a + b + s. e = 0 (within two standard errors): the
-pulse keeps its energy; e < 0: it leaks into the tail behind it, as r^e.
+:math:`r v_m^2 w c`, that is as :math:`r^e` with :math:`e = 1 + 2a + b + s`. e = 0 (within two standard
+errors): the pulse keeps its energy; e < 0: it leaks into the tail behind it, as :math:`r^e`.
 """
 
 from __future__ import annotations
@@ -104,7 +104,7 @@ class Ray:
         return bool(self.middle_residual < COLLAPSE_TOLERANCE)
 
     def energy_exponent(self) -> tuple[float, float]:
-        """(e, its standard error) of the energy crossing a ring, r v_m² w c ∝ r^e; the error
+        """(e, its standard error) of the energy crossing a ring, :math:`r v_m^2 w c ∝ r^e`; the error
         treats the three fitted exponents as independent, though they come from the same beads."""
         (a, sa), (b, sb), (s, ss) = (self.exponents[k] for k in ("amplitude", "width", "speed"))
         return 1 + 2 * a + b + s, float(np.sqrt(4 * sa**2 + sb**2 + ss**2))

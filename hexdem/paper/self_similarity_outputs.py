@@ -25,7 +25,7 @@ def rows(measured: dict[str, dict[str, Ray]]) -> list[tuple]:
 
 
 def energy_verdict(value: float, stderr: float) -> str:
-    """Does the leading pulse keep the energy it carries across a ring along this ray (r^e, e = 0
+    """Does the leading pulse keep the energy it carries across a ring along this ray (:math:`r^e`, e = 0
     within two standard errors), leak it into its tail, or gain it from the neighbouring
     directions (the budget is per unit angle)? "undetermined" without a finite fit."""
     if not (np.isfinite(value) and np.isfinite(stderr)):

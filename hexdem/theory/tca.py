@@ -172,7 +172,7 @@ class EqualVelocity:
 
     @property
     def decay_factor(self) -> float:
-        """c = ẋ₀(t*) / (V₀/2): the velocity reached relative to the BCA's (eq. TCA_decay)."""
+        """c = ẋ₀(t*) / (V₀/2): the velocity reached relative to the BCA's (eq. (8))."""
         return self.velocity / (BCA_EQUAL_VELOCITY_FRACTION * self.v0)
 
 
@@ -243,7 +243,7 @@ class PulsePrediction:
 
 def predict_pulses(v_first: float, n_first: int, n_last: int, theta: float = THETA) -> PulsePrediction:
     r"""Residence times of beads n_first … n_last for
-    :math:`V_n = v_\text{first}\, c^{n − n_\text{first}}` (eq. TCA_decay).
+    :math:`V_n = v_\text{first}\, c^{n − n_\text{first}}` (eq. (8), started at bead n_first).
 
     30° strike: v_first = V₀ at n_first = 0. 0° strike observed at 30°: v_first = V₀/2 at
     n_first = 1 (Sec. IV, last paragraph).

@@ -2,7 +2,7 @@
 
 Fig. 5a: pulse speeds c_n = 1/T_n along the 30° line of a 30° strike at V₀ = 0.1
 (nondimensional); Fig. 5b: arrival times along the 30° line of the 11-per-edge experiment
-struck at 0° with 0.4 m/s. Each against the TCA and its closed form (eq. hyperg).
+struck at 0° with 0.4 m/s. Each against the TCA and its closed form (eq. (6)).
 """
 
 from __future__ import annotations

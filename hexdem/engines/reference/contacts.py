@@ -16,8 +16,9 @@ from hexdem.model.walls import wall_normals
 
 
 def coefficient(stiffness_pa, r_eff_m, units: UnitSystem):
-    """k sqrt(R_eff) [N/m^1.5] of a contact in ``units``: Hertz's A = k_n sqrt(R_eff), or Mindlin's
-    k_t sqrt(R_eff) (whose force k_t a ξ = k_t sqrt(R_eff) sqrt(δ) ξ has the same units)."""
+    r""":math:`k \sqrt{R_\text{eff}}` [:math:`\mathrm{N/m^{1.5}}`] of a contact in ``units``: Hertz's
+    :math:`A = k_n \sqrt{R_\text{eff}}`, or Mindlin's :math:`k_t \sqrt{R_\text{eff}}` (whose force
+    :math:`k_t a ξ = k_t \sqrt{R_\text{eff}} \sqrt{δ}\, ξ` has the same units)."""
     return stiffness_pa * np.sqrt(r_eff_m) * units.length_m**1.5 / units.force_n
 
 

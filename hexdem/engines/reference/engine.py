@@ -1,17 +1,18 @@
-"""Reference integrator of the paper's Hamiltonian (Sec. III): an engine independent of LAMMPS.
+r"""Reference integrator of the paper's Hamiltonian (Sec. III): an engine independent of LAMMPS.
 
 It integrates eq. (4) as the paper does, with classical 4th-order Runge–Kutta:
 
 * contacts found from the bodies' positions, as in LAMMPS: a neighbour search
   (:mod:`hexdem.engines.reference.neighbours`) lists the pairs whose gap is below a skin, and is
   run again whenever a body has moved half the skin; each touching pair (gap below 0) has
-  V(r) = (2/5) A [c − r]_+^{5/2}: no tension, a per-pair contact distance c = R_i + R_j and
-  A = k_n sqrt(R_eff), so any packing and per-bead diameters work (for equal beads c = d and A is
-  the paper's A); contacts open and close during a run;
-* the Hertz force along the *current* line of centres, r = |rest + q_j − q_i|;
+  :math:`V(r) = \tfrac{2}{5} A\, [c − r]_+^{5/2}`: no tension, a per-pair contact distance
+  :math:`c = R_i + R_j` and :math:`A = k_n \sqrt{R_\text{eff}}`, so any packing and per-bead
+  diameters work (for equal beads c = d and A is the paper's A); contacts open and close during
+  a run;
+* the Hertz force along the *current* line of centres, :math:`r = \left|\text{rest} + q_j − q_i\right|`;
 * flat walls as sphere–half-plane Hertz contacts with the wall's own modulus
-  (F = k_n,wall sqrt(R) δ^{3/2}, the paper's "spheres with an infinite radius"), acting on
-  the wall's member beads only, so the struck bead sits in the impact hole as in the decks;
+  (:math:`F = k_{n,\text{wall}} \sqrt{R}\, δ^{3/2}`, the paper's "spheres with an infinite
+  radius"), acting on the wall's member beads only, so the struck bead sits in the impact hole as in the decks;
 * each impact's V0 on its bead, or on a striker sphere, a body like the beads for the
   neighbour search.
 

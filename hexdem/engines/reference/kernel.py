@@ -1,12 +1,14 @@
-"""Compiled kernel of the reference integrator: the forces of eq. (4) and classical RK4.
+r"""Compiled kernel of the reference integrator: the forces of eq. (4) and classical RK4.
 
-The paper's equations of motion (Sec. III, eq. (4)) with V(r) = (2/5) A [c − r]_+^{5/2}
-give each pair of bodies a repulsive force A [c − r]_+^{3/2} along the current line of centres,
-where r = |rest + q_j − q_i| is the current distance of the pair (rest vector ``rest`` between
-their positions at t = 0 plus displacements q) and c their contact distance. A bead touching a
-flat wall with normal n feels A_w [−(g₀ + q·n)]_+^{3/2} along n (g₀ its gap at rest). Inside a
-curved wall (a circle whose centre is ρ from the bead's rest position along n) the depth is exact,
-−(g₀ + q·n) + (|ρn − q| − (ρ − q·n)), and the force acts along the current radius.
+The paper's equations of motion (Sec. III, eq. (4)) with
+:math:`V(r) = \tfrac{2}{5} A\, [c − r]_+^{5/2}` give each pair of bodies a repulsive force
+:math:`A\, [c − r]_+^{3/2}` along the current line of centres, where
+:math:`r = \left|\text{rest} + q_j − q_i\right|` is the current distance of the pair (rest vector
+``rest`` between their positions at t = 0 plus displacements q) and c their contact distance. A bead
+touching a flat wall with normal n feels :math:`A_w\, [−(g_0 + q \cdot n)]_+^{3/2}` along n (g₀ its
+gap at rest). Inside a curved wall (a circle whose centre is ρ from the bead's rest position along
+n) the depth is exact, :math:`−(g_0 + q \cdot n) + (\left|ρn − q\right| − (ρ − q \cdot n))`, and the
+force acts along the current radius.
 
 The pairs are the neighbour list's (:mod:`hexdem.engines.reference.neighbours`): every pair whose
 gap was below the skin at the list's build, sorted by i, then j. A listed pair that does not touch
@@ -81,8 +83,9 @@ def stale(k, x, y):
 
 @_jit
 def _pair_forces(k, x, y, u, w, fx, fy):
-    """Add the force of every touching listed pair: A δ^{3/2}, plus Tsuji's η δ^{1/4} δ̇ (δ̇ > 0 while
-    compressing) in a damped model, the sum clipped at zero (it never pulls)."""
+    r"""Add the force of every touching listed pair: :math:`A δ^{3/2}`, plus Tsuji's
+    :math:`η δ^{1/4} \dot{δ}` (:math:`\dot{δ} > 0` while compressing) in a damped model, the sum
+    clipped at zero (it never pulls)."""
     for b in range(k.pair_i.shape[0]):
         i, j = k.pair_i[b], k.pair_j[b]
         dx = k.pair_rest_x[b] + x[j] - x[i]
