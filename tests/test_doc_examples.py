@@ -11,6 +11,7 @@ import numpy as np
 
 from hexdem.model.config import RunConfig
 from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.random_disc import random_diameters
 
 GUIDE = Path(__file__).resolve().parents[1] / "docs" / "guide"
 
@@ -35,10 +36,14 @@ def test_the_python_api_example_runs(tmp_path):
 def test_every_packing_config_of_the_guide_builds_the_packing_its_comment_names():
     section = (GUIDE / "packings.md").read_text()
     blocks = re.findall(r"```toml\n(.*?)```", section, flags=re.DOTALL)
-    assert len(blocks) == 10
+    assert len(blocks) == 11
     packing = [k for k, block in enumerate(blocks) if "packing_file" in block]
     assert len(packing) == 1, "the packing file's example names a file of the reader's"
-    lattices = [build_lattice(RunConfig(**tomllib.loads(block))) for k, block in enumerate(blocks) if k not in packing]
+    (random,) = [k for k, block in enumerate(blocks) if 'shape = "random"' in block]  # packed by LAMMPS
+    disc = RunConfig(**tomllib.loads(blocks[random]))
+    assert len(random_diameters(disc.radius_m, disc.diameter_m, disc.diameter_spread, disc.seed)) == 196
+    lattices = [build_lattice(RunConfig(**tomllib.loads(block))) for k, block in enumerate(blocks)
+                if k not in packing and k != random]
     # 9 x 12 corners and 8 x 11 interstitials; the chain's 40 beads
     assert [len(lattice) for lattice in lattices] == [28, 30, 514, 329, 10, 225, 9 * 12 + 8 * 11, 40, 1]
     assert [len(lattice.walls) for lattice in lattices] == [3, 4, 1, 6, 1, 4, 4, 0, 1]
