@@ -26,7 +26,7 @@ from hexdem.model.config import RunConfig
 from hexdem.model.config_keys import KEY_DESCRIPTIONS
 
 #: Width of the help texts (argparse reads COLUMNS).
-HELP_COLUMNS = "84"
+HELP_COLUMNS = "82"
 #: A docstring's inline math, whose bars are LaTeX's and stay as written.
 MATH_ROLE = re.compile(r"(:math:`[^`]*`)")
 
