@@ -76,5 +76,7 @@ def assign_materials(lattice: Lattice, regions, bead: Material, lookup) -> tuple
         ids[chosen] = 0 if material == bead else 1 + extra.index(material)
     used = [m for i, m in enumerate(extra) if np.any(ids == i + 1)]
     renumber = {extra.index(m) + 1: k + 1 for k, m in enumerate(used)}
-    ids = np.array([renumber.get(i, i) for i in ids], dtype=int)
+    table = np.arange(len(extra) + 1)
+    table[list(renumber)] = list(renumber.values())
+    ids = table[ids]
     return replace(lattice, material_ids=ids), tuple(used)

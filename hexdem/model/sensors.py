@@ -13,7 +13,7 @@ from hexdem.model.lattice import Lattice
 
 def sensor_beads(sensors, lattice: Lattice) -> dict[str, int]:
     """{label: bead index} of ``sensors`` on ``lattice``, in the order given."""
-    beads, lines = {}, lattice.lines()
+    beads, lines = {}, lattice.lines() if sensors else {}
     for sensor in sensors:
         if isinstance(sensor, int) and not isinstance(sensor, bool):
             if not 1 <= sensor <= len(lattice):

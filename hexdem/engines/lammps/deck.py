@@ -61,6 +61,12 @@ def _fmt(value: float) -> str:
     return repr(float(value))
 
 
+def _columns(*arrays) -> list[list[str]]:
+    """Each array's values as :func:`_fmt` writes them, a column at a time (a million beads' data
+    file in 2 s, not 5 s)."""
+    return [list(map(repr, np.asarray(values, float).tolist())) for values in arrays]
+
+
 def _striker_type_materials(model: GranularModel) -> list[int]:
     """The material ids of the strikers' atom types: one per material the strikers are of, in
     order of first use (one type, of the beads' material, when there is no striker)."""
@@ -95,12 +101,13 @@ def data_file(model: GranularModel, units: UnitSystem) -> str:
              f"{model.n_bodies} atoms", f"{len(type_materials(model))} atom types", "",
              f"{_fmt(lo[0])} {_fmt(hi[0])} xlo xhi", f"{_fmt(lo[1])} {_fmt(hi[1])} ylo yhi",
              f"{_fmt(-diam.max())} {_fmt(diam.max())} zlo zhi", "", "Atoms # sphere", ""]
-    lines += [f"{i + 1} {t} {_fmt(d)} {_fmt(rho)} {_fmt(x)} {_fmt(y)} 0.0"
-              for i, (t, d, rho, (x, y)) in enumerate(zip(types, diam, densities, pos))]
+    ids = [str(i + 1) for i in range(model.n_bodies)]
+    lines += [f"{row} 0.0" for row in map(" ".join, zip(ids, map(str, types.tolist()), *_columns(
+        diam, densities, pos[:, 0], pos[:, 1])))]
     if model.initial_state is not None:
         velocities = model.initial_velocities_m_s() / units.velocity_m_s
         lines += ["", "Velocities", ""]
-        lines += [f"{i + 1} {_fmt(vx)} {_fmt(vy)} 0.0 0.0 0.0 0.0" for i, (vx, vy) in enumerate(velocities)]
+        lines += [f"{row} 0.0 0.0 0.0 0.0" for row in map(" ".join, zip(ids, *_columns(*velocities.T)))]
     return "\n".join(lines) + "\n"
 
 
