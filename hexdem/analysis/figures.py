@@ -13,7 +13,7 @@ from matplotlib import colormaps
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import EllipseCollection
 from matplotlib.patches import Patch
-from matplotlib.colors import LogNorm
+from matplotlib.colors import ListedColormap, LogNorm
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, LogFormatter
 
@@ -99,6 +99,57 @@ def _circles(ax, positions, diameters, **style) -> EllipseCollection:
                              offset_transform=ax.transData, **{"linewidths": 0.2, **style})
 
 
+#: Above this many beads a bead is about a pixel of a map or less: the map is drawn as an image
+#: (:func:`_pixel_beads`), which takes a second where a million circles took 40.
+PIXEL_MAP_BEADS = 50_000
+#: Pixels across such a map, at most; a pixel is at least 1.5 bead diameters wide, so that in a
+#: packing every pixel holds a bead centre (the widest gap of a triangular packing, a circle of
+#: radius d/√3, fits in no square of 1.5 d).
+MAP_PIXELS = 700
+PIXEL_DIAMETERS = 1.5
+#: How beads without a value fill their pixels on such a map: greys, which no colour map used
+#: here holds (the hatches of :data:`UNMEASURED_STYLES` need a bead larger than a pixel).
+PIXEL_UNMEASURED = {"still rising at the run's end": "0.6", "never moved": "0.85", "no value": "0.35"}
+
+
+def _pixel_beads(ax, positions, diameters, values, coloured, groups: dict, outlined: dict, cmap, norm, clim):
+    """The beads as an image of :data:`MAP_PIXELS` across: a pixel shows the mean value of the
+    coloured beads whose centres it holds, or else the grey of the unmeasured ones it holds
+    (:data:`PIXEL_UNMEASURED`); each ring group's outline is a contour of its pixels. Returns the
+    image and the legend's patches."""
+    radius = float(np.max(diameters)) / 2
+    low, high = positions.min(axis=0) - radius, positions.max(axis=0) + radius
+    step = max(float(np.max(high - low)) / MAP_PIXELS, PIXEL_DIAMETERS * float(np.max(diameters)))
+    shape = tuple(np.maximum(np.ceil((high - low) / step).astype(int), 1))
+    cells = np.minimum(((positions - low) / step).astype(int), np.array(shape) - 1)
+    flat = cells[:, 1] * shape[0] + cells[:, 0]
+    size = shape[0] * shape[1]
+    counts = np.bincount(flat[coloured], minlength=size)
+    sums = np.bincount(flat[coloured], weights=values[coloured], minlength=size)
+    mean = np.where(counts > 0, sums / np.maximum(counts, 1), np.nan).reshape(shape[1], shape[0])
+    extent = (low[0], low[0] + shape[0] * step, low[1], low[1] + shape[1] * step)
+    legend = []
+    for name, beads in groups.items():
+        if np.any(beads):
+            held = np.bincount(flat[beads], minlength=size).reshape(shape[1], shape[0]) > 0
+            grey = np.where(held & np.isnan(mean), 1.0, np.nan)
+            ax.imshow(grey, origin="lower", extent=extent, cmap=_single_colour(PIXEL_UNMEASURED[name]),
+                      interpolation="nearest", vmin=0.0, vmax=1.0)
+            legend.append(Patch(label=name, facecolor=PIXEL_UNMEASURED[name], edgecolor="0.45"))
+    image = ax.imshow(mean, origin="lower", extent=extent, cmap=colormaps[cmap], norm=norm, interpolation="nearest")
+    if clim is not None:
+        image.set_clim(*clim)
+    for (name, beads), colour in zip(outlined.items(), OUTLINE_COLOURS):
+        held = np.bincount(flat[beads], minlength=size).reshape(shape[1], shape[0]) > 0
+        ax.contour(held.astype(float), levels=[0.5], colors=[colour], linewidths=1.2, origin="lower", extent=extent)
+        legend.append(Patch(label=name, linewidth=1.2, facecolor="none", edgecolor=colour))
+    return image, legend
+
+
+def _single_colour(colour: str) -> ListedColormap:
+    return ListedColormap([colour])
+
+
 def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=None, norm=None, unmeasured=None,
              outlined=None, colorbar=True):
     """Beads as true-size circles (one collection, sized in data units) coloured by ``values``
@@ -107,12 +158,36 @@ def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=No
     :data:`UNMEASURED_STYLES`: mask of the beads it describes}, drawn in that style outside the
     colour scale and named in a legend; any other NaN is drawn as "no value". ``outlined``:
     {name: mask} of beads to ring in a colour of :data:`OUTLINE_COLOURS` (a region of another
-    material: an interface, intruders), named in the same legend."""
+    material: an interface, intruders), named in the same legend. A packing of more than
+    :data:`PIXEL_MAP_BEADS` beads is drawn as an image of its beads' values instead
+    (:func:`_pixel_beads`)."""
     values = np.asarray(values, float)
     groups = {name: np.asarray(beads, bool) for name, beads in (unmeasured or {}).items()}
     flagged = np.any([np.zeros(len(values), bool), *groups.values()], axis=0)
     groups["no value"] = ~np.isfinite(values) & ~flagged
     coloured = ~np.any(list(groups.values()), axis=0)
+    if len(values) > PIXEL_MAP_BEADS:
+        mappable, legend = _pixel_beads(ax, positions, diameters, values, coloured, groups, outlined or {}, cmap,
+                                        norm, clim)
+    else:
+        mappable, legend = _circle_beads(ax, positions, diameters, values, coloured, groups, outlined or {}, cmap,
+                                         norm, clim)
+    if legend:
+        ax.figure.legend(handles=legend, loc="lower center", ncol=len(legend), frameon=False, fontsize="small")
+    radius = np.max(diameters) / 2
+    ax.update_datalim(np.vstack([positions.min(axis=0) - radius, positions.max(axis=0) + radius]))
+    ax.set_aspect("equal")
+    ax.autoscale_view()
+    if colorbar:
+        bar = ax.figure.colorbar(mappable, ax=ax, label=label, shrink=0.8)
+        if isinstance(norm, LogNorm):
+            plain_log_ticks(bar.ax.yaxis)
+    return mappable
+
+
+def _circle_beads(ax, positions, diameters, values, coloured, groups: dict, outlined: dict, cmap, norm, clim):
+    """The beads as true-size circles (see :func:`bead_map`); returns their collection and the
+    legend's patches."""
     circles = _circles(ax, positions[coloured], diameters[coloured], norm=norm, cmap=colormaps[cmap], edgecolor="k")
     circles.set_array(values[coloured])
     if clim is not None:
@@ -123,21 +198,11 @@ def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=No
         if np.any(beads):
             ax.add_collection(_circles(ax, positions[beads], diameters[beads], **UNMEASURED_STYLES[name]))
             legend.append(Patch(label=name, **UNMEASURED_STYLES[name]))
-    for (name, beads), colour in zip((outlined or {}).items(), OUTLINE_COLOURS):
+    for (name, beads), colour in zip(outlined.items(), OUTLINE_COLOURS):
         ring = {"facecolor": "none", "edgecolor": colour}
         ax.add_collection(_circles(ax, positions[beads], diameters[beads] * 0.9, **ring, linewidths=1.6))
         legend.append(Patch(label=name, linewidth=1.6, **ring))
-    if legend:
-        ax.figure.legend(handles=legend, loc="lower center", ncol=len(legend), frameon=False, fontsize="small")
-    radius = np.max(diameters) / 2
-    ax.update_datalim(np.vstack([positions.min(axis=0) - radius, positions.max(axis=0) + radius]))
-    ax.set_aspect("equal")
-    ax.autoscale_view()
-    if colorbar:
-        bar = ax.figure.colorbar(circles, ax=ax, label=label, shrink=0.8)
-        if isinstance(norm, LogNorm):
-            plain_log_ticks(bar.ax.yaxis)
-    return circles
+    return circles, legend
 
 
 def draw_walls(ax, walls, positions, radii, scale=1.0, **style):
