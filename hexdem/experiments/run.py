@@ -31,7 +31,7 @@ import numpy as np
 from hexdem.analysis.front_shape import FRONT_SHAPE_COLUMNS, FrontShape, front_shape, front_times, front_unmeasurable
 from hexdem.analysis.impact import PEAK_COLUMNS, ImpactAnalysis
 from hexdem.analysis.movie import movie_samples
-from hexdem.common.io import staged_directory, write_csv, write_json
+from hexdem.common.io import staged_directory, write_csv, write_csv_columns, write_json
 from hexdem.common.machine import free_disk_bytes
 from hexdem.errors import HexdemError
 from hexdem.experiments.deck_config import write_deck_config
@@ -183,7 +183,7 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
         log(f"skipped {name}: {reason}")
     rows = analysis.line_rows()
     write_csv(out / "peaks.csv", PEAK_COLUMNS, rows)
-    write_csv(out / "beads.csv", BEAD_COLUMNS, bead_rows(analysis))
+    write_csv_columns(out / "beads.csv", BEAD_COLUMNS, bead_columns(analysis))
     write_json(out / "summary.json", {**summary(config, analysis, wall_time_s), "skipped_outputs": skipped})
     r, model = analysis.results, analysis.model
     v0 = analysis.v0
@@ -211,16 +211,15 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
                         title=model.lattice.shape, label=SPIN_LABEL)
 
 
-def bead_rows(analysis: ImpactAnalysis) -> list[tuple]:
-    """Rows of ``beads.csv``: every bead, id from 1, with its label {m, n}, position, material,
-    pulse and final velocity."""
+def bead_columns(analysis: ImpactAnalysis) -> list:
+    """Columns of ``beads.csv`` (:data:`BEAD_COLUMNS`): every bead, id from 1, with its label
+    {m, n}, position, material, pulse and final velocity."""
     r, model = analysis.results, analysis.model
-    names = [material.name for material in model.materials]
-    return [(b + 1, int(m), int(n), float(x), float(y), names[material], float(peak), float(t_peak), float(arrival),
-             float(spin), float(vx), float(vy))
-            for b, ((m, n), (x, y), material, peak, t_peak, arrival, spin, (vx, vy))
-            in enumerate(zip(model.lattice.indices, r.positions, model.lattice.material_ids, r.peak_speed, r.t_peak,
-                             r.arrival_time, r.peak_angular_speed, r.end_velocity))]
+    names = np.array([material.name for material in model.materials])
+    labels = np.asarray(model.lattice.indices, int)
+    return [np.arange(1, len(labels) + 1), labels[:, 0], labels[:, 1], r.positions[:, 0], r.positions[:, 1],
+            names[model.lattice.material_ids], r.peak_speed, r.t_peak, r.arrival_time, r.peak_angular_speed,
+            r.end_velocity[:, 0], r.end_velocity[:, 1]]
 
 
 def energy_region_rows(results) -> list[tuple]:
