@@ -1,5 +1,6 @@
 """The analysis inside the run against the analysis of a whole record (issue 10's accuracy)."""
 
+import os
 import tracemalloc
 from dataclasses import dataclass
 from pathlib import Path
@@ -112,7 +113,8 @@ class MigratingBeads:
 def test_beads_that_change_ranks_keep_their_pulses(tmp_path, monkeypatch):
     """The same speeds, tracked on one rank and on two between which every bead moves at random
     every 7 samples (each bead's state handed over from its last owner): identical results."""
-    monkeypatch.setenv("PYTHONPATH", str(Path(__file__).parent))  # the ranks unpickle the job from here
+    # the ranks unpickle the job from here, with the hexdem this test imports
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(filter(None, [str(Path(__file__).parent), os.environ.get("PYTHONPATH")])))
     one, _ = MigratingBeads()(None)
     two, handed_over = run_on_ranks(MigratingBeads(), 2, tmp_path)
     assert handed_over > 500  # about half of 37 beads at each of 42 draws

@@ -68,7 +68,8 @@ class TrackedPulses:
     there, each bead's |ω_z| r, the speed its rim turns at (empty, (0, N), for spheres that do
     not turn); ``sensor_times`` (K,) and
     ``sensor_states`` (K, n_sensors, 4): vx, vy, ax, ay of the model's sensor beads every
-    ``settings.sensor_every`` steps. ``peak_angular_speed`` (N,) each bead's largest |ω_z| (0 for
+    ``settings.sensor_every`` steps. ``collectives`` the MPI collective operations the tracker took
+    part in (each rank takes part in the same ones; 0 on one rank). ``peak_angular_speed`` (N,) each bead's largest |ω_z| (0 for
     spheres that do not turn); ``rotational_energy_fraction`` the largest share of the kinetic and
     contact energy held in rotation at the audited times; ``end_velocity`` (N, 2) each bead's
     velocity at the last sample (a rebound's outgoing velocity).
@@ -95,6 +96,7 @@ class TrackedPulses:
     peak_angular_speed: np.ndarray
     rotational_energy_fraction: float
     end_velocity: np.ndarray
+    collectives: int = 0
 
 
 class PulseTracker:
@@ -136,6 +138,13 @@ class PulseTracker:
         self.energies, self.energy_times, self.impact_energy, self.region_energies = [], [], None, []
         self.rotational_energies = []
         self.count = 0
+        self.collectives = 0
+
+    def _collective(self, name: str, *args, **kwargs):
+        """``comm.<name>(*args, **kwargs)``, counted in :attr:`TrackedPulses.collectives`: every
+        collective the analysis takes goes through here."""
+        self.collectives += 1
+        return getattr(self.comm, name)(*args, **kwargs)
 
     # ---- state shared across ranks
     def _bead_state(self) -> list[np.ndarray]:
@@ -148,7 +157,7 @@ class PulseTracker:
         arrays = self._bead_state()
         left = np.flatnonzero(self.owned & ~owned)
         arrived = owned & ~self.owned
-        for beads, rows in self.comm.allgather((left, [array[left] for array in arrays])):
+        for beads, rows in self._collective("allgather", (left, [array[left] for array in arrays])):
             mine = beads[arrived[beads]]
             for array, values in zip(arrays, rows):
                 array[mine] = values[arrived[beads]]
@@ -160,21 +169,22 @@ class PulseTracker:
 
         arrays = self._bead_state()
         mine = np.flatnonzero(self.owned)
-        parts = self.comm.gather((mine, [array[mine] for array in arrays]), root=0)
+        parts = self._collective("gather", (mine, [array[mine] for array in arrays]), root=0)
         for beads, rows in parts if self.root else ():
             for array, values in zip(arrays, rows):
                 array[beads] = values
         for array in (self.traces, self.fields, self.rim_fields, self.sensors):
             taken = np.isfinite(array).astype(np.int64)
             counts = np.empty_like(taken) if self.root else None
-            self.comm.Reduce(taken, counts, op=MPI.SUM, root=0)
-            self.comm.Reduce(np.nan_to_num(array, nan=0.0), array if self.root else None, op=MPI.SUM, root=0)
+            self._collective("Reduce", taken, counts, op=MPI.SUM, root=0)
+            self._collective("Reduce", np.nan_to_num(array, nan=0.0), array if self.root else None, op=MPI.SUM,
+                             root=0)
             if self.root:
                 array[counts == 0] = np.nan
 
     def _gather(self, ids, values):
         """(n_bodies, k) ``values`` of all bodies on rank 0 (None elsewhere)."""
-        parts = [(ids, values)] if self.comm is None else self.comm.gather((ids, values), root=0)
+        parts = [(ids, values)] if self.comm is None else self._collective("gather", (ids, values), root=0)
         if not self.root:
             return None
         whole = np.empty((self.n_bodies,) + values.shape[1:])
@@ -192,7 +202,7 @@ class PulseTracker:
             owned = np.zeros(self.n_beads, dtype=np.bool_)
             owned[index] = True
             moved = s > 0 and not np.array_equal(owned, self.owned)
-            if self.comm.allreduce(moved):
+            if self._collective("allreduce", moved):
                 self._hand_over(owned)
             self.owned = owned
         else:
@@ -306,7 +316,8 @@ class PulseTracker:
                              sensor_times=np.arange(len(self.sensors)) * self.sensor_every * self.settings.dt_s
                              / self.settings.units.time_s, sensor_states=self.sensors,
                              peak_angular_speed=self.peak_spin, end_velocity=self.end_velocity,
-                             rotational_energy_fraction=rotational_share(self.rotational_energies, self.region_energies))
+                             rotational_energy_fraction=rotational_share(self.rotational_energies, self.region_energies),
+                             collectives=self.collectives)
 
 
 def rotational_share(rotational_j, region_energies_j) -> float:
