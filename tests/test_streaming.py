@@ -9,9 +9,11 @@ import numpy as np
 import pytest
 from conftest import read_csv
 
+from hexdem.analysis.energy import EnergyAudit
 from hexdem.analysis.peaks import pulse_times
 from hexdem.analysis.tracker import PulseTracker
 from hexdem.cli.main import main
+from hexdem.engines.lammps.engine import LammpsEngine
 from hexdem.engines.sampling import Sample
 from hexdem.experiments.parallel import run_on_ranks
 from hexdem.experiments.run import RESULT_FILES, simulate
@@ -20,13 +22,12 @@ from hexdem.model.granular import RunSettings
 
 
 class NoAudit:
-    """Synthetic speeds: no mechanics to audit."""
+    """Synthetic speeds: no mechanics to audit (one region, a constant energy)."""
 
-    def measure(self, positions, velocities, angular_velocities=None):
-        return 1.0, np.zeros((1, 2))
+    region_names = ["all"]
 
-    def rotational_j(self, angular_velocities):
-        return np.zeros(1)
+    def part(self, bodies, n_own, positions, velocities, angular_velocities=None):
+        return np.array([1.0, 0.0, 0.0, 0.0, 0.0])
 
 
 def test_streaming_agrees_with_hexdem_analyse_of_the_dump(dumped_run, tmp_path):
@@ -101,8 +102,7 @@ class MigratingBeads:
         owners = np.repeat(rng.integers(0, ranks, (self.n_samples // self.every + 1, n)), self.every, axis=0)
         tracker = PulseTracker(model, RunSettings(dt_s=times[1], n_steps=self.n_samples - 1, dump_every=1), comm,
                                threshold_speed=0.05)
-        if tracker.root:
-            tracker.audit = NoAudit()
+        tracker.audit = NoAudit()
         rank = 0 if comm is None else comm.Get_rank()
         for s, row in enumerate(speeds):
             ids = np.flatnonzero(owners[s] == rank) + 1
@@ -179,3 +179,49 @@ def test_an_earlier_small_pulse_just_above_half_the_peak_is_the_arrival():
     whole = pulse_times(np.arange(60.0), series[:, None])
     assert whole.arrival_time[0] == pytest.approx(7.96, abs=0.01)
     assert tracker.finish().arrival_time[0] == pytest.approx(whole.arrival_time[0], abs=0.2)
+
+
+@dataclass(frozen=True)
+class GatheredAudit:
+    """An MPI job: the default packing struck by a striker (a body of its own region), tracked
+    across the ranks, and beside the tracker's audit (each rank's part, summed) the audit of the
+    whole state gathered onto rank 0 at the same samples. Rank 0 returns (tracked, gathered
+    (T, R, 2) region energies, samples at which atoms may have changed ranks after the first)."""
+
+    directory: Path
+
+    def __call__(self, comm):
+        config = RunConfig(impact="striker", duration=3e-4)
+        model = config.model()
+        settings = config.settings(model)
+        tracker, audit = PulseTracker(model, settings, comm), EnergyAudit(model)
+        units, gathered, migrations = settings.units, [], []
+
+        def observe(sample):
+            tracker(sample)
+            migrations.append(sample.index > 0 and sample.migrated)
+            if sample.index % tracker.energy_every and sample.index != tracker.n_samples_expected - 1:
+                return
+            parts = comm.gather((sample.ids, sample.positions, sample.velocities), root=0)
+            if comm.Get_rank() == 0:
+                positions, velocities = np.empty((model.n_bodies, 2)), np.empty((model.n_bodies, 2))
+                for ids, x, v in parts:
+                    positions[ids - 1], velocities[ids - 1] = x, v
+                gathered.append(audit.measure(positions * units.length_m, velocities * units.velocity_m_s)[1])
+
+        LammpsEngine().run(model, settings, self.directory, observe, comm, show_progress=False)
+        tracked = tracker.finish()
+        return None if tracked is None else (tracked, np.array(gathered), sum(migrations))
+
+
+def test_the_energy_audit_summed_over_ranks_equals_the_gathered_one(tmp_path, monkeypatch):
+    """On 3 ranks each rank audits its own bodies, with half of each contact that crosses to another
+    rank: the parts' sum equals the audit of the whole gathered state to round-off, region by region
+    (the packing and the striker). Collectives: one per sample at which atoms may have changed ranks,
+    one per audited sample, and the final merge."""
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(filter(None, [str(Path(__file__).parent), os.environ.get("PYTHONPATH")])))
+    tracked, gathered, migrations = run_on_ranks(GatheredAudit(tmp_path / "deck"), 3, tmp_path)
+    assert gathered.shape == tracked.region_energies.shape == (len(tracked.energy_times), 2, 2)
+    assert np.all(gathered[1:, 0, 1] > 0) and gathered[:, 1, 1].max() > 0, "contacts in both regions"
+    np.testing.assert_allclose(tracked.region_energies, gathered, rtol=1e-12, atol=1e-12 * gathered[0].sum())
+    assert tracked.collectives <= migrations + len(tracked.energy_times) + 9

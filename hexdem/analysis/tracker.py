@@ -23,9 +23,13 @@ bead's speed reaches it (a second measure of the front, interpolated linearly be
 state arrays for all beads but updates only its own; the state of a bead is exact on the
 rank that owns it. When atoms change ranks (LAMMPS migrates them when it rebuilds its
 neighbour lists) each migrated bead's state is handed from its previous owner to its new one
-before the new sample is taken (only those beads' rows travel); :meth:`finish` brings every
-bead's state from its owner onto rank 0, which alone returns the results. The energy audit and
-the snapshot fields gather whole states onto rank 0.
+before the new sample is taken (only those beads' rows travel), at the samples the engine
+marks as possibly migrated (:attr:`~hexdem.engines.sampling.Sample.migrated`; LAMMPS: after it
+rebuilt its neighbour lists), and only there; :meth:`finish` brings every bead's state from its
+owner onto rank 0, which alone returns the results. The energy audit sums each rank's part
+(:meth:`~hexdem.analysis.energy.EnergyAudit.part`: its own bodies, with its ghosts for the
+contacts that cross ranks) onto rank 0 in one small Reduce per audited sample. The snapshot
+fields are merged onto rank 0 at the end.
 """
 
 from __future__ import annotations
@@ -34,7 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hexdem.analysis.energy import EnergyAudit, energy_error, energy_regions, energy_scale_j, kinetic_energy_j
+from hexdem.analysis.energy import EnergyAudit, energy_error, energy_regions, energy_scale_j
 from hexdem.analysis.peaks import refine_peak, refine_peaks
 from hexdem.analysis.tracker_kernel import PulseState
 from hexdem.engines.sampling import Sample
@@ -134,7 +138,7 @@ class PulseTracker:
         self.rim_fields = np.full((len(self.field_samples) if model.laws.tangential else 0, n), np.nan)
         self.radii = model.lattice.diameters_m[:n] / 2 / settings.units.length_m
         self.energy_every = max(1, (total - 1) // ENERGY_SAMPLES)
-        self.audit = EnergyAudit(model, gravity_m_s2) if self.root else None
+        self.audit = EnergyAudit(model, gravity_m_s2)
         self.energies, self.energy_times, self.impact_energy, self.region_energies = [], [], None, []
         self.rotational_energies = []
         self.count = 0
@@ -182,16 +186,6 @@ class PulseTracker:
             if self.root:
                 array[counts == 0] = np.nan
 
-    def _gather(self, ids, values):
-        """(n_bodies, k) ``values`` of all bodies on rank 0 (None elsewhere)."""
-        parts = [(ids, values)] if self.comm is None else self._collective("gather", (ids, values), root=0)
-        if not self.root:
-            return None
-        whole = np.empty((self.n_bodies,) + values.shape[1:])
-        for part_ids, part_values in parts:
-            whole[part_ids - 1] = part_values
-        return whole
-
     # ---- observing
     def __call__(self, sample: Sample) -> None:
         s = sample.index
@@ -199,12 +193,12 @@ class PulseTracker:
         index = sample.ids[beads] - 1
         speeds = np.hypot(sample.velocities[beads, 0], sample.velocities[beads, 1])
         if self.comm is not None and self.comm.Get_size() > 1:
-            owned = np.zeros(self.n_beads, dtype=np.bool_)
-            owned[index] = True
-            moved = s > 0 and not np.array_equal(owned, self.owned)
-            if self._collective("allreduce", moved):
-                self._hand_over(owned)
-            self.owned = owned
+            if sample.migrated:
+                owned = np.zeros(self.n_beads, dtype=np.bool_)
+                owned[index] = True
+                if s > 0:
+                    self._hand_over(owned)
+                self.owned = owned
         else:
             self.owned[index] = True
         self.pulses.update(index, speeds, s)
@@ -251,21 +245,32 @@ class PulseTracker:
             [sample.velocities[rows], sample.accelerations[rows]])
 
     def _audit(self, sample: Sample) -> None:
-        spins = () if sample.angular_velocities is None else (sample.angular_velocities[:, None],)
-        state = self._gather(sample.ids, np.hstack([sample.positions, sample.velocities, *spins]))
-        if state is not None:
-            units = self.settings.units
-            velocities = state[:, 2:4] * units.velocity_m_s
-            angular = state[:, 4] / units.time_s if spins else None
+        """This rank's part of the energy audit (its bodies, with its ghosts' positions for the
+        contacts that cross to another rank), summed onto rank 0 in one small Reduce."""
+        units = self.settings.units
+        bodies, positions = sample.ids - 1, sample.positions
+        if sample.ghost_ids is not None:
+            bodies = np.concatenate([bodies, sample.ghost_ids - 1])
+            positions = np.concatenate([positions, sample.ghost_positions])
+        angular = None if sample.angular_velocities is None else sample.angular_velocities / units.time_s
+        part = self.audit.part(bodies, len(sample.ids), positions * units.length_m,
+                               sample.velocities * units.velocity_m_s, angular)
+        if self.comm is not None and self.comm.Get_size() > 1:
+            from mpi4py import MPI
+
+            whole = np.empty_like(part) if self.root else None
+            self._collective("Reduce", part, whole, op=MPI.SUM, root=0)
+            part = whole
+        if self.root:
+            energy, translational, rotational, by_region = part[0], part[1], part[2], part[3:]
             if self.impact_energy is None:
-                self.impact_energy = kinetic_energy_j(velocities, self.model) + self._displacement_energy_j(angular)
-            energy, by_region = self.audit.measure(state[:, :2] * units.length_m, velocities, angular)
-            self.energies.append(energy)
-            self.region_energies.append(by_region)
-            self.rotational_energies.append(float(np.sum(self.audit.rotational_j(angular))))
+                self.impact_energy = translational + self._displacement_energy_j()
+            self.energies.append(float(energy))
+            self.region_energies.append(by_region.reshape(len(self.audit.region_names), 2))
+            self.rotational_energies.append(float(rotational))
             self.energy_times.append(sample.time)
 
-    def _displacement_energy_j(self, angular) -> float:
+    def _displacement_energy_j(self) -> float:
         """The contact energy [J] the initial state's displacements add to the packed state's:
         with the kinetic energy, what the run was given (0 without displacements)."""
         state = self.model.initial_state
@@ -274,8 +279,8 @@ class PulseTracker:
         moved = self.model.initial_positions_m()
         packed = moved.copy()
         packed[:len(state.displacements_m)] -= state.displacements_m
-        still, spins = np.zeros_like(moved), None if angular is None else np.zeros_like(angular)
-        return self.audit.measure(moved, still, spins)[0] - self.audit.measure(packed, still, spins)[0]
+        still = np.zeros_like(moved)
+        return self.audit(moved, still) - self.audit(packed, still)
 
     # ---- results
     def finish(self) -> TrackedPulses | None:
