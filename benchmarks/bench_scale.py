@@ -1,6 +1,6 @@
 """hexdem at scale: a large run stage by stage, each MPI rank's peak memory and the analysis's collectives.
 
-Usage: python benchmarks/bench_scale.py [--edges 100,200] [--ranks 2,4,8] [--duration 1e-4] [--quick]
+Usage: python benchmarks/bench_scale.py [--edges 100,200] [--ranks 1,2,4,8] [--duration 1e-4] [--quick]
 
 For a hexagon of each of ``--edges`` beads per edge (100: 29,701 beads; 200: 119,401; 578:
 1,000,519), run ``--duration`` seconds (default 1e-4) on each of ``--ranks`` rank counts (more ranks
@@ -18,11 +18,14 @@ than cores is fine for memory and collective counts, not for times):
 * **bare LAMMPS**: ``mpiexec -n N lmp -in in.nooutput`` of the same deck without its output
   section, the yardstick: the analysis's share of the loop is hexdem's loop / the bare loop − 1;
 * **peak RSS per process** (:func:`harness.run_watched`): the ``hexdem run`` process (which
-  also writes the results and figures) and each MPI rank, read from ``/proc``.
+  also writes the results and figures) and each MPI rank, read from ``/proc``;
+* **the same results on every rank count**: ``peaks.csv`` and ``beads.csv`` of each rank count
+  against those of the first (default: one rank), text columns equal, numbers within
+  :data:`RESULTS_RTOL` (round-off: LAMMPS sums forces in another order on other ranks).
 
 Targets: at 119,401 beads on 8 ranks the largest process <= 400 MB; each rank's peak falls as
 ranks are added; collectives <= one per neighbour-list rebuild + one per audited sample + 2 (the
-first sample's layout and the final gather).
+first sample's layout and the final gather); results equal on every rank count.
 ``--quick``: hexagons of 5 and 7 per edge for 0.2 ms on 1 and 2 ranks (the same code path, seconds).
 """
 
@@ -38,6 +41,7 @@ import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
 from baseline import hexdem_command
 from harness import MB, NOOUTPUT_NAME, nooutput_deck, run_watched, write_config
 from machine import describe
@@ -52,6 +56,8 @@ MEMORY_TARGET = 400 * MB
 MEMORY_TARGET_RUN = (119_401, 8)
 #: Collectives beside one per rebuild and one per audited sample: the first sample's layout, the final gather.
 COLLECTIVES_BESIDE = 2
+#: Result tables compared across rank counts, and how close their numbers must be.
+TABLES, RESULTS_RTOL, RESULTS_ATOL = ("peaks.csv", "beads.csv"), 1e-9, 1e-15
 
 
 def parse_list(text: str, kind=int) -> list:
@@ -67,6 +73,31 @@ def audited_samples(table: Path) -> int:
     """The samples the energy audit measured: the distinct times of ``energy_regions.csv``."""
     with open(table, newline="") as fh:
         return len({row["time"] for row in csv.DictReader(fh)})
+
+
+def read_table(path: Path) -> np.ndarray:
+    """A result table as a structured array (a field per column, text or number)."""
+    return np.genfromtxt(path, delimiter=",", names=True, dtype=None, encoding="utf-8")
+
+
+def table_mismatch(table: np.ndarray, reference: np.ndarray) -> float:
+    """The largest |a - b| / (atol + rtol |b|) over the numbers of two result tables (NaN where
+    they are, equal; inf where a text, a NaN or the shape differs): <= 1 is round-off."""
+    if table.shape != reference.shape or table.dtype.names != reference.dtype.names:
+        return np.inf
+    worst = 0.0
+    for name in table.dtype.names:
+        a, b = table[name], reference[name]
+        if a.dtype.kind not in "fiu":
+            worst = worst if np.array_equal(a, b) else np.inf
+            continue
+        a, b = a.astype(float), b.astype(float)
+        if not np.array_equal(np.isnan(a), np.isnan(b)):
+            return np.inf
+        seen = ~np.isnan(b)
+        worst = max(worst, float(np.max(np.abs(a[seen] - b[seen]) / (RESULTS_ATOL + RESULTS_RTOL * np.abs(b[seen])),
+                                        initial=0.0)))
+    return worst
 
 
 def results_span_s(out: Path) -> float:
@@ -96,7 +127,8 @@ def measure(config: RunConfig, ranks: int, work: Path) -> dict:
            "hexdem loop": loop_time_s(log), "run": summary["wall_time_s"], "results": results_span_s(out),
            "wall": watched.wall_s, "largest": watched.peak_per_process, "ranks rss": rank_peaks,
            "cli rss": watched.peaks.get(watched.pid, ("", 0))[1], "collectives": summary["collectives"],
-           "rebuilds": neighbour_builds(log), "audited": audited_samples(out / "energy_regions.csv")}
+           "rebuilds": neighbour_builds(log), "audited": audited_samples(out / "energy_regions.csv"),
+           "tables": {name: read_table(out / name) for name in TABLES}}
     shutil.rmtree(out)
     run_bare(deck, ranks, NOOUTPUT_NAME)
     row["bare loop"] = loop_time_s(deck.log_path)
@@ -107,7 +139,7 @@ def measure(config: RunConfig, ranks: int, work: Path) -> dict:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--edges", type=parse_list, default=[100, 200], help="hexagon edges in beads (default 100,200)")
-    parser.add_argument("--ranks", type=parse_list, default=[2, 4, 8], help="rank counts (default 2,4,8)")
+    parser.add_argument("--ranks", type=parse_list, default=[1, 2, 4, 8], help="rank counts (default 1,2,4,8)")
     parser.add_argument("--duration", type=float, default=1e-4, help="simulated time [s] (default 1e-4)")
     parser.add_argument("--quick", action="store_true", help="5- and 7-per-edge hexagons for 0.2 ms on 1 and 2 ranks")
     args = parser.parse_args()
@@ -149,6 +181,13 @@ def main() -> None:
         print(f"target per-rank memory falls with ranks, {results[edge, ranks[0]]['beads']:,} beads: largest rank "
               f"{' -> '.join(f'{p / MB:.0f}' for p in peaks)} MB on {', '.join(map(str, ranks))} ranks: "
               f"{'met' if falling else 'NOT met'}")
+    for (edge, n), r in results.items():
+        if n == ranks[0]:
+            continue
+        reference = results[edge, ranks[0]]["tables"]
+        worst = max(table_mismatch(r["tables"][name], reference[name]) for name in TABLES)
+        print(f"target results, {r['beads']:,} beads on {n} vs {ranks[0]} rank(s): {' and '.join(TABLES)} within "
+              f"{worst:.2g} of round-off (rtol {RESULTS_RTOL:g}): {'met' if worst <= 1 else 'NOT met'}")
     beads, n = MEMORY_TARGET_RUN
     row = next((r for (edge, m), r in results.items() if r["beads"] == beads and m == n), None)
     verdict = ("not measured (--edges 200 --ranks 8)" if row is None else
