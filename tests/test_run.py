@@ -167,3 +167,12 @@ def test_config_file_sets_parameters(tmp_path):
     assert len(model.lattice) == 61 and model.has_striker
     np.testing.assert_allclose(model.impact.direction, [np.sqrt(3) / 2, 0.5])
     assert model.impact.speed_m_s == pytest.approx(0.05 * config.unit_system.velocity_m_s)
+
+
+def test_ranks_that_own_no_bead_take_part(tmp_path):
+    """Seven beads on 8 ranks (some own none of them): the same peaks as on one rank."""
+    config = RunConfig(edge_beads=2)
+    one = simulate(config, tmp_path / "one").results
+    eight = simulate(config.replace(ranks=8), tmp_path / "eight").results
+    np.testing.assert_allclose(eight.peak_speed, one.peak_speed, rtol=1e-9)
+    np.testing.assert_allclose(eight.arrival_time, one.arrival_time, rtol=1e-9)

@@ -124,7 +124,7 @@ class PulseTracker:
         if threshold_speed is not None and not threshold_speed > 0:
             raise HexdemError(f"the threshold speed must be > 0, got {threshold_speed!r}")
         self.threshold_speed = threshold_speed
-        self.sample_ids, self.ids = np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+        self.sample_ids, self.ids = None, np.zeros(0, dtype=np.int64)  # (no sample yet)
         self._start_rows(0)
         self.trace_beads = np.asarray(trace_beads, dtype=np.int64)
         self.traces = np.full((total, len(self.trace_beads)), np.nan)
@@ -171,7 +171,12 @@ class PulseTracker:
         """Lay this rank's rows out as its beads in ``sample`` (possibly migrated, see
         :attr:`~hexdem.engines.sampling.Sample.migrated`): the beads it kept keep their state, those
         that left hand theirs to the other ranks in one collective (only their rows travel), and
-        those that arrived take it from there."""
+        those that arrived take it from there. A rank whose bodies are those of its previous sample, in
+        the same order, keeps its rows as they are (and hands nothing over)."""
+        if self.sample_ids is not None and np.array_equal(sample.ids, self.sample_ids):
+            if self.several and sample.index > 0:  # the others may hand their beads over to each other
+                self._collective("allgather", (self.ids[:0], []))
+            return
         beads = np.flatnonzero(sample.ids <= self.n_beads)
         ids = sample.ids[beads]
         kept, rows = self._rows_of(ids, self.ids)
