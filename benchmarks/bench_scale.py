@@ -1,179 +1,204 @@
-"""hexdem at scale: end to end vs bare LAMMPS and vs hexdem before, peak memory per process and bytes written.
+"""hexdem at scale: a large run stage by stage, each MPI rank's peak memory and the analysis's collectives.
 
-Usage: python benchmarks/bench_scale.py [--sizes 331,3151,10621,29701,52599] [--ranks 1,2] [--steps 140]
-       [--before REV] [--repeats 1] [--quick]
+Usage: python benchmarks/bench_scale.py [--edges 100,200] [--ranks 1,2,4,8] [--duration 1e-4] [--quick]
 
-For 331 beads (hexagon, 11 per edge), 3151 beads (half-hexagon 91/46), 10,621 and 29,701 beads
-(hexagons of 60 and 100 per edge) and 52,599 beads (the front study's half-disc of radius 170 d),
-each with its default run length (the largest take minutes), on 1 and 2 ranks, at each of
-``--steps`` steps per contact (default today's 140), with today's hexdem and with hexdem as it
-was at ``--before`` (default e8fb865, the last commit before the speed work; skipped when this
-clone lacks it), alternating for each size, rank count and step (so that all see the same
-machine load):
+For a hexagon of each of ``--edges`` beads per edge (100: 29,701 beads; 200: 119,401; 578:
+1,000,519), run ``--duration`` seconds (default 1e-4) on each of ``--ranks`` rank counts (more ranks
+than cores is fine for memory and collective counts, not for times):
 
-* **hexdem end to end**: ``hexdem run --config FILE --out DIR --ranks N`` as a subprocess (its
-  deck's set-up checked equal to the bare deck's; the output sections differ in sampling)
-  (Python start-up, imports, MPI launch, the run with its analysis inside, the result files);
-  its wall time, and LAMMPS's "Loop time" inside it (which includes the sampling callback):
-  the in-run analysis's share is that loop over the bare loop, minus 1.
-* **bare LAMMPS**: ``mpiexec -n N lmp -in in.nooutput`` (``run_bare``) of the same deck,
-  rendered with ``write_deck`` into a scratch directory, without its output section; its
-  "Loop time" is the yardstick.
-* **peak RSS per process**: while ``hexdem run`` runs, ``VmHWM`` of it and of every
-  descendant (the MPI launcher, its proxies, each rank) is read from ``/proc/<pid>/status``
-  every 0.2 s, and checked against the ``ru_maxrss`` that ``wait4`` returns for the whole
-  tree (its largest single process; what ``/usr/bin/time -v`` prints as "Maximum resident
-  set size"): the larger is printed, the sampled processes above 20 MB below the table.
-* **bytes written**: all files in hexdem's output directory after the run (deck, log,
-  results, figures), and in the bare deck directory (deck, ``in.nooutput``, log).
+* **model build** and **data file**: :func:`~hexdem.model.model_builder.build_model` with its settings, and rendering the
+  deck with its data file (``write_deck``, as rank 0 does in the run), in this process;
+* **hexdem run end to end**: ``hexdem run --config FILE --out DIR --ranks N`` as a subprocess
+  (Python start-up, the MPI launch, the run with its analysis inside, the result files and
+  figures); from its outputs: LAMMPS's "Loop time" (which includes the sampling callback), the
+  **run** (``summary.json``'s ``wall_time_s``: model, MPI job, engine and gathered results, up to
+  the result files), the **results** (from ``peaks.csv``, which ``write_results`` writes first, to
+  the newest result file: tables and figures), the **collectives** the analysis took
+  (``summary.json``), the neighbour-list rebuilds (LAMMPS's log) and the audited samples;
+* **bare LAMMPS**: ``mpiexec -n N lmp -in in.nooutput`` of the same deck without its output
+  section, the yardstick: the analysis's share of the loop is hexdem's loop / the bare loop − 1;
+* **peak RSS per process** (:func:`harness.run_watched`): the ``hexdem run`` process (which
+  also writes the results and figures) and each MPI rank, read from ``/proc``;
+* **the same results on every rank count**: ``peaks.csv`` and ``beads.csv`` of each rank count
+  against those of the first (default: one rank), text columns equal, numbers within
+  :data:`RESULTS_RTOL` (round-off: LAMMPS sums forces in another order on other ranks).
 
-Targets per row of today's hexdem: the in-run analysis <= 0.25 x the bare loop; end to end <=
-1.3 x bare loop + 5 s for 3151 beads and more on 2 ranks (+ 10 s for the front study's 52,599),
-and <= 500 MB per process.
+Targets: at 119,401 beads on 8 ranks the largest process <= 400 MB; each rank's peak falls as
+ranks are added; collectives <= one per neighbour-list rebuild + one per audited sample + 2 (the
+first sample's layout and the final gather); results equal on every rank count.
 ``--quick``: hexagons of 5 and 7 per edge for 0.2 ms on 1 and 2 ranks (the same code path, seconds).
 """
 
 from __future__ import annotations
 
 import argparse
+import csv
+import json
 import os
+import re
 import shutil
-import statistics
 import tempfile
+import time
 from pathlib import Path
 
-from baseline import BEFORE, baseline_tree, hexdem_command, hexdem_env
-from harness import MB, NOOUTPUT_NAME, nooutput_deck, run_watched, tree_bytes, write_config
+import numpy as np
+from baseline import hexdem_command
+from harness import MB, NOOUTPUT_NAME, nooutput_deck, run_watched, write_config
 from machine import describe
 
-from hexdem.engines.lammps.deck import DECK_NAME
-from hexdem.engines.lammps.driver import split_deck
 from hexdem.engines.lammps.partitions import loop_time_s
 from hexdem.engines.lammps.runner import run_bare
-from hexdem.model.config import STEPS_PER_CONTACT, RunConfig
+from hexdem.experiments.run import RESULT_FILES
+from hexdem.model.config import RunConfig
 from hexdem.model.model_builder import build_model
 from hexdem.model.run_settings import run_settings
 
-SIZES = {331: RunConfig(shape="hexagon", edge_beads=11),
-         3151: RunConfig(shape="half-hexagon", long_edge=91, short_edge=46),
-         10621: RunConfig(shape="hexagon", edge_beads=60),
-         29701: RunConfig(shape="hexagon", edge_beads=100),
-         52599: RunConfig(shape="half-disc", radius_beads=170, v0=0.4)}
-QUICK_SIZES = {61: RunConfig(shape="hexagon", edge_beads=5, duration=2e-4),
-               127: RunConfig(shape="hexagon", edge_beads=7, duration=2e-4)}
-TARGET_FACTOR = 1.3
-#: The end-to-end allowance over 1.3 x the bare loop [s], by bead count (the front study's packing: more).
-TARGET_OFFSETS_S = {3151: 5.0, 10621: 5.0, 29701: 5.0, 52599: 10.0}
-MEMORY_TARGET = 500 * MB
-ANALYSIS_SHARE_TARGET = 0.25
+MEMORY_TARGET = 400 * MB
+#: The memory target's run: this many beads on this many ranks.
+MEMORY_TARGET_RUN = (119_401, 8)
+#: Collectives beside one per rebuild and one per audited sample: the first sample's layout, the final gather.
+COLLECTIVES_BESIDE = 2
+#: Result tables compared across rank counts, and how close their numbers must be.
+TABLES, RESULTS_RTOL, RESULTS_ATOL = ("peaks.csv", "beads.csv"), 1e-9, 1e-15
 
 
-def parse_list(text: str) -> list[int]:
-    return [int(item) for item in text.replace("_", "").split(",") if item.strip()]
+def parse_list(text: str, kind=int) -> list:
+    return [kind(item) for item in text.replace("_", "").split(",") if item.strip()]
 
 
-def measure(config: RunConfig, ranks: int, steps: int, work: Path, repeat: int, tree: Path | None) -> dict:
-    """hexdem end to end (the version unpacked at ``tree``, None: today's), then bare LAMMPS, on
-    ``ranks`` ranks at ``steps`` steps per contact: one row's measurements."""
-    config = config.replace(ranks=ranks, steps_per_contact=steps)
+def neighbour_builds(log: Path) -> int:
+    """LAMMPS's "Neighbor list builds" over the runs of a log."""
+    return sum(int(n) for n in re.findall(r"Neighbor list builds = (\d+)", log.read_text()))
+
+
+def audited_samples(table: Path) -> int:
+    """The samples the energy audit measured: the distinct times of ``energy_regions.csv``."""
+    with open(table, newline="") as fh:
+        return len({row["time"] for row in csv.DictReader(fh)})
+
+
+def read_table(path: Path) -> np.ndarray:
+    """A result table as a structured array (a field per column, text or number)."""
+    return np.genfromtxt(path, delimiter=",", names=True, dtype=None, encoding="utf-8")
+
+
+def table_mismatch(table: np.ndarray, reference: np.ndarray) -> float:
+    """The largest |a - b| / (atol + rtol |b|) over the numbers of two result tables: <= 1 is
+    round-off. A NaN (no complete pulse) may face a value within atol of zero (a bead that stayed
+    at rest to round-off in one run and moved by round-off, 1e-33 m/s, in the other); inf where a
+    text, the shape or any other NaN differs."""
+    if table.shape != reference.shape or table.dtype.names != reference.dtype.names:
+        return np.inf
+    worst = 0.0
+    for name in table.dtype.names:
+        a, b = table[name], reference[name]
+        if a.dtype.kind not in "fiu":
+            worst = worst if np.array_equal(a, b) else np.inf
+            continue
+        a, b = a.astype(float), b.astype(float)
+        odd = np.isnan(a) != np.isnan(b)
+        if np.any(np.abs(np.where(np.isnan(a), b, a)[odd]) > RESULTS_ATOL):
+            return np.inf
+        seen = ~np.isnan(a) & ~np.isnan(b)
+        worst = max(worst, float(np.max(np.abs(a[seen] - b[seen]) / (RESULTS_ATOL + RESULTS_RTOL * np.abs(b[seen])),
+                                        initial=0.0)))
+    return worst
+
+
+def results_span_s(out: Path) -> float:
+    """Seconds from ``peaks.csv`` (the first result file written) to the newest result file."""
+    stamps = [(out / name).stat().st_mtime for name in RESULT_FILES if (out / name).exists()]
+    return max(stamps) - (out / "peaks.csv").stat().st_mtime
+
+
+def measure(config: RunConfig, ranks: int, work: Path) -> dict:
+    """One row: the stages, each process's peak memory and the collectives of ``config`` on ``ranks``."""
+    config = config.replace(ranks=ranks)
+    tag = f"{config.edge_beads}-{ranks}"
+    start = time.perf_counter()
     model = build_model(config)
     settings = run_settings(config, model)
-    tag = f"{config.n_beads()}-{ranks}-{steps}-{repeat}-{'before' if tree else 'now'}"
-    config_path = write_config(config, work / f"{tag}.toml")
+    built = time.perf_counter()
     deck = nooutput_deck(model, settings, work / f"bare-{tag}")
+    written = time.perf_counter()
     out = work / f"hexdem-{tag}"
-    watched = run_watched(hexdem_command("run", "--config", str(config_path), "--out", str(out), "--ranks", str(ranks)),
-                          cwd=work, env=hexdem_env(tree)).check(f"hexdem run ({tag})")
-    if split_deck((out / "deck" / DECK_NAME).read_text())[0] != split_deck(deck.input_path.read_text())[0]:
-        raise SystemExit(f"hexdem run set up another run than {deck.input_path}: the comparison would be unfair")
-    hexdem_loop = loop_time_s(out / "deck" / "log.lammps")
-    hexdem_bytes = tree_bytes(out)
+    watched = run_watched(hexdem_command("run", "--config", str(write_config(config, work / f"{tag}.toml")),
+                                         "--out", str(out), "--ranks", str(ranks)), cwd=work).check(f"hexdem run ({tag})")
+    summary = json.loads((out / "summary.json").read_text())
+    log = out / "deck" / "log.lammps"
+    rank_peaks = sorted((rss for pid, (name, rss) in watched.peaks.items()
+                         if name.startswith("python") and (pid != watched.pid or ranks == 1)), reverse=True)
+    row = {"beads": model.n_bodies, "steps": settings.n_steps, "model": built - start, "data file": written - built,
+           "hexdem loop": loop_time_s(log), "run": summary["wall_time_s"], "results": results_span_s(out),
+           "wall": watched.wall_s, "largest": watched.peak_per_process, "ranks rss": rank_peaks,
+           "cli rss": watched.peaks.get(watched.pid, ("", 0))[1], "collectives": summary["collectives"],
+           "rebuilds": neighbour_builds(log), "audited": audited_samples(out / "energy_regions.csv"),
+           "tables": {name: read_table(out / name) for name in TABLES}}
     shutil.rmtree(out)
-    bare = run_bare(deck, ranks, NOOUTPUT_NAME)
-    row = {"wall": watched.wall_s, "hexdem loop": hexdem_loop, "bare wall": bare.wall_time_s,
-           "bare loop": loop_time_s(deck.log_path), "rss": watched.peak_per_process,
-           "hexdem bytes": hexdem_bytes, "bare bytes": tree_bytes(deck.directory),
-           "steps": settings.n_steps, "breakdown": watched.breakdown()}
+    run_bare(deck, ranks, NOOUTPUT_NAME)
+    row["bare loop"] = loop_time_s(deck.log_path)
     shutil.rmtree(deck.directory)
     return row
 
 
-def median_row(rows: list[dict]) -> dict:
-    merged = {key: statistics.median(row[key] for row in rows) for key, value in rows[0].items()
-              if isinstance(value, (int, float))}
-    merged["rss"] = max(row["rss"] for row in rows)
-    merged["breakdown"] = rows[-1]["breakdown"]
-    return merged
-
-
-def verdicts(beads: int, ranks: int, r: dict) -> str:
-    """The targets of a row of today's hexdem, each met or not."""
-    share = r["hexdem loop"] / r["bare loop"] - 1
-    words = [f"analysis {share:.2f} {'<=' if share <= ANALYSIS_SHARE_TARGET else '>'} {ANALYSIS_SHARE_TARGET:g}"]
-    if beads in TARGET_OFFSETS_S and ranks == 2:
-        target = TARGET_FACTOR * r["bare loop"] + TARGET_OFFSETS_S[beads]
-        words.append(f"end to end {r['wall']:.1f} {'<=' if r['wall'] <= target else '>'} {target:.1f} s")
-        words.append(f"memory {r['rss'] / MB:.0f} {'<=' if r['rss'] <= MEMORY_TARGET else '>'} "
-                     f"{MEMORY_TARGET / MB:.0f} MB")
-    met = all("<=" in word for word in words)
-    return f"{'met' if met else 'NOT met'}: " + ", ".join(words)
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--sizes", type=parse_list, help=f"bead counts among {', '.join(map(str, SIZES))} "
-                        "(default: all)")
-    parser.add_argument("--ranks", type=parse_list, default=[1, 2], help="rank counts (default 1,2)")
-    parser.add_argument("--steps", type=parse_list, default=[STEPS_PER_CONTACT],
-                        help=f"steps per contact time (default {STEPS_PER_CONTACT})")
-    parser.add_argument("--before", default=BEFORE, metavar="REV", help=f"the revision to compare with (default {BEFORE})")
-    parser.add_argument("--repeats", type=int, default=1, help="alternating repeats per row (default 1)")
-    parser.add_argument("--quick", action="store_true", help="5- and 7-per-edge hexagons for 0.2 ms (seconds)")
+    parser.add_argument("--edges", type=parse_list, default=[100, 200], help="hexagon edges in beads (default 100,200)")
+    parser.add_argument("--ranks", type=parse_list, default=[1, 2, 4, 8], help="rank counts (default 1,2,4,8)")
+    parser.add_argument("--duration", type=float, default=1e-4, help="simulated time [s] (default 1e-4)")
+    parser.add_argument("--quick", action="store_true", help="5- and 7-per-edge hexagons for 0.2 ms on 1 and 2 ranks")
     args = parser.parse_args()
-    table = QUICK_SIZES if args.quick else SIZES
-    sizes = args.sizes if args.sizes and not args.quick else list(table)
-    unknown = [n for n in sizes if n not in table]
-    if unknown:
-        parser.error(f"unknown size(s) {unknown}; choose among {', '.join(map(str, table))}")
+    edges, ranks, duration = ([5, 7], [1, 2], 2e-4) if args.quick else (args.edges, args.ranks, args.duration)
     print(f"machine: {describe()}; load average {os.getloadavg()[0]:.2f}", flush=True)
     work = Path(tempfile.mkdtemp(prefix="hexdem-bench-scale-"))
     results = {}
     try:
-        versions = {"now": None, "before": baseline_tree(work, args.before)}
-        if versions["before"] is None:
-            print(f"(this clone lacks {args.before}: today's hexdem only)")
-            del versions["before"]
-        for beads in sizes:
-            for ranks in args.ranks:
-                for steps in args.steps:
-                    for version, tree in versions.items():
-                        rows = [measure(table[beads], ranks, steps, work, repeat, tree) for repeat in range(args.repeats)]
-                        results[beads, ranks, steps, version] = r = median_row(rows)
-                        print(f"  measured {beads} beads on {ranks} rank(s), {steps} steps per contact, {version}: "
-                              f"hexdem {r['wall']:.2f} s, bare loop {r['bare loop']:.2f} s", flush=True)
+        for edge in edges:
+            for n in ranks:
+                results[edge, n] = r = measure(RunConfig(shape="hexagon", edge_beads=edge, duration=duration), n, work)
+                print(f"  measured {r['beads']} beads on {n} rank(s): end to end {r['wall']:.1f} s, "
+                      f"largest process {r['largest'] / MB:.0f} MB", flush=True)
     finally:
         shutil.rmtree(work)
-    print(f"hexdem run (CLI) vs bare lmp -in {NOOUTPUT_NAME} on the same deck, today's hexdem and at {args.before} "
-          f"(before); median of {args.repeats} alternating run(s)")
-    header = (f"{'beads':>6} {'ranks':>5} {'steps/τ':>7} {'version':>7} {'steps':>7} {'bare loop [s]':>13} "
-              f"{'hexdem loop [s]':>15} {'analysis':>8} {'end-to-end [s]':>14} {'ratio':>6} "
-              f"{'peak RSS per process [MB]':>25} {'hexdem bytes':>13} {'bare bytes':>11}")
-    print(header)
-    for (beads, ranks, steps, version), r in results.items():
-        print(f"{beads:>6} {ranks:>5} {steps:>7} {version:>7} {r['steps']:>7.0f} {r['bare loop']:>13.2f} "
-              f"{r['hexdem loop']:>15.2f} {r['hexdem loop'] / r['bare loop'] - 1:>8.2f} {r['wall']:>14.2f} "
-              f"{r['wall'] / r['bare loop']:>6.2f} {r['rss'] / MB:>25.0f} {r['hexdem bytes']:>13,.0f} "
-              f"{r['bare bytes']:>11,.0f}")
-    print("(analysis: hexdem's loop / bare loop - 1, the in-run sampling's share; ratio: end to end / bare loop)")
-    for (beads, ranks, steps, version), r in results.items():
-        if version == "now":
-            before = results.get((beads, ranks, steps, "before"))
-            speed_up = f"; before / now {before['wall'] / r['wall']:.2f} x end to end" if before else ""
-            print(f"target {beads} beads, {ranks} rank(s), {steps} steps per contact: {verdicts(beads, ranks, r)}"
-                  f"{speed_up}")
-    print("sampled peak RSS [MB] of the processes above 20 MB (python = the CLI or an MPI rank):")
-    for (beads, ranks, steps, version), r in results.items():
-        print(f"  {beads} beads, {ranks} rank(s), {steps} steps per contact, {version}: {r['breakdown']}")
+    print(f"hexdem run (CLI) of hexagons for {duration:g} s, stage by stage [s], beside bare lmp -in {NOOUTPUT_NAME}")
+    print(f"{'beads':>9} {'ranks':>5} {'steps':>6} {'model [s]':>9} {'data file [s]':>13} {'bare loop [s]':>13} "
+          f"{'hexdem loop [s]':>15} {'analysis':>8} {'run [s]':>8} {'results [s]':>11} {'end-to-end [s]':>14}")
+    for (edge, n), r in results.items():
+        print(f"{r['beads']:>9,} {n:>5} {r['steps']:>6} {r['model']:>9.2f} {r['data file']:>13.2f} "
+              f"{r['bare loop']:>13.2f} {r['hexdem loop']:>15.2f} {r['hexdem loop'] / r['bare loop'] - 1:>8.2f} "
+              f"{r['run']:>8.2f} {r['results']:>11.2f} {r['wall']:>14.2f}")
+    print("(analysis: hexdem's loop / bare loop - 1; run: summary.json's wall_time_s, to the result files; "
+          "results: the result tables and figures)")
+    print(f"{'beads':>9} {'ranks':>5} {'largest process [MB]':>20} {'hexdem run [MB]':>15} "
+          f"{'collectives':>11} {'rebuilds':>8} {'audited':>7}  peak RSS per rank [MB]")
+    for (edge, n), r in results.items():
+        per_rank = ", ".join(f"{rss / MB:.0f}" for rss in r["ranks rss"])
+        print(f"{r['beads']:>9,} {n:>5} {r['largest'] / MB:>20.0f} {r['cli rss'] / MB:>15.0f} "
+              f"{r['collectives']:>11} {r['rebuilds']:>8} {r['audited']:>7}  {per_rank}")
+    for (edge, n), r in results.items():
+        bound = r["rebuilds"] + r["audited"] + COLLECTIVES_BESIDE
+        print(f"target collectives, {r['beads']:,} beads on {n} rank(s): {r['collectives']} "
+              f"{'<=' if r['collectives'] <= bound else '>'} {bound} (rebuilds + audited + {COLLECTIVES_BESIDE}): "
+              f"{'met' if r['collectives'] <= bound else 'NOT met'}")
+    for edge in edges:
+        peaks = [max(results[edge, n]["ranks rss"]) for n in ranks]
+        falling = all(b < a for a, b in zip(peaks, peaks[1:]))
+        print(f"target per-rank memory falls with ranks, {results[edge, ranks[0]]['beads']:,} beads: largest rank "
+              f"{' -> '.join(f'{p / MB:.0f}' for p in peaks)} MB on {', '.join(map(str, ranks))} ranks: "
+              f"{'met' if falling else 'NOT met'}")
+    for (edge, n), r in results.items():
+        if n == ranks[0]:
+            continue
+        reference = results[edge, ranks[0]]["tables"]
+        worst = max(table_mismatch(r["tables"][name], reference[name]) for name in TABLES)
+        print(f"target results, {r['beads']:,} beads on {n} vs {ranks[0]} rank(s): {' and '.join(TABLES)} within "
+              f"{worst:.2g} of round-off (rtol {RESULTS_RTOL:g}): {'met' if worst <= 1 else 'NOT met'}")
+    beads, n = MEMORY_TARGET_RUN
+    row = next((r for (edge, m), r in results.items() if r["beads"] == beads and m == n), None)
+    verdict = ("not measured (--edges 200 --ranks 8)" if row is None else
+               f"{row['largest'] / MB:.0f} {'<=' if row['largest'] <= MEMORY_TARGET else '>'} "
+               f"{MEMORY_TARGET / MB:.0f} MB: {'met' if row['largest'] <= MEMORY_TARGET else 'NOT met'}")
+    print(f"target largest process, {beads:,} beads on {n} ranks: {verdict}")
 
 
 if __name__ == "__main__":

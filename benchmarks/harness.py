@@ -1,5 +1,5 @@
-"""What the benchmarks share: the bare yardstick deck, config files for the CLI, bytes on disk,
-and a subprocess runner that records wall time and each process's peak resident memory.
+"""What the benchmarks share: the bare yardstick deck, config files for the CLI, and a subprocess
+runner that records wall time and each process's peak resident memory.
 
 **Peak RSS per process.** :func:`run_watched` starts the command and, until it exits, reads
 ``VmHWM`` (the kernel's high-water mark of resident memory) from ``/proc/<pid>/status`` of it
@@ -67,11 +67,6 @@ def write_config(config: RunConfig, path) -> Path:
     return path
 
 
-def tree_bytes(path) -> int:
-    """Total size of the files under ``path`` [bytes]."""
-    return sum(p.stat().st_size for p in Path(path).rglob("*") if p.is_file())
-
-
 def _children() -> dict[int, list[int]]:
     children: dict[int, list[int]] = {}
     for entry in os.scandir("/proc"):
@@ -110,23 +105,20 @@ def _status(pid: int) -> tuple[str, int] | None:
 @dataclass
 class Watched:
     """A finished command: ``wall_s``, ``returncode``, ``stderr``, ``peaks`` {pid: (name, VmHWM
-    bytes)} as last sampled, ``tree_maxrss`` the largest single-process peak from ``wait4``."""
+    bytes)} as last sampled, ``tree_maxrss`` the largest single-process peak from ``wait4``, ``pid``
+    the command's own process (its descendants are the others in ``peaks``)."""
 
     wall_s: float
     returncode: int
     stderr: str
     peaks: dict[int, tuple[str, int]] = field(default_factory=dict)
     tree_maxrss: int = 0
+    pid: int = 0
 
     @property
     def peak_per_process(self) -> int:
         """The largest peak resident memory of any one process of the command [bytes]."""
         return max([self.tree_maxrss, *(rss for _, rss in self.peaks.values())])
-
-    def breakdown(self, min_bytes: float = 20 * MB) -> str:
-        """The sampled peaks of the processes above ``min_bytes``, largest first, in MB."""
-        big = sorted((rss, name) for name, rss in self.peaks.values() if rss >= min_bytes)[::-1]
-        return ", ".join(f"{name} {rss / MB:.0f}" for rss, name in big) or "none sampled"
 
     def check(self, what: str) -> Watched:
         if self.returncode != 0:
@@ -161,4 +153,4 @@ def run_watched(command, cwd=None, env=None) -> Watched:
         process.returncode = os.waitstatus_to_exitcode(ended["status"])
         err.seek(0)
         stderr = err.read().decode(errors="replace")
-    return Watched(ended["time"] - start, process.returncode, stderr, peaks, ended["usage"].ru_maxrss * 1024)
+    return Watched(ended["time"] - start, process.returncode, stderr, peaks, ended["usage"].ru_maxrss * 1024, process.pid)

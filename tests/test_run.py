@@ -7,7 +7,7 @@ import pytest
 from conftest import read_csv
 
 from hexdem.analysis.impact import PEAK_COLUMNS
-from hexdem.experiments.run import BEAD_COLUMNS, RESULT_FILES, simulate
+from hexdem.experiments.run import BEAD_COLUMNS, RESULT_FILES, run_experiment, simulate
 from hexdem.model.config import RunConfig
 from hexdem.model.model_builder import build_model
 
@@ -84,6 +84,46 @@ def test_one_and_two_ranks_give_the_same_peaks(default_run, tmp_path):
     np.testing.assert_allclose(two.t_peak, one.t_peak, rtol=1e-9)
 
 
+def _numbers(path):
+    """(the text columns, the numeric columns as a float array) of a result table."""
+    header, rows = read_csv(path)
+    text = {key for key in header if any(not _is_number(row[key]) for row in rows)}
+    return ([[row[key] for key in header if key in text] for row in rows],
+            np.array([[float(row[key]) for key in header if key not in text] for row in rows]))
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _assert_same_tables(one, many) -> None:
+    """``peaks.csv`` and ``beads.csv`` in directories ``one`` and ``many`` equal to round-off."""
+    for name in ("peaks.csv", "beads.csv"):
+        (text_one, numbers_one), (text_many, numbers_many) = _numbers(one / name), _numbers(many / name)
+        assert text_many == text_one and numbers_many.shape == numbers_one.shape and len(numbers_one) > 20, name
+        np.testing.assert_allclose(numbers_many, numbers_one, rtol=1e-9, atol=1e-15, err_msg=name)
+
+
+def test_eight_ranks_write_the_peaks_and_beads_of_one(default_run, tmp_path):
+    """``peaks.csv`` and ``beads.csv`` of the default run on 8 ranks equal one rank's to round-off."""
+    run_experiment(RunConfig(ranks=8), tmp_path, log=lambda message: None)
+    _assert_same_tables(default_run[0], tmp_path)
+
+
+def test_beads_that_migrate_in_lammps_keep_their_pulses(tmp_path):
+    """A hard strike whose LAMMPS rebuilds its neighbour lists (when the ranks' atoms may migrate and
+    are sorted anew): ``peaks.csv`` and ``beads.csv`` on 4 ranks equal one rank's to round-off."""
+    config = RunConfig(edge_beads=8, v0=8.0, duration=6e-4)
+    run_experiment(config, tmp_path / "one", log=lambda message: None)
+    run_experiment(config.replace(ranks=4), tmp_path / "four", log=lambda message: None)
+    assert "Neighbor list builds = 0" not in (tmp_path / "four" / "deck" / "log.lammps").read_text()
+    _assert_same_tables(tmp_path / "one", tmp_path / "four")
+
+
 def test_nondimensional_deck_reproduces_the_si_run(default_run, tmp_path):
     si = default_run[1]
     nondim_config = RunConfig(units="nondimensional")
@@ -128,3 +168,12 @@ def test_config_file_sets_parameters(tmp_path):
     assert len(model.lattice) == 61 and model.has_striker
     np.testing.assert_allclose(model.impact.direction, [np.sqrt(3) / 2, 0.5])
     assert model.impact.speed_m_s == pytest.approx(0.05 * config.unit_system.velocity_m_s)
+
+
+def test_ranks_that_own_no_bead_take_part(tmp_path):
+    """Seven beads on 8 ranks (some own none of them): the same peaks as on one rank."""
+    config = RunConfig(edge_beads=2)
+    one = simulate(config, tmp_path / "one").results
+    eight = simulate(config.replace(ranks=8), tmp_path / "eight").results
+    np.testing.assert_allclose(eight.peak_speed, one.peak_speed, rtol=1e-9)
+    np.testing.assert_allclose(eight.arrival_time, one.arrival_time, rtol=1e-9)

@@ -1,5 +1,6 @@
 """The analysis inside the run against the analysis of a whole record (issue 10's accuracy)."""
 
+import os
 import tracemalloc
 from dataclasses import dataclass
 from pathlib import Path
@@ -8,25 +9,27 @@ import numpy as np
 import pytest
 from conftest import read_csv
 
+from hexdem.analysis.energy import EnergyAudit
 from hexdem.analysis.peaks import pulse_times
 from hexdem.analysis.tracker import PulseTracker
 from hexdem.cli.main import main
+from hexdem.engines.lammps.engine import LammpsEngine
 from hexdem.engines.sampling import Sample
 from hexdem.experiments.parallel import run_on_ranks
 from hexdem.experiments.run import RESULT_FILES, simulate
 from hexdem.model.config import RunConfig
 from hexdem.model.granular import RunSettings
 from hexdem.model.model_builder import build_model
+from hexdem.model.run_settings import run_settings
 
 
 class NoAudit:
-    """Synthetic speeds: no mechanics to audit."""
+    """Synthetic speeds: no mechanics to audit (one region, a constant energy)."""
 
-    def measure(self, positions, velocities, angular_velocities=None):
-        return 1.0, np.zeros((1, 2))
+    region_names = ["all"]
 
-    def rotational_j(self, angular_velocities):
-        return np.zeros(1)
+    def part(self, bodies, n_own, positions, velocities, angular_velocities=None):
+        return np.array([1.0, 0.0, 0.0, 0.0, 0.0])
 
 
 def test_streaming_agrees_with_hexdem_analyse_of_the_dump(dumped_run, tmp_path):
@@ -86,8 +89,9 @@ def test_tracker_reproduces_the_whole_record_definitions(n_samples):
 @dataclass(frozen=True)
 class MigratingBeads:
     """An MPI job (see :func:`~hexdem.experiments.parallel.run_on_ranks`): the synthetic speeds of
-    a 4-per-edge hexagon fed to one tracker across the ranks, every bead handed to a random rank
-    every ``every`` samples, as LAMMPS migrates atoms."""
+    a 4-per-edge hexagon fed to one tracker across the ranks, every bead handed to a random rank,
+    and each rank's beads shuffled, every ``every`` samples, as LAMMPS migrates and sorts atoms
+    when it rebuilds its neighbour lists (those samples alone say they may have migrated)."""
 
     n_samples: int = 300
     every: int = 7
@@ -98,28 +102,36 @@ class MigratingBeads:
         model = build_model(RunConfig(edge_beads=4))
         n, ranks = len(model.lattice), 1 if comm is None else comm.Get_size()
         speeds = _synthetic_speeds(times, n, rng)
-        owners = np.repeat(rng.integers(0, ranks, (self.n_samples // self.every + 1, n)), self.every, axis=0)
+        draws = self.n_samples // self.every + 1
+        owners = np.repeat(rng.integers(0, ranks, (draws, n)), self.every, axis=0)
+        orders = np.repeat([rng.permutation(n) for _ in range(draws)], self.every, axis=0)
         tracker = PulseTracker(model, RunSettings(dt_s=times[1], n_steps=self.n_samples - 1, dump_every=1), comm,
-                               threshold_speed=0.05)
-        if tracker.root:
-            tracker.audit = NoAudit()
+                               trace_beads=(0, 5, 17), field_samples=(10, 150), threshold_speed=0.05)
+        tracker.audit = NoAudit()
         rank = 0 if comm is None else comm.Get_rank()
         for s, row in enumerate(speeds):
-            ids = np.flatnonzero(owners[s] == rank) + 1
-            tracker(Sample(s, s, times[s], ids, np.zeros((len(ids), 2)), np.column_stack([row[ids - 1], np.zeros(len(ids))])))
+            ids = orders[s][owners[s][orders[s]] == rank] + 1
+            tracker(Sample(s, s, times[s], ids, np.zeros((len(ids), 2)), np.column_stack([row[ids - 1], np.zeros(len(ids))]),
+                           migrated=s % self.every == 0))
         return tracker.finish(), int(np.sum(owners[1:] != owners[:-1]))
 
 
 def test_beads_that_change_ranks_keep_their_pulses(tmp_path, monkeypatch):
     """The same speeds, tracked on one rank and on two between which every bead moves at random
-    every 7 samples (each bead's state handed over from its last owner): identical results."""
-    monkeypatch.setenv("PYTHONPATH", str(Path(__file__).parent))  # the ranks unpickle the job from here
+    every 7 samples (each bead's state handed over from its last owner): identical results, traces
+    and snapshot fields. One collective per such sample, one per audited sample and the final
+    gather; none at the other samples."""
+    # the ranks unpickle the job from here, with the hexdem this test imports
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(filter(None, [str(Path(__file__).parent), os.environ.get("PYTHONPATH")])))
     one, _ = MigratingBeads()(None)
     two, handed_over = run_on_ranks(MigratingBeads(), 2, tmp_path)
     assert handed_over > 500  # about half of 37 beads at each of 42 draws
     assert np.isfinite(one.arrival_time).sum() > 20 and np.isfinite(one.threshold_time).sum() > 20
-    for name in ("peak_speed", "t_peak", "arrival_time", "reach_time", "threshold_time"):
+    for name in ("peak_speed", "t_peak", "arrival_time", "reach_time", "threshold_time", "trace_speeds", "field_speeds"):
         np.testing.assert_array_equal(getattr(two, name), getattr(one, name), err_msg=name)
+    assert np.isfinite(two.trace_speeds).all() and np.isfinite(two.field_speeds).all()
+    assert one.collectives == 0
+    assert two.collectives == (300 - 1) // 7 + len(two.energy_times) + 1
 
 
 def test_the_tracker_records_when_each_bead_first_reaches_a_fixed_speed(tmp_path):
@@ -178,3 +190,51 @@ def test_an_earlier_small_pulse_just_above_half_the_peak_is_the_arrival():
     whole = pulse_times(np.arange(60.0), series[:, None])
     assert whole.arrival_time[0] == pytest.approx(7.96, abs=0.01)
     assert tracker.finish().arrival_time[0] == pytest.approx(whole.arrival_time[0], abs=0.2)
+
+
+@dataclass(frozen=True)
+class GatheredAudit:
+    """An MPI job: the default packing struck by a striker (a body of its own region), tracked
+    across the ranks, and beside the tracker's audit (each rank's part, summed) the audit of the
+    whole state gathered onto rank 0 at the same samples. Rank 0 returns (tracked, gathered
+    (T, R, 2) region energies, samples at which atoms may have changed ranks after the first)."""
+
+    directory: Path
+
+    def __call__(self, comm):
+        config = RunConfig(impact="striker", duration=3e-4)
+        model = build_model(config)
+        settings = run_settings(config, model)
+        tracker, audit = PulseTracker(model, settings, comm), EnergyAudit(model)
+        units, gathered, migrations = settings.units, [], []
+
+        def observe(sample):
+            tracker(sample)
+            migrations.append(sample.index > 0 and sample.migrated)
+            if sample.index % tracker.energy_every and sample.index != tracker.n_samples_expected - 1:
+                return
+            parts = comm.gather((sample.ids, sample.positions, sample.velocities), root=0)
+            if comm.Get_rank() == 0:
+                positions, velocities = np.empty((model.n_bodies, 2)), np.empty((model.n_bodies, 2))
+                for ids, x, v in parts:
+                    positions[ids - 1], velocities[ids - 1] = x, v
+                gathered.append(audit.measure(positions * units.length_m, velocities * units.velocity_m_s)[1])
+
+        LammpsEngine().run(model, settings, self.directory, observe, comm, show_progress=False)
+        tracked = tracker.finish()
+        return None if tracked is None else (tracked, np.array(gathered), sum(migrations))
+
+
+def test_the_energy_audit_summed_over_ranks_equals_the_gathered_one(tmp_path, monkeypatch):
+    """On 3 ranks each rank audits its own bodies, with half of each contact that crosses to another
+    rank: the parts' sum equals the audit of the whole gathered state to round-off, region by region
+    (the packing and the striker). Collectives: one per sample at which atoms may have changed ranks
+    (the first of the run, and after each rebuild of the neighbour lists), one per audited sample, and the
+    final gather."""
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(filter(None, [str(Path(__file__).parent), os.environ.get("PYTHONPATH")])))
+    tracked, gathered, migrations = run_on_ranks(GatheredAudit(tmp_path / "deck"), 3, tmp_path)
+    assert gathered.shape == tracked.region_energies.shape == (len(tracked.energy_times), 2, 2)
+    assert np.all(gathered[1:, 0, 1] > 0) and gathered[:, 1, 1].max() > 0, "contacts in both regions"
+    np.testing.assert_allclose(tracked.region_energies, gathered, rtol=1e-12, atol=1e-12 * gathered[0].sum())
+    assert migrations >= 1
+    assert tracked.collectives == migrations + len(tracked.energy_times) + 1

@@ -57,12 +57,18 @@ def _pair_contacts(positions_m, radii, candidates):
     return i[touching], j[touching], stiffness[touching], r_eff[touching], overlap[touching]
 
 
-def _wall_constants(model: GranularModel) -> list[tuple]:
-    """Per wall, (wall, members, their k_n against it, their radii, their contact radii R_eff: R
-    against a plane)."""
+def _wall_constants(model: GranularModel, bodies=None) -> list[tuple]:
+    """Per wall, (wall, its members' rows, their k_n against it, their radii, their contact radii
+    R_eff: R against a plane). ``bodies``: the body index of each row of the positions the
+    contacts are sought in (None: every body, row = body)."""
     radii = model.diameters_m / 2
-    return [(wall, wall.members, model.wall_stiffness_pa(wall.members), radii[wall.members],
-             wall.contact_radii_m(radii[wall.members])) for wall in model.walls]
+    constants = []
+    for wall in model.walls:
+        rows = wall.members if bodies is None else np.flatnonzero(np.isin(bodies, wall.members))
+        members = rows if bodies is None else bodies[rows]
+        constants.append((wall, rows, model.wall_stiffness_pa(members), radii[members],
+                          wall.contact_radii_m(radii[members])))
+    return constants
 
 
 def _wall_contacts(positions_m, walls) -> list[tuple]:
@@ -111,8 +117,14 @@ class EnergyAudit:
     not change during a run (masses, radii, regions, each wall's members and stiffness, the
     candidate pairs' stiffness) is worked out once, and the candidate contact pairs are kept
     between calls and searched again only after some body has moved half of
-    :data:`PAIR_SKIN_D` bead diameters, so a large packing costs a few vector operations per
-    state instead of a tree search.
+    :data:`PAIR_SKIN_D` bead diameters (or the bodies seen changed), so a large packing costs a
+    few vector operations per state instead of a tree search.
+
+    **A share of the bodies.** :meth:`part` audits the bodies one MPI rank owns, given also the
+    positions of its ghosts (the other ranks' bodies near its own, as LAMMPS keeps them): each
+    body's kinetic energy and external work, half of each of its contacts' Hertz energy (the
+    other half belongs to the other body's owner) and its wall contacts. The parts of all ranks
+    sum to the whole state's audit, to round-off.
     """
 
     def __init__(self, model: GranularModel, gravity_m_s2=None):
@@ -122,52 +134,54 @@ class EnergyAudit:
         self.inertia_kg_m2 = inertia_kg_m2(model)
         self.radii_m = model.diameters_m / 2
         self.skin_m = PAIR_SKIN_D * model.lattice.diameter_m
-        self.walls = _wall_constants(model)
         self.region_names, self.regions = energy_regions(model)
         gravity = np.zeros(2) if gravity_m_s2 is None else np.asarray(gravity_m_s2, float)
         self.external_n = model.external_forces_n() + self.masses_kg[:, None] * gravity
-        self._listed_at, self._candidates = None, None
+        self.everybody = np.arange(model.n_bodies)
+        self._listed, self._listed_at, self._candidates, self._walls = None, None, None, None
 
-    def _candidate_pairs(self, positions_m):
-        if self._listed_at is None or np.max(np.linalg.norm(positions_m - self._listed_at, axis=1)) > self.skin_m / 2:
-            self._listed_at = positions_m.copy()
-            pairs = _pairs(positions_m, 2 * self.radii_m.max() + self.skin_m)
-            self._candidates = _pair_constants(self.model, *pairs, self.radii_m)
-        return self._candidates
+    def _contacts(self, bodies, n_own: int, positions_m):
+        """(pairs, walls) of the touching contacts among the rows of ``positions_m`` (bodies
+        ``bodies``, the first ``n_own`` audited) with an audited body: pairs (i, j, k_n, R_eff, δ)
+        of rows, walls per wall (rows, k_n, R_eff, δ) of audited members."""
+        listed = self._listed is not None and n_own == self._listed[1] and np.array_equal(bodies, self._listed[0])
+        if not listed or np.max(np.linalg.norm(positions_m - self._listed_at, axis=1)) > self.skin_m / 2:
+            self._listed, self._listed_at = (bodies.copy(), n_own), positions_m.copy()
+            i, j = _pairs(positions_m, 2 * self.radii_m.max() + self.skin_m)
+            keep = (i < n_own) | (j < n_own)
+            i, j = i[keep], j[keep]
+            self._candidates = (i, j, *_pair_constants(self.model, bodies[i], bodies[j], self.radii_m)[2:])
+            self._walls = _wall_constants(self.model, bodies[:n_own])
+        return (_pair_contacts(positions_m, self.radii_m[bodies], self._candidates),
+                _wall_contacts(positions_m, self._walls))
 
-    def _contacts(self, positions_m):
-        return (_pair_contacts(positions_m, self.radii_m, self._candidate_pairs(positions_m)),
-                _wall_contacts(positions_m, self.walls))
-
-    def rotational_j(self, angular_velocities_s) -> np.ndarray:
-        """(n_bodies,) ½ I ω² [J] of spins ω_z [rad/s] (None: spheres that do not turn, 0)."""
-        if angular_velocities_s is None:
-            return np.zeros(len(self.masses_kg))
-        return 0.5 * self.inertia_kg_m2 * np.asarray(angular_velocities_s, float) ** 2
-
-    def _kinetic_j(self, velocities_m_s, angular_velocities_s) -> np.ndarray:
-        """(n_bodies,) ½ M v² + ½ I ω² [J] of each body."""
-        translational = 0.5 * self.masses_kg * np.sum(np.asarray(velocities_m_s, float) ** 2, axis=1)
-        return translational + self.rotational_j(angular_velocities_s)
-
-    def _total(self, positions_m, kinetic_j, pairs, walls) -> float:
-        energy = float(np.sum(kinetic_j)) + hertz_energy_j(*pairs[2:]) + _wall_energy_j(walls)
-        return energy - float(np.sum((positions_m - self.start_m) * self.external_n))
+    def part(self, bodies, n_own: int, positions_m, velocities_m_s, angular_velocities_s=None) -> np.ndarray:
+        """The audit's sums over the bodies ``bodies[:n_own]`` (indices; the rest are ghosts, see the
+        class docstring) at ``positions_m`` (len(bodies), 2), ``velocities_m_s`` and spins ω_z
+        (n_own,) [rad/s] (None: spheres that do not turn): [total energy, translational kinetic,
+        rotational kinetic, then the (R, 2) kinetic and contact energy of each
+        :func:`energy_regions` region, flattened] [J], to be summed over the ranks."""
+        bodies, positions_m = np.asarray(bodies), np.asarray(positions_m, float)
+        own = bodies[:n_own]
+        pairs, walls = self._contacts(bodies, n_own, positions_m)
+        translational = 0.5 * self.masses_kg[own] * np.sum(np.asarray(velocities_m_s, float) ** 2, axis=1)
+        rotational = (np.zeros(n_own) if angular_velocities_s is None
+                      else 0.5 * self.inertia_kg_m2[own] * np.asarray(angular_velocities_s, float) ** 2)
+        by_region = _region_energies_j(translational + rotational, self.regions[bodies], len(self.region_names), n_own,
+                                       pairs, walls)
+        external = float(np.sum((positions_m[:n_own] - self.start_m[own]) * self.external_n[own]))
+        return np.concatenate([[float(np.sum(by_region)) - external, float(np.sum(translational)),
+                                float(np.sum(rotational))], by_region.ravel()])
 
     def __call__(self, positions_m, velocities_m_s, angular_velocities_s=None) -> float:
-        positions_m = np.asarray(positions_m, float)
-        return self._total(positions_m, self._kinetic_j(velocities_m_s, angular_velocities_s),
-                           *self._contacts(positions_m))
+        return self.measure(positions_m, velocities_m_s, angular_velocities_s)[0]
 
     def measure(self, positions_m, velocities_m_s, angular_velocities_s=None) -> tuple[float, np.ndarray]:
-        """(the total energy [J] as :meth:`__call__` gives it, (R, 2) kinetic (translational and
-        rotational) and contact energy [J] of each :func:`energy_regions` region), from one search
-        of the contacts."""
-        positions_m = np.asarray(positions_m, float)
-        pairs, walls = self._contacts(positions_m)
-        kinetic = self._kinetic_j(velocities_m_s, angular_velocities_s)
-        return (self._total(positions_m, kinetic, pairs, walls),
-                _region_energies_j(kinetic, self.regions, len(self.region_names), pairs, walls))
+        """(the total energy [J] of the whole state, (R, 2) kinetic (translational and rotational)
+        and contact energy [J] of each :func:`energy_regions` region), from one search of the
+        contacts."""
+        sums = self.part(self.everybody, len(self.everybody), positions_m, velocities_m_s, angular_velocities_s)
+        return float(sums[0]), sums[3:].reshape(len(self.region_names), 2)
 
 
 def energy_regions(model: GranularModel) -> tuple[list[str], np.ndarray]:
@@ -180,18 +194,22 @@ def energy_regions(model: GranularModel) -> tuple[list[str], np.ndarray]:
     return names, regions
 
 
-def _region_energies_j(kinetic_j, regions, n_regions: int, pairs, walls) -> np.ndarray:
-    """(R, 2) kinetic and contact energy [J] of each region (``regions``: each body's, from
-    :func:`energy_regions`; ``kinetic_j`` each body's): a contact's Hertz energy half to each of its
-    bodies' regions, a wall contact's to its bead's."""
+def _region_energies_j(kinetic_j, regions, n_regions: int, n_own: int, pairs, walls) -> np.ndarray:
+    """(R, 2) kinetic and contact energy [J] of each region of the first ``n_own`` rows
+    (``regions``: each row's, from :func:`energy_regions`; ``kinetic_j`` each of those rows'): a
+    contact's Hertz energy half to each of its bodies' regions (only the halves of those rows),
+    a wall contact's to its bead's."""
 
     def by_region(bodies, energies) -> np.ndarray:  # (float even when empty, unlike bincount's)
         return np.bincount(bodies, energies, n_regions).astype(float)
 
-    kinetic = by_region(regions, kinetic_j)
+    kinetic = by_region(regions[:n_own], kinetic_j)
     i, j, *pair = pairs
     halves = _hertz_energies_j(*pair) / 2
-    contact = by_region(regions[i], halves) + by_region(regions[j], halves)
+    contact = np.zeros(n_regions)
+    for side in (i, j):
+        own = side < n_own
+        contact += by_region(regions[side[own]], halves[own])
     for beads, *wall in walls:
         contact += by_region(regions[beads], _hertz_energies_j(*wall))
     return np.column_stack([kinetic, contact])

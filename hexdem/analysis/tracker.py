@@ -19,13 +19,18 @@ every sample (pulse shapes for the theory), the speed of every bead at the sampl
 ``field_samples`` (wavefront snapshots), and, given a ``threshold_speed``, the first time each
 bead's speed reaches it (a second measure of the front, interpolated linearly between samples).
 
-**Several ranks.** Under MPI every rank owns some atoms and sees only those. Each rank keeps
-state arrays for all beads but updates only its own; the state of a bead is exact on the
-rank that owns it. When atoms change ranks (LAMMPS migrates them when it rebuilds its
-neighbour lists) each migrated bead's state is handed from its previous owner to its new one
-before the new sample is taken (only those beads' rows travel); :meth:`finish` brings every
-bead's state from its owner onto rank 0, which alone returns the results. The energy audit and
-the snapshot fields gather whole states onto rank 0.
+**Several ranks.** Under MPI every rank owns some atoms and sees only those, and keeps state
+for those beads only, one row each, in the order of the engine's samples, so that per-rank memory
+follows the rank's own beads. When atoms change ranks (LAMMPS migrates them, and reorders them,
+only when it rebuilds its neighbour lists, which a sample says:
+:attr:`~hexdem.engines.sampling.Sample.migrated`), the rows are laid out anew before the sample
+is taken: the beads a rank kept keep their rows, and each bead that left hands its row to its new
+owner in one collective (only those beads' rows travel). A sample at which nothing can have
+migrated takes no collective. The energy audit sums each rank's part
+(:meth:`~hexdem.analysis.energy.EnergyAudit.part`: its own bodies, with its ghosts for the
+contacts that cross ranks) onto rank 0 in one small Reduce per audited sample. :meth:`finish`
+works out each bead's results on its owner and gathers them, with the traces, sensors and
+snapshot fields each rank took, onto rank 0 in one collective; rank 0 alone returns the results.
 """
 
 from __future__ import annotations
@@ -34,7 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hexdem.analysis.energy import EnergyAudit, energy_error, energy_regions, energy_scale_j, kinetic_energy_j
+from hexdem.analysis.energy import EnergyAudit, energy_error, energy_regions, energy_scale_j
 from hexdem.analysis.peaks import refine_peak, refine_peaks
 from hexdem.analysis.tracker_kernel import PulseState
 from hexdem.engines.sampling import Sample
@@ -68,7 +73,8 @@ class TrackedPulses:
     there, each bead's |ω_z| r, the speed its rim turns at (empty, (0, N), for spheres that do
     not turn); ``sensor_times`` (K,) and
     ``sensor_states`` (K, n_sensors, 4): vx, vy, ax, ay of the model's sensor beads every
-    ``settings.sensor_every`` steps. ``peak_angular_speed`` (N,) each bead's largest |ω_z| (0 for
+    ``settings.sensor_every`` steps. ``collectives`` the MPI collective operations the tracker took
+    part in (each rank takes part in the same ones; 0 on one rank). ``peak_angular_speed`` (N,) each bead's largest |ω_z| (0 for
     spheres that do not turn); ``rotational_energy_fraction`` the largest share of the kinetic and
     contact energy held in rotation at the audited times; ``end_velocity`` (N, 2) each bead's
     velocity at the last sample (a rebound's outgoing velocity).
@@ -95,6 +101,7 @@ class TrackedPulses:
     peak_angular_speed: np.ndarray
     rotational_energy_fraction: float
     end_velocity: np.ndarray
+    collectives: int = 0
 
 
 class PulseTracker:
@@ -111,16 +118,14 @@ class PulseTracker:
                  field_samples=(), gravity_m_s2=None, threshold_speed: float | None = None):
         self.model, self.settings, self.comm = model, settings, comm
         self.root = comm is None or comm.Get_rank() == 0
-        n, total = len(model.lattice), settings.n_samples
-        self.n_beads, self.n_bodies, self.n_samples_expected = n, model.n_bodies, total
-        self.pulses = PulseState(n, RECORD_CAPACITY)
-        self.peak_spin = np.zeros(n)
-        self.end_velocity = np.zeros((n, 2))
+        self.several = comm is not None and comm.Get_size() > 1
+        total = settings.n_samples
+        self.n_beads, self.n_samples_expected = len(model.lattice), total
         if threshold_speed is not None and not threshold_speed > 0:
             raise HexdemError(f"the threshold speed must be > 0, got {threshold_speed!r}")
         self.threshold_speed = threshold_speed
-        self.threshold_index, self.previous_speed = np.full(n, np.nan), np.zeros(n)
-        self.owned = np.zeros(n, dtype=np.bool_)
+        self.sample_ids, self.ids = None, np.zeros(0, dtype=np.int64)  # (no sample yet)
+        self._start_rows(0)
         self.trace_beads = np.asarray(trace_beads, dtype=np.int64)
         self.traces = np.full((total, len(self.trace_beads)), np.nan)
         self.sensor_beads = np.asarray(model.sensor_beads, dtype=np.int64)
@@ -128,91 +133,103 @@ class PulseTracker:
         n_sensed = settings.n_steps // settings.sensor_every + 1 if settings.sensor_every else 0
         self.sensors = np.full((n_sensed, len(self.sensor_beads), 4), np.nan)
         self.field_samples = np.asarray(sorted(field_samples), dtype=np.int64)
-        self.fields = np.full((len(self.field_samples), n), np.nan)
-        self.rim_fields = np.full((len(self.field_samples) if model.laws.tangential else 0, n), np.nan)
-        self.radii = model.lattice.diameters_m[:n] / 2 / settings.units.length_m
+        self.field_parts = []
         self.energy_every = max(1, (total - 1) // ENERGY_SAMPLES)
-        self.audit = EnergyAudit(model, gravity_m_s2) if self.root else None
+        self.audit = EnergyAudit(model, gravity_m_s2)
         self.energies, self.energy_times, self.impact_energy, self.region_energies = [], [], None, []
         self.rotational_energies = []
         self.count = 0
+        self.collectives = 0
 
-    # ---- state shared across ranks
+    def _collective(self, name: str, *args, **kwargs):
+        """``comm.<name>(*args, **kwargs)``, counted in :attr:`TrackedPulses.collectives`: every
+        collective the analysis takes goes through here."""
+        self.collectives += 1
+        return getattr(self.comm, name)(*args, **kwargs)
+
+    # ---- this rank's beads
+    def _start_rows(self, n: int) -> None:
+        """State for ``n`` beads as before their first sample."""
+        self.pulses = PulseState(n, RECORD_CAPACITY)
+        self.peak_spin, self.end_velocity = np.zeros(n), np.zeros((n, 2))
+        self.threshold_index, self.previous_speed = np.full(n, np.nan), np.zeros(n)
+
     def _bead_state(self) -> list[np.ndarray]:
-        """Every per-bead array that the bead's owner keeps up to date."""
+        """Every per-bead array, row by row this rank's beads (:attr:`ids`)."""
         return [*self.pulses.arrays(), self.peak_spin, self.threshold_index, self.previous_speed, self.end_velocity]
 
-    def _hand_over(self, owned: np.ndarray) -> None:
-        """Give each bead that changed ranks since the last sample (``owned``: this rank's beads
-        now) its state from the rank that owned it until now: only those beads' rows travel."""
-        arrays = self._bead_state()
-        left = np.flatnonzero(self.owned & ~owned)
-        arrived = owned & ~self.owned
-        for beads, rows in self.comm.allgather((left, [array[left] for array in arrays])):
-            mine = beads[arrived[beads]]
-            for array, values in zip(arrays, rows):
-                array[mine] = values[arrived[beads]]
+    def _rows_of(self, ids: np.ndarray, among: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(mask of ``ids`` found in ``among``, their positions there)."""
+        if not len(among):
+            return np.zeros(len(ids), dtype=np.bool_), np.zeros(0, dtype=np.int64)
+        order = np.argsort(among)
+        at = np.minimum(np.searchsorted(among, ids, sorter=order), len(among) - 1)
+        found = among[order[at]] == ids
+        return found, order[at[found]]
 
-    def _collect(self) -> None:
-        """Bring every bead's state to rank 0 from its owner for the results; each sample of a
-        trace or field was taken by exactly one rank (NaN elsewhere)."""
-        from mpi4py import MPI
-
-        arrays = self._bead_state()
-        mine = np.flatnonzero(self.owned)
-        parts = self.comm.gather((mine, [array[mine] for array in arrays]), root=0)
-        for beads, rows in parts if self.root else ():
-            for array, values in zip(arrays, rows):
-                array[beads] = values
-        for array in (self.traces, self.fields, self.rim_fields, self.sensors):
-            taken = np.isfinite(array).astype(np.int64)
-            counts = np.empty_like(taken) if self.root else None
-            self.comm.Reduce(taken, counts, op=MPI.SUM, root=0)
-            self.comm.Reduce(np.nan_to_num(array, nan=0.0), array if self.root else None, op=MPI.SUM, root=0)
-            if self.root:
-                array[counts == 0] = np.nan
-
-    def _gather(self, ids, values):
-        """(n_bodies, k) ``values`` of all bodies on rank 0 (None elsewhere)."""
-        parts = [(ids, values)] if self.comm is None else self.comm.gather((ids, values), root=0)
-        if not self.root:
-            return None
-        whole = np.empty((self.n_bodies,) + values.shape[1:])
-        for part_ids, part_values in parts:
-            whole[part_ids - 1] = part_values
-        return whole
+    def _arrange(self, sample: Sample) -> None:
+        """Lay this rank's rows out as its beads in ``sample`` (possibly migrated, see
+        :attr:`~hexdem.engines.sampling.Sample.migrated`): the beads it kept keep their state, those
+        that left hand theirs to the other ranks in one collective (only their rows travel), and
+        those that arrived take it from there. A rank whose bodies are those of its previous sample, in
+        the same order, keeps its rows as they are (and hands nothing over)."""
+        if self.sample_ids is not None and np.array_equal(sample.ids, self.sample_ids):
+            if self.several and sample.index > 0:  # the others may hand their beads over to each other
+                self._collective("allgather", (self.ids[:0], []))
+            return
+        beads = np.flatnonzero(sample.ids <= self.n_beads)
+        ids = sample.ids[beads]
+        kept, rows = self._rows_of(ids, self.ids)
+        left = np.ones(len(self.ids), dtype=np.bool_)
+        left[rows] = False
+        old = self._bead_state()
+        self._start_rows(len(ids))
+        new = self._bead_state()
+        for array, values in zip(new, old):
+            array[kept] = values[rows]
+        if self.several and sample.index > 0:
+            arrived = np.flatnonzero(~kept)
+            missing = np.ones(len(arrived), dtype=np.bool_)
+            for their_ids, their_rows in self._collective("allgather", (self.ids[left], [a[left] for a in old])):
+                found, at = self._rows_of(ids[arrived], their_ids)
+                missing &= ~found
+                for array, values in zip(new, their_rows):
+                    array[arrived[found]] = values[at]
+            if missing.any():
+                raise HexdemError(f"bead {ids[arrived[missing]][0]} came to rank {self.comm.Get_rank()} at sample "
+                                  f"{sample.index} from no rank: its pulse state is lost")
+        self.sample_ids, self.bead_rows, self.ids = sample.ids.copy(), beads, ids
+        self.trace_here, self.trace_rows = self._rows_of(self.trace_beads + 1, ids)
+        self.sensors_here, self.sensor_rows = self._rows_of(self.sensor_beads + 1, ids)
 
     # ---- observing
     def __call__(self, sample: Sample) -> None:
         s = sample.index
-        beads = sample.ids <= self.n_beads
-        index = sample.ids[beads] - 1
-        speeds = np.hypot(sample.velocities[beads, 0], sample.velocities[beads, 1])
-        if self.comm is not None and self.comm.Get_size() > 1:
-            owned = np.zeros(self.n_beads, dtype=np.bool_)
-            owned[index] = True
-            moved = s > 0 and not np.array_equal(owned, self.owned)
-            if self.comm.allreduce(moved):
-                self._hand_over(owned)
-            self.owned = owned
-        else:
-            self.owned[index] = True
+        if sample.migrated:
+            self._arrange(sample)
+        elif not np.array_equal(sample.ids, self.sample_ids):
+            raise HexdemError(f"sample {s} reordered the bodies of rank {0 if self.comm is None else self.comm.Get_rank()} "
+                              "without saying that they may have migrated")
+        index = np.arange(len(self.ids))
+        velocities = sample.velocities[self.bead_rows]
+        speeds = np.hypot(velocities[:, 0], velocities[:, 1])
         self.pulses.update(index, speeds, s)
-        self.end_velocity[index] = sample.velocities[beads]
+        self.end_velocity[:] = velocities
         if self.threshold_speed is not None:
             self._cross_threshold(index, speeds, s)
-        if sample.angular_velocities is not None:
-            self.peak_spin[index] = np.maximum(self.peak_spin[index], np.abs(sample.angular_velocities[beads]))
+        spins = None if sample.angular_velocities is None else np.abs(sample.angular_velocities[self.bead_rows])
+        if spins is not None:
+            np.maximum(self.peak_spin, spins, out=self.peak_spin)
         if len(self.trace_beads):
-            here, rows = self._rows(sample, self.trace_beads)
-            self.traces[s, here] = np.hypot(sample.velocities[rows, 0], sample.velocities[rows, 1])
+            self.traces[s, self.trace_here] = speeds[self.trace_rows]
         if self.sensor_every and sample.step % self.sensor_every == 0 and len(self.sensor_beads):
-            self._sense(sample)
+            rows = self.bead_rows[self.sensor_rows]
+            self.sensors[sample.step // self.sensor_every, self.sensors_here] = np.hstack(
+                [sample.velocities[rows], sample.accelerations[rows]])
         if s in self.field_samples:
-            self.fields[np.searchsorted(self.field_samples, s), index] = speeds
-            if len(self.rim_fields):
-                self.rim_fields[np.searchsorted(self.field_samples, s), index] = (
-                    np.abs(sample.angular_velocities[beads]) * self.radii[index])
+            radii = self.model.lattice.diameters_m[self.ids - 1] / 2 / self.settings.units.length_m
+            rims = spins * radii if self.model.laws.tangential else None
+            self.field_parts.append((np.searchsorted(self.field_samples, s), self.ids, speeds, rims))
         if s % self.energy_every == 0 or s == self.n_samples_expected - 1:
             self._audit(sample)
         self.count = s + 1
@@ -227,35 +244,33 @@ class PulseTracker:
             self.threshold_index[beads] = np.maximum(s - (now - self.threshold_speed) / (now - before), 0.0)
         self.previous_speed[index] = speeds
 
-    def _rows(self, sample: Sample, beads: np.ndarray):
-        """(mask of ``beads`` this rank owns, their rows in ``sample``)."""
-        row = np.full(self.n_bodies + 1, -1, dtype=np.int64)
-        row[sample.ids] = np.arange(len(sample.ids))
-        rows = row[beads + 1]
-        return rows >= 0, rows[rows >= 0]
-
-    def _sense(self, sample: Sample) -> None:
-        """Velocity and acceleration of the sensor beads this rank owns, at a sensor sample."""
-        here, rows = self._rows(sample, self.sensor_beads)
-        self.sensors[sample.step // self.sensor_every, here] = np.hstack(
-            [sample.velocities[rows], sample.accelerations[rows]])
-
     def _audit(self, sample: Sample) -> None:
-        spins = () if sample.angular_velocities is None else (sample.angular_velocities[:, None],)
-        state = self._gather(sample.ids, np.hstack([sample.positions, sample.velocities, *spins]))
-        if state is not None:
-            units = self.settings.units
-            velocities = state[:, 2:4] * units.velocity_m_s
-            angular = state[:, 4] / units.time_s if spins else None
+        """This rank's part of the energy audit (its bodies, with its ghosts' positions for the
+        contacts that cross to another rank), summed onto rank 0 in one small Reduce."""
+        units = self.settings.units
+        bodies, positions = sample.ids - 1, sample.positions
+        if sample.ghost_ids is not None:
+            bodies = np.concatenate([bodies, sample.ghost_ids - 1])
+            positions = np.concatenate([positions, sample.ghost_positions])
+        angular = None if sample.angular_velocities is None else sample.angular_velocities / units.time_s
+        part = self.audit.part(bodies, len(sample.ids), positions * units.length_m,
+                               sample.velocities * units.velocity_m_s, angular)
+        if self.comm is not None and self.comm.Get_size() > 1:
+            from mpi4py import MPI
+
+            whole = np.empty_like(part) if self.root else None
+            self._collective("Reduce", part, whole, op=MPI.SUM, root=0)
+            part = whole
+        if self.root:
+            energy, translational, rotational, by_region = part[0], part[1], part[2], part[3:]
             if self.impact_energy is None:
-                self.impact_energy = kinetic_energy_j(velocities, self.model) + self._displacement_energy_j(angular)
-            energy, by_region = self.audit.measure(state[:, :2] * units.length_m, velocities, angular)
-            self.energies.append(energy)
-            self.region_energies.append(by_region)
-            self.rotational_energies.append(float(np.sum(self.audit.rotational_j(angular))))
+                self.impact_energy = translational + self._displacement_energy_j()
+            self.energies.append(float(energy))
+            self.region_energies.append(by_region.reshape(len(self.audit.region_names), 2))
+            self.rotational_energies.append(float(rotational))
             self.energy_times.append(sample.time)
 
-    def _displacement_energy_j(self, angular) -> float:
+    def _displacement_energy_j(self) -> float:
         """The contact energy [J] the initial state's displacements add to the packed state's:
         with the kinetic energy, what the run was given (0 without displacements)."""
         state = self.model.initial_state
@@ -264,18 +279,15 @@ class PulseTracker:
         moved = self.model.initial_positions_m()
         packed = moved.copy()
         packed[:len(state.displacements_m)] -= state.displacements_m
-        still, spins = np.zeros_like(moved), None if angular is None else np.zeros_like(angular)
-        return self.audit.measure(moved, still, spins)[0] - self.audit.measure(packed, still, spins)[0]
+        still = np.zeros_like(moved)
+        return self.audit(moved, still) - self.audit(packed, still)
 
     # ---- results
-    def finish(self) -> TrackedPulses | None:
-        """The results on rank 0 (None on the other ranks); see :class:`TrackedPulses`."""
-        if self.comm is not None and self.comm.Get_size() > 1:
-            self._collect()
-        if not self.root:
-            return None
+    def _own_results(self) -> np.ndarray:
+        """(n, 8) per bead of this rank (:attr:`ids`): peak speed, time of peak, arrival and reach
+        times, threshold time, largest |ω_z|, last velocity (vx, vy)."""
         interval = self.settings.dump_every * self.settings.dt_s / self.settings.units.time_s
-        peak, t_peak, arrival, reach = (np.full(self.n_beads, np.nan) for _ in range(4))
+        peak, t_peak, arrival, reach = (np.full(len(self.ids), np.nan) for _ in range(4))
         state = self.pulses
         moved = state.peak > 0.0
         peak[~moved] = 0.0
@@ -292,21 +304,46 @@ class PulseTracker:
                 valid = (index >= 0) & (index < self.count) & np.isfinite(state.window[b])
                 t_peak[b], peak[b] = refine_peak(index[valid] * interval, state.window[b, valid])
             arrival[b] = reach[b] = interval * state.first_crossing(b, 0.5 * peak[b])
+        return np.column_stack([peak, t_peak, arrival, reach, self.threshold_index * interval, self.peak_spin,
+                                self.end_velocity])
+
+    def finish(self) -> TrackedPulses | None:
+        """The results on rank 0 (None on the other ranks); see :class:`TrackedPulses`. Each rank
+        works out its own beads' results; rank 0 gathers them, with the traces, sensors and snapshot
+        fields each rank took, in one collective."""
+        mine = (self.ids, self._own_results(), self.traces, self.sensors, self.field_parts)
+        parts = self._collective("gather", mine, root=0) if self.several else [mine]
+        if not self.root:
+            return None
+        beads = np.full((self.n_beads, 8), np.nan)
+        traces, sensors = self.traces, self.sensors
+        fields = np.full((len(self.field_samples), self.n_beads), np.nan)
+        rim_fields = np.full((len(self.field_samples) if self.model.laws.tangential else 0, self.n_beads), np.nan)
+        for ids, results, their_traces, their_sensors, their_fields in parts:
+            beads[ids - 1] = results
+            traces = np.where(np.isnan(traces), their_traces, traces)
+            sensors = np.where(np.isnan(sensors), their_sensors, sensors)
+            for slot, field_ids, speeds, rims in their_fields:
+                fields[slot, field_ids - 1] = speeds
+                if rims is not None:
+                    rim_fields[slot, field_ids - 1] = rims
+        interval = self.settings.dump_every * self.settings.dt_s / self.settings.units.time_s
         scale = energy_scale_j(self.energies, self.impact_energy)
-        return TrackedPulses(peak_speed=peak, t_peak=t_peak, arrival_time=arrival, reach_time=reach,
+        return TrackedPulses(peak_speed=beads[:, 0], t_peak=beads[:, 1], arrival_time=beads[:, 2], reach_time=beads[:, 3],
                              energy_drift=energy_error(self.energies, self.impact_energy, self.model.dissipative),
                              energy_lost=(self.energies[0] - self.energies[-1]) / scale,
                              energy_times=np.array(self.energy_times),
                              region_energies=np.array(self.region_energies).reshape(
                                  len(self.energy_times), len(energy_regions(self.model)[0]), 2),
                              n_samples=self.count, trace_beads=self.trace_beads,
-                             trace_times=np.arange(self.count) * interval, trace_speeds=self.traces[:self.count],
-                             field_times=self.field_samples * interval, field_speeds=self.fields,
-                             field_rim_speeds=self.rim_fields, threshold_time=self.threshold_index * interval,
-                             sensor_times=np.arange(len(self.sensors)) * self.sensor_every * self.settings.dt_s
-                             / self.settings.units.time_s, sensor_states=self.sensors,
-                             peak_angular_speed=self.peak_spin, end_velocity=self.end_velocity,
-                             rotational_energy_fraction=rotational_share(self.rotational_energies, self.region_energies))
+                             trace_times=np.arange(self.count) * interval, trace_speeds=traces[:self.count],
+                             field_times=self.field_samples * interval, field_speeds=fields,
+                             field_rim_speeds=rim_fields, threshold_time=beads[:, 4],
+                             sensor_times=np.arange(len(sensors)) * self.sensor_every * self.settings.dt_s
+                             / self.settings.units.time_s, sensor_states=sensors,
+                             peak_angular_speed=beads[:, 5], end_velocity=beads[:, 6:8],
+                             rotational_energy_fraction=rotational_share(self.rotational_energies, self.region_energies),
+                             collectives=self.collectives)
 
 
 def rotational_share(rotational_j, region_energies_j) -> float:

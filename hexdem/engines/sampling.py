@@ -23,6 +23,13 @@ class Sample:
     ``accelerations`` (n, 2), total force / mass, only at the sensor samples (every
     ``settings.sensor_every`` steps), else None; ``angular_velocities`` (n,) ω_z, the spins of a
     frictional model's spheres (None: the engine gives none; frictionless spheres never turn).
+
+    Under MPI: ``migrated`` False promises that every rank owns the same bodies as at its previous
+    sample, in the same order (LAMMPS moves atoms between ranks, and reorders them, only when it
+    rebuilds its neighbour lists), the same on every rank; True (the default) that they may have
+    changed. ``ghost_ids`` and ``ghost_positions`` (g, 2): the other ranks' bodies that this rank
+    keeps copies of at ``step`` (LAMMPS's ghost atoms: all those within contact of its own);
+    None: none (one rank).
     """
 
     index: int
@@ -33,4 +40,7 @@ class Sample:
     velocities: np.ndarray
     accelerations: np.ndarray | None = None
     angular_velocities: np.ndarray | None = None
+    migrated: bool = True
+    ghost_ids: np.ndarray | None = None
+    ghost_positions: np.ndarray | None = None
 

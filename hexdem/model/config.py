@@ -46,11 +46,14 @@ STEPS_PER_CONTACT = 140
 #: grows as dt²: about 4e-5 at 140 steps, 1e-3 at about 30).
 MIN_STEPS_PER_CONTACT = 20
 #: Memory a run needs on each process, a conservative bound: a fixed part (Python, NumPy, SciPy,
-#: numba, LAMMPS and the plotting libraries loaded) and a part per bead (LAMMPS's atoms and
-#: neighbour lists, the lattice, the tracker's state). benchmarks/bench_scale.py measured
-#: 267 MB at 331 beads and 313 MB at 29,701 (about 2 kB per bead).
+#: numba, LAMMPS and the plotting libraries loaded), a part per bead that every process holds (the
+#: packing and model, and rank 0's final results) and a part per bead of its own (LAMMPS's atoms
+#: and neighbour lists, the tracker's rows), its share of the beads. benchmarks/bench_scale.py
+#: measured 208 MB per process at 119,401 beads on 8 ranks (464 MB on 2) and 1,337 MB at
+#: 1,000,519 beads on 8: about 6 kB per own bead and 0.5 kB per bead in all.
 MEMORY_BASE_BYTES = 400e6
-MEMORY_PER_BEAD_BYTES = 8e3
+MEMORY_PER_BEAD_BYTES = 1e3
+MEMORY_PER_OWN_BEAD_BYTES = 8e3
 
 
 @dataclass(frozen=True)
@@ -182,10 +185,12 @@ class RunConfig:
             self.material(self.wall_material)
 
     def memory_estimate_bytes(self) -> float | None:
-        """Peak memory of the run on each of its processes [bytes] (see MEMORY_PER_BEAD_BYTES),
-        for the shapes :meth:`n_beads` counts; None for the others."""
+        """Peak memory of the run on each of its processes [bytes] (see MEMORY_PER_BEAD_BYTES and
+        MEMORY_PER_OWN_BEAD_BYTES), for the shapes :meth:`n_beads` counts; None for the others."""
         beads = self.n_beads()
-        return None if beads is None else MEMORY_BASE_BYTES + MEMORY_PER_BEAD_BYTES * beads
+        ranks = self.ranks if self.engine == "lammps" else 1
+        return (None if beads is None else
+                MEMORY_BASE_BYTES + MEMORY_PER_BEAD_BYTES * beads + MEMORY_PER_OWN_BEAD_BYTES * beads / ranks)
 
     def _check_size(self) -> None:
         """Refuse a packing counted without building it (:meth:`n_beads`) that this machine's

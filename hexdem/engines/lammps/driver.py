@@ -15,8 +15,12 @@ the default deck: bit-identical to reading the velocities between chunked ``run`
 A frictional model's spins are completed alike from the torques (``fix nve/sphere``).
 
 On several ranks the same driver runs in every rank of ``comm`` (an ``mpi4py``
-communicator, under ``mpiexec``): each rank sees its own atoms, and the observer decides
-what to reduce.
+communicator, under ``mpiexec``): each rank sees its own atoms, with the positions of its ghost
+atoms (the other ranks' atoms within reach of its own), and the observer decides what to reduce.
+Each sample says whether atoms may have changed ranks since the previous one: LAMMPS moves
+(and reorders) atoms only when it rebuilds its neighbour lists, on every rank at the same step,
+and counts the rebuilds (the thermo keyword ``nbuild``, read locally without communication),
+so a sample whose count is unchanged keeps every rank's atoms and their order.
 """
 
 from __future__ import annotations
@@ -71,6 +75,7 @@ class _Stream:
         self.sensor_every = deck.settings.sensor_every
         self.bar = progress_bar(deck.settings.n_steps, "LAMMPS", unit="step") if show_progress else None
         self.error: BaseException | None = None
+        self.builds = None  # neighbour list builds at the previous sample (None: it came before this run)
 
     def per_atom(self, name: str, n: int, columns: int = 3) -> np.ndarray:
         """A view of per-atom property ``name`` of the first ``n`` local atoms, (n, columns) or (n,)
@@ -85,6 +90,12 @@ class _Stream:
         n = self.lmp.extract_global("nlocal")
         ids = np.array(self.lmp.numpy.extract_atom("id")[:n], dtype=np.int64)
         return ids, self.per_atom("x", n)[:, :2].copy(), self.per_atom("v", n)[:, :2].copy()
+
+    def ghosts(self, nlocal: int):
+        """(ids, (g, 2) positions) of this rank's ghost atoms."""
+        n = nlocal + self.lmp.extract_global("nghost")
+        ids = np.array(self.lmp.numpy.extract_atom("id", nelem=n)[nlocal:n], dtype=np.int64)
+        return ids, self.per_atom("x", n)[nlocal:, :2].copy()
 
     def angular_velocities(self, n: int, mass=None) -> np.ndarray | None:
         """(n,) ω_z of the first ``n`` local atoms, or None for spheres that do not turn. Given their
@@ -103,14 +114,14 @@ class _Stream:
         return self.per_atom("f", n)[:, :2], self.per_atom("rmass", n, 0)
 
     def initial(self) -> None:
+        self.lmp.command("run 0 post no")  # distributes the atoms, finds the ghosts, computes the forces at t = 0
         ids, positions, velocities = self.local_state()
         accelerations = None
         if self.sensor_every:
-            self.lmp.command("run 0 post no")  # computes the forces at t = 0
             force, mass = self.forces_and_masses(len(ids))
             accelerations = force / mass[:, None]
         self.on_sample(Sample(0, 0, 0.0, ids, positions, velocities, accelerations,
-                              self.angular_velocities(len(ids))))
+                              self.angular_velocities(len(ids)), True, *self.ghosts(len(ids))))
 
     def __call__(self, caller, step, nlocal, tag, x, fexternal) -> None:
         if step == 0 or self.error is not None:
@@ -121,8 +132,10 @@ class _Stream:
             ids, positions = tag.astype(np.int64), x[:, :2].copy()
             sensed = self.sensor_every and step % self.sensor_every == 0
             accelerations = force / mass[:, None] if sensed else None
+            builds = self.lmp.get_thermo("nbuild")
+            migrated, self.builds = builds != self.builds, builds
             self.on_sample(Sample(step // self.every, int(step), step * self.dt, ids, positions, velocities,
-                                  accelerations, self.angular_velocities(nlocal, mass)))
+                                  accelerations, self.angular_velocities(nlocal, mass), migrated, *self.ghosts(nlocal)))
             if self.bar is not None:
                 self.bar.update(int(step) - self.bar.n)
         except BaseException as exc:  # a ctypes callback cannot raise: keep it for after the run
