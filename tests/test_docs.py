@@ -125,11 +125,6 @@ def test_the_pages_count_the_slow_tests():
     assert len(quoted) == 2 and set(quoted) == {int(collected.group(1))}
 
 
-#: Modules and pages whose formulas are still plain text: their files were being rewritten when
-#: the rest became math (issue 35). Each leaves the set as its formulas are converted.
-PLAIN_TEXT_FORMULAS = {"hexdem.analysis.energy", "hexdem.analysis.tracker_kernel", "hexdem.engines.lammps.deck"}
-
-
 def test_formulas_are_typeset_not_raw_latex(built):
     """No ``^{``, ``^(`` or ``_{``, nor a bare power such as ``r^a``, ``R^−p`` or ``m^1.5``, in a
     page's text outside code and math: a formula is math (``$...$`` on a page, ``:math:`` in a
@@ -150,8 +145,7 @@ def test_formulas_are_typeset_not_raw_latex(built):
             hits = re.findall(r".{0,30}(?:\^[{(]|_\{|\w\^[−-]?\w).{0,30}", text)
             if hits:
                 raw[module.group(1) if module else path.relative_to(built).as_posix()] = hits
-    assert set(raw) <= PLAIN_TEXT_FORMULAS, {name: raw[name] for name in set(raw) - PLAIN_TEXT_FORMULAS}
-    assert PLAIN_TEXT_FORMULAS <= set(raw), f"math now, leave the set: {PLAIN_TEXT_FORMULAS - set(raw)}"
+    assert not raw, raw
 
 
 def test_docstrings_with_backslashes_are_raw_strings():

@@ -1,11 +1,12 @@
-"""Total mechanical energy of a granular state: kinetic (translational, and rotational for a
+r"""Total mechanical energy of a granular state: kinetic (translational, and rotational for a
 frictional model's turning spheres, ½ I ω² with I = (2/5) m r²) + Hertz contact (+ gravity) energy.
 Mindlin's tangential springs and what friction dissipates are not counted: a frictional model's
 audit is that of a dissipative one (:attr:`~hexdem.model.granular.GranularModel.dissipative`).
 
 LAMMPS reports no potential energy for granular pairs, so hexdem computes it itself from
-positions: a contact of overlap δ stores U = (2/5) k_n sqrt(R_eff) δ^{5/2} (the integral of
-F = k_n sqrt(R_eff) δ^{3/2}; with equal spheres this is the paper's V = (2/5) A δ^{5/2}).
+positions: a contact of overlap δ stores :math:`U = \tfrac{2}{5} k_n \sqrt{R_\text{eff}}\, δ^{5/2}` (the
+integral of :math:`F = k_n \sqrt{R_\text{eff}}\, δ^{3/2}`; with equal spheres this is the paper's
+:math:`V = \tfrac{2}{5} A δ^{5/2}`, eq. (2)).
 Every pair closer than the sum of radii counts, as in LAMMPS, not only lattice bonds.
 Under constant forces F (gravity m g in the tilted set-up of Sec. VI-A; the force holding a
 precompressed packing's struck bead) the conserved total also holds their potential −Σ F·u
@@ -30,12 +31,12 @@ def _pairs(positions_m, cutoff_m: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _hertz_energies_j(stiffness_pa, r_eff_m, overlap_m) -> np.ndarray:
-    """(2/5) k_n sqrt(R_eff) δ^{5/2} [J] of each contact with overlap δ > 0."""
+    r""":math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}\, δ^{5/2}` [J] of each contact with overlap δ > 0."""
     return 0.4 * np.asarray(stiffness_pa, float) * np.sqrt(r_eff_m) * overlap_m**2.5
 
 
 def hertz_energy_j(stiffness_pa, r_eff_m, overlap_m) -> float:
-    """Σ (2/5) k_n sqrt(R_eff) δ^{5/2} [J] over contacts with overlap δ > 0 (k_n per contact; one
+    r""":math:`\sum \tfrac{2}{5} k_n \sqrt{R_\text{eff}}\, δ^{5/2}` [J] over contacts with overlap δ > 0 (k_n per contact; one
     value factored out when all are equal, the single-material sum as it always was)."""
     stiffness_pa = np.asarray(stiffness_pa, float)
     terms = np.sqrt(r_eff_m) * overlap_m**2.5
@@ -230,12 +231,12 @@ def energy_scale_j(energies_j, impact_energy_j: float) -> float:
 
 
 def energy_error(energies_j, impact_energy_j: float, dissipative: bool = False) -> float:
-    """The energy audit's figure of merit, 0 for an exact integrator, relative to
+    r"""The energy audit's figure of merit, 0 for an exact integrator, relative to
     :func:`energy_scale_j`.
 
     Conservative model: max_t |E(t) − E(0)|. Dissipative model (restitution < 1): the energy may
     only fall, so the largest rise above the lowest energy reached before,
-    max_t [E(t) − min_{s ≤ t} E(s)].
+    :math:`\max_t [E(t) − \min_{s ≤ t} E(s)]`.
     """
     energies_j = np.asarray(energies_j, float)
     scale = energy_scale_j(energies_j, impact_energy_j)

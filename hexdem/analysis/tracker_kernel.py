@@ -11,7 +11,7 @@ For every bead it keeps, in fixed-size arrays, exactly what the definitions of
   them, which brackets the crossing from below. The records kept form
   a ladder in value: each is at least a factor ``q`` above the one before it, except the
   newest, which is always kept (a new record replaces the newest when that one had not
-  climbed a rung). With q = 2^(1/(C − 4)) at most C − 2 records lie in [M/2, M], so with the
+  climbed a rung). With :math:`q = 2^{1/(C − 4)}` at most C − 2 records lie in [M/2, M], so with the
   one below the C slots never overflow, whatever the sampling or the run's length.
 
   Each slot also remembers the first record that entered it (later ones in the same rung

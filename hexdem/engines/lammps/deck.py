@@ -1,10 +1,10 @@
-"""Render a :class:`~hexdem.model.granular.GranularModel` into a standalone LAMMPS run directory.
+r"""Render a :class:`~hexdem.model.granular.GranularModel` into a standalone LAMMPS run directory.
 
 The directory holds ``data.hexdem`` (atoms: id type diameter density x y z) and
 ``in.hexdem`` (from ``lammps_inputs/impact.in``); ``cd DIR && lmp -in in.hexdem`` reruns it
 by hand. Quantities are written in the chosen :class:`~hexdem.model.units.UnitSystem`: SI
 (``units si``) or the paper's A = d = M = 1 (``units lj``). Contacts use the ``hertz k_n``
-model, F = k_n sqrt(R_eff δ) δ, for bead pairs and for the walls alike, so the walls carry
+model, :math:`F = k_n \sqrt{R_\text{eff}\, δ}\, δ`, for bead pairs and for the walls alike, so the walls carry
 their own modulus (the wall fix's ``hertz/material`` cannot mix materials, LAMMPS issue 4141);
 Tsuji's damping with ``limit_damping`` (the normal force clipped at zero); with friction,
 Mindlin's ``tangential mindlin`` with each contact's own k_t = 8 G* (given, as LAMMPS cannot
@@ -171,9 +171,10 @@ def contact_model(law: ContactLaw, units: UnitSystem) -> str:
 
 
 def pair_block(model: GranularModel, units: UnitSystem) -> str:
-    """The contacts of ``model``'s bodies: ``pair_style granular`` with each pair of atom types' own
-    law (:func:`contact_model`: k_n = (4/3) E*, F = k_n sqrt(R_eff) δ^{3/2}, and with friction
-    Mindlin's k_t = 8 G*), one ``pair_coeff * *`` for one material.
+    r"""The contacts of ``model``'s bodies: ``pair_style granular`` with each pair of atom types'
+    own law (:func:`contact_model`: :math:`k_n = \tfrac{4}{3} E^*`,
+    :math:`F = k_n \sqrt{R_\text{eff}}\, δ^{3/2}`, and with friction Mindlin's
+    :math:`k_t = 8 G^*`), one ``pair_coeff * *`` for one material.
 
     A frictionless elastic contact of one material is rendered as ``pair_style gran/hertz/history
     k_n NULL 0 NULL 0 0``: with no damping and a friction coefficient of 0 its normal force is the
