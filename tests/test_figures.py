@@ -12,7 +12,7 @@ from matplotlib.colors import LogNorm
 from matplotlib import colormaps
 from matplotlib.colors import to_rgb
 
-from hexdem.analysis.figures import (PIXEL_DIAMETERS, PIXEL_MAP_BEADS, PIXEL_UNMEASURED, UNMEASURED_STYLES,
+from hexdem.analysis.figures import (PIXEL_MAP_BEADS, PIXEL_REACH_D, PIXEL_UNMEASURED, UNMEASURED_STYLES,
                                      bead_map, subplots)
 from hexdem.model.lattice import hexagon
 
@@ -35,12 +35,12 @@ def test_beads_without_a_peak_are_drawn_outside_the_scale_and_named_in_the_legen
     assert {text.get_text() for text in fig.legends[0].get_texts()} == set(UNMEASURED_STYLES)
 
 
-def test_a_packing_of_more_beads_than_pixels_is_drawn_as_an_image_of_their_values():
-    """Above PIXEL_MAP_BEADS beads a map is an image: inside the packing every pixel holds a bead
-    and shows the mean of its beads' values (here x, so within half a pixel of its centre's x);
-    the unmeasured beads fill theirs with greys that no colour map holds, named in the legend,
-    and the ringed beads' region is outlined."""
-    lattice = hexagon(135, 1.0)
+def test_a_large_packing_is_drawn_as_an_image_of_its_beads_values():
+    """Above PIXEL_MAP_BEADS beads a map is an image: inside the packing every pixel shows a bead
+    (no gap, no moiré), the bead whose centre is nearest (here the value is x, so within
+    PIXEL_REACH_D diameters of the pixel's x); the unmeasured beads fill theirs with greys that
+    no colour map holds, named in the legend, and the ringed beads' region is outlined."""
+    lattice = hexagon(60, 1.0)
     assert len(lattice) > PIXEL_MAP_BEADS
     x = lattice.positions_m[:, 0]
     values = np.where(x < 0.8 * x.max(), x, np.nan)
@@ -50,14 +50,12 @@ def test_a_packing_of_more_beads_than_pixels_is_drawn_as_an_image_of_their_value
     left, right, bottom, top = image.get_extent()
     pixels = np.ma.filled(image.get_array(), np.nan)
     step = (right - left) / pixels.shape[1]
-    assert step >= PIXEL_DIAMETERS
-    centres_x = left + (np.arange(pixels.shape[1]) + 0.5) * step
-    centres_y = bottom + (np.arange(pixels.shape[0]) + 0.5) * step
-    cx, cy = np.meshgrid(centres_x, centres_y)
+    cx, cy = np.meshgrid(left + (np.arange(pixels.shape[1]) + 0.5) * step,
+                         bottom + (np.arange(pixels.shape[0]) + 0.5) * step)
     middle = lattice.positions_m.mean(axis=0)
-    inside = (np.hypot(cx - middle[0], cy - middle[1]) < 0.8 * 135) & (cx < 0.8 * x.max() - step)
-    assert np.all(np.isfinite(pixels[inside])), "no hole inside the packing"
-    assert np.max(np.abs(pixels[inside] - cx[inside])) <= step / 2
+    inside = (np.hypot(cx - middle[0], cy - middle[1]) < 0.8 * 60) & (cx < 0.8 * x.max() - 1)
+    assert np.all(np.isfinite(pixels[inside])), "no gap inside the packing"
+    assert np.max(np.abs(pixels[inside] - cx[inside])) <= PIXEL_REACH_D
     greys = [np.array(to_rgb(colour)) for colour in PIXEL_UNMEASURED.values()]
     for name in ("magma", "viridis", "viridis_r", "inferno", "hot_r"):
         table = colormaps[name](np.linspace(0, 1, 256))[:, :3]

@@ -99,49 +99,56 @@ def _circles(ax, positions, diameters, **style) -> EllipseCollection:
                              offset_transform=ax.transData, **{"linewidths": 0.2, **style})
 
 
-#: Above this many beads a bead is about a pixel of a map or less: the map is drawn as an image
-#: (:func:`_pixel_beads`), which takes a second where a million circles took 40.
-PIXEL_MAP_BEADS = 50_000
-#: Pixels across such a map, at most; a pixel is at least 1.5 bead diameters wide, so that in a
-#: packing every pixel holds a bead centre (the widest gap of a triangular packing, a circle of
-#: radius d/√3, fits in no square of 1.5 d).
+#: Above this many beads a map is drawn as an image (:func:`_pixel_beads`): matplotlib draws
+#: circles at about 0.5 ms a bead (14 s a map at 29,701 beads, 40 s at a million), an image of the
+#: same beads takes a second.
+PIXEL_MAP_BEADS = 10_000
+#: Pixels across such a map (about the axes' width at the figures' DPI).
 MAP_PIXELS = 700
-PIXEL_DIAMETERS = 1.5
+#: A pixel shows the bead whose centre is nearest if that centre lies within this many of the
+#: bead's diameters (or within half the pixel's diagonal, if more): a packing's beads then tile
+#: it without gaps (the farthest point from every centre of a touching triangular packing is
+#: d/√3 = 0.577 d away; drawing each bead's own disc left its gaps as a moiré), while a void
+#: wider than 1.2 d stays white.
+PIXEL_REACH_D = 0.6
 #: How beads without a value fill their pixels on such a map: greys, which no colour map used
 #: here holds (the hatches of :data:`UNMEASURED_STYLES` need a bead larger than a pixel).
 PIXEL_UNMEASURED = {"still rising at the run's end": "0.6", "never moved": "0.85", "no value": "0.35"}
 
 
 def _pixel_beads(ax, positions, diameters, values, coloured, groups: dict, outlined: dict, cmap, norm, clim):
-    """The beads as an image of :data:`MAP_PIXELS` across: a pixel shows the mean value of the
-    coloured beads whose centres it holds, or else the grey of the unmeasured ones it holds
-    (:data:`PIXEL_UNMEASURED`); each ring group's outline is a contour of its pixels. Returns the
-    image and the legend's patches."""
+    """The beads rasterized, :data:`MAP_PIXELS` across: a pixel takes the value of the bead whose
+    centre is nearest, within :data:`PIXEL_REACH_D` of its diameter (each bead a cell of the
+    packing's Voronoi tiling); an unmeasured bead's pixels take its grey
+    (:data:`PIXEL_UNMEASURED`), and each ring group's region is outlined by a contour of its
+    pixels. Returns the image and the legend's patches."""
+    from scipy.spatial import cKDTree
+
     radius = float(np.max(diameters)) / 2
     low, high = positions.min(axis=0) - radius, positions.max(axis=0) + radius
-    step = max(float(np.max(high - low)) / MAP_PIXELS, PIXEL_DIAMETERS * float(np.max(diameters)))
+    step = float(np.max(high - low)) / MAP_PIXELS
     shape = tuple(np.maximum(np.ceil((high - low) / step).astype(int), 1))
-    cells = np.minimum(((positions - low) / step).astype(int), np.array(shape) - 1)
-    flat = cells[:, 1] * shape[0] + cells[:, 0]
-    size = shape[0] * shape[1]
-    counts = np.bincount(flat[coloured], minlength=size)
-    sums = np.bincount(flat[coloured], weights=values[coloured], minlength=size)
-    mean = np.where(counts > 0, sums / np.maximum(counts, 1), np.nan).reshape(shape[1], shape[0])
+    centres = [low[axis] + (np.arange(shape[axis]) + 0.5) * step for axis in (0, 1)]
+    grid = np.stack(np.meshgrid(*centres), axis=-1).reshape(-1, 2)
+    distance, nearest = cKDTree(positions).query(grid)
+    inside = distance <= np.maximum(PIXEL_REACH_D * diameters[nearest], step / np.sqrt(2))
+    bead = np.where(inside, nearest, -1).reshape(shape[1], shape[0])
+    covered = bead >= 0
     extent = (low[0], low[0] + shape[0] * step, low[1], low[1] + shape[1] * step)
     legend = []
     for name, beads in groups.items():
         if np.any(beads):
-            held = np.bincount(flat[beads], minlength=size).reshape(shape[1], shape[0]) > 0
-            grey = np.where(held & np.isnan(mean), 1.0, np.nan)
+            grey = np.where(covered & beads[bead], 1.0, np.nan)
             ax.imshow(grey, origin="lower", extent=extent, cmap=_single_colour(PIXEL_UNMEASURED[name]),
                       interpolation="nearest", vmin=0.0, vmax=1.0)
             legend.append(Patch(label=name, facecolor=PIXEL_UNMEASURED[name], edgecolor="0.45"))
-    image = ax.imshow(mean, origin="lower", extent=extent, cmap=colormaps[cmap], norm=norm, interpolation="nearest")
+    shown = np.where(covered & coloured[bead], values[bead], np.nan)
+    image = ax.imshow(shown, origin="lower", extent=extent, cmap=colormaps[cmap], norm=norm, interpolation="nearest")
     if clim is not None:
         image.set_clim(*clim)
     for (name, beads), colour in zip(outlined.items(), OUTLINE_COLOURS):
-        held = np.bincount(flat[beads], minlength=size).reshape(shape[1], shape[0]) > 0
-        ax.contour(held.astype(float), levels=[0.5], colors=[colour], linewidths=1.2, origin="lower", extent=extent)
+        ax.contour((covered & beads[bead]).astype(float), levels=[0.5], colors=[colour], linewidths=1.2,
+                   origin="lower", extent=extent)
         legend.append(Patch(label=name, linewidth=1.2, facecolor="none", edgecolor=colour))
     return image, legend
 
@@ -159,8 +166,7 @@ def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=No
     colour scale and named in a legend; any other NaN is drawn as "no value". ``outlined``:
     {name: mask} of beads to ring in a colour of :data:`OUTLINE_COLOURS` (a region of another
     material: an interface, intruders), named in the same legend. A packing of more than
-    :data:`PIXEL_MAP_BEADS` beads is drawn as an image of its beads' values instead
-    (:func:`_pixel_beads`)."""
+    :data:`PIXEL_MAP_BEADS` beads is drawn rasterized instead (:func:`_pixel_beads`)."""
     values = np.asarray(values, float)
     groups = {name: np.asarray(beads, bool) for name, beads in (unmeasured or {}).items()}
     flagged = np.any([np.zeros(len(values), bool), *groups.values()], axis=0)
