@@ -102,12 +102,19 @@ def write_csv(path, header, rows) -> None:
         writer.writerows(rows)
 
 
+def text_columns(columns) -> list[list[str]]:
+    """Each of ``columns`` (NumPy arrays or lists of numbers or names) as text, a column at a time,
+    as the csv module writes a value: a float by ``repr`` (the shortest text that reads back as the
+    same number), anything else by ``str``."""
+    return [list(map(repr if np.asarray(column).dtype.kind == "f" else str, np.asarray(column).tolist()))
+            for column in columns]
+
+
 def write_csv_columns(path, header, columns) -> None:
     """The CSV :func:`write_csv` writes for the rows of ``columns`` (one sequence per name of
-    ``header``: NumPy arrays or lists of numbers or names), written a column at a time: a million
-    rows of twelve columns in seconds, where a row writer takes half a minute."""
-    texts = [list(map(repr if np.asarray(column).dtype.kind == "f" else str, np.asarray(column).tolist()))
-             for column in columns]
+    ``header``, :func:`text_columns`), written a column at a time: a million rows of twelve
+    columns in seconds, where a row writer takes half a minute."""
+    texts = text_columns(columns)
     with atomic_path(path) as tmp, open(tmp, "w", newline="") as fh:
         fh.write(",".join(header) + "\r\n")
         fh.writelines(",".join(row) + "\r\n" for row in zip(*texts))

