@@ -139,7 +139,7 @@ def _pixel_beads(ax, positions, diameters, values, coloured, groups: dict, outli
     for name, beads in groups.items():
         if np.any(beads):
             grey = np.where(covered & beads[bead], 1.0, np.nan)
-            ax.imshow(grey, origin="lower", extent=extent, cmap=_single_colour(PIXEL_UNMEASURED[name]),
+            ax.imshow(grey, origin="lower", extent=extent, cmap=ListedColormap([PIXEL_UNMEASURED[name]]),
                       interpolation="nearest", vmin=0.0, vmax=1.0)
             legend.append(Patch(label=name, facecolor=PIXEL_UNMEASURED[name], edgecolor="0.45"))
     shown = np.where(covered & coloured[bead], values[bead], np.nan)
@@ -151,10 +151,6 @@ def _pixel_beads(ax, positions, diameters, values, coloured, groups: dict, outli
                    origin="lower", extent=extent)
         legend.append(Patch(label=name, linewidth=1.2, facecolor="none", edgecolor=colour))
     return image, legend
-
-
-def _single_colour(colour: str) -> ListedColormap:
-    return ListedColormap([colour])
 
 
 def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=None, norm=None, unmeasured=None,

@@ -87,7 +87,7 @@ def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples
         write_deck_config(config, workdir)
     log(f"running {config.engine}: {model.lattice.shape}, {model.n_bodies} bodies, "
         f"{settings.n_steps} steps of {settings.dt_s:.4g} s ({settings.duration_s * 1e3:.4g} ms), "
-        f"{config.ranks if config.engine == 'lammps' else 1} rank(s), {settings.n_samples} samples analysed in the run")
+        f"{config.processes} rank(s), {settings.n_samples} samples analysed in the run")
     traced = tuple(dict.fromkeys([*(int(bead) for line in trace_lines for bead in model.lattice.line(line)),
                                   *(int(bead) for bead in trace_beads)]))
     frames = movie_samples(settings.n_samples) if config.movie else ()

@@ -64,4 +64,4 @@ def record_waves(config: RunConfig, workdir, wave_vectors_m=(), block: int = 0, 
             f"{settings.dt_s:.4g} s, {settings.n_samples} samples recorded")
     job = WaveJob(model, settings, config.engine, workdir, tuple(map(tuple, np.asarray(wave_vectors_m, float).reshape(-1, 2))),
                   block, show_progress, tuple(map(float, weights)))
-    return run_on_ranks(job, config.ranks if config.engine == "lammps" else 1, workdir, config.launcher)
+    return run_on_ranks(job, config.processes, workdir, config.launcher)

@@ -184,13 +184,17 @@ class RunConfig:
         if self.wall_material != "none":
             self.material(self.wall_material)
 
+    @property
+    def processes(self) -> int:
+        """The processes the run takes: ``ranks`` for LAMMPS, one for the reference engine."""
+        return self.ranks if self.engine == "lammps" else 1
+
     def memory_estimate_bytes(self) -> float | None:
         """Peak memory of the run on each of its processes [bytes] (see MEMORY_PER_BEAD_BYTES and
         MEMORY_PER_OWN_BEAD_BYTES), for the shapes :meth:`n_beads` counts; None for the others."""
         beads = self.n_beads()
-        ranks = self.ranks if self.engine == "lammps" else 1
-        return (None if beads is None else
-                MEMORY_BASE_BYTES + MEMORY_PER_BEAD_BYTES * beads + MEMORY_PER_OWN_BEAD_BYTES * beads / ranks)
+        return (None if beads is None else MEMORY_BASE_BYTES + MEMORY_PER_BEAD_BYTES * beads
+                + MEMORY_PER_OWN_BEAD_BYTES * beads / self.processes)
 
     def _check_size(self) -> None:
         """Refuse a packing counted without building it (:meth:`n_beads`) that this machine's
@@ -198,11 +202,11 @@ class RunConfig:
         counted = {"hexagon": (self.edge_beads,), "half-hexagon": (self.short_edge, self.long_edge)}
         if self.shape not in counted or not all(n >= 2 for n in counted[self.shape]):
             return
-        needed = self.memory_estimate_bytes() * (self.ranks if self.engine == "lammps" else 1)
+        needed = self.memory_estimate_bytes() * self.processes
         available = available_memory_bytes()
         if needed > available:
             raise HexdemError(f"{self.shape} of {self.n_beads():,} beads needs about {needed / 1e9:.3g} GB of memory "
-                              f"({self.ranks if self.engine == 'lammps' else 1} process(es)); this machine has "
+                              f"({self.processes} process(es)); this machine has "
                               f"{available / 1e9:.3g} GB available")
 
     @classmethod

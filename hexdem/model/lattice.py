@@ -176,14 +176,14 @@ def from_sites(labels, diameter_m: float = 1.0, wall_angles_deg=(), shape: str =
     if len(odd):
         raise HexdemError(f"{shape}: site {{{odd[0, 0]}, {odd[0, 1]}}} has m + n odd: it is not a site of the "
                           "hexagonal packing (m + n must be even)")
-    low = labels.min(axis=0) if len(labels) else np.zeros(2, int)
-    keys = (labels[:, 0] - low[0]) * (int(np.ptp(labels[:, 1])) + 1 if len(labels) else 1) + labels[:, 1] - low[1]
+    if len(labels) < 1:
+        raise HexdemError(f"{shape}: a packing needs at least 1 bead, got none")
+    low = labels.min(axis=0)
+    keys = (labels[:, 0] - low[0]) * (int(np.ptp(labels[:, 1])) + 1) + labels[:, 1] - low[1]
     _, first, counts = np.unique(keys, return_index=True, return_counts=True)  # one number a site: a quick sort
     if np.any(counts > 1):
         m, n = labels[first[np.argmax(counts > 1)]]
         raise HexdemError(f"{shape}: site {{{m}, {n}}} is listed twice")
-    if len(labels) < 1:
-        raise HexdemError(f"{shape}: a packing needs at least 1 bead, got none")
     hit = np.flatnonzero((labels[:, 0] == struck[0]) & (labels[:, 1] == struck[1]))
     if not len(hit):
         raise HexdemError(f"{shape}: the struck site {{{struck[0]}, {struck[1]}}} is not in the packing")

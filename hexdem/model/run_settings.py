@@ -51,18 +51,19 @@ def contact_time_s(config, model: GranularModel | None = None) -> float:
                                  config.precompression_n, sized)
 
 
-def rebound_time_s(config, model: GranularModel) -> float:
+def rebound_time_s(model: GranularModel, contact_s: float) -> float:
     """The default duration [s] when nothing lies ahead of the struck beads (a single bead, a
     row struck along its normal): the longest of each struck bead's head-on Hertz contacts
     with the walls at its impact's speed (mass m against a rigid body, A = k_n sqrt(r)), plus one
-    contact time, so that the run holds the whole rebound and the bead's flight after it."""
+    contact time ``contact_s`` [s], so that the run holds the whole rebound and the bead's flight
+    after it."""
     walls = [0.0]
     if model.walls:
         masses, radii = model.masses_kg, model.lattice.radii_m
         for bead, impact in zip(model.struck_beads, model.impacts):
             coefficient = float(model.wall_stiffness_pa([bead])[0]) * math.sqrt(radii[bead])
             walls.append(float(contact_time(masses[bead], coefficient, impact.speed_m_s)))
-    return contact_time_s(config, model) + max(walls)
+    return contact_s + max(walls)
 
 
 def step_and_sampling(config, contact_s: float) -> tuple[float, int]:
@@ -108,7 +109,7 @@ def run_settings(config, model: GranularModel | None = None) -> RunSettings:
         duration_s = config.duration * scale
     else:
         crossing_s = crossing_time_s(model, contact_s if config.precompression_n > 0 else None)
-        duration_s = crossing_s + striker_launch_s(model) if crossing_s > 0 else rebound_time_s(config, model)
+        duration_s = crossing_s + striker_launch_s(model) if crossing_s > 0 else rebound_time_s(model, contact_s)
     sensor_every = 0
     if config.sensors:
         samples = math.ceil(1.0 / config.sensor_rate_hz / (dt_s * every) - 1e-9)
