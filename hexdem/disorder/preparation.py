@@ -67,7 +67,7 @@ import numpy as np
 
 from hexdem.common.checks import is_number
 from hexdem.engines.lammps.deck import gravity_block, walls_block
-from hexdem.engines.lammps.settling import SettlingStage, write_settling_deck
+from hexdem.engines.lammps.settling import SettlingStage, kinetic_tolerance_j, write_settling_deck
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel
 from hexdem.model.lattice import BOND_STEPS, Lattice
@@ -176,8 +176,9 @@ class Preparation:
         return self.gravity_m_s2 * math.sin(math.radians(self.tilt_deg)) * np.asarray(direction, float)
 
     def kinetic_tolerance_j(self, masses_kg) -> float:
-        """The settling criterion: Σ ½ m v² below ½ (Σ m) v_rms² [J]."""
-        return 0.5 * float(np.sum(masses_kg)) * self.settled_rms_speed_m_s**2
+        """The settling criterion: Σ ½ m v² below ½ (Σ m) v_rms² [J]
+        (:func:`~hexdem.engines.lammps.settling.kinetic_tolerance_j`)."""
+        return kinetic_tolerance_j(masses_kg, self.settled_rms_speed_m_s)
 
 
 def walls_for_settling(compacted: Lattice, preparation: Preparation) -> Lattice:
@@ -290,7 +291,6 @@ def write_stage_deck(model: GranularModel, stage: str, preparation: Preparation,
     return write_settling_deck(model, SettlingStage(
         name=stage, purpose="Preparation of a weakly disordered packing (Sec. VI-A).", walls=blocks["walls"],
         loads=blocks["loads"], loads_note=blocks["loads_note"], damping_s=blocks["damping_s"],
-        kinetic_tolerance_j=preparation.kinetic_tolerance_j(model.masses_kg[:len(model.lattice)]),
         force_tolerance_n=blocks["force_tolerance"], settled_rms_speed_m_s=preparation.settled_rms_speed_m_s,
         max_step_m=preparation.max_step_m, max_dt_s=preparation.max_dt_s, check_every=preparation.check_every,
         min_steps=preparation.min_steps, max_steps=preparation.max_steps), directory)

@@ -67,7 +67,7 @@ def pull_block(force_n: float) -> str:
             "fix             pull all addforce v_pull_x v_pull_y 0.0\n")
 
 
-def settling_stage(name: str, masses_kg) -> SettlingStage:
+def settling_stage(name: str) -> SettlingStage:
     """The settling deck of stage ``name`` ("compact" or "relax"; see the module docstring)."""
     compact = name == "compact"
     return SettlingStage(
@@ -75,7 +75,6 @@ def settling_stage(name: str, masses_kg) -> SettlingStage:
         walls="# (none)\n", loads=pull_block(PULL_FORCE_N) if compact else "# (none)\n",
         loads_note=f"{PULL_FORCE_N:g} N on every bead towards the centre" if compact else "none: the pull is removed",
         damping_s=COMPACT_DAMPING_S if compact else RELAX_DAMPING_S,
-        kinetic_tolerance_j=0.5 * float(np.sum(masses_kg)) * SETTLED_RMS_SPEED_M_S**2,
         force_tolerance_n=None if compact else SETTLED_MAX_FORCE_N, settled_rms_speed_m_s=SETTLED_RMS_SPEED_M_S,
         max_step_m=COMPACT_MAX_STEP_M if compact else RELAX_MAX_STEP_M,
         max_dt_s=COMPACT_MAX_DT_S if compact else RELAX_MAX_DT_S, check_every=100,
@@ -109,7 +108,7 @@ def prepare_random_packing(config: RunConfig, directory, comm=None, log=None) ->
     log(f"packing a random disc of {len(diameters)} beads (radius {config.radius_m:g} m, "
         f"diameters d (1 ± {config.diameter_spread:g}), seed {config.seed}) with LAMMPS")
     for name in STAGES:
-        deck = write_settling_deck(model, settling_stage(name, model.masses_kg), directory / name)
+        deck = write_settling_deck(model, settling_stage(name), directory / name)
         run_settling_deck(deck, comm)
         result = read_stage(deck)
         if not result.settled:

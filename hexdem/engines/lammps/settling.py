@@ -29,12 +29,18 @@ STATS_NAME = "settle.txt"
 SETTLED_NAME = "settled.data"
 
 
+def kinetic_tolerance_j(masses_kg, rms_speed_m_s: float) -> float:
+    """The settling criterion on the kinetic energy: Σ ½ m v² below ½ (Σ m) v_rms² [J]."""
+    return 0.5 * float(np.sum(masses_kg)) * rms_speed_m_s**2
+
+
 @dataclass(frozen=True)
 class SettlingStage:
     """What one settling deck does. ``name`` and ``purpose`` title the deck; ``walls`` and
     ``loads`` are deck blocks, ``loads_note`` says what the loads are; ``damping_s`` is the
-    damping time M/γ (M: the mean bead mass) [s]; ``kinetic_tolerance_j`` [J] and
-    ``force_tolerance_n`` [N] (None: no force criterion) say when it is settled;
+    damping time M/γ (M: the mean bead mass) [s]; ``settled_rms_speed_m_s`` [m/s]
+    (:func:`kinetic_tolerance_j`) and ``force_tolerance_n`` [N] (None: no force criterion) say
+    when it is settled;
     ``max_step_m`` [m] and ``max_dt_s`` [s] bound the distance a bead moves in a step and the
     step; the check runs every ``check_every`` steps after ``min_steps``, for at most
     ``max_steps`` more."""
@@ -45,7 +51,6 @@ class SettlingStage:
     loads: str
     loads_note: str
     damping_s: float
-    kinetic_tolerance_j: float
     force_tolerance_n: float | None
     settled_rms_speed_m_s: float
     max_step_m: float
@@ -61,7 +66,7 @@ def write_settling_deck(model: GranularModel, stage: SettlingStage, directory) -
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     masses = model.masses_kg[:len(model.lattice)]
-    kinetic = repr(stage.kinetic_tolerance_j)
+    kinetic = repr(kinetic_tolerance_j(masses, stage.settled_rms_speed_m_s))
     condition = f"c_kinetic<{kinetic}"
     note = f"kinetic energy below {kinetic} J (rms bead speed {stage.settled_rms_speed_m_s!r} m/s)"
     force = stage.force_tolerance_n
