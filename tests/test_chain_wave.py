@@ -9,7 +9,7 @@ import pytest
 from hexdem.experiments.run import simulate
 from hexdem.model.materials import BRASS, STEEL_316, hertz_coefficient, sphere_mass
 from hexdem.theory.chain_wave import CHAIN_LINE, chain_config, measure_chain
-from hexdem.theory.solitary import (
+from hexdem.model.solitary_wave import (
     HALF_MAXIMUM_WIDTH_D,
     SUPPORT_WIDTH_D,
     chain_speed_scale_m_s,

@@ -17,7 +17,6 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.analysis.peaks import PulseTimes, pulse_times
 from hexdem.analysis.trajectory import Trajectory
 from hexdem.errors import HexdemError
 from hexdem.model.granular import RunSettings
@@ -78,10 +77,6 @@ class BeadRecord(_analysis_base()):
 
     def _conclude(self):
         self.results.speeds = np.linalg.norm(self.results.velocities, axis=2)
-
-    def pulses(self, atoms=slice(None)) -> PulseTimes:
-        """Peak speed, time of peak and arrival time (see :mod:`hexdem.analysis.peaks`) of ``atoms``."""
-        return pulse_times(self.results.times, self.results.speeds[:, atoms])
 
 
 def read_dump(path, dt: float, expected_frames: int | None = None) -> BeadRecord:

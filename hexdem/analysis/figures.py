@@ -269,13 +269,25 @@ def arrival_map(results, model, path, title="Wavefront arrival time") -> None:
                 f"arrival time [{units['time']}]", title, cmap="viridis_r")
 
 
+def peak_scale(ratio) -> tuple[float, float]:
+    """(bottom, top) of a peak map's logarithmic colour scale for peaks ``ratio`` (over V0; 0 never
+    moved, NaN still rising): it ends at the largest peak and spans at least a decade, widened
+    downward (to 1e-3 at the lowest), so that peaks that barely decay (a square crystal's row) are
+    drawn in the scale's upper colours, not at its dark end."""
+    ratio = np.asarray(ratio, float)
+    moved = ratio[ratio > 0]
+    if not len(moved):
+        return 1e-1, 1.0
+    top = float(np.max(moved))
+    return min(max(float(np.min(moved)), 1e-3), top / 10), top
+
+
 def peak_map(results, model, v0: float, path, title="Peak speed") -> None:
     """Every bead's peak speed over V0 on the lattice, on a logarithmic scale (the fronts decay
-    by decades as they spread)."""
+    by decades as they spread; :func:`peak_scale`)."""
     ratio = results.peak_speed / v0
-    floor = max(float(np.nanmin(ratio[ratio > 0])) if np.any(ratio > 0) else 1e-3, 1e-3)
     lattice_map(results, model, ratio, path, "peak speed Vₘₐₓ / V₀", title, cmap="magma",
-                norm=LogNorm(floor, max(float(np.nanmax(ratio)), floor * 10)))
+                norm=LogNorm(*peak_scale(ratio)))
 
 
 def peak_decay(rows_by_line: dict, path, units_name: str, v0: float, title="Peak speed along the observation lines"):

@@ -15,7 +15,7 @@ import numpy as np
 
 from hexdem.analysis.peaks import pulse_times
 from hexdem.analysis.energy import energy_regions
-from hexdem.analysis.tracker import ENERGY_SAMPLES, TrackedPulses
+from hexdem.analysis.tracker import ENERGY_SAMPLES, TrackedPulses, run_noise_floor
 from hexdem.analysis.trajectory import Trajectory
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel, RunSettings
@@ -71,22 +71,28 @@ class ImpactAnalysis:
     def from_trajectory(cls, model: GranularModel, settings: RunSettings, trajectory: Trajectory) -> "ImpactAnalysis":
         units = settings.units
         pulses = pulse_times(trajectory.times_s / units.time_s,
-                             trajectory.speeds_m_s[:, :len(model.lattice)] / units.velocity_m_s)
+                             trajectory.speeds_m_s[:, :len(model.lattice)] / units.velocity_m_s,
+                             run_noise_floor(model, settings))
         times_s, energies = trajectory.region_energies_j(model, ENERGY_SAMPLES)
         return cls(model, settings, trajectory.engine, pulses.peak_speed, pulses.t_peak, pulses.arrival_time,
                    pulses.reach_time, trajectory.energy_drift(model), (times_s / units.time_s, energies),
                    trajectory.velocities_m_s[-1, :len(model.lattice)] / units.velocity_m_s)
 
     def _far_wall_reached(self) -> bool:
-        """Did the leading waves reach every bead at the walls facing the strikes within the run?
-        For each impact, those are the wall beads whose inward normal points against its
-        direction within 30° as much as the most-facing one's does (the far wall of a hexagon,
-        both far walls of a triangle, the far arc of a disc; a double strike's two far walls);
-        without such a wall (no walls, or only the struck edge's) every bead counts. A bead counts as reached when its speed rose to
-        half of its largest value at least one impact time scale (``settings.contact_time_s``)
-        before the run ended: a bead still on its first rise at the end has not been passed by
-        the front, while one whose speed keeps growing under reflections (a precompressed box
-        rings) has."""
+        """Did the leading waves cross the packing within the run? They did when every bead they
+        set moving at the walls facing the strikes was passed by its front, and at least one was.
+
+        For each impact, the beads at the walls facing it are those whose inward normal points
+        against its direction within 30° as much as the most-facing one's does (the far wall of a
+        hexagon, both far walls of a triangle, the far arc of a disc; a double strike's two far
+        walls); without such a wall (no walls, or only the struck edge's) every bead counts.
+        Beads that never moved (their speed never rose above the noise floor,
+        :func:`~hexdem.analysis.peaks.noise_floor`) do not count: no wave reaches a square
+        crystal's other rows, nor a packing's rattlers, however long the run. A bead counts as
+        passed when its speed rose to half of its largest value at least one impact time scale
+        (``settings.contact_time_s``) before the run ended: a bead still on its first rise at the
+        end has not been passed by the front, while one whose speed keeps growing under
+        reflections (a precompressed box rings) has."""
         r = self.results
         members, normals = wall_normals(self.model.walls, self.model.lattice.positions_m)
         facing = []
@@ -97,9 +103,10 @@ class ImpactAnalysis:
                 break
             facing.append(members[against >= against.max() * FAR_WALL_COSINE - 1e-9])
         beads = np.unique(np.concatenate(facing))
+        beads = beads[r.peak_speed[beads] != 0.0]  # (NaN: still rising, it moved)
         units = self.settings.units
         latest = (self.settings.duration_s - self.settings.contact_time_s) / units.time_s
-        return bool(np.all(r.reach_time[beads] <= latest))
+        return bool(len(beads)) and bool(np.all(r.reach_time[beads] <= latest))
 
     def line_trace(self, line: str) -> tuple[np.ndarray, np.ndarray]:
         """(times (S,), speeds (S, L)) of the beads of observation ``line`` at every sample, in

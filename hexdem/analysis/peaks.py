@@ -12,8 +12,10 @@ Definitions (used for LAMMPS dumps and for the reference integrator alike):
 
 A bead whose largest sample is among the last two of the record has not yet been passed
 by its pulse: its three values are NaN (the run was too short to see its peak). A bead
-that never moved (|v| exactly 0 throughout) has peak speed 0, a measured value, and NaN time
-of peak and arrival: no pulse passed it.
+that never moved has peak speed 0, a measured value, and NaN time of peak and arrival: no
+pulse passed it. Never moved means that |v| never rose above the run's **noise floor**
+(:func:`noise_floor`): the speed that round-off alone gives a bead at rest (LAMMPS leaves
+4e-17 m/s on a square crystal's still rows, the reference integrator 1e-58 m/s) is not motion.
 
 * **reach time**: when |v| first reached half of its largest sample of the record: the
   arrival time where that is defined, and also for beads whose speed is largest at the end of
@@ -31,6 +33,19 @@ from hexdem.analysis.local_spline import IMAGINARY_TOLERANCE, ROOT_TOLERANCE, Lo
 
 #: Samples on each side of the discrete maximum used for the spline refinement.
 HALF_WINDOW = 3
+#: The noise floor relative to the run's speed scale: the square root of a double's precision,
+#: 1.49e-8. A bead that never moved faster than this has never held more than ε = 2.2e-16 of the
+#: kinetic energy it would hold at the run's fastest speed (½ m v² ≤ ε ½ m V₀²): less than the
+#: round-off of any sum of the run's energies, so nothing the run computes can tell such motion
+#: from round-off. It lies far above what round-off gives a bead at rest (1e-16 V₀ in LAMMPS) and
+#: far below any pulse the analysis reads (a front's precursor is measured from half its peak).
+ROUND_OFF_SPEED = float(np.sqrt(np.finfo(float).eps))
+
+
+def noise_floor(speed_scale: float) -> float:
+    """The speed below which a bead counts as never moved, in the units of ``speed_scale``, the run's
+    fastest speed at t = 0 (V₀; see :data:`ROUND_OFF_SPEED`)."""
+    return ROUND_OFF_SPEED * float(speed_scale)
 
 
 @dataclass(frozen=True)
@@ -115,10 +130,11 @@ def rising_crossing(times, values, level) -> float:
     return float(min(roots)) if roots else float(np.interp(level, values[k - 1:k + 1], times[k - 1:k + 1]))
 
 
-def pulse_times(times, speeds) -> PulseTimes:
+def pulse_times(times, speeds, floor: float = 0.0) -> PulseTimes:
     """Peak speed, time of peak and half-maximum arrival time of every bead.
 
-    ``times`` (n_frames,) sample times; ``speeds`` (n_frames, n_beads) bead speeds |v|.
+    ``times`` (n_frames,) sample times; ``speeds`` (n_frames, n_beads) bead speeds |v|; ``floor``
+    the run's :func:`noise_floor`, at or below which a bead never moved.
     """
     times = np.asarray(times, float)
     speeds = np.asarray(speeds, float)
@@ -128,7 +144,7 @@ def pulse_times(times, speeds) -> PulseTimes:
     for bead in range(n_beads):
         series = speeds[:, bead]
         k = int(np.argmax(series))
-        if series[k] <= 0.0:
+        if series[k] <= floor:
             peak[bead] = 0.0
             continue
         if k > last_complete:

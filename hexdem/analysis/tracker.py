@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from hexdem.analysis.energy import EnergyAudit, energy_error, energy_regions, energy_scale_j
-from hexdem.analysis.peaks import refine_peak, refine_peaks
+from hexdem.analysis.peaks import noise_floor, refine_peak, refine_peaks
 from hexdem.analysis.tracker_kernel import PulseState
 from hexdem.engines.sampling import Sample
 from hexdem.errors import HexdemError
@@ -124,6 +124,7 @@ class PulseTracker:
         if threshold_speed is not None and not threshold_speed > 0:
             raise HexdemError(f"the threshold speed must be > 0, got {threshold_speed!r}")
         self.threshold_speed = threshold_speed
+        self.floor = run_noise_floor(model, settings)
         self.sample_ids, self.ids = None, np.zeros(0, dtype=np.int64)  # (no sample yet)
         self._start_rows(0)
         self.trace_beads = np.asarray(trace_beads, dtype=np.int64)
@@ -150,7 +151,7 @@ class PulseTracker:
     # ---- this rank's beads
     def _start_rows(self, n: int) -> None:
         """State for ``n`` beads as before their first sample."""
-        self.pulses = PulseState(n, RECORD_CAPACITY)
+        self.pulses = PulseState(n, RECORD_CAPACITY, self.floor)
         self.peak_spin, self.end_velocity = np.zeros(n), np.zeros((n, 2))
         self.threshold_index, self.previous_speed = np.full(n, np.nan), np.zeros(n)
 
@@ -289,7 +290,7 @@ class PulseTracker:
         interval = self.settings.dump_every * self.settings.dt_s / self.settings.units.time_s
         peak, t_peak, arrival, reach = (np.full(len(self.ids), np.nan) for _ in range(4))
         state = self.pulses
-        moved = state.peak > 0.0
+        moved = state.peak_index >= 0
         peak[~moved] = 0.0
         complete = moved & (state.peak_index <= self.count - 3)
         full = complete & np.isfinite(state.window).all(axis=1)  # the 7 samples: one refinement for all
@@ -344,6 +345,13 @@ class PulseTracker:
                              peak_angular_speed=beads[:, 5], end_velocity=beads[:, 6:8],
                              rotational_energy_fraction=rotational_share(self.rotational_energies, self.region_energies),
                              collectives=self.collectives)
+
+
+def run_noise_floor(model: GranularModel, settings: RunSettings) -> float:
+    """The run's :func:`~hexdem.analysis.peaks.noise_floor` in its units: round-off relative to the
+    fastest body at t = 0 (an impact's V₀, or the initial state's fastest bead)."""
+    fastest_m_s = float(np.max(np.linalg.norm(model.initial_velocities_m_s(), axis=1), initial=0.0))
+    return noise_floor(fastest_m_s / settings.units.velocity_m_s)
 
 
 def rotational_share(rotational_j, region_energies_j) -> float:

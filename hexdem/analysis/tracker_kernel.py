@@ -47,12 +47,15 @@ def rung(capacity: int) -> float:
 
 class PulseState:
     """The per-bead state of :mod:`hexdem.analysis.tracker` for ``n`` beads and a ladder of
-    ``capacity`` slots (module docstring); every array is indexed by bead first."""
+    ``capacity`` slots (module docstring); every array is indexed by bead first. ``floor``: the
+    run's noise floor (:func:`~hexdem.analysis.peaks.noise_floor`), the running maximum's start: a
+    bead's samples enter it only once they rise above the floor (``peak_index`` stays −1 for a bead
+    that never moved)."""
 
-    def __init__(self, n: int, capacity: int):
+    def __init__(self, n: int, capacity: int, floor: float = 0.0):
         self.q = rung(capacity)
         self.ring = np.zeros((n, 3))
-        self.peak = np.full(n, -1.0)
+        self.peak = np.full(n, float(floor))
         self.peak_index = np.full(n, -1, dtype=np.int64)
         self.window = np.full((n, 7), np.nan)
         self.after = np.zeros(n, dtype=np.int64)

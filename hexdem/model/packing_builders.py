@@ -36,6 +36,9 @@ from hexdem.model.square_crystals import centered_square, square
 
 TRIANGULAR_SHAPES = ("hexagon", "half-hexagon", "half-disc", "triangle", "parallelogram", "disc", "sites")
 PLACED_SHAPES = ("square", "centered-square", "chain", "packing")
+#: Placed crystals whose pulse runs along straight chains of touching beads, as a solitary wave
+#: (their default duration: :func:`~hexdem.model.timescale.solitary_crossing_time_s`).
+CHAIN_SHAPES = ("square", "centered-square", "chain")
 #: Shapes whose positions a LAMMPS run makes (:mod:`hexdem.experiments.random_packing`); they are
 #: built as the ``packing`` of that run's positions.
 PREPARED_SHAPES = ("random",)

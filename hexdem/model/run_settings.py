@@ -14,11 +14,10 @@ import math
 from hexdem.errors import HexdemError
 from hexdem.model.config import MIN_STEPS_PER_CONTACT
 from hexdem.model.granular import GranularModel, RunSettings
-from hexdem.model.hertz import contact_time
 from hexdem.model.model_builder import build_model
-from hexdem.model.packing_builders import PLACED_SHAPES
+from hexdem.model.packing_builders import CHAIN_SHAPES, PLACED_SHAPES
 from hexdem.model.timescale import (crossing_time_s, fastest_approach_m_s, impact_contact_time_s, sized_bodies,
-                                    striker_launch_s)
+                                    solitary_crossing_time_s, striker_launch_s, wall_contact_time_s)
 
 #: Samples per contact time, whatever the step (every 3.6 µs at 0.4 m/s; its error with the step's
 #: stays inside the targets: ``convergence.sampling_error``); default ``dump_every``:
@@ -53,17 +52,11 @@ def contact_time_s(config, model: GranularModel | None = None) -> float:
 
 def rebound_time_s(model: GranularModel, contact_s: float) -> float:
     """The default duration [s] when nothing lies ahead of the struck beads (a single bead, a
-    row struck along its normal): the longest of each struck bead's head-on Hertz contacts
-    with the walls at its impact's speed (mass m against a rigid body, A = k_n sqrt(r)), plus one
+    row struck along its normal): the longest of each struck bead's head-on Hertz contacts with
+    the walls at its impact's speed (:func:`~hexdem.model.timescale.wall_contact_time_s`), plus one
     contact time ``contact_s`` [s], so that the run holds the whole rebound and the bead's flight
     after it."""
-    walls = [0.0]
-    if model.walls:
-        masses, radii = model.masses_kg, model.lattice.radii_m
-        for bead, impact in zip(model.struck_beads, model.impacts):
-            coefficient = float(model.wall_stiffness_pa([bead])[0]) * math.sqrt(radii[bead])
-            walls.append(float(contact_time(masses[bead], coefficient, impact.speed_m_s)))
-    return contact_s + max(walls)
+    return contact_s + wall_contact_time_s(model)
 
 
 def step_and_sampling(config, contact_s: float) -> tuple[float, int]:
@@ -107,6 +100,8 @@ def run_settings(config, model: GranularModel | None = None) -> RunSettings:
     dt_s, every = step_and_sampling(config, contact_s)
     if config.duration is not None:
         duration_s = config.duration * scale
+    elif config.shape in CHAIN_SHAPES:
+        duration_s = solitary_crossing_time_s(model, contact_s, wall_contact_time_s(model)) + striker_launch_s(model)
     else:
         crossing_s = crossing_time_s(model, contact_s if config.precompression_n > 0 else None)
         duration_s = crossing_s + striker_launch_s(model) if crossing_s > 0 else rebound_time_s(model, contact_s)

@@ -27,6 +27,7 @@ from hexdem.errors import HexdemError
 from hexdem.model.hertz import contact_time, max_overlap
 from hexdem.model.materials import Material, hertz_coefficient, hertz_stiffness, sphere_mass
 from hexdem.model.precompression import spring_stiffness
+from hexdem.model.solitary_wave import chain_speed_scale_m_s, solitary_speed_m_s
 
 
 def fastest_approach_m_s(model) -> float:
@@ -138,6 +139,44 @@ def crossing_time_s(model, linear_contact_s: float | None = None) -> float:
         paces, counts = np.unique(quickest[1:], return_counts=True)  # count × pace: exact for one material
         times.append(scale * sum(float(n * p) for p, n in zip(paces, counts)))
     return max(times)
+
+
+def wall_contact_time_s(model) -> float:
+    """The longest head-on Hertz contact [s] of a struck bead with the walls at its impact's speed
+    (mass m against a rigid body, A = k_n sqrt(r)); 0 without walls."""
+    walls = [0.0]
+    if model.walls:
+        masses, radii = model.masses_kg, model.lattice.radii_m
+        for bead, impact in zip(model.struck_beads, model.impacts):
+            coefficient = float(model.wall_stiffness_pa([bead])[0]) * math.sqrt(radii[bead])
+            walls.append(float(contact_time(masses[bead], coefficient, impact.speed_m_s)))
+    return max(walls)
+
+
+def solitary_crossing_time_s(model, contact_s: float, wall_contact_s: float) -> float:
+    r"""The default duration [s] of a crystal whose pulse runs along straight chains of touching
+    beads (a square crystal's row, a centered square's rows, a chain): long enough for the
+    leading pulse to reach the far end and peak there, short enough to end before the far wall's
+    reflection reaches the beads before it.
+
+    The pulse is Nesterenko's solitary wave, which does not decay along a chain: it crosses the
+    packing's depth D along each impact (from the struck bead to the farthest bead ahead) at no
+    more than :math:`V_s = (16/25)^{1/5} c^{4/5} V_0^{1/5}` (:func:`~hexdem.model.solitary_wave.solitary_speed_m_s`,
+    c of the quickest material: its beads never exceed V0). The far bead then peaks within half
+    its head-on contact with the wall (``wall_contact_s``, the turning point of its push) or,
+    without walls, within one contact time ``contact_s`` as it leaves its neighbour; one more
+    contact time lets the tracker see the peak pass. The wall's reflection needs the other half of
+    that wall contact, and a layer's transit, to come back: the 15 × 15 steel square's last bead
+    peaks 0.53 ms after the strike, its neighbour meets the reflection at 0.74 ms, and this gives
+    0.68 ms."""
+    lattice = model.lattice
+    fastest = max(chain_speed_scale_m_s(model.materials[k]) for k in np.unique(model.material_ids[:len(lattice)]))
+    times = []
+    for bead, impact in zip(model.struck_beads, model.impacts):
+        depth_m = float(np.max((lattice.positions_m - lattice.positions_m[bead]) @ impact.direction))
+        times.append(depth_m / solitary_speed_m_s(fastest, impact.speed_m_s))
+    far_end_s = wall_contact_s / 2 if model.walls else contact_s
+    return max(times) + max(far_end_s, contact_s) + contact_s
 
 
 def striker_launch_s(model) -> float:

@@ -10,12 +10,12 @@ the beads of :data:`WINDOW`, where it has formed and the free end is still far.
   (half maximum, :mod:`hexdem.analysis.peaks`);
 * ``peak_velocity_m_s``: their mean peak speed V_m, and ``peak_ratio`` the last bead's over the
   first's (1 for a pulse that keeps its amplitude);
-* ``nesterenko_speed_m_s``: the continuum law at that V_m (:func:`~hexdem.theory.solitary.solitary_speed_m_s`),
+* ``nesterenko_speed_m_s``: the continuum law at that V_m (:func:`~hexdem.model.solitary_wave.solitary_speed_m_s`),
   ``relative_deviation`` the measured speed's from it;
 * ``half_maximum_width_d``: the time the middle bead's speed stays above half its peak
   (:func:`~hexdem.analysis.pulse_shape.pulse_shapes`), times
-  the front speed, in diameters, beside the continuum's (:data:`~hexdem.theory.solitary.HALF_MAXIMUM_WIDTH_D`,
-  of a pulse spanning :data:`~hexdem.theory.solitary.SUPPORT_WIDTH_D` ≈ 5 d).
+  the front speed, in diameters, beside the continuum's (:data:`~hexdem.model.solitary_wave.HALF_MAXIMUM_WIDTH_D`,
+  of a pulse spanning :data:`~hexdem.model.solitary_wave.SUPPORT_WIDTH_D` ≈ 5 d).
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ import numpy as np
 from hexdem.analysis.pulse_shape import pulse_shapes
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
-from hexdem.theory.solitary import (
+from hexdem.model.solitary_wave import (
     HALF_MAXIMUM_WIDTH_D,
     SUPPORT_WIDTH_D,
     chain_speed_scale_m_s,
