@@ -128,7 +128,7 @@ class EnergyAudit:
     sum to the whole state's audit, to round-off.
     """
 
-    def __init__(self, model: GranularModel, gravity_m_s2=None):
+    def __init__(self, model: GranularModel, gravity_m_s2=None, compiled: bool = False):
         self.model = model
         self.start_m = model.initial_positions_m()
         self.masses_kg = model.masses_kg
@@ -139,22 +139,50 @@ class EnergyAudit:
         gravity = np.zeros(2) if gravity_m_s2 is None else np.asarray(gravity_m_s2, float)
         self.external_n = model.external_forces_n() + self.masses_kg[:, None] * gravity
         self.everybody = np.arange(model.n_bodies)
+        self.compiled = compiled
         self._listed, self._listed_at, self._candidates, self._walls = None, None, None, None
 
     def _contacts(self, bodies, n_own: int, positions_m):
-        """(pairs, walls) of the touching contacts among the rows of ``positions_m`` (bodies
-        ``bodies``, the first ``n_own`` audited) with an audited body: pairs (i, j, k_n, R_eff, δ)
-        of rows, walls per wall (rows, k_n, R_eff, δ) of audited members."""
+        """(candidate pairs, walls) among the rows of ``positions_m`` (bodies ``bodies``, the first
+        ``n_own`` audited) with an audited body: the candidates (i, j, k_n, R_eff) of rows within
+        contact distance and the skin, kept from one search to the next until a body has moved half
+        the skin (:func:`_pair_constants`), the walls per wall (rows, k_n, R_eff, δ) of the audited
+        members that touch it."""
         listed = self._listed is not None and n_own == self._listed[1] and np.array_equal(bodies, self._listed[0])
-        if not listed or np.max(np.linalg.norm(positions_m - self._listed_at, axis=1)) > self.skin_m / 2:
+        if not listed or self._moved_beyond(positions_m, self.skin_m / 2):
             self._listed, self._listed_at = (bodies.copy(), n_own), positions_m.copy()
             i, j = _pairs(positions_m, 2 * self.radii_m.max() + self.skin_m)
             keep = (i < n_own) | (j < n_own)
             i, j = i[keep], j[keep]
             self._candidates = (i, j, *_pair_constants(self.model, bodies[i], bodies[j], self.radii_m)[2:])
             self._walls = _wall_constants(self.model, bodies[:n_own])
-        return (_pair_contacts(positions_m, self.radii_m[bodies], self._candidates),
-                _wall_contacts(positions_m, self._walls))
+        return self._candidates, _wall_contacts(positions_m, self._walls)
+
+    def _moved_beyond(self, positions_m, distance_m: float) -> bool:
+        """Whether a body has moved more than ``distance_m`` since the candidates were listed."""
+        if self.compiled:
+            from hexdem.analysis.compiled import moved_beyond  # numba: only for large ranks
+
+            return moved_beyond(positions_m, self._listed_at, distance_m)
+        return np.max(np.linalg.norm(positions_m - self._listed_at, axis=1)) > distance_m
+
+    def _contact_energies_j(self, bodies, n_own: int, positions_m) -> np.ndarray:
+        """(R,) contact energy [J] of each region of the audited bodies (:func:`_pair_energies_j`, then
+        :func:`_add_wall_energies_j`),
+        by the compiled kernel (:func:`~hexdem.analysis.compiled.pair_contact_energies`) where the
+        audit was made ``compiled``, else by NumPy: the same sums."""
+        candidates, walls = self._contacts(bodies, n_own, positions_m)
+        n_regions = len(self.region_names)
+        if self.compiled:
+            from hexdem.analysis.compiled import pair_contact_energies  # numba: only for large ranks
+
+            contact = pair_contact_energies(positions_m, bodies, self.radii_m, self.regions, *candidates, n_own,
+                                            n_regions)
+        else:
+            contact = _pair_energies_j(_pair_contacts(positions_m, self.radii_m[bodies], candidates),
+                                       self.regions[bodies], n_regions, n_own)
+        _add_wall_energies_j(contact, walls, self.regions[bodies], n_regions)
+        return contact
 
     def part(self, bodies, n_own: int, positions_m, velocities_m_s, angular_velocities_s=None) -> np.ndarray:
         """The audit's sums over the bodies ``bodies[:n_own]`` (indices; the rest are ghosts, see the
@@ -163,16 +191,27 @@ class EnergyAudit:
         rotational kinetic, then the (R, 2) kinetic and contact energy of each
         :func:`energy_regions` region, flattened] [J], to be summed over the ranks."""
         bodies, positions_m = np.asarray(bodies), np.asarray(positions_m, float)
-        own = bodies[:n_own]
-        pairs, walls = self._contacts(bodies, n_own, positions_m)
-        translational = 0.5 * self.masses_kg[own] * np.sum(np.asarray(velocities_m_s, float) ** 2, axis=1)
-        rotational = (np.zeros(n_own) if angular_velocities_s is None
+        translational, rotational, kinetic, external = self._body_energies_j(
+            bodies[:n_own], positions_m[:n_own], np.asarray(velocities_m_s, float), angular_velocities_s)
+        by_region = np.column_stack([kinetic, self._contact_energies_j(bodies, n_own, positions_m)])
+        return np.concatenate([[float(np.sum(by_region)) - external, translational, rotational], by_region.ravel()])
+
+    def _body_energies_j(self, own, positions_m, velocities_m_s, angular_velocities_s) -> tuple:
+        """(translational and rotational kinetic energy [J], (R,) kinetic energy [J] of each region, the
+        work [J] of the constant forces) of the audited bodies ``own`` at ``positions_m`` with
+        ``velocities_m_s`` and spins (None: spheres that do not turn)."""
+        if self.compiled:
+            from hexdem.analysis.compiled import body_energies  # numba: only for large ranks
+
+            spins = np.zeros(0) if angular_velocities_s is None else np.asarray(angular_velocities_s, float)
+            return body_energies(positions_m, velocities_m_s, spins, own, self.masses_kg, self.inertia_kg_m2,
+                                 self.regions, self.start_m, self.external_n, len(self.region_names))
+        translational = 0.5 * self.masses_kg[own] * np.sum(velocities_m_s**2, axis=1)
+        rotational = (np.zeros(len(own)) if angular_velocities_s is None
                       else 0.5 * self.inertia_kg_m2[own] * np.asarray(angular_velocities_s, float) ** 2)
-        by_region = _region_energies_j(translational + rotational, self.regions[bodies], len(self.region_names), n_own,
-                                       pairs, walls)
-        external = float(np.sum((positions_m[:n_own] - self.start_m[own]) * self.external_n[own]))
-        return np.concatenate([[float(np.sum(by_region)) - external, float(np.sum(translational)),
-                                float(np.sum(rotational))], by_region.ravel()])
+        kinetic = _by_region(self.regions[own], translational + rotational, len(self.region_names))
+        external = float(np.sum((positions_m - self.start_m[own]) * self.external_n[own]))
+        return float(np.sum(translational)), float(np.sum(rotational)), kinetic, external
 
     def __call__(self, positions_m, velocities_m_s, angular_velocities_s=None) -> float:
         return self.measure(positions_m, velocities_m_s, angular_velocities_s)[0]
@@ -195,25 +234,28 @@ def energy_regions(model: GranularModel) -> tuple[list[str], np.ndarray]:
     return names, regions
 
 
-def _region_energies_j(kinetic_j, regions, n_regions: int, n_own: int, pairs, walls) -> np.ndarray:
-    """(R, 2) kinetic and contact energy [J] of each region of the first ``n_own`` rows
-    (``regions``: each row's, from :func:`energy_regions`; ``kinetic_j`` each of those rows'): a
-    contact's Hertz energy half to each of its bodies' regions (only the halves of those rows),
-    a wall contact's to its bead's."""
+def _by_region(regions, energies_j, n_regions: int) -> np.ndarray:
+    """(R,) sums of ``energies_j`` by each body's region (float even when empty, unlike bincount's)."""
+    return np.bincount(regions, energies_j, n_regions).astype(float)
 
-    def by_region(bodies, energies) -> np.ndarray:  # (float even when empty, unlike bincount's)
-        return np.bincount(bodies, energies, n_regions).astype(float)
 
-    kinetic = by_region(regions[:n_own], kinetic_j)
+def _pair_energies_j(pairs, regions, n_regions: int, n_own: int) -> np.ndarray:
+    """(R,) Hertz energy [J] of the touching ``pairs`` (i, j, k_n, R_eff, δ of rows, whose regions are
+    ``regions``): a contact's half to each of its bodies' regions, for the first ``n_own`` rows only."""
     i, j, *pair = pairs
     halves = _hertz_energies_j(*pair) / 2
     contact = np.zeros(n_regions)
     for side in (i, j):
         own = side < n_own
-        contact += by_region(regions[side[own]], halves[own])
+        contact += _by_region(regions[side[own]], halves[own], n_regions)
+    return contact
+
+
+def _add_wall_energies_j(contact_j, walls, regions, n_regions: int) -> None:
+    """Add to ``contact_j`` (R,) the Hertz energy [J] of the wall contacts (:func:`_wall_contacts`),
+    each to its bead's region, wall by wall."""
     for beads, *wall in walls:
-        contact += by_region(regions[beads], _hertz_energies_j(*wall))
-    return np.column_stack([kinetic, contact])
+        contact_j += _by_region(regions[beads], _hertz_energies_j(*wall), n_regions)
 
 
 #: The audit's yardstick never falls below this fraction of the total energy: the round-off of a

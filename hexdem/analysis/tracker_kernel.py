@@ -30,9 +30,9 @@ instead of copying the slots.
 
 **Cost.** Most beads, at most samples, only enter the ring (and, for three samples after a
 new maximum, the peak window); the ladder's bookkeeping runs on the few beads whose running
-maximum rises at that sample. Every step is a NumPy operation over those beads: no Python per
-bead and no compiler to load (numba's start-up alone cost more than the default run's whole
-tracking).
+maximum rises at that sample (beads at rest never do: their samples stay below the noise floor).
+Every step is a NumPy operation over those beads, for ranks too small to pay numba's start-up; a
+large rank runs the same update compiled (:func:`~hexdem.analysis.compiled.update_pulses`).
 """
 
 from __future__ import annotations

@@ -1,0 +1,145 @@
+r"""The in-run analysis's per-sample arithmetic compiled (numba): the pulse tracker's update and the
+energy audit's contact sums, one loop over a rank's beads or candidate pairs each.
+
+They compute exactly what the NumPy code of :class:`~hexdem.analysis.tracker_kernel.PulseState`
+and :class:`~hexdem.analysis.energy.EnergyAudit` computes, in the same order (the tests hold the
+two equal): the NumPy code indexes arrays of beads and pairs, which at 29,701 beads cost about
+300 ns per bead per sample for the tracker and 480 ns per bead per audited sample for the audit,
+where one compiled pass over a bead's few numbers takes a few nanoseconds. Loading numba and these
+kernels (cached on disk, ``cache=True``) costs about half a second, more than the whole analysis of
+a small run, so the analysis uses them only for ranks that hold at least
+:data:`~hexdem.analysis.tracker.COMPILED_BEADS` beads.
+
+Compiled without fast-math, so that each operation is IEEE-exact, as NumPy's.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+_jit = njit(cache=True, error_model="numpy")
+
+
+@_jit
+def update_pulses(speeds, s, q, ring, peak, peak_index, window, after, start, length, rec_index, rec_value, rec_prev,
+                  rec_prev2, first_index, first_value, first_prev, first_prev2):
+    """:meth:`~hexdem.analysis.tracker_kernel.PulseState.update` of every row, row ``b`` taking
+    ``speeds[b]`` as its sample ``s`` (the state arrays are the state's, updated in place)."""
+    capacity = rec_value.shape[1]
+    nan = np.nan
+    for b in range(len(speeds)):
+        v = speeds[b]
+        if v > peak[b]:
+            before = ring[b, (s - 1) % 3] if s >= 1 else nan
+            before2 = ring[b, (s - 2) % 3] if s >= 2 else nan
+            peak[b] = v
+            peak_index[b] = s
+            for j in range(3):
+                window[b, j] = ring[b, (s - 3 + j) % 3] if s - 3 + j >= 0 else nan
+            window[b, 3] = v
+            for j in range(4, 7):
+                window[b, j] = nan
+            after[b] = 0
+            n = length[b]
+            half = 0.5 * v
+            below = 0
+            for k in range(capacity):
+                if rec_value[b, k] < half:
+                    below += 1
+            below -= capacity - n
+            drop = max(below - 1, 0)
+            first = (start[b] + drop) % capacity
+            n -= drop
+            if n >= 2 and rec_value[b, (first + n - 1) % capacity] < q * rec_value[b, (first + n - 2) % capacity]:
+                n -= 1
+            else:
+                slot = (first + n) % capacity
+                first_index[b, slot] = s
+                first_value[b, slot] = v
+                first_prev[b, slot] = before
+                first_prev2[b, slot] = before2
+            slot = (first + n) % capacity
+            rec_index[b, slot] = s
+            rec_value[b, slot] = v
+            rec_prev[b, slot] = before
+            rec_prev2[b, slot] = before2
+            start[b] = first
+            length[b] = n + 1
+        elif after[b] < 3:
+            window[b, 4 + after[b]] = v
+            after[b] += 1
+        ring[b, s % 3] = v
+
+
+@_jit
+def pair_contact_energies(positions, bodies, radii, regions, i, j, stiffness, r_eff, n_own, n_regions):
+    r"""(R,) Hertz energy [J] of the touching candidate pairs ``i``, ``j`` (rows of ``positions``, of
+    bodies ``bodies``, whose ``radii`` and ``regions`` these are),
+    :math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}\, δ^{5/2}` each, half to each of its bodies' regions where
+    that body is one of the first ``n_own`` rows: :func:`~hexdem.analysis.energy._pair_energies_j`,
+    summed in its order (the i sides' halves, pair by pair, then the j sides')."""
+    sides = np.zeros((2, n_regions))
+    for p in range(len(i)):
+        a, b = i[p], j[p]
+        dx = positions[a, 0] - positions[b, 0]
+        dy = positions[a, 1] - positions[b, 1]
+        overlap = radii[bodies[a]] + radii[bodies[b]] - math.sqrt(dx * dx + dy * dy)
+        if overlap > 0:
+            half = 0.4 * stiffness[p] * math.sqrt(r_eff[p]) * overlap**2.5 / 2
+            if a < n_own:
+                sides[0, regions[bodies[a]]] += half
+            if b < n_own:
+                sides[1, regions[bodies[b]]] += half
+    contact = np.zeros(n_regions)
+    contact += sides[0]
+    contact += sides[1]
+    return contact
+
+
+
+@_jit
+def body_energies(positions, velocities, spins, bodies, masses, inertia, regions, start, external, n_regions):
+    """The audited bodies' own terms of :meth:`~hexdem.analysis.energy.EnergyAudit.part`, one pass
+    over the rows of ``positions``, ``velocities`` and ``spins`` (ω_z, empty for spheres that do not
+    turn), bodies ``bodies``: (translational and rotational kinetic energy [J], (R,) kinetic energy
+    [J] of each region, the work −Σ F·u [J] of the constant forces ``external`` over the
+    displacements from ``start``), summed row by row (NumPy sums in pairs: the two differ by
+    round-off)."""
+    translational, rotational, work = 0.0, 0.0, 0.0
+    kinetic = np.zeros(n_regions)
+    for r in range(len(bodies)):
+        b = bodies[r]
+        vx, vy = velocities[r, 0], velocities[r, 1]
+        moving = 0.5 * masses[b] * (vx * vx + vy * vy)
+        turning = 0.5 * inertia[b] * spins[r] ** 2 if len(spins) else 0.0
+        translational += moving
+        rotational += turning
+        kinetic[regions[b]] += moving + turning
+        work += (positions[r, 0] - start[b, 0]) * external[b, 0] + (positions[r, 1] - start[b, 1]) * external[b, 1]
+    return translational, rotational, kinetic, work
+
+
+@_jit
+def moved_beyond(positions, listed_at, distance) -> bool:
+    """Whether a row of ``positions`` lies more than ``distance`` from the same row of ``listed_at``."""
+    limit = distance * distance
+    for r in range(len(positions)):
+        dx = positions[r, 0] - listed_at[r, 0]
+        dy = positions[r, 1] - listed_at[r, 1]
+        if dx * dx + dy * dy > limit:
+            return True
+    return False
+
+
+@_jit
+def bead_speeds(velocities, rows, speeds, end_velocity):
+    """|v| of the sample's rows ``rows`` into ``speeds``, and their velocities into ``end_velocity``
+    (``np.hypot``'s arithmetic, C's hypot)."""
+    for k in range(len(rows)):
+        vx, vy = velocities[rows[k], 0], velocities[rows[k], 1]
+        speeds[k] = math.hypot(vx, vy)
+        end_velocity[k, 0] = vx
+        end_velocity[k, 1] = vy
