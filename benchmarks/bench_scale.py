@@ -1,6 +1,6 @@
 """hexdem at scale: a large run stage by stage, each MPI rank's peak memory and the analysis's collectives.
 
-Usage: python benchmarks/bench_scale.py [--edges 100,200] [--ranks 1,2,4,8] [--duration 1e-4] [--quick]
+Usage: python benchmarks/bench_scale.py [--edges 100,200] [--ranks 1,2,4,8] [--duration 1e-4] [--before REV] [--quick]
 
 For a hexagon of each of ``--edges`` beads per edge (100: 29,701 beads; 200: 119,401; 578:
 1,000,519), run ``--duration`` seconds (default 1e-4) on each of ``--ranks`` rank counts (more ranks
@@ -23,9 +23,17 @@ than cores is fine for memory and collective counts, not for times):
   against those of the first (default: one rank), text columns equal, numbers within
   :data:`RESULTS_RTOL` (round-off: LAMMPS sums forces in another order on other ranks).
 
+* **before**, with ``--before REV`` (a revision of this clone, or a directory holding its unpacked
+  package, :func:`baseline.baseline_tree`): the same ``hexdem run`` by that version, on the same
+  machine and deck, beside the same bare loop: its loop, its analysis's share and its end to end.
+
 Targets: at 119,401 beads on 8 ranks the largest process <= 400 MB; each rank's peak falls as
 ranks are added; collectives <= one per neighbour-list rebuild + one per audited sample + 2 (the
-first sample's layout and the final gather); results equal on every rank count.
+first sample's layout and the final gather); results equal on every rank count. The analysis's
+share of the loop <= :data:`SHARE_TARGET` at 29,701 and 119,401 beads on 1 and 2 ranks, and <=
+:data:`MANY_RANKS_SHARE_TARGET` from :data:`MANY_RANKS` ranks on (a machine of that many cores); end
+to end <= :data:`END_TO_END_FACTOR` × the bare loop + :data:`END_TO_END_OFFSET_S` at 29,701 beads on 2
+ranks; a million beads' result files and figures <= :data:`MILLION_RESULTS_S`.
 ``--quick``: hexagons of 5 and 7 per edge for 0.2 ms on 1 and 2 ranks (the same code path, seconds).
 """
 
@@ -42,7 +50,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from baseline import hexdem_command
+from baseline import baseline_tree, hexdem_command, hexdem_env
 from harness import MB, NOOUTPUT_NAME, nooutput_deck, run_watched, write_config
 from machine import describe
 
@@ -58,6 +66,14 @@ MEMORY_TARGET = 400 * MB
 MEMORY_TARGET_RUN = (119_401, 8)
 #: Collectives beside one per rebuild and one per audited sample: the first sample's layout, the final gather.
 COLLECTIVES_BESIDE = 2
+#: The analysis's share of the loop (hexdem's loop / the bare loop − 1), at most, on 1 and 2 ranks of
+#: 29,701 and 119,401 beads, and from MANY_RANKS ranks on.
+SHARE_TARGET, MANY_RANKS_SHARE_TARGET, MANY_RANKS = 0.10, 0.15, 16
+SHARE_TARGET_BEADS = (29_701, 119_401)
+#: End to end at 29,701 beads on 2 ranks <= this × the bare loop + this offset.
+END_TO_END_FACTOR, END_TO_END_OFFSET_S, END_TO_END_RUN = 1.25, 3.0, (29_701, 2)
+#: A million beads' result files and figures (the 578-per-edge hexagon), at most.
+MILLION_RESULTS_S = 5.0
 #: Result tables compared across rank counts, and how close their numbers must be.
 TABLES, RESULTS_RTOL, RESULTS_ATOL = ("peaks.csv", "beads.csv"), 1e-9, 1e-15
 
@@ -111,8 +127,9 @@ def results_span_s(out: Path) -> float:
     return max(stamps) - (out / "peaks.csv").stat().st_mtime
 
 
-def measure(config: RunConfig, ranks: int, work: Path) -> dict:
-    """One row: the stages, each process's peak memory and the collectives of ``config`` on ``ranks``."""
+def measure(config: RunConfig, ranks: int, work: Path, before: Path | None = None) -> dict:
+    """One row: the stages, each process's peak memory and the collectives of ``config`` on ``ranks``;
+    with ``before`` (an earlier version's package tree), that version's loop and end to end too."""
     config = config.replace(ranks=ranks)
     tag = f"{config.edge_beads}-{ranks}"
     start = time.perf_counter()
@@ -122,8 +139,9 @@ def measure(config: RunConfig, ranks: int, work: Path) -> dict:
     deck = nooutput_deck(model, settings, work / f"bare-{tag}")
     written = time.perf_counter()
     out = work / f"hexdem-{tag}"
-    watched = run_watched(hexdem_command("run", "--config", str(write_config(config, work / f"{tag}.toml")),
-                                         "--out", str(out), "--ranks", str(ranks)), cwd=work).check(f"hexdem run ({tag})")
+    config_file = write_config(config, work / f"{tag}.toml")
+    watched = run_watched(hexdem_command("run", "--config", str(config_file), "--out", str(out), "--ranks", str(ranks)),
+                          cwd=work).check(f"hexdem run ({tag})")
     summary = json.loads((out / "summary.json").read_text())
     log = out / "deck" / "log.lammps"
     rank_peaks = sorted((rss for pid, (name, rss) in watched.peaks.items()
@@ -135,6 +153,13 @@ def measure(config: RunConfig, ranks: int, work: Path) -> dict:
            "rebuilds": neighbour_builds(log), "audited": audited_samples(out / "energy_regions.csv"),
            "tables": {name: read_table(out / name) for name in TABLES}}
     shutil.rmtree(out)
+    if before is not None:
+        earlier = work / f"before-{tag}"
+        row["before wall"] = run_watched(hexdem_command("run", "--config", str(config_file), "--out", str(earlier),
+                                                        "--ranks", str(ranks)), cwd=work, env=hexdem_env(before)
+                                         ).check(f"hexdem run before ({tag})").wall_s
+        row["before loop"] = loop_time_s(earlier / "deck" / "log.lammps")
+        shutil.rmtree(earlier)
     run_bare(deck, ranks, NOOUTPUT_NAME)
     row["bare loop"] = loop_time_s(deck.log_path)
     shutil.rmtree(deck.directory)
@@ -146,6 +171,7 @@ def main() -> None:
     parser.add_argument("--edges", type=parse_list, default=[100, 200], help="hexagon edges in beads (default 100,200)")
     parser.add_argument("--ranks", type=parse_list, default=[1, 2, 4, 8], help="rank counts (default 1,2,4,8)")
     parser.add_argument("--duration", type=float, default=1e-4, help="simulated time [s] (default 1e-4)")
+    parser.add_argument("--before", help="also time hexdem of this revision (or unpacked package tree) side by side")
     parser.add_argument("--quick", action="store_true", help="5- and 7-per-edge hexagons for 0.2 ms on 1 and 2 ranks")
     args = parser.parse_args()
     edges, ranks, duration = ([5, 7], [1, 2], 2e-4) if args.quick else (args.edges, args.ranks, args.duration)
@@ -153,9 +179,15 @@ def main() -> None:
     work = Path(tempfile.mkdtemp(prefix="hexdem-bench-scale-"))
     results = {}
     try:
+        before = None
+        if args.before is not None:
+            before = Path(args.before) if Path(args.before).is_dir() else baseline_tree(work, args.before)
+            if before is None:
+                raise SystemExit(f"bench_scale.py: this clone holds no revision {args.before}")
         for edge in edges:
             for n in ranks:
-                results[edge, n] = r = measure(RunConfig(shape="hexagon", edge_beads=edge, duration=duration), n, work)
+                results[edge, n] = r = measure(RunConfig(shape="hexagon", edge_beads=edge, duration=duration), n, work,
+                                               before)
                 print(f"  measured {r['beads']} beads on {n} rank(s): end to end {r['wall']:.1f} s, "
                       f"largest process {r['largest'] / MB:.0f} MB", flush=True)
     finally:
@@ -169,6 +201,33 @@ def main() -> None:
               f"{r['run']:>8.2f} {r['results']:>11.2f} {r['wall']:>14.2f}")
     print("(analysis: hexdem's loop / bare loop - 1; run: summary.json's wall_time_s, to the result files; "
           "results: the result tables and figures)")
+    if args.before is not None:
+        print(f"before ({args.before}) and now, side by side on the same deck and bare loop")
+        print(f"{'beads':>9} {'ranks':>5} {'bare loop [s]':>13} {'loop before':>11} {'loop now':>8} "
+              f"{'analysis before':>15} {'analysis now':>12} {'end-to-end before':>17} {'end-to-end now':>14}")
+        for (edge, n), r in results.items():
+            print(f"{r['beads']:>9,} {n:>5} {r['bare loop']:>13.2f} {r['before loop']:>11.2f} {r['hexdem loop']:>8.2f} "
+                  f"{r['before loop'] / r['bare loop'] - 1:>15.2f} {r['hexdem loop'] / r['bare loop'] - 1:>12.2f} "
+                  f"{r['before wall']:>17.2f} {r['wall']:>14.2f}")
+    for (edge, n), r in results.items():
+        limit = MANY_RANKS_SHARE_TARGET if n >= MANY_RANKS else SHARE_TARGET if n <= 2 else None
+        if limit is None or (n <= 2 and r["beads"] not in SHARE_TARGET_BEADS):
+            continue
+        share = r["hexdem loop"] / r["bare loop"] - 1
+        print(f"target analysis share, {r['beads']:,} beads on {n} rank(s): {share:.3f} "
+              f"{'<=' if share <= limit else '>'} {limit:g}: {'met' if share <= limit else 'NOT met'}")
+    beads, n = END_TO_END_RUN
+    row = next((r for (edge, m), r in results.items() if r["beads"] == beads and m == n), None)
+    if row is not None:
+        bound = END_TO_END_FACTOR * row["bare loop"] + END_TO_END_OFFSET_S
+        print(f"target end to end, {beads:,} beads on {n} ranks: {row['wall']:.2f} {'<=' if row['wall'] <= bound else '>'} "
+              f"{END_TO_END_FACTOR:g} x bare loop + {END_TO_END_OFFSET_S:g} s = {bound:.2f}: "
+              f"{'met' if row['wall'] <= bound else 'NOT met'}")
+    for (edge, n), r in results.items():
+        if r["beads"] >= 1_000_000:
+            print(f"target million-bead result files, {r['beads']:,} beads on {n} ranks: {r['results']:.2f} s "
+                  f"{'<=' if r['results'] <= MILLION_RESULTS_S else '>'} {MILLION_RESULTS_S:g} s: "
+                  f"{'met' if r['results'] <= MILLION_RESULTS_S else 'NOT met'}")
     print(f"{'beads':>9} {'ranks':>5} {'largest process [MB]':>20} {'hexdem run [MB]':>15} "
           f"{'collectives':>11} {'rebuilds':>8} {'audited':>7}  peak RSS per rank [MB]")
     for (edge, n), r in results.items():
