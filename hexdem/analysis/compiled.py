@@ -1,14 +1,16 @@
 r"""The in-run analysis's per-sample arithmetic compiled (numba): the pulse tracker's update and the
-energy audit's contact sums, one loop over a rank's beads or candidate pairs each.
+energy audit's contact and body sums, one loop over a rank's beads or candidate pairs each.
 
-They compute exactly what the NumPy code of :class:`~hexdem.analysis.tracker_kernel.PulseState`
-and :class:`~hexdem.analysis.energy.EnergyAudit` computes, in the same order (the tests hold the
-two equal): the NumPy code indexes arrays of beads and pairs, which at 29,701 beads cost about
-300 ns per bead per sample for the tracker and 480 ns per bead per audited sample for the audit,
-where one compiled pass over a bead's few numbers takes a few nanoseconds. Loading numba and these
-kernels (cached on disk, ``cache=True``) costs about half a second, more than the whole analysis of
-a small run, so the analysis uses them only for ranks that hold at least
-:data:`~hexdem.analysis.tracker.COMPILED_BEADS` beads.
+They compute what the NumPy code of :class:`~hexdem.analysis.tracker_kernel.PulseState` and
+:class:`~hexdem.analysis.energy.EnergyAudit` computes, in the same order: the tests hold the
+tracker's results equal to the bit and the energies to round-off (δ^{5/2} is taken as δ² √δ, see
+:func:`pair_contact_energies`; sums run body by body where NumPy's go in pairs). The NumPy code
+indexes arrays of beads and pairs, which at 29,701 beads cost about 300 ns per bead per sample for
+the tracker and 480 ns per bead per audited sample for the audit, where one compiled pass over a
+bead's few numbers takes a few nanoseconds. Loading numba and these kernels (cached on disk,
+``cache=True``) costs about half a second, more than the whole analysis of a small run, so the
+analysis uses them only for ranks that hold at least :data:`~hexdem.analysis.tracker.COMPILED_BEADS`
+beads.
 
 Compiled without fast-math, so that each operation is IEEE-exact, as NumPy's.
 """
@@ -75,50 +77,50 @@ def update_pulses(speeds, s, q, ring, peak, peak_index, window, after, start, le
 
 
 @_jit
-def pair_contact_energies(positions, bodies, radii, regions, i, j, stiffness, r_eff, n_own, n_regions):
-    r"""(R,) Hertz energy [J] of the touching candidate pairs ``i``, ``j`` (rows of ``positions``, of
-    bodies ``bodies``, whose ``radii`` and ``regions`` these are),
-    :math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}\, δ^{5/2}` each, half to each of its bodies' regions where
-    that body is one of the first ``n_own`` rows: :func:`~hexdem.analysis.energy._pair_energies_j`,
-    summed in its order (the i sides' halves, pair by pair, then the j sides')."""
+def pair_contact_energies(positions, i, j, contact_m, coefficient, region_i, region_j, n_regions):
+    r"""(R,) Hertz energy [J] of the touching candidate pairs ``i``, ``j`` (rows of ``positions``):
+    :math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}\, δ^{5/2}` each, δ = ``contact_m`` (the pair's sum of radii) less
+    its distance, ``coefficient`` = :math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}`, half to each of its bodies'
+    regions ``region_i``, ``region_j`` (−1: a ghost, not audited here):
+    :func:`~hexdem.analysis.energy._pair_energies_j`, summed in its order (the i sides' halves, pair by
+    pair, then the j sides'). :math:`δ^{5/2}` is taken as δ² √δ, within an ulp of NumPy's power and a
+    third quicker."""
     sides = np.zeros((2, n_regions))
     for p in range(len(i)):
         a, b = i[p], j[p]
         dx = positions[a, 0] - positions[b, 0]
         dy = positions[a, 1] - positions[b, 1]
-        overlap = radii[bodies[a]] + radii[bodies[b]] - math.sqrt(dx * dx + dy * dy)
+        overlap = contact_m[p] - math.sqrt(dx * dx + dy * dy)
         if overlap > 0:
-            half = 0.4 * stiffness[p] * math.sqrt(r_eff[p]) * overlap**2.5 / 2
-            if a < n_own:
-                sides[0, regions[bodies[a]]] += half
-            if b < n_own:
-                sides[1, regions[bodies[b]]] += half
+            half = coefficient[p] * (overlap * overlap * math.sqrt(overlap)) / 2
+            if region_i[p] >= 0:
+                sides[0, region_i[p]] += half
+            if region_j[p] >= 0:
+                sides[1, region_j[p]] += half
     contact = np.zeros(n_regions)
     contact += sides[0]
     contact += sides[1]
     return contact
 
 
-
 @_jit
-def body_energies(positions, velocities, spins, bodies, masses, inertia, regions, start, external, n_regions):
+def body_energies(positions, velocities, spins, masses, inertia, regions, start, external, n_regions):
     """The audited bodies' own terms of :meth:`~hexdem.analysis.energy.EnergyAudit.part`, one pass
-    over the rows of ``positions``, ``velocities`` and ``spins`` (ω_z, empty for spheres that do not
-    turn), bodies ``bodies``: (translational and rotational kinetic energy [J], (R,) kinetic energy
-    [J] of each region, the work −Σ F·u [J] of the constant forces ``external`` over the
-    displacements from ``start``), summed row by row (NumPy sums in pairs: the two differ by
-    round-off)."""
+    over their rows: ``positions``, ``velocities``, ``spins`` (ω_z, empty for spheres that do not
+    turn) and each row's body's ``masses``, ``inertia``, ``regions``, ``start`` positions and constant
+    forces ``external``: (translational and rotational kinetic energy [J], (R,) kinetic energy [J]
+    of each region, the work −Σ F·u [J] of the constant forces over the displacements from
+    ``start``), summed row by row (NumPy sums in pairs: the two differ by round-off)."""
     translational, rotational, work = 0.0, 0.0, 0.0
     kinetic = np.zeros(n_regions)
-    for r in range(len(bodies)):
-        b = bodies[r]
+    for r in range(len(masses)):
         vx, vy = velocities[r, 0], velocities[r, 1]
-        moving = 0.5 * masses[b] * (vx * vx + vy * vy)
-        turning = 0.5 * inertia[b] * spins[r] ** 2 if len(spins) else 0.0
+        moving = 0.5 * masses[r] * (vx * vx + vy * vy)
+        turning = 0.5 * inertia[r] * spins[r] ** 2 if len(spins) else 0.0
         translational += moving
         rotational += turning
-        kinetic[regions[b]] += moving + turning
-        work += (positions[r, 0] - start[b, 0]) * external[b, 0] + (positions[r, 1] - start[b, 1]) * external[b, 1]
+        kinetic[regions[r]] += moving + turning
+        work += (positions[r, 0] - start[r, 0]) * external[r, 0] + (positions[r, 1] - start[r, 1]) * external[r, 1]
     return translational, rotational, kinetic, work
 
 

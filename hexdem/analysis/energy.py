@@ -140,7 +140,7 @@ class EnergyAudit:
         self.external_n = model.external_forces_n() + self.masses_kg[:, None] * gravity
         self.everybody = np.arange(model.n_bodies)
         self.compiled = compiled
-        self._listed, self._listed_at, self._candidates, self._walls = None, None, None, None
+        self._listed, self._listed_at, self._candidates, self._walls, self._rows = None, None, None, None, None
 
     def _contacts(self, bodies, n_own: int, positions_m):
         """(candidate pairs, walls) among the rows of ``positions_m`` (bodies ``bodies``, the first
@@ -156,7 +156,23 @@ class EnergyAudit:
             i, j = i[keep], j[keep]
             self._candidates = (i, j, *_pair_constants(self.model, bodies[i], bodies[j], self.radii_m)[2:])
             self._walls = _wall_constants(self.model, bodies[:n_own])
+            if self.compiled:
+                self._rows = self._row_constants(bodies, n_own)
         return self._candidates, _wall_contacts(positions_m, self._walls)
+
+    def _row_constants(self, bodies, n_own: int) -> tuple:
+        r"""What the compiled kernels read of the listed rows, laid out once per list (see
+        :mod:`hexdem.analysis.compiled`): per candidate pair its sum of radii, its
+        :math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}` and the regions of its two rows (−1 for a ghost); per audited
+        row its body's mass, inertia, region, start position and constant force."""
+        i, j, stiffness, r_eff = self._candidates
+        regions = self.regions[bodies]
+        own = np.where(np.arange(len(bodies)) < n_own, regions, -1)
+        pairs = (i, j, self.radii_m[bodies[i]] + self.radii_m[bodies[j]], 0.4 * stiffness * np.sqrt(r_eff), own[i], own[j])
+        audited = bodies[:n_own]
+        rows = (self.masses_kg[audited], self.inertia_kg_m2[audited], regions[:n_own], self.start_m[audited],
+                self.external_n[audited])
+        return pairs, rows
 
     def _moved_beyond(self, positions_m, distance_m: float) -> bool:
         """Whether a body has moved more than ``distance_m`` since the candidates were listed."""
@@ -176,8 +192,7 @@ class EnergyAudit:
         if self.compiled:
             from hexdem.analysis.compiled import pair_contact_energies  # numba: only for large ranks
 
-            contact = pair_contact_energies(positions_m, bodies, self.radii_m, self.regions, *candidates, n_own,
-                                            n_regions)
+            contact = pair_contact_energies(positions_m, *self._rows[0], n_regions)
         else:
             contact = _pair_energies_j(_pair_contacts(positions_m, self.radii_m[bodies], candidates),
                                        self.regions[bodies], n_regions, n_own)
@@ -191,9 +206,10 @@ class EnergyAudit:
         rotational kinetic, then the (R, 2) kinetic and contact energy of each
         :func:`energy_regions` region, flattened] [J], to be summed over the ranks."""
         bodies, positions_m = np.asarray(bodies), np.asarray(positions_m, float)
+        contact = self._contact_energies_j(bodies, n_own, positions_m)
         translational, rotational, kinetic, external = self._body_energies_j(
             bodies[:n_own], positions_m[:n_own], np.asarray(velocities_m_s, float), angular_velocities_s)
-        by_region = np.column_stack([kinetic, self._contact_energies_j(bodies, n_own, positions_m)])
+        by_region = np.column_stack([kinetic, contact])
         return np.concatenate([[float(np.sum(by_region)) - external, translational, rotational], by_region.ravel()])
 
     def _body_energies_j(self, own, positions_m, velocities_m_s, angular_velocities_s) -> tuple:
@@ -204,8 +220,7 @@ class EnergyAudit:
             from hexdem.analysis.compiled import body_energies  # numba: only for large ranks
 
             spins = np.zeros(0) if angular_velocities_s is None else np.asarray(angular_velocities_s, float)
-            return body_energies(positions_m, velocities_m_s, spins, own, self.masses_kg, self.inertia_kg_m2,
-                                 self.regions, self.start_m, self.external_n, len(self.region_names))
+            return body_energies(positions_m, velocities_m_s, spins, *self._rows[1], len(self.region_names))
         translational = 0.5 * self.masses_kg[own] * np.sum(velocities_m_s**2, axis=1)
         rotational = (np.zeros(len(own)) if angular_velocities_s is None
                       else 0.5 * self.inertia_kg_m2[own] * np.asarray(angular_velocities_s, float) ** 2)

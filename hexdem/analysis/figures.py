@@ -8,6 +8,8 @@ importing pyplot and its interactive backends (about 0.5 s).
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from matplotlib import colormaps
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -116,25 +118,35 @@ PIXEL_REACH_D = 0.6
 PIXEL_UNMEASURED = {"still rising at the run's end": "0.6", "never moved": "0.85", "no value": "0.35"}
 
 
-def _pixel_beads(ax, positions, diameters, values, coloured, groups: dict, outlined: dict, cmap, norm, clim):
-    """The beads rasterized, :data:`MAP_PIXELS` across: a pixel takes the value of the bead whose
-    centre is nearest, within :data:`PIXEL_REACH_D` of its diameter (each bead a cell of the
-    packing's Voronoi tiling); an unmeasured bead's pixels take its grey
-    (:data:`PIXEL_UNMEASURED`), and each ring group's region is outlined by a contour of its
-    pixels. Returns the image and the legend's patches."""
+@functools.lru_cache(maxsize=1)
+def _pixel_tiling(positions_bytes: bytes, diameters_bytes: bytes) -> tuple[np.ndarray, tuple]:
+    """(the bead of each pixel, −1 for none, (rows, columns); the image's extent) of the beads at
+    ``positions`` of ``diameters`` (as raw bytes of float arrays, so that the maps of one run, which
+    share their beads, find them once): :data:`MAP_PIXELS` across, a pixel the bead whose centre is
+    nearest, within :data:`PIXEL_REACH_D` of its diameter (each bead a cell of the packing's
+    Voronoi tiling). The nearest centres are sought on every core: the run is over."""
     from scipy.spatial import cKDTree
 
+    positions, diameters = np.frombuffer(positions_bytes).reshape(-1, 2), np.frombuffer(diameters_bytes)
     radius = float(np.max(diameters)) / 2
     low, high = positions.min(axis=0) - radius, positions.max(axis=0) + radius
     step = float(np.max(high - low)) / MAP_PIXELS
     shape = tuple(np.maximum(np.ceil((high - low) / step).astype(int), 1))
     centres = [low[axis] + (np.arange(shape[axis]) + 0.5) * step for axis in (0, 1)]
     grid = np.stack(np.meshgrid(*centres), axis=-1).reshape(-1, 2)
-    distance, nearest = cKDTree(positions).query(grid)
+    distance, nearest = cKDTree(positions).query(grid, workers=-1)
     inside = distance <= np.maximum(PIXEL_REACH_D * diameters[nearest], step / np.sqrt(2))
     bead = np.where(inside, nearest, -1).reshape(shape[1], shape[0])
+    return bead, (low[0], low[0] + shape[0] * step, low[1], low[1] + shape[1] * step)
+
+
+def _pixel_beads(ax, positions, diameters, values, coloured, groups: dict, outlined: dict, cmap, norm, clim):
+    """The beads rasterized (:func:`_pixel_tiling`): a pixel takes its bead's value; an unmeasured
+    bead's pixels take its grey (:data:`PIXEL_UNMEASURED`), and each ring group's region is
+    outlined by a contour of its pixels. Returns the image and the legend's patches."""
+    bead, extent = _pixel_tiling(np.ascontiguousarray(positions, float).tobytes(),
+                                 np.ascontiguousarray(diameters, float).tobytes())
     covered = bead >= 0
-    extent = (low[0], low[0] + shape[0] * step, low[1], low[1] + shape[1] * step)
     legend = []
     for name, beads in groups.items():
         if np.any(beads):
