@@ -18,6 +18,8 @@ sys.path.insert(0, str(BENCHMARKS))
 from baseline import BEFORE  # noqa: E402  (the revision the benchmarks compare with)
 #: Words each benchmark's printed table must contain (headers, row names, the target line).
 EXPECTED = {
+    "bench_analysis.py": ("beads", "part", "before", "NumPy", "compiled", "before / compiled", "tracker", "audit",
+                          "gathering", "result files"),
     "bench_accuracy.py": ("case", "engine", "steps/τ", "peak error", "arrival [µs]", "energy drift", "order",
                           "wall [s]", "lammps", "reference", "target at 140 steps per contact"),
     "bench_run.py": ("runner", "wall [s]", "loop [s]", "wall / bare loop", "hexdem run (CLI, subprocess)",
