@@ -6,8 +6,9 @@ run (every ``dump_every`` steps, step 0 included) and, at the end, :meth:`PulseT
 gives each bead's peak speed, time of peak and half-maximum arrival time with the
 definitions of :mod:`hexdem.analysis.peaks`:
 
-* **peak speed** and **time of peak**: the same local cubic spline through the 7 samples
-  around the largest one as the dump analysis, so that equal samples give equal peaks;
+* **peak speed** and **time of peak**: the same largest maximum of the local cubic splines
+  through the 7 samples around the largest one and around each rival local maximum as the dump
+  analysis, so that equal samples give equal peaks;
 * **arrival time**: the first time |v| reaches half of the (spline) peak, interpolated
   linearly between the sample before the crossing and the crossing sample (the dump analysis
   uses its spline there; the two differ by a few ns at the default sampling);

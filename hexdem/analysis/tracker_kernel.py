@@ -39,7 +39,9 @@ instead of copying the slots.
 
 **Cost.** Most beads, at most samples, only enter the ring (and, for three samples after a
 new maximum, the peak window); the ladder's bookkeeping runs on the few beads whose running
-maximum rises at that sample (beads at rest never do: their samples stay below the noise floor).
+maximum rises at that sample (beads at rest never do: their samples stay below the noise floor),
+and the refinement on the few whose rival window completes (a local maximum within
+:data:`~hexdem.analysis.peaks.PEAK_OVERSHOOT` of the running maximum).
 Every step is a NumPy operation over those beads, for ranks too small to pay numba's start-up; a
 large rank runs the same update compiled (:func:`~hexdem.analysis.compiled.update_pulses`).
 """
