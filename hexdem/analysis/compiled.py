@@ -169,7 +169,7 @@ def moved_beyond(positions, listed_at, distance) -> bool:
 
 @_jit
 def bead_speeds(velocities, rows, speeds, end_velocity):
-    """|v| of the sample's rows ``rows`` into ``speeds``, and their velocities into ``end_velocity``
+    """The speeds ``|v|`` of the sample's rows ``rows`` into ``speeds``, and their velocities into ``end_velocity``
     (``np.hypot``'s arithmetic, C's hypot)."""
     for k in range(len(rows)):
         vx, vy = velocities[rows[k], 0], velocities[rows[k], 1]
