@@ -24,13 +24,13 @@ _jit = njit(cache=True, error_model="numpy")
 
 
 @_jit
-def update_pulses(speeds, s, q, reach, ring, peak, peak_index, window, after, start, length, rec_index, rec_value,
+def update_pulses(speeds, s, q, rival_ratio, ring, peak, peak_index, window, after, start, length, rec_index, rec_value,
                   rec_prev, rec_prev2, first_index, first_value, first_prev, first_prev2, rival, rival_index,
                   rival_after):
     """:meth:`~hexdem.analysis.tracker_kernel.PulseState.update` of every row but its refinement, row
     ``b`` taking ``speeds[b]`` as its sample ``s`` (the state arrays are the state's
-    :meth:`~hexdem.analysis.tracker_kernel.PulseState.sample_arrays`, updated in place; ``reach``:
-    :data:`~hexdem.analysis.tracker_kernel.RIVAL_REACH`). Returns the rows whose rival window is
+    :meth:`~hexdem.analysis.tracker_kernel.PulseState.sample_arrays`, updated in place; ``rival_ratio``:
+    :data:`~hexdem.analysis.tracker_kernel.RIVAL_RATIO`). Returns the rows whose rival window is
     complete, for :meth:`~hexdem.analysis.tracker_kernel.PulseState.challenge`."""
     capacity = rec_value.shape[1]
     nan = np.nan
@@ -82,7 +82,7 @@ def update_pulses(speeds, s, q, reach, ring, peak, peak_index, window, after, st
             earlier = -np.inf
             for k in range(1, min(s, 3) + 1):
                 earlier = max(earlier, ring[b, (s - k) % 3])
-            if v * reach >= peak[b] and v > earlier:
+            if v * rival_ratio >= peak[b] and v > earlier:
                 open_window(rival, rival_index, rival_after, ring, b, v, s)
             elif rival_after[b] < 3:
                 rival[b, 4 + rival_after[b]] = v

@@ -42,7 +42,7 @@ import numpy as np
 
 from hexdem.analysis.energy import EnergyAudit, energy_error, energy_regions, energy_scale_j
 from hexdem.analysis.peaks import noise_floor, refine_peak, refine_peaks
-from hexdem.analysis.tracker_kernel import RIVAL_REACH, PulseState
+from hexdem.analysis.tracker_kernel import RIVAL_RATIO, PulseState
 from hexdem.engines.sampling import Sample
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel, RunSettings
@@ -223,7 +223,7 @@ class PulseTracker:
 
             speeds = np.empty(len(self.ids))
             bead_speeds(sample.velocities, self.bead_rows, speeds, self.end_velocity)
-            self.pulses.challenge(update_pulses(speeds, s, self.pulses.q, RIVAL_REACH, *self.pulses.sample_arrays()))
+            self.pulses.challenge(update_pulses(speeds, s, self.pulses.q, RIVAL_RATIO, *self.pulses.sample_arrays()))
         else:
             velocities = sample.velocities[self.bead_rows]
             speeds = np.hypot(velocities[:, 0], velocities[:, 1])

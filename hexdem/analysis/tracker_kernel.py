@@ -54,7 +54,7 @@ from hexdem.analysis.peaks import PEAK_OVERSHOOT, may_overtake, refine_peaks
 
 #: A local maximum of the samples this many times the running maximum or above may overtake it
 #: (:func:`~hexdem.analysis.peaks.may_overtake`; the compiled update takes it as an argument).
-RIVAL_REACH = 1 + PEAK_OVERSHOOT
+RIVAL_RATIO = 1 + PEAK_OVERSHOOT
 
 
 def rung(capacity: int) -> float:
