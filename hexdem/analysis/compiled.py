@@ -26,25 +26,32 @@ _jit = njit(cache=True, error_model="numpy")
 
 
 @_jit
-def update_pulses(speeds, s, q, ring, peak, peak_index, window, after, start, length, rec_index, rec_value, rec_prev,
-                  rec_prev2, first_index, first_value, first_prev, first_prev2):
-    """:meth:`~hexdem.analysis.tracker_kernel.PulseState.update` of every row, row ``b`` taking
-    ``speeds[b]`` as its sample ``s`` (the state arrays are the state's, updated in place)."""
+def update_pulses(speeds, s, q, rival_ratio, ring, peak, peak_index, window, after, start, length, rec_index, rec_value,
+                  rec_prev, rec_prev2, first_index, first_value, first_prev, first_prev2, rival, rival_index,
+                  rival_after):
+    """:meth:`~hexdem.analysis.tracker_kernel.PulseState.update` of every row but its refinement, row
+    ``b`` taking ``speeds[b]`` as its sample ``s`` (the state arrays are the state's
+    :meth:`~hexdem.analysis.tracker_kernel.PulseState.sample_arrays`, updated in place; ``rival_ratio``:
+    :data:`~hexdem.analysis.tracker_kernel.RIVAL_RATIO`). Returns the rows whose rival window is
+    complete, for :meth:`~hexdem.analysis.tracker_kernel.PulseState.challenge`."""
     capacity = rec_value.shape[1]
     nan = np.nan
+    complete = np.empty(len(speeds), dtype=np.int64)
+    count = 0
     for b in range(len(speeds)):
         v = speeds[b]
         if v > peak[b]:
             before = ring[b, (s - 1) % 3] if s >= 1 else nan
             before2 = ring[b, (s - 2) % 3] if s >= 2 else nan
+            if after[b] == 3 and peak_index[b] >= 3:
+                for j in range(7):
+                    rival[b, j] = window[b, j]
+                rival_index[b] = peak_index[b]
+                complete[count] = b
+                count += 1
+            rival_after[b] = 3
             peak[b] = v
-            peak_index[b] = s
-            for j in range(3):
-                window[b, j] = ring[b, (s - 3 + j) % 3] if s - 3 + j >= 0 else nan
-            window[b, 3] = v
-            for j in range(4, 7):
-                window[b, j] = nan
-            after[b] = 0
+            open_window(window, peak_index, after, ring, b, v, s)
             n = length[b]
             half = 0.5 * v
             below = 0
@@ -70,10 +77,36 @@ def update_pulses(speeds, s, q, ring, peak, peak_index, window, after, start, le
             rec_prev2[b, slot] = before2
             start[b] = first
             length[b] = n + 1
-        elif after[b] < 3:
-            window[b, 4 + after[b]] = v
-            after[b] += 1
+        else:
+            if after[b] < 3:
+                window[b, 4 + after[b]] = v
+                after[b] += 1
+            earlier = -np.inf
+            for k in range(1, min(s, 3) + 1):
+                earlier = max(earlier, ring[b, (s - k) % 3])
+            if v * rival_ratio >= peak[b] and v > earlier:
+                open_window(rival, rival_index, rival_after, ring, b, v, s)
+            elif rival_after[b] < 3:
+                rival[b, 4 + rival_after[b]] = v
+                rival_after[b] += 1
+                if rival_after[b] == 3 and rival_index[b] >= 3:
+                    complete[count] = b
+                    count += 1
         ring[b, s % 3] = v
+    return complete[:count]
+
+
+@_jit
+def open_window(window, index, after, ring, b, v, s):
+    """Row ``b``'s window centred on its sample ``s`` of speed ``v``
+    (:func:`~hexdem.analysis.tracker_kernel._open`)."""
+    for j in range(3):
+        window[b, j] = ring[b, (s - 3 + j) % 3] if s - 3 + j >= 0 else np.nan
+    window[b, 3] = v
+    for j in range(4, 7):
+        window[b, j] = np.nan
+    index[b] = s
+    after[b] = 0
 
 
 @_jit
@@ -138,7 +171,7 @@ def moved_beyond(positions, listed_at, distance) -> bool:
 
 @_jit
 def bead_speeds(velocities, rows, speeds, end_velocity):
-    """|v| of the sample's rows ``rows`` into ``speeds``, and their velocities into ``end_velocity``
+    """The speeds ``|v|`` of the sample's rows ``rows`` into ``speeds``, and their velocities into ``end_velocity``
     (``np.hypot``'s arithmetic, C's hypot)."""
     for k in range(len(rows)):
         vx, vy = velocities[rows[k], 0], velocities[rows[k], 1]

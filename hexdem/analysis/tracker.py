@@ -6,8 +6,9 @@ run (every ``dump_every`` steps, step 0 included) and, at the end, :meth:`PulseT
 gives each bead's peak speed, time of peak and half-maximum arrival time with the
 definitions of :mod:`hexdem.analysis.peaks`:
 
-* **peak speed** and **time of peak**: the same local cubic spline through the 7 samples
-  around the largest one as the dump analysis, so that equal samples give equal peaks;
+* **peak speed** and **time of peak**: the same largest maximum of the local cubic splines
+  through the 7 samples around the largest one and around each rival local maximum as the dump
+  analysis, so that equal samples give equal peaks;
 * **arrival time**: the first time |v| reaches half of the (spline) peak, interpolated
   linearly between the sample before the crossing and the crossing sample (the dump analysis
   uses its spline there; the two differ by a few ns at the default sampling);
@@ -43,7 +44,7 @@ import numpy as np
 
 from hexdem.analysis.energy import EnergyAudit, energy_error, energy_regions, energy_scale_j
 from hexdem.analysis.peaks import noise_floor, refine_peak, refine_peaks
-from hexdem.analysis.tracker_kernel import PulseState
+from hexdem.analysis.tracker_kernel import RIVAL_RATIO, PulseState
 from hexdem.engines.sampling import Sample
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel, RunSettings
@@ -229,7 +230,7 @@ class PulseTracker:
 
             speeds = np.empty(len(self.ids))
             bead_speeds(sample.velocities, self.bead_rows, speeds, self.end_velocity)
-            update_pulses(speeds, s, self.pulses.q, *self.pulses.arrays())
+            self.pulses.challenge(update_pulses(speeds, s, self.pulses.q, RIVAL_RATIO, *self.pulses.sample_arrays()))
         else:
             velocities = sample.velocities[self.bead_rows]
             speeds = np.hypot(velocities[:, 0], velocities[:, 1])
@@ -315,15 +316,18 @@ class PulseTracker:
         full = complete & np.isfinite(state.window).all(axis=1)  # the 7 samples: one refinement for all
         offset, peak[full] = refine_peaks(state.window[full], interval)
         t_peak[full] = state.peak_index[full] * interval + offset
+        for b in np.flatnonzero(complete & ~full):
+            index = np.arange(state.peak_index[b] - 3, state.peak_index[b] + 4)
+            valid = (index >= 0) & (index < self.count) & np.isfinite(state.window[b])
+            t_peak[b], peak[b] = refine_peak(index[valid] * interval, state.window[b, valid])
+        rival = complete & (state.best_peak > peak)  # a larger maximum than the largest sample's
+        peak[rival] = state.best_peak[rival]
+        t_peak[rival] = state.best_index[rival] * interval + state.best_offset[rival] * interval
         for b in np.flatnonzero(moved):
-            if not complete[b]:
-                reach[b] = interval * state.first_crossing(b, 0.5 * state.peak[b])
-                continue
-            if not full[b]:
-                index = np.arange(state.peak_index[b] - 3, state.peak_index[b] + 4)
-                valid = (index >= 0) & (index < self.count) & np.isfinite(state.window[b])
-                t_peak[b], peak[b] = refine_peak(index[valid] * interval, state.window[b, valid])
-            arrival[b] = reach[b] = interval * state.first_crossing(b, 0.5 * peak[b])
+            level = 0.5 * (peak[b] if complete[b] else state.peak[b])
+            reach[b] = interval * state.first_crossing(b, level)
+            if complete[b]:
+                arrival[b] = reach[b]
         return np.column_stack([peak, t_peak, arrival, reach, self.threshold_index * interval, self.peak_spin,
                                 self.end_velocity])
 

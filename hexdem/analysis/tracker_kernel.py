@@ -5,6 +5,15 @@ For every bead it keeps, in fixed-size arrays, exactly what the definitions of
 
 * the **peak window**: the samples from three before to three after the largest sample so
   far (the same 7 samples the dump analysis puts its cubic spline through);
+* the **rival window**: the same 7 samples around the latest sample that exceeds the three
+  before it and lies within :data:`~hexdem.analysis.peaks.PEAK_OVERSHOOT` of the largest sample so
+  far without exceeding it (:func:`~hexdem.analysis.peaks.rival_maxima`). A sample that exceeds
+  the rival within the three after it ends it (and may start the next); one that exceeds the
+  running maximum also starts a new peak window, and a complete peak window that it replaces
+  becomes the rival. At most one rival is open at a time: none opens within three samples of an
+  open one unless it exceeds it. A complete rival (three samples after it) is refined at once
+  (:meth:`PulseState.challenge`) and the largest refined (peak, time) kept, so that the peak can be
+  the largest maximum of the interpolant wherever it lies, in fixed memory;
 * the **arrival candidates**. The arrival is the first sample at or above half of the final
   peak P. Such a sample exceeds every earlier one, so it is a *record* of the running
   maximum M; records below M/2 can never be it (P ≥ M) and are dropped, all but the last of
@@ -30,7 +39,9 @@ instead of copying the slots.
 
 **Cost.** Most beads, at most samples, only enter the ring (and, for three samples after a
 new maximum, the peak window); the ladder's bookkeeping runs on the few beads whose running
-maximum rises at that sample (beads at rest never do: their samples stay below the noise floor).
+maximum rises at that sample (beads at rest never do: their samples stay below the noise floor),
+and the refinement on the few whose rival window completes (a local maximum within
+:data:`~hexdem.analysis.peaks.PEAK_OVERSHOOT` of the running maximum).
 Every step is a NumPy operation over those beads, for ranks too small to pay numba's start-up; a
 large rank runs the same update compiled (:func:`~hexdem.analysis.compiled.update_pulses`).
 """
@@ -38,6 +49,12 @@ large rank runs the same update compiled (:func:`~hexdem.analysis.compiled.updat
 from __future__ import annotations
 
 import numpy as np
+
+from hexdem.analysis.peaks import PEAK_OVERSHOOT, may_overtake, refine_peaks
+
+#: A local maximum of the samples this many times the running maximum or above may overtake it
+#: (:func:`~hexdem.analysis.peaks.may_overtake`; the compiled update takes it as an argument).
+RIVAL_RATIO = 1 + PEAK_OVERSHOOT
 
 
 def rung(capacity: int) -> float:
@@ -69,41 +86,76 @@ class PulseState:
         self.first_value = np.zeros((n, capacity))
         self.first_prev = np.zeros((n, capacity))
         self.first_prev2 = np.zeros((n, capacity))
+        self.rival = np.full((n, 7), np.nan)
+        self.rival_index = np.full(n, -1, dtype=np.int64)
+        self.rival_after = np.full(n, 3, dtype=np.int64)  # 3: no rival open
+        self.best_peak = np.full(n, -np.inf)
+        self.best_index = np.zeros(n, dtype=np.int64)
+        self.best_offset = np.zeros(n)
 
-    def arrays(self) -> list[np.ndarray]:
-        """Every state array (for merging the beads' states across MPI ranks)."""
+    def sample_arrays(self) -> list[np.ndarray]:
+        """The state arrays a sample updates (those of :func:`~hexdem.analysis.compiled.update_pulses`)."""
         return [self.ring, self.peak, self.peak_index, self.window, self.after, self.start, self.length, self.rec_index,
                 self.rec_value, self.rec_prev, self.rec_prev2, self.first_index, self.first_value, self.first_prev,
-                self.first_prev2]
+                self.first_prev2, self.rival, self.rival_index, self.rival_after]
+
+    def arrays(self) -> list[np.ndarray]:
+        """Every state array (for merging the beads' states across MPI ranks): the sample's and the
+        best refined rival's peak, sample index and offset from it (in samples)."""
+        return [*self.sample_arrays(), self.best_peak, self.best_index, self.best_offset]
 
     def update(self, beads, speeds, s: int) -> None:
         """Take sample ``s`` (speeds of ``beads``, distinct) into the state, in place."""
-        rising = speeds > self.peak[beads]
+        peak = self.peak[beads]
+        rising = speeds > peak
+        complete = []
         if not rising.all():
-            self._enter_window(beads[~rising], speeds[~rising])
+            calm = ~rising
+            _fill(self.window, self.after, beads[calm], speeds[calm])
+            complete.append(self._follow_rivals(beads[calm], speeds[calm], peak[calm], s))
         if rising.any():
-            self._new_maxima(beads[rising], speeds[rising], s)
+            complete.append(self._new_maxima(beads[rising], speeds[rising], s))
         self.ring[beads, s % 3] = speeds
+        self.challenge(np.concatenate(complete))
 
-    def _enter_window(self, beads, speeds) -> None:
-        """Beads past their running maximum: the sample fills the next of the three window slots
-        after the peak, while any is left."""
-        slot = self.after[beads]
-        open_ = slot < 3
-        self.window[beads[open_], 4 + slot[open_]] = speeds[open_]
-        self.after[beads[open_]] += 1
+    def challenge(self, beads) -> None:
+        """Refine the complete rival windows of ``beads`` and keep each bead's largest maximum (the
+        earliest of equal ones)."""
+        if not len(beads):
+            return
+        offset, value = refine_peaks(self.rival[beads], 1.0)
+        better = value > self.best_peak[beads]
+        beads = beads[better]
+        self.best_peak[beads] = value[better]
+        self.best_index[beads] = self.rival_index[beads]
+        self.best_offset[beads] = offset[better]
 
-    def _new_maxima(self, beads, speeds, s: int) -> None:
-        """Beads whose running maximum rises to ``speeds`` at sample ``s``: a new peak window, and
-        the new record, with the two samples before it, climbs the ladder (module docstring)."""
+    def _follow_rivals(self, beads, speeds, peak, s: int) -> np.ndarray:
+        """Beads at or below their running maximum ``peak``: a sample that may overtake it and
+        exceeds the three before it opens a rival window; any other fills the open rival's next
+        slot. Returns the beads whose rival this completes (with three samples before it)."""
+        near = np.flatnonzero(may_overtake(speeds, peak))
+        if s:
+            earlier = self.ring[beads[near]][:, [(s - k) % 3 for k in range(1, min(s, 3) + 1)]].max(axis=1)
+            near = near[speeds[near] > earlier]
+        _open(self.rival, self.rival_index, self.rival_after, self.ring, beads[near], speeds[near], s)
+        rest = np.ones(len(beads), dtype=np.bool_)
+        rest[near] = False
+        done = _fill(self.rival, self.rival_after, beads[rest], speeds[rest])
+        return done[self.rival_index[done] >= 3]
+
+    def _new_maxima(self, beads, speeds, s: int) -> np.ndarray:
+        """Beads whose running maximum rises to ``speeds`` at sample ``s``: the open rival ends, a
+        complete peak window (with three samples before it) becomes the rival, a new peak window
+        opens, and the new record, with the two samples before it, climbs the ladder (module
+        docstring). Returns the beads whose old peak window became their rival."""
         before, before2 = ((self.ring[beads, (s - k) % 3] if s >= k else np.full(len(beads), np.nan)) for k in (1, 2))
+        replaced = beads[(self.after[beads] == 3) & (self.peak_index[beads] >= 3)]
+        self.rival[replaced] = self.window[replaced]
+        self.rival_index[replaced] = self.peak_index[replaced]
+        self.rival_after[beads] = 3
         self.peak[beads] = speeds
-        self.peak_index[beads] = s
-        for j in range(3):
-            self.window[beads, j] = self.ring[beads, (s - 3 + j) % 3] if s - 3 + j >= 0 else np.nan
-        self.window[beads, 3] = speeds
-        self.window[beads, 4:] = np.nan
-        self.after[beads] = 0
+        _open(self.window, self.peak_index, self.after, self.ring, beads, speeds, s)
         capacity = self.rec_value.shape[1]
         # records below half the new maximum cannot be the arrival: all but the last of them go.
         # Records rise along the ladder, and a free slot holds -inf or a dropped record, which was
@@ -129,6 +181,7 @@ class PulseState:
         self.rec_prev2[beads, slot] = before2
         self.start[beads] = start
         self.length[beads] = n + 1
+        return replaced
 
     def first_crossing(self, bead: int, level: float) -> float:
         """Fractional sample index at which ``bead``'s samples first reached ``level`` (NaN if never)."""
@@ -146,6 +199,27 @@ class PulseState:
                     return s - 1 + parabolic_crossing(before2, before, value, level)
                 return s0 + (level - v0) / (before - v0) * (s - 1 - s0)
         return np.nan
+
+
+def _open(window, index, after, ring, beads, speeds, s: int) -> None:
+    """A window (peak or rival) centred on sample ``s`` of ``beads``: the three samples before it
+    from the ``ring`` (NaN before the first), ``speeds``, and three free slots."""
+    for j in range(3):
+        window[beads, j] = ring[beads, (s - 3 + j) % 3] if s - 3 + j >= 0 else np.nan
+    window[beads, 3] = speeds
+    window[beads, 4:] = np.nan
+    index[beads] = s
+    after[beads] = 0
+
+
+def _fill(window, after, beads, speeds) -> np.ndarray:
+    """The next free slot after the centre of each of ``beads``' windows takes its speed, while any
+    is left; returns the beads whose window this completes."""
+    open_ = after[beads] < 3
+    beads = beads[open_]
+    window[beads, 4 + after[beads]] = speeds[open_]
+    after[beads] += 1
+    return beads[after[beads] == 3]
 
 
 def parabolic_crossing(before2: float, before: float, value: float, level: float) -> float:
