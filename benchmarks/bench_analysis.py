@@ -91,11 +91,13 @@ def measure(model, settings, way: str, samples, out: Path) -> dict:
     positions, velocities = samples
     ids = np.arange(1, model.n_bodies + 1)
     order = np.argsort(positions[:, 0] // (10 * model.lattice.diameter_m) * 1e6 + positions[:, 1])  # LAMMPS's bins
-    start = time.perf_counter()
+    observed = 0.0
     for s in range(settings.n_samples):
-        tracker(Sample(s, s * settings.dump_every, s * settings.dt_s * settings.dump_every, ids[order],
-                       positions[order], velocities(s)[order], migrated=s == 0))
-    observed = time.perf_counter() - start
+        sample = Sample(s, s * settings.dump_every, s * settings.dt_s * settings.dump_every, ids[order],
+                        positions[order], velocities(s)[order], migrated=s == 0)
+        start = time.perf_counter()
+        tracker(sample)
+        observed += time.perf_counter() - start
     start = time.perf_counter()
     tracked = tracker.finish()
     gathered = time.perf_counter() - start
