@@ -3,7 +3,7 @@ energy audit's contact and body sums, one loop over a rank's beads or candidate 
 
 They compute what the NumPy code of :class:`~hexdem.analysis.tracker_kernel.PulseState` and
 :class:`~hexdem.analysis.energy.EnergyAudit` computes, in the same order: the tests hold the
-tracker's results equal to the bit and the energies to round-off (δ^{5/2} is taken as δ² √δ, see
+tracker's results equal to the bit and the energies to round-off (:math:`δ^{5/2}` is taken as :math:`δ^2 \sqrt{δ}`, see
 :func:`pair_contact_energies`; sums run body by body where NumPy's go in pairs). The NumPy code
 indexes arrays of beads and pairs, which at 29,701 beads cost about 300 ns per bead per sample for
 the tracker and 480 ns per bead per audited sample for the audit, where one compiled pass over a
