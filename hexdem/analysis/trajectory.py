@@ -8,6 +8,8 @@ from the samples of a small run when every sample is wanted (contact tests, one-
 
 from __future__ import annotations
 
+import dataclasses
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -70,7 +72,8 @@ class TrajectoryRecorder:
         self.samples: list[Sample] = []
 
     def __call__(self, sample: Sample) -> None:
-        self.samples.append(sample)
+        self.samples.append(dataclasses.replace(sample, ids=sample.ids.copy(), positions=sample.positions.copy(),
+                                                velocities=sample.velocities.copy()))
 
     def trajectory(self, engine: dict) -> Trajectory:
         order = [np.argsort(s.ids) for s in self.samples]
