@@ -80,6 +80,20 @@ def kept_deck(message: str) -> Path:
     ('[[regions]]\nmaterial = "brass"\nx_min_d = "far"', "regions.0.x_min_d must be a number, got 'far'"),
     ('[[impacts]]\nsite = [0, 0]\nkind = 1', "impacts.0.kind must be a string, got 1"),
     ('[materials.bronze]\nyoungs_modulus_pa = "stiff"', "materials.bronze.youngs_modulus_pa must be a number"),
+    ('shape = "chain"\nstruck_bead = 3', 'struck_bead describes shape = "packing", not \'chain\''),
+    ("struck_bead = 3", 'struck_bead describes shape = "packing", not \'hexagon\''),
+    ('shape = "square"\nwalls = "hull"', 'walls describes shape = "packing" or "random", not \'square\''),
+    ('shape = "square"\ninterstitial_diameter_m = 0.008', "interstitial_diameter_m describes shape = \"centered-square\""),
+    ('shape = "square"\ndiameters_m = [0.02]', 'diameters_m describes shape = "chain", not \'square\''),
+    ('shape = "square"\nbead_materials = ["brass"]', 'bead_materials describes shape = "chain", not \'square\''),
+    ('shape = "square"\n[[lines]]\nname = "up"\nsite = [0, 0]\nangle_deg = 90',
+     'lines describes shape = "hexagon", "half-hexagon", "half-disc", "triangle", "parallelogram", "disc" or "sites"'),
+    ('shape = "random"\nstruck_bead = 2', 'struck_bead describes shape = "packing", not \'random\''),
+    ("rows = 5", 'rows describes shape = "square" or "centered-square", not \'hexagon\''),
+    ('shape = "chain"\nedge_beads = 5', 'edge_beads describes shape = "hexagon", "triangle" or "parallelogram"'),
+    ('materials = ["brass"]', "a chain's material per bead goes in bead_materials"),
+    ('shape = "chain"\nangle_deg = 180.0\nstrike_angle_deg = 0.0',
+     "strike angle 0.0° does not point into the packing, which lies at 180° from its struck bead"),
 ])
 def test_bad_config_is_one_line_and_writes_nothing(tmp_path, capsys, config_text, message):
     code, err = run_cli(tmp_path, capsys, config_text)

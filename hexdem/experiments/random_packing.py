@@ -82,7 +82,9 @@ def settling_stage(name: str) -> SettlingStage:
 
 
 def _packing_config(config: RunConfig, path: Path, struck: int, walls: str) -> RunConfig:
-    return config.replace(shape="packing", packing_file=str(path), struck_bead=struck, walls=walls)
+    """``config`` as the ``packing`` of the file at ``path``, its random disc's keys at their defaults."""
+    return config.replace(shape="packing", packing_file=str(path), struck_bead=struck, walls=walls,
+                          radius_m=RunConfig.radius_m, diameter_spread=RunConfig.diameter_spread, seed=RunConfig.seed)
 
 
 def _write_packing(path: Path, positions_m, diameters_m) -> Path:
@@ -103,7 +105,7 @@ def prepare_random_packing(config: RunConfig, directory, comm=None, log=None) ->
     diameters = random_diameters(config.radius_m, config.diameter_m, config.diameter_spread, config.seed)
     loose = _write_packing(directory / "loose.csv", loose_positions(diameters, config.seed), diameters)
     bare = config.replace(impacts=(), lines=(), sensors=(), regions=(), vacancies=(), initial_state_file=None,
-                          strike_angle_deg=0.0, precompression_n=0.0)
+                          strike_angle_deg=None, precompression_n=0.0)
     model = build_model(_packing_config(bare, loose, 0, "none"))
     log(f"packing a random disc of {len(diameters)} beads (radius {config.radius_m:g} m, "
         f"diameters d (1 ± {config.diameter_spread:g}), seed {config.seed}) with LAMMPS")
@@ -118,7 +120,7 @@ def prepare_random_packing(config: RunConfig, directory, comm=None, log=None) ->
         state = read_data_file(deck / SETTLED_NAME)
         model = replace(model, lattice=model.lattice.with_geometry(state.positions_m, state.diameters_m))
     packed = _write_packing(directory / PACKING_NAME, state.positions_m, state.diameters_m)
-    struck = edge_bead(state.positions_m, state.diameters_m, strike_direction(config.strike_angle_deg))
+    struck = edge_bead(state.positions_m, state.diameters_m, strike_direction(config.strike_direction_deg))
     log(f"random disc packed: {len(diameters)} beads, area fraction {area_fraction(state):.3f}, "
         f"struck bead {struck}")
     return _packing_config(config, packed, struck, config.walls)

@@ -37,6 +37,17 @@ def check_no_overlap(positions_m, diameters_m, what: str) -> None:
                           "a packing's beads may touch but not overlap")
 
 
+def check_extent(positions_m, diameters_m, what: str) -> None:
+    """Refuse beads spread farther apart than all of them laid end to end could reach (the diagonal
+    of their bounding box above the sum of their diameters): a position in other units than
+    metres, or a bead far from the rest, which no pulse could reach."""
+    span = float(np.hypot(*np.ptp(positions_m, axis=0)))
+    reach = float(np.sum(diameters_m))
+    if not span <= reach:
+        raise HexdemError(f"{what}: the beads span {span:.3g} m, farther than all {len(diameters_m)} of them laid end "
+                          f"to end ({reach:.3g} m); positions are in metres and a packing's beads touch")
+
+
 def placed_packing(labels, positions_m, diameters_m, diameter_m: float, wall_angles_deg, shape: str, struck,
                    ray_angles_deg) -> Lattice:
     """The packing of beads labelled ``labels`` (N, 2) int at ``positions_m`` (N, 2) [m] with
@@ -49,6 +60,7 @@ def placed_packing(labels, positions_m, diameters_m, diameter_m: float, wall_ang
         raise HexdemError(f"{shape}: a packing needs at least 1 bead, got none")
     if not (np.all(np.isfinite(positions)) and np.all(diameters > 0) and len(diameters) == len(labels)):
         raise HexdemError(f"{shape}: every bead needs a finite position and a diameter > 0")
+    check_extent(positions, diameters, shape)
     check_no_overlap(positions, diameters, shape)
     hit = np.flatnonzero(np.all(labels == np.asarray(struck, dtype=int), axis=1))
     if not len(hit):

@@ -27,10 +27,16 @@ SQUARE_WALLS_DEG = (0, 180, 90, -90)
 SQUARE_RAYS_DEG = (0, 45, -45, 90, -90)
 
 
+#: The fewest rows and columns of a square or centered-square crystal: the struck bead's column
+#: holds another bead, which places the wall it is struck through, and its row another, which
+#: carries the pulse.
+MIN_GRID = 2
+
+
 def _grid_size(rows, columns) -> tuple[int, int]:
-    for name, value in (("rows", rows), ("columns", columns)):
-        if int(value) != value or value < 1:
-            raise HexdemError(f"a square crystal needs {name} >= 1, got {value}")
+    if not all(int(value) == value and value >= MIN_GRID for value in (rows, columns)):
+        raise HexdemError(f"a square crystal needs at least {MIN_GRID} rows and {MIN_GRID} columns, "
+                          f"got {rows} x {columns}")
     return int(rows), int(columns)
 
 
@@ -56,8 +62,6 @@ def centered_square(rows: int, columns: int, diameter_m: float, interstitial_dia
     and one interstitial of ``interstitial_diameter_m`` (None: :func:`interstitial_fit_m`) in each
     of the (rows − 1)(columns − 1) cells."""
     rows, columns = _grid_size(rows, columns)
-    if rows < 2 or columns < 2:
-        raise HexdemError(f"a centered-square crystal needs at least 2 rows and 2 columns, got {rows} x {columns}")
     small = interstitial_fit_m(diameter_m) if interstitial_diameter_m is None else float(interstitial_diameter_m)
     if not 0 < small:
         raise HexdemError(f"interstitial_diameter_m must be > 0, got {interstitial_diameter_m!r}")
