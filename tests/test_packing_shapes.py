@@ -210,3 +210,20 @@ def test_a_chain_is_struck_along_itself_by_default(tmp_path):
                               tmp_path / str(angle)).results for angle in (0.0, 180.0))
     assert turned.peak_speed[-1] > 0.5 * along.peak_speed[0]
     np.testing.assert_allclose(turned.peak_speed, along.peak_speed, rtol=1e-9)
+
+
+def test_a_packing_file_is_read_with_its_byte_order_mark_and_from_the_configs_folder(tmp_path, monkeypatch):
+    """A CSV saved with a UTF-8 byte-order mark (was: 'the header must be x,y,diameter'), and a
+    relative packing_file, which hexdem sweep read from the current directory, from the config's
+    folder as hexdem run reads it."""
+    from hexdem.experiments.sweep_plan import Variation, plan_sweep, read_base
+
+    folder = tmp_path / "study"
+    folder.mkdir()
+    (folder / "beads.csv").write_text("x,y,diameter\n0.0,0.0,0.01905\n0.01905,0.0,0.01905\n", encoding="utf-8-sig")
+    assert (folder / "beads.csv").read_bytes().startswith(b"\xef\xbb\xbf")
+    (folder / "base.toml").write_text('shape = "packing"\npacking_file = "beads.csv"\nwalls = "none"\n')
+    monkeypatch.chdir(tmp_path)
+    runs = plan_sweep(read_base(folder / "base.toml"), [Variation.parse("v0=0.3,0.4")])
+    assert {run.config.packing_file for run in runs} == {str(folder / "beads.csv")}
+    assert len(build_model(runs[0].config).lattice) == 2

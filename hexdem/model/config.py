@@ -57,6 +57,15 @@ MEMORY_PER_BEAD_BYTES = 1e3
 MEMORY_PER_OWN_BEAD_BYTES = 8e3
 
 
+def read_config_table(path) -> dict:
+    """The table of run-config keys in the TOML file at ``path``, a relative ``packing_file`` made
+    relative to the file's folder, as every command that reads a configuration file reads it."""
+    data = read_toml(path)
+    if isinstance(data.get("packing_file"), str) and not Path(data["packing_file"]).is_absolute():
+        data["packing_file"] = str(Path(path).parent / data["packing_file"])
+    return data
+
+
 @dataclass(frozen=True)
 class RunConfig:
     """One simulation: every key a configuration file may set, each checked against its declared
@@ -250,12 +259,8 @@ class RunConfig:
 
     @classmethod
     def from_toml(cls, path) -> "RunConfig":
-        """Read a TOML file whose keys are :class:`RunConfig` field names; a relative ``packing_file``
-        is read from the TOML file's folder."""
-        data = read_toml(path)
-        if isinstance(data.get("packing_file"), str) and not Path(data["packing_file"]).is_absolute():
-            data["packing_file"] = str(Path(path).parent / data["packing_file"])
-        return cls.from_dict(data, source=str(path))
+        """Read a TOML file whose keys are :class:`RunConfig` field names (:func:`read_config_table`)."""
+        return cls.from_dict(read_config_table(path), source=str(path))
 
     @classmethod
     def from_dict(cls, data: dict, source: str = "config") -> "RunConfig":
