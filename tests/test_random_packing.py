@@ -133,3 +133,16 @@ def test_both_engines_agree_on_a_struck_random_disc(compared):
     _, comparison = compared
     assert comparison.agree, comparison.verdict()
     assert comparison.n_checked >= 8
+
+
+def test_a_random_discs_summary_says_what_it_is_and_lists_its_own_keys(tmp_path):
+    """Its titles and summary name a random disc of N beads (they said 'packing of packing.csv'),
+    and summary.json's config holds the keys of a random disc, not a hexagon's edge_beads."""
+    import json
+
+    (tmp_path / "random.toml").write_text('shape = "random"\nradius_m = 0.06\nseed = 1\n')
+    assert main(["run", "--config", str(tmp_path / "random.toml"), "--out", str(tmp_path / "out")]) == 0
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["lattice"]["shape"] == f"random disc of {summary['lattice']['n_beads']} beads (seed 1)"
+    assert {"radius_m", "seed", "walls", "v0"} <= set(summary["config"])
+    assert not {"edge_beads", "rows", "beads", "struck_bead", "packing_file"} & set(summary["config"])

@@ -261,7 +261,7 @@ def run_comparison(config: RunConfig, out, log=None, tolerances: Tolerances = To
     tolerances = comparison.tolerances
     write_csv(out / "compare.csv", COMPARE_COLUMNS, comparison.rows)
     write_json(out / "compare.json", {
-        "config": {key: value for key, value in config.as_dict().items() if key != "engine"},
+        "config": {key: value for key, value in config.shape_dict().items() if key != "engine"},
         "units": comparison.units,
         "tolerances": {"peak_rel": tolerances.peak_rel, "arrival": comparison.arrival_tolerance,
                        "arrival_s": tolerances.arrival_s, "arrival_rate": tolerances.arrival_rate,

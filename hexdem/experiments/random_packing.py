@@ -168,6 +168,12 @@ def prepare_random_packing(config: RunConfig, directory, comm=None, log=None) ->
     return _packing_config(config, packed, struck, config.walls)
 
 
+def packing_name(config: RunConfig, lattice) -> str:
+    """What the packing ``lattice`` of ``config`` is, for titles: ``random disc of N beads (seed s)``
+    for a random disc (built as the packing of its ``packing.csv``), else its builder's name."""
+    return f"random disc of {len(lattice)} beads (seed {config.seed})" if config.shape == "random" else lattice.shape
+
+
 def area_fraction(state) -> float:
     """The beads' area over that of the smallest disc about their centroid that holds them all."""
     centre = state.positions_m.mean(axis=0)

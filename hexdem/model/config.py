@@ -28,7 +28,7 @@ from hexdem.model.dissipation import damping_coefficient, lammps_tsuji_coefficie
 from hexdem.model.impacts import ImpactSpec, ImpactTable, impact_specs
 from hexdem.model.lines import LineTable
 from hexdem.model.materials import PAPER_DIAMETER_M, Material, MaterialTable, custom_materials, material
-from hexdem.model.packing_builders import SHAPES, IntruderTable, check_shape_keys
+from hexdem.model.packing_builders import SHAPE_KEYS, SHAPES, IntruderTable, check_shape_keys
 from hexdem.model.random_disc import DENSE_FRACTION, check_random_disc
 from hexdem.model.regions import RegionTable
 from hexdem.model.units import SI, UnitSystem, nondimensional
@@ -275,6 +275,11 @@ class RunConfig:
 
     def as_dict(self) -> dict:
         return dataclasses.asdict(self)
+
+    def shape_dict(self) -> dict:
+        """:meth:`as_dict` less the keys that describe other shapes (:data:`SHAPE_KEYS`): the keys
+        that apply to this run, which ``summary.json`` records."""
+        return {key: value for key, value in self.as_dict().items() if self.shape in SHAPE_KEYS.get(key, (self.shape,))}
 
     def material(self, name: str) -> Material:
         """The material called ``name``: a preset or one of this configuration's ``materials``."""
