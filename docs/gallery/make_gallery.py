@@ -75,7 +75,7 @@ ENTRIES = (
      'shape = "square"\nrows = 15\ncolumns = 15\n', "peak_map.png"),
     ("centered_square", "Centered-square crystal with interstitials",
      "A 9 × 12 square of steel beads with a brass interstitial in every cell, sized to touch its four "
-     "corners (Leonard & Daraio): the pulse leaks off the struck row through the interstitials.",
+     "corners (spherical interstitials, as Szelengowicz et al.'s): the pulse leaks off the struck row through the interstitials.",
      'shape = "centered-square"\nrows = 9\ncolumns = 12\ninterstitial_material = "brass"\nduration = 1.2e-3\n',
      "peak_map.png"),
     ("chain", "A chain with a light intruder",

@@ -34,7 +34,8 @@ def check_no_overlap(positions_m, diameters_m, what: str) -> None:
     worst = int(np.argmax(overlap / np.minimum(diameters[i], diameters[j])))
     if overlap[worst] > MAX_REST_OVERLAP * min(diameters[i[worst]], diameters[j[worst]]):
         raise HexdemError(f"{what}: beads {i[worst]} and {j[worst]} overlap by {overlap[worst]:.3g} m at rest; "
-                          "a packing's beads may touch but not overlap")
+                          f"a packing's beads may touch but not overlap (by {MAX_REST_OVERLAP:g} of the smaller "
+                          "diameter at most: write positions with every digit, as repr or %.17g do)")
 
 
 def check_extent(positions_m, diameters_m, what: str) -> None:

@@ -1,5 +1,8 @@
 """Square and centered-square crystals: the seed paper's contrast to the hexagonal packing, and
-Leonard & Daraio's crystal with small interstitial beads (PRL 108, 214301, 2012).
+the square crystal with spherical interstitial intruders of Szelengowicz, Kevrekidis & Daraio
+(Phys. Rev. E 86, 061306, 2012). Every bead is a sphere and every contact sphere on sphere: the
+centered-square experiments of Leonard & Daraio put cylinders in the cells, which this model
+does not describe.
 
 Both stand in a square basin of four walls, struck in the middle of the left column
 (label {0, 0}) through a hole of the left wall. A square crystal of ``rows`` × ``columns``
