@@ -112,6 +112,14 @@ def test_every_key_is_checked_against_its_declared_type(name):
     assert str(error.value).startswith(f"{name} must be ") and str(error.value).endswith(f", got {wrong!r}")
 
 
+def test_a_bead_far_from_the_others_is_one_line(tmp_path, capsys):
+    """A packing file with a bead at 1e30 m (a ValueError traceback before)."""
+    (tmp_path / "far.csv").write_text("x,y,diameter\n0,0,0.01905\n0.01905,0,0.01905\n1e30,0,0.01905\n")
+    code, err = run_cli(tmp_path, capsys, f'shape = "packing"\npacking_file = "{tmp_path / "far.csv"}"')
+    assert code == 2 and len(err) == 1 and "the beads span 1e+30 m, farther than all 3 of them laid end to end" in err[0]
+    assert_no_results(tmp_path / "out")
+
+
 def test_input_files_that_are_not_utf8_are_one_line(tmp_path, capsys):
     """A configuration and a sites file saved in Latin-1 (the ® is byte 0xae, the 33rd)."""
     latin = tmp_path / "latin.toml"
@@ -196,6 +204,12 @@ def test_run_whose_energy_drifts_is_refused(tmp_path, capsys):
     ("duration = 1e-6", "too few samples to analyse"),
     ("edge_beads = 100000", "needs about"),
     ('shape = "half-hexagon"\nshort_edge = 40000\nlong_edge = 79999', "needs about"),
+    ('shape = "square"\nrows = 100000\ncolumns = 100000', "square of up to 10,000,000,000 beads needs about"),
+    ('shape = "chain"\nbeads = 10000000000', "chain of up to 10,000,000,000 beads needs about"),
+    ('shape = "random"\nradius_m = 1000.0', "random of up to"),
+    ("precompression_n = 1e12", "precompression_n = 1e+12 N would squeeze each contact by 1.15e+03 diameters"),
+    ('shape = "square"\nrows = 1\ncolumns = 1', "a square crystal needs at least 2 rows and 2 columns, got 1 x 1"),
+    ('shape = "sites"\nsites = [[0, 0]]', "a packing needs at least 2 beads, or 1 bead and a wall to rebound from"),
 ])
 def test_runs_that_cannot_be_analysed_or_cannot_fit_are_refused(tmp_path, capsys, config_text, message):
     code, err = run_cli(tmp_path, capsys, config_text)
