@@ -199,7 +199,8 @@ class RunConfig:
         names = [self.bead_material, self.striker_material, self.interstitial_material,
                  *(spec.striker_material for spec in self.impact_specs()),
                  *(region["material"] for region in self.regions if isinstance(region, dict) and "material" in region),
-                 *(name for name in self.bead_materials if name), *(intruder.get("material") for intruder in self.intruders)]
+                 *(name for name in self.bead_materials if name),
+                 *(intruder.get("material") for intruder in self.intruders)]
         for name in dict.fromkeys(names):
             if isinstance(name, str):
                 self.material(name)
@@ -227,7 +228,7 @@ class RunConfig:
         smallest = self.diameter_m * (1 - self.diameter_spread)
         return int({
             "triangle": lambda: self.edge_beads * (self.edge_beads + 1) / 2,
-            "parallelogram": lambda: self.edge_beads * (self.edge_beads if self.depth_beads is None else self.depth_beads),
+            "parallelogram": lambda: self.edge_beads * (self.depth_beads or self.edge_beads),
             "half-disc": lambda: disc_sites / 2,
             "disc": lambda: disc_sites,
             "sites": lambda: len(self.sites) + lines(self.sites_file, 4),
