@@ -92,6 +92,7 @@ def kept_deck(message: str) -> Path:
     ("rows = 5", 'rows describes shape = "square" or "centered-square", not \'hexagon\''),
     ('shape = "chain"\nedge_beads = 5', 'edge_beads describes shape = "hexagon", "triangle" or "parallelogram"'),
     ('materials = ["brass"]', "a chain's material per bead goes in bead_materials"),
+    ('shape = "chain"\nwall_friction = 0.3', 'wall_friction describes shape = "hexagon", "half-hexagon", '),
     ('shape = "chain"\nangle_deg = 180.0\nstrike_angle_deg = 0.0',
      "strike angle 0.0° does not point into the packing, which lies at 180° from its struck bead"),
 ])

@@ -47,7 +47,7 @@ PREPARED_SHAPES = ("random",)
 SHAPES = TRIANGULAR_SHAPES + PLACED_SHAPES + PREPARED_SHAPES
 #: The keys that describe some shapes only, and those shapes; every other key applies to every
 #: shape. ``lines`` follow the triangular lattice's directions (the other shapes' lines are their
-#: rays); a random disc's struck bead is found on its edge.
+#: rays); a random disc's struck bead is found on its edge; a chain has no walls.
 SHAPE_KEYS = {
     "edge_beads": ("hexagon", "triangle", "parallelogram"),
     "long_edge": ("half-hexagon",),
@@ -73,6 +73,8 @@ SHAPE_KEYS = {
     "radius_m": ("random",),
     "diameter_spread": ("random",),
     "seed": ("random",),
+    **dict.fromkeys(("wall_material", "wall_restitution", "wall_friction"),
+                    tuple(shape for shape in SHAPES if shape != "chain")),
 }
 
 
