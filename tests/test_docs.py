@@ -253,6 +253,8 @@ def _quoted_numbers() -> list[tuple[str, str, tuple]]:
           f"{placed.MAX_REST_OVERLAP * config.RunConfig().diameter_m * 1e9:.0f}")),
         ("docs/guide/packings.md", r"a chain at least (\d+) beads, a square or centered-square crystal at least "
          r"(\d+) rows and (\d+) columns", (f"{chain.MIN_CHAIN_BEADS}", *(f"{square_crystals.MIN_GRID}",) * 2)),
+        ("docs/guide/packings.md", r"spread over more than (\d+) times all of them laid end to end.*? not within "
+         r"a factor (\d+) of `diameter_m`", (f"{placed.MAX_SPAN_FACTOR:g}", f"{placed.MAX_DIAMETER_RATIO:g}")),
     ]
 
 

@@ -117,7 +117,7 @@ def test_a_bead_far_from_the_others_is_one_line(tmp_path, capsys):
     """A packing file with a bead at 1e30 m (a ValueError traceback before)."""
     (tmp_path / "far.csv").write_text("x,y,diameter\n0,0,0.01905\n0.01905,0,0.01905\n1e30,0,0.01905\n")
     code, err = run_cli(tmp_path, capsys, f'shape = "packing"\npacking_file = "{tmp_path / "far.csv"}"')
-    assert code == 2 and len(err) == 1 and "the beads span 1e+30 m, farther than all 3 of them laid end to end" in err[0]
+    assert code == 2 and len(err) == 1 and "the beads span 1e+30 m, more than 10 times all 3 of them laid end to end" in err[0]
     assert_no_results(tmp_path / "out")
 
 
@@ -211,6 +211,8 @@ def test_run_whose_energy_drifts_is_refused(tmp_path, capsys):
     ("precompression_n = 1e12", "precompression_n = 1e+12 N would squeeze each contact by 1.15e+03 diameters"),
     ('shape = "square"\nrows = 1\ncolumns = 1', "a square crystal needs at least 2 rows and 2 columns, got 1 x 1"),
     ('shape = "sites"\nsites = [[0, 0]]', "a packing needs at least 2 beads, or 1 bead and a wall to rebound from"),
+    ('shape = "sites"\nsites = [[0, 0], [1, 1], [0, 2000000000]]', "3 listed sites: the beads span 3.3e+07 m, more than 10 times all 3"),
+    ('shape = "chain"\nbeads = 3\ndiameters_m = [0.02, 1e30, 0.02]', "not within a factor 10 of diameter_m"),
 ])
 def test_runs_that_cannot_be_analysed_or_cannot_fit_are_refused(tmp_path, capsys, config_text, message):
     code, err = run_cli(tmp_path, capsys, config_text)
