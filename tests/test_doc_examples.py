@@ -36,7 +36,7 @@ def test_the_python_api_example_runs(tmp_path):
 def test_every_packing_config_of_the_guide_builds_the_packing_its_comment_names():
     section = (GUIDE / "packings.md").read_text()
     blocks = re.findall(r"```toml\n(.*?)```", section, flags=re.DOTALL)
-    assert len(blocks) == 11
+    assert len(blocks) == 12
     packing = [k for k, block in enumerate(blocks) if "packing_file" in block]
     assert len(packing) == 1, "the packing file's example names a file of the reader's"
     (random,) = [k for k, block in enumerate(blocks) if 'shape = "random"' in block]  # packed by LAMMPS
@@ -44,9 +44,9 @@ def test_every_packing_config_of_the_guide_builds_the_packing_its_comment_names(
     assert len(random_diameters(disc.radius_m, disc.diameter_m, disc.diameter_spread, disc.seed)) == 196
     lattices = [build_lattice(RunConfig(**tomllib.loads(block))) for k, block in enumerate(blocks)
                 if k not in packing and k != random]
-    # 9 x 12 corners and 8 x 11 interstitials; the chain's 40 beads
-    assert [len(lattice) for lattice in lattices] == [28, 30, 514, 329, 10, 225, 9 * 12 + 8 * 11, 40, 1]
-    assert [len(lattice.walls) for lattice in lattices] == [3, 4, 1, 6, 1, 4, 4, 0, 1]
+    # 9 x 12 corners and 8 x 11 interstitials; the intruder's and the dimer's chains of 40 beads
+    assert [len(lattice) for lattice in lattices] == [28, 30, 514, 329, 10, 225, 9 * 12 + 8 * 11, 40, 40, 1]
+    assert [len(lattice.walls) for lattice in lattices] == [3, 4, 1, 6, 1, 4, 4, 0, 0, 1]
 
 
 def test_the_guides_interface_config_builds_its_materials():

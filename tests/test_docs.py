@@ -182,7 +182,7 @@ def _quoted_numbers() -> list[tuple[str, str, tuple]]:
     import bench_scale
 
     from hexdem.experiments import compare
-    from hexdem.model import config, run_settings
+    from hexdem.model import chain, config, placed, run_settings, square_crystals
     from hexdem.model.dissipation import damping_coefficient
 
     from hexdem.theory.phonons import Lattice2D, cone_slope, frequencies, sound_speeds
@@ -247,6 +247,14 @@ def _quoted_numbers() -> list[tuple[str, str, tuple]]:
          r"targets: ≤ (\d+) min for the parts .*? `--quick` ≤ (\d+) min; ≥ ([\d.]+) × faster",
          (f"{bench_paper.TARGETS_S[False] / 60:g}", f"{bench_paper.TARGETS_S[True] / 60:g}",
           f"{bench_paper.SPEED_UP_TARGET:g}")),
+        ("docs/guide/packings.md", r"by more than ([\d.e-]+) of the smaller diameter are refused.*?that "
+         r"tolerance \((\d+) nm for the paper's beads\)",
+         (_sci(placed.MAX_REST_OVERLAP, 1).replace(".0e", "e"),
+          f"{placed.MAX_REST_OVERLAP * config.RunConfig().diameter_m * 1e9:.0f}")),
+        ("docs/guide/packings.md", r"a chain at least (\d+) beads, a square or centered-square crystal at least "
+         r"(\d+) rows and (\d+) columns", (f"{chain.MIN_CHAIN_BEADS}", *(f"{square_crystals.MIN_GRID}",) * 2)),
+        ("docs/guide/packings.md", r"spread over more than (\d+) times all of them laid end to end.*? not within "
+         r"a factor (\d+) of `diameter_m`", (f"{placed.MAX_SPAN_FACTOR:g}", f"{placed.MAX_DIAMETER_RATIO:g}")),
     ]
 
 

@@ -80,6 +80,21 @@ def kept_deck(message: str) -> Path:
     ('[[regions]]\nmaterial = "brass"\nx_min_d = "far"', "regions.0.x_min_d must be a number, got 'far'"),
     ('[[impacts]]\nsite = [0, 0]\nkind = 1', "impacts.0.kind must be a string, got 1"),
     ('[materials.bronze]\nyoungs_modulus_pa = "stiff"', "materials.bronze.youngs_modulus_pa must be a number"),
+    ('shape = "chain"\nstruck_bead = 3', 'struck_bead describes shape = "packing", not \'chain\''),
+    ("struck_bead = 3", 'struck_bead describes shape = "packing", not \'hexagon\''),
+    ('shape = "square"\nwalls = "hull"', 'walls describes shape = "packing" or "random", not \'square\''),
+    ('shape = "square"\ninterstitial_diameter_m = 0.008', "interstitial_diameter_m describes shape = \"centered-square\""),
+    ('shape = "square"\ndiameters_m = [0.02]', 'diameters_m describes shape = "chain", not \'square\''),
+    ('shape = "square"\nbead_materials = ["brass"]', 'bead_materials describes shape = "chain", not \'square\''),
+    ('shape = "square"\n[[lines]]\nname = "up"\nsite = [0, 0]\nangle_deg = 90',
+     'lines describes shape = "hexagon", "half-hexagon", "half-disc", "triangle", "parallelogram", "disc" or "sites"'),
+    ('shape = "random"\nstruck_bead = 2', 'struck_bead describes shape = "packing", not \'random\''),
+    ("rows = 5", 'rows describes shape = "square" or "centered-square", not \'hexagon\''),
+    ('shape = "chain"\nedge_beads = 5', 'edge_beads describes shape = "hexagon", "triangle" or "parallelogram"'),
+    ('materials = ["brass"]', "a chain's material per bead goes in bead_materials"),
+    ('shape = "chain"\nwall_friction = 0.3', 'wall_friction describes shape = "hexagon", "half-hexagon", '),
+    ('shape = "chain"\nangle_deg = 180.0\nstrike_angle_deg = 0.0',
+     "strike angle 0.0° does not point into the packing, which lies at 180° from its struck bead"),
 ])
 def test_bad_config_is_one_line_and_writes_nothing(tmp_path, capsys, config_text, message):
     code, err = run_cli(tmp_path, capsys, config_text)
@@ -96,6 +111,14 @@ def test_every_key_is_checked_against_its_declared_type(name):
     with pytest.raises(HexdemError) as error:
         RunConfig(**{name: wrong})
     assert str(error.value).startswith(f"{name} must be ") and str(error.value).endswith(f", got {wrong!r}")
+
+
+def test_a_bead_far_from_the_others_is_one_line(tmp_path, capsys):
+    """A packing file with a bead at 1e30 m (a ValueError traceback before)."""
+    (tmp_path / "far.csv").write_text("x,y,diameter\n0,0,0.01905\n0.01905,0,0.01905\n1e30,0,0.01905\n")
+    code, err = run_cli(tmp_path, capsys, f'shape = "packing"\npacking_file = "{tmp_path / "far.csv"}"')
+    assert code == 2 and len(err) == 1 and "the beads span 1e+30 m, more than 10 times all 3 of them laid end to end" in err[0]
+    assert_no_results(tmp_path / "out")
 
 
 def test_input_files_that_are_not_utf8_are_one_line(tmp_path, capsys):
@@ -182,6 +205,14 @@ def test_run_whose_energy_drifts_is_refused(tmp_path, capsys):
     ("duration = 1e-6", "too few samples to analyse"),
     ("edge_beads = 100000", "needs about"),
     ('shape = "half-hexagon"\nshort_edge = 40000\nlong_edge = 79999', "needs about"),
+    ('shape = "square"\nrows = 100000\ncolumns = 100000', "square of up to 10,000,000,000 beads needs about"),
+    ('shape = "chain"\nbeads = 10000000000', "chain of up to 10,000,000,000 beads needs about"),
+    ('shape = "random"\nradius_m = 1000.0', "random of up to"),
+    ("precompression_n = 1e12", "precompression_n = 1e+12 N would squeeze each contact by 1.15e+03 diameters"),
+    ('shape = "square"\nrows = 1\ncolumns = 1', "a square crystal needs at least 2 rows and 2 columns, got 1 x 1"),
+    ('shape = "sites"\nsites = [[0, 0]]', "a packing needs at least 2 beads, or 1 bead and a wall to rebound from"),
+    ('shape = "sites"\nsites = [[0, 0], [1, 1], [0, 2000000000]]', "3 listed sites: the beads span 3.3e+07 m, more than 10 times all 3"),
+    ('shape = "chain"\nbeads = 3\ndiameters_m = [0.02, 1e30, 0.02]', "not within a factor 10 of diameter_m"),
 ])
 def test_runs_that_cannot_be_analysed_or_cannot_fit_are_refused(tmp_path, capsys, config_text, message):
     code, err = run_cli(tmp_path, capsys, config_text)

@@ -118,10 +118,16 @@ def test_a_packing_file_is_the_packing_it_was_written_from(tmp_path):
 
 
 @pytest.mark.parametrize("changes, message", [
-    ({"shape": "square", "rows": 0}, "rows >= 1"),
+    ({"shape": "square", "rows": 0}, "at least 2 rows and 2 columns, got 0 x 15"),
+    ({"shape": "square", "rows": 1, "columns": 1}, "at least 2 rows and 2 columns, got 1 x 1"),
     ({"shape": "centered-square", "rows": 1}, "at least 2 rows"),
+    ({"shape": "sites", "sites": [[0, 0]]}, "a packing needs at least 2 beads, or 1 bead and a wall"),
     ({"shape": "chain", "beads": 3, "diameters_m": [0.01, 0.01]}, "2 diameters for a chain of 3"),
-    ({"shape": "chain", "beads": 2, "materials": ["brass"]}, "1 names for a chain of 2"),
+    ({"shape": "chain", "beads": 3, "bead_materials": ["brass", "glass"]}, "2 names for a chain of 3"),
+    ({"shape": "chain", "beads": 2, "materials": ["brass"]}, "per bead goes in bead_materials"),
+    ({"shape": "chain", "beads": 1}, "a chain needs beads >= 2"),
+    ({"shape": "chain", "intruders": [{"bead": 20, "diameter_m": 0.01}]}, "bead from 0 to 19"),
+    ({"shape": "chain", "intruders": [{"bead": 2}]}, "a diameter_m or a material"),
     ({"shape": "packing"}, "needs packing_file"),
     ({"shape": "hexagon", "packing_file": "x.csv"}, "describes shape = \"packing\""),
 ])
@@ -139,6 +145,21 @@ def test_overlapping_or_badly_written_packing_files_are_refused(tmp_path):
         path.write_text(text)
         with pytest.raises(HexdemError, match=message):
             build_model(RunConfig(shape="packing", packing_file=str(path)))
+
+
+def test_a_chains_short_forms_equal_the_lists_typed_out():
+    """A dimer's repeating pattern and an intruder's table give the chain of the whole lists."""
+    d, small = 0.01905, 0.009525
+    pairs = (({"diameters_m": [d, small], "bead_materials": ["steel316", "brass"]},
+              {"diameters_m": [d, small] * 5, "bead_materials": ["steel316", "brass"] * 5}),
+             ({"intruders": [{"bead": 5, "diameter_m": small, "material": "brass"}]},
+              {"diameters_m": [d] * 5 + [small] + [d] * 4, "bead_materials": [""] * 5 + ["brass"] + [""] * 4}))
+    for short, typed in pairs:
+        a, b = (build_model(RunConfig(shape="chain", beads=10, **keys)) for keys in (short, typed))
+        np.testing.assert_array_equal(a.lattice.positions_m, b.lattice.positions_m)
+        np.testing.assert_array_equal(a.masses_kg, b.masses_kg)
+        assert [m.name for m in a.materials] == [m.name for m in b.materials]
+        assert a.materials[a.lattice.material_ids[5]].name == "brass"
 
 
 def test_a_chains_intruder_mass_follows_its_diameter():
@@ -180,3 +201,29 @@ def test_compares_peak_tolerance_off_the_triangular_lattice_is_the_measured_one(
         settings = run_settings(config, model)
         steps = settings.contact_time_s / settings.dt_s
         assert Tolerances().for_run(model, settings).peak_rel == pytest.approx(MARGIN * coefficient / steps**2)
+
+
+def test_a_chain_is_struck_along_itself_by_default(tmp_path):
+    """Turned to 180°, the default strike follows the chain (it once went along +x, and bead 0 flew
+    away): the pulse is the same as along +x, mirrored."""
+    along, turned = (simulate(RunConfig(shape="chain", beads=6, angle_deg=angle, engine="reference"),
+                              tmp_path / str(angle)).results for angle in (0.0, 180.0))
+    assert turned.peak_speed[-1] > 0.5 * along.peak_speed[0]
+    np.testing.assert_allclose(turned.peak_speed, along.peak_speed, rtol=1e-9)
+
+
+def test_a_packing_file_is_read_with_its_byte_order_mark_and_from_the_configs_folder(tmp_path, monkeypatch):
+    """A CSV saved with a UTF-8 byte-order mark (was: 'the header must be x,y,diameter'), and a
+    relative packing_file, which hexdem sweep read from the current directory, from the config's
+    folder as hexdem run reads it."""
+    from hexdem.experiments.sweep_plan import Variation, plan_sweep, read_base
+
+    folder = tmp_path / "study"
+    folder.mkdir()
+    (folder / "beads.csv").write_text("x,y,diameter\n0.0,0.0,0.01905\n0.01905,0.0,0.01905\n", encoding="utf-8-sig")
+    assert (folder / "beads.csv").read_bytes().startswith(b"\xef\xbb\xbf")
+    (folder / "base.toml").write_text('shape = "packing"\npacking_file = "beads.csv"\nwalls = "none"\n')
+    monkeypatch.chdir(tmp_path)
+    runs = plan_sweep(read_base(folder / "base.toml"), [Variation.parse("v0=0.3,0.4")])
+    assert {run.config.packing_file for run in runs} == {str(folder / "beads.csv")}
+    assert len(build_model(runs[0].config).lattice) == 2

@@ -2,12 +2,17 @@
 bead rests on its neighbours, then struck, with both engines agreeing."""
 
 import math
+from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
+from hexdem.cli.main import main
+from hexdem.engines.lammps.settling import DECK_NAME
 from hexdem.errors import HexdemError
+from hexdem.experiments import random_packing
 from hexdem.experiments.compare import run_comparison
 from hexdem.experiments.random_packing import PACKING_NAME, prepare_random_packing
 from hexdem.model.config import RunConfig
@@ -72,6 +77,29 @@ def test_a_random_disc_is_built_only_once_packed():
         build_model(RunConfig(**SMALL))
 
 
+@pytest.mark.parametrize("command", [["run"], ["compare"], ["sweep", "--vary", "v0=0.3,0.4"]])
+def test_a_random_disc_that_cannot_run_is_refused_before_it_is_packed(tmp_path, capsys, command):
+    """A sensor id beyond the disc's beads: refused on the loose start in one line, before LAMMPS
+    packs it, by every command (compare once left the packing in --out; sweep checked nothing)."""
+    (tmp_path / "random.toml").write_text('shape = "random"\nradius_m = 0.06\nseed = 1\nsensors = [100000]\n')
+    out = tmp_path / "out"
+    assert main([*command, "--config", str(tmp_path / "random.toml"), "--out", str(out)]) == 2
+    lines = [line for line in capsys.readouterr().err.strip().splitlines() if "error" in line]
+    assert len(lines) == 1 and "sensor bead id 100000 is not in the packing" in lines[0], lines
+    assert not out.exists() or not any(out.iterdir())
+
+
+def test_a_stage_that_does_not_settle_is_kept_where_its_message_says(tmp_path, monkeypatch, capsys):
+    stage = random_packing.settling_stage
+    monkeypatch.setattr(random_packing, "settling_stage", lambda name: replace(stage(name), max_steps=1000))
+    (tmp_path / "random.toml").write_text('shape = "random"\nradius_m = 0.06\nseed = 1\n')
+    assert main(["run", "--config", str(tmp_path / "random.toml"), "--out", str(tmp_path / "out")]) == 2
+    error = [line for line in capsys.readouterr().err.splitlines() if "error" in line][0]
+    assert "compact stage did not settle in" in error
+    assert (Path(error.rsplit("see ", 1)[1]) / DECK_NAME).is_file()
+    assert not (tmp_path / "out").exists()
+
+
 @pytest.fixture(scope="module")
 def compared(tmp_path_factory):
     out = tmp_path_factory.mktemp("random")
@@ -105,3 +133,16 @@ def test_both_engines_agree_on_a_struck_random_disc(compared):
     _, comparison = compared
     assert comparison.agree, comparison.verdict()
     assert comparison.n_checked >= 8
+
+
+def test_a_random_discs_summary_says_what_it_is_and_lists_its_own_keys(tmp_path):
+    """Its titles and summary name a random disc of N beads (they said 'packing of packing.csv'),
+    and summary.json's config holds the keys of a random disc, not a hexagon's edge_beads."""
+    import json
+
+    (tmp_path / "random.toml").write_text('shape = "random"\nradius_m = 0.06\nseed = 1\n')
+    assert main(["run", "--config", str(tmp_path / "random.toml"), "--out", str(tmp_path / "out")]) == 0
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["lattice"]["shape"] == f"random disc of {summary['lattice']['n_beads']} beads (seed 1)"
+    assert {"radius_m", "seed", "walls", "v0"} <= set(summary["config"])
+    assert not {"edge_beads", "rows", "beads", "struck_bead", "packing_file"} & set(summary["config"])

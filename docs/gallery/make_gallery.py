@@ -1,6 +1,7 @@
 """Regenerate the gallery: every packing shape and impact kind, run and drawn.
 
-Usage: python docs/gallery/make_gallery.py   (about a minute on 2 cores)
+Usage: python docs/gallery/make_gallery.py [NAME ...]   (about a minute on 2 cores; NAME: only
+those entries, as ``chain`` or ``dimer``)
 
 Each entry of :data:`ENTRIES` is written to ``configs/<name>.toml``, run with ``hexdem run`` (a
 subprocess, as a user would) in a scratch directory, and its peak-speed map (or, where the
@@ -25,8 +26,6 @@ WIDTH = 640
 #: Colours of each image's palette (a tenth of the size of full colour, no visible loss).
 PALETTE_COLOURS = 128
 
-#: The chain's diameters [m]: 40 steel beads, bead 20 of half the diameter (an eighth of the mass).
-CHAIN_DIAMETERS = ["0.01905"] * 20 + ["0.009525"] + ["0.01905"] * 19
 #: (name, title, what it shows, config, figure of the run shown).
 ENTRIES = (
     ("hexagon", "The experiment: hexagon, velocity impact",
@@ -76,15 +75,20 @@ ENTRIES = (
      'shape = "square"\nrows = 15\ncolumns = 15\n', "peak_map.png"),
     ("centered_square", "Centered-square crystal with interstitials",
      "A 9 × 12 square of steel beads with a brass interstitial in every cell, sized to touch its four "
-     "corners (Leonard & Daraio): the pulse leaks off the struck row through the interstitials.",
+     "corners (spherical interstitials, as Szelengowicz et al.'s): the pulse leaks off the struck row through the interstitials.",
      'shape = "centered-square"\nrows = 9\ncolumns = 12\ninterstitial_material = "brass"\nduration = 1.2e-3\n',
      "peak_map.png"),
     ("chain", "A chain with a light intruder",
      "Forty steel beads in a free chain, bead 20 half their diameter: most of the solitary wave passes it, "
      "part comes back.",
-     'shape = "chain"\nbeads = 40\nduration = 2e-3\n# 40 diameters, bead 20 half the others\ndiameters_m = [\n'
-     + "".join(f"    {', '.join(CHAIN_DIAMETERS[k:k + 6])},\n" for k in range(0, len(CHAIN_DIAMETERS), 6))
-     + ']\n', "peak_decay.png"),
+     'shape = "chain"\nbeads = 40\nduration = 2e-3\n# bead 20 (counted from 0, the struck one) half the '
+     "others' diameter\nintruders = [{bead = 20, diameter_m = 0.009525}]\n", "peak_decay.png"),
+    ("dimer", "A dimer chain",
+     "Forty steel beads alternating between 19.05 mm and half that diameter (an eighth of the mass), "
+     "written as a pattern that repeats: within a few beads the pulse settles into a steady wave, the light "
+     "beads (odd n) peaking above the heavy ones, and the free end flies off.",
+     'shape = "chain"\nbeads = 40\nduration = 2e-3\n# a pattern that repeats: heavy, light, heavy, light, ...\n'
+     "diameters_m = [0.01905, 0.009525]\n", "peak_decay.png"),
     ("packing", "Measured positions: a packing file",
      "Beads read from packing.csv (x, y, diameter in metres and material, one per line; here a hexagon of "
      "8 per edge with five undersized rattlers and five brass beads, written by this script), in flat walls "
@@ -153,12 +157,17 @@ def page() -> str:
     return "\n".join(lines)
 
 
-def main() -> int:
+def main(names=()) -> int:
+    """Run every entry, or those called ``names``, and write the page."""
+    unknown = set(names) - {entry[0] for entry in ENTRIES}
+    if unknown:
+        print(f"make_gallery: no entry {', '.join(sorted(unknown))}", file=sys.stderr)
+        return 2
     for folder in ("configs", "images"):
         (HERE / folder).mkdir(exist_ok=True)
     write_packing_file(HERE / "configs" / "packing.csv")
     with tempfile.TemporaryDirectory(prefix="hexdem-gallery-") as scratch:
-        for name, _, _, config, figure in ENTRIES:
+        for name, _, _, config, figure in (entry for entry in ENTRIES if not names or entry[0] in names):
             print(f"gallery: {name}", file=sys.stderr, flush=True)
             run_entry(name, config, figure, Path(scratch))
     (HERE / "index.md").write_text(page())
@@ -166,4 +175,4 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(main(sys.argv[1:]))

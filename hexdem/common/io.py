@@ -52,10 +52,10 @@ def locked_directory(out: Path, holder: str):
 
 
 def read_text(path, what: str) -> str:
-    """The text of the UTF-8 file at ``path``; an unreadable file, or one that is not UTF-8 text,
-    is one clear line naming it as ``what``."""
+    """The text of the UTF-8 file at ``path``, without the byte-order mark some editors write
+    first; an unreadable file, or one that is not UTF-8 text, is one clear line naming it as ``what``."""
     try:
-        return Path(path).read_text(encoding="utf-8")
+        return Path(path).read_text(encoding="utf-8-sig")
     except OSError as exc:
         raise HexdemError(f"cannot read {what} {path}: {exc.strerror}") from None
     except UnicodeDecodeError as exc:

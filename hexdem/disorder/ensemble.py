@@ -132,8 +132,9 @@ class EnsembleConfig:
 
     def run_config(self, v_striker: float) -> RunConfig:
         """The ideal-lattice striker run at ``v_striker`` (also sets every run's dt and length)."""
-        base = RunConfig(shape=self.shape, edge_beads=self.edge_beads, rows=self.rows, columns=self.columns,
-                         diameter_m=self.disorder.diameter_m,
+        size = ({"edge_beads": self.edge_beads} if self.shape == "hexagon"
+                else {"rows": self.rows, "columns": self.columns})
+        base = RunConfig(shape=self.shape, **size, diameter_m=self.disorder.diameter_m,
                          impact="striker", v0=float(v_striker), steps_per_contact=self.steps_per_contact,
                          dump_every=self.steps_per_contact // IMPACT_SAMPLES_PER_CONTACT, friction=self.friction)
         if self.duration_s is not None:

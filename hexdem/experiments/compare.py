@@ -18,6 +18,7 @@ larger than that.
 from __future__ import annotations
 
 import itertools
+import shutil
 import textwrap
 from dataclasses import dataclass, replace
 
@@ -244,16 +245,23 @@ def comparison_plot(comparison: EngineComparison, v0: float, path) -> None:
 
 
 def run_comparison(config: RunConfig, out, log=None, tolerances: Tolerances = Tolerances()) -> EngineComparison:
-    """Run ``config`` with both engines into ``out`` and write the comparison files."""
+    """Run ``config`` with both engines into ``out`` and write the comparison files. A failure
+    removes what this call had written (a random disc's ``preparation``, the first engine's run)."""
     out = ensure_writable_dir(out)
-    prepared = prepare_random_packing(config, out / "preparation", log=log)  # one packing for both engines
-    analyses = {name: run_experiment(prepared.replace(engine=name), out / name, log) for name in ENGINE_NAMES}
+    fresh = [path for path in (out / "preparation", *(out / name for name in ENGINE_NAMES)) if not path.exists()]
+    try:
+        prepared = prepare_random_packing(config, out / "preparation", log=log)  # one packing for both engines
+        analyses = {name: run_experiment(prepared.replace(engine=name), out / name, log) for name in ENGINE_NAMES}
+    except BaseException:
+        for path in fresh:
+            shutil.rmtree(path, ignore_errors=True)
+        raise
     v0 = analyses["lammps"].v0  # the fastest impact's, which may not be config.v0
     comparison = compare_analyses(analyses["lammps"], analyses["reference"], v0, tolerances)
     tolerances = comparison.tolerances
     write_csv(out / "compare.csv", COMPARE_COLUMNS, comparison.rows)
     write_json(out / "compare.json", {
-        "config": {key: value for key, value in config.as_dict().items() if key != "engine"},
+        "config": {key: value for key, value in config.shape_dict().items() if key != "engine"},
         "units": comparison.units,
         "tolerances": {"peak_rel": tolerances.peak_rel, "arrival": comparison.arrival_tolerance,
                        "arrival_s": tolerances.arrival_s, "arrival_rate": tolerances.arrival_rate,

@@ -86,7 +86,8 @@ class FrontStudy:
         c_l = longitudinal_sound_speed(self.control_force_n, coefficient, float(sphere_mass(d, bead)),
                                        d - static_overlap(self.control_force_n, coefficient))
         far_m = math.sqrt(3) * (self.edge_beads - 1) * d
-        return {"uncompressed": base.replace(shape="half-disc", radius_beads=self.radius_beads, v0=self.v0_m_s),
+        return {"uncompressed": base.replace(shape="half-disc", edge_beads=RunConfig.edge_beads,
+                                             radius_beads=self.radius_beads, v0=self.v0_m_s),
                 "precompressed": base.replace(precompression_n=self.control_force_n, v0=self.control_v0_m_s, impact="striker",
                                               duration=self.control_crossings * far_m / c_l)}
 

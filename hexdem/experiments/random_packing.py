@@ -24,10 +24,15 @@ header of a ``packing_file``), and the run goes on as ``shape = "packing"`` of t
 struck at the middle of the edge facing the strike
 (:func:`~hexdem.model.random_disc.edge_bead`), with the configuration's ``walls``. The decks
 stay beside it, to be rerun by hand (``lmp -in in.hexdem``).
+
+Before LAMMPS packs it, the run is checked on the loose start (:func:`check_random_run`), so that
+``hexdem run``, ``compare`` and ``sweep`` refuse it before anything is written.
 """
 
 from __future__ import annotations
 
+import shutil
+import tempfile
 from dataclasses import replace
 from pathlib import Path
 
@@ -41,6 +46,7 @@ from hexdem.model.config import RunConfig
 from hexdem.model.lattice import strike_direction
 from hexdem.model.model_builder import build_model
 from hexdem.model.random_disc import edge_bead, loose_positions, random_diameters
+from hexdem.model.run_settings import run_settings
 
 #: The pull towards the centre in the compaction [N per bead].
 PULL_FORCE_N = 5.0
@@ -82,7 +88,9 @@ def settling_stage(name: str) -> SettlingStage:
 
 
 def _packing_config(config: RunConfig, path: Path, struck: int, walls: str) -> RunConfig:
-    return config.replace(shape="packing", packing_file=str(path), struck_bead=struck, walls=walls)
+    """``config`` as the ``packing`` of the file at ``path``, its random disc's keys at their defaults."""
+    return config.replace(shape="packing", packing_file=str(path), struck_bead=struck, walls=walls,
+                          radius_m=RunConfig.radius_m, diameter_spread=RunConfig.diameter_spread, seed=RunConfig.seed)
 
 
 def _write_packing(path: Path, positions_m, diameters_m) -> Path:
@@ -90,38 +98,80 @@ def _write_packing(path: Path, positions_m, diameters_m) -> Path:
     return path
 
 
+def _loose_start(config: RunConfig, directory: Path) -> tuple[Path, np.ndarray, np.ndarray]:
+    """(its file ``loose.csv`` in ``directory``, positions [m], diameters [m]) of the random disc's loose start."""
+    diameters = random_diameters(config.radius_m, config.diameter_m, config.diameter_spread, config.seed)
+    positions = loose_positions(diameters, config.seed)
+    return _write_packing(directory / "loose.csv", positions, diameters), positions, diameters
+
+
+def _struck(config: RunConfig, positions_m, diameters_m) -> int:
+    return edge_bead(positions_m, diameters_m, strike_direction(config.strike_direction_deg))
+
+
+def check_random_run(config: RunConfig) -> None:
+    """Refuse, before LAMMPS packs it, a random disc whose run could not go on: its run is built and
+    its time step and sampling set (:func:`~hexdem.model.run_settings.run_settings`) on the loose
+    start, whose beads, labels and struck edge are those the packing will have; any other
+    configuration passes."""
+    if config.shape != "random":
+        return
+    with tempfile.TemporaryDirectory(prefix="hexdem-loose-") as scratch:
+        loose, positions, diameters = _loose_start(config, Path(scratch))
+        run_settings(_packing_config(config, loose, _struck(config, positions, diameters), config.walls))
+
+
+def _kept(deck: Path) -> Path:
+    """Move a failed settling ``deck`` out of the run's folder, which a failed run removes, into a
+    fresh folder of the system's temporary directory, for inspection."""
+    kept = Path(tempfile.mkdtemp(prefix="hexdem-failed-")) / deck.name
+    shutil.move(str(deck), kept)
+    return kept
+
+
 def prepare_random_packing(config: RunConfig, directory, comm=None, log=None) -> RunConfig:
     """Pack ``config``'s random disc in ``directory`` (its decks and ``packing.csv``) and return
     the configuration that strikes it (``shape = "packing"``); any other configuration is
     returned as it is. ``comm``: a communicator of the ranks that run LAMMPS together, as for
-    :func:`~hexdem.experiments.run.simulate`."""
+    :func:`~hexdem.experiments.run.simulate`. A run that cannot go on is refused first
+    (:func:`check_random_run`); a deck that fails or does not settle is kept outside
+    ``directory``, in the folder its message names."""
     if config.shape != "random":
         return config
+    check_random_run(config)
     log = log or (lambda message: None)
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
-    diameters = random_diameters(config.radius_m, config.diameter_m, config.diameter_spread, config.seed)
-    loose = _write_packing(directory / "loose.csv", loose_positions(diameters, config.seed), diameters)
+    loose, _, diameters = _loose_start(config, directory)
     bare = config.replace(impacts=(), lines=(), sensors=(), regions=(), vacancies=(), initial_state_file=None,
-                          strike_angle_deg=0.0, precompression_n=0.0)
+                          strike_angle_deg=None, precompression_n=0.0)
     model = build_model(_packing_config(bare, loose, 0, "none"))
     log(f"packing a random disc of {len(diameters)} beads (radius {config.radius_m:g} m, "
         f"diameters d (1 ± {config.diameter_spread:g}), seed {config.seed}) with LAMMPS")
     for name in STAGES:
         deck = write_settling_deck(model, settling_stage(name), directory / name)
-        run_settling_deck(deck, comm)
+        try:
+            run_settling_deck(deck, comm)
+        except HexdemError as exc:
+            raise HexdemError(str(exc).replace(str(deck), str(_kept(deck)))) from None
         result = read_stage(deck)
         if not result.settled:
             raise HexdemError(f"the random disc's {name} stage did not settle in {result.steps} steps "
                               f"(kinetic energy {result.kinetic_energy_j:.3g} J, largest force "
-                              f"{result.max_force_n:.3g} N); see {deck}")
+                              f"{result.max_force_n:.3g} N); see {_kept(deck)}")
         state = read_data_file(deck / SETTLED_NAME)
         model = replace(model, lattice=model.lattice.with_geometry(state.positions_m, state.diameters_m))
     packed = _write_packing(directory / PACKING_NAME, state.positions_m, state.diameters_m)
-    struck = edge_bead(state.positions_m, state.diameters_m, strike_direction(config.strike_angle_deg))
+    struck = _struck(config, state.positions_m, state.diameters_m)
     log(f"random disc packed: {len(diameters)} beads, area fraction {area_fraction(state):.3f}, "
         f"struck bead {struck}")
     return _packing_config(config, packed, struck, config.walls)
+
+
+def packing_name(config: RunConfig, lattice) -> str:
+    """What the packing ``lattice`` of ``config`` is, for titles: ``random disc of N beads (seed s)``
+    for a random disc (built as the packing of its ``packing.csv``), else its builder's name."""
+    return f"random disc of {len(lattice)} beads (seed {config.seed})" if config.shape == "random" else lattice.shape
 
 
 def area_fraction(state) -> float:

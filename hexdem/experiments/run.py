@@ -35,7 +35,7 @@ from hexdem.common.io import staged_directory, write_csv, write_csv_columns, wri
 from hexdem.common.machine import free_disk_bytes
 from hexdem.errors import HexdemError
 from hexdem.experiments.deck_config import write_deck_config
-from hexdem.experiments.random_packing import prepare_random_packing
+from hexdem.experiments.random_packing import packing_name, prepare_random_packing
 from hexdem.experiments.sensors import write_sensor_files
 from hexdem.experiments.tracked_run import ImpactJob, track_impact
 from hexdem.model.config import RunConfig
@@ -129,9 +129,9 @@ def summary(config: RunConfig, analysis: ImpactAnalysis, wall_time_s: float) -> 
     r, settings, engine = analysis.results, analysis.settings, analysis.engine
     return {
         "hexdem_version": version("hexdem"),
-        "config": config.as_dict(),
+        "config": config.shape_dict(),
         "units": r.units,
-        "lattice": {"shape": analysis.model.lattice.shape, "n_beads": len(analysis.model.lattice),
+        "lattice": {"shape": packing_name(config, analysis.model.lattice), "n_beads": len(analysis.model.lattice),
                     "struck_bead_id": analysis.model.lattice.struck + 1},
         "time_step": settings.dt_s / settings.units.time_s,
         "n_steps": settings.n_steps,
@@ -187,10 +187,10 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
     write_csv_columns(out / "beads.csv", BEAD_COLUMNS, bead_columns(analysis))
     write_json(out / "summary.json", {**summary(config, analysis, wall_time_s), "skipped_outputs": skipped})
     r, model = analysis.results, analysis.model
-    v0 = analysis.v0
+    v0, name = analysis.v0, packing_name(config, model.lattice)
     impact = f"V₀ = {v0:g} {plots.UNIT_LABELS[r.units]['speed']}"
-    plots.arrival_map(r, model, out / "arrival_map.png", title=f"Arrival time, {model.lattice.shape}, {impact}")
-    plots.peak_map(r, model, v0, out / "peak_map.png", title=f"Peak speed, {model.lattice.shape}, {impact}")
+    plots.arrival_map(r, model, out / "arrival_map.png", title=f"Arrival time, {name}, {impact}")
+    plots.peak_map(r, model, v0, out / "peak_map.png", title=f"Peak speed, {name}, {impact}")
     if "peak_decay.png" not in skipped:
         by_line = {name: (np.arange(len(beads)), r.peak_speed[beads]) for name, beads in r.lines.items()}
         plots.peak_decay(by_line, out / "peak_decay.png", r.units, v0)
@@ -199,17 +199,17 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
     if "front_shape.csv" not in skipped:
         shape = measure_front_shape(analysis)
         write_csv(out / "front_shape.csv", FRONT_SHAPE_COLUMNS, shape.rows())
-        plots.front_shape_figure({analysis.model.lattice.shape: shape}, out / "front_shape.png")
+        plots.front_shape_figure({name: shape}, out / "front_shape.png")
     write_csv(out / "energy_regions.csv", ENERGY_REGION_COLUMNS, energy_region_rows(r))
     if analysis.model.extra_materials:
         plots.energy_regions_figure(r, out / "energy_regions.png",
                                     title=f"Where the energy is, {', '.join(r.region_names)}")
     tracked = analysis.tracked
     if config.movie and tracked is not None and len(tracked.field_times):  # (a dump read back has no fields)
-        speed_movie(r, model, tracked.field_times, tracked.field_speeds, v0, out / "movie.gif", title=model.lattice.shape)
+        speed_movie(r, model, tracked.field_times, tracked.field_speeds, v0, out / "movie.gif", title=name)
         if len(tracked.field_rim_speeds):
             speed_movie(r, model, tracked.field_times, tracked.field_rim_speeds, v0, out / "spin_movie.gif",
-                        title=model.lattice.shape, label=SPIN_LABEL)
+                        title=name, label=SPIN_LABEL)
 
 
 def bead_columns(analysis: ImpactAnalysis) -> list:

@@ -147,7 +147,7 @@ def run_snapshots(config: RunConfig, times_s, out, outline_edge: int | None = No
     settings = run_settings(snapshots.config)
     engine = snapshots.engine
     write_json(out / "snapshots.json", {
-        "hexdem_version": version("hexdem"), "config": snapshots.config.as_dict(),
+        "hexdem_version": version("hexdem"), "config": snapshots.config.shape_dict(),
         "times_s": snapshots.times_s.tolist(), "n_beads": len(snapshots.lattice),
         "lammps_version": engine["version"], "ranks": engine["ranks"], "lammps_wall_time_s": engine["wall_time_s"],
         "atom_steps_per_s": (len(snapshots.lattice) + 1) * settings.n_steps / engine["wall_time_s"],

@@ -10,8 +10,9 @@ TOML values (``0.4``, ``1e-3``, ``true``, ``"brass"``); a bare word is a string
 (``brass``). Each value is checked against its key's declared type as it is read
 (:func:`~hexdem.common.typecheck.type_at`), and every run's configuration is built and
 validated (its keys by :class:`RunConfig`, its model and time step by
-:func:`~hexdem.model.run_settings.run_settings`) before anything runs, so a bad key or value is
-one line naming the key or the run.
+:func:`~hexdem.model.run_settings.run_settings`, a random disc's on its loose start by
+:func:`~hexdem.experiments.random_packing.check_random_run`) before anything runs, so a bad key
+or value is one line naming the key or the run.
 
 A run's name, its directory under ``DIR/runs/``, is its ``key=value`` pairs joined by commas,
 as given on the command line (characters a file name cannot hold become ``_``).
@@ -25,10 +26,10 @@ import re
 import tomllib
 from dataclasses import dataclass, fields
 
-from hexdem.common.io import read_toml
 from hexdem.common.typecheck import check_type, type_at
 from hexdem.errors import HexdemError
-from hexdem.model.config import RunConfig
+from hexdem.experiments.random_packing import check_random_run
+from hexdem.model.config import RunConfig, read_config_table
 from hexdem.model.packing_builders import PREPARED_SHAPES
 from hexdem.model.run_settings import run_settings
 
@@ -133,7 +134,9 @@ def plan_sweep(base: dict, variations: list[Variation], source: str = "the base 
         name = run_name(pairs)
         try:
             config = RunConfig.from_dict(data, source=f"run {name}")
-            if config.shape not in PREPARED_SHAPES:  # packed by LAMMPS when it runs
+            if config.shape in PREPARED_SHAPES:  # packed by LAMMPS when it runs: checked on its loose start
+                check_random_run(config)
+            else:
                 run_settings(config)
         except HexdemError as exc:
             message = str(exc)
@@ -151,5 +154,6 @@ def plan_sweep(base: dict, variations: list[Variation], source: str = "the base 
 
 
 def read_base(path) -> dict:
-    """The base configuration file's table (empty: the built-in default experiment)."""
-    return {} if path is None else read_toml(path)
+    """The base configuration file's table (empty: the built-in default experiment), a relative
+    ``packing_file`` read from its folder as ``hexdem run`` reads it."""
+    return {} if path is None else read_config_table(path)

@@ -15,12 +15,22 @@ from hexdem.model.lattice import Lattice, unit_vector
 from hexdem.model.placed import placed_packing
 
 
+#: The fewest beads of a chain: the struck one and one to pass the pulse to.
+MIN_CHAIN_BEADS = 2
+
+
+def chain_beads(beads) -> int:
+    """``beads`` as the bead count of a chain, or a one-line HexdemError below :data:`MIN_CHAIN_BEADS`."""
+    if int(beads) != beads or beads < MIN_CHAIN_BEADS:
+        raise HexdemError(f"a chain needs beads >= {MIN_CHAIN_BEADS} (the struck one and one to pass the pulse to), "
+                          f"got {beads}")
+    return int(beads)
+
+
 def chain(beads: int, diameter_m: float, angle_deg: float = 0.0, diameters_m=(), struck=(0, 0)) -> Lattice:
     """``beads`` touching beads along ``angle_deg``, each of ``diameter_m`` or of its own size in
     ``diameters_m`` (one per bead, or empty), struck at the bead labelled ``struck`` ({0, k}: bead k)."""
-    if int(beads) != beads or beads < 1:
-        raise HexdemError(f"a chain needs beads >= 1, got {beads}")
-    beads = int(beads)
+    beads = chain_beads(beads)
     sizes = np.full(beads, float(diameter_m)) if not len(diameters_m) else np.asarray(diameters_m, float)
     if sizes.shape != (beads,):
         raise HexdemError(f"diameters_m lists {len(sizes)} diameters for a chain of {beads} beads")

@@ -14,6 +14,7 @@ keys are the field names. ``v0``, ``dt`` and ``duration`` are in the run's ``uni
 from __future__ import annotations
 
 import dataclasses
+import math
 from pathlib import Path
 from dataclasses import dataclass
 
@@ -27,8 +28,8 @@ from hexdem.model.dissipation import damping_coefficient, lammps_tsuji_coefficie
 from hexdem.model.impacts import ImpactSpec, ImpactTable, impact_specs
 from hexdem.model.lines import LineTable
 from hexdem.model.materials import PAPER_DIAMETER_M, Material, MaterialTable, custom_materials, material
-from hexdem.model.packing_builders import SHAPES
-from hexdem.model.random_disc import check_random_disc
+from hexdem.model.packing_builders import SHAPE_KEYS, SHAPES, IntruderTable, check_shape_keys
+from hexdem.model.random_disc import DENSE_FRACTION, check_random_disc
 from hexdem.model.regions import RegionTable
 from hexdem.model.units import SI, UnitSystem, nondimensional
 
@@ -54,6 +55,15 @@ MIN_STEPS_PER_CONTACT = 20
 MEMORY_BASE_BYTES = 400e6
 MEMORY_PER_BEAD_BYTES = 1e3
 MEMORY_PER_OWN_BEAD_BYTES = 8e3
+
+
+def read_config_table(path) -> dict:
+    """The table of run-config keys in the TOML file at ``path``, a relative ``packing_file`` made
+    relative to the file's folder, as every command that reads a configuration file reads it."""
+    data = read_toml(path)
+    if isinstance(data.get("packing_file"), str) and not Path(data["packing_file"]).is_absolute():
+        data["packing_file"] = str(Path(path).parent / data["packing_file"])
+    return data
 
 
 @dataclass(frozen=True)
@@ -83,7 +93,7 @@ class RunConfig:
     diameter_m: float = PAPER_DIAMETER_M
     bead_material: str = "steel316"
     wall_material: str = "delrin"
-    materials: dict[str, MaterialTable] | tuple[str, ...] = dataclasses.field(default_factory=dict)
+    materials: dict[str, MaterialTable] = dataclasses.field(default_factory=dict)
     regions: tuple[RegionTable, ...] = ()
     striker_material: str | None = None
     striker_diameter_m: float | None = None
@@ -92,7 +102,7 @@ class RunConfig:
     movie: bool = False
     units: str = "si"
     v0: float = 0.4
-    strike_angle_deg: float = 0.0
+    strike_angle_deg: float | None = None
     impact: str = "velocity"
     dt: float | None = None
     steps_per_contact: int = STEPS_PER_CONTACT
@@ -119,6 +129,8 @@ class RunConfig:
     beads: int = 20
     angle_deg: float = 0.0
     diameters_m: tuple[float, ...] = ()
+    bead_materials: tuple[str, ...] = ()
+    intruders: tuple[IntruderTable, ...] = ()
     packing_file: str | None = None
     walls: str = "none"
     struck_bead: int = 0
@@ -127,6 +139,9 @@ class RunConfig:
     seed: int = 0
 
     def __post_init__(self):
+        if isinstance(self.materials, (list, tuple)):
+            raise HexdemError("materials is a table of this configuration's own materials; a chain's material "
+                              "per bead goes in bead_materials = [\"steel316\", \"brass\", ...]")
         check_fields(self)
         for name, allowed in (("shape", SHAPES), ("impact", IMPACTS), ("units", UNITS), ("engine", ENGINES)):
             if getattr(self, name) not in allowed:
@@ -137,7 +152,8 @@ class RunConfig:
         if positive_int("steps_per_contact", self.steps_per_contact) < MIN_STEPS_PER_CONTACT:
             raise HexdemError(f"steps_per_contact must be at least {MIN_STEPS_PER_CONTACT} (the Hertz contact "
                               f"needs them), got {self.steps_per_contact}")
-        for name in ("sensors", "sites", "site_walls_deg", "vacancies", "regions", "impacts", "lines", "diameters_m"):
+        for name in ("sensors", "sites", "site_walls_deg", "vacancies", "regions", "impacts", "lines", "diameters_m",
+                     "bead_materials", "intruders"):
             object.__setattr__(self, name, tuple(tuple(v) if isinstance(v, list) else v for v in getattr(self, name)))
         if not self.sensor_rate_hz > 0:
             raise HexdemError(f"sensor_rate_hz must be > 0, got {self.sensor_rate_hz!r}")
@@ -151,13 +167,18 @@ class RunConfig:
                 raise HexdemError(f"{name} must be a positive number of {self.units} time units, got {value!r}")
         if not self.v0 > 0:
             raise HexdemError(f"v0 must be > 0 (the impact moves into the packing), got {self.v0!r}")
+        check_shape_keys(self)
+        if self.strike_angle_deg is not None and math.cos(math.radians(self.strike_angle_deg - self.inward_deg)) <= 0:
+            raise HexdemError(f"strike angle {self.strike_angle_deg}° does not point into the packing, which lies at "
+                              f"{self.inward_deg:g}° from its struck bead: use an angle within 90° of it, or leave "
+                              "strike_angle_deg out")
         for alpha in {damping_coefficient(self.restitution), damping_coefficient(self.effective_wall_restitution)}:
             if alpha:
                 lammps_tsuji_coefficient(alpha)
-        self._check_size()
         self._check_materials()
         if self.shape == "random":
             check_random_disc(self.radius_m, self.diameter_m, self.diameter_spread, self.seed)
+        self._check_size()
         Friction.of(self.friction, self.wall_friction, self.rolling_friction)  # refuses a bad coefficient
 
     def n_beads(self) -> int | None:
@@ -173,11 +194,13 @@ class RunConfig:
 
     def _check_materials(self) -> None:
         """Every material the keys name must be a preset or one of ``materials`` (each table
-        complete); chain ``materials`` lists and ``regions`` name theirs the same way."""
+        complete); a chain's ``bead_materials`` and ``intruders`` and the ``regions`` name theirs the
+        same way."""
         names = [self.bead_material, self.striker_material, self.interstitial_material,
                  *(spec.striker_material for spec in self.impact_specs()),
                  *(region["material"] for region in self.regions if isinstance(region, dict) and "material" in region),
-                 *(() if isinstance(self.materials, dict) else (name for name in self.materials if name))]
+                 *(name for name in self.bead_materials if name),
+                 *(intruder.get("material") for intruder in self.intruders)]
         for name in dict.fromkeys(names):
             if isinstance(name, str):
                 self.material(name)
@@ -189,34 +212,56 @@ class RunConfig:
         """The processes the run takes: ``ranks`` for LAMMPS, one for the reference engine."""
         return self.ranks if self.engine == "lammps" else 1
 
-    def memory_estimate_bytes(self) -> float | None:
+    def max_beads(self) -> int:
+        """The most beads the packing can hold, counted without building it (:meth:`n_beads` where
+        it counts): rows × columns of a square, plus the interstitials of a centered square; a
+        chain's beads; the sites listed; the triangular lattice's sites within the disc's area
+        (2π/√3 (R + 1)² for a radius of R d, half for a half-disc); a file's lines, at least
+        4 bytes each (``0,0``) for sites and 6 (``0,0,1``) for a packing; a random disc's share
+        of its area, :data:`~hexdem.model.random_disc.DENSE_FRACTION`, over its smallest bead's."""
+        def lines(path, shortest):
+            return Path(path).stat().st_size // shortest if path and Path(path).is_file() else 0
+        counted = self.n_beads()
+        if counted is not None:
+            return counted
+        disc_sites = 2 * math.pi / math.sqrt(3) * (self.radius_beads + 1) ** 2
+        smallest = self.diameter_m * (1 - self.diameter_spread)
+        return int({
+            "triangle": lambda: self.edge_beads * (self.edge_beads + 1) / 2,
+            "parallelogram": lambda: self.edge_beads * (self.depth_beads or self.edge_beads),
+            "half-disc": lambda: disc_sites / 2,
+            "disc": lambda: disc_sites,
+            "sites": lambda: len(self.sites) + lines(self.sites_file, 4),
+            "square": lambda: self.rows * self.columns,
+            "centered-square": lambda: self.rows * self.columns + (self.rows - 1) * (self.columns - 1),
+            "chain": lambda: self.beads,
+            "packing": lambda: lines(self.packing_file, 6),
+            "random": lambda: DENSE_FRACTION * (2 * self.radius_m / smallest) ** 2 + 2,
+        }[self.shape]())
+
+    def memory_estimate_bytes(self) -> float:
         """Peak memory of the run on each of its processes [bytes] (see MEMORY_PER_BEAD_BYTES and
-        MEMORY_PER_OWN_BEAD_BYTES), for the shapes :meth:`n_beads` counts; None for the others."""
-        beads = self.n_beads()
-        return (None if beads is None else MEMORY_BASE_BYTES + MEMORY_PER_BEAD_BYTES * beads
-                + MEMORY_PER_OWN_BEAD_BYTES * beads / self.processes)
+        MEMORY_PER_OWN_BEAD_BYTES), for the most beads its packing can hold (:meth:`max_beads`)."""
+        beads = self.max_beads()
+        return MEMORY_BASE_BYTES + MEMORY_PER_BEAD_BYTES * beads + MEMORY_PER_OWN_BEAD_BYTES * beads / self.processes
 
     def _check_size(self) -> None:
-        """Refuse a packing counted without building it (:meth:`n_beads`) that this machine's
-        memory cannot hold; the builders word any error in the sizes themselves."""
-        counted = {"hexagon": (self.edge_beads,), "half-hexagon": (self.short_edge, self.long_edge)}
-        if self.shape not in counted or not all(n >= 2 for n in counted[self.shape]):
+        """Refuse a packing that this machine's memory cannot hold, counted without building it
+        (:meth:`max_beads`); the builders word any error in the sizes themselves."""
+        if not self.diameter_m > 0 or any(getattr(self, key) < 1 for key in (
+                "edge_beads", "long_edge", "short_edge", "radius_beads", "rows", "columns", "beads")):
             return
         needed = self.memory_estimate_bytes() * self.processes
         available = available_memory_bytes()
         if needed > available:
-            raise HexdemError(f"{self.shape} of {self.n_beads():,} beads needs about {needed / 1e9:.3g} GB of memory "
-                              f"({self.processes} process(es)); this machine has "
-                              f"{available / 1e9:.3g} GB available")
+            raise HexdemError(f"{self.shape} of up to {self.max_beads():,} beads needs about {needed / 1e9:.3g} GB of "
+                              f"memory ({self.processes} process(es)); this machine has {available / 1e9:.3g} GB "
+                              "available")
 
     @classmethod
     def from_toml(cls, path) -> "RunConfig":
-        """Read a TOML file whose keys are :class:`RunConfig` field names; a relative ``packing_file``
-        is read from the TOML file's folder."""
-        data = read_toml(path)
-        if isinstance(data.get("packing_file"), str) and not Path(data["packing_file"]).is_absolute():
-            data["packing_file"] = str(Path(path).parent / data["packing_file"])
-        return cls.from_dict(data, source=str(path))
+        """Read a TOML file whose keys are :class:`RunConfig` field names (:func:`read_config_table`)."""
+        return cls.from_dict(read_config_table(path), source=str(path))
 
     @classmethod
     def from_dict(cls, data: dict, source: str = "config") -> "RunConfig":
@@ -232,9 +277,14 @@ class RunConfig:
     def as_dict(self) -> dict:
         return dataclasses.asdict(self)
 
+    def shape_dict(self) -> dict:
+        """:meth:`as_dict` less the keys that describe other shapes (:data:`SHAPE_KEYS`): the keys
+        that apply to this run, which ``summary.json`` records."""
+        return {key: value for key, value in self.as_dict().items() if self.shape in SHAPE_KEYS.get(key, (self.shape,))}
+
     def material(self, name: str) -> Material:
         """The material called ``name``: a preset or one of this configuration's ``materials``."""
-        return material(name, custom_materials(self.materials if isinstance(self.materials, dict) else {}))
+        return material(name, custom_materials(self.materials))
 
     @property
     def effective_wall_restitution(self) -> float:
@@ -246,7 +296,18 @@ class RunConfig:
         """The units of ``v0``, ``dt``, ``duration`` and of every result of this run."""
         return SI if self.units == "si" else nondimensional(self.diameter_m, self.material(self.bead_material))
 
+    @property
+    def inward_deg(self) -> float:
+        """The direction from the struck bead into the packing [deg from +x]: a chain's ``angle_deg``;
+        0 for every other shape, struck through the wall whose inward normal is +x."""
+        return self.angle_deg if self.shape == "chain" else 0.0
+
+    @property
+    def strike_direction_deg(self) -> float:
+        """The strike's direction [deg from +x]: ``strike_angle_deg``, or if None :attr:`inward_deg`."""
+        return self.inward_deg if self.strike_angle_deg is None else self.strike_angle_deg
+
     def impact_specs(self) -> list[ImpactSpec]:
         """The configured impacts, the run's values filled in (:func:`~hexdem.model.impacts.impact_specs`)."""
-        return impact_specs(self.impacts, self.v0, self.strike_angle_deg, self.impact, self.striker_material,
+        return impact_specs(self.impacts, self.v0, self.strike_direction_deg, self.impact, self.striker_material,
                             self.striker_diameter_m)

@@ -23,7 +23,7 @@ KEY_DESCRIPTIONS = {
                      "of materials",
     "wall_material": "the walls' lining (its own E and ν against each bead), or \"none\" for no walls",
     "materials": "a table of the configuration's own materials {name: {youngs_modulus_pa, poisson_ratio, "
-                 "density_kg_m3}}; for a chain, a list of each bead's material instead",
+                 "density_kg_m3}}, named like the presets by every key that takes a material",
     "regions": "tables {material, sites, x_min_d, x_max_d, y_min_d, y_max_d}: the beads they select take "
                "that material (interfaces, strips, intruders)",
     "striker_material": "the striker sphere's material (none: the beads')",
@@ -35,8 +35,9 @@ KEY_DESCRIPTIONS = {
     "units": "si, or nondimensional (the paper's A = d = M = 1, eq. 3): the units of v0, dt, duration and "
              "of every result",
     "v0": "impact speed V0 (the paper's 0.4 m/s)",
-    "strike_angle_deg": "direction of the strike from +x [deg], into the packing: 0 is perpendicular to the "
-                        "struck edge, 30 along a row of the hexagonal lattice",
+    "strike_angle_deg": "direction of the strike from +x [deg], within 90° of the way into the packing: 0 is "
+                        "perpendicular to the struck edge, 30 along a row of the hexagonal lattice (none: into "
+                        "the packing, 0, or a chain's angle_deg)",
     "impact": "velocity (V0 given to the struck bead) or striker (a sphere at V0 hits it)",
     "dt": "time step (none: the contact time over steps_per_contact)",
     "steps_per_contact": "steps per two-body Hertz contact time at the fastest approach (at least 20)",
@@ -64,10 +65,16 @@ KEY_DESCRIPTIONS = {
     "interstitial_material": "a centered-square crystal's interstitial material (none: the beads')",
     "beads": "beads of a chain",
     "angle_deg": "direction of a chain from +x [deg]",
-    "diameters_m": "a chain's bead diameters [m], one per bead (empty: all diameter_m)",
+    "diameters_m": "a chain's bead diameters [m], one per bead or a pattern that repeats from bead 0 (its length "
+                   "dividing beads: [0.01905, 0.009525] is a dimer chain; empty: all diameter_m)",
+    "bead_materials": "a chain's bead materials, one per bead or a pattern that repeats from bead 0, as "
+                      "diameters_m (an empty name, or none: bead_material)",
+    "intruders": "a chain's intruders: tables {bead, diameter_m, material}, bead counted from 0 (the struck "
+                 "one), each with its own diameter [m] and/or material",
     "packing_file": "shape = \"packing\": a CSV x,y,diameter[,material] of measured positions [m]",
     "walls": "shape = \"packing\" or \"random\": none, or hull (flat walls along the convex hull)",
-    "struck_bead": "shape = \"packing\": the struck bead, its line in the file from 0",
+    "struck_bead": "shape = \"packing\": the struck bead, its line in the file counted from 0 (beads.csv's "
+                   "bead_id counts from 1: bead_id = struck_bead + 1)",
     "radius_m": "shape = \"random\": radius of the disc the beads fill [m]",
     "diameter_spread": "shape = \"random\": the diameters are uniform in d (1 ± diameter_spread), below 0.5",
     "seed": "shape = \"random\": seed of the diameters and the loose start (the same seed, the same packing)",

@@ -62,6 +62,9 @@ def build_model(config) -> GranularModel:
     wall = None if config.wall_material == "none" else config.material(config.wall_material)
     bead, held = config.material(config.bead_material), (0.0, 0.0)
     built = configured_packing(config)
+    if len(built.lattice) < 2 and not built.lattice.walls:
+        raise HexdemError(f"{built.lattice.shape}: a packing needs at least 2 beads, or 1 bead and a wall to rebound "
+                          "from; a lone free bead carries no wave")
     lattice, extra = assign_materials(built.lattice, built.regions + config.regions, bead, config.material)
     if config.precompression_n > 0:
         lattice, held = _precompressed(config, lattice, extra, bead, wall)
@@ -85,6 +88,7 @@ def model_impacts(config, lattice: Lattice) -> list[Impact]:
     """The model's impacts: the paper's single one on the struck bead, or those of ``impacts``."""
     if not config.impacts:
         striker = None if config.striker_material is None else config.material(config.striker_material)
-        return [Impact(config.v0 * config.unit_system.velocity_m_s, config.strike_angle_deg,
-                       config.impact == "striker", None, striker, config.striker_diameter_m)]
+        bead = lattice.struck if config.shape == "chain" else None  # a chain's way in is along it, at any angle
+        return [Impact(config.v0 * config.unit_system.velocity_m_s, config.strike_direction_deg,
+                       config.impact == "striker", bead, striker, config.striker_diameter_m)]
     return resolve_impacts(config.impact_specs(), lattice, config.unit_system.velocity_m_s, config.material)

@@ -7,9 +7,9 @@ The triangular shapes (``hexagon``, ``half-hexagon``, ``half-disc``, ``triangle`
 * ``square`` (``rows``, ``columns``) and ``centered-square`` (also ``interstitial_diameter_m``,
   None: the size that touches the four corners, and ``interstitial_material``, None: the beads'),
   in a square basin (:mod:`hexdem.model.square_crystals`);
-* ``chain`` (``beads`` along ``angle_deg``, with optional per-bead ``diameters_m`` and, when
-  ``materials`` is a list, per-bead material names: intruders and dimers), free
-  (:mod:`hexdem.model.chain`);
+* ``chain`` (``beads`` along ``angle_deg``, with ``diameters_m`` and ``bead_materials`` one per
+  bead or a pattern that repeats (a dimer: two), and ``intruders``, beads of their own size or
+  material), free (:mod:`hexdem.model.chain`);
 * ``packing``: the measured positions of ``packing_file``, struck at row ``struck_bead``, with
   ``walls`` ``"none"`` or ``"hull"`` (:mod:`hexdem.model.packing_file`);
 * ``random``: a disordered polydisperse disc (``radius_m``, ``diameter_spread``, ``seed``), whose
@@ -18,16 +18,21 @@ The triangular shapes (``hexagon``, ``half-hexagon``, ``half-disc``, ``triangle`
 
 A builder that gives some beads another material hands them over as material regions, which
 go before the configuration's own ``regions`` (:mod:`hexdem.model.regions`).
+
+A key that describes some shapes only (:data:`SHAPE_KEYS`) is refused on any other, so that no
+key is silently ignored (:func:`check_shape_keys`).
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
+from typing import TypedDict
 
 import numpy as np
 
 from hexdem.errors import HexdemError
-from hexdem.model.chain import chain
+from hexdem.model.chain import chain, chain_beads
 from hexdem.model.lattice import (Lattice, disc, half_disc, half_hexagon, hexagon, parallelogram, strike_direction,
                                   triangle)
 from hexdem.model.packing_file import packing_from_file, read_packing_rows
@@ -43,6 +48,58 @@ CHAIN_SHAPES = ("square", "centered-square", "chain")
 #: built as the ``packing`` of that run's positions.
 PREPARED_SHAPES = ("random",)
 SHAPES = TRIANGULAR_SHAPES + PLACED_SHAPES + PREPARED_SHAPES
+#: The keys that describe some shapes only, and those shapes; every other key applies to every
+#: shape. ``lines`` follow the triangular lattice's directions (the other shapes' lines are their
+#: rays); a random disc's struck bead is found on its edge; a chain has no walls.
+SHAPE_KEYS = {
+    "edge_beads": ("hexagon", "triangle", "parallelogram"),
+    "long_edge": ("half-hexagon",),
+    "short_edge": ("half-hexagon",),
+    "radius_beads": ("half-disc", "disc"),
+    "depth_beads": ("parallelogram",),
+    "sites": ("sites",),
+    "sites_file": ("sites",),
+    "site_walls_deg": ("sites",),
+    "lines": TRIANGULAR_SHAPES,
+    "rows": ("square", "centered-square"),
+    "columns": ("square", "centered-square"),
+    "interstitial_diameter_m": ("centered-square",),
+    "interstitial_material": ("centered-square",),
+    "beads": ("chain",),
+    "angle_deg": ("chain",),
+    "diameters_m": ("chain",),
+    "bead_materials": ("chain",),
+    "intruders": ("chain",),
+    "packing_file": ("packing",),
+    "struck_bead": ("packing",),
+    "walls": ("packing", "random"),
+    "radius_m": ("random",),
+    "diameter_spread": ("random",),
+    "seed": ("random",),
+    **dict.fromkeys(("wall_material", "wall_restitution", "wall_friction"),
+                    tuple(shape for shape in SHAPES if shape != "chain")),
+}
+
+
+class IntruderTable(TypedDict, total=False):
+    """A chain's intruder: its ``bead`` (from 0, the struck one) and its own ``diameter_m`` [m]
+    and/or ``material`` (checked by :class:`~hexdem.model.config.RunConfig`)."""
+
+    bead: int
+    diameter_m: float
+    material: str
+
+
+def check_shape_keys(config) -> None:
+    """Refuse a key of :data:`SHAPE_KEYS` set (different from its default) on a shape it does
+    not describe, in one line naming the key and the shape."""
+    for field in dataclasses.fields(config):
+        shapes = SHAPE_KEYS.get(field.name, (config.shape,))
+        default = field.default_factory() if field.default is dataclasses.MISSING else field.default
+        if config.shape not in shapes and getattr(config, field.name) != default:
+            named = " or ".join(", ".join(f'"{shape}"' for shape in shapes).rsplit(", ", 1))
+            raise HexdemError(f"{field.name} describes shape = {named}, not {config.shape!r}: remove it or change "
+                              "the shape")
 
 
 @dataclass(frozen=True)
@@ -62,13 +119,31 @@ def material_regions(lattice: Lattice, names) -> tuple:
                  for name in dict.fromkeys(names.tolist()) if name)
 
 
+def per_bead(values, fill, beads: int, key: str, what: str) -> list:
+    """One value per bead of a chain of ``beads``: ``fill`` for each when ``values`` is empty,
+    ``values`` itself when it lists one per bead, or repeated from bead 0 when its length divides
+    ``beads`` (a dimer: two). ``key`` names ``values`` and ``what`` its items in an error."""
+    if not values:
+        return [fill] * beads
+    if beads % len(values):
+        raise HexdemError(f"{key} lists {len(values)} {what} for a chain of {beads} beads: list one per bead, or a "
+                          "pattern that repeats, whose length divides beads")
+    return list(values) * (beads // len(values))
+
+
 def _chain(config, struck) -> BuiltPacking:
-    lattice = chain(config.beads, config.diameter_m, config.angle_deg, config.diameters_m, struck)
-    if isinstance(config.materials, dict):
-        return BuiltPacking(lattice)
-    if len(config.materials) != len(lattice):
-        raise HexdemError(f"materials lists {len(config.materials)} names for a chain of {len(lattice)} beads")
-    return BuiltPacking(lattice, material_regions(lattice, config.materials))
+    beads = chain_beads(config.beads)
+    sizes = per_bead(config.diameters_m, config.diameter_m, beads, "diameters_m", "diameters")
+    names = per_bead(config.bead_materials, "", beads, "bead_materials", "names")
+    for k, intruder in enumerate(config.intruders):
+        bead = intruder.get("bead")
+        if bead is None or not 0 <= bead < beads or not {"diameter_m", "material"} & set(intruder):
+            raise HexdemError(f"intruders.{k} must be a table {{bead = k, diameter_m = ..., material = ...}} with "
+                              f"bead from 0 to {beads - 1} and a diameter_m or a material, got {intruder!r}")
+        sizes[bead] = intruder.get("diameter_m", sizes[bead])
+        names[bead] = intruder.get("material", names[bead])
+    lattice = chain(beads, config.diameter_m, config.angle_deg, sizes, struck)
+    return BuiltPacking(lattice, material_regions(lattice, names))
 
 
 def _centered_square(config, struck) -> BuiltPacking:
@@ -86,7 +161,7 @@ def _packing_file(config) -> BuiltPacking:
         raise HexdemError('shape = "packing" needs packing_file = "beads.csv" (header x,y,diameter[,material])')
     beads = read_packing_rows(config.packing_file)
     lattice = packing_from_file(config.packing_file, beads, config.diameter_m, config.struck_bead, config.walls,
-                                strike_direction(config.strike_angle_deg))
+                                strike_direction(config.strike_direction_deg))
     return BuiltPacking(lattice, material_regions(lattice, beads.materials))
 
 
@@ -110,10 +185,6 @@ def build_packing(config, struck) -> BuiltPacking:
         "chain": lambda: _chain(config, struck),
         "packing": lambda: _packing_file(config),
     }
-    if config.shape != "sites" and (config.sites or config.sites_file or config.site_walls_deg):
-        raise HexdemError(f"sites, sites_file and site_walls_deg describe shape = \"sites\", not {config.shape!r}")
-    if config.shape != "packing" and config.packing_file is not None:
-        raise HexdemError(f"packing_file describes shape = \"packing\", not {config.shape!r}")
     if config.shape in PREPARED_SHAPES:
         raise HexdemError(f"shape = {config.shape!r} is packed by a LAMMPS compaction before it is built: "
                           "hexdem run, compare and sweep prepare it (hexdem.experiments.random_packing)")

@@ -40,9 +40,13 @@ from dataclasses import replace
 
 import numpy as np
 
+from hexdem.errors import HexdemError
 from hexdem.model.lattice import BOND_STEPS, Lattice
 from hexdem.model.walls import Wall
 
+#: A precompression may squeeze each contact by less than this fraction of a diameter: from half a
+#: diameter on, Hertz's law no longer holds (as for an impact, :mod:`hexdem.model.timescale`).
+MAX_STATIC_OVERLAP_D = 0.5
 #: Neighbour offsets {Δm, Δn} of a bead in the paper's labels: the bond steps and their opposites.
 NEIGHBOURS = BOND_STEPS + tuple((-dm, -dn) for dm, dn in BOND_STEPS)
 
@@ -56,6 +60,17 @@ def _unit(step) -> np.ndarray:
 def static_overlap(force_n: float, coefficient: float) -> float:
     """δ [m] at which a Hertz contact :math:`F = A δ^{3/2}` carries ``force_n``."""
     return (force_n / coefficient) ** (2.0 / 3.0)
+
+
+def checked_static_overlap(force_n: float, coefficient: float, diameter_m: float) -> float:
+    """:func:`static_overlap` of ``force_n`` [N], refused in one line from :data:`MAX_STATIC_OVERLAP_D`
+    of ``diameter_m`` [m] on."""
+    overlap = static_overlap(force_n, coefficient)
+    if not overlap < MAX_STATIC_OVERLAP_D * diameter_m:
+        raise HexdemError(f"precompression_n = {force_n:g} N would squeeze each contact by {overlap / diameter_m:.3g} "
+                          f"diameters (from {MAX_STATIC_OVERLAP_D:g} on, Hertz's law no longer holds and the beads "
+                          "pass through one another): lower it")
+    return overlap
 
 
 def spring_stiffness(force_n: float, coefficient: float) -> float:
@@ -103,7 +118,7 @@ def precompressed_lattice(lattice: Lattice, force_n: float, pair_coefficient: fl
     (:math:`A_w = k_{n,\text{wall}} \sqrt{R}`)."""
     d = lattice.diameter_m
     centre = lattice.positions_m[lattice.struck]
-    scale = (d - static_overlap(force_n, pair_coefficient)) / d
+    scale = (d - checked_static_overlap(force_n, pair_coefficient, d)) / d
     shrunk = lattice.with_geometry(centre + (lattice.positions_m - centre) * scale, lattice.diameters_m)
     loads = _wall_loads(shrunk, missing_contact_forces(shrunk, force_n))
     walls = []

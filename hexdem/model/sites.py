@@ -8,12 +8,16 @@ the inward-normal angles given (:func:`~hexdem.model.lattice.from_sites`), none 
 from __future__ import annotations
 
 import csv
+import math
 import tomllib
 from pathlib import Path
+
+import numpy as np
 
 from hexdem.common.io import read_text
 from hexdem.errors import HexdemError
 from hexdem.model.lattice import Lattice, from_sites
+from hexdem.model.placed import check_extent
 
 
 def _sites_from_file(path: Path) -> list:
@@ -47,5 +51,12 @@ def read_sites(sites, sites_file, diameter_m: float, walls_deg=(), struck=(0, 0)
         angles = [float(a) for a in walls_deg]
     except (TypeError, ValueError):
         raise HexdemError(f"site_walls_deg must be a list of angles in degrees, got {walls_deg!r}") from None
-    source = f"sites of {sites_file}" if sites_file else "listed sites"
-    return from_sites(listed, diameter_m, angles, f"{len(listed)} {source}", struck)
+    source = f"{len(listed)} sites of {sites_file}" if sites_file else f"{len(listed)} listed sites"
+    try:
+        labels = np.asarray(listed, dtype=float)
+    except (TypeError, ValueError):
+        labels = None  # from_sites words the error
+    if labels is not None and len(labels) and diameter_m > 0:
+        check_extent(labels[:, ::-1] * [math.sqrt(3) / 2 * diameter_m, diameter_m / 2],
+                     np.full(len(labels), float(diameter_m)), source)
+    return from_sites(listed, diameter_m, angles, source, struck)

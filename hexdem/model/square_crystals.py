@@ -1,5 +1,8 @@
 """Square and centered-square crystals: the seed paper's contrast to the hexagonal packing, and
-Leonard & Daraio's crystal with small interstitial beads (PRL 108, 214301, 2012).
+the square crystal with spherical interstitial intruders of Szelengowicz, Kevrekidis & Daraio
+(Phys. Rev. E 86, 061306, 2012). Every bead is a sphere and every contact sphere on sphere: the
+centered-square experiments of Leonard & Daraio put cylinders in the cells, which this model
+does not describe.
 
 Both stand in a square basin of four walls, struck in the middle of the left column
 (label {0, 0}) through a hole of the left wall. A square crystal of ``rows`` × ``columns``
@@ -27,10 +30,16 @@ SQUARE_WALLS_DEG = (0, 180, 90, -90)
 SQUARE_RAYS_DEG = (0, 45, -45, 90, -90)
 
 
+#: The fewest rows and columns of a square or centered-square crystal: the struck bead's column
+#: holds another bead, which places the wall it is struck through, and its row another, which
+#: carries the pulse.
+MIN_GRID = 2
+
+
 def _grid_size(rows, columns) -> tuple[int, int]:
-    for name, value in (("rows", rows), ("columns", columns)):
-        if int(value) != value or value < 1:
-            raise HexdemError(f"a square crystal needs {name} >= 1, got {value}")
+    if not all(int(value) == value and value >= MIN_GRID for value in (rows, columns)):
+        raise HexdemError(f"a square crystal needs at least {MIN_GRID} rows and {MIN_GRID} columns, "
+                          f"got {rows} x {columns}")
     return int(rows), int(columns)
 
 
@@ -56,8 +65,6 @@ def centered_square(rows: int, columns: int, diameter_m: float, interstitial_dia
     and one interstitial of ``interstitial_diameter_m`` (None: :func:`interstitial_fit_m`) in each
     of the (rows − 1)(columns − 1) cells."""
     rows, columns = _grid_size(rows, columns)
-    if rows < 2 or columns < 2:
-        raise HexdemError(f"a centered-square crystal needs at least 2 rows and 2 columns, got {rows} x {columns}")
     small = interstitial_fit_m(diameter_m) if interstitial_diameter_m is None else float(interstitial_diameter_m)
     if not 0 < small:
         raise HexdemError(f"interstitial_diameter_m must be > 0, got {interstitial_diameter_m!r}")
