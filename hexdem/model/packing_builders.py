@@ -41,9 +41,12 @@ from hexdem.model.square_crystals import centered_square, square
 
 TRIANGULAR_SHAPES = ("hexagon", "half-hexagon", "half-disc", "triangle", "parallelogram", "disc", "sites")
 PLACED_SHAPES = ("square", "centered-square", "chain", "packing")
-#: Placed crystals whose pulse runs along straight chains of touching beads, as a solitary wave
-#: (their default duration: :func:`~hexdem.model.timescale.solitary_crossing_time_s`).
-CHAIN_SHAPES = ("square", "centered-square", "chain")
+#: Walled crystals whose pulse runs along straight rows of touching beads, as a solitary wave that
+#: the far wall sends back undiminished (their default duration ends before it returns:
+#: :func:`~hexdem.model.timescale.solitary_crossing_time_s`). A chain has no walls: its far end
+#: flies off and nothing comes back, so it keeps the generous layer-by-layer duration, which
+#: also lets a dimer chain's slower pulse arrive.
+ROW_CRYSTAL_SHAPES = ("square", "centered-square")
 #: Shapes whose positions a LAMMPS run makes (:mod:`hexdem.experiments.random_packing`); they are
 #: built as the ``packing`` of that run's positions.
 PREPARED_SHAPES = ("random",)

@@ -15,7 +15,7 @@ from hexdem.errors import HexdemError
 from hexdem.model.config import MIN_STEPS_PER_CONTACT
 from hexdem.model.granular import GranularModel, RunSettings
 from hexdem.model.model_builder import build_model
-from hexdem.model.packing_builders import CHAIN_SHAPES, PLACED_SHAPES
+from hexdem.model.packing_builders import PLACED_SHAPES, ROW_CRYSTAL_SHAPES
 from hexdem.model.timescale import (crossing_time_s, fastest_approach_m_s, impact_contact_time_s, sized_bodies,
                                     solitary_crossing_time_s, striker_launch_s, wall_contact_time_s)
 
@@ -100,7 +100,7 @@ def run_settings(config, model: GranularModel | None = None) -> RunSettings:
     dt_s, every = step_and_sampling(config, contact_s)
     if config.duration is not None:
         duration_s = config.duration * scale
-    elif config.shape in CHAIN_SHAPES:
+    elif config.shape in ROW_CRYSTAL_SHAPES:
         duration_s = solitary_crossing_time_s(model, contact_s, wall_contact_time_s(model)) + striker_launch_s(model)
     else:
         crossing_s = crossing_time_s(model, contact_s if config.precompression_n > 0 else None)

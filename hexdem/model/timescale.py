@@ -154,10 +154,10 @@ def wall_contact_time_s(model) -> float:
 
 
 def solitary_crossing_time_s(model, contact_s: float, wall_contact_s: float) -> float:
-    r"""The default duration [s] of a crystal whose pulse runs along straight chains of touching
-    beads (a square crystal's row, a centered square's rows, a chain): long enough for the
-    leading pulse to reach the far end and peak there, short enough to end before the far wall's
-    reflection reaches the beads before it.
+    r"""The default duration [s] of a walled crystal whose pulse runs along straight rows of touching
+    beads (a square crystal's row, a centered square's rows): long enough for the leading pulse to
+    reach the far end and peak there, short enough to end before the far wall's reflection reaches
+    the beads before it.
 
     The pulse is Nesterenko's solitary wave, which does not decay along a chain: it crosses the
     packing's depth D along each impact (from the struck bead to the farthest bead ahead) at no
