@@ -8,8 +8,6 @@ from the samples of a small run when every sample is wanted (contact tests, one-
 
 from __future__ import annotations
 
-import dataclasses
-
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -72,8 +70,7 @@ class TrajectoryRecorder:
         self.samples: list[Sample] = []
 
     def __call__(self, sample: Sample) -> None:
-        self.samples.append(dataclasses.replace(sample, ids=sample.ids.copy(), positions=sample.positions.copy(),
-                                                velocities=sample.velocities.copy()))
+        self.samples.append(sample)
 
     def trajectory(self, engine: dict) -> Trajectory:
         order = [np.argsort(s.ids) for s in self.samples]

@@ -24,9 +24,6 @@ class Sample:
     ``settings.sensor_every`` steps), else None; ``angular_velocities`` (n,) ω_z, the spins of a
     frictional model's spheres (None: the engine gives none; frictionless spheres never turn).
 
-    The arrays are the engine's and valid while the observer is called (LAMMPS's driver writes
-    the next sample into the same ones): an observer that keeps them keeps copies.
-
     Under MPI: ``migrated`` False promises that every rank owns the same bodies as at its previous
     sample, in the same order (LAMMPS moves atoms between ranks, and reorders them, only when it
     rebuilds its neighbour lists), the same on every rank; True (the default) that they may have

@@ -76,17 +76,6 @@ class _Stream:
         self.bar = progress_bar(deck.settings.n_steps, "LAMMPS", unit="step") if show_progress else None
         self.error: BaseException | None = None
         self.builds = None  # neighbour list builds at the previous sample (None: it came before this run)
-        self.buffers = None  # (see _buffers)
-
-    def _buffers(self, n: int) -> tuple[np.ndarray, ...]:
-        """The arrays a sample of ``n`` local atoms is written into: (n,) half kicks dt/2m, (n, 2)
-        velocities, (n,) ids, (n, 2) positions, kept from one sample to the next while ``n`` stays
-        (fresh arrays of this size cost the kernel's page faults at every sample, twice the
-        arithmetic's time at 29,701 beads). A sample's arrays are valid while the observer is
-        called: one that keeps them copies them."""
-        if self.buffers is None or len(self.buffers[0]) != n:
-            self.buffers = (np.empty(n), np.empty((n, 2)), np.empty(n, dtype=np.int64), np.empty((n, 2)))
-        return self.buffers
 
     def per_atom(self, name: str, n: int, columns: int = 3) -> np.ndarray:
         """A view of per-atom property ``name`` of the first ``n`` local atoms, (n, columns) or (n,)
@@ -139,11 +128,8 @@ class _Stream:
             return
         try:  # (``tag`` and ``x``: the ids and positions of the local atoms, handed over by LAMMPS)
             force, mass = self.forces_and_masses(nlocal)
-            kick, velocities, ids, positions = self._buffers(nlocal)
-            np.divide(0.5 * self.dt, mass, out=kick)
-            np.multiply(force, kick[:, None], out=velocities)
-            velocities += self.per_atom("v", nlocal)[:, :2]
-            ids[:], positions[:] = tag, x[:, :2]
+            velocities = self.per_atom("v", nlocal)[:, :2] + (0.5 * self.dt / mass)[:, None] * force
+            ids, positions = tag.astype(np.int64), x[:, :2].copy()
             sensed = self.sensor_every and step % self.sensor_every == 0
             accelerations = force / mass[:, None] if sensed else None
             builds = self.lmp.get_thermo("nbuild")
