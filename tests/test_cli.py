@@ -8,6 +8,7 @@ import socket
 import subprocess
 import sys
 import time
+import tomllib
 from datetime import datetime, timedelta, timezone
 from importlib.metadata import version
 from pathlib import Path
@@ -93,3 +94,23 @@ def test_workers_default_to_the_cpus_the_job_may_use():
                           preexec_fn=lambda: os.sched_setaffinity(0, {min(os.sched_getaffinity(0))}))
     assert done.stdout.split() == ["1", "1"], done.stderr
     assert usable_cpus() == len(os.sched_getaffinity(0))
+
+
+def test_analyse_without_mdanalysis_says_what_to_install(tmp_path):
+    """MDAnalysis is the extra ``dumps``; here it is made unimportable, as in an environment without it."""
+    script = ("import sys\nsys.modules['MDAnalysis'] = None\nfrom hexdem.cli.main import main\n"
+              f"sys.exit(main(['analyse', {str(tmp_path)!r}]))")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 3
+    assert done.stderr.strip().splitlines() == ['hexdem: error: hexdem analyse reads dumps through MDAnalysis, which '
+                                                'is not installed; install it with: pip install "hexdem[dumps]"']
+
+
+def test_mdanalysis_is_an_extra_that_only_the_dump_reader_imports():
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    assert not any(text.lower().startswith("mdanalysis") for text in project["dependencies"])
+    assert project["optional-dependencies"]["dumps"] == ["MDAnalysis>=2.7"]
+    assert "hexdem[dumps]" in project["optional-dependencies"]["test"]
+    importers = {path.relative_to(ROOT).as_posix() for path in (ROOT / "hexdem").rglob("*.py")
+                 if re.search(r"^\s*(import|from) MDAnalysis", path.read_text(), flags=re.MULTILINE)}
+    assert importers == {"hexdem/analysis/dump.py", "hexdem/cli/analyse.py"}
