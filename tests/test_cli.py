@@ -1,12 +1,16 @@
 """The command as users of LAMMPS, ASE and MDAnalysis expect it: ``python -m hexdem``, ``--version``,
 exit statuses that tell a typo from a refused input and a failed run, and a run's provenance."""
 
+import fcntl
 import json
 import os
+import pty
 import re
 import socket
+import struct
 import subprocess
 import sys
+import termios
 import time
 import tomllib
 from datetime import datetime, timedelta, timezone
@@ -114,3 +118,29 @@ def test_mdanalysis_is_an_extra_that_only_the_dump_reader_imports():
     importers = {path.relative_to(ROOT).as_posix() for path in (ROOT / "hexdem").rglob("*.py")
                  if re.search(r"^\s*(import|from) MDAnalysis", path.read_text(), flags=re.MULTILINE)}
     assert importers == {"hexdem/analysis/dump.py", "hexdem/cli/analyse.py"}
+
+
+def test_a_run_on_a_terminal_shows_its_steps_and_the_time_left(tmp_path):
+    """``hexdem run`` with stderr on a terminal (a pseudo-terminal here) draws a bar of LAMMPS's
+    steps done, of all, and the time left; in a pipe or a log it stays quiet (tests/test_errors.py)."""
+    (tmp_path / "run.toml").write_text("edge_beads = 6\n")
+    leader, follower = pty.openpty()
+    fcntl.ioctl(follower, termios.TIOCSWINSZ, struct.pack("HHHH", 40, 120, 0, 0))  # 120 columns: a bar fits
+    child = subprocess.Popen([sys.executable, "-m", "hexdem", "run", "--config", str(tmp_path / "run.toml"),
+                              "--out", str(tmp_path / "out")], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                             stderr=follower)
+    os.close(follower)
+    output = b""
+    while True:
+        try:
+            chunk = os.read(leader, 4096)
+        except OSError:  # the terminal closed with the child
+            break
+        if not chunk:
+            break
+        output += chunk
+    os.close(leader)
+    assert child.wait(timeout=120) == 0
+    steps = json.loads((tmp_path / "out" / "summary.json").read_text())["n_steps"]
+    bars = re.findall(rf"LAMMPS: +\d+%.*?\| *(\d+)/{steps} \[[\d:]+<([\d:?]+)", output.decode(errors="replace"))
+    assert bars and all(0 <= int(done) <= steps for done, _ in bars), output[-2000:]

@@ -28,6 +28,7 @@ stay beside it, to be rerun by hand (``lmp -in in.hexdem``).
 
 from __future__ import annotations
 
+import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -107,10 +108,15 @@ def prepare_random_packing(config: RunConfig, directory, comm=None, log=None) ->
     model = build_model(_packing_config(bare, loose, 0, "none"))
     log(f"packing a random disc of {len(diameters)} beads (radius {config.radius_m:g} m, "
         f"diameters d (1 ± {config.diameter_spread:g}), seed {config.seed}) with LAMMPS")
-    for name in STAGES:
-        deck = write_settling_deck(model, settling_stage(name), directory / name)
+    for number, name in enumerate(STAGES, 1):
+        stage, start = settling_stage(name), time.perf_counter()
+        log(f"random disc, stage {number} of {len(STAGES)}: {name} (loads {stage.loads_note}), until the rms speed "
+            f"is below {stage.settled_rms_speed_m_s:g} m/s")
+        deck = write_settling_deck(model, stage, directory / name)
         run_settling_deck(deck, comm)
         result = read_stage(deck)
+        log(f"random disc, {name}: {'settled' if result.settled else 'stopped'} after {result.steps} steps, "
+            f"{result.time_s:.3g} s simulated, in {time.perf_counter() - start:.1f} s")
         if not result.settled:
             raise HexdemError(f"the random disc's {name} stage did not settle in {result.steps} steps "
                               f"(kinetic energy {result.kinetic_energy_j:.3g} J, largest force "
