@@ -29,6 +29,7 @@ REFUSED, FAILED, INTERRUPTED = 3, 4, 130
 #: name → (module, one-line help)
 COMMANDS = {
     "run": ("hexdem.cli.run", "simulate one impact (default: the paper's 11-per-edge experiment)"),
+    "preview": ("hexdem.cli.preview", "draw a packing (beads, walls, impacts, observation lines) without running it"),
     "analyse": ("hexdem.cli.analyse", "result files from the dump of a deck run by hand (lmp -in in.hexdem)"),
     "compare": ("hexdem.cli.compare", "run one configuration through LAMMPS and the reference integrator"),
     "signals": ("hexdem.cli.signals", "measured accelerometer signals beside a run's sensor particles"),
