@@ -4,7 +4,7 @@ Subcommand modules are imported lazily (only the one asked for), following ASE's
 Every :class:`~hexdem.errors.HexdemError` is printed as one line, ``hexdem: error: ...``;
 ``--traceback`` shows the full traceback instead. The exit status tells what went wrong
 (:data:`EXIT_CODES`): 2 for a usage error (argparse's), 3 for input or an environment that
-hexdem refused before running anything, 4 for a simulation that started and failed
+hexdem refused (or a check of its results that failed), 4 for a simulation that started and failed
 (:class:`~hexdem.errors.RunFailed`), 130 for an interrupt; 1 is left to an unexpected error,
 a bug, which Python reports with its traceback.
 """
@@ -21,7 +21,8 @@ from hexdem.errors import HexdemError, RunFailed
 #: Exit status → what it means (also in the CLI reference).
 EXIT_CODES = {0: "success", 1: "an unexpected error (a bug: Python prints its traceback)",
               2: "a usage error: an unknown command or option, a value of the wrong form",
-              3: "refused: input or environment hexdem cannot use, reported before anything ran",
+              3: "refused: input or an environment hexdem cannot use, or a check that failed (the engines "
+                 "disagree), named in one line",
               4: "a simulation that started and failed (LAMMPS stopped, or the energy drifted)",
               130: "interrupted (Ctrl-C)"}
 REFUSED, FAILED, INTERRUPTED = 3, 4, 130
