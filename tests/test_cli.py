@@ -18,6 +18,7 @@ from importlib.metadata import version
 from pathlib import Path
 
 import hexdem
+from hexdem.cli.main import EXIT_CODES
 from hexdem.common.machine import usable_cpus
 from hexdem.engines.lammps.library import load_lammps
 from hexdem.experiments.provenance import source_commit
@@ -144,3 +145,9 @@ def test_a_run_on_a_terminal_shows_its_steps_and_the_time_left(tmp_path):
     steps = json.loads((tmp_path / "out" / "summary.json").read_text())["n_steps"]
     bars = re.findall(rf"LAMMPS: +\d+%.*?\| *(\d+)/{steps} \[[\d:]+<([\d:?]+)", output.decode(errors="replace"))
     assert bars and all(0 <= int(done) <= steps for done, _ in bars), output[-2000:]
+
+
+def test_the_getting_started_page_lists_every_exit_status():
+    page = (ROOT / "docs" / "getting-started.md").read_text()
+    table = page.split("| status | meaning |")[1].split("\n\n")[0]
+    assert [int(code) for code in re.findall(r"^\| (\d+) \|", table, flags=re.MULTILINE)] == list(EXIT_CODES)
