@@ -11,6 +11,7 @@ from hexdem.experiments.provenance import versions
 
 
 def version_text() -> str:
+    """The lines ``hexdem --version`` prints (:func:`~hexdem.experiments.provenance.versions`)."""
     v = versions()
     commit = f" (git {v['git_commit']})" if v["git_commit"] else ""
     return f"hexdem {v['hexdem_version']}{commit}\n{v['lammps_version']}\n{v['mpi_version']}\nPython {v['python_version']}"

@@ -37,7 +37,7 @@ import numpy as np
 from hexdem.common.io import write_csv
 from hexdem.engines.lammps.settling import (SETTLED_NAME, SettlingStage, read_data_file, read_stage,
                                             run_settling_deck, write_settling_deck)
-from hexdem.errors import HexdemError
+from hexdem.errors import RunFailed
 from hexdem.model.config import RunConfig
 from hexdem.model.lattice import strike_direction
 from hexdem.model.model_builder import build_model
@@ -118,7 +118,7 @@ def prepare_random_packing(config: RunConfig, directory, comm=None, log=None) ->
         log(f"random disc, {name}: {'settled' if result.settled else 'stopped'} after {result.steps} steps, "
             f"{result.time_s:.3g} s simulated, in {time.perf_counter() - start:.1f} s")
         if not result.settled:
-            raise HexdemError(f"the random disc's {name} stage did not settle in {result.steps} steps "
+            raise RunFailed(f"the random disc's {name} stage did not settle in {result.steps} steps "
                               f"(kinetic energy {result.kinetic_energy_j:.3g} J, largest force "
                               f"{result.max_force_n:.3g} N); see {deck}")
         state = read_data_file(deck / SETTLED_NAME)
