@@ -13,8 +13,8 @@ class HexdemError(Exception):
 
 
 class RunFailed(HexdemError):
-    """A simulation that started and failed: LAMMPS stopped with an error, or the integration went
-    wrong (its energy drifted)."""
+    """A simulation that started and failed: LAMMPS stopped with an error, the integration went
+    wrong (its energy drifted), or a settling deck did not settle."""
 
 
 def one_line(exc: BaseException) -> str:

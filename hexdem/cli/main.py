@@ -23,7 +23,8 @@ EXIT_CODES = {0: "success", 1: "an unexpected error (a bug: Python prints its tr
               2: "a usage error: an unknown command or option, a value of the wrong form",
               3: "refused: input or an environment hexdem cannot use, or a check that failed (the engines "
                  "disagree), named in one line",
-              4: "a simulation that started and failed (LAMMPS stopped, or the energy drifted)",
+              4: "a simulation that started and failed (LAMMPS stopped, the energy drifted, a packing did not "
+                 "settle)",
               130: "interrupted (Ctrl-C)"}
 REFUSED, FAILED, INTERRUPTED = 3, 4, 130
 
