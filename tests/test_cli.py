@@ -17,10 +17,13 @@ from datetime import datetime, timedelta, timezone
 from importlib.metadata import version
 from pathlib import Path
 
+import pytest
+
 import hexdem
 from hexdem.cli.main import EXIT_CODES
 from hexdem.common.machine import usable_cpus
 from hexdem.engines.lammps.library import load_lammps
+from hexdem.engines.lammps.runner import logged_step
 from hexdem.experiments.provenance import source_commit
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -121,15 +124,17 @@ def test_mdanalysis_is_an_extra_that_only_the_dump_reader_imports():
     assert importers == {"hexdem/analysis/dump.py", "hexdem/cli/analyse.py"}
 
 
-def test_a_run_on_a_terminal_shows_its_steps_and_the_time_left(tmp_path):
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_a_run_on_a_terminal_shows_its_steps_and_the_time_left(tmp_path, ranks):
     """``hexdem run`` with stderr on a terminal (a pseudo-terminal here) draws a bar of LAMMPS's
-    steps done, of all, and the time left; in a pipe or a log it stays quiet (tests/test_errors.py)."""
+    steps done, of all, and the time left: in-process from the run's callback, on launched ranks
+    from LAMMPS's log. In a pipe or a log it stays quiet (tests/test_errors.py)."""
     (tmp_path / "run.toml").write_text("edge_beads = 6\n")
     leader, follower = pty.openpty()
     fcntl.ioctl(follower, termios.TIOCSWINSZ, struct.pack("HHHH", 40, 120, 0, 0))  # 120 columns: a bar fits
     child = subprocess.Popen([sys.executable, "-m", "hexdem", "run", "--config", str(tmp_path / "run.toml"),
-                              "--out", str(tmp_path / "out")], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                             stderr=follower)
+                              "--ranks", str(ranks), "--out", str(tmp_path / "out")], stdin=subprocess.DEVNULL,
+                             stdout=subprocess.DEVNULL, stderr=follower)
     os.close(follower)
     output = b""
     while True:
@@ -143,8 +148,20 @@ def test_a_run_on_a_terminal_shows_its_steps_and_the_time_left(tmp_path):
     os.close(leader)
     assert child.wait(timeout=120) == 0
     steps = json.loads((tmp_path / "out" / "summary.json").read_text())["n_steps"]
-    bars = re.findall(rf"LAMMPS: +\d+%.*?\| *(\d+)/{steps} \[[\d:]+<([\d:?]+)", output.decode(errors="replace"))
+    name = "LAMMPS" if ranks == 1 else f"LAMMPS on {ranks} ranks"
+    bars = re.findall(rf"{name}: +\d+%.*?\| *(\d+)/{steps} \[[\d:]+<([\d:?]+)", output.decode(errors="replace"))
     assert bars and all(0 <= int(done) <= steps for done, _ in bars), output[-2000:]
+
+
+def test_the_last_logged_step_is_read_from_the_last_thermo_table(tmp_path):
+    log = tmp_path / "log.lammps"
+    assert logged_step(log) == 0, "no log yet"
+    log.write_text("LAMMPS (22 Jul 2025)\n  1 by 2 by 1 MPI processor grid\n   Step   Time   KinEng\n"
+                   "         0   0   0.0023\nLoop time of 2e-06 on 2 procs for 0 steps with 331 atoms\n")
+    assert logged_step(log) == 0
+    log.write_text(log.read_text() + "   Step   Time   KinEng\n         0   0   0.0023\n"
+                   "       140   7.17e-05   0.0011\n       280   0.00014   0.0013\n")
+    assert logged_step(log) == 280
 
 
 def test_the_getting_started_page_lists_every_exit_status():

@@ -35,6 +35,18 @@ def log_version(log: Path) -> str:
     return first.strip() or "unknown"
 
 
+def logged_step(log: Path) -> int:
+    """The last step of the thermo output in the LAMMPS ``log`` (0 before any): how far a run on
+    several ranks, in other processes, has gone (hexdem's decks flush their thermo lines)."""
+    try:
+        table = log.read_text().rsplit("Step", 1)[1]
+    except (OSError, IndexError):
+        return 0
+    rows = [line.split() for line in table.splitlines()[1:]]
+    steps = [int(row[0]) for row in rows if row and row[0].isdigit()]
+    return steps[-1] if steps else 0
+
+
 def error_line(text: str) -> str:
     """LAMMPS's ``ERROR...`` line from its output, without the source-file reference."""
     match = re.search(r"ERROR[^\n]*", text)
