@@ -26,10 +26,18 @@ source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
 exclude_patterns = ["_build", "gallery/configs"]
 autodoc_member_order = "bysource"
 autodoc_typehints = "none"
-html_theme = "alabaster"
-html_theme_options = {"description": "Impulses in 2D hexagonal granular crystals", "page_width": "1100px"}
+#: The theme of NumPy's, SciPy's and MDAnalysis's sites, which hexdem's readers know.
+html_theme = "pydata_sphinx_theme"
+html_title = "hexdem"
+#: The page's own headings below the section's navigation, in the one sidebar: without a second
+#: sidebar the article is wide enough for the 82 columns of the code blocks and CLI help at 1280 px
+#: (an API page lists its modules there).
+html_theme_options = {"logo": {"text": "hexdem"}, "navbar_align": "left", "show_toc_level": 2,
+                      "navigation_with_keys": False, "secondary_sidebar_items": [],
+                      "footer_start": ["copyright"], "footer_end": ["sphinx-version"]}
+html_sidebars = {"**": ["sidebar-nav-bs", "page-toc"]}
+html_static_path = ["_static"]
+html_css_files = ["hexdem.css"]
 suppress_warnings = ["myst.header", "myst.xref_missing"]
-#: The page's own headings below the site's navigation: an API page lists its modules there.
-html_sidebars = {"**": ["about.html", "searchfield.html", "navigation.html", "localtoc.html"]}
 #: Module headings in that table of contents, not every function (their names would be cut off).
 toc_object_entries = False

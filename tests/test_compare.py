@@ -191,7 +191,7 @@ def test_compare_cli_reports_agreement_and_fails_on_disagreement(tmp_path, small
     assert {p.name for p in (tmp_path / "ok").iterdir()} == {"compare.csv", "compare.json", "compare.png",
                                                            "lammps", "reference"}
     assert main(["compare", "--config", str(small_toml), "--out", str(tmp_path / "strict"),
-                 "--peak-tol", "1e-15"]) == 2
+                 "--peak-tol", "1e-15"]) == 3
     error = capsys.readouterr().err.strip().splitlines()[-1]
     assert error.startswith("hexdem: error: ") and "DISAGREE" in error and "compare.csv" in error
 
@@ -201,7 +201,7 @@ def test_bad_tolerance_is_a_one_line_error(tmp_path, small_toml, capsys):
         Tolerances(peak_rel=float("nan"))
     with pytest.raises(HexdemError, match="tolerance arrival_rate must be a number >= 0, got -0.1"):
         Tolerances(arrival_rate=-0.1)
-    assert main(["compare", "--config", str(small_toml), "--out", str(tmp_path), "--arrival-tol", "-1"]) == 2
+    assert main(["compare", "--config", str(small_toml), "--out", str(tmp_path), "--arrival-tol", "-1"]) == 3
     assert capsys.readouterr().err.strip() == "hexdem: error: tolerance arrival_s must be a number >= 0, got -1.0"
     assert not any(tmp_path.glob("compare*"))
 

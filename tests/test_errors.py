@@ -1,4 +1,4 @@
-"""Bad input gets one clear line from the CLI, exit status 2, and no partial result files."""
+"""Bad input gets one clear line from the CLI, exit status 3 (a failed run 4), and no partial result files."""
 
 import dataclasses
 import functools
@@ -98,7 +98,7 @@ def kept_deck(message: str) -> Path:
 ])
 def test_bad_config_is_one_line_and_writes_nothing(tmp_path, capsys, config_text, message):
     code, err = run_cli(tmp_path, capsys, config_text)
-    assert code == 2
+    assert code == 3
     assert len(err) == 1 and err[0].startswith("hexdem: error:") and message in err[0]
     assert_no_results(tmp_path / "out")
 
@@ -129,7 +129,7 @@ def test_input_files_that_are_not_utf8_are_one_line(tmp_path, capsys):
     (tmp_path / "sites.toml").write_text(f'shape = "sites"\nsites_file = "{tmp_path / "sites.csv"}"\n')
     for config, message in ((latin, f"config {latin} is not UTF-8 text (byte 32: {bytes([0xae])!r})"),
                             (tmp_path / "sites.toml", f"sites_file {tmp_path / 'sites.csv'} is not UTF-8 text")):
-        assert main(["run", "--config", str(config), "--out", str(tmp_path / "out")]) == 2
+        assert main(["run", "--config", str(config), "--out", str(tmp_path / "out")]) == 3
         lines = capsys.readouterr().err.strip().splitlines()
         assert len(lines) == 1 and message in lines[0], lines
         assert_no_results(tmp_path / "out")
@@ -159,7 +159,7 @@ def test_analyse_refuses_a_damaged_deck_in_one_line(small_deck, tmp_path, capsys
         (deck / entry.name).symlink_to(entry)
     (deck / "hexdem.json").unlink()
     (deck / "hexdem.json").write_text(text)
-    assert main(["analyse", str(deck), "--out", str(tmp_path / "analysed")]) == 2
+    assert main(["analyse", str(deck), "--out", str(tmp_path / "analysed")]) == 3
     lines = [line for line in capsys.readouterr().err.strip().splitlines() if not line.startswith("hexdem analyse: ")]
     assert len(lines) == 1 and message in lines[0], lines
     assert_no_results(tmp_path / "analysed")
@@ -169,7 +169,7 @@ def test_unwritable_output_directory(tmp_path, capsys):
     blocker = tmp_path / "file"
     blocker.write_text("not a directory")
     code, err = run_cli(tmp_path, capsys, out=blocker / "out")
-    assert code == 2 and len(err) == 1 and "is not writable" in err[0]
+    assert code == 3 and len(err) == 1 and "is not writable" in err[0]
 
 
 def test_lammps_failure_names_lammps_message_and_the_kept_deck(tmp_path, capsys, monkeypatch):
@@ -177,7 +177,7 @@ def test_lammps_failure_names_lammps_message_and_the_kept_deck(tmp_path, capsys,
     monkeypatch.setattr(deck, "render_input", lambda *args: render(*args).replace("timestep ", "timestpe "))
     code, err = run_cli(tmp_path, capsys, "edge_beads = 3")
     out = tmp_path / "out"
-    assert code == 2 and len(err) == 1
+    assert code == 4 and len(err) == 1
     assert "LAMMPS failed on" in err[0] and "ERROR: Unknown command: timestpe" in err[0]
     assert "in.hexdem" in err[0] and (kept_deck(err[0]) / "log.lammps").exists()
     assert_no_results(out)
@@ -186,7 +186,7 @@ def test_lammps_failure_names_lammps_message_and_the_kept_deck(tmp_path, capsys,
 def test_time_step_not_small_against_the_contact_is_refused_before_running(tmp_path, capsys):
     """dt = 2e-5 s against the 71.7 µs two-bead contact at 0.4 m/s: fewer than 20 steps per contact."""
     code, err = run_cli(tmp_path, capsys, "edge_beads = 5\ndt = 2e-5\nduration = 1e-3")
-    assert code == 2 and len(err) == 1 and "not small against the Hertz contact time 7.17e-05" in err[0]
+    assert code == 3 and len(err) == 1 and "not small against the Hertz contact time 7.17e-05" in err[0]
     assert "hexdem-failed-" not in err[0]
     assert_no_results(tmp_path / "out")
 
@@ -194,7 +194,7 @@ def test_time_step_not_small_against_the_contact_is_refused_before_running(tmp_p
 def test_run_whose_energy_drifts_is_refused(tmp_path, capsys):
     """dt = τ/24 passes the step check, but its energy drift (≈ 2e-6 · (700/24)² ≈ 2e-3) does not."""
     code, err = run_cli(tmp_path, capsys, "edge_beads = 5\ndt = 3e-6\nduration = 1e-3\ndump_every = 2")
-    assert code == 2 and len(err) == 1 and "energy drift" in err[0] and "time step" in err[0]
+    assert code == 4 and len(err) == 1 and "energy drift" in err[0] and "time step" in err[0]
     assert (kept_deck(err[0]) / "in.hexdem").exists()
     assert_no_results(tmp_path / "out")
 
@@ -216,7 +216,7 @@ def test_run_whose_energy_drifts_is_refused(tmp_path, capsys):
 ])
 def test_runs_that_cannot_be_analysed_or_cannot_fit_are_refused(tmp_path, capsys, config_text, message):
     code, err = run_cli(tmp_path, capsys, config_text)
-    assert code == 2 and len(err) == 1 and message in err[0]
+    assert code == 3 and len(err) == 1 and message in err[0]
     assert_no_results(tmp_path / "out")
 
 

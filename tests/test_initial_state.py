@@ -71,7 +71,7 @@ def test_bad_initial_state_files_are_one_line_and_write_nothing(tmp_path, capsys
     (tmp_path / "state.csv").write_text(text)
     (tmp_path / "run.toml").write_text('shape = "sites"\nsites = [[0, 0], [1, 1]]\nsite_walls_deg = []\n'
                                       f'initial_state_file = "{tmp_path / "state.csv"}"\n')
-    assert main(["run", "--config", str(tmp_path / "run.toml"), "--out", str(tmp_path / "out")]) == 2
+    assert main(["run", "--config", str(tmp_path / "run.toml"), "--out", str(tmp_path / "out")]) == 3
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], lines
     assert not (tmp_path / "out").exists()
@@ -109,7 +109,7 @@ def test_a_state_too_fast_for_hertz_contacts_is_refused_in_one_line(tmp_path, ca
     packing, end at half a diameter."""
     (tmp_path / "state.csv").write_text("m,n,vx,vy\n4,0,1e6,0\n")
     (tmp_path / "run.toml").write_text(f'edge_beads = 5\ninitial_state_file = "{tmp_path / "state.csv"}"\n')
-    assert main(["run", "--config", str(tmp_path / "run.toml"), "--out", str(tmp_path / "out")]) == 2
+    assert main(["run", "--config", str(tmp_path / "run.toml"), "--out", str(tmp_path / "out")]) == 3
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and "at 1e+06 m/s, two steel316 beads meeting head on would overlap by 67.2 diameters" \
         in lines[0], lines

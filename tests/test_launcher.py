@@ -88,7 +88,7 @@ def test_an_empty_launcher_is_refused():
 def test_a_launcher_that_does_not_exist_is_one_line(tmp_path, capfd):
     missing = str(tmp_path / "no-such-mpiexec")
     assert main(["run", "--config", small_config(tmp_path), "--ranks", "2", "--launcher", missing,
-                 "--out", str(tmp_path / "out")]) == 2
+                 "--out", str(tmp_path / "out")]) == 3
     error = capfd.readouterr().err
     assert f"cannot start the MPI launcher '{missing}'" in error and "Traceback" not in error
     assert not (tmp_path / "out" / "summary.json").exists()

@@ -175,13 +175,13 @@ def test_the_arrival_verdict_names_the_lines_friction_delays():
 
 
 def test_other_settings_in_the_same_directory_are_refused(quick, capsys):
-    assert main(["paper", "--out", str(quick)]) == 2
+    assert main(["paper", "--out", str(quick)]) == 3
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and "other settings" in lines[0]
 
 
 def test_bad_workers_is_one_clear_line(tmp_path, capsys):
-    assert main(["paper", "--out", str(tmp_path / "out"), "--workers", "0", "--quick"]) == 2
+    assert main(["paper", "--out", str(tmp_path / "out"), "--workers", "0", "--quick"]) == 3
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and "--workers must be a positive integer" in lines[0]
     assert not (tmp_path / "out").exists()

@@ -2,6 +2,7 @@
 bead rests on its neighbours, then struck, with both engines agreeing."""
 
 import math
+import re
 from dataclasses import replace
 from pathlib import Path
 
@@ -122,11 +123,17 @@ def test_the_packed_disc_rests_bead_on_bead(compared):
     assert 3.8 < contacts[contacts >= 3].mean() < 5.0
 
 
-def test_the_same_seed_packs_the_same_disc(compared, tmp_path):
+def test_the_same_seed_packs_the_same_disc_and_says_so_stage_by_stage(compared, tmp_path):
     out, _ = compared
-    again = prepare_random_packing(RunConfig(**SMALL), tmp_path)
+    messages = []
+    again = prepare_random_packing(RunConfig(**SMALL), tmp_path, log=messages.append)
     assert (tmp_path / PACKING_NAME).read_bytes() == (out / "preparation" / PACKING_NAME).read_bytes()
     assert again.shape == "packing" and again.struck_bead >= 0
+    stages = [found.group(2) for message in messages if (found := re.match(r"random disc(, stage \d of 2:|,) (\w+)",
+                                                                              message))]
+    assert stages == ["compact", "compact", "relax", "relax"] and messages[-1].startswith("random disc packed")
+    assert all(re.search(r"settled after \d+ steps, [\d.e+-]+ s simulated, in [\d.]+ s$", message)
+               for message in messages[2:-1:2])
 
 
 def test_both_engines_agree_on_a_struck_random_disc(compared):

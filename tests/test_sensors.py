@@ -125,7 +125,7 @@ def test_measured_signals_are_aligned_and_compared(sensor_run, tmp_path):
 def test_measured_file_without_accelerations_is_a_one_line_error(sensor_run, tmp_path, capsys):
     bad = tmp_path / "bad.csv"
     bad.write_text("sensor,time,vx\n0:1,0.0,1.0\n")
-    assert main(["signals", "--measured", str(bad), "--run", str(sensor_run[0])]) == 2
+    assert main(["signals", "--measured", str(bad), "--run", str(sensor_run[0])]) == 3
     assert "lacks the column(s) ax, ay" in capsys.readouterr().err
 
 

@@ -93,6 +93,6 @@ def test_the_panels_share_one_colour_bar_readable_in_the_report(monkeypatch, con
 
 
 def test_bad_times_on_the_command_line_are_one_clear_line(tmp_path, capsys):
-    assert main(["snapshots", "--out", str(tmp_path / "x"), "--times", "0.1;0.2"]) == 2
+    assert main(["snapshots", "--out", str(tmp_path / "x"), "--times", "0.1;0.2"]) == 3
     lines = capsys.readouterr().err.strip().splitlines()
     assert lines == ["hexdem: error: --times must be comma-separated numbers in ms, e.g. 0.2,0.4,0.6; got '0.1;0.2'"]

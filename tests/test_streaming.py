@@ -238,3 +238,19 @@ def test_the_energy_audit_summed_over_ranks_equals_the_gathered_one(tmp_path, mo
     np.testing.assert_allclose(tracked.region_energies, gathered, rtol=1e-12, atol=1e-12 * gathered[0].sum())
     assert migrations >= 1
     assert tracked.collectives == migrations + len(tracked.energy_times) + 1
+
+
+def test_the_dump_carries_each_beads_radius_and_mass_which_mdanalysis_reads(dumped_run):
+    """``radius`` for OVITO (true sizes), ``mass`` for MDAnalysis (``atoms.masses``, not guessed
+    from the atom type), both of each bead as the model has them (SI units: kg, m)."""
+    import MDAnalysis as mda
+
+    out, analysis = dumped_run
+    dump = out / "deck" / "dump.lammpstrj"
+    with dump.open() as lines:
+        header = next(line for line in lines if line.startswith("ITEM: ATOMS")).split()[2:]
+    assert header[:4] == ["id", "type", "radius", "mass"]
+    assert analysis.settings.units.name == "si"
+    universe = mda.Universe(str(dump), format="LAMMPSDUMP", additional_columns=["radius"])
+    np.testing.assert_allclose(universe.atoms.masses, analysis.model.masses_kg, rtol=1e-12)
+    np.testing.assert_allclose(universe.trajectory.ts.data["radius"], analysis.model.lattice.diameters_m / 2, rtol=1e-15)

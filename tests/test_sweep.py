@@ -113,7 +113,7 @@ def test_a_rerun_resumes_an_interrupted_sweep(swept, tmp_path, capsys):
 
 
 def test_another_plan_in_the_same_directory_is_refused(swept, tmp_path, capsys):
-    assert sweep(tmp_path, "--vary", "v0=0.2,0.5", "--out", str(swept), base=SMALL) == 2
+    assert sweep(tmp_path, "--vary", "v0=0.2,0.5", "--out", str(swept), base=SMALL) == 3
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and "another plan" in lines[0]
 
@@ -142,7 +142,7 @@ def test_another_plan_in_the_same_directory_is_refused(swept, tmp_path, capsys):
 ])
 def test_bad_plans_are_one_line_before_any_run(tmp_path, capsys, options, message):
     """Refused before anything is written: a corrected command may then use the same --out."""
-    assert sweep(tmp_path, *options, "--out", str(tmp_path / "out")) == 2
+    assert sweep(tmp_path, *options, "--out", str(tmp_path / "out")) == 3
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], lines
     assert not (tmp_path / "out").exists()

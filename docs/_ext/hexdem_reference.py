@@ -1,7 +1,8 @@
 """Sphinx extension: the CLI, configuration and API references, generated from the code at
 build time into ``reference/_generated/`` (never edited by hand, never committed).
 
-* ``cli.md``: every ``hexdem`` subcommand's ``--help``, from the argparse parser itself;
+* ``cli.md``: ``hexdem --help``, the exit statuses and every subcommand's ``--help``, from the
+  argparse parser itself;
 * ``config.md``: every run-configuration key with its default and type, from :class:`RunConfig`'s
   fields, and its meaning (:data:`~hexdem.model.config_keys.KEY_DESCRIPTIONS`);
 * ``api.md`` and ``api_<subpackage>.md``: every module of the package, a page per subpackage and a
@@ -21,7 +22,7 @@ import re
 from pathlib import Path
 
 import hexdem
-from hexdem.cli.main import COMMANDS, build_parser
+from hexdem.cli.main import COMMANDS, EXIT_CODES, build_parser
 from hexdem.model.config import RunConfig
 from hexdem.model.config_keys import KEY_DESCRIPTIONS
 
@@ -39,7 +40,10 @@ def _write(path: Path, text: str) -> None:
 
 def cli_page() -> str:
     os.environ["COLUMNS"] = HELP_COLUMNS
-    lines = ["# Command line", "", "Every subcommand's `--help`, as `hexdem` prints it.", ""]
+    lines = ["# Command line", "", "`hexdem` (or `python -m hexdem`) and every subcommand's `--help`, as `hexdem` "
+             "prints it.", "", "```text", build_parser([]).format_help().rstrip(), "```", "", "## Exit status", "",
+             "| status | meaning |", "|---|---|", *(f"| {code} | {meaning} |" for code, meaning in EXIT_CODES.items()),
+             ""]
     for name, (_, summary) in COMMANDS.items():
         parser = build_parser([name])
         subcommand = parser._subparsers._group_actions[0].choices[name]

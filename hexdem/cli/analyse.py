@@ -1,6 +1,14 @@
-"""``hexdem analyse``: result files from the dump of a deck run by hand (through MDAnalysis)."""
+"""``hexdem analyse``: result files from the dump of a deck run by hand (through MDAnalysis).
+
+MDAnalysis is an optional dependency, the extra ``dumps``: without it the command says in one line
+what to install.
+"""
 
 from __future__ import annotations
+
+from hexdem.errors import HexdemError
+
+INSTALL_DUMPS = 'pip install "hexdem[dumps]"'
 
 
 def add_arguments(parser) -> None:
@@ -10,6 +18,11 @@ def add_arguments(parser) -> None:
 
 
 def run(args) -> None:
+    try:
+        import MDAnalysis  # noqa: F401
+    except ImportError:
+        raise HexdemError(f"hexdem analyse reads dumps through MDAnalysis, which is not installed; install it with: "
+                          f"{INSTALL_DUMPS}") from None
     from hexdem.experiments.analyse import analyse_deck
 
     analyse_deck(args.deck, args.out)

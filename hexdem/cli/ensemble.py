@@ -9,10 +9,10 @@ writes ``peaks_stats.csv``, ``ideal_peaks.csv``, ``arrival_map.csv``, ``disorder
 
 from __future__ import annotations
 
-import os
 import re
 
 from hexdem.cli.options import add_launcher
+from hexdem.common.machine import usable_cpus
 from hexdem.errors import HexdemError
 
 DEFAULT_VELOCITIES = "0.25,0.40,0.70"
@@ -43,8 +43,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--velocities", default=DEFAULT_VELOCITIES, metavar="V1,V2,...",
                         help=f"striker speeds in m/s (default {DEFAULT_VELOCITIES})")
     parser.add_argument("--seed", type=int, default=0, help="seed of the diameters (default 0)")
-    parser.add_argument("--workers", type=int, default=os.cpu_count() or 1, metavar="N",
-                        help="LAMMPS partitions (processes) at once (default: the number of cores)")
+    parser.add_argument("--workers", type=int, default=usable_cpus(), metavar="N",
+                        help="LAMMPS partitions (processes) at once (default: the CPUs this job may use, "
+                             "its CPU affinity as Slurm or taskset set it)")
     add_launcher(parser, "-n N lmp -partition Nx1 -in run.in")
     parser.add_argument("--shape", default="hexagon", help="packing: hexagon, square or centered-square "
                         "(default hexagon)")

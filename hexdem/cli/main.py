@@ -1,8 +1,12 @@
 """``hexdem`` entry point: subcommands as modules with ``add_arguments`` and ``run``.
 
 Subcommand modules are imported lazily (only the one asked for), following ASE's CLI.
-Every :class:`~hexdem.errors.HexdemError` is printed as one line, ``hexdem: error: ...``,
-with exit status 2; ``--traceback`` shows the full traceback instead.
+Every :class:`~hexdem.errors.HexdemError` is printed as one line, ``hexdem: error: ...``;
+``--traceback`` shows the full traceback instead. The exit status tells what went wrong
+(:data:`EXIT_CODES`): 2 for a usage error (argparse's), 3 for input or an environment that
+hexdem refused (or a check of its results that failed), 4 for a simulation that started and failed
+(:class:`~hexdem.errors.RunFailed`), 130 for an interrupt; 1 is left to an unexpected error,
+a bug, which Python reports with its traceback.
 """
 
 from __future__ import annotations
@@ -11,11 +15,23 @@ import argparse
 import importlib
 import sys
 
-from hexdem.errors import HexdemError
+from hexdem.cli.version import VersionAction
+from hexdem.errors import HexdemError, RunFailed
+
+#: Exit status → what it means (also in the CLI reference).
+EXIT_CODES = {0: "success", 1: "an unexpected error (a bug: Python prints its traceback)",
+              2: "a usage error: an unknown command or option, a value of the wrong form",
+              3: "refused: input or an environment hexdem cannot use, or a check that failed (the engines "
+                 "disagree), named in one line",
+              4: "a simulation that started and failed (LAMMPS stopped, the energy drifted, a packing did not "
+                 "settle)",
+              130: "interrupted (Ctrl-C)"}
+REFUSED, FAILED, INTERRUPTED = 3, 4, 130
 
 #: name → (module, one-line help)
 COMMANDS = {
     "run": ("hexdem.cli.run", "simulate one impact (default: the paper's 11-per-edge experiment)"),
+    "preview": ("hexdem.cli.preview", "draw a packing (beads, walls, impacts, observation lines) without running it"),
     "analyse": ("hexdem.cli.analyse", "result files from the dump of a deck run by hand (lmp -in in.hexdem)"),
     "compare": ("hexdem.cli.compare", "run one configuration through LAMMPS and the reference integrator"),
     "signals": ("hexdem.cli.signals", "measured accelerometer signals beside a run's sensor particles"),
@@ -32,6 +48,7 @@ def build_parser(argv) -> argparse.ArgumentParser:
     """The parser, with full options only for the subcommand named in ``argv``."""
     wanted = next((token for token in argv if token in COMMANDS), None)
     parser = argparse.ArgumentParser(prog="hexdem", description="Impulses in 2D hexagonal granular crystals.")
+    parser.add_argument("--version", action=VersionAction)
     parser.add_argument("--traceback", action="store_true", help="show full tracebacks on errors")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name, (module_name, help_text) in COMMANDS.items():
@@ -52,10 +69,10 @@ def main(argv=None) -> int:
         if args.traceback:
             raise
         print(f"hexdem: error: {exc}", file=sys.stderr)
-        return 2
+        return FAILED if isinstance(exc, RunFailed) else REFUSED
     except KeyboardInterrupt:
         print("hexdem: interrupted", file=sys.stderr)
-        return 130
+        return INTERRUPTED
     return 0
 
 

@@ -7,15 +7,15 @@ difference, protocol), with every part's files in its own folder. A rerun resume
 
 from __future__ import annotations
 
-import os
 
 from hexdem.cli.options import add_launcher
+from hexdem.common.machine import usable_cpus
 from hexdem.model.config import STEPS_PER_CONTACT
 
 
 def add_arguments(parser) -> None:
     parser.add_argument("--out", metavar="DIR", required=True, help="output directory (rerun to resume)")
-    parser.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1), metavar="N",
+    parser.add_argument("--workers", type=int, default=min(2, usable_cpus()), metavar="N",
                         help="processes at once: sweep runs, LAMMPS partitions, MPI ranks (default 2)")
     parser.add_argument("--quick", action="store_true",
                         help="fewer V0 values and realizations, same code paths (about 2 minutes; rough numbers)")

@@ -1,4 +1,5 @@
-"""What this machine can hold: available memory and free disk, for refusing jobs that cannot fit."""
+"""What this machine can hold and what this job may use: available memory and free disk, for
+refusing jobs that cannot fit, and the CPUs the job may run on."""
 
 from __future__ import annotations
 
@@ -25,3 +26,11 @@ def free_disk_bytes(path) -> int:
     while not path.exists():
         path = path.parent
     return shutil.disk_usage(path).free
+
+
+def usable_cpus() -> int:
+    """The CPUs this process may run on: its CPU affinity, which Slurm, taskset and container
+    limits set (``os.sched_getaffinity``), or where that is unknown every core (``os.cpu_count``)."""
+    if hasattr(os, "sched_getaffinity"):
+        return len(os.sched_getaffinity(0))
+    return os.cpu_count() or 1

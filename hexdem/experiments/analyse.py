@@ -24,6 +24,7 @@ from hexdem.engines.lammps.deck import DUMP_NAME
 from hexdem.engines.lammps.runner import log_version
 from hexdem.errors import HexdemError
 from hexdem.experiments.deck_config import CONFIG_NAME, read_deck_config
+from hexdem.experiments.provenance import run_provenance
 from hexdem.experiments.run import write_results
 from hexdem.model.model_builder import build_model
 from hexdem.model.run_settings import run_settings
@@ -33,7 +34,7 @@ def analyse_deck(deck_dir, out=None, log=None) -> ImpactAnalysis:
     """Analyse the dump in ``deck_dir`` and write the result files into ``out`` (default: the
     deck's parent directory)."""
     log = log or (lambda message: print(f"hexdem analyse: {message}", file=sys.stderr, flush=True))
-    start = time.perf_counter()
+    start, provenance = time.perf_counter(), run_provenance()
     deck_dir = Path(deck_dir)
     config = read_deck_config(deck_dir)
     dump = deck_dir / DUMP_NAME
@@ -53,6 +54,6 @@ def analyse_deck(deck_dir, out=None, log=None) -> ImpactAnalysis:
     analysis = ImpactAnalysis.from_trajectory(model, settings, trajectory)
     out = Path(out if out is not None else deck_dir.parent)
     with staged_directory(out) as staging:
-        write_results(config, analysis, staging, time.perf_counter() - start, log)
+        write_results(config, analysis, staging, time.perf_counter() - start, provenance, log)
     log(f"energy drift {analysis.results.energy_drift:.2e}; results in {out}")
     return analysis

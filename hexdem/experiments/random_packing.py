@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import shutil
 import tempfile
+import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -41,7 +42,7 @@ import numpy as np
 from hexdem.common.io import write_csv
 from hexdem.engines.lammps.settling import (SETTLED_NAME, SettlingStage, read_data_file, read_stage,
                                             run_settling_deck, write_settling_deck)
-from hexdem.errors import HexdemError
+from hexdem.errors import RunFailed
 from hexdem.model.config import RunConfig
 from hexdem.model.lattice import strike_direction
 from hexdem.model.model_builder import build_model
@@ -148,15 +149,20 @@ def prepare_random_packing(config: RunConfig, directory, comm=None, log=None) ->
     model = build_model(_packing_config(bare, loose, 0, "none"))
     log(f"packing a random disc of {len(diameters)} beads (radius {config.radius_m:g} m, "
         f"diameters d (1 ± {config.diameter_spread:g}), seed {config.seed}) with LAMMPS")
-    for name in STAGES:
-        deck = write_settling_deck(model, settling_stage(name), directory / name)
+    for number, name in enumerate(STAGES, 1):
+        stage, start = settling_stage(name), time.perf_counter()
+        log(f"random disc, stage {number} of {len(STAGES)}: {name} (loads {stage.loads_note}), until the rms speed "
+            f"is below {stage.settled_rms_speed_m_s:g} m/s")
+        deck = write_settling_deck(model, stage, directory / name)
         try:
             run_settling_deck(deck, comm)
         except HexdemError as exc:
-            raise HexdemError(str(exc).replace(str(deck), str(_kept(deck)))) from None
+            raise type(exc)(str(exc).replace(str(deck), str(_kept(deck)))) from None
         result = read_stage(deck)
+        log(f"random disc, {name}: {'settled' if result.settled else 'stopped'} after {result.steps} steps, "
+            f"{result.time_s:.3g} s simulated, in {time.perf_counter() - start:.1f} s")
         if not result.settled:
-            raise HexdemError(f"the random disc's {name} stage did not settle in {result.steps} steps "
+            raise RunFailed(f"the random disc's {name} stage did not settle in {result.steps} steps "
                               f"(kinetic energy {result.kinetic_energy_j:.3g} J, largest force "
                               f"{result.max_force_n:.3g} N); see {_kept(deck)}")
         state = read_data_file(deck / SETTLED_NAME)

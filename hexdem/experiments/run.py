@@ -33,8 +33,9 @@ from hexdem.analysis.impact import PEAK_COLUMNS, ImpactAnalysis
 from hexdem.analysis.movie import movie_samples
 from hexdem.common.io import staged_directory, write_csv, write_csv_columns, write_json
 from hexdem.common.machine import free_disk_bytes
-from hexdem.errors import HexdemError
+from hexdem.errors import HexdemError, RunFailed
 from hexdem.experiments.deck_config import write_deck_config
+from hexdem.experiments.provenance import run_provenance
 from hexdem.experiments.random_packing import packing_name, prepare_random_packing
 from hexdem.experiments.sensors import write_sensor_files
 from hexdem.experiments.tracked_run import ImpactJob, track_impact
@@ -120,7 +121,7 @@ def check_energy(analysis: ImpactAnalysis, where) -> None:
     and convergence hold the frictional step (tests/test_friction_*.py)."""
     drift = analysis.results.energy_drift
     if not analysis.model.laws.tangential and not drift <= MAX_ENERGY_DRIFT:
-        raise HexdemError(f"energy drift {drift:.1e} exceeds {MAX_ENERGY_DRIFT:g} in {where}: the time step "
+        raise RunFailed(f"energy drift {drift:.1e} exceeds {MAX_ENERGY_DRIFT:g} in {where}: the time step "
                           f"{analysis.settings.dt_s:.3g} s is too large for V0; leave dt at its default or reduce it")
 
 
@@ -171,10 +172,13 @@ def unmeasurable_outputs(analysis: ImpactAnalysis) -> dict[str, str]:
     return skipped
 
 
-def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_time_s: float, log=None) -> None:
+def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_time_s: float, provenance: dict,
+                  log=None) -> None:
     """Every result file of the run (see the module docstring), each written atomically; those
     that cannot be measured on the packing are skipped, named with their reason in
-    ``summary.json``'s ``skipped_outputs`` and in the ``log``."""
+    ``summary.json``'s ``skipped_outputs`` and in the ``log``. ``provenance``
+    (:func:`~hexdem.experiments.provenance.run_provenance`, taken when the run started) goes into
+    ``summary.json`` as its ``provenance``."""
     from hexdem.analysis import figures as plots  # matplotlib: only where figures are drawn
     from hexdem.analysis.movie import SPIN_LABEL, speed_movie
 
@@ -185,7 +189,8 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
     rows = analysis.line_rows()
     write_csv(out / "peaks.csv", PEAK_COLUMNS, rows)
     write_csv_columns(out / "beads.csv", BEAD_COLUMNS, bead_columns(analysis))
-    write_json(out / "summary.json", {**summary(config, analysis, wall_time_s), "skipped_outputs": skipped})
+    write_json(out / "summary.json", {**summary(config, analysis, wall_time_s), "skipped_outputs": skipped,
+                                        "provenance": provenance})
     r, model = analysis.results, analysis.model
     v0, name = analysis.v0, packing_name(config, model.lattice)
     impact = f"V₀ = {v0:g} {plots.UNIT_LABELS[r.units]['speed']}"
@@ -260,16 +265,16 @@ def run_experiment(config: RunConfig, out, log=None, comm=None) -> ImpactAnalysi
     log = log or (lambda message: print(f"hexdem: {message}", file=sys.stderr))
     with staged_directory(out, STAGING_PREFIX) as staging:
         try:
-            start = time.perf_counter()
+            start, provenance = time.perf_counter(), run_provenance()
             prepared = prepare_random_packing(config, staging / "preparation", comm, log)
             check_dump_space(prepared, Path(out))
             analysis = simulate(prepared, staging / "deck", log, comm=comm)
-            write_results(config, analysis, staging, time.perf_counter() - start, log)
+            write_results(config, analysis, staging, time.perf_counter() - start, provenance, log)
         except HexdemError as exc:
             kept = _keep_failed_deck(staging / "deck")
             if kept is None:
                 raise
-            raise HexdemError(str(exc).replace(str(staging / "deck"), str(kept))) from None
+            raise type(exc)(str(exc).replace(str(staging / "deck"), str(kept))) from None
     log(f"energy drift {analysis.results.energy_drift:.2e}; results in {out}")
     if not analysis.results.far_wall_reached:
         log("warning: the leading wave had not reached every bead at the far wall one contact time before the run "

