@@ -1,7 +1,8 @@
 """``hexdem ensemble``: weakly disordered packings struck by a striker (Sec. VI; Figs. 8, 9).
 
-Runs (or resumes) the ensemble in ``--out`` on ``--workers`` LAMMPS partitions (``mpiexec -n
-N lmp -partition Nx1``; ``--launcher`` replaces ``mpiexec`` to reach other machines) and
+Runs (or resumes) the ensemble in ``--out``: its preparation on ``--workers`` LAMMPS partitions
+(``mpiexec -n N lmp -partition Nx1``; ``--launcher`` replaces ``mpiexec`` to reach other
+machines), its impacts in ``--workers`` local processes or on Parsl (``--parsl CONFIG.py``), and
 writes ``peaks_stats.csv``, ``ideal_peaks.csv``, ``arrival_map.csv``, ``disorder_effect.csv``,
 ``ensemble.json`` and the PNGs of Figs. 8 and 9 (see :mod:`hexdem.disorder.ensemble`,
 :mod:`hexdem.disorder.stats`).
@@ -12,7 +13,7 @@ from __future__ import annotations
 import os
 import re
 
-from hexdem.cli.options import add_launcher
+from hexdem.cli.options import add_launcher, add_parsl
 from hexdem.errors import HexdemError
 
 DEFAULT_VELOCITIES = "0.25,0.40,0.70"
@@ -44,7 +45,8 @@ def add_arguments(parser) -> None:
                         help=f"striker speeds in m/s (default {DEFAULT_VELOCITIES})")
     parser.add_argument("--seed", type=int, default=0, help="seed of the diameters (default 0)")
     parser.add_argument("--workers", type=int, default=os.cpu_count() or 1, metavar="N",
-                        help="LAMMPS partitions (processes) at once (default: the number of cores)")
+                        help="LAMMPS partitions and impacts (processes) at once (default: the number of cores)")
+    add_parsl(parser)
     add_launcher(parser, "-n N lmp -partition Nx1 -in run.in")
     parser.add_argument("--shape", default="hexagon", help="packing: hexagon, square or centered-square "
                         "(default hexagon)")
@@ -91,5 +93,5 @@ def config_from_args(args):
 def run(args) -> None:
     from hexdem.disorder.runner import run_ensemble
 
-    run_ensemble(config_from_args(args), args.out, workers=args.workers, launcher=args.launcher,
+    run_ensemble(config_from_args(args), args.out, workers=args.workers, launcher=args.launcher, parsl=args.parsl,
                  keep_dumps=args.keep_dumps, scaling_json=args.scaling)

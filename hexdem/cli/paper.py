@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import os
 
-from hexdem.cli.options import add_launcher
+from hexdem.cli.options import add_launcher, add_parsl
 from hexdem.model.config import STEPS_PER_CONTACT
 
 
@@ -19,6 +19,7 @@ def add_arguments(parser) -> None:
                         help="processes at once: sweep runs, LAMMPS partitions, MPI ranks (default 2)")
     parser.add_argument("--quick", action="store_true",
                         help="fewer V0 values and realizations, same code paths (about 2 minutes; rough numbers)")
+    add_parsl(parser)
     add_launcher(parser, "-n N and each MPI job or LAMMPS partition run")
     parser.add_argument("--steps-per-contact", type=int, default=STEPS_PER_CONTACT, metavar="N",
                         help=f"time step of the LAMMPS impacts: the Hertz contact time / N (default {STEPS_PER_CONTACT}; "
@@ -29,5 +30,5 @@ def run(args) -> None:
     from hexdem.paper.pipeline import run_paper
     from hexdem.paper.settings import PaperSettings
 
-    run_paper(PaperSettings(quick=args.quick, workers=args.workers, launcher=args.launcher,
+    run_paper(PaperSettings(quick=args.quick, workers=args.workers, launcher=args.launcher, parsl=args.parsl,
                             steps_per_contact=args.steps_per_contact), args.out)

@@ -1,8 +1,9 @@
 """Running a disorder ensemble: preparation on LAMMPS partitions, impacts analysed as they run.
 
 Three phases, compact → settle → impacts. The preparation stages run their pending decks on
-LAMMPS partitions (:mod:`hexdem.engines.lammps.partitions`); the impacts run on ``workers``
-MPI ranks with the tracker inside (:mod:`hexdem.disorder.impacts`), each publishing its
+LAMMPS partitions (:mod:`hexdem.engines.lammps.partitions`); the impacts are tasks of the
+study executor (:mod:`hexdem.experiments.executors`: ``workers`` local processes, or Parsl),
+one LAMMPS each with the tracker inside (:mod:`hexdem.disorder.impacts`), each publishing its
 ``impact.npz``. Each realization's ``result.npz`` is then assembled, and
 :func:`run_ensemble` writes the statistics (:mod:`hexdem.disorder.stats`). See
 :mod:`hexdem.disorder.ensemble` for resuming, determinism and the directory layout.
@@ -20,13 +21,14 @@ from hexdem.common.checks import positive_int
 from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
 from hexdem.disorder.ensemble import MANIFEST_NAME, PHASE_LABELS, Ensemble, EnsembleConfig
 from hexdem.disorder.figures import fitted_laws
-from hexdem.disorder.impacts import ImpactTasks, impact_done, publish_result
+from hexdem.common.progress import progress_bar
+from hexdem.disorder.impacts import impact_done, impact_task, publish_result
 from hexdem.disorder.preparation import STAGES, write_stage_deck
 from hexdem.disorder.sharing import adopt_preparation, adopt_ideal_impacts
 from hexdem.disorder.stats import write_statistics
 from hexdem.engines.lammps.partitions import is_done, run_partitioned
 from hexdem.errors import HexdemError
-from hexdem.experiments.parallel import run_on_ranks
+from hexdem.experiments.executors import describe, load_parsl_config, run_tasks, study_executor
 
 
 def _check_manifest(out: Path, config: EnsembleConfig) -> dict:
@@ -54,17 +56,40 @@ def _pending_impacts(ensemble: Ensemble, groups) -> list[tuple[int | None, float
     return [(k, v) for k in groups for v in ensemble.config.velocities_m_s if not impact_done(ensemble, k, v)]
 
 
-def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | None = None,
+def _run_impacts(config: EnsembleConfig, out: Path, tasks, workers: int, parsl, launcher: str | None,
+                 keep_dumps: bool, on_done) -> None:
+    """Run the impacts ``tasks`` [(realization or None, speed)], one task of the study executor
+    each, calling ``on_done()`` as each finishes; the impacts that failed are named at the end."""
+    failed = []
+    bar = progress_bar(len(tasks), PHASE_LABELS["impacts"], unit="run")
+    with study_executor(min(workers, len(tasks)), parsl) as executor:
+        for (k, v), _, error in run_tasks(executor, {(k, v): (impact_task, config, out, k, v, keep_dumps, launcher)
+                                                     for k, v in tasks}):
+            if error is not None:
+                failed.append(f"{'ideal' if k is None else f'realization {k}'} at {v:g} m/s: {describe(error)}")
+            on_done()
+            bar.update(1)
+    bar.close()
+    if failed:
+        raise HexdemError(f"{len(failed)} of {len(tasks)} impacts failed (rerun to run them again); "
+                          f"{'; '.join(failed)}")
+
+
+def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | None = None, parsl=None,
                  keep_dumps: bool = False, scaling_json=None, log=None, share_from=()) -> dict:
     """Run (or resume) the ensemble in ``out`` and write its statistics; returns the summary.
 
     ``workers`` LAMMPS partitions run at once, started by ``launcher`` (default: this
-    environment's ``mpiexec``); ``scaling_json`` adds the fitted laws to Fig. 9;
+    environment's ``mpiexec``), and ``workers`` impacts in local processes, or on Parsl with the
+    configuration file ``parsl`` (each impact's rank started by ``launcher`` when given);
+    ``scaling_json`` adds the fitted laws to Fig. 9;
     ``share_from`` other :class:`Ensemble` s whose identical finished runs are copied rather
     than run again (:mod:`hexdem.disorder.sharing`).
     """
     log = log or (lambda message: print(f"hexdem ensemble: {message}", file=sys.stderr, flush=True))
     positive_int("--workers", workers)
+    if parsl is not None:
+        load_parsl_config(parsl)  # refused before anything is written into out
     laws = fitted_laws(scaling_json, config.disorder.diameter_m) if scaling_json else {}
     out = ensure_writable_dir(out)
     ensemble = Ensemble(config, out)
@@ -105,19 +130,16 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
         start = time.perf_counter()
         published: set = set()
 
-        def publish_finished() -> int:
-            """Publish every realization whose impacts are all done; the impacts done so far."""
+        def publish_finished() -> None:
+            """Publish every realization whose impacts are all done."""
             for k in groups:
                 if k not in published and all(impact_done(ensemble, k, v) for v in config.velocities_m_s):
                     publish_result(ensemble, k)
                     published.add(k)
-            return sum(impact_done(ensemble, k, v) for k, v in tasks)
 
-        if tasks:
-            run_on_ranks(ImpactTasks(config, out, tuple(tasks), keep_dumps), min(workers, len(tasks)),
-                         out / "lammps" / "impacts", launcher,
-                         progress=(len(tasks), PHASE_LABELS["impacts"], publish_finished))
         publish_finished()
+        if tasks:
+            _run_impacts(config, out, tasks, workers, parsl, launcher, keep_dumps, publish_finished)
         wall["impacts"] = time.perf_counter() - start
         summary = write_statistics(ensemble, laws)
         summary["this_run"] = {"realizations_run": len(todo), "workers": workers,

@@ -118,6 +118,12 @@ def study_executor(workers: int, parsl=None):
         executor.shutdown(cancel_futures=True)
 
 
+def describe(error: BaseException) -> str:
+    """A task's error in one line: hexdem's own message, or the exception's type and message."""
+    text = str(error) if isinstance(error, HexdemError) else f"{type(error).__name__}: {error}"
+    return " ".join(text.split())
+
+
 def run_tasks(executor, tasks: dict):
     """Submit ``tasks`` {key: (fn, *args)} to ``executor``; yield (key, result, error) as each
     finishes (``error``: None, or the exception of its last try), a failed task being submitted

@@ -38,7 +38,7 @@ from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
 from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.partitions import launcher_command
 from hexdem.errors import HexdemError
-from hexdem.experiments.executors import load_parsl_config, run_tasks, study_executor
+from hexdem.experiments.executors import describe, load_parsl_config, run_tasks, study_executor
 from hexdem.experiments.sweep_plan import SweepRun, Variation, plan_sweep
 
 PLAN_NAME = "sweep.json"
@@ -60,12 +60,6 @@ def run_status(out: Path, run: SweepRun) -> tuple[str, str]:
         return "done", ""
     failed = failure_path(out, run)
     return ("failed", failed.read_text().strip()) if failed.exists() else ("missing", "")
-
-
-def describe(error: BaseException) -> str:
-    """An error in one line: hexdem's own message, or the exception's type and message."""
-    text = str(error) if isinstance(error, HexdemError) else f"{type(error).__name__}: {error}"
-    return " ".join(text.split())
 
 
 def run_one(run: SweepRun, out: Path, ranks: int | None = None, launcher: str | None = None) -> None:
