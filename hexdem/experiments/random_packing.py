@@ -90,11 +90,10 @@ def _write_packing(path: Path, positions_m, diameters_m) -> Path:
     return path
 
 
-def prepare_random_packing(config: RunConfig, directory, comm=None, log=None) -> RunConfig:
+def prepare_random_packing(config: RunConfig, directory, log=None) -> RunConfig:
     """Pack ``config``'s random disc in ``directory`` (its decks and ``packing.csv``) and return
     the configuration that strikes it (``shape = "packing"``); any other configuration is
-    returned as it is. ``comm``: a communicator of the ranks that run LAMMPS together, as for
-    :func:`~hexdem.experiments.run.simulate`."""
+    returned as it is."""
     if config.shape != "random":
         return config
     log = log or (lambda message: None)
@@ -109,7 +108,7 @@ def prepare_random_packing(config: RunConfig, directory, comm=None, log=None) ->
         f"diameters d (1 ± {config.diameter_spread:g}), seed {config.seed}) with LAMMPS")
     for name in STAGES:
         deck = write_settling_deck(model, settling_stage(name), directory / name)
-        run_settling_deck(deck, comm)
+        run_settling_deck(deck)
         result = read_stage(deck)
         if not result.settled:
             raise HexdemError(f"the random disc's {name} stage did not settle in {result.steps} steps "

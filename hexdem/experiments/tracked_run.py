@@ -56,16 +56,9 @@ def make_engine(name: str, dump: bool = False, gravity_m_s2=None):
     return LammpsEngine(dump=dump, gravity_m_s2=gravity_m_s2)
 
 
-def track_impact(job: ImpactJob, ranks: int = 1, comm=None, launcher: str | None = None) -> ImpactAnalysis | None:
+def track_impact(job: ImpactJob, ranks: int = 1, launcher: str | None = None) -> ImpactAnalysis:
     """Run ``job`` on ``ranks`` MPI ranks (LAMMPS only; 1 without ``launcher``: in this
     process) started by ``launcher`` (see :func:`~hexdem.experiments.parallel.run_on_ranks`)
-    and analyse it. Given ``comm``, every rank of that communicator calls this instead; rank 0
-    gets the analysis, the others None."""
-    if comm is not None:
-        result = job(comm)
-    else:
-        result = run_on_ranks(job, ranks if job.engine == "lammps" else 1, job.directory, launcher)
-    if result is None:
-        return None
-    tracked, description = result
+    and analyse it."""
+    tracked, description = run_on_ranks(job, ranks if job.engine == "lammps" else 1, job.directory, launcher)
     return ImpactAnalysis.from_tracker(job.model, job.settings, tracked, description)
