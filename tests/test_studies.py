@@ -170,3 +170,21 @@ def test_a_bad_parsl_file_is_one_line_before_anything_is_written(tmp_path, capsy
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and f"--parsl {path}" in lines[0] and message in lines[0], lines
     assert not (tmp_path / "out").exists()
+
+
+def test_the_local_pools_processes_end_with_a_killed_study(tmp_path):
+    """A study killed outright leaves no worker behind to go on writing into its folder."""
+    import subprocess
+    import sys
+
+    script = tmp_path / "killed.py"
+    script.write_text("import os, time\nfrom hexdem.experiments.executors import LocalPool\n"
+                      "if __name__ == '__main__':\n    pool = LocalPool(2)\n"
+                      "    print(*{pool.submit(os.getpid).result() for _ in range(4)}, flush=True)\n"
+                      "    pool.submit(time.sleep, 60)\n    os._exit(0)\n")
+    workers = [int(pid) for pid in subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                                                  check=True, timeout=60).stdout.split()]
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and any(psutil.pid_exists(pid) for pid in workers):
+        time.sleep(0.1)
+    assert workers and not any(psutil.pid_exists(pid) for pid in workers)

@@ -30,6 +30,7 @@ from multiprocessing import get_context
 from pathlib import Path
 
 from hexdem.common.checks import positive_int
+from hexdem.engines.lammps.partitions import die_with_parent
 from hexdem.errors import HexdemError
 
 #: Times a task of the local pool is submitted again after it failed.
@@ -38,7 +39,8 @@ LOCAL_RETRIES = 1
 
 class LocalPool(Executor):
     """A process pool of ``workers`` spawned processes that starts a fresh pool when one of its
-    processes died (a broken :class:`ProcessPoolExecutor` takes no more tasks)."""
+    processes died (a broken :class:`ProcessPoolExecutor` takes no more tasks). The processes end
+    with this one (on Linux), so that none keeps writing into a study that was killed."""
 
     retries = LOCAL_RETRIES
 
@@ -47,7 +49,8 @@ class LocalPool(Executor):
         self._pool = self._new()
 
     def _new(self) -> ProcessPoolExecutor:
-        return ProcessPoolExecutor(max_workers=self.workers, mp_context=get_context("spawn"))
+        return ProcessPoolExecutor(max_workers=self.workers, mp_context=get_context("spawn"),
+                                   initializer=die_with_parent, initargs=(os.getpid(),))
 
     def submit(self, fn, /, *args, **kwargs):
         try:
