@@ -188,3 +188,21 @@ def test_the_local_pools_processes_end_with_a_killed_study(tmp_path):
     while time.monotonic() < deadline and any(psutil.pid_exists(pid) for pid in workers):
         time.sleep(0.1)
     assert workers and not any(psutil.pid_exists(pid) for pid in workers)
+
+
+def test_the_guides_slurm_configuration_is_a_parsl_config(tmp_path):
+    """The across-machines guide's Parsl configuration loads (its address made local)."""
+    import re
+    from pathlib import Path
+
+    from parsl.providers import SlurmProvider
+
+    from hexdem.experiments.executors import load_parsl_config
+
+    guide = Path(__file__).resolve().parents[1] / "docs" / "guide" / "across-machines.md"
+    (block,) = re.findall(r"```python\n(.*?)```", guide.read_text(), flags=re.DOTALL)
+    path = tmp_path / "parsl_slurm.py"
+    path.write_text(block.replace('address_by_interface("ib0")', '"127.0.0.1"'))
+    config = load_parsl_config(path)
+    assert config.retries == 2 and isinstance(config.executors[0].provider, SlurmProvider)
+    assert config.executors[0].block_error_handler is False
