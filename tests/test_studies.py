@@ -205,4 +205,3 @@ def test_the_guides_slurm_configuration_is_a_parsl_config(tmp_path):
     path.write_text(block.replace('address_by_interface("ib0")', '"127.0.0.1"'))
     config = load_parsl_config(path)
     assert config.retries == 2 and isinstance(config.executors[0].provider, SlurmProvider)
-    assert config.executors[0].block_error_handler is False
