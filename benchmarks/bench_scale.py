@@ -46,7 +46,7 @@ from baseline import hexdem_command
 from harness import MB, NOOUTPUT_NAME, nooutput_deck, run_watched, write_config
 from machine import describe
 
-from hexdem.engines.lammps.partitions import loop_time_s
+from hexdem.engines.lammps.standalone import loop_time_s
 from hexdem.engines.lammps.runner import run_bare
 from hexdem.experiments.run import RESULT_FILES
 from hexdem.model.config import RunConfig

@@ -1,8 +1,7 @@
 """``hexdem ensemble``: weakly disordered packings struck by a striker (Sec. VI; Figs. 8, 9).
 
-Runs (or resumes) the ensemble in ``--out``: its preparation on ``--workers`` LAMMPS partitions
-(``mpiexec -n N lmp -partition Nx1``; ``--launcher`` replaces ``mpiexec`` to reach other
-machines), its impacts in ``--workers`` local processes or on Parsl (``--parsl CONFIG.py``), and
+Runs (or resumes) the ensemble in ``--out``, every deck of its preparation and every impact one
+task of ``--workers`` local processes or of Parsl (``--parsl CONFIG.py``), and
 writes ``peaks_stats.csv``, ``ideal_peaks.csv``, ``arrival_map.csv``, ``disorder_effect.csv``,
 ``ensemble.json`` and the PNGs of Figs. 8 and 9 (see :mod:`hexdem.disorder.ensemble`,
 :mod:`hexdem.disorder.stats`).
@@ -45,9 +44,9 @@ def add_arguments(parser) -> None:
                         help=f"striker speeds in m/s (default {DEFAULT_VELOCITIES})")
     parser.add_argument("--seed", type=int, default=0, help="seed of the diameters (default 0)")
     parser.add_argument("--workers", type=int, default=os.cpu_count() or 1, metavar="N",
-                        help="LAMMPS partitions and impacts (processes) at once (default: the number of cores)")
+                        help="decks (local processes) at once (default: the number of cores)")
     add_parsl(parser)
-    add_launcher(parser, "-n N lmp -partition Nx1 -in run.in")
+    add_launcher(parser, "-n 1 and each deck's lmp or impact's job")
     parser.add_argument("--shape", default="hexagon", help="packing: hexagon, square or centered-square "
                         "(default hexagon)")
     parser.add_argument("--edge-beads", type=int, default=11, help="beads per hexagon edge (default 11)")

@@ -16,11 +16,11 @@ from hexdem.model.config import STEPS_PER_CONTACT
 def add_arguments(parser) -> None:
     parser.add_argument("--out", metavar="DIR", required=True, help="output directory (rerun to resume)")
     parser.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1), metavar="N",
-                        help="processes at once: sweep runs, LAMMPS partitions, MPI ranks (default 2)")
+                        help="processes at once: the studies' runs, the MPI ranks of Fig. 4 (default 2)")
     parser.add_argument("--quick", action="store_true",
                         help="fewer V0 values and realizations, same code paths (about 2 minutes; rough numbers)")
     add_parsl(parser)
-    add_launcher(parser, "-n N and each MPI job or LAMMPS partition run")
+    add_launcher(parser, "-n N and each run's job")
     parser.add_argument("--steps-per-contact", type=int, default=STEPS_PER_CONTACT, metavar="N",
                         help=f"time step of the LAMMPS impacts: the Hertz contact time / N (default {STEPS_PER_CONTACT}; "
                              "a multiple of 14 of at least 28: the impacts are sampled every 1/14 of it; 700 was the former default)")

@@ -21,7 +21,7 @@ from hexdem.common.io import atomic_path
 from hexdem.disorder.ensemble import Ensemble, EnsembleConfig
 from hexdem.disorder.preparation import STAGES
 from hexdem.disorder.prestress import prestress
-from hexdem.engines.lammps.partitions import loop_time_s
+from hexdem.engines.lammps.standalone import loop_time_s
 from hexdem.engines.lammps.settling import read_stage
 from hexdem.experiments.run import check_energy
 from hexdem.experiments.tracked_run import ImpactJob, track_impact

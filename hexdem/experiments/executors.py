@@ -30,7 +30,7 @@ from multiprocessing import get_context
 from pathlib import Path
 
 from hexdem.common.checks import positive_int
-from hexdem.engines.lammps.partitions import die_with_parent
+from hexdem.engines.lammps.standalone import die_with_parent
 from hexdem.errors import HexdemError
 
 #: Times a task of the local pool is submitted again after it failed.

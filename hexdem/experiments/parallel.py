@@ -29,7 +29,7 @@ from hexdem.common.io import atomic_path
 from hexdem.common.job_failure import ERROR_FILE_VARIABLE, abort_job
 from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.library import load_lammps
-from hexdem.engines.lammps.partitions import die_with_parent, launcher_command
+from hexdem.engines.lammps.standalone import die_with_parent, launcher_command
 from hexdem.errors import HexdemError
 
 JOB_NAME, RESULT_NAME, ERROR_NAME = "job.pickle", "job.result.pickle", "job.error"

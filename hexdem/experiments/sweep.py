@@ -36,7 +36,7 @@ from pathlib import Path
 from hexdem.common.checks import positive_int
 from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
 from hexdem.common.progress import progress_bar
-from hexdem.engines.lammps.partitions import launcher_command
+from hexdem.engines.lammps.standalone import launcher_command
 from hexdem.errors import HexdemError
 from hexdem.experiments.executors import describe, load_parsl_config, run_tasks, study_executor
 from hexdem.experiments.sweep_plan import SweepRun, Variation, plan_sweep

@@ -37,8 +37,8 @@ RELAXED_WALL_SLACK_M = TOLERANCE_M
 
 @dataclass(frozen=True)
 class PaperSettings:
-    """``quick``: the thinned variant; ``workers``: processes (sweep runs, LAMMPS partitions,
-    MPI ranks of Fig. 4) at once; ``launcher``: the MPI launcher command that starts them
+    """``quick``: the thinned variant; ``workers``: processes (the studies' runs, MPI ranks of
+    Fig. 4) at once; ``launcher``: the MPI launcher command that starts them
     (None: this environment's ``mpiexec``); ``parsl``: a Parsl configuration file that takes
     the runs of the studies (the scaling sweep, the ensembles' impacts) instead of local
     processes (:mod:`hexdem.experiments.executors`);
