@@ -146,6 +146,8 @@ def test_a_job_arrays_runs_one_at_a_time_then_the_table(serial, tmp_path, capsys
     (["sweep", "--vary", "v0=0.1,0.2"], "a sweep needs --vary"),
     (["sweep", "--run", "0"], "--run and --collect need the study folder"),
     (["sweep", "{out}", "--run", "0", "--parsl", "x.py"], "--run I runs here, without --parsl"),
+    (["sweep", "{out}", "--run", "0", "--ranks-per-run", "0"], "--ranks-per-run must be a positive integer"),
+    (["sweep", "{out}", "--workers", "0"], "--workers must be a positive integer"),
 ])
 def test_bad_study_commands_are_one_line(tmp_path, capsys, arguments, message):
     out = tmp_path / "out"

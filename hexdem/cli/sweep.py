@@ -60,6 +60,7 @@ def run(args) -> None:
     elif args.collect:
         sweep.collect(out, runs, variations)
     else:
+        sweep.check_options(args.workers, args.parsl, args.ranks_per_run, args.launcher)
         sweep.run_study(out, runs, args.workers, args.parsl, args.ranks_per_run, args.launcher)
         sweep.collect(out, runs, variations)
 

@@ -153,6 +153,7 @@ def run_study(out: Path, runs: list[SweepRun], workers: int = 1, parsl=None, ran
 def run_single(out, index: int, ranks: int | None = None, launcher: str | None = None) -> SweepRun:
     """Run run ``index`` (from 0, in the plan's order) of the study planned in ``out`` in this
     process, whatever it left before; a failure is recorded and raised."""
+    check_options(ranks=ranks, launcher=launcher)
     out = Path(out)
     runs, _ = planned_study(out)
     if not 0 <= index < len(runs):
@@ -191,17 +192,22 @@ def _log(message: str) -> None:
     print(f"hexdem sweep: {message}", file=sys.stderr, flush=True)
 
 
-def run_sweep(base: dict, variations: list[Variation], out, workers: int = 1, parsl=None, ranks: int | None = None,
-              launcher: str | None = None, source: str = "the base configuration", log=None) -> list[tuple]:
-    """Plan (or resume) the sweep into ``out``, run it and write its table and figure; the table's
-    rows. An error names the runs that failed, after the table is written."""
+def check_options(workers: int = 1, parsl=None, ranks: int | None = None, launcher: str | None = None) -> None:
+    """Refuse bad running options in one line, before anything is written."""
     positive_int("--workers", workers)
     if ranks is not None:
         positive_int("--ranks-per-run", ranks)
     if launcher is not None:
-        launcher_command(launcher)  # refused before anything is written into out
+        launcher_command(launcher)
     if parsl is not None:
         load_parsl_config(parsl)
+
+
+def run_sweep(base: dict, variations: list[Variation], out, workers: int = 1, parsl=None, ranks: int | None = None,
+              launcher: str | None = None, source: str = "the base configuration", log=None) -> list[tuple]:
+    """Plan (or resume) the sweep into ``out``, run it and write its table and figure; the table's
+    rows. An error names the runs that failed, after the table is written."""
+    check_options(workers, parsl, ranks, launcher)
     runs = plan_study(base, variations, out, source)
     out = Path(out)
     run_study(out, runs, workers, parsl, ranks, launcher, log)
