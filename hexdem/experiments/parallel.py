@@ -20,61 +20,28 @@ import os
 import pickle
 import subprocess
 import sys
-import threading
-from contextlib import contextmanager
 from pathlib import Path
 
 from hexdem.common.checks import positive_int
 from hexdem.common.io import atomic_path
 from hexdem.common.job_failure import ERROR_FILE_VARIABLE, abort_job
-from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.library import load_lammps
 from hexdem.engines.lammps.standalone import die_with_parent, launcher_command
 from hexdem.errors import HexdemError
 
 JOB_NAME, RESULT_NAME, ERROR_NAME = "job.pickle", "job.result.pickle", "job.error"
-#: Seconds between looks at a running job's progress.
-POLL_S = 0.5
 
 
-@contextmanager
-def _progress(progress):
-    """Poll ``progress = (total, description, count_done)`` while the job runs, into a bar on a
-    terminal; ``count_done`` is called every :data:`POLL_S` seconds either way (and once at the end)."""
-    if progress is None:
-        yield
-        return
-    total, description, count_done = progress
-    bar, stop = progress_bar(total, description), threading.Event()
-
-    def follow():
-        while not stop.wait(POLL_S):
-            bar.update(count_done() - bar.n)
-
-    watcher = threading.Thread(target=follow, daemon=True)
-    watcher.start()
-    try:
-        yield
-    finally:
-        stop.set()
-        watcher.join()
-        bar.update(count_done() - bar.n)
-        bar.close()
-
-
-def run_on_ranks(job, ranks: int, directory, launcher: str | None = None, progress=None):
+def run_on_ranks(job, ranks: int, directory, launcher: str | None = None):
     """``job(comm)`` on ``ranks`` MPI ranks; returns rank 0's result.
 
     ``directory`` holds the job's hand-over files (kept only on failure); ``launcher`` the MPI
     launcher command (default: this environment's ``mpiexec``; e.g. ``"mpiexec -f hosts"`` to
-    reach other machines); ``progress`` an optional (total, description, count_done):
-    ``count_done()`` is polled while the job runs (it may publish what is finished) and its
-    count shown in a bar on a terminal.
+    reach other machines).
     """
     ranks = positive_int("--ranks", ranks)
     if ranks == 1 and launcher is None:
-        with _progress(progress):
-            return job(None)
+        return job(None)
     prefix = launcher_command(launcher)
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
@@ -83,12 +50,11 @@ def run_on_ranks(job, ranks: int, directory, launcher: str | None = None, progre
         path.unlink(missing_ok=True)
     paths[JOB_NAME].write_bytes(pickle.dumps(job))
     command = [*prefix, "-n", str(ranks), sys.executable, "-P", "-m", __name__, str(paths[JOB_NAME].resolve())]
-    with _progress(progress):
-        try:
-            done = subprocess.run(command, stdout=subprocess.PIPE, stderr=None, text=True,
-                                  preexec_fn=functools.partial(die_with_parent, os.getpid()))
-        except OSError as exc:
-            raise HexdemError(f"cannot start the MPI launcher {prefix[0]!r}: {exc.strerror}") from None
+    try:
+        done = subprocess.run(command, stdout=subprocess.PIPE, stderr=None, text=True,
+                              preexec_fn=functools.partial(die_with_parent, os.getpid()))
+    except OSError as exc:
+        raise HexdemError(f"cannot start the MPI launcher {prefix[0]!r}: {exc.strerror}") from None
     if done.returncode != 0 or not paths[RESULT_NAME].exists():
         reported = paths[ERROR_NAME].read_text().strip() if paths[ERROR_NAME].exists() else ""
         if reported:
