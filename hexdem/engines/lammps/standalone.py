@@ -1,10 +1,10 @@
-"""Decks run by LAMMPS's own ``lmp`` program in a process of their own, as a user runs them by
-hand (``cd DIR && lmp -in in.hexdem``), and the MPI launcher that starts such processes.
+"""Decks run on their own, as a user runs them by hand (``cd DIR && lmp -in in.hexdem``), and
+the MPI launcher that starts processes.
 
 :func:`run_deck` is one task of a study (the ensembles' preparation stages hand each of their
-decks to the study executor, :mod:`hexdem.experiments.executors`): ``lmp`` logs to
-``log.lammps`` in the deck's directory, and once it has exited (its dump and data files closed)
-the marker ``hexdem.done`` is written: a deck with the marker is complete, one without it is
+decks to the study executor, :mod:`hexdem.experiments.executors`): LAMMPS logs to
+``log.lammps`` in the deck's directory, and once it has closed its dump and data files the
+marker ``hexdem.done`` is written: a deck with the marker is complete, one without it is
 never read. On Linux the processes hexdem starts get SIGTERM if hexdem dies
 (:func:`die_with_parent`), so that no orphaned LAMMPS keeps writing.
 """
@@ -24,7 +24,8 @@ from pathlib import Path
 
 from hexdem.engines.lammps.deck import DECK_NAME
 from hexdem.engines.lammps.library import environment_command
-from hexdem.engines.lammps.runner import error_line
+from hexdem.engines.lammps.runner import lammps_failure
+from hexdem.engines.lammps.settling import run_settling_deck
 from hexdem.errors import HexdemError
 
 #: Written into a deck directory once its run has finished and closed its files.
@@ -64,21 +65,21 @@ def launcher_command(launcher: str | None) -> list[str]:
 
 
 def run_deck(directory, launcher: str | None = None) -> None:
-    """Run ``in.hexdem`` in ``directory`` with ``lmp`` (on one rank that ``launcher`` starts, when
-    given), then write its done marker; a failure is one line naming the deck and LAMMPS's error."""
+    """Run ``in.hexdem`` in ``directory`` as ``lmp -in in.hexdem`` would: in this process, or in
+    ``lmp`` on one rank that ``launcher`` starts; then write its done marker. A failure is one
+    line naming the deck and LAMMPS's error."""
     directory = Path(directory)
     (directory / DONE_MARKER).unlink(missing_ok=True)
-    prefix = [*launcher_command(launcher), "-n", "1"] if launcher is not None else []
-    command = [*prefix, environment_command("lmp"), "-in", DECK_NAME, "-log", "log.lammps", "-screen", "none",
-               "-nocite"]
-    try:
-        done = subprocess.run(command, cwd=directory, capture_output=True, text=True,
-                              preexec_fn=functools.partial(die_with_parent, os.getpid()))
-    except OSError as exc:
-        raise HexdemError(f"cannot start {command[0]!r}: {exc.strerror}") from None
-    if done.returncode != 0:
-        log = directory / "log.lammps"
-        text = log.read_text() if log.exists() else ""
-        raise HexdemError(f"LAMMPS failed on {directory / DECK_NAME}: "
-                          f"{error_line(text if 'ERROR' in text else done.stdout + done.stderr)}")
+    if launcher is None:
+        run_settling_deck(directory)
+    else:
+        command = [*launcher_command(launcher), "-n", "1", environment_command("lmp"), "-in", DECK_NAME,
+                   "-log", "log.lammps", "-screen", "none", "-nocite"]
+        try:
+            done = subprocess.run(command, cwd=directory, capture_output=True, text=True,
+                                  preexec_fn=functools.partial(die_with_parent, os.getpid()))
+        except OSError as exc:
+            raise HexdemError(f"cannot start the MPI launcher {command[0]!r}: {exc.strerror}") from None
+        if done.returncode != 0:
+            raise lammps_failure(directory, done.stdout + done.stderr)
     (directory / DONE_MARKER).write_text("complete\n")
