@@ -5,15 +5,17 @@ Usage: python benchmarks/bench_study.py [--repeats 3] [--runs 8] [--workers 2] [
 
 The sweeps vary the striker's speed of the default experiment (0.30 m/s up, in steps of
 0.01). After a discarded warm-up of each, the two executors alternate, so that both see the
-same machine load, each sweep into a fresh folder: a sweep of N = ``--runs`` runs and one of 2N.
-A sweep's wall time (planning, start-up of the pool's processes or of Parsl's interchange and
-block, the runs, the table and figure, shutdown) grows by N (a run's own time + the overhead
-per run) / workers from N to 2N runs, so per executor (medians over the repeats):
+same machine load, each sweep into a fresh folder: a sweep of N = ``--runs`` runs and one of 2N,
+and one run of the sweep in this process, without an executor (``run_one``: model, LAMMPS,
+analysis, result files and figures). A sweep's wall time (planning, start-up of the pool's
+processes or of Parsl's interchange and block, the runs, the table and figure, shutdown) grows
+by N (a run's own time + the overhead per run) / workers from N to 2N runs, so (medians over
+the repeats):
 
-* **a run's own time**: the mean of the runs' ``summary.json`` ``wall_time_s`` (model, LAMMPS,
-  analysis, result files);
-* **overhead per run**: (T(2N) - T(N)) x workers / N - a run's own time, what each task costs
-  the executor beyond its run (hand-over, scheduling, the result's return);
+* **a run, in-process**: the run without an executor;
+* **overhead per run** of each executor: (T(2N) - T(N)) x workers / N - a run in-process, what
+  each task costs beyond its run (hand-over, scheduling, the result's return, and the runs
+  slowing each other down on shared cores, which both executors pay alike);
 * **start-up and end**: 2 T(N) - T(2N), what a sweep costs once whatever its size (process or
   block start, imports in the workers, the table, shutdown).
 
@@ -25,7 +27,6 @@ runs of a 5-per-edge hexagon for 0.2 ms, one repeat, no warm-up (the same code p
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import shutil
 import statistics
@@ -35,8 +36,8 @@ from pathlib import Path
 
 from machine import describe
 
-from hexdem.experiments.sweep import run_sweep
-from hexdem.experiments.sweep_plan import Variation
+from hexdem.experiments.sweep import RUNS_NAME, run_one, run_sweep
+from hexdem.experiments.sweep_plan import Variation, plan_sweep
 
 QUICK_BASE = {"edge_beads": 5, "duration": 2e-4}
 TARGET_S, TARGET_SHARE = 0.2, 0.05
@@ -55,13 +56,19 @@ def quiet(message: str) -> None:
     pass
 
 
-def timed_sweep(base: dict, variation: Variation, out: Path, workers: int, parsl: str | None) -> tuple[float, float]:
-    """(wall time of the sweep, the mean of its runs' own wall times) [s]."""
+def timed_sweep(base: dict, variation: Variation, out: Path, workers: int, parsl: str | None) -> float:
+    """Wall time of the sweep [s]."""
     start = time.perf_counter()
     run_sweep(base, [variation], out, workers, parsl, log=quiet)
-    wall = time.perf_counter() - start
-    own = [json.loads(path.read_text())["wall_time_s"] for path in (out / "runs").glob("*/summary.json")]
-    return wall, statistics.mean(own)
+    return time.perf_counter() - start
+
+
+def timed_run(base: dict, variation: Variation, out: Path) -> float:
+    """Wall time of the sweep's first run in this process, without an executor [s]."""
+    (out / RUNS_NAME).mkdir(parents=True)
+    start = time.perf_counter()
+    run_one(plan_sweep(base, [variation])[0], out)
+    return time.perf_counter() - start
 
 
 def peaks(out: Path) -> dict:
@@ -87,12 +94,15 @@ def main() -> None:
     executors = {"process pool": None, "Parsl (HighThroughputExecutor, local)": str(config)}
     print(f"machine: {describe()}; load average {os.getloadavg()[0]:.2f}", flush=True)
     times = {(name, size): [] for name in executors for size in (n, 2 * n)}
+    alone = []
     try:
         if not args.quick:
+            timed_run(base, speeds(n), work / "warm-up-alone")
             for parsl in executors.values():
                 timed_sweep(base, speeds(n), work / f"warm-up-{'pool' if parsl is None else 'parsl'}", args.workers,
                             parsl)
         for repeat in range(repeats):
+            alone.append(timed_run(base, speeds(n), work / f"{repeat}-alone"))
             for size in (n, 2 * n):
                 outs = {}
                 for name, parsl in executors.items():
@@ -108,17 +118,17 @@ def main() -> None:
     print(f"sweeps of {n} and {2 * n} runs of {'a 5-per-edge hexagon for 0.2 ms' if args.quick else 'the default experiment'}"
           f" (v0 from 0.30 m/s), {args.workers} workers; medians of {repeats} alternating repeat(s)"
           f"{'' if args.quick else ', after a warm-up'}")
+    run_s = statistics.median(alone)
+    print(f"a run, in-process (no executor): {run_s:.2f} s")
     print(f"{'executor':<38} {f'{n} runs [s]':>11} {f'{2 * n} runs [s]':>11} {'start-up and end [s]':>21} "
-          f"{'a run own [s]':>14} {'overhead per run [s]':>21}")
-    overhead, own = {}, {}
+          f"{'overhead per run [s]':>21}")
+    overhead = {}
     for name in executors:
-        small, large = (statistics.median(wall for wall, _ in times[name, size]) for size in (n, 2 * n))
-        own[name] = statistics.median(run for size in (n, 2 * n) for _, run in times[name, size])
-        overhead[name] = (large - small) * args.workers / n - own[name]
-        print(f"{name:<38} {small:>11.2f} {large:>11.2f} {2 * small - large:>21.2f} {own[name]:>14.3f} "
-              f"{overhead[name]:>21.3f}")
+        small, large = (statistics.median(times[name, size]) for size in (n, 2 * n))
+        overhead[name] = (large - small) * args.workers / n - run_s
+        print(f"{name:<38} {small:>11.2f} {large:>11.2f} {2 * small - large:>21.2f} {overhead[name]:>21.3f}")
     pool, parsl = overhead.values()
-    extra, run_s = parsl - pool, own["process pool"]
+    extra = parsl - pool
     limit = max(TARGET_S, TARGET_SHARE * run_s)
     print(f"Parsl's overhead per run over the pool's: {extra:+.3f} s = {extra / run_s:+.1%} of a run ({run_s:.2f} s)")
     print(f"target <= {TARGET_S:g} s or {TARGET_SHARE:.0%} of a run ({limit:.3f} s): "
