@@ -39,7 +39,7 @@ from harness import NOOUTPUT_NAME, nooutput_deck
 from machine import describe
 
 from hexdem.disorder.runner import MANIFEST_NAME
-from hexdem.engines.lammps.partitions import loop_time_s
+from hexdem.engines.lammps.standalone import loop_time_s
 from hexdem.engines.lammps.runner import run_bare
 from hexdem.experiments.snapshots import DEFAULT_TIMES_MS, snapshot_config, take_snapshots
 from hexdem.model.config import RunConfig

@@ -42,7 +42,7 @@ from harness import NOOUTPUT_NAME, nooutput_deck, write_config
 from machine import describe
 
 from hexdem.engines.lammps.engine import LammpsEngine
-from hexdem.engines.lammps.partitions import loop_time_s
+from hexdem.engines.lammps.standalone import loop_time_s
 from hexdem.engines.lammps.runner import run_bare
 from hexdem.engines.reference.engine import ReferenceEngine
 from hexdem.model.config import RunConfig

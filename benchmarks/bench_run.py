@@ -48,7 +48,7 @@ from machine import describe
 
 from hexdem.engines.lammps.deck import DECK_NAME
 from hexdem.engines.lammps.driver import run_streaming
-from hexdem.engines.lammps.partitions import loop_time_s
+from hexdem.engines.lammps.standalone import loop_time_s
 from hexdem.engines.lammps.runner import run_bare
 from hexdem.experiments.run import run_experiment
 from hexdem.model.config import RunConfig

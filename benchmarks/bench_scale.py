@@ -54,7 +54,7 @@ from baseline import baseline_tree, hexdem_command, hexdem_env
 from harness import MB, NOOUTPUT_NAME, nooutput_deck, run_watched, write_config
 from machine import describe
 
-from hexdem.engines.lammps.partitions import loop_time_s
+from hexdem.engines.lammps.standalone import loop_time_s
 from hexdem.engines.lammps.runner import run_bare
 from hexdem.experiments.run import RESULT_FILES
 from hexdem.model.config import RunConfig

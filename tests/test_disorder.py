@@ -24,7 +24,7 @@ from hexdem.disorder.preparation import (
 )
 from hexdem.disorder.prestress import touching_pairs
 from hexdem.engines.lammps.engine import LammpsEngine
-from hexdem.engines.lammps.partitions import run_partitioned
+from hexdem.engines.lammps.standalone import run_deck
 from hexdem.engines.lammps.settling import SETTLED_NAME, read_data_file, read_stage
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
@@ -124,11 +124,11 @@ def prepare(directory, sigma_m=None, seed=0) -> SimpleNamespace:
     ideal = base.lattice
     spaced = spaced_lattice(ideal, disorder.diameters_m(len(ideal), seed, 0), disorder)
     compact = dataclasses.replace(base, lattice=spaced)
-    run_partitioned([write_stage_deck(compact, "compact", preparation, directory / "compact")], 1, directory / "run1")
+    run_deck(write_stage_deck(compact, "compact", preparation, directory / "compact"))
     compacted = read_data_file(directory / "compact" / SETTLED_NAME)
     walled = ideal.with_geometry(compacted.positions_m, compacted.diameters_m)
     settle = dataclasses.replace(base, lattice=walled)
-    run_partitioned([write_stage_deck(settle, "settle", preparation, directory / "settle")], 1, directory / "run2")
+    run_deck(write_stage_deck(settle, "settle", preparation, directory / "settle"))
     settled = read_data_file(directory / "settle" / SETTLED_NAME)
     model = dataclasses.replace(base, lattice=dataclasses.replace(walled, positions_m=settled.positions_m))
     return SimpleNamespace(directory=directory, preparation=preparation, compact=compact, compacted=compacted,

@@ -1,4 +1,4 @@
-"""Disorder ensembles (hexdem.disorder.ensemble) on real LAMMPS partitions: contract, statistics,
+"""Disorder ensembles (hexdem.disorder.ensemble) on real LAMMPS: contract, statistics,
 determinism per seed and across workers, resuming after a kill, bad input.
 
 The ensembles are small (4 beads per edge, 37 beads, 3 realizations, 2 striker speeds) so
@@ -22,7 +22,7 @@ from hexdem.disorder.preparation import Preparation
 from hexdem.disorder.runner import run_ensemble
 from hexdem.disorder.sharing import adopt_preparation, adopt_ideal_impacts
 from hexdem.disorder.stats import STATS_COLUMNS
-from hexdem.engines.lammps.partitions import DONE_MARKER, run_partitioned
+from hexdem.engines.lammps.standalone import DONE_MARKER, run_deck
 from hexdem.errors import HexdemError
 
 VELOCITIES = (0.4, 0.7)
@@ -37,7 +37,7 @@ def quiet(message):
 
 @pytest.fixture(scope="module")
 def reference(tmp_path_factory):
-    """The small ensemble on two partitions."""
+    """The small ensemble on two workers."""
     out = tmp_path_factory.mktemp("reference")
     config = EnsembleConfig(**SMALL)
     summary = run_ensemble(config, out, workers=2, log=quiet)
@@ -229,9 +229,25 @@ def test_a_failing_deck_is_named_with_lammps_error(tmp_path):
     for directory, text in ((good, 'print "fine"\n'), (bad, "units si\nbogus_command 1\n")):
         directory.mkdir()
         (directory / "in.hexdem").write_text(text)
+    run_deck(good)
     with pytest.raises(HexdemError, match=r"LAMMPS failed on .*bad/in.hexdem: ERROR: Unknown command: bogus_command"):
-        run_partitioned([good, bad], 2, tmp_path / "run")
-    assert not (bad / DONE_MARKER).exists()
+        run_deck(bad)
+    assert (good / DONE_MARKER).exists() and not (bad / DONE_MARKER).exists()
+
+
+def test_a_failing_deck_in_an_ensemble_is_named_after_the_others_ran(tmp_path, capsys):
+    """A preparation deck that LAMMPS refuses: the phase's other decks still run, and the error
+    names the realization and LAMMPS's message."""
+    from hexdem.disorder.runner import _run_phase
+
+    decks = [tmp_path / name for name in ("a", "b", "c")]
+    for directory, text in zip(decks, ('print "fine"\n', "units si\nbogus_command 1\n", 'print "fine"\n')):
+        directory.mkdir()
+        (directory / "in.hexdem").write_text(text)
+    with pytest.raises(HexdemError, match=r"1 of 3 compact decks failed .*; realization 1: LAMMPS failed on "
+                                          r".*b/in.hexdem: ERROR: Unknown command: bogus_command"):
+        _run_phase("compact", {f"realization {k}": (run_deck, deck) for k, deck in enumerate(decks)}, 2, None)
+    assert [(deck / DONE_MARKER).exists() for deck in decks] == [True, False, True]
 
 
 def test_fitted_laws_follow_the_papers_rule_for_physical_units(tmp_path):

@@ -66,13 +66,13 @@ def test_compare_and_snapshots_go_through_the_launcher(launcher, tmp_path):
     assert json.loads((tmp_path / "snapshots" / "snapshots.json").read_text())["ranks"] == 2
 
 
-def test_scaling_on_lammps_spreads_its_runs_over_the_launchers_ranks(launcher, tmp_path):
+def test_scaling_on_lammps_starts_each_run_through_the_launcher(launcher, tmp_path):
+    """--workers runs at once in local processes; --launcher starts each run's rank."""
     command, log = launcher
     before = jobs_so_far(log)
     common = ["scaling", "--engine", "lammps", "--n-v0", "4", "--last", "5", "--workers", "2"]
     assert main([*common, "--launcher", command, "--out", str(tmp_path / "mpi")]) == 0
-    (job,) = launched_since(log, before)
-    assert job.startswith("-n 2 ")
+    assert [job.split()[:2] for job in launched_since(log, before)] == [["-n", "1"]] * 8
     assert main([*common, "--out", str(tmp_path / "local")]) == 0
     mpi, local = (json.loads((tmp_path / name / "scaling.json").read_text()) for name in ("mpi", "local"))
     for combination in ("30/30", "30/0", "0/0", "0/30"):

@@ -108,13 +108,17 @@ def test_a_rerun_resumes_without_recomputing(quick, capsys):
 
 
 def test_every_mpi_job_of_the_paper_went_through_the_launcher(quick, launcher):
-    """Fig. 3 on 1 rank and Fig. 4 on 2, the sweep's runs, the ensembles' preparation partitions and
-    their impacts (the launcher's log also holds the jobs of test_launcher.py)."""
+    """Fig. 3 on 1 rank and Fig. 4 on 2, each run of the V0 sweep, each of the ensembles'
+    preparation decks and impacts on one rank (the launcher's log also holds the jobs of
+    test_launcher.py)."""
     jobs = launcher[1].read_text().splitlines()
-    for folder, ranks in (("fig3", 1), ("fig4", 2), ("disorder/sigma6tol/lammps/impacts", 2)):
+    for folder, ranks in (("fig3", 1), ("fig4", 2)):
         assert [job.split()[:2] for job in jobs if f"{quick}/{folder}/" in job] == [["-n", str(ranks)]], folder
-    assert any("hexdem-sweep-" in job for job in jobs), "the V0 sweep"
-    assert any("-partition 2x1 -in run.in" in job for job in jobs), "the ensembles' preparation"
+    impacts = [job for job in jobs if f"{quick}/disorder/sigma6tol/" in job and "/v0." in job]
+    assert impacts and all(job.startswith("-n 1 ") for job in impacts), "the impacts"
+    assert sum("hexdem-scaling-" in job for job in jobs) == 2 * 8, "the V0 sweep"
+    decks = [job for job in jobs if job.endswith("-in in.hexdem -log log.lammps -screen none -nocite")]
+    assert decks and all(job.startswith("-n 1 ") for job in decks), "the ensembles' preparation"
 
 
 def test_the_friction_study_covers_every_friction_speed_and_line(quick):

@@ -35,8 +35,9 @@ def swept(tmp_path_factory):
 
 def test_the_table_has_a_row_per_run_in_the_plans_order(swept):
     header, rows = read_csv(swept / "sweep.csv")
-    assert header[:3] == ("regions.0.material", "v0", "run")
-    assert header[3:3 + len(SUMMARY_COLUMNS)] == SUMMARY_COLUMNS
+    assert header[:4] == ("regions.0.material", "v0", "run", "status") and header[-1] == "error"
+    assert header[4:4 + len(SUMMARY_COLUMNS)] == SUMMARY_COLUMNS
+    assert {(row["status"], row["error"]) for row in rows} == {("done", "")}
     assert [(r["regions.0.material"], float(r["v0"])) for r in rows] == PLAN
     assert {"energy_share_steel316", "energy_share_brass", "energy_share_ptfe", "decay_exponent_0",
             "decay_exponent_+30", "decay_exponent_-30"} <= set(header)
@@ -157,13 +158,13 @@ def test_nested_keys_change_one_part_of_a_table_or_list():
     assert runs[0].config.impacts[0]["v0"] == 0.3 and base["regions"][0]["material"] == "brass"
 
 
-def test_a_sweep_reaches_its_ranks_through_the_launcher(tmp_path, launcher):
-    """--launcher starts the sweep's --workers ranks (as "mpiexec -f hosts" would across machines);
-    the reference engine's runs go the same way, one process per rank."""
+def test_each_run_reaches_its_rank_through_the_launcher(tmp_path, launcher):
+    """--launcher starts each run's ranks (as "srun" would inside an allocation); the reference
+    engine's runs go the same way, one process each."""
     out = tmp_path / "out"
     assert sweep(tmp_path, "--vary", "v0=0.2,0.4", "--vary", "engine=reference", "--out", str(out),
                  "--workers", "2", "--launcher", launcher[0]) == 0
-    jobs = [job for job in launcher[1].read_text().splitlines() if f"{out}/mpi/" in job]
-    assert [job.split()[:2] for job in jobs] == [["-n", "2"]]
+    jobs = [job for job in launcher[1].read_text().splitlines() if f"{out}/runs/" in job]
+    assert [job.split()[:2] for job in jobs] == [["-n", "1"]] * 2
     _, rows = read_csv(out / "sweep.csv")
     assert [json.loads((out / r["run"] / "summary.json").read_text())["engine"] for r in rows] == ["reference"] * 2

@@ -1,7 +1,7 @@
 """``hexdem ensemble``: weakly disordered packings struck by a striker (Sec. VI; Figs. 8, 9).
 
-Runs (or resumes) the ensemble in ``--out`` on ``--workers`` LAMMPS partitions (``mpiexec -n
-N lmp -partition Nx1``; ``--launcher`` replaces ``mpiexec`` to reach other machines) and
+Runs (or resumes) the ensemble in ``--out``, every deck of its preparation and every impact one
+task of ``--workers`` local processes or of Parsl (``--parsl CONFIG.py``), and
 writes ``peaks_stats.csv``, ``ideal_peaks.csv``, ``arrival_map.csv``, ``disorder_effect.csv``,
 ``ensemble.json`` and the PNGs of Figs. 8 and 9 (see :mod:`hexdem.disorder.ensemble`,
 :mod:`hexdem.disorder.stats`).
@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import re
 
-from hexdem.cli.options import add_launcher
+from hexdem.cli.options import add_launcher, add_parsl
 from hexdem.common.machine import usable_cpus
 from hexdem.errors import HexdemError
 
@@ -44,9 +44,10 @@ def add_arguments(parser) -> None:
                         help=f"striker speeds in m/s (default {DEFAULT_VELOCITIES})")
     parser.add_argument("--seed", type=int, default=0, help="seed of the diameters (default 0)")
     parser.add_argument("--workers", type=int, default=usable_cpus(), metavar="N",
-                        help="LAMMPS partitions (processes) at once (default: the CPUs this job may use, "
-                             "its CPU affinity as Slurm or taskset set it)")
-    add_launcher(parser, "-n N lmp -partition Nx1 -in run.in")
+                        help="decks (local processes) at once (default: the CPUs this job may use, its CPU "
+                             "affinity as Slurm or taskset set it)")
+    add_parsl(parser)
+    add_launcher(parser, "-n 1 and each deck's lmp or impact's job")
     parser.add_argument("--shape", default="hexagon", help="packing: hexagon, square or centered-square "
                         "(default hexagon)")
     parser.add_argument("--edge-beads", type=int, default=11, help="beads per hexagon edge (default 11)")
@@ -92,5 +93,5 @@ def config_from_args(args):
 def run(args) -> None:
     from hexdem.disorder.runner import run_ensemble
 
-    run_ensemble(config_from_args(args), args.out, workers=args.workers, launcher=args.launcher,
+    run_ensemble(config_from_args(args), args.out, workers=args.workers, launcher=args.launcher, parsl=args.parsl,
                  keep_dumps=args.keep_dumps, scaling_json=args.scaling)

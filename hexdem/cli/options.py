@@ -10,3 +10,10 @@ def add_launcher(parser, appended: str = "-n N python -P -m hexdem.experiments.p
                         help=f'MPI launcher to which "{appended}" is appended (default: this environment\'s '
                              'mpiexec), e.g. "mpiexec -f hosts" or "srun"; given, the job goes through it even '
                              'on one rank')
+
+
+def add_parsl(parser) -> None:
+    """``--parsl CONFIG.py``: hand the study's runs to Parsl (:mod:`hexdem.experiments.executors`)."""
+    parser.add_argument("--parsl", metavar="CONFIG.py",
+                        help="hand the runs to Parsl: a Parsl configuration file that defines config = "
+                             "parsl.config.Config(...) (default: --workers local processes)")

@@ -7,10 +7,10 @@ no gravity, as in the paper's ideal simulations) is struck by the same striker f
 reference. Striker: steel, nominal diameter, touching the edge-centre bead at t = 0 and
 entering through the hole in the wall.
 
-**Running.** Three phases, compact → settle → impacts, each running all its pending decks
-on LAMMPS partitions (:mod:`hexdem.engines.lammps.partitions`): ``workers`` one-rank LAMMPS
-instances here, or as many as an MPI launcher reaches across machines. A realization's
-impacts are analysed (in ``workers`` spawned processes) as soon as its last deck finishes.
+**Running.** Three phases, compact → settle → impacts, each running all its pending decks,
+every deck one task of the study executor (:mod:`hexdem.experiments.executors`): ``workers``
+local processes, or Parsl across machines. An impact is analysed while it runs, and a
+realization's result assembled as soon as its last impact finishes.
 
 **Resuming.** A deck is finished when it has its done marker; a realization when its
 ``result.npz`` exists (written atomically once all its impacts are analysed; the dumps are
@@ -23,8 +23,7 @@ on one rank, bit-identical results, however many workers share the work.
 
 **Layout of OUT**: ``ensemble.json`` (parameters, timings, disorder effect),
 ``realizations/r0007/{compact,settle,v0.400,...}/`` decks and ``result.npz``,
-``ideal/v0.400/`` decks and ``ideal/result.npz``, ``lammps/<phase>/`` partition drivers,
-and the tables and figures of :func:`hexdem.disorder.stats.write_statistics`.
+``ideal/v0.400/`` decks and ``ideal/result.npz``, and the tables and figures of :func:`hexdem.disorder.stats.write_statistics`.
 """
 
 from __future__ import annotations

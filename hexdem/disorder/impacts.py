@@ -1,18 +1,16 @@
-"""The impacts of a disorder ensemble, analysed while they run, spread over MPI ranks.
+"""The impacts of a disorder ensemble, analysed while they run, one task each.
 
 Every impact (realization k, or the ideal lattice, at one striker speed) is one tracked run
 (:mod:`hexdem.experiments.tracked_run`) whose results go atomically into ``impact.npz`` in
 its deck directory: that file is the impact's done marker, so an interrupted ensemble
-resumes with the impacts that lack it. :class:`ImpactTasks` is an MPI job
-(:mod:`hexdem.experiments.parallel`): the world communicator is split into one-rank
-communicators, one LAMMPS each, and rank r takes tasks r, r + P, r + 2P, … of the list
-(all impacts cost about the same). A realization's ``result.npz`` is assembled from its
-impacts and its preparation once all of them exist (:func:`publish_result`).
+resumes with the impacts that lack it. :func:`impact_task` is one task of the study
+executor (:mod:`hexdem.experiments.executors`): one LAMMPS rank, in the worker's process or
+started by the MPI launcher. A realization's ``result.npz`` is assembled from its impacts
+and its preparation once all of them exist (:func:`publish_result`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -23,9 +21,8 @@ from hexdem.common.io import atomic_path
 from hexdem.disorder.ensemble import Ensemble, EnsembleConfig
 from hexdem.disorder.preparation import STAGES
 from hexdem.disorder.prestress import prestress
-from hexdem.engines.lammps.partitions import loop_time_s
+from hexdem.engines.lammps.standalone import loop_time_s
 from hexdem.engines.lammps.settling import read_stage
-from hexdem.experiments.parallel import spread_tasks
 from hexdem.experiments.run import check_energy
 from hexdem.experiments.tracked_run import ImpactJob, track_impact
 
@@ -44,16 +41,15 @@ def _load(path: Path) -> dict:
         return {name: data[name] for name in data.files}
 
 
-def run_impact(ensemble: Ensemble, k: int | None, v: float, dump: bool, comm=None) -> str:
+def run_impact(ensemble: Ensemble, k: int | None, v: float, dump: bool, launcher: str | None = None) -> None:
     """Run and analyse one impact of realization k (None: ideal) at striker speed ``v`` [m/s]
-    on the ranks of ``comm`` (None: this process); write its ``impact.npz``. Returns the
-    LAMMPS version."""
+    on one rank (in this process, or started by ``launcher``); write its ``impact.npz``."""
     directory = ensemble.impact_dir(k, v)
     gravity = None if k is None else tuple(float(g) for g in ensemble.gravity_m_s2)
     line_beads = tuple(sorted({int(b) for beads in ensemble.ideal.lines().values() for b in beads}))
     job = ImpactJob(ensemble.impact_model(k, v), ensemble.settings(v), "lammps", directory, dump=dump,
                     gravity_m_s2=gravity, trace_beads=line_beads, show_progress=False)
-    analysis: ImpactAnalysis = track_impact(job, comm=comm)
+    analysis: ImpactAnalysis = track_impact(job, launcher=launcher)
     check_energy(analysis, analysis.engine["deck"])
     r = analysis.results
     lead = np.full(len(r.peak_speed), np.nan)
@@ -62,23 +58,12 @@ def run_impact(ensemble: Ensemble, k: int | None, v: float, dump: bool, comm=Non
                                     "arrival_time": r.arrival_time, "energy_drift": r.energy_drift,
                                     "far_wall_reached": r.far_wall_reached,
                                     "impact_lammps_s": analysis.engine["wall_time_s"]})
-    return analysis.engine["version"]
 
 
-@dataclass(frozen=True)
-class ImpactTasks:
-    """An MPI job: the impacts ``tasks`` [(realization or None, striker speed)] of the ensemble
-    ``config`` in ``out``, spread over the ranks. Returns the LAMMPS version (rank 0)."""
-
-    config: EnsembleConfig
-    out: Path
-    tasks: tuple[tuple[int | None, float], ...]
-    dump: bool = False
-
-    def __call__(self, comm):
-        ensemble = Ensemble(self.config, self.out)
-        versions = spread_tasks(comm, self.tasks, lambda task, alone: run_impact(ensemble, *task, self.dump, alone))
-        return None if versions is None else next(iter(versions), "unknown")
+def impact_task(config: EnsembleConfig, out: Path, k: int | None, v: float, dump: bool,
+                launcher: str | None = None) -> None:
+    """One impact of the ensemble ``config`` in ``out`` (see :func:`run_impact`): a task."""
+    run_impact(Ensemble(config, out), k, v, dump, launcher)
 
 
 def impact_done(ensemble: Ensemble, k: int | None, v: float) -> bool:

@@ -1,8 +1,9 @@
-"""Running a disorder ensemble: preparation on LAMMPS partitions, impacts analysed as they run.
+"""Running a disorder ensemble: its preparation and its impacts, every deck a task.
 
-Three phases, compact → settle → impacts. The preparation stages run their pending decks on
-LAMMPS partitions (:mod:`hexdem.engines.lammps.partitions`); the impacts run on ``workers``
-MPI ranks with the tracker inside (:mod:`hexdem.disorder.impacts`), each publishing its
+Three phases, compact → settle → impacts, each deck of each phase one task of the study
+executor (:mod:`hexdem.experiments.executors`: ``workers`` local processes, or Parsl). A
+preparation deck runs in ``lmp`` (:func:`~hexdem.engines.lammps.standalone.run_deck`); an
+impact in one LAMMPS with the tracker inside (:mod:`hexdem.disorder.impacts`), publishing its
 ``impact.npz``. Each realization's ``result.npz`` is then assembled, and
 :func:`run_ensemble` writes the statistics (:mod:`hexdem.disorder.stats`). See
 :mod:`hexdem.disorder.ensemble` for resuming, determinism and the directory layout.
@@ -18,15 +19,16 @@ from pathlib import Path
 
 from hexdem.common.checks import positive_int
 from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
+from hexdem.common.progress import progress_bar
 from hexdem.disorder.ensemble import MANIFEST_NAME, PHASE_LABELS, Ensemble, EnsembleConfig
 from hexdem.disorder.figures import fitted_laws
-from hexdem.disorder.impacts import ImpactTasks, impact_done, publish_result
+from hexdem.disorder.impacts import impact_done, impact_task, publish_result
 from hexdem.disorder.preparation import STAGES, write_stage_deck
 from hexdem.disorder.sharing import adopt_preparation, adopt_ideal_impacts
 from hexdem.disorder.stats import write_statistics
-from hexdem.engines.lammps.partitions import is_done, run_partitioned
+from hexdem.engines.lammps.standalone import is_done, launcher_command, run_deck
 from hexdem.errors import HexdemError
-from hexdem.experiments.parallel import run_on_ranks
+from hexdem.experiments.executors import describe, load_parsl_config, run_tasks, study_executor
 
 
 def _check_manifest(out: Path, config: EnsembleConfig) -> dict:
@@ -54,21 +56,46 @@ def _pending_impacts(ensemble: Ensemble, groups) -> list[tuple[int | None, float
     return [(k, v) for k in groups for v in ensemble.config.velocities_m_s if not impact_done(ensemble, k, v)]
 
 
-def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | None = None,
+def _run_phase(name: str, tasks: dict, workers: int, parsl, on_done=None) -> None:
+    """Run the phase ``name``'s ``tasks`` {what: (fn, *args)}, one task of the study executor
+    each, calling ``on_done()`` as each finishes; the tasks that failed are named at the end."""
+    if not tasks:
+        return
+    failed = []
+    bar = progress_bar(len(tasks), PHASE_LABELS[name], unit="deck")
+    with study_executor(min(workers, len(tasks)), parsl) as executor:
+        for what, _, error in run_tasks(executor, tasks):
+            if error is not None:
+                failed.append(f"{what}: {describe(error)}")
+            if on_done is not None:
+                on_done()
+            bar.update(1)
+    bar.close()
+    if failed:
+        raise HexdemError(f"{len(failed)} of {len(tasks)} {name} decks failed (rerun to run them again); "
+                          f"{'; '.join(failed)}")
+
+
+def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | None = None, parsl=None,
                  keep_dumps: bool = False, scaling_json=None, log=None, share_from=()) -> dict:
     """Run (or resume) the ensemble in ``out`` and write its statistics; returns the summary.
 
-    ``workers`` LAMMPS partitions run at once, started by ``launcher`` (default: this
-    environment's ``mpiexec``); ``scaling_json`` adds the fitted laws to Fig. 9;
+    ``workers`` decks run at once in local processes, or on Parsl with the configuration file
+    ``parsl``, each on one rank (started by the MPI launcher ``launcher`` when given);
+    ``scaling_json`` adds the fitted laws to Fig. 9;
     ``share_from`` other :class:`Ensemble` s whose identical finished runs are copied rather
     than run again (:mod:`hexdem.disorder.sharing`).
     """
     log = log or (lambda message: print(f"hexdem ensemble: {message}", file=sys.stderr, flush=True))
     positive_int("--workers", workers)
+    if launcher is not None:
+        launcher_command(launcher)  # refused before anything is written into out
+    if parsl is not None:
+        load_parsl_config(parsl)
     laws = fitted_laws(scaling_json, config.disorder.diameter_m) if scaling_json else {}
     out = ensure_writable_dir(out)
     ensemble = Ensemble(config, out)
-    with locked_directory(out, "another hexdem ensemble (or its LAMMPS is still shutting down)") as lock:
+    with locked_directory(out, "another hexdem ensemble (or its LAMMPS is still shutting down)"):
         manifest = _check_manifest(out, config)
         for leftover in list(out.rglob(".*.part")):  # atomic writes and copies cut short by a killed run
             if leftover.is_dir():
@@ -84,12 +111,6 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
             f"{ensemble.ideal.shape}, seed {config.seed}: {len(todo)} to run, {workers} workers")
         wall: dict[str, float] = {}
 
-        def run_phase(name: str, directories, on_done=None) -> None:
-            start = time.perf_counter()
-            run_partitioned(directories, workers, out / "lammps" / name, PHASE_LABELS[name], launcher,
-                            on_done=on_done, pass_fds=(lock,))
-            wall[name] = time.perf_counter() - start
-
         for stage in STAGES:
             pending = [k for k in todo if not is_done(ensemble.stage_dir(k, stage))]
             for k in pending:
@@ -97,7 +118,10 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
                 write_stage_deck(ensemble.stage_model(k, stage), stage, config.preparation,
                                  ensemble.stage_dir(k, stage))
             log(f"{stage}: {len(pending)} decks")
-            run_phase(stage, [ensemble.stage_dir(k, stage) for k in pending])
+            start = time.perf_counter()
+            _run_phase(stage, {f"realization {k}": (run_deck, ensemble.stage_dir(k, stage), launcher) for k in pending},
+                       workers, parsl)
+            wall[stage] = time.perf_counter() - start
 
         groups = [*todo, *([None] if ideal_todo else [])]
         tasks = _pending_impacts(ensemble, groups)
@@ -105,19 +129,17 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
         start = time.perf_counter()
         published: set = set()
 
-        def publish_finished() -> int:
-            """Publish every realization whose impacts are all done; the impacts done so far."""
+        def publish_finished() -> None:
+            """Publish every realization whose impacts are all done."""
             for k in groups:
                 if k not in published and all(impact_done(ensemble, k, v) for v in config.velocities_m_s):
                     publish_result(ensemble, k)
                     published.add(k)
-            return sum(impact_done(ensemble, k, v) for k, v in tasks)
 
-        if tasks:
-            run_on_ranks(ImpactTasks(config, out, tuple(tasks), keep_dumps), min(workers, len(tasks)),
-                         out / "lammps" / "impacts", launcher,
-                         progress=(len(tasks), PHASE_LABELS["impacts"], publish_finished))
         publish_finished()
+        _run_phase("impacts", {f"{'ideal' if k is None else f'realization {k}'} at {v:g} m/s":
+                               (impact_task, config, out, k, v, keep_dumps, launcher) for k, v in tasks},
+                   workers, parsl, publish_finished)
         wall["impacts"] = time.perf_counter() - start
         summary = write_statistics(ensemble, laws)
         summary["this_run"] = {"realizations_run": len(todo), "workers": workers,

@@ -33,7 +33,7 @@ from hexdem.disorder.ensemble import Ensemble
 from hexdem.disorder.impacts import IMPACT_NAME
 from hexdem.disorder.preparation import write_stage_deck
 from hexdem.engines.lammps.deck import DATA_NAME, DECK_NAME
-from hexdem.engines.lammps.partitions import is_done
+from hexdem.engines.lammps.standalone import is_done
 
 
 def adopt_ideal_impacts(ensemble: Ensemble, source: Ensemble) -> int:

@@ -1,4 +1,6 @@
-"""Run a job on one or several MPI ranks: in this process for one, under ``mpiexec`` for more.
+"""Run one job (one run of hexdem) on one or several MPI ranks: in this process for one, under
+``mpiexec`` for more. Studies of many runs hand each run to a study executor instead
+(:mod:`hexdem.experiments.executors`), whose task runs it here.
 
 A *job* is a picklable callable ``job(comm)`` that every rank calls with the mpi4py world
 communicator (None when it runs alone, in-process); rank 0 returns the result, the others
@@ -27,7 +29,7 @@ from hexdem.common.io import atomic_path
 from hexdem.common.job_failure import ERROR_FILE_VARIABLE, abort_job
 from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.library import load_lammps
-from hexdem.engines.lammps.partitions import die_with_parent, launcher_command
+from hexdem.engines.lammps.standalone import die_with_parent, launcher_command
 from hexdem.errors import HexdemError
 
 JOB_NAME, RESULT_NAME, ERROR_NAME = "job.pickle", "job.result.pickle", "job.error"
@@ -97,20 +99,6 @@ def run_on_ranks(job, ranks: int, directory, launcher: str | None = None, progre
     for name in (JOB_NAME, RESULT_NAME):
         paths[name].unlink()
     return result
-
-
-def spread_tasks(comm, tasks, work) -> list | None:
-    """``work(task, alone)`` for every task, rank r of ``comm`` taking tasks r, r + P, r + 2P, …
-    with ``alone`` a one-rank communicator of its own (one LAMMPS per rank; None when ``comm``
-    is None). Rank 0 returns the results in the order of ``tasks``, the other ranks None."""
-    rank, size = (0, 1) if comm is None else (comm.Get_rank(), comm.Get_size())
-    alone = None if comm is None else comm.Split(color=rank, key=0)
-    mine = [(i, work(task, alone)) for i, task in enumerate(tasks) if i % size == rank]
-    parts = [mine] if comm is None else comm.gather(mine, root=0)
-    if rank != 0:
-        return None
-    results = dict(pair for part in parts for pair in part)
-    return [results[i] for i in range(len(tasks))]
 
 
 def _rank_main(job_path: Path) -> None:

@@ -130,11 +130,10 @@ def _kept(deck: Path) -> Path:
     return kept
 
 
-def prepare_random_packing(config: RunConfig, directory, comm=None, log=None) -> RunConfig:
+def prepare_random_packing(config: RunConfig, directory, log=None) -> RunConfig:
     """Pack ``config``'s random disc in ``directory`` (its decks and ``packing.csv``) and return
     the configuration that strikes it (``shape = "packing"``); any other configuration is
-    returned as it is. ``comm``: a communicator of the ranks that run LAMMPS together, as for
-    :func:`~hexdem.experiments.run.simulate`. A run that cannot go on is refused first
+    returned as it is. A run that cannot go on is refused first
     (:func:`check_random_run`); a deck that fails or does not settle is kept outside
     ``directory``, in the folder its message names."""
     if config.shape != "random":
@@ -155,7 +154,7 @@ def prepare_random_packing(config: RunConfig, directory, comm=None, log=None) ->
             f"is below {stage.settled_rms_speed_m_s:g} m/s")
         deck = write_settling_deck(model, stage, directory / name)
         try:
-            run_settling_deck(deck, comm)
+            run_settling_deck(deck)
         except HexdemError as exc:
             raise type(exc)(str(exc).replace(str(deck), str(_kept(deck)))) from None
         result = read_stage(deck)

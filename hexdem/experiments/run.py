@@ -64,12 +64,9 @@ STAGING_PREFIX = ".hexdem-run-"
 FRONT_WALL_MARGIN_D = 2.0
 
 
-def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples=(), comm=None,
+def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples=(),
              trace_beads=(), threshold_speed: float | None = None) -> ImpactAnalysis:
     """Run ``config`` with its engine in ``workdir``, analysed while it runs (no result files).
-
-    ``comm``: a one-rank mpi4py communicator when this runs inside an MPI job of several
-    independent runs (see :func:`~hexdem.experiments.parallel.spread_tasks`), else None.
 
     ``trace_lines`` (observation line names) keep the speeds of those lines' beads at every
     sample, and so do ``trace_beads`` (bead indices) for theirs; ``threshold_speed`` (run units)
@@ -94,7 +91,7 @@ def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples
     frames = movie_samples(settings.n_samples) if config.movie else ()
     job = ImpactJob(model, settings, config.engine, workdir, dump=config.dump, trace_beads=traced,
                     field_samples=tuple(sorted(set(field_samples) | set(frames))), threshold_speed=threshold_speed)
-    analysis = track_impact(job, config.ranks, comm, config.launcher)
+    analysis = track_impact(job, config.ranks, config.launcher)
     check_energy(analysis, workdir)
     return analysis
 
@@ -259,16 +256,15 @@ def measure_front_shape(analysis: ImpactAnalysis, count: int = 8, geometric: boo
     return front_shape(positions, arrivals, origin, times, wall_margin=wall_margin_d, window_deg=window_deg)
 
 
-def run_experiment(config: RunConfig, out, log=None, comm=None) -> ImpactAnalysis:
-    """Run ``config`` and publish its result files in ``out`` (see module docstring); ``comm`` as
-    for :func:`simulate`."""
+def run_experiment(config: RunConfig, out, log=None) -> ImpactAnalysis:
+    """Run ``config`` and publish its result files in ``out`` (see module docstring)."""
     log = log or (lambda message: print(f"hexdem: {message}", file=sys.stderr))
     with staged_directory(out, STAGING_PREFIX) as staging:
         try:
             start, provenance = time.perf_counter(), run_provenance()
-            prepared = prepare_random_packing(config, staging / "preparation", comm, log)
+            prepared = prepare_random_packing(config, staging / "preparation", log)
             check_dump_space(prepared, Path(out))
-            analysis = simulate(prepared, staging / "deck", log, comm=comm)
+            analysis = simulate(prepared, staging / "deck", log)
             write_results(config, analysis, staging, time.perf_counter() - start, provenance, log)
         except HexdemError as exc:
             kept = _keep_failed_deck(staging / "deck")

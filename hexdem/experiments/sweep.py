@@ -1,22 +1,28 @@
 """``hexdem sweep``: a study of any run-config keys, every run a full ``hexdem run`` result.
 
-:mod:`hexdem.experiments.sweep_plan` makes and checks the plan; this module runs it and
-:mod:`hexdem.experiments.sweep_table` tabulates and draws it.
-
-**Running.** ``workers`` runs at once, each on a one-rank communicator of its own: a LAMMPS
-instance, or the reference engine's process (:func:`~hexdem.experiments.parallel.spread_tasks`
-inside :func:`~hexdem.experiments.parallel.run_on_ranks`, whose MPI ranks ``launcher`` may start
-on other machines). A progress bar counts the runs done. A launcher whose program cannot be
-found is refused before anything is written.
+:mod:`hexdem.experiments.sweep_plan` makes and checks the plan; this module plans it into the
+study folder, runs it and collects it; :mod:`hexdem.experiments.sweep_table` tabulates and
+draws it.
 
 **Layout of DIR.** ``sweep.json`` (the plan: the base configuration, the varied keys and their
 values), ``runs/<name>/`` (each run's full result directory, as ``hexdem run --out`` leaves it),
-``sweep.csv`` and ``sweep.png``.
+``runs/<name>.failed`` (the error of a run that failed, in one line), ``sweep.csv`` and
+``sweep.png``. Every machine that runs a part of the study must see DIR at the same absolute
+path (a shared filesystem).
 
-**Resuming.** A run is done when its directory exists: it runs in ``runs/.<name>.part`` and
-is renamed into place once all its files are written. A rerun of the same command keeps the
-finished runs, removes what an interrupted one left and runs it again; the table is read from
-the runs' files either way. A rerun with another plan is refused rather than mixed.
+**Running.** Each run is one task of a study executor (:mod:`hexdem.experiments.executors`):
+``workers`` local processes, or Parsl with ``--parsl CONFIG.py``. A run takes ``ranks`` MPI
+ranks of its own (``hexdem run --ranks``: ``mpiexec -n K``, or ``launcher``). A run that fails
+is retried (once in the local pool, as Parsl's ``retries`` says with Parsl), then its error is
+written to ``runs/<name>.failed`` and the study goes on; the table marks it ``failed`` and the
+sweep ends with an error naming every run that failed. ``hexdem sweep DIR --run I`` runs run I
+of a planned study alone, in this process, with no executor (one task of a Slurm job array),
+and ``hexdem sweep DIR --collect`` writes the table and figure of whatever has finished.
+
+**Resuming.** A run is done when its directory exists: it runs in ``runs/.<name>.part``, which
+is removed if the run fails and renamed into place once all its files are written. A rerun of
+the same command keeps the finished runs and runs the missing and failed ones again; the table
+is read from the runs' files either way. A rerun with another plan is refused rather than mixed.
 """
 
 from __future__ import annotations
@@ -25,46 +31,52 @@ import json
 import os
 import shutil
 import sys
-from dataclasses import dataclass
 from pathlib import Path
 
 from hexdem.common.checks import positive_int
 from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
-from hexdem.engines.lammps.partitions import launcher_command
+from hexdem.common.progress import progress_bar
+from hexdem.engines.lammps.standalone import launcher_command
 from hexdem.errors import HexdemError
-from hexdem.experiments.parallel import run_on_ranks, spread_tasks
+from hexdem.experiments.executors import describe, load_parsl_config, run_tasks, study_executor
 from hexdem.experiments.sweep_plan import SweepRun, Variation, plan_sweep
 
 PLAN_NAME = "sweep.json"
 RUNS_NAME = "runs"
-
-
-@dataclass(frozen=True)
-class SweepJob:
-    """An MPI job: the ``runs`` into ``out / runs``, spread over the ranks."""
-
-    runs: tuple[SweepRun, ...]
-    out: Path
-
-    def __call__(self, comm):
-        spread_tasks(comm, self.runs, lambda run, alone: run_one(run, self.out, alone))
+FAILED_SUFFIX = ".failed"
 
 
 def run_dir(out: Path, run: SweepRun) -> Path:
     return out / RUNS_NAME / run.name
 
 
-def run_one(run: SweepRun, out: Path, comm=None) -> None:
-    """Run ``run`` in its part directory and rename it into place when every file is written."""
+def failure_path(out: Path, run: SweepRun) -> Path:
+    return out / RUNS_NAME / f"{run.name}{FAILED_SUFFIX}"
+
+
+def run_status(out: Path, run: SweepRun) -> tuple[str, str]:
+    """(status, error) of a run of the study in ``out``: done, failed (with its error) or missing."""
+    if run_dir(out, run).is_dir():
+        return "done", ""
+    failed = failure_path(out, run)
+    return ("failed", failed.read_text().strip()) if failed.exists() else ("missing", "")
+
+
+def run_one(run: SweepRun, out: Path, ranks: int | None = None, launcher: str | None = None) -> None:
+    """Run ``run`` (on ``ranks`` ranks started by ``launcher``, when given) in its part directory
+    and rename it into place when every file is written; a run that fails leaves no directory."""
     from hexdem.experiments.run import run_experiment
 
+    config = run.config.replace(**{key: value for key, value in (("ranks", ranks), ("launcher", launcher))
+                                   if value is not None})
     final = run_dir(out, run)
     partial = final.with_name(f".{final.name}.part")
     shutil.rmtree(partial, ignore_errors=True)
     try:
-        run_experiment(run.config, partial, log=lambda message: None, comm=comm)
-    except HexdemError as exc:
-        raise HexdemError(f"run {run.name}: {exc}") from None
+        run_experiment(config, partial, log=lambda message: None)
+    except BaseException:
+        shutil.rmtree(partial, ignore_errors=True)
+        raise
     os.replace(partial, final)
 
 
@@ -81,30 +93,122 @@ def _check_plan(out: Path, plan: dict) -> None:
     write_json(path, plan)
 
 
-def run_sweep(base: dict, variations: list[Variation], out, workers: int = 1, launcher: str | None = None,
-              source: str = "the base configuration", log=None) -> list[tuple]:
-    """Run (or resume) the sweep into ``out`` and write its table and figure; the table's rows."""
-    from hexdem.experiments.sweep_table import sweep_figure, write_table
-
-    log = log or (lambda message: print(f"hexdem sweep: {message}", file=sys.stderr, flush=True))
-    positive_int("--workers", workers)
+def plan_study(base: dict, variations: list[Variation], out, source: str = "the base configuration") -> list[SweepRun]:
+    """Check the sweep and write its plan into ``out`` (a folder made if needed); its runs."""
     runs = plan_sweep(base, variations, source)
-    if launcher is not None or workers > 1:
-        launcher_command(launcher)  # refused before anything is written into out
     out = ensure_writable_dir(out)
+    _check_plan(out, {"base": base, "vary": {v.key: list(v.texts) for v in variations}})
+    ensure_writable_dir(out / RUNS_NAME)
+    return runs
+
+
+def planned_study(out) -> tuple[list[SweepRun], list[Variation]]:
+    """The runs and variations of the study planned in ``out``."""
+    path = Path(out) / PLAN_NAME
+    try:
+        plan = json.loads(path.read_text())
+        base, vary = plan["base"], plan["vary"]
+    except FileNotFoundError:
+        raise HexdemError(f"{out} holds no planned sweep (no {PLAN_NAME}); plan it with "
+                          f"hexdem sweep --vary KEY=V1,V2,... --out {out} --plan-only") from None
+    except (OSError, ValueError, KeyError, TypeError):
+        raise HexdemError(f"{path} is unreadable: {out} does not hold a hexdem sweep") from None
+    variations = [Variation.parse(f"{key}={','.join(texts)}") for key, texts in vary.items()]
+    return plan_sweep(base, variations, str(path)), variations
+
+
+def _record_failure(out: Path, run: SweepRun, error: BaseException) -> str:
+    message = describe(error)
+    failure_path(out, run).write_text(message + "\n")
+    return message
+
+
+def run_study(out: Path, runs: list[SweepRun], workers: int = 1, parsl=None, ranks: int | None = None,
+              launcher: str | None = None, log=None) -> None:
+    """Run the runs of ``runs`` that are missing or failed in the study folder ``out``, each one a
+    task of the study executor, recording the failures."""
+    log = log or _log
     with locked_directory(out, "another hexdem sweep"):
-        _check_plan(out, {"base": base, "vary": {v.key: list(v.texts) for v in variations}})
-        ensure_writable_dir(out / RUNS_NAME)
         for leftover in (out / RUNS_NAME).glob(".*.part"):
             shutil.rmtree(leftover, ignore_errors=True)
-        todo = tuple(run for run in runs if not run_dir(out, run).is_dir())
-        log(f"{len(runs)} runs ({len(runs) - len(todo)} done before), {min(workers, max(len(todo), 1))} at once")
-        if todo:
-            done_before = len(runs) - len(todo)
-            run_on_ranks(SweepJob(todo, out), min(workers, len(todo)), out / "mpi", launcher,
-                         progress=(len(runs), "hexdem sweep", lambda: done_before + sum(
-                             run_dir(out, run).is_dir() for run in todo)))
-        rows = write_table(out, runs, variations)
-        sweep_figure(out, runs, variations, rows)
+        todo = [run for run in runs if not run_dir(out, run).is_dir()]
+        where = f"on Parsl ({parsl})" if parsl is not None else f"{min(workers, max(len(todo), 1))} at once"
+        log(f"{len(runs)} runs ({len(runs) - len(todo)} done before), {where}")
+        if not todo:
+            return
+        for run in todo:
+            failure_path(out, run).unlink(missing_ok=True)
+        bar = progress_bar(len(runs), "hexdem sweep", unit="run")
+        bar.update(len(runs) - len(todo))
+        with study_executor(min(workers, len(todo)), parsl) as executor:
+            named = {run.name: run for run in todo}
+            tasks = {name: (run_one, run, out, ranks, launcher) for name, run in named.items()}
+            for name, _, error in run_tasks(executor, tasks):
+                if error is not None:
+                    log(f"run {name} failed: {_record_failure(out, named[name], error)}")
+                bar.update(1)
+        bar.close()
+
+
+def run_single(out, index: int, ranks: int | None = None, launcher: str | None = None) -> SweepRun:
+    """Run run ``index`` (from 0, in the plan's order) of the study planned in ``out`` in this
+    process, whatever it left before; a failure is recorded and raised."""
+    check_options(ranks=ranks, launcher=launcher)
+    out = Path(out)
+    runs, _ = planned_study(out)
+    if not 0 <= index < len(runs):
+        raise HexdemError(f"--run {index}: {out} plans runs 0 to {len(runs) - 1}")
+    run = runs[index]
+    shutil.rmtree(run_dir(out, run), ignore_errors=True)
+    failure_path(out, run).unlink(missing_ok=True)
+    try:
+        run_one(run, out, ranks, launcher)
+    except Exception as exc:
+        raise HexdemError(f"run {index} ({run.name}) failed: {_record_failure(out, run, exc)}") from None
+    return run
+
+
+def collect(out: Path, runs: list[SweepRun], variations: list[Variation], log=None) -> list[tuple]:
+    """Write the table and figure of the study in ``out``; its rows. Failed or missing runs are
+    rows without figures, and then an error naming them once the table is written."""
+    from hexdem.experiments.sweep_table import sweep_figure, write_table
+
+    log = log or _log
+    states = [run_status(out, run) for run in runs]
+    rows = write_table(out, runs, variations, states)
+    sweep_figure(out, runs, variations, rows)
     log(f"results in {out / 'sweep.csv'}")
+    unfinished = {what: [run.name for run, (status, _) in zip(runs, states) if status == what]
+                  for what in ("failed", "missing")}
+    if any(unfinished.values()):
+        parts = [f"{len(names)} {what} ({'; '.join(names)})" for what, names in unfinished.items() if names]
+        raise HexdemError(f"{sum(map(len, unfinished.values()))} of {len(runs)} runs did not finish: "
+                          f"{', '.join(parts)}; errors in {out / RUNS_NAME}/NAME{FAILED_SUFFIX}; "
+                          "rerun to run them again")
     return rows
+
+
+def _log(message: str) -> None:
+    print(f"hexdem sweep: {message}", file=sys.stderr, flush=True)
+
+
+def check_options(workers: int = 1, parsl=None, ranks: int | None = None, launcher: str | None = None) -> None:
+    """Refuse bad running options in one line, before anything is written."""
+    positive_int("--workers", workers)
+    if ranks is not None:
+        positive_int("--ranks-per-run", ranks)
+    if launcher is not None:
+        launcher_command(launcher)
+    if parsl is not None:
+        load_parsl_config(parsl)
+
+
+def run_sweep(base: dict, variations: list[Variation], out, workers: int = 1, parsl=None, ranks: int | None = None,
+              launcher: str | None = None, source: str = "the base configuration", log=None) -> list[tuple]:
+    """Plan (or resume) the sweep into ``out``, run it and write its table and figure; the table's
+    rows. An error names the runs that failed, after the table is written."""
+    check_options(workers, parsl, ranks, launcher)
+    runs = plan_study(base, variations, out, source)
+    out = Path(out)
+    run_study(out, runs, workers, parsl, ranks, launcher, log)
+    return collect(out, runs, variations, log)

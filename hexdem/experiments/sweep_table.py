@@ -4,6 +4,8 @@ One row per run, in the plan's order:
 
 * the varied keys, one column each, headed by the key as given (``regions.0.material``);
 * ``run``: the run's directory, relative to the sweep's;
+* ``status``: ``done``, ``failed`` (its error is in ``runs/<name>.failed`` and in ``error``) or
+  ``missing`` (not run yet); the figures of a run that is not done are empty;
 * :data:`SUMMARY_COLUMNS`, the scalar figures of the run's ``summary.json`` (``n_beads`` is its
   ``lattice.n_beads``);
 * ``energy_share_<region>``: each material region's share of the energy (kinetic and contact)
@@ -11,7 +13,8 @@ One row per run, in the plan's order:
 * ``decay_exponent_<line>``: the power law :math:`V_n ∝ n^{−p}` fitted to the peak speeds of each
   observation line in ``peaks.csv`` (least squares of log V_n on log n) over the beads
   :data:`DECAY_FIRST_N` ≤ n ≤ N − 2 of a line of N beads: n = 0 and 1 are set by the impact,
-  and the last bead meets the far wall; empty with fewer than three beads in that range.
+  and the last bead meets the far wall; empty with fewer than three beads in that range;
+* ``error``: the error of a failed run, in one line.
 """
 
 from __future__ import annotations
@@ -77,19 +80,22 @@ def _first_seen(keys_per_run) -> list[str]:
     return list(seen)
 
 
-def write_table(out: Path, runs: list[SweepRun], variations) -> list[tuple]:
-    """Write ``out / sweep.csv`` (see the module docstring); its rows."""
-    figures = [_run_figures(out / "runs" / run.name) for run in runs]
+def write_table(out: Path, runs: list[SweepRun], variations, states) -> list[tuple]:
+    """Write ``out / sweep.csv`` (see the module docstring) from the runs' ``states``, a
+    (status, error) each; its rows."""
+    empty = (dict.fromkeys(SUMMARY_COLUMNS, ""), {}, {})
+    figures = [_run_figures(out / "runs" / run.name) if status == "done" else empty
+               for run, (status, _) in zip(runs, states)]
     regions = _first_seen(shares for _, shares, _ in figures)
     lines = _first_seen(exponents for _, _, exponents in figures)
-    header = (*(v.key for v in variations), "run", *SUMMARY_COLUMNS, *(f"energy_share_{r}" for r in regions),
-              *(f"decay_exponent_{line}" for line in lines))
+    header = (*(v.key for v in variations), "run", "status", *SUMMARY_COLUMNS,
+              *(f"energy_share_{r}" for r in regions), *(f"decay_exponent_{line}" for line in lines), "error")
     def cell(value):
         return "" if value == "" or not np.isfinite(value) else value
 
-    rows = [(*run.values.values(), f"runs/{run.name}", *scalars.values(), *(shares.get(r, "") for r in regions),
-             *(cell(exponents.get(line, "")) for line in lines))
-            for run, (scalars, shares, exponents) in zip(runs, figures)]
+    rows = [(*run.values.values(), f"runs/{run.name}", status, *scalars.values(),
+             *(shares.get(r, "") for r in regions), *(cell(exponents.get(line, "")) for line in lines), error)
+            for run, (status, error), (scalars, shares, exponents) in zip(runs, states, figures)]
     write_csv(out / "sweep.csv", header, rows)
     return [header, *rows]
 

@@ -58,22 +58,15 @@ def make_engine(name: str, dump: bool = False, gravity_m_s2=None):
     return LammpsEngine(dump=dump, gravity_m_s2=gravity_m_s2)
 
 
-def track_impact(job: ImpactJob, ranks: int = 1, comm=None, launcher: str | None = None) -> ImpactAnalysis | None:
+def track_impact(job: ImpactJob, ranks: int = 1, launcher: str | None = None) -> ImpactAnalysis:
     """Run ``job`` on ``ranks`` MPI ranks (LAMMPS only; 1 without ``launcher``: in this
     process) started by ``launcher`` (see :func:`~hexdem.experiments.parallel.run_on_ranks`)
     and analyse it; launched ranks show their progress through LAMMPS's log (the steps it has
-    logged, every twentieth of the run), as one rank in-process does through its callback. Given ``comm``, every rank of that communicator calls this instead; rank 0
-    gets the analysis, the others None."""
-    if comm is not None:
-        result = job(comm)
-    else:
-        ranks = ranks if job.engine == "lammps" else 1
-        launched = ranks > 1 or launcher is not None
-        log = Deck(job.directory, job.settings, job.model.n_bodies).log_path
-        progress = ((job.settings.n_steps, f"LAMMPS on {ranks} ranks", lambda: logged_step(log))
-                    if launched and job.show_progress else None)
-        result = run_on_ranks(job, ranks, job.directory, launcher, progress)
-    if result is None:
-        return None
-    tracked, description = result
+    logged, every twentieth of the run), as one rank in-process does through its callback."""
+    ranks = ranks if job.engine == "lammps" else 1
+    launched = ranks > 1 or launcher is not None
+    log = Deck(job.directory, job.settings, job.model.n_bodies).log_path
+    progress = ((job.settings.n_steps, f"LAMMPS on {ranks} ranks", lambda: logged_step(log))
+                if launched and job.show_progress else None)
+    tracked, description = run_on_ranks(job, ranks, job.directory, launcher, progress)
     return ImpactAnalysis.from_tracker(job.model, job.settings, tracked, description)

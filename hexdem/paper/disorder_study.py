@@ -96,7 +96,7 @@ def run_study_ensemble(entry: StudyEnsemble, settings: PaperSettings, out: Path,
     config = entry.config(settings)
     sources = tuple(Ensemble(other.config(settings), out / other.name) for other in others
                     if other != entry and (out / other.name).is_dir())
-    summary = run_ensemble(config, out / entry.name, workers=settings.workers, launcher=settings.launcher,
+    summary = run_ensemble(config, out / entry.name, workers=settings.workers, launcher=settings.launcher, parsl=settings.parsl,
                            scaling_json=scaling_json, log=lambda message: None, share_from=sources)
     return {"name": entry.name, "sigma_per_tol": entry.sigma_per_tol, "preparation": entry.preparation_name,
             **{key: summary[key] for key in ("prestress", "this_run", "leading_pulse_defined_fraction",

@@ -80,7 +80,7 @@ def run_friction_ensemble(mu: float, settings: PaperSettings, out: Path, scaling
     if not paper.out.is_dir():
         raise HexdemError(f"{paper.out} is missing: the friction study strikes that ensemble's packings")
     summary = run_ensemble(friction_config(mu, settings), out / "friction" / friction_name(mu),
-                           workers=settings.workers, launcher=settings.launcher, scaling_json=scaling_json,
+                           workers=settings.workers, launcher=settings.launcher, parsl=settings.parsl, scaling_json=scaling_json,
                            log=lambda message: None, share_from=(paper,))
     return {"name": friction_name(mu), "friction": mu,
             **{key: summary[key] for key in ("this_run", *MEASURES.values())}}

@@ -82,7 +82,8 @@ def _scaling(settings: PaperSettings, out: Path) -> dict:
     from hexdem.theory.outputs import write_outputs
     from hexdem.theory.sweep import SweepSettings, run_sweep
 
-    sweep = run_sweep(SweepSettings(n_v0=settings.n_v0, workers=settings.workers, launcher=settings.launcher),
+    sweep = run_sweep(SweepSettings(n_v0=settings.n_v0, workers=settings.workers, launcher=settings.launcher,
+                                    parsl=settings.parsl),
                       log=_quiet)
     return write_outputs(sweep, out / "scaling")
 

@@ -11,6 +11,7 @@ from dataclasses import asdict, dataclass
 from hexdem.common.checks import positive_int
 from hexdem.disorder.ensemble import check_impact_steps
 from hexdem.disorder.preparation import TOLERANCE_M
+from hexdem.experiments.executors import load_parsl_config
 from hexdem.model.config import STEPS_PER_CONTACT
 
 #: Disorder strengths σ / tol of the disorder study (the paper's is 6).
@@ -36,9 +37,11 @@ RELAXED_WALL_SLACK_M = TOLERANCE_M
 
 @dataclass(frozen=True)
 class PaperSettings:
-    """``quick``: the thinned variant; ``workers``: processes (sweep runs, LAMMPS partitions,
-    MPI ranks of Fig. 4) at once; ``launcher``: the MPI launcher command that starts them
-    (None: this environment's ``mpiexec``, and the sweep in local processes);
+    """``quick``: the thinned variant; ``workers``: processes (the studies' runs, MPI ranks of
+    Fig. 4) at once; ``launcher``: the MPI launcher command that starts them
+    (None: this environment's ``mpiexec``); ``parsl``: a Parsl configuration file that takes
+    the runs of the studies (the scaling sweep, the ensembles' impacts) instead of local
+    processes (:mod:`hexdem.experiments.executors`);
     ``steps_per_contact`` the time step of the LAMMPS impacts (snapshots, ensembles), τ/this:
     the sweep keeps its own 140 (:class:`~hexdem.theory.sweep.SweepSettings`).
 
@@ -51,10 +54,13 @@ class PaperSettings:
     quick: bool = False
     workers: int = 2
     launcher: str | None = None
+    parsl: str | None = None
     steps_per_contact: int = STEPS_PER_CONTACT
 
     def __post_init__(self):
         positive_int("--workers", self.workers)
+        if self.parsl is not None:
+            load_parsl_config(self.parsl)
         check_impact_steps("--steps-per-contact", self.steps_per_contact)
 
     @property
@@ -80,7 +86,7 @@ class PaperSettings:
         return (41, 21) if self.quick else (91, 46)
 
     def identity(self) -> dict:
-        """What the results depend on (not the number of workers nor the launcher)."""
+        """What the results depend on (not the number of workers, the launcher nor Parsl)."""
         return {"quick": self.quick, "steps_per_contact": self.steps_per_contact}
 
     def as_dict(self) -> dict:

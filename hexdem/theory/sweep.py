@@ -16,25 +16,20 @@ the fitted beads (a larger hexagon gives identical peaks).
 
 from __future__ import annotations
 
-import os
 import sys
 import tempfile
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field
-from multiprocessing import get_context
 
 import numpy as np
 
 from hexdem.errors import HexdemError
-from hexdem.experiments.parallel import run_on_ranks, spread_tasks
+from hexdem.experiments.executors import describe, load_parsl_config, run_tasks, study_executor
 from hexdem.theory.scaling import DEFAULT_LAST, Combination, CombinationFit, fit_combination
 from hexdem.model.run_settings import contact_time_s
 
 #: Strike angles of the sweep [deg]: each one serves two combinations.
 STRIKES_DEG = (0.0, 30.0)
-#: Names of the markers that runs of the sweep on MPI ranks leave when they finish.
-DONE_PREFIX = "done-"
 
 
 @dataclass(frozen=True)
@@ -44,10 +39,10 @@ class SweepSettings:
     ``v0_min``, ``v0_max``, ``n_v0``: evenly spaced V₀; ``last``: the last bead any fit may
     use; ``edge_beads``: hexagon size (None: ``last`` + 4); ``steps_per_contact``: time step
     τ(V₀)/this; ``samples_per_contact``: output samples per τ(V₀); ``duration_contacts``: run
-    length in τ(V₀); ``engine``: "reference" or "lammps"; ``workers``: parallel runs;
-    ``launcher``: an MPI launcher command (e.g. ``"mpiexec -f hosts"``): the runs then go to
-    ``workers`` MPI ranks it starts, on as many machines as it reaches, instead of local
-    processes.
+    length in τ(V₀); ``engine``: "reference" or "lammps"; ``workers``: runs at once in local
+    processes; ``parsl``: a Parsl configuration file that takes the runs instead
+    (:mod:`hexdem.experiments.executors`); ``launcher``: the MPI launcher command that starts
+    each run's rank (e.g. ``"srun"``; None: in the worker's process).
     """
 
     v0_min: float = 0.01
@@ -61,6 +56,7 @@ class SweepSettings:
     engine: str = "reference"
     workers: int = 2
     launcher: str | None = None
+    parsl: str | None = None
 
     def __post_init__(self):
         if not (0 < self.v0_min < self.v0_max and self.n_v0 >= 4):
@@ -70,6 +66,8 @@ class SweepSettings:
             raise HexdemError("need steps_per_contact >= samples_per_contact >= 5")
         if self.workers < 1:
             raise HexdemError(f"workers must be >= 1, got {self.workers}")
+        if self.parsl is not None:
+            load_parsl_config(self.parsl)
         if self.last < 3:
             raise HexdemError(f"the last bead of the windows must be >= 3, got {self.last}")
 
@@ -91,7 +89,8 @@ class SweepSettings:
 
         base = RunConfig(shape="hexagon", edge_beads=self.hexagon_edge, wall_material="none",
                          units="nondimensional", v0=float(v0), strike_angle_deg=float(strike_deg),
-                         engine=self.engine, dump_every=self.steps_per_contact // self.samples_per_contact)
+                         engine=self.engine, dump_every=self.steps_per_contact // self.samples_per_contact,
+                         launcher=self.launcher)
         tau = contact_time_s(base) / base.unit_system.time_s
         return base.replace(dt=tau / self.steps_per_contact, duration=self.duration_contacts * tau)
 
@@ -110,15 +109,14 @@ class RunPeaks:
     wall_time_s: float
 
 
-def run_one(settings: SweepSettings, v0: float, strike_deg: float, comm=None) -> RunPeaks:
-    """Simulate one V₀ and strike of the sweep in a scratch directory (``comm``: a one-rank
-    communicator inside an MPI job, else None)."""
+def run_one(settings: SweepSettings, v0: float, strike_deg: float) -> RunPeaks:
+    """Simulate one V₀ and strike of the sweep in a scratch directory."""
     from hexdem.experiments.run import simulate
 
     start = time.perf_counter()
     config = settings.config(v0, strike_deg)
     with tempfile.TemporaryDirectory(prefix="hexdem-scaling-") as scratch:
-        analysis = simulate(config, scratch, trace_lines=("0", "+30"), comm=comm)
+        analysis = simulate(config, scratch, trace_lines=("0", "+30"))
     r = analysis.results
     lines = {name: r.lines[name][:settings.last + 2] for name in ("0", "+30")}
     traces = {}
@@ -167,8 +165,8 @@ def run_sweep(settings: SweepSettings, log=None) -> Sweep:
     log = log or (lambda message: print(f"hexdem scaling: {message}", file=sys.stderr, flush=True))
     jobs = [(strike, i, v0) for strike in STRIKES_DEG for i, v0 in enumerate(settings.v0)]
     sweep, start = Sweep(settings), time.perf_counter()
-    log(f"{len(jobs)} runs ({settings.engine}, hexagon {settings.hexagon_edge} per edge, no walls, "
-        f"{settings.workers} workers)")
+    where = f"on Parsl ({settings.parsl})" if settings.parsl is not None else f"{settings.workers} workers"
+    log(f"{len(jobs)} runs ({settings.engine}, hexagon {settings.hexagon_edge} per edge, no walls, {where})")
     for done, (key, result) in enumerate(_results(settings, jobs), 1):
         sweep.runs[key] = result
         log(f"[{done}/{len(jobs)}] strike {result.strike_deg:g} deg, V0 = {result.v0:.4g}: "
@@ -177,51 +175,17 @@ def run_sweep(settings: SweepSettings, log=None) -> Sweep:
     return sweep
 
 
-@dataclass(frozen=True)
-class SweepTasks:
-    """An MPI job: the sweep's runs ``jobs`` [(strike, i, V₀)] spread over the ranks, one
-    engine per rank; each finished run leaves a marker in ``directory`` (for the progress)."""
-
-    settings: SweepSettings
-    jobs: tuple
-    directory: str
-
-    def __call__(self, comm):
-        return spread_tasks(comm, self.jobs, self._run)
-
-    def _run(self, job, alone) -> RunPeaks:
-        strike, i, v0 = job
-        result = run_one(self.settings, v0, strike, alone)
-        open(os.path.join(self.directory, f"{DONE_PREFIX}{strike:g}-{i}"), "w").close()
-        return result
-
-
-def _on_ranks(settings: SweepSettings, jobs):
-    """Yield ((strike, i), RunPeaks) of every run, the runs spread over MPI ranks that
-    ``settings.launcher`` starts. The runs are handed over in a hidden directory under the
-    current one, which ranks on other machines must share (a local /tmp would not be)."""
-    with tempfile.TemporaryDirectory(prefix=".hexdem-sweep-", dir=os.getcwd()) as directory:
-        def count_done() -> int:
-            return sum(name.startswith(DONE_PREFIX) for name in os.listdir(directory))
-
-        results = run_on_ranks(SweepTasks(settings, tuple(jobs), directory), min(settings.workers, len(jobs)),
-                               directory, settings.launcher, progress=(len(jobs), "V0 sweep", count_done))
-    for (strike, i, _), result in zip(jobs, results):
-        yield (strike, i), result
-
-
 def _results(settings: SweepSettings, jobs):
-    """Yield ((strike, i), RunPeaks) as runs finish: on MPI ranks with a launcher, in this
-    process for one worker, else in spawned processes (callers' scripts need an
-    ``if __name__ == "__main__":`` guard)."""
-    if settings.launcher is not None:
-        yield from _on_ranks(settings, jobs)
-        return
-    if settings.workers == 1:
-        for strike, i, v0 in jobs:
-            yield (strike, i), run_one(settings, v0, strike)
-        return
-    with ProcessPoolExecutor(max_workers=settings.workers, mp_context=get_context("spawn")) as pool:
-        futures = {pool.submit(run_one, settings, v0, strike): (strike, i) for strike, i, v0 in jobs}
-        for future in as_completed(futures):
-            yield futures[future], future.result()
+    """Yield ((strike, i), RunPeaks) as runs finish, each run a task of the study executor
+    (local processes: callers' scripts need an ``if __name__ == "__main__":`` guard); the runs
+    that failed are named at the end."""
+    tasks = {(strike, i): (run_one, settings, v0, strike) for strike, i, v0 in jobs}
+    failed = []
+    with study_executor(min(settings.workers, len(jobs)), settings.parsl) as executor:
+        for (strike, i), result, error in run_tasks(executor, tasks):
+            if error is None:
+                yield (strike, i), result
+            else:
+                failed.append(f"strike {strike:g} deg, V0 = {settings.v0[i]:.4g}: {describe(error)}")
+    if failed:
+        raise HexdemError(f"{len(failed)} of {len(jobs)} runs of the V0 sweep failed; {'; '.join(failed)}")

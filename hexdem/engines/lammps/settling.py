@@ -87,12 +87,12 @@ def write_settling_deck(model: GranularModel, stage: SettlingStage, directory) -
     return directory
 
 
-def run_settling_deck(directory, comm=None) -> None:
-    """Run the settling deck in ``directory`` in this process (``comm``: an mpi4py communicator
-    of the ranks that run it together, None: this one alone), as ``lmp -in in.hexdem`` would."""
+def run_settling_deck(directory) -> None:
+    """Run the settling deck in ``directory`` in this process, on this rank alone, as
+    ``lmp -in in.hexdem`` would."""
     directory = Path(directory)
     with working_directory(directory):
-        lmp = start_lammps(directory, comm)
+        lmp = start_lammps(directory)
         try:
             lmp.file(DECK_NAME)
         except Exception as exc:

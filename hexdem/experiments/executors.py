@@ -1,0 +1,144 @@
+"""Where the runs of a study go: a local process pool, or Parsl.
+
+Every study (``hexdem sweep``, ``hexdem ensemble``'s impacts, ``hexdem scaling``'s V₀ sweep,
+``hexdem paper``'s parts) hands each of its runs, one task each, to a
+:class:`concurrent.futures.Executor` that :func:`study_executor` opens:
+
+* by default a :class:`LocalPool` of ``workers`` spawned processes on this machine;
+* with ``parsl`` (the path of a Parsl configuration file that defines ``config``, a
+  :class:`parsl.config.Config`) Parsl's DataFlowKernel of that configuration, behind
+  :class:`ParslExecutor`, whose ``submit`` returns Parsl's AppFutures (they are
+  :class:`concurrent.futures.Future` s). Parsl then places the tasks on whatever its providers
+  reach (a Slurm allocation, a laptop) and retries them as its ``retries`` says.
+
+:func:`run_tasks` submits the tasks and yields each one's outcome as it finishes, so that a
+failed task is recorded by the study and the others go on. A task whose local worker process
+died or raised is submitted once more (:data:`LOCAL_RETRIES`); Parsl's tasks are retried by
+Parsl. Tasks that write files must write them where every worker sees them at the same
+absolute path (a shared filesystem across machines).
+"""
+
+from __future__ import annotations
+
+import os
+import runpy
+import sys
+from concurrent.futures import FIRST_COMPLETED, Executor, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+from contextlib import contextmanager
+from multiprocessing import get_context
+from pathlib import Path
+
+from hexdem.common.checks import positive_int
+from hexdem.engines.lammps.standalone import die_with_parent
+from hexdem.errors import HexdemError
+
+#: Times a task of the local pool is submitted again after it failed.
+LOCAL_RETRIES = 1
+
+
+class LocalPool(Executor):
+    """A process pool of ``workers`` spawned processes that starts a fresh pool when one of its
+    processes died (a broken :class:`ProcessPoolExecutor` takes no more tasks). The processes end
+    with this one (on Linux), so that none keeps writing into a study that was killed."""
+
+    retries = LOCAL_RETRIES
+
+    def __init__(self, workers: int):
+        self.workers = positive_int("--workers", workers)
+        self._pool = self._new()
+
+    def _new(self) -> ProcessPoolExecutor:
+        return ProcessPoolExecutor(max_workers=self.workers, mp_context=get_context("spawn"),
+                                   initializer=die_with_parent, initargs=(os.getpid(),))
+
+    def submit(self, fn, /, *args, **kwargs):
+        try:
+            return self._pool.submit(fn, *args, **kwargs)
+        except BrokenProcessPool:
+            self._pool.shutdown(wait=False, cancel_futures=True)
+            self._pool = self._new()
+            return self._pool.submit(fn, *args, **kwargs)
+
+    def shutdown(self, wait=True, *, cancel_futures=False):
+        self._pool.shutdown(wait=wait, cancel_futures=cancel_futures)
+
+
+def _call(fn, *args, **kwargs):
+    """The one Parsl app: any picklable callable, called on a worker."""
+    return fn(*args, **kwargs)
+
+
+def load_parsl_config(path):
+    """The ``config`` that the Parsl configuration file ``path`` defines; a missing or broken
+    file, or one without a :class:`parsl.config.Config` named ``config``, is one clear line."""
+    try:
+        from parsl.config import Config
+    except ImportError:
+        raise HexdemError("--parsl needs Parsl: pip install 'hexdem[parsl]'") from None
+    if not Path(path).is_file():
+        raise HexdemError(f"--parsl {path}: no such file")
+    try:
+        namespace = runpy.run_path(str(path))
+    except Exception as exc:
+        raise HexdemError(f"--parsl {path}: the configuration file fails: {type(exc).__name__}: {exc}") from None
+    config = namespace.get("config")
+    if not isinstance(config, Config):
+        raise HexdemError(f"--parsl {path} must define config = parsl.config.Config(...), "
+                          f"got {type(config).__name__ if 'config' in namespace else 'no config'}")
+    return config
+
+
+class ParslExecutor(Executor):
+    """Parsl's DataFlowKernel of ``config`` as an :class:`Executor`: ``submit`` returns an
+    AppFuture. Parsl retries failed tasks itself (``config.retries``)."""
+
+    retries = 0
+
+    def __init__(self, config):
+        from parsl import DataFlowKernel, python_app
+
+        # Parsl's HighThroughputExecutor starts interchange.py and process_worker_pool.py from PATH
+        os.environ["PATH"] = os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", "")])
+        self._dfk = DataFlowKernel(config)
+        self._app = python_app(_call, data_flow_kernel=self._dfk)
+
+    def submit(self, fn, /, *args, **kwargs):
+        return self._app(fn, *args, **kwargs)
+
+    def shutdown(self, wait=True, *, cancel_futures=False):
+        self._dfk.cleanup()
+
+
+@contextmanager
+def study_executor(workers: int, parsl=None):
+    """The executor of a study's runs: Parsl with the configuration file ``parsl``, else a
+    :class:`LocalPool` of ``workers`` processes; shut down on leaving."""
+    executor = ParslExecutor(load_parsl_config(parsl)) if parsl is not None else LocalPool(workers)
+    try:
+        yield executor
+    finally:
+        executor.shutdown(cancel_futures=True)
+
+
+def describe(error: BaseException) -> str:
+    """A task's error in one line: hexdem's own message, or the exception's type and message."""
+    text = str(error) if isinstance(error, HexdemError) else f"{type(error).__name__}: {error}"
+    return " ".join(text.split())
+
+
+def run_tasks(executor, tasks: dict):
+    """Submit ``tasks`` {key: (fn, *args)} to ``executor``; yield (key, result, error) as each
+    finishes (``error``: None, or the exception of its last try), a failed task being submitted
+    again up to ``executor.retries`` times."""
+    tries = dict.fromkeys(tasks, 0)
+    futures = {executor.submit(*task): key for key, task in tasks.items()}
+    while futures:
+        for future in wait(futures, return_when=FIRST_COMPLETED).done:
+            key = futures.pop(future)
+            error = future.exception()
+            if error is not None and tries[key] < executor.retries:
+                tries[key] += 1
+                futures[executor.submit(*tasks[key])] = key
+            else:
+                yield key, None if error is not None else future.result(), error

@@ -1,0 +1,209 @@
+"""Studies on an executor (hexdem.experiments.executors): a real Parsl HighThroughputExecutor on
+this machine survives a worker killed mid-run and gives the serial sweep's runs; a failed run is
+recorded and the others finish; runs of two ranks each; one run at a time of a planned study
+(a job array's task) and the table collected after; bad input in one line."""
+
+import threading
+import time
+
+import psutil
+import pytest
+from conftest import read_csv
+
+from hexdem.cli.main import main
+
+#: A 6-per-edge hexagon (91 beads) for 3 ms: about half a second of LAMMPS a run.
+SMALL = "edge_beads = 6\nduration = 3e-3\n"
+#: Eight runs.
+EIGHT = ["--vary", "v0=0.2,0.3,0.4,0.5", "--vary", "friction=0,0.1"]
+#: Parsl on this machine: one block of two workers, a lost worker noticed within seconds, its
+#: tasks retried on a block started afresh.
+PARSL_CONFIG = '''
+from parsl.config import Config
+from parsl.executors import HighThroughputExecutor
+from parsl.providers import LocalProvider
+
+config = Config(
+    executors=[HighThroughputExecutor(label="local", address="127.0.0.1", max_workers_per_node=2,
+                                      heartbeat_threshold=5, heartbeat_period=1, block_error_handler=False,
+                                      provider=LocalProvider(init_blocks=1, min_blocks=1, max_blocks=1))],
+    retries=2, run_dir="{run_dir}")
+'''
+
+
+def sweep(tmp_path, *options):
+    base = tmp_path / "base.toml"
+    base.write_text(SMALL)
+    return main(["sweep", "--config", str(base), *options])
+
+
+def parsl_config(tmp_path) -> str:
+    path = tmp_path / "parsl_local.py"
+    path.write_text(PARSL_CONFIG.format(run_dir=tmp_path / "runinfo"))
+    return str(path)
+
+
+def peaks_of(out) -> dict:
+    _, rows = read_csv(out / "sweep.csv")
+    return {row["run"]: read_csv(out / row["run"] / "peaks.csv") for row in rows}
+
+
+@pytest.fixture(scope="module")
+def serial(tmp_path_factory):
+    """The eight runs one after the other."""
+    root = tmp_path_factory.mktemp("serial")
+    assert sweep(root, *EIGHT, "--out", str(root / "out")) == 0
+    return root / "out"
+
+
+def kill_a_worker_mid_run(out, killed: list) -> None:
+    """Once two runs are done, kill -9 the Parsl worker that has a run's part folder open."""
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not killed:
+        if len([path for path in (out / "runs").glob("*") if path.is_dir() and not path.name.startswith(".")]) >= 2:
+            for process in psutil.process_iter(["cmdline"]):
+                try:
+                    if any("spawn_main" in word for word in process.info["cmdline"] or ()) and \
+                            any("/runs/." in f.path for f in process.open_files()):
+                        process.kill()
+                        killed.append(process.pid)
+                        return
+                except psutil.Error:
+                    pass
+        time.sleep(0.05)
+
+
+def test_parsl_survives_a_killed_worker_with_the_serial_sweeps_runs(serial, tmp_path, capsys):
+    out, killed = tmp_path / "out", []
+    killer = threading.Thread(target=kill_a_worker_mid_run, args=(out, killed))
+    killer.start()
+    assert sweep(tmp_path, *EIGHT, "--out", str(out), "--parsl", parsl_config(tmp_path)) == 0
+    killer.join()
+    assert killed, "no worker was found mid-run"
+    assert "8 runs (0 done before), on Parsl" in capsys.readouterr().err
+    _, rows = read_csv(out / "sweep.csv")
+    assert [row["status"] for row in rows] == ["done"] * 8
+    assert peaks_of(out) == peaks_of(serial)
+    assert not list((out / "runs").glob(".*"))
+
+
+def test_a_failed_run_is_recorded_and_the_others_finish(tmp_path, capsys):
+    """dt = 3.5e-6 s passes the plan (under the contact time / 20) but its energy drift does not:
+    retried as Parsl's config says, recorded, named at the end; a rerun runs only that one."""
+    out = tmp_path / "out"
+    options = ["--vary", "dt=1e-7,3.5e-6", "--out", str(out)]
+    assert sweep(tmp_path, *options, "--parsl", parsl_config(tmp_path)) == 2
+    error = capsys.readouterr().err
+    assert "run dt=3.5e-6 failed: energy drift" in error
+    assert "1 of 2 runs did not finish: 1 failed (dt=3.5e-6)" in error.strip().splitlines()[-1]
+    header, rows = read_csv(out / "sweep.csv")
+    assert [(row["status"], row["error"][:12]) for row in rows] == [("done", ""), ("failed", "energy drift")]
+    assert (out / "runs" / "dt=1e-7" / "peaks.csv").exists()
+    assert not (out / "runs" / "dt=3.5e-6").exists() and not list((out / "runs").glob(".*"))
+    assert "energy drift" in (out / "runs" / "dt=3.5e-6.failed").read_text()
+    assert sweep(tmp_path, *options, "--workers", "2") == 2
+    assert "2 runs (1 done before), 1 at once" in capsys.readouterr().err
+
+
+def test_runs_of_two_ranks_each(tmp_path, launcher):
+    """--ranks-per-run 2: every run starts its own two ranks (here through a launcher that notes
+    them) and gives the one-rank runs' peaks."""
+    command, log = launcher
+    before = len(log.read_text().splitlines()) if log.exists() else 0
+    two, one = tmp_path / "two", tmp_path / "one"
+    vary = ["--vary", "v0=0.2,0.4"]
+    assert sweep(tmp_path, *vary, "--out", str(two), "--workers", "2", "--ranks-per-run", "2",
+                 "--launcher", command) == 0
+    assert sweep(tmp_path, *vary, "--out", str(one), "--workers", "2") == 0
+    jobs = log.read_text().splitlines()[before:]
+    assert sorted(job.split()[:2] for job in jobs) == [["-n", "2"]] * 2
+    for (run, (header, mine)), (_, (_, theirs)) in zip(peaks_of(two).items(), peaks_of(one).items()):
+        speeds = [float(row["peak_speed"] or "nan") for row in mine]
+        assert speeds == pytest.approx([float(row["peak_speed"] or "nan") for row in theirs], rel=1e-9,
+                                       nan_ok=True), run
+
+
+def test_a_job_arrays_runs_one_at_a_time_then_the_table(serial, tmp_path, capsys):
+    """--plan-only lists the runs; --run I runs one (as a job array's task would), --collect
+    names what is missing and then writes the serial sweep's table."""
+    out = tmp_path / "out"
+    assert sweep(tmp_path, "--vary", "v0=0.2,0.3", "--vary", "friction=0", "--out", str(out), "--plan-only") == 0
+    listed = capsys.readouterr().out.splitlines()
+    assert listed == ["0\tv0=0.2,friction=0", "1\tv0=0.3,friction=0"]
+    assert main(["sweep", str(out), "--run", "1"]) == 0
+    assert main(["sweep", str(out), "--collect"]) == 2
+    assert "1 missing (v0=0.2,friction=0)" in capsys.readouterr().err
+    assert main(["sweep", str(out), "--run", "0"]) == 0
+    assert main(["sweep", str(out), "--collect"]) == 0
+    ours = peaks_of(out)
+    assert ours == {run: rows for run, rows in peaks_of(serial).items() if run in ours}
+
+
+@pytest.mark.parametrize("arguments, message", [
+    (["sweep", "{out}", "--run", "5"], "--run 5: {out} plans runs 0 to 1"),
+    (["sweep", "{tmp}/nothing", "--collect"], "holds no planned sweep"),
+    (["sweep", "{out}", "--vary", "v0=0.1"], "is a planned study"),
+    (["sweep", "--vary", "v0=0.1,0.2"], "a sweep needs --vary"),
+    (["sweep", "--run", "0"], "--run and --collect need the study folder"),
+    (["sweep", "{out}", "--run", "0", "--parsl", "x.py"], "--run I runs here, without --parsl"),
+    (["sweep", "{out}", "--run", "0", "--ranks-per-run", "0"], "--ranks-per-run must be a positive integer"),
+    (["sweep", "{out}", "--workers", "0"], "--workers must be a positive integer"),
+])
+def test_bad_study_commands_are_one_line(tmp_path, capsys, arguments, message):
+    out = tmp_path / "out"
+    assert sweep(tmp_path, "--vary", "v0=0.2,0.3", "--out", str(out), "--plan-only") == 0
+    capsys.readouterr()
+    filled = [word.format(out=out, tmp=tmp_path) for word in arguments]
+    assert main(filled) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and message.format(out=out) in lines[0], lines
+
+
+@pytest.mark.parametrize("text, message", [
+    (None, "no such file"),
+    ("config = 3\n", "must define config = parsl.config.Config(...), got int"),
+    ("import nonexistent_module\n", "the configuration file fails: ModuleNotFoundError"),
+])
+def test_a_bad_parsl_file_is_one_line_before_anything_is_written(tmp_path, capsys, text, message):
+    path = tmp_path / "parsl.py"
+    if text is not None:
+        path.write_text(text)
+    assert sweep(tmp_path, "--vary", "v0=0.2,0.3", "--out", str(tmp_path / "out"), "--parsl", str(path)) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and f"--parsl {path}" in lines[0] and message in lines[0], lines
+    assert not (tmp_path / "out").exists()
+
+
+def test_the_local_pools_processes_end_with_a_killed_study(tmp_path):
+    """A study killed outright leaves no worker behind to go on writing into its folder."""
+    import subprocess
+    import sys
+
+    script = tmp_path / "killed.py"
+    script.write_text("import os, time\nfrom hexdem.experiments.executors import LocalPool\n"
+                      "if __name__ == '__main__':\n    pool = LocalPool(2)\n"
+                      "    print(*{pool.submit(os.getpid).result() for _ in range(4)}, flush=True)\n"
+                      "    pool.submit(time.sleep, 60)\n    os._exit(0)\n")
+    workers = [int(pid) for pid in subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                                                  check=True, timeout=60).stdout.split()]
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and any(psutil.pid_exists(pid) for pid in workers):
+        time.sleep(0.1)
+    assert workers and not any(psutil.pid_exists(pid) for pid in workers)
+
+
+def test_the_guides_slurm_configuration_is_a_parsl_config(tmp_path):
+    """The across-machines guide's Parsl configuration loads (its address made local)."""
+    import re
+    from pathlib import Path
+
+    from parsl.providers import SlurmProvider
+
+    from hexdem.experiments.executors import load_parsl_config
+
+    guide = Path(__file__).resolve().parents[1] / "docs" / "guide" / "across-machines.md"
+    (block,) = re.findall(r"```python\n(.*?)```", guide.read_text(), flags=re.DOTALL)
+    path = tmp_path / "parsl_slurm.py"
+    path.write_text(block.replace('address_by_interface("ib0")', '"127.0.0.1"'))
+    config = load_parsl_config(path)
+    assert config.retries == 2 and isinstance(config.executors[0].provider, SlurmProvider)
