@@ -117,7 +117,7 @@ def test_a_bead_far_from_the_others_is_one_line(tmp_path, capsys):
     """A packing file with a bead at 1e30 m (a ValueError traceback before)."""
     (tmp_path / "far.csv").write_text("x,y,diameter\n0,0,0.01905\n0.01905,0,0.01905\n1e30,0,0.01905\n")
     code, err = run_cli(tmp_path, capsys, f'shape = "packing"\npacking_file = "{tmp_path / "far.csv"}"')
-    assert code == 2 and len(err) == 1 and "the beads span 1e+30 m, more than 10 times all 3 of them laid end to end" in err[0]
+    assert code == 3 and len(err) == 1 and "the beads span 1e+30 m, more than 10 times all 3 of them laid end to end" in err[0]
     assert_no_results(tmp_path / "out")
 
 

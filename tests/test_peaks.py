@@ -180,7 +180,8 @@ def test_a_dimer_chains_peaks_are_the_integrators(tmp_path):
     seen = np.isfinite(r.peak_speed)
     assert seen.sum() >= beads - 2, "only the chain's last beads may still be rising at the run's end"
     np.testing.assert_allclose(r.peak_speed[seen], peak[seen], rtol=2e-4, atol=0)
-    np.testing.assert_allclose(r.t_peak[seen], times[np.argmax(speeds, axis=0)][seen], rtol=0, atol=5e-8)
+    sharp = seen & (np.arange(beads) < beads - 2)  # the far end's two beads leave at their peak: a flat maximum
+    np.testing.assert_allclose(r.t_peak[sharp], times[np.argmax(speeds, axis=0)][sharp], rtol=0, atol=5e-8)
     half = np.array([times[np.argmax(speeds[:, b] >= 0.5 * peak[b])] for b in range(beads)])
     np.testing.assert_allclose(r.arrival_time[seen], half[seen], rtol=0, atol=5e-8)
     light = speeds[:, 3]

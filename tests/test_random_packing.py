@@ -84,7 +84,7 @@ def test_a_random_disc_that_cannot_run_is_refused_before_it_is_packed(tmp_path, 
     packs it, by every command (compare once left the packing in --out; sweep checked nothing)."""
     (tmp_path / "random.toml").write_text('shape = "random"\nradius_m = 0.06\nseed = 1\nsensors = [100000]\n')
     out = tmp_path / "out"
-    assert main([*command, "--config", str(tmp_path / "random.toml"), "--out", str(out)]) == 2
+    assert main([*command, "--config", str(tmp_path / "random.toml"), "--out", str(out)]) == 3  # refused before it is packed
     lines = [line for line in capsys.readouterr().err.strip().splitlines() if "error" in line]
     assert len(lines) == 1 and "sensor bead id 100000 is not in the packing" in lines[0], lines
     assert not out.exists() or not any(out.iterdir())
@@ -94,7 +94,7 @@ def test_a_stage_that_does_not_settle_is_kept_where_its_message_says(tmp_path, m
     stage = random_packing.settling_stage
     monkeypatch.setattr(random_packing, "settling_stage", lambda name: replace(stage(name), max_steps=1000))
     (tmp_path / "random.toml").write_text('shape = "random"\nradius_m = 0.06\nseed = 1\n')
-    assert main(["run", "--config", str(tmp_path / "random.toml"), "--out", str(tmp_path / "out")]) == 2
+    assert main(["run", "--config", str(tmp_path / "random.toml"), "--out", str(tmp_path / "out")]) == 4  # the run started and failed
     error = [line for line in capsys.readouterr().err.splitlines() if "error" in line][0]
     assert "compact stage did not settle in" in error
     assert (Path(error.rsplit("see ", 1)[1]) / DECK_NAME).is_file()

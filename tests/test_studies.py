@@ -92,7 +92,7 @@ def test_a_failed_run_is_recorded_and_the_others_finish(tmp_path, capsys):
     retried as Parsl's config says, recorded, named at the end; a rerun runs only that one."""
     out = tmp_path / "out"
     options = ["--vary", "dt=1e-7,3.5e-6", "--out", str(out)]
-    assert sweep(tmp_path, *options, "--parsl", parsl_config(tmp_path)) == 2
+    assert sweep(tmp_path, *options, "--parsl", parsl_config(tmp_path)) == 4  # runs of the study failed
     error = capsys.readouterr().err
     assert "run dt=3.5e-6 failed: energy drift" in error
     assert "1 of 2 runs did not finish: 1 failed (dt=3.5e-6)" in error.strip().splitlines()[-1]
@@ -101,7 +101,7 @@ def test_a_failed_run_is_recorded_and_the_others_finish(tmp_path, capsys):
     assert (out / "runs" / "dt=1e-7" / "peaks.csv").exists()
     assert not (out / "runs" / "dt=3.5e-6").exists() and not list((out / "runs").glob(".*"))
     assert "energy drift" in (out / "runs" / "dt=3.5e-6.failed").read_text()
-    assert sweep(tmp_path, *options, "--workers", "2") == 2
+    assert sweep(tmp_path, *options, "--workers", "2") == 4
     assert "2 runs (1 done before), 1 at once" in capsys.readouterr().err
 
 
@@ -131,7 +131,7 @@ def test_a_job_arrays_runs_one_at_a_time_then_the_table(serial, tmp_path, capsys
     listed = capsys.readouterr().out.splitlines()
     assert listed == ["0\tv0=0.2,friction=0", "1\tv0=0.3,friction=0"]
     assert main(["sweep", str(out), "--run", "1"]) == 0
-    assert main(["sweep", str(out), "--collect"]) == 2
+    assert main(["sweep", str(out), "--collect"]) == 4
     assert "1 missing (v0=0.2,friction=0)" in capsys.readouterr().err
     assert main(["sweep", str(out), "--run", "0"]) == 0
     assert main(["sweep", str(out), "--collect"]) == 0
@@ -154,7 +154,7 @@ def test_bad_study_commands_are_one_line(tmp_path, capsys, arguments, message):
     assert sweep(tmp_path, "--vary", "v0=0.2,0.3", "--out", str(out), "--plan-only") == 0
     capsys.readouterr()
     filled = [word.format(out=out, tmp=tmp_path) for word in arguments]
-    assert main(filled) == 2
+    assert main(filled) == 3  # a refused input
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and message.format(out=out) in lines[0], lines
 
@@ -168,7 +168,7 @@ def test_a_bad_parsl_file_is_one_line_before_anything_is_written(tmp_path, capsy
     path = tmp_path / "parsl.py"
     if text is not None:
         path.write_text(text)
-    assert sweep(tmp_path, "--vary", "v0=0.2,0.3", "--out", str(tmp_path / "out"), "--parsl", str(path)) == 2
+    assert sweep(tmp_path, "--vary", "v0=0.2,0.3", "--out", str(tmp_path / "out"), "--parsl", str(path)) == 3
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and f"--parsl {path}" in lines[0] and message in lines[0], lines
     assert not (tmp_path / "out").exists()

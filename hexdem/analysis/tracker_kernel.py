@@ -108,7 +108,7 @@ class PulseState:
         """Take sample ``s`` (speeds of ``beads``, distinct) into the state, in place."""
         peak = self.peak[beads]
         rising = speeds > peak
-        complete = []
+        complete = [beads[:0]]  # (a rank may own no bead)
         if not rising.all():
             calm = ~rising
             _fill(self.window, self.after, beads[calm], speeds[calm])

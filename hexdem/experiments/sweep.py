@@ -37,7 +37,7 @@ from hexdem.common.checks import positive_int
 from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
 from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.standalone import launcher_command
-from hexdem.errors import HexdemError
+from hexdem.errors import HexdemError, RunFailed
 from hexdem.experiments.executors import describe, load_parsl_config, run_tasks, study_executor
 from hexdem.experiments.sweep_plan import SweepRun, Variation, plan_sweep
 
@@ -170,7 +170,8 @@ def run_single(out, index: int, ranks: int | None = None, launcher: str | None =
 
 def collect(out: Path, runs: list[SweepRun], variations: list[Variation], log=None) -> list[tuple]:
     """Write the table and figure of the study in ``out``; its rows. Failed or missing runs are
-    rows without figures, and then an error naming them once the table is written."""
+    rows without figures, and then an error naming them once the table is written (a
+    :class:`~hexdem.errors.RunFailed`: the study ran, and runs of it did not finish)."""
     from hexdem.experiments.sweep_table import sweep_figure, write_table
 
     log = log or _log
@@ -182,7 +183,7 @@ def collect(out: Path, runs: list[SweepRun], variations: list[Variation], log=No
                   for what in ("failed", "missing")}
     if any(unfinished.values()):
         parts = [f"{len(names)} {what} ({'; '.join(names)})" for what, names in unfinished.items() if names]
-        raise HexdemError(f"{sum(map(len, unfinished.values()))} of {len(runs)} runs did not finish: "
+        raise RunFailed(f"{sum(map(len, unfinished.values()))} of {len(runs)} runs did not finish: "
                           f"{', '.join(parts)}; errors in {out / RUNS_NAME}/NAME{FAILED_SUFFIX}; "
                           "rerun to run them again")
     return rows
