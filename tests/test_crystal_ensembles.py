@@ -31,7 +31,7 @@ def test_a_squares_edge_beads_are_pushed_perpendicular_to_their_own_edges():
     directions = edge_directions(lattice)
     pushed = np.flatnonzero(np.linalg.norm(directions, axis=1))
     assert len(pushed) == 2 * (5 + 6) - 4
-    rows, columns = lattice.indices.T
+    rows, columns = lattice.labels.T
     for i in pushed:
         expected = np.array([int(columns[i] == 0) - int(columns[i] == 5), int(rows[i] == -2) - int(rows[i] == 2)], float)
         np.testing.assert_allclose(directions[i], expected / np.linalg.norm(expected), atol=1e-12)
@@ -77,7 +77,7 @@ def test_a_square_realization_is_prepared_and_struck_and_keeps_its_square_geomet
     summary = run_ensemble(config, tmp_path, workers=1, log=quiet)
     ensemble = Ensemble(config, tmp_path)
     settled, ideal = ensemble.settled_lattice(0), ensemble.ideal
-    rows, columns = ideal.indices.T
+    rows, columns = ideal.labels.T
     for labels, axis in ((rows, 1), (columns, 0)):
         for label in np.unique(labels):
             line = settled.positions_m[labels == label, axis]

@@ -67,7 +67,7 @@ def test_the_guides_impact_configs_build_their_impacts_and_lines():
     models = [build_model(config) for config in impacts]
     assert [len(model.impacts) for model in models] == [2, 11, 1]  # double strike, the 11 beads of an edge, interior
     assert [len(model.strikers) for model in models] == [0, 11, 0]
-    assert [list(lattice.indices[b]) for lattice in [models[2].lattice] for b in models[2].struck_beads] == [[0, 14]]
+    assert [list(lattice.labels[b]) for lattice in [models[2].packing] for b in models[2].struck_beads] == [[0, 14]]
     assert len(build_lattice(lines).line("across")) == 21  # the middle column of 11 per edge: 2 * 11 - 1 beads
 
 

@@ -148,7 +148,7 @@ def test_both_engines_agree_on_a_random_initial_state_in_a_precompressed_packing
     config = RunConfig(edge_beads=5, precompression_n=20.0, v0=1e-4)
     velocities, displacements = 1e-4 * rng.standard_normal((61, 2)), 1e-8 * rng.standard_normal((61, 2))
     lines = ["m,n,vx,vy,dx,dy"] + [f"{m},{n}," + ",".join(repr(float(v)) for v in (*u, *d))
-                                   for (m, n), u, d in zip(build_lattice(config).indices.tolist(), velocities, displacements)]
+                                   for (m, n), u, d in zip(build_lattice(config).labels.tolist(), velocities, displacements)]
     (tmp_path / "state.csv").write_text("\n".join(lines) + "\n")
     config = config.replace(initial_state_file=str(tmp_path / "state.csv"), duration=5e-4)
     reference = simulate(config.replace(engine="reference", steps_per_contact=280), tmp_path / "reference").results

@@ -8,7 +8,6 @@ from hexdem.errors import HexdemError
 from hexdem.experiments.compare import compare_analyses
 from hexdem.experiments.run import simulate
 from hexdem.model.config import RunConfig
-from hexdem.model.lattice import half_hexagon, hexagon
 from hexdem.model.materials import DELRIN, STEEL_316, hertz_coefficient, hertz_stiffness, sphere_mass
 from hexdem.model.model_builder import build_model
 from hexdem.model.precompression import (
@@ -18,6 +17,7 @@ from hexdem.model.precompression import (
     spring_stiffness,
     static_overlap,
 )
+from hexdem.model.triangular import half_hexagon, hexagon
 
 D = 0.01905
 A = float(hertz_coefficient(D))

@@ -51,7 +51,7 @@ def test_sensors_may_name_the_extra_lines():
     config = RunConfig(lines=lines, sensors=["across:3", "0:1"])
     lattice = build_lattice(config)
     beads = sensor_beads(config.sensors, lattice)
-    assert list(beads) == ["across:3", "0:1"] and tuple(lattice.indices[beads["across:3"]]) == (-14, 10)
+    assert list(beads) == ["across:3", "0:1"] and tuple(lattice.labels[beads["across:3"]]) == (-14, 10)
     with pytest.raises(HexdemError, match="line one of 0, [+]30, -30, across"):
         build_model(RunConfig(lines=lines, sensors=["acros:3"]))
 

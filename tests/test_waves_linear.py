@@ -66,7 +66,7 @@ def test_the_resolution_of_a_packing_by_hand():
     falls with the distance from it and is 0 from the inscribed circle's rim on. Near Γ the
     bands are ω = c q, so over a disc of radius r about q the spread is c r for each band."""
     config = DispersionSettings(edge_beads=20).config()
-    positions = build_model(config).lattice.positions_m[:config.n_beads()]
+    positions = build_model(config).packing.positions_m[:config.n_beads()]
     a = Lattice2D.of(config).spacing_m
     width = packing_width(positions)
     assert width == pytest.approx(math.sqrt(3) * 19 * a, rel=1e-9)
@@ -94,7 +94,7 @@ def test_the_recorder_keeps_the_lattice_fourier_sum_and_the_block_energies():
         recorder(Sample(index, index, 0.0, np.array([1, 3]), np.zeros((2, 2)), scaled[[0, 2]]))
         recorder(Sample(index, index, 0.0, np.array([2]), np.zeros((1, 2)), scaled[[1]]))
     waves = recorder.finish()
-    phases = np.exp(-1j * model.lattice.positions_m @ q[0])
+    phases = np.exp(-1j * model.packing.positions_m @ q[0])
     np.testing.assert_allclose(waves.components[1, 0], 2 * phases @ velocities)
     kinetic = 0.5 * model.masses_kg[:3] * np.sum(velocities**2, axis=1)
     np.testing.assert_allclose(waves.block_kinetic_j[0], kinetic * (1 + 4) / 2)

@@ -26,7 +26,7 @@ from typing import TypedDict
 
 from hexdem.errors import HexdemError
 from hexdem.model.granular import Impact
-from hexdem.model.lattice import HOLE_COSINE, Lattice, facing_edge, unit_vector, with_holes
+from hexdem.model.packing import HOLE_COSINE, Packing, facing_edge, unit_vector, with_holes
 
 
 
@@ -97,7 +97,7 @@ def struck_site(specs: list[ImpactSpec]) -> tuple[int, int]:
     return specs[0].site if specs[0].site is not None else (0, 0)
 
 
-def resolve_impacts(specs: list[ImpactSpec], lattice: Lattice, velocity_scale_m_s: float, material) -> list[Impact]:
+def resolve_impacts(specs: list[ImpactSpec], lattice: Packing, velocity_scale_m_s: float, material) -> list[Impact]:
     """The model's :class:`Impact` s of ``specs`` on ``lattice`` (an edge: one per bead of it);
     ``velocity_scale_m_s`` converts the run's speeds to m/s and ``material(name)`` finds a
     material."""
@@ -120,12 +120,12 @@ def resolve_impacts(specs: list[ImpactSpec], lattice: Lattice, velocity_scale_m_
     return impacts
 
 
-def _wall_members(lattice: Lattice) -> set[int]:
+def _wall_members(lattice: Packing) -> set[int]:
     return {int(b) for wall in lattice.walls for b in wall.members}
 
 
-def cut_holes(lattice: Lattice, impacts: list[Impact]) -> tuple[Lattice, set[int]]:
-    """(``lattice`` (its walls whole, :func:`~hexdem.model.lattice.without_hole`) with a hole for
+def cut_holes(lattice: Packing, impacts: list[Impact]) -> tuple[Packing, set[int]]:
+    """(``lattice`` (its walls whole, :func:`~hexdem.model.packing.without_hole`) with a hole for
     the bead of each of ``impacts`` (:func:`resolve_impacts`'s, each naming its bead) in every
     wall it is pushed through, the beads that left every wall). An
     impact on a wall bead that points out through that wall (within 60° of its outward normal;
@@ -134,7 +134,7 @@ def cut_holes(lattice: Lattice, impacts: list[Impact]) -> tuple[Lattice, set[int
     for impact, bead in zip(impacts, beads):
         for wall in lattice.walls:
             if bead in wall.members and wall.normals_at(lattice.positions_m[[bead]])[0] @ impact.direction < -HOLE_COSINE:
-                m, n = lattice.indices[bead]
+                m, n = lattice.labels[bead]
                 raise HexdemError(f"the impact on bead {{{m}, {n}}} at {impact.angle_deg:g}° points out of the packing "
                                   f"through {wall.name}: strike it inwards")
     holed = with_holes(lattice, beads, [impact.direction for impact in impacts])

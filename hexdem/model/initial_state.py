@@ -23,7 +23,7 @@ import numpy as np
 
 from hexdem.common.io import read_text, write_csv
 from hexdem.errors import HexdemError
-from hexdem.model.lattice import Lattice
+from hexdem.model.packing import Packing
 
 #: The accepted headers.
 HEADERS = (("m", "n", "vx", "vy"), ("m", "n", "vx", "vy", "dx", "dy"))
@@ -37,7 +37,7 @@ class InitialState:
     displacements_m: np.ndarray
 
 
-def read_initial_state(path, lattice: Lattice) -> InitialState:
+def read_initial_state(path, lattice: Packing) -> InitialState:
     """The state in the CSV at ``path`` for the beads of ``lattice`` (see the module docstring)."""
     path = Path(path)
     name = f"initial_state_file {path}"
@@ -73,7 +73,7 @@ def read_initial_state(path, lattice: Lattice) -> InitialState:
     return InitialState(velocities, displacements)
 
 
-def write_initial_state(path, lattice: Lattice, velocities_m_s, displacements_m=None) -> None:
+def write_initial_state(path, lattice: Packing, velocities_m_s, displacements_m=None) -> None:
     """Write (N, 2) ``velocities_m_s`` and optionally ``displacements_m`` of ``lattice``'s beads
     as an ``initial_state_file`` (atomically), every bead on its own line, full precision."""
     columns = [np.asarray(velocities_m_s, float)]
@@ -84,5 +84,5 @@ def write_initial_state(path, lattice: Lattice, velocities_m_s, displacements_m=
                           f"{' and '.join(str(column.shape) for column in columns)}")
     header = HEADERS[len(columns) - 1]
     rows = [[m, n, *(repr(float(value)) for value in values)]
-            for (m, n), values in zip(lattice.indices.tolist(), np.hstack(columns))]
+            for (m, n), values in zip(lattice.labels.tolist(), np.hstack(columns))]
     write_csv(path, header, rows)

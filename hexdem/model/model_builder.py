@@ -16,13 +16,14 @@ from hexdem.model.contact_law import Friction
 from hexdem.model.granular import GranularModel, Impact
 from hexdem.model.impacts import cut_holes, resolve_impacts, struck_site
 from hexdem.model.initial_state import read_initial_state
-from hexdem.model.lattice import Lattice, without_hole, without_sites
 from hexdem.model.lines import with_lines
 from hexdem.model.materials import hertz_coefficient, hertz_stiffness
+from hexdem.model.packing import Packing, without_hole
 from hexdem.model.packing_builders import PLACED_SHAPES, BuiltPacking, build_packing
 from hexdem.model.precompression import hole_force, precompressed_lattice
 from hexdem.model.regions import assign_materials
 from hexdem.model.sensors import sensor_beads
+from hexdem.model.triangular import without_sites
 
 
 def configured_packing(config) -> BuiltPacking:
@@ -30,17 +31,17 @@ def configured_packing(config) -> BuiltPacking:
     less the ``vacancies``, struck at the first impact's site, with the extra observation
     ``lines``, and the material regions of its builder."""
     built = build_packing(config, struck_site(config.impact_specs()))
-    lattice = without_hole(built.lattice) if config.impacts else built.lattice  # each impact cuts its own
+    lattice = without_hole(built.packing) if config.impacts else built.packing  # each impact cuts its own
     lattice = without_sites(lattice, config.vacancies) if config.vacancies else lattice
     return BuiltPacking(with_lines(lattice, config.lines) if config.lines else lattice, built.regions)
 
 
-def build_lattice(config) -> Lattice:
+def build_lattice(config) -> Packing:
     """The packing of :func:`configured_packing`, without its material regions."""
-    return configured_packing(config).lattice
+    return configured_packing(config).packing
 
 
-def _precompressed(config, lattice: Lattice, extra, bead, wall) -> tuple[Lattice, tuple[float, float]]:
+def _precompressed(config, lattice: Packing, extra, bead, wall) -> tuple[Packing, tuple[float, float]]:
     """The packing squeezed by ``precompression_n`` and the force that holds the struck bead in
     its hole (:mod:`hexdem.model.precompression`), after checking that the packing allows it."""
     if extra:
@@ -62,10 +63,10 @@ def build_model(config) -> GranularModel:
     wall = None if config.wall_material == "none" else config.material(config.wall_material)
     bead, held = config.material(config.bead_material), (0.0, 0.0)
     built = configured_packing(config)
-    if len(built.lattice) < 2 and not built.lattice.walls:
-        raise HexdemError(f"{built.lattice.shape}: a packing needs at least 2 beads, or 1 bead and a wall to rebound "
+    if len(built.packing) < 2 and not built.packing.walls:
+        raise HexdemError(f"{built.packing.shape}: a packing needs at least 2 beads, or 1 bead and a wall to rebound "
                           "from; a lone free bead carries no wave")
-    lattice, extra = assign_materials(built.lattice, built.regions + config.regions, bead, config.material)
+    lattice, extra = assign_materials(built.packing, built.regions + config.regions, bead, config.material)
     if config.precompression_n > 0:
         lattice, held = _precompressed(config, lattice, extra, bead, wall)
     impacts = model_impacts(config, lattice)
@@ -84,7 +85,7 @@ def build_model(config) -> GranularModel:
                          Friction.of(config.friction, config.wall_friction, config.rolling_friction), state)
 
 
-def model_impacts(config, lattice: Lattice) -> list[Impact]:
+def model_impacts(config, lattice: Packing) -> list[Impact]:
     """The model's impacts: the paper's single one on the struck bead, or those of ``impacts``."""
     if not config.impacts:
         striker = None if config.striker_material is None else config.material(config.striker_material)

@@ -2,7 +2,7 @@
 
 The triangular shapes (``hexagon``, ``half-hexagon``, ``half-disc``, ``triangle``,
 ``parallelogram``, ``disc``, ``sites``) place beads on the paper's lattice
-(:mod:`hexdem.model.lattice`, :mod:`hexdem.model.sites`). The others place them themselves:
+(:mod:`hexdem.model.triangular`, :mod:`hexdem.model.sites`). The others place them themselves:
 
 * ``square`` (``rows``, ``columns``) and ``centered-square`` (also ``interstitial_diameter_m``,
   None: the size that touches the four corners, and ``interstitial_material``, None: the beads'),
@@ -33,11 +33,11 @@ import numpy as np
 
 from hexdem.errors import HexdemError
 from hexdem.model.chain import chain, chain_beads
-from hexdem.model.lattice import (Lattice, disc, half_disc, half_hexagon, hexagon, parallelogram, strike_direction,
-                                  triangle)
+from hexdem.model.packing import Packing, strike_direction
 from hexdem.model.packing_file import packing_from_file, read_packing_rows
 from hexdem.model.sites import read_sites
 from hexdem.model.square_crystals import centered_square, square
+from hexdem.model.triangular import disc, half_disc, half_hexagon, hexagon, parallelogram, triangle
 
 TRIANGULAR_SHAPES = ("hexagon", "half-hexagon", "half-disc", "triangle", "parallelogram", "disc", "sites")
 PLACED_SHAPES = ("square", "centered-square", "chain", "packing")
@@ -109,16 +109,16 @@ def check_shape_keys(config) -> None:
 class BuiltPacking:
     """A shape's packing and the material ``regions`` its builder sets (tables {material, sites})."""
 
-    lattice: Lattice
+    packing: Packing
     regions: tuple = ()
 
 
-def material_regions(lattice: Lattice, names) -> tuple:
+def material_regions(lattice: Packing, names) -> tuple:
     """Regions {material, sites} giving each bead of ``lattice`` its name in ``names`` (one per
     bead; an empty name keeps the beads' material)."""
     names = np.asarray(names, dtype=object)
     return tuple({"material": str(name), "sites": tuple(tuple(int(v) for v in label)
-                                                         for label in lattice.indices[names == name])}
+                                                         for label in lattice.labels[names == name])}
                  for name in dict.fromkeys(names.tolist()) if name)
 
 

@@ -41,7 +41,8 @@ from dataclasses import replace
 import numpy as np
 
 from hexdem.errors import HexdemError
-from hexdem.model.lattice import BOND_STEPS, Lattice
+from hexdem.model.packing import Packing
+from hexdem.model.triangular import BOND_STEPS
 from hexdem.model.walls import Wall
 
 #: A precompression may squeeze each contact by less than this fraction of a diameter: from half a
@@ -84,17 +85,17 @@ def longitudinal_sound_speed(force_n: float, coefficient: float, mass_kg: float,
     return math.sqrt(9.0 / 8.0) * spacing_m * math.sqrt(spring_stiffness(force_n, coefficient) / mass_kg)
 
 
-def missing_contact_forces(lattice: Lattice, force_n: float) -> np.ndarray:
+def missing_contact_forces(lattice: Packing, force_n: float) -> np.ndarray:
     """(N, 2) force [N] that each bead's missing neighbours would push it with, f0 Σ (−u)."""
     forces = np.zeros((len(lattice), 2))
-    for b, (m, n) in enumerate(lattice.indices.tolist()):
+    for b, (m, n) in enumerate(lattice.labels.tolist()):
         for step in NEIGHBOURS:
             if lattice.index_of(m + step[0], n + step[1]) is None:
                 forces[b] -= force_n * _unit(step)
     return forces
 
 
-def _wall_loads(lattice: Lattice, needed: np.ndarray) -> dict[tuple[int, int], float]:
+def _wall_loads(lattice: Packing, needed: np.ndarray) -> dict[tuple[int, int], float]:
     """{(wall index, bead): normal force [N] the wall must give the bead}: one wall takes the
     bead's whole need along its normal, two walls (a corner) share it."""
     touching: dict[int, list[int]] = {}
@@ -109,8 +110,8 @@ def _wall_loads(lattice: Lattice, needed: np.ndarray) -> dict[tuple[int, int], f
     return loads
 
 
-def precompressed_lattice(lattice: Lattice, force_n: float, pair_coefficient: float,
-                          wall_stiffness_pa: float) -> Lattice:
+def precompressed_lattice(lattice: Packing, force_n: float, pair_coefficient: float,
+                          wall_stiffness_pa: float) -> Packing:
     r"""The ideal ``lattice`` (equal beads) in static equilibrium with every contact at ``force_n``
     [N] (steps 1 and 2): shrunk about the struck bead, each wall split into planes that meet
     their members at the overlap that gives them their missing contacts' force.
@@ -135,7 +136,7 @@ def precompressed_lattice(lattice: Lattice, force_n: float, pair_coefficient: fl
     return replace(shrunk, walls=tuple(walls))
 
 
-def hole_force(lattice: Lattice, force_n: float) -> np.ndarray:
+def hole_force(lattice: Packing, force_n: float) -> np.ndarray:
     """(2,) force [N] on the struck bead from its missing wall: its missing contacts' force (√3 f0
     along +x for a bead in the middle of a straight edge)."""
     return missing_contact_forces(lattice, force_n)[lattice.struck]

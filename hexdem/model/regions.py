@@ -15,8 +15,8 @@ from typing import TypedDict
 import numpy as np
 
 from hexdem.errors import HexdemError
-from hexdem.model.lattice import Lattice
 from hexdem.model.materials import Material
+from hexdem.model.packing import Packing
 
 
 
@@ -36,7 +36,7 @@ BOUNDS = {"x_min_d": (0, True), "x_max_d": (0, False), "y_min_d": (1, True), "y_
 KEYS = set(RegionTable.__annotations__)
 
 
-def _selected(lattice: Lattice, region: dict, k: int) -> np.ndarray:
+def _selected(lattice: Packing, region: dict, k: int) -> np.ndarray:
     """(N,) bool: the beads region ``k`` selects."""
     unknown = sorted(set(region) - KEYS)
     if unknown or "material" not in region:
@@ -63,7 +63,7 @@ def _selected(lattice: Lattice, region: dict, k: int) -> np.ndarray:
     return chosen
 
 
-def assign_materials(lattice: Lattice, regions, bead: Material, lookup) -> tuple[Lattice, tuple[Material, ...]]:
+def assign_materials(lattice: Packing, regions, bead: Material, lookup) -> tuple[Packing, tuple[Material, ...]]:
     """``lattice`` with the material ids the ``regions`` give, and the materials beyond ``bead``
     by id (1, 2, …, in order of first use); ``lookup(name)`` finds a material by name."""
     extra: list[Material] = []

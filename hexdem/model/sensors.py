@@ -8,10 +8,10 @@ A sensor is ``"line:n"``, bead n of an observation line (one of the paper's ``0`
 from __future__ import annotations
 
 from hexdem.errors import HexdemError
-from hexdem.model.lattice import Lattice
+from hexdem.model.packing import Packing
 
 
-def sensor_beads(sensors, lattice: Lattice) -> dict[str, int]:
+def sensor_beads(sensors, lattice: Packing) -> dict[str, int]:
     """{label: bead index} of ``sensors`` on ``lattice``, in the order given."""
     beads, lines = {}, lattice.lines() if sensors else {}
     for sensor in sensors:

@@ -34,8 +34,8 @@ import numpy as np
 
 from hexdem.analysis.pulse_shape import collapse_residuals, power_law, profiles, pulse_shapes, reference_profile
 from hexdem.experiments.front_study import FrontStudy
-from hexdem.model.lattice import Lattice
 from hexdem.model.model_builder import build_lattice
+from hexdem.model.packing import Packing
 
 #: The rays followed, degrees from the strike direction (the two lattice lines and between).
 RAYS_DEG = (0.0, 15.0, 30.0)
@@ -68,7 +68,7 @@ class SelfSimilarityStudy:
         return asdict(self)
 
 
-def ray_beads(lattice: Lattice, angle_deg: float, radius_min_d: float, radius_max_d: float) -> np.ndarray:
+def ray_beads(lattice: Packing, angle_deg: float, radius_min_d: float, radius_max_d: float) -> np.ndarray:
     """Indices of the beads nearest the points of the ray at ``angle_deg`` from the struck bead,
     one every diameter from ``radius_min_d`` to ``radius_max_d`` (each bead once, in order of
     distance)."""
