@@ -103,7 +103,7 @@ def measure(model, settings, way: str, samples, out: Path) -> dict:
     gathered = time.perf_counter() - start
     analysis = ImpactAnalysis.from_tracker(model, settings, tracked, {"name": "synthetic"})
     start = time.perf_counter()
-    write_results(RunConfig(), analysis, out, 0.0, lambda message: None)
+    write_results(RunConfig(), analysis, out, 0.0, {}, lambda message: None)
     written = time.perf_counter() - start
     n, samples_count = len(model.packing), settings.n_samples
     return {"tracker": (observed - audit.seconds) / (n * samples_count) * 1e9,
