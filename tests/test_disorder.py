@@ -18,7 +18,7 @@ from hexdem.disorder.preparation import (
     Disorder,
     Preparation,
     edge_directions,
-    spaced_lattice,
+    spaced_packing,
     walls_for_settling,
     write_stage_deck,
 )
@@ -64,7 +64,7 @@ def test_zero_sigma_gives_the_ideal_diameters():
 @pytest.mark.parametrize("seed", range(5))
 def test_the_spaced_lattice_has_no_overlap(seed):
     disorder = Disorder(D)
-    lattice = spaced_lattice(hexagon(11, D), disorder.diameters_m(331, seed, 0), disorder)
+    lattice = spaced_packing(hexagon(11, D), disorder.diameters_m(331, seed, 0), disorder)
     i, j = lattice.bonds().T
     distances = np.linalg.norm(lattice.positions_m[i] - lattice.positions_m[j], axis=1)
     gaps = distances - lattice.radii_m[i] - lattice.radii_m[j]
@@ -122,7 +122,7 @@ def prepare(directory, sigma_m=None, seed=0) -> SimpleNamespace:
     disorder, preparation = Disorder(D, sigma_m=sigma_m), Preparation()
     base = build_model(RunConfig(edge_beads=EDGE, impact="striker"))
     ideal = base.packing
-    spaced = spaced_lattice(ideal, disorder.diameters_m(len(ideal), seed, 0), disorder)
+    spaced = spaced_packing(ideal, disorder.diameters_m(len(ideal), seed, 0), disorder)
     compact = dataclasses.replace(base, packing=spaced)
     run_deck(write_stage_deck(compact, "compact", preparation, directory / "compact"))
     compacted = read_data_file(directory / "compact" / SETTLED_NAME)

@@ -11,7 +11,7 @@ from hexdem.errors import HexdemError
 from hexdem.experiments.run import run_experiment, simulate
 from hexdem.model.config import RunConfig
 from hexdem.model.materials import BRASS, STEEL_316
-from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.model_builder import build_model, build_packing
 from hexdem.model.run_settings import run_settings
 
 ENGINES = [LammpsEngine(), ReferenceEngine()]
@@ -101,8 +101,8 @@ def test_holes_do_not_depend_on_the_order_of_the_impacts_and_only_struck_beads_s
 
 def test_the_papers_single_impact_keeps_its_one_hole_in_the_struck_edges_wall():
     """In a hexagon of 2 per edge {0, 0} is also the corner of the lower-left edge: it stays on that wall."""
-    walls = {w.name: w.members for w in build_lattice(RunConfig(edge_beads=2)).walls}
-    struck = build_lattice(RunConfig(edge_beads=2)).struck
+    walls = {w.name: w.members for w in build_packing(RunConfig(edge_beads=2)).walls}
+    struck = build_packing(RunConfig(edge_beads=2)).struck
     assert struck not in walls["wall_000"] and struck in walls["wall_060"]
 
 
@@ -120,7 +120,7 @@ def test_extra_observation_lines_follow_the_lattice_from_any_bead(tmp_path):
     config = RunConfig(edge_beads=5, engine="reference",
                        lines=[{"name": "up", "site": [-8, 4], "angle_deg": 90},
                               {"name": "sixty", "site": [0, 0], "angle_deg": 60}])
-    lattice = build_lattice(config)
+    lattice = build_packing(config)
     assert [tuple(lattice.labels[b]) for b in lattice.line("up")] == [(m, 4) for m in range(-8, 9, 2)]
     assert [tuple(lattice.labels[b]) for b in lattice.line("sixty")] == [(0, 0), (3, 1), (6, 2)]
     run_experiment(config, tmp_path, log=lambda message: None)

@@ -5,7 +5,7 @@ import pytest
 
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
-from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.model_builder import build_model, build_packing
 from hexdem.model.packing import strike_direction
 from hexdem.model.triangular import (disc, from_sites, half_disc, half_hexagon, hexagon, parallelogram, triangle,
                                      without_sites)
@@ -175,9 +175,9 @@ def test_config_reads_sites_from_csv_and_toml(tmp_path):
     csv_file, toml_file = tmp_path / "sites.csv", tmp_path / "sites.toml"
     csv_file.write_text("m,n\n0,0\n2,0\n1,1\n")
     toml_file.write_text("sites = [[0, 0], [2, 0], [1, 1]]\n")
-    inline = build_lattice(RunConfig(shape="sites", sites=[[0, 0], [2, 0], [1, 1]]))
+    inline = build_packing(RunConfig(shape="sites", sites=[[0, 0], [2, 0], [1, 1]]))
     for path in (csv_file, toml_file):
-        lattice = build_lattice(RunConfig(shape="sites", sites_file=str(path)))
+        lattice = build_packing(RunConfig(shape="sites", sites_file=str(path)))
         np.testing.assert_array_equal(lattice.labels, inline.labels)
         assert lattice.walls == ()
     (tmp_path / "bad.csv").write_text("m,n\n0,0\nx,1\n")

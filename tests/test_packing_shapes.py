@@ -15,7 +15,7 @@ from hexdem.model.config import RunConfig
 from hexdem.model.materials import sphere_mass
 from hexdem.model.square_crystals import interstitial_fit_m
 from hexdem.model.solitary_wave import chain_speed_scale_m_s, solitary_speed_m_s
-from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.model_builder import build_model, build_packing
 from hexdem.model.run_settings import run_settings
 
 V0 = 0.4
@@ -99,12 +99,12 @@ def test_a_packing_file_is_the_packing_it_was_written_from(tmp_path):
     walls and holes, and the same peaks and arrivals on every bead the pulse reaches before it
     could meet a wall (1e-6)."""
     default = RunConfig()
-    lattice = build_lattice(default)
+    lattice = build_packing(default)
     rows = "\n".join(f"{float(x)!r},{float(y)!r},{float(d)!r}" for (x, y), d in zip(lattice.positions_m, lattice.diameters_m))
     (tmp_path / "hexagon.csv").write_text("x,y,diameter\n" + rows + "\n")
     from_file = RunConfig(shape="packing", packing_file=str(tmp_path / "hexagon.csv"), walls="hull",
                           struck_bead=int(lattice.struck))
-    packed = build_lattice(from_file)
+    packed = build_packing(from_file)
     np.testing.assert_allclose(sorted(np.round(w.normal, 12).tolist() for w in packed.walls),
                                sorted(np.round(w.normal, 12).tolist() for w in lattice.walls), atol=1e-12)
     assert sorted(sorted(w.members.tolist()) for w in packed.walls) == sorted(sorted(w.members.tolist())

@@ -20,7 +20,7 @@ from hexdem.theory.phonons import Lattice2D, cone_slope, sound_speeds
 from hexdem.waves.conical import ConicalSettings, measure_conical
 from hexdem.waves.dispersion import DispersionSettings, band_spread, measure_dispersion, packing_width, taper
 from hexdem.waves.states import bloch_packet, broadband_state
-from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.model_builder import build_model, build_packing
 from hexdem.model.run_settings import run_settings
 
 STEEL_20N = Lattice2D.precompressed(20.0, 0.01905)
@@ -181,7 +181,7 @@ def test_a_packet_at_the_dirac_point_opens_into_a_ring_at_the_cone_slope(engine,
 
 
 def test_an_initial_state_written_reads_back_bit_for_bit(tmp_path):
-    lattice = build_lattice(RunConfig(edge_beads=4))
+    lattice = build_packing(RunConfig(edge_beads=4))
     velocities, displacements = broadband_state(len(lattice), 1e-3, 3), broadband_state(len(lattice), 1e-9, 4)
     write_initial_state(tmp_path / "state.csv", lattice, velocities, displacements)
     state = read_initial_state(tmp_path / "state.csv", lattice)
@@ -196,7 +196,7 @@ def test_two_ranks_record_what_one_rank_records(tmp_path):
     each rank sums over its own beads and the sums merge at the end, so the plane-wave
     components and the energy blocks agree to round-off (the atoms' order differs)."""
     config = RunConfig(edge_beads=12, precompression_n=20.0, v0=1e-6, steps_per_contact=40, duration=2e-3)
-    write_initial_state(tmp_path / "state.csv", build_lattice(config), broadband_state(config.n_beads(), 5e-4, 2))
+    write_initial_state(tmp_path / "state.csv", build_packing(config), broadband_state(config.n_beads(), 5e-4, 2))
     config = config.replace(initial_state_file=str(tmp_path / "state.csv"), dump_every=4)
     q = STEEL_20N.high_symmetry_points()["K"][None, :] * np.array([[0.3], [1.0]])
     one = record_waves(config, tmp_path / "one", q, block=8, show_progress=False)

@@ -233,7 +233,7 @@ def geometric_neighbour_sums(positions_m, diameters_m) -> np.ndarray:
     return sums
 
 
-def spaced_lattice(lattice: Packing, diameters_m, disorder: Disorder) -> Packing:
+def spaced_packing(lattice: Packing, diameters_m, disorder: Disorder) -> Packing:
     """``lattice`` with the given diameters, its positions scaled about the struck bead so that
     nothing overlaps: by :meth:`Disorder.spacing_m` over d, or more where a bead grew by a larger
     share of its own nominal diameter (a centered-square's small interstitials)."""

@@ -28,7 +28,7 @@ from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.errors import HexdemError
 from hexdem.experiments.tracked_run import ImpactJob, track_impact
 from hexdem.model.config import RunConfig
-from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.model_builder import build_model, build_packing
 from hexdem.model.packing import Packing
 from hexdem.model.run_settings import run_settings
 from hexdem.model.triangular import hexagon
@@ -139,7 +139,7 @@ def run_snapshots(config: RunConfig, times_s, out, outline_edge: int | None = No
     outline = hexagon(outline_edge, config.diameter_m) if outline_edge else None
     out = ensure_writable_dir(out)
     start = time.perf_counter()
-    log(f"{build_lattice(config).shape}, striker at {config.v0:g} m/s, {config.ranks} rank(s), "
+    log(f"{build_packing(config).shape}, striker at {config.v0:g} m/s, {config.ranks} rank(s), "
         f"{len(times_s)} snapshots up to {max(times_s) * 1e3:g} ms")
     snapshots = take_snapshots(config, times_s, out / "deck")
     name = FIGURE_NAMES.get(config.shape, "snapshots")

@@ -32,7 +32,7 @@ class Impact:
     V0 is given to the struck bead (the paper's numerics); True: a striker sphere moving
     at V0 hits it (the experiment), of ``striker_material`` (None: the beads' material) and
     diameter ``striker_diameter_m`` (None: the nominal d). ``bead``: the index of the struck
-    bead (None: the lattice's struck bead, on the paper's edge, where the angle must point
+    bead (None: the packing's struck bead, on the paper's edge, where the angle must point
     into the packing, |angle| < 90°).
     """
 
@@ -77,7 +77,7 @@ class GranularModel:
     whose mass is ``sensor_mass_factor`` times a plain bead's (the accelerometer inside).
 
     Materials: bead material id 0 is ``bead``, ids 1, 2, … are ``extra_materials`` (the
-    lattice's ``material_ids`` say which bead is which); then the strikers' own materials.
+    packing's ``material_ids`` say which bead is which); then the strikers' own materials.
     Every contact is Hertz's with the pair's own E* and R_eff (:meth:`contact_stiffness_pa`);
     ``friction`` adds Mindlin's tangential force and the bodies' rotation (:attr:`laws`).
 

@@ -103,10 +103,10 @@ LAYER_ROUND_OFF = 1e-9
 def own_contact_times_s(model) -> dict[int, float]:
     """{material id: the Hertz contact time [s] of two beads of that material and the nominal
     diameter meeting at the first impact's speed}, for the packing's bead materials."""
-    lattice, speed, d = model.packing, model.impacts[0].speed_m_s, model.packing.diameter_m
+    packing, speed, d = model.packing, model.impacts[0].speed_m_s, model.packing.diameter_m
     return {int(k): float(contact_time(float(sphere_mass(d, model.materials[k])) / 2,
                                        float(hertz_coefficient(d, model.materials[k])), speed))
-            for k in np.unique(model.material_ids[:len(lattice)])}
+            for k in np.unique(model.material_ids[:len(packing)])}
 
 
 def crossing_time_s(model, linear_contact_s: float | None = None) -> float:
@@ -121,15 +121,15 @@ def crossing_time_s(model, linear_contact_s: float | None = None) -> float:
     precompressed packing's ``linear_contact_s`` (its linearized contact's half period) replaces
     the Hertz time, scaled alike. For a packing of one material this is the layer count times
     the two-bead contact time. The largest over the impacts."""
-    lattice = model.packing
+    packing = model.packing
     own = own_contact_times_s(model)
     fastest = min(own.values())
-    pace = np.vectorize(own.get, otypes=[float])(model.material_ids[:len(lattice)])  # each bead's material's
+    pace = np.vectorize(own.get, otypes=[float])(model.material_ids[:len(packing)])  # each bead's material's
     scale = 1.0 if linear_contact_s is None else linear_contact_s / fastest
-    layer_m = math.sqrt(3) / 2 * lattice.diameter_m
+    layer_m = math.sqrt(3) / 2 * packing.diameter_m
     times = []
     for bead, impact in zip(model.struck_beads, model.impacts):
-        depth = (lattice.positions_m - lattice.positions_m[bead]) @ impact.direction
+        depth = (packing.positions_m - packing.positions_m[bead]) @ impact.direction
         count = math.ceil(float(depth.max()) / layer_m)
         layers = np.ceil(depth / layer_m - LAYER_ROUND_OFF).astype(int)  # a bead on a layer's line is in it
         ahead = (layers > 0) & (layers <= count)
@@ -169,11 +169,11 @@ def solitary_crossing_time_s(model, contact_s: float, wall_contact_s: float) -> 
     that wall contact, and a layer's transit, to come back: the 15 × 15 steel square's last bead
     peaks 0.53 ms after the strike, its neighbour meets the reflection at 0.74 ms, and this gives
     0.68 ms."""
-    lattice = model.packing
-    fastest = max(chain_speed_scale_m_s(model.materials[k]) for k in np.unique(model.material_ids[:len(lattice)]))
+    packing = model.packing
+    fastest = max(chain_speed_scale_m_s(model.materials[k]) for k in np.unique(model.material_ids[:len(packing)]))
     times = []
     for bead, impact in zip(model.struck_beads, model.impacts):
-        depth_m = float(np.max((lattice.positions_m - lattice.positions_m[bead]) @ impact.direction))
+        depth_m = float(np.max((packing.positions_m - packing.positions_m[bead]) @ impact.direction))
         times.append(depth_m / solitary_speed_m_s(fastest, impact.speed_m_s))
     far_end_s = wall_contact_s / 2 if model.walls else contact_s
     return max(times) + max(far_end_s, contact_s) + contact_s

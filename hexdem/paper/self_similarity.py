@@ -34,7 +34,7 @@ import numpy as np
 
 from hexdem.analysis.pulse_shape import collapse_residuals, power_law, profiles, pulse_shapes, reference_profile
 from hexdem.experiments.front_study import FrontStudy
-from hexdem.model.model_builder import build_lattice
+from hexdem.model.model_builder import build_packing
 from hexdem.model.packing import Packing
 
 #: The rays followed, degrees from the strike direction (the two lattice lines and between).
@@ -141,7 +141,7 @@ def run_study_packing(study: SelfSimilarityStudy, name: str, workdir, log=None) 
     from hexdem.experiments.run import simulate
 
     config = study.front.configs()[name]
-    lattice = build_lattice(config)
+    lattice = build_packing(config)
     rays = {f"{angle:g}": ray_beads(lattice, angle, study.radius_min_d, study.radius_max_d[name]) for angle in RAYS_DEG}
     traced = [int(b) for beads in rays.values() for b in beads]
     analysis = simulate(config, workdir, log, trace_beads=traced)
