@@ -53,6 +53,8 @@ class LocalPool(Executor):
                                    initializer=die_with_parent, initargs=(os.getpid(),))
 
     def submit(self, fn, /, *args, **kwargs):
+        """A future of ``fn`` called with ``args`` and ``kwargs`` in a worker; a broken pool is
+        replaced first."""
         try:
             return self._pool.submit(fn, *args, **kwargs)
         except BrokenProcessPool:
@@ -104,6 +106,7 @@ class ParslExecutor(Executor):
         self._app = python_app(_call, data_flow_kernel=self._dfk)
 
     def submit(self, fn, /, *args, **kwargs):
+        """A future of ``fn`` called with ``args`` and ``kwargs`` as a Parsl app."""
         return self._app(fn, *args, **kwargs)
 
     def shutdown(self, wait=True, *, cancel_futures=False):
@@ -128,7 +131,7 @@ def describe(error: BaseException) -> str:
 
 
 def run_tasks(executor, tasks: dict):
-    """Submit ``tasks`` {key: (fn, *args)} to ``executor``; yield (key, result, error) as each
+    """Submit ``tasks`` ``{key: (fn, *args)}`` to ``executor``; yield (key, result, error) as each
     finishes (``error``: None, or the exception of its last try), a failed task being submitted
     again up to ``executor.retries`` times."""
     tries = dict.fromkeys(tasks, 0)
