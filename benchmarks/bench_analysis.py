@@ -53,7 +53,7 @@ def synthetic_samples(model, n_samples: int, interval_s: float):
     offset = positions - positions[model.struck_beads[0]]
     r = np.hypot(offset[:, 0], offset[:, 1])
     direction = offset / np.maximum(r, 1e-12)[:, None]
-    amplitude = 0.4 * np.minimum(1.0, (r / model.lattice.diameter_m + 1) ** -DECAY)
+    amplitude = 0.4 * np.minimum(1.0, (r / model.packing.diameter_m + 1) ** -DECAY)
 
     def velocities(s: int) -> np.ndarray:
         t = s * interval_s
@@ -90,7 +90,7 @@ def measure(model, settings, way: str, samples, out: Path) -> dict:
     tracker.audit = audit = Timed(tracker.audit)
     positions, velocities = samples
     ids = np.arange(1, model.n_bodies + 1)
-    order = np.argsort(positions[:, 0] // (10 * model.lattice.diameter_m) * 1e6 + positions[:, 1])  # LAMMPS's bins
+    order = np.argsort(positions[:, 0] // (10 * model.packing.diameter_m) * 1e6 + positions[:, 1])  # LAMMPS's bins
     observed = 0.0
     for s in range(settings.n_samples):
         sample = Sample(s, s * settings.dump_every, s * settings.dt_s * settings.dump_every, ids[order],
@@ -105,7 +105,7 @@ def measure(model, settings, way: str, samples, out: Path) -> dict:
     start = time.perf_counter()
     write_results(RunConfig(), analysis, out, 0.0, {}, lambda message: None)
     written = time.perf_counter() - start
-    n, samples_count = len(model.lattice), settings.n_samples
+    n, samples_count = len(model.packing), settings.n_samples
     return {"tracker": (observed - audit.seconds) / (n * samples_count) * 1e9,
             "audit": audit.seconds / (n * audit.calls) * 1e9, "gathering": gathered / n * 1e9,
             "result files": written, "peaks": tracked.peak_speed, "energies": tracked.region_energies}
@@ -131,8 +131,8 @@ def main() -> None:
         now, compiled = results["NumPy"], results["compiled"]
         np.testing.assert_array_equal(compiled["peaks"], now["peaks"])
         np.testing.assert_allclose(compiled["energies"], now["energies"], rtol=1e-12)
-        rows.append((len(model.lattice), results))
-        print(f"  measured {len(model.lattice):,} beads", flush=True)
+        rows.append((len(model.packing), results))
+        print(f"  measured {len(model.packing):,} beads", flush=True)
     print(f"in-run analysis of one rank, {n_samples} synthetic samples: ns per bead per sample "
           "(audit: per audited sample; gathering: per bead, once), result files [s]")
     print(f"{'beads':>9} {'part':>12} " + " ".join(f"{way:>10}" for way in WAYS) + f" {'before / compiled':>17}")

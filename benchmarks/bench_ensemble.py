@@ -118,7 +118,7 @@ def bench_ranks(work: Path, repeats: int, base: RunConfig, times_s) -> None:
                 times[name]["wall"].append(info.wall_time_s)
                 times[name]["lammps"].append(info.wall_time_s)
                 times[name]["loop"].append(loop_time_s(decks[ranks].log_path))
-    print(f"snapshot run, {model.lattice.shape}: {model.n_bodies} atoms x {settings.n_steps} steps, "
+    print(f"snapshot run, {model.packing.shape}: {model.n_bodies} atoms x {settings.n_steps} steps, "
           f"{len(times_s)} fields; median of {repeats} alternating run(s)")
     print(f"  {'runner':<18} {'wall [s]':>9} {'LAMMPS [s]':>11} {'loop [s]':>9} {'M atom-steps/s (loop)':>22}")
     median = {name: {key: statistics.median(values) for key, values in t.items()} for name, t in times.items()}

@@ -157,8 +157,8 @@ def main() -> None:
                     shutil.rmtree(directory)
             for name, times in seconds.items():
                 rate = model.n_bodies * steps / statistics.median(times) / 1e6
-                rates[name, len(model.lattice)] = rate
-                print(f"{model.lattice.shape:<36} {model.n_bodies:>6} {name:<26} {steps:>6} "
+                rates[name, len(model.packing)] = rate
+                print(f"{model.packing.shape:<36} {model.n_bodies:>6} {name:<26} {steps:>6} "
                       f"{statistics.median(times):>9.3f} {rate:>22.2f}", flush=True)
     finally:
         shutil.rmtree(work)

@@ -136,7 +136,7 @@ def main() -> None:
     m = {key: statistics.median(values) if values else math.nan for key, values in t.items()}
     bare_loop = m["bare loop"]
     atom_steps = model.n_bodies * settings.n_steps
-    print(f"deck: {'quick: ' if args.quick else 'default experiment, '}{model.lattice.shape}, {model.n_bodies} atoms x "
+    print(f"deck: {'quick: ' if args.quick else 'default experiment, '}{model.packing.shape}, {model.n_bodies} atoms x "
           f"{settings.n_steps} steps, a sample every {settings.dump_every} steps; median of {repeats} alternating "
           "run(s), after a warm-up")
     print(f"{'runner':<34} {'wall [s]':>9} {'loop [s]':>9} {'wall / bare loop':>17} {'M atom-steps/s (loop)':>22}")

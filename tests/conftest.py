@@ -11,8 +11,9 @@ from hexdem.analysis.trajectory import TrajectoryRecorder
 from hexdem.experiments.run import run_experiment
 from hexdem.model.config import RunConfig
 from hexdem.model.granular import GranularModel, Impact
-from hexdem.model.lattice import Lattice, hexagon
 from hexdem.model.materials import DELRIN, STEEL_316
+from hexdem.model.packing import Packing
+from hexdem.model.triangular import hexagon
 
 D, V0 = 0.01905, 0.4
 
@@ -70,9 +71,9 @@ def record(engine, model, settings, directory, **options):
     return recorder.trajectory(engine.run(model, settings, directory, recorder, **options))
 
 
-def single_bead(diameter_m=0.01905) -> Lattice:
+def single_bead(diameter_m=0.01905) -> Packing:
     """A one-bead 'packing' at the origin, for two-body collisions with a striker or a wall."""
-    return Lattice(indices=np.array([[0, 0]]), positions_m=np.zeros((1, 2)),
+    return Packing(labels=np.array([[0, 0]]), positions_m=np.zeros((1, 2)),
                    diameters_m=np.array([diameter_m]), diameter_m=diameter_m,
                    struck=0, walls=(), shape="single bead")
 

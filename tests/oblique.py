@@ -31,8 +31,8 @@ from hexdem.engines.reference.friction import FrictionalSystem
 from hexdem.model.contact_law import Friction
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time
-from hexdem.model.lattice import Lattice
 from hexdem.model.materials import DELRIN, STEEL_316
+from hexdem.model.packing import Packing
 from hexdem.model.units import SI
 from hexdem.model.walls import CurvedWall, Wall
 
@@ -52,13 +52,13 @@ def sphere_in_ring(incidence_deg: float, friction: float, ring_radius_d: float =
     """As :func:`sphere_on_wall`, inside a curved (cylindrical) wall of radius ``ring_radius_d`` d
     touching the sphere from below."""
     ring = CurvedWall("ring", (0.0, (ring_radius_d - 0.5) * D), ring_radius_d * D, np.array([0]))
-    return replace(sphere_on_wall(incidence_deg, friction), lattice=replace(single_bead(D), walls=(ring,)))
+    return replace(sphere_on_wall(incidence_deg, friction), packing=replace(single_bead(D), walls=(ring,)))
 
 
 def sphere_pair(incidence_deg: float, friction: float, speed: float = V0) -> GranularModel:
     """Two touching steel spheres on the x axis; the first moves at ``speed`` at ``incidence_deg`` from
     the line of centres towards the second, at rest."""
-    lattice = Lattice(np.array([[0, 0], [2, 0]]), np.array([[0.0, 0.0], [D, 0.0]]), np.full(2, D), D, 0, (), "pair")
+    lattice = Packing(np.array([[0, 0], [2, 0]]), np.array([[0.0, 0.0], [D, 0.0]]), np.full(2, D), D, 0, (), "pair")
     return GranularModel(lattice, Impact(speed, incidence_deg, bead=0), STEEL_316, None,
                          friction=Friction(friction, friction))
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from hexdem.disorder.ensemble import Ensemble, EnsembleConfig
-from hexdem.disorder.preparation import CRYSTAL_PUSH_FORCE_N, Disorder, Preparation, edge_directions, spaced_lattice
+from hexdem.disorder.preparation import CRYSTAL_PUSH_FORCE_N, Disorder, Preparation, edge_directions, spaced_packing
 from hexdem.disorder.prestress import touching_pairs
 from hexdem.disorder.runner import run_ensemble
 from hexdem.errors import HexdemError
@@ -31,7 +31,7 @@ def test_a_squares_edge_beads_are_pushed_perpendicular_to_their_own_edges():
     directions = edge_directions(lattice)
     pushed = np.flatnonzero(np.linalg.norm(directions, axis=1))
     assert len(pushed) == 2 * (5 + 6) - 4
-    rows, columns = lattice.indices.T
+    rows, columns = lattice.labels.T
     for i in pushed:
         expected = np.array([int(columns[i] == 0) - int(columns[i] == 5), int(rows[i] == -2) - int(rows[i] == 2)], float)
         np.testing.assert_allclose(directions[i], expected / np.linalg.norm(expected), atol=1e-12)
@@ -51,7 +51,7 @@ def test_a_spaced_centered_square_has_no_overlap_and_keeps_its_struck_bead(seed)
     diameters = ensemble.diameters_m(0)
     np.testing.assert_allclose(np.mean(diameters[interstitials]), lattice.diameters_m[interstitials][0],
                                atol=3 * Disorder(D).sigma / np.sqrt(len(interstitials)))
-    spaced = spaced_lattice(lattice, diameters, Disorder(D))
+    spaced = spaced_packing(lattice, diameters, Disorder(D))
     assert len(touching_pairs(spaced.positions_m, spaced.diameters_m)[2]) == 0
     np.testing.assert_array_equal(spaced.positions_m[spaced.struck], lattice.positions_m[lattice.struck])
 
@@ -76,8 +76,8 @@ def test_a_square_realization_is_prepared_and_struck_and_keeps_its_square_geomet
     config = EnsembleConfig(shape="square", **CRYSTAL)
     summary = run_ensemble(config, tmp_path, workers=1, log=quiet)
     ensemble = Ensemble(config, tmp_path)
-    settled, ideal = ensemble.settled_lattice(0), ensemble.ideal
-    rows, columns = ideal.indices.T
+    settled, ideal = ensemble.settled_packing(0), ensemble.ideal
+    rows, columns = ideal.labels.T
     for labels, axis in ((rows, 1), (columns, 0)):
         for label in np.unique(labels):
             line = settled.positions_m[labels == label, axis]

@@ -1,7 +1,7 @@
 """A curved wall (the disc's basin) in both engines: one sphere inside a circle of radius 3r.
 
 Head-on, the contact is Hertz's with LAMMPS's contact radius of a cylinder,
-R_eff = r · 2R / (2R − r) = 1.2 r (model.lattice.CurvedWall), 3.6 % shorter in time than a
+R_eff = r · 2R / (2R − r) = 1.2 r (model.packing.CurvedWall), 3.6 % shorter in time than a
 plane's. Struck obliquely, the sphere slides along the curve while in contact: the engines
 agree on the rebound only if both follow the circle (a tangent plane would be off by about
 u_t²/R, 0.4 % of the overlap here).
@@ -38,7 +38,7 @@ def expected_contact():
 
 
 def test_contact_radius_is_lammps_rule():
-    wall = bead_in_a_circle(0.0).lattice.walls[0]
+    wall = bead_in_a_circle(0.0).packing.walls[0]
     assert wall.contact_radii_m(D / 2) == pytest.approx(1.2 * D / 2)
     np.testing.assert_allclose(wall.normals_at(np.zeros((1, 2))), [[-1.0, 0.0]])
     assert wall.gaps_m(np.zeros((1, 2)), D / 2)[0] == pytest.approx(0.0, abs=1e-15)

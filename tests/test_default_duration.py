@@ -61,5 +61,5 @@ def test_the_interface_gallery_run_reaches_its_brass(tmp_path):
 
     config = RunConfig.from_toml(DOCS / "gallery" / "configs" / "interface.toml")
     analysis = simulate(config, tmp_path)
-    brass = analysis.model.lattice.material_ids == [m.name for m in analysis.model.materials].index("brass")
+    brass = analysis.model.packing.material_ids == [m.name for m in analysis.model.materials].index("brass")
     assert np.count_nonzero(np.isnan(analysis.results.arrival_time[brass])) <= 1 < np.count_nonzero(brass)

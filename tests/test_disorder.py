@@ -18,7 +18,7 @@ from hexdem.disorder.preparation import (
     Disorder,
     Preparation,
     edge_directions,
-    spaced_lattice,
+    spaced_packing,
     walls_for_settling,
     write_stage_deck,
 )
@@ -28,10 +28,10 @@ from hexdem.engines.lammps.standalone import run_deck
 from hexdem.engines.lammps.settling import SETTLED_NAME, read_data_file, read_stage
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
-from hexdem.model.lattice import hexagon
 from hexdem.model.materials import PAPER_DIAMETER_M, sphere_mass
 from hexdem.model.model_builder import build_model
 from hexdem.model.run_settings import run_settings
+from hexdem.model.triangular import hexagon
 
 D = PAPER_DIAMETER_M
 EDGE = 4
@@ -64,7 +64,7 @@ def test_zero_sigma_gives_the_ideal_diameters():
 @pytest.mark.parametrize("seed", range(5))
 def test_the_spaced_lattice_has_no_overlap(seed):
     disorder = Disorder(D)
-    lattice = spaced_lattice(hexagon(11, D), disorder.diameters_m(331, seed, 0), disorder)
+    lattice = spaced_packing(hexagon(11, D), disorder.diameters_m(331, seed, 0), disorder)
     i, j = lattice.bonds().T
     distances = np.linalg.norm(lattice.positions_m[i] - lattice.positions_m[j], axis=1)
     gaps = distances - lattice.radii_m[i] - lattice.radii_m[j]
@@ -121,16 +121,16 @@ def prepare(directory, sigma_m=None, seed=0) -> SimpleNamespace:
     """Both preparation stages of a 4-per-edge hexagon, chained as the ensemble chains them."""
     disorder, preparation = Disorder(D, sigma_m=sigma_m), Preparation()
     base = build_model(RunConfig(edge_beads=EDGE, impact="striker"))
-    ideal = base.lattice
-    spaced = spaced_lattice(ideal, disorder.diameters_m(len(ideal), seed, 0), disorder)
-    compact = dataclasses.replace(base, lattice=spaced)
+    ideal = base.packing
+    spaced = spaced_packing(ideal, disorder.diameters_m(len(ideal), seed, 0), disorder)
+    compact = dataclasses.replace(base, packing=spaced)
     run_deck(write_stage_deck(compact, "compact", preparation, directory / "compact"))
     compacted = read_data_file(directory / "compact" / SETTLED_NAME)
     walled = ideal.with_geometry(compacted.positions_m, compacted.diameters_m)
-    settle = dataclasses.replace(base, lattice=walled)
+    settle = dataclasses.replace(base, packing=walled)
     run_deck(write_stage_deck(settle, "settle", preparation, directory / "settle"))
     settled = read_data_file(directory / "settle" / SETTLED_NAME)
-    model = dataclasses.replace(base, lattice=dataclasses.replace(walled, positions_m=settled.positions_m))
+    model = dataclasses.replace(base, packing=dataclasses.replace(walled, positions_m=settled.positions_m))
     return SimpleNamespace(directory=directory, preparation=preparation, compact=compact, compacted=compacted,
                            settled=settled, model=model,
                            gravity=preparation.gravity_vector_m_s2(base.impact.direction))
@@ -144,13 +144,13 @@ def prepared(tmp_path_factory):
 
 def hertz_overlap(model, force_n):
     """Overlap of the softest bead pair carrying ``force_n``: F = k_n sqrt(R_eff) δ^{3/2}."""
-    r_eff = model.lattice.radii_m.min() / 2
+    r_eff = model.packing.radii_m.min() / 2
     return (force_n / (model.stiffness_table_pa[0, 0] * np.sqrt(r_eff))) ** (2 / 3)
 
 
 def net_forces(model, gravity):
     """Net force on every bead [N] recomputed from the positions: Hertz pairs, walls, gravity."""
-    lattice = model.lattice
+    lattice = model.packing
     pos, r = lattice.positions_m, lattice.radii_m
     force = np.outer(model.masses_kg[:len(lattice)], gravity)
     for i, j in cKDTree(pos).query_pairs(2 * r.max()):
@@ -170,7 +170,7 @@ def net_forces(model, gravity):
 
 def test_both_stages_meet_the_settling_criterion(prepared):
     masses = sphere_mass(prepared.settled.diameters_m)
-    np.testing.assert_allclose(prepared.settled.diameters_m, prepared.compact.lattice.diameters_m, rtol=1e-15)
+    np.testing.assert_allclose(prepared.settled.diameters_m, prepared.compact.packing.diameters_m, rtol=1e-15)
     for stage, state in (("compact", prepared.compacted), ("settle", prepared.settled)):
         result = read_stage(prepared.directory / stage)
         assert result.settled and result.steps < prepared.preparation.max_steps
@@ -182,7 +182,7 @@ def test_both_stages_meet_the_settling_criterion(prepared):
 
 def test_overlaps_stay_below_those_of_the_whole_applied_load(prepared):
     masses = sphere_mass(prepared.settled.diameters_m)
-    pushed = np.count_nonzero(np.linalg.norm(edge_directions(prepared.compact.lattice), axis=1))
+    pushed = np.count_nonzero(np.linalg.norm(edge_directions(prepared.compact.packing), axis=1))
     bound = hertz_overlap(prepared.model, pushed * prepared.preparation.push_force_n + masses.sum() * 9.81)
     for state in (prepared.compacted, prepared.settled):
         assert 0 < touching_pairs(state.positions_m, state.diameters_m)[2].max() < bound
@@ -201,7 +201,7 @@ def test_the_settled_packing_is_in_static_equilibrium(prepared):
 
 def test_compaction_brings_equal_beads_into_a_touching_lattice(tmp_path):
     ideal = prepare(tmp_path, sigma_m=0.0)
-    lattice = ideal.compact.lattice
+    lattice = ideal.compact.packing
     pos = ideal.compacted.positions_m
     i, j = lattice.bonds().T
     overlaps = D - np.linalg.norm(pos[i] - pos[j], axis=1)

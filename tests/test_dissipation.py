@@ -18,7 +18,7 @@ from hexdem.model.contact_law import Friction
 from hexdem.model.dissipation import TSUJI_POLYNOMIAL, damping_coefficient, lammps_tsuji_coefficient, restitution_of
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time
-from hexdem.model.lattice import Lattice
+from hexdem.model.packing import Packing
 from hexdem.model.walls import Wall
 from hexdem.model.materials import DELRIN, STEEL_316, hertz_stiffness, sphere_mass
 
@@ -74,7 +74,7 @@ def steel_contacts(kind: str, mu: float) -> tuple[GranularModel, float, float]:
         model = GranularModel(lattice, Impact(V0), STEEL_316, STEEL_316, wall_restitution=0.8, friction=friction)
         return model, mass, hertz_stiffness(STEEL_316, STEEL_316) * np.sqrt(D / 2)
     if kind == "pair":
-        lattice = Lattice(np.array([[0, 0], [2, 0]]), np.array([[0.0, 0.0], [D, 0.0]]), np.full(2, D), D, 0, (), "pair")
+        lattice = Packing(np.array([[0, 0], [2, 0]]), np.array([[0.0, 0.0], [D, 0.0]]), np.full(2, D), D, 0, (), "pair")
         model = GranularModel(lattice, Impact(V0, bead=0), STEEL_316, None, restitution=0.8, friction=friction)
     else:
         model = GranularModel(single_bead(D), Impact(V0, striker=True), STEEL_316, None, restitution=0.8,

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from hexdem.model.config import RunConfig
-from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.model_builder import build_model, build_packing
 from hexdem.model.random_disc import random_diameters
 
 GUIDE = Path(__file__).resolve().parents[1] / "docs" / "guide"
@@ -42,7 +42,7 @@ def test_every_packing_config_of_the_guide_builds_the_packing_its_comment_names(
     (random,) = [k for k, block in enumerate(blocks) if 'shape = "random"' in block]  # packed by LAMMPS
     disc = RunConfig(**tomllib.loads(blocks[random]))
     assert len(random_diameters(disc.radius_m, disc.diameter_m, disc.diameter_spread, disc.seed)) == 196
-    lattices = [build_lattice(RunConfig(**tomllib.loads(block))) for k, block in enumerate(blocks)
+    lattices = [build_packing(RunConfig(**tomllib.loads(block))) for k, block in enumerate(blocks)
                 if k not in packing and k != random]
     # 9 x 12 corners and 8 x 11 interstitials; the intruder's and the dimer's chains of 40 beads
     assert [len(lattice) for lattice in lattices] == [28, 30, 514, 329, 10, 225, 9 * 12 + 8 * 11, 40, 40, 1]
@@ -67,8 +67,8 @@ def test_the_guides_impact_configs_build_their_impacts_and_lines():
     models = [build_model(config) for config in impacts]
     assert [len(model.impacts) for model in models] == [2, 11, 1]  # double strike, the 11 beads of an edge, interior
     assert [len(model.strikers) for model in models] == [0, 11, 0]
-    assert [list(lattice.indices[b]) for lattice in [models[2].lattice] for b in models[2].struck_beads] == [[0, 14]]
-    assert len(build_lattice(lines).line("across")) == 21  # the middle column of 11 per edge: 2 * 11 - 1 beads
+    assert [list(lattice.labels[b]) for lattice in [models[2].packing] for b in models[2].struck_beads] == [[0, 14]]
+    assert len(build_packing(lines).line("across")) == 21  # the middle column of 11 per edge: 2 * 11 - 1 beads
 
 
 def test_the_configuration_pages_file_is_the_built_in_default():

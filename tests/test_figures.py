@@ -14,7 +14,7 @@ from matplotlib.colors import to_rgb
 
 from hexdem.analysis.figures import (PIXEL_MAP_BEADS, PIXEL_REACH_D, PIXEL_UNMEASURED, UNMEASURED_STYLES,
                                      bead_map, subplots)
-from hexdem.model.lattice import hexagon
+from hexdem.model.triangular import hexagon
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -55,10 +55,10 @@ def test_lammps_multiplies_the_mindlin_stiffness_by_the_contact_radius(tmp_path)
     dt, u, overlap = 1e-8, 0.1, 2e-6
     for name, model in (("wall", sphere_on_wall(90.0, 10.0, speed=u)), ("pair", sphere_pair(90.0, 10.0, speed=u))):
         contact = Contact.of(model)
-        shifted = model.lattice.positions_m.copy()
+        shifted = model.packing.positions_m.copy()
         shifted[0] += (0.0, -overlap) if contact.wall else (overlap, 0.0)
-        lattice = replace(model.lattice, positions_m=shifted)  # the walls stay
-        with lammps_deck(replace(model, lattice=lattice), RunSettings(dt, 1, 1), tmp_path / name) as lmp:
+        lattice = replace(model.packing, positions_m=shifted)  # the walls stay
+        with lammps_deck(replace(model, packing=lattice), RunSettings(dt, 1, 1), tmp_path / name) as lmp:
             lmp.command("run 1")
             order = np.argsort(lmp.numpy.extract_atom("id"))
             x = np.array(lmp.numpy.extract_atom("x"))[order, :2]

@@ -20,7 +20,7 @@ from hexdem.analysis.front_shape import (
     sixfold_roundness,
 )
 from hexdem.errors import HexdemError
-from hexdem.model.lattice import hexagon
+from hexdem.model.triangular import hexagon
 
 C = 2.0  # front speed, bead diameters per time unit
 ORIGIN = np.zeros(2)

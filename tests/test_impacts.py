@@ -11,7 +11,7 @@ from hexdem.errors import HexdemError
 from hexdem.experiments.run import run_experiment, simulate
 from hexdem.model.config import RunConfig
 from hexdem.model.materials import BRASS, STEEL_316
-from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.model_builder import build_model, build_packing
 from hexdem.model.run_settings import run_settings
 
 ENGINES = [LammpsEngine(), ReferenceEngine()]
@@ -49,7 +49,7 @@ def test_three_strikers_keep_the_momentum_and_energy_they_bring(engine, tmp_path
 
 def mirror(lattice, site_map):
     """Index of each bead's mirror image under ``site_map`` (m, n) → (m', n')."""
-    return np.array([lattice.index_of(*site_map(m, n)) for m, n in lattice.indices.tolist()])
+    return np.array([lattice.index_of(*site_map(m, n)) for m, n in lattice.labels.tolist()])
 
 
 @pytest.mark.parametrize("engine", ["lammps", "reference"])
@@ -64,7 +64,7 @@ def test_a_symmetric_strike_gives_mirror_symmetric_pulses(engine, case, tmp_path
                "flat-striker": {"impacts": [{"edge_deg": 0.0}], "impact": "striker"}}[case]
     config = RunConfig(edge_beads=5, engine=engine, **changes)
     analysis = simulate(config, tmp_path)
-    r, lattice = analysis.results, analysis.model.lattice
+    r, lattice = analysis.results, analysis.model.packing
     image = mirror(lattice, (lambda m, n: (-m, n)) if case == "flat-striker" else (lambda m, n: (m, 8 - n)))
     assert np.all(image >= 0)
     np.testing.assert_allclose(r.peak_speed[image], r.peak_speed, rtol=1e-9, atol=1e-12)
@@ -74,19 +74,19 @@ def test_a_symmetric_strike_gives_mirror_symmetric_pulses(engine, case, tmp_path
 
 def test_a_flat_striker_is_one_sphere_per_edge_bead_and_replaces_the_wall():
     model = build_model(RunConfig(impact="striker", impacts=[{"edge_deg": 0.0}]))
-    left = np.flatnonzero(model.lattice.indices[:, 1] == 0)
+    left = np.flatnonzero(model.packing.labels[:, 1] == 0)
     assert sorted(model.struck_beads) == sorted(left) and len(left) == 11
     assert len(model.strikers) == 11 and "wall_000" not in [w.name for w in model.walls]
-    velocities = model.initial_velocities_m_s()[len(model.lattice):]
+    velocities = model.initial_velocities_m_s()[len(model.packing):]
     np.testing.assert_array_equal(velocities, np.tile([0.4, 0.0], (11, 1)))
-    gaps = np.diff(model.initial_positions_m()[len(model.lattice):, 1])
+    gaps = np.diff(model.initial_positions_m()[len(model.packing):, 1])
     np.testing.assert_allclose(np.sort(np.abs(gaps)), 0.01905, rtol=1e-12)  # the spheres touch: a plate
 
 
 def test_every_struck_bead_sits_in_a_hole_of_the_wall_it_is_pushed_through():
     model = build_model(RunConfig(edge_beads=5, impacts=[{"site": [0, 0]}, {"site": [0, 8], "angle_deg": 180.0},
                                              {"site": [-4, 0], "angle_deg": 0.0}]))
-    members = {w.name: {tuple(model.lattice.indices[b]) for b in w.members} for w in model.walls}
+    members = {w.name: {tuple(model.packing.labels[b]) for b in w.members} for w in model.walls}
     assert (0, 0) not in members["wall_000"] and (0, 8) not in members["wall_180"]
     assert (-4, 0) not in members["wall_000"] and (-4, 0) in members["wall_060"]  # the corner's other wall stays
 
@@ -96,13 +96,13 @@ def test_holes_do_not_depend_on_the_order_of_the_impacts_and_only_struck_beads_s
     second = build_model(RunConfig(edge_beads=4, impacts=[{"site": [2, 6], "angle_deg": -120.0}, {"site": [0, 0]}]))
     assert {w.name: w.members.tolist() for w in first.walls} == {w.name: w.members.tolist() for w in second.walls}
     far = build_model(RunConfig(edge_beads=4, impacts=[{"edge_deg": 180.0}]))  # {0, 0} is not struck: no hole there
-    assert far.lattice.struck in next(w for w in far.walls if w.name == "wall_000").members
+    assert far.packing.struck in next(w for w in far.walls if w.name == "wall_000").members
 
 
 def test_the_papers_single_impact_keeps_its_one_hole_in_the_struck_edges_wall():
     """In a hexagon of 2 per edge {0, 0} is also the corner of the lower-left edge: it stays on that wall."""
-    walls = {w.name: w.members for w in build_lattice(RunConfig(edge_beads=2)).walls}
-    struck = build_lattice(RunConfig(edge_beads=2)).struck
+    walls = {w.name: w.members for w in build_packing(RunConfig(edge_beads=2)).walls}
+    struck = build_packing(RunConfig(edge_beads=2)).struck
     assert struck not in walls["wall_000"] and struck in walls["wall_060"]
 
 
@@ -120,9 +120,9 @@ def test_extra_observation_lines_follow_the_lattice_from_any_bead(tmp_path):
     config = RunConfig(edge_beads=5, engine="reference",
                        lines=[{"name": "up", "site": [-8, 4], "angle_deg": 90},
                               {"name": "sixty", "site": [0, 0], "angle_deg": 60}])
-    lattice = build_lattice(config)
-    assert [tuple(lattice.indices[b]) for b in lattice.line("up")] == [(m, 4) for m in range(-8, 9, 2)]
-    assert [tuple(lattice.indices[b]) for b in lattice.line("sixty")] == [(0, 0), (3, 1), (6, 2)]
+    lattice = build_packing(config)
+    assert [tuple(lattice.labels[b]) for b in lattice.line("up")] == [(m, 4) for m in range(-8, 9, 2)]
+    assert [tuple(lattice.labels[b]) for b in lattice.line("sixty")] == [(0, 0), (3, 1), (6, 2)]
     run_experiment(config, tmp_path, log=lambda message: None)
     assert json.loads((tmp_path / "summary.json").read_text())["impacts"] == [
         {"bead_id": lattice.struck + 1, "site": [0, 0], "v0": 0.4, "angle_deg": 0.0, "kind": "velocity"}]
@@ -167,7 +167,7 @@ def test_the_far_wall_of_every_impact_must_be_reached():
     config = RunConfig(impacts=[{"site": [0, 0]}, {"site": [0, 20], "angle_deg": 180.0}])
     model = build_model(config)
     settings = run_settings(config, model)
-    n = len(model.lattice)
+    n = len(model.packing)
     left = next(w for w in model.walls if w.normal[0] > 0.99)
 
     def far_wall_reached(reach_time):

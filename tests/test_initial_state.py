@@ -15,7 +15,7 @@ from hexdem.experiments.run import simulate
 from hexdem.model.config import RunConfig
 from hexdem.model.materials import hertz_coefficient, sphere_mass
 from hexdem.model.run_settings import contact_time_s, run_settings
-from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.model_builder import build_model, build_packing
 
 #: Two touching spheres on the +30° line, no walls, the first struck along the line.
 PAIR = {"shape": "sites", "sites": [[0, 0], [1, 1]], "site_walls_deg": [], "strike_angle_deg": 30.0}
@@ -148,7 +148,7 @@ def test_both_engines_agree_on_a_random_initial_state_in_a_precompressed_packing
     config = RunConfig(edge_beads=5, precompression_n=20.0, v0=1e-4)
     velocities, displacements = 1e-4 * rng.standard_normal((61, 2)), 1e-8 * rng.standard_normal((61, 2))
     lines = ["m,n,vx,vy,dx,dy"] + [f"{m},{n}," + ",".join(repr(float(v)) for v in (*u, *d))
-                                   for (m, n), u, d in zip(build_lattice(config).indices.tolist(), velocities, displacements)]
+                                   for (m, n), u, d in zip(build_packing(config).labels.tolist(), velocities, displacements)]
     (tmp_path / "state.csv").write_text("\n".join(lines) + "\n")
     config = config.replace(initial_state_file=str(tmp_path / "state.csv"), duration=5e-4)
     reference = simulate(config.replace(engine="reference", steps_per_contact=280), tmp_path / "reference").results
@@ -170,7 +170,7 @@ def test_beads_csv_places_the_beads_where_the_state_starts_them(tmp_path):
     config.write_text('shape = "sites"\nsites = [[0, 0], [1, 1], [0, 4]]\nsite_walls_deg = []\nduration = 2e-4\n'
                       f'initial_state_file = "{state}"\n')
     assert main(["run", "--config", str(config), "--out", str(tmp_path / "out")]) == 0
-    packed = build_lattice(RunConfig(shape="sites", sites=[[0, 0], [1, 1], [0, 4]])).positions_m
+    packed = build_packing(RunConfig(shape="sites", sites=[[0, 0], [1, 1], [0, 4]])).positions_m
     rows = read_csv(tmp_path / "out" / "beads.csv")[1]
     placed = np.array([[float(row["x"]), float(row["y"])] for row in rows])
     np.testing.assert_allclose(placed - packed, [[0, 0], [0.001, -0.002], [0, 0]], atol=1e-15)

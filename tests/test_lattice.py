@@ -5,9 +5,10 @@ import pytest
 
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
-from hexdem.model.lattice import (disc, from_sites, half_disc, half_hexagon, hexagon, parallelogram, strike_direction,
-                                   triangle, without_sites)
-from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.model_builder import build_model, build_packing
+from hexdem.model.packing import strike_direction
+from hexdem.model.triangular import (disc, from_sites, half_disc, half_hexagon, hexagon, parallelogram, triangle,
+                                     without_sites)
 
 D = 0.01905
 
@@ -27,7 +28,7 @@ def test_bonds_are_touching_and_labels_follow_the_paper(lattice):
     i, j = lattice.bonds().T
     lengths = np.linalg.norm(lattice.positions_m[i] - lattice.positions_m[j], axis=1)
     np.testing.assert_allclose(lengths, D, rtol=1e-12)
-    assert np.all(lattice.indices.sum(axis=1) % 2 == 0)
+    assert np.all(lattice.labels.sum(axis=1) % 2 == 0)
     distances = np.linalg.norm(lattice.positions_m[:, None] - lattice.positions_m[None], axis=2)
     touching = np.sum(np.isclose(distances, D, rtol=1e-9)) // 2
     assert touching == len(i), "every touching pair is exactly one bond"
@@ -98,11 +99,11 @@ def test_half_disc_holds_every_site_within_its_radius_on_the_struck_side():
     lattice = half_disc(12, 1.0)
     expected = {(m, n) for n in range(0, 15) for m in range(-24, 25)
                 if (m + n) % 2 == 0 and 0.75 * n**2 + 0.25 * m**2 <= 144 + 1e-9}
-    assert {tuple(mn) for mn in lattice.indices.tolist()} == expected
+    assert {tuple(mn) for mn in lattice.labels.tolist()} == expected
     assert np.hypot(*lattice.positions_m.T).max() <= 12.0 + 1e-12
     (wall,) = lattice.walls
     assert wall.normal == (1.0, 0.0) and wall.offset_m == pytest.approx(-0.5)
-    assert set(wall.members.tolist()) == set(np.flatnonzero(lattice.indices[:, 1] == 0)) - {lattice.struck}
+    assert set(wall.members.tolist()) == set(np.flatnonzero(lattice.labels[:, 1] == 0)) - {lattice.struck}
     assert len(lattice.line("0")) == 7 and len(lattice.line("+30")) == 13
 
 
@@ -112,7 +113,7 @@ def test_triangle_holds_a_triangular_number_of_beads_with_three_walls(edge):
     each hold N beads, every one touching its wall (the struck bead in its hole)."""
     lattice = triangle(edge, D)
     assert len(lattice) == edge * (edge + 1) // 2
-    assert tuple(lattice.indices[lattice.struck]) == (0, 0)
+    assert tuple(lattice.labels[lattice.struck]) == (0, 0)
     apex = lattice.positions_m[:, 0].max()
     assert apex == pytest.approx(np.sqrt(3) / 2 * (edge - 1) * D)
     for wall in lattice.walls:
@@ -125,9 +126,9 @@ def test_triangle_holds_a_triangular_number_of_beads_with_three_walls(edge):
 def test_parallelogram_has_equal_layers_sheared_along_30_degrees():
     lattice = parallelogram(5, 7, D)
     assert len(lattice) == 35
-    layers = np.bincount(lattice.indices[:, 1])
+    layers = np.bincount(lattice.labels[:, 1])
     assert list(layers) == [5] * 7
-    lowest = [lattice.indices[lattice.indices[:, 1] == n, 0].min() for n in range(7)]
+    lowest = [lattice.labels[lattice.labels[:, 1] == n, 0].min() for n in range(7)]
     assert np.all(np.diff(lowest) == 1), "each layer one half-diameter higher: edges at +30 deg"
     counts = {wall.name: len(wall.members) for wall in lattice.walls}
     assert counts == {"wall_000": 4, "wall_180": 5, "wall_120": 7, "wall_m60": 7}
@@ -138,7 +139,7 @@ def test_parallelogram_has_equal_layers_sheared_along_30_degrees():
 def test_listed_sites_are_the_packing_and_their_walls_touch_it():
     sites = [(0, 0), (2, 0), (-2, 0), (1, 1), (-1, 1), (0, 2)]
     lattice = from_sites(sites, D, (0,), "six")
-    assert [tuple(mn) for mn in lattice.indices.tolist()] == sites
+    assert [tuple(mn) for mn in lattice.labels.tolist()] == sites
     (wall,) = lattice.walls
     assert set(wall.members.tolist()) == {1, 2}, "the n = 0 beads but the struck one"
 
@@ -157,12 +158,12 @@ def test_vacancies_leave_sites_out_and_keep_the_walls():
     holed = without_sites(full, [(1, 1), (4, 4)])
     assert len(holed) == len(full) - 2
     assert holed.index_of(1, 1) is None and holed.index_of(4, 4) is None
-    assert tuple(holed.indices[holed.struck]) == (0, 0)
+    assert tuple(holed.labels[holed.struck]) == (0, 0)
     for before, after in zip(full.walls, holed.walls):
         assert after.offset_m == before.offset_m
-        kept = [tuple(full.indices[i]) for i in before.members if tuple(full.indices[i]) not in {(1, 1), (4, 4)}]
-        assert [tuple(holed.indices[i]) for i in after.members] == kept
-    bonds = {tuple(sorted(map(tuple, holed.indices[pair]))) for pair in holed.bonds()}
+        kept = [tuple(full.labels[i]) for i in before.members if tuple(full.labels[i]) not in {(1, 1), (4, 4)}]
+        assert [tuple(holed.labels[i]) for i in after.members] == kept
+    bonds = {tuple(sorted(map(tuple, holed.labels[pair]))) for pair in holed.bonds()}
     assert not any((1, 1) in bond or (4, 4) in bond for bond in bonds)
     with pytest.raises(HexdemError, match="struck bead cannot be a vacancy"):
         without_sites(full, [(0, 0)])
@@ -174,10 +175,10 @@ def test_config_reads_sites_from_csv_and_toml(tmp_path):
     csv_file, toml_file = tmp_path / "sites.csv", tmp_path / "sites.toml"
     csv_file.write_text("m,n\n0,0\n2,0\n1,1\n")
     toml_file.write_text("sites = [[0, 0], [2, 0], [1, 1]]\n")
-    inline = build_lattice(RunConfig(shape="sites", sites=[[0, 0], [2, 0], [1, 1]]))
+    inline = build_packing(RunConfig(shape="sites", sites=[[0, 0], [2, 0], [1, 1]]))
     for path in (csv_file, toml_file):
-        lattice = build_lattice(RunConfig(shape="sites", sites_file=str(path)))
-        np.testing.assert_array_equal(lattice.indices, inline.indices)
+        lattice = build_packing(RunConfig(shape="sites", sites_file=str(path)))
+        np.testing.assert_array_equal(lattice.labels, inline.labels)
         assert lattice.walls == ()
     (tmp_path / "bad.csv").write_text("m,n\n0,0\nx,1\n")
     with pytest.raises(HexdemError, match="two integers"):
@@ -192,7 +193,7 @@ def test_disc_holds_every_site_within_its_radius_inside_a_touching_circle():
     lattice = disc(12, 1.0)
     expected = {(m, n) for n in range(0, 28) for m in range(-24, 25)
                 if (m + n) % 2 == 0 and (np.sqrt(3) / 2 * n - 12) ** 2 + (m / 2) ** 2 <= 144 + 1e-9}
-    assert {tuple(mn) for mn in lattice.indices.tolist()} == expected
+    assert {tuple(mn) for mn in lattice.labels.tolist()} == expected
     (wall,) = lattice.walls
     gaps = wall.gaps_m(lattice.positions_m, lattice.radii_m)
     others = np.delete(gaps, lattice.struck)

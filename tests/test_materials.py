@@ -58,9 +58,9 @@ def test_regions_give_materials_half_plane_strip_and_intruders():
                                               {"material": "ptfe", "sites": [[0, 6], [1, 7]]}])
     model = build_model(config)
     assert [m.name for m in model.materials] == ["steel316", "brass", "glass", "ptfe"]
-    x_d = (model.lattice.positions_m[:, 0] - model.lattice.positions_m[model.lattice.struck, 0]) / D
-    names = np.array([model.materials[k].name for k in model.lattice.material_ids])
-    intruders = [model.lattice.index_of(0, 6), model.lattice.index_of(1, 7)]
+    x_d = (model.packing.positions_m[:, 0] - model.packing.positions_m[model.packing.struck, 0]) / D
+    names = np.array([model.materials[k].name for k in model.packing.material_ids])
+    intruders = [model.packing.index_of(0, 6), model.packing.index_of(1, 7)]
     assert set(names[intruders]) == {"ptfe"}
     rest = np.setdiff1d(np.arange(len(names)), intruders)
     expected = np.where(x_d[rest] >= 5.0 - 1e-9, "brass", np.where((x_d[rest] >= 2.0 - 1e-9) & (x_d[rest] <= 3.0 + 1e-9),
@@ -108,7 +108,7 @@ def test_energy_by_region_adds_up_to_the_impact_and_starts_in_the_struck_region(
     shares = r.region_energies.sum(axis=2) / totals[:, None]
     assert shares[0, r.region_names.index(first)] == pytest.approx(1.0, abs=1e-12)
     ptfe = r.region_names.index("ptfe")
-    reached = np.nanmin(r.arrival_time[analysis.model.lattice.material_ids == 1])
+    reached = np.nanmin(r.arrival_time[analysis.model.packing.material_ids == 1])
     assert np.all(shares[r.region_times < 0.25 * reached, ptfe] < 1e-9) and shares[-1, ptfe] > 0.05
     header, rows = read_csv(tmp_path / "energy_regions.csv")
     assert header == ENERGY_REGION_COLUMNS and len(rows) == len(r.region_times) * len(r.region_names)

@@ -15,19 +15,19 @@ from hexdem.experiments.compare import Tolerances
 from hexdem.model.config import RunConfig
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time
-from hexdem.model.lattice import Lattice
 from hexdem.model.materials import STEEL_316, hertz_stiffness, sphere_mass
 from hexdem.model.model_builder import build_model
+from hexdem.model.packing import Packing
 from hexdem.model.run_settings import run_settings
 
 #: Steel beads of the experiment at V0: the two-bead Hertz contact time [s].
 TAU = contact_time(sphere_mass(D, STEEL_316) / 2, hertz_stiffness(STEEL_316, STEEL_316) * np.sqrt(D / 4), V0)
 
 
-def packing(positions_m, struck: int, shape: str) -> Lattice:
+def packing(positions_m, struck: int, shape: str) -> Packing:
     """Beads of diameter D at ``positions_m``, labelled 0, 1, … (the engines use positions only)."""
     n = len(positions_m)
-    return Lattice(indices=np.column_stack([np.arange(n), np.zeros(n, int)]),
+    return Packing(labels=np.column_stack([np.arange(n), np.zeros(n, int)]),
                    positions_m=np.asarray(positions_m, float), diameters_m=np.full(n, D), diameter_m=D, struck=struck,
                    walls=(), shape=shape)
 
@@ -58,7 +58,7 @@ def test_a_square_packing_carries_the_pulse_along_its_struck_row_as_a_chain(tmp_
     settings = RunSettings(TAU / 140, 20 * 140, 7)
     grid = record(ReferenceEngine(), model, settings, tmp_path / "square")
     assert grid.engine["n_pairs"] == 2 * 7 * 12 - 7 - 12
-    chain_model = GranularModel(packing(model.lattice.positions_m[row], 0, "chain"), Impact(V0), STEEL_316, wall=None)
+    chain_model = GranularModel(packing(model.packing.positions_m[row], 0, "chain"), Impact(V0), STEEL_316, wall=None)
     chain = record(ReferenceEngine(), chain_model, settings, tmp_path / "chain")
     np.testing.assert_allclose(grid.velocities_m_s[:, row], chain.velocities_m_s, rtol=0, atol=1e-12 * V0)
     others = np.setdiff1d(np.arange(model.n_bodies), row)
@@ -116,7 +116,7 @@ def test_engines_agree_on_a_square_packing(tmp_path):
     on a square packing struck obliquely at 20°, within the comparison's tolerances, on every bead:
     the pulse runs along the struck row (the strike's x part) and up the struck column (its y part)."""
     model, row = square(6, 8)
-    model = GranularModel(model.lattice, Impact(V0, angle_deg=20.0), STEEL_316, wall=None)
+    model = GranularModel(model.packing, Impact(V0, angle_deg=20.0), STEEL_316, wall=None)
     settings = RunSettings(dt_s=TAU / 140, n_steps=8 * 140, dump_every=7, contact_time_s=TAU)
     tolerances = Tolerances().for_run(model, settings)
     lammps, reference = (ImpactAnalysis.from_trajectory(model, settings, record(engine, model, settings,

@@ -15,7 +15,7 @@ from hexdem.model.config import RunConfig
 from hexdem.model.materials import sphere_mass
 from hexdem.model.square_crystals import interstitial_fit_m
 from hexdem.model.solitary_wave import chain_speed_scale_m_s, solitary_speed_m_s
-from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.model_builder import build_model, build_packing
 from hexdem.model.run_settings import run_settings
 
 V0 = 0.4
@@ -38,11 +38,11 @@ def test_the_square_crystals_struck_row_carries_nesterenkos_solitary_wave(square
     r, model = square_run.results, square_run.model
     row = r.lines["0"]
     n = np.arange(*SQUARE_WINDOW)
-    speed = np.polyfit(r.arrival_time[row[n]], n * model.lattice.diameter_m, 1)[0]
+    speed = np.polyfit(r.arrival_time[row[n]], n * model.packing.diameter_m, 1)[0]
     peak = float(np.mean(r.peak_speed[row[n]]))
     law = solitary_speed_m_s(chain_speed_scale_m_s(model.bead), peak)
     assert -0.015 < speed / law - 1 < 0
-    off_row = model.lattice.indices[:, 0] != 0
+    off_row = model.packing.labels[:, 0] != 0
     assert np.all(r.peak_speed[off_row] == 0.0)  # never moved: not NaN, not round-off
 
 
@@ -61,14 +61,14 @@ def test_the_centered_square_crystal_is_symmetric_about_its_strike(tmp_path, eng
     """Mirrored in the strike axis (label {m, n} to {−m, n}), every bead peaks and arrives as its image."""
     analysis = simulate(RunConfig(shape="centered-square", rows=7, columns=7, interstitial_material="brass",
                                   engine=engine), tmp_path)
-    r, labels = analysis.results, analysis.model.lattice.indices
-    image = [analysis.model.lattice.index_of(-m, n) for m, n in labels.tolist()]
+    r, labels = analysis.results, analysis.model.packing.labels
+    image = [analysis.model.packing.index_of(-m, n) for m, n in labels.tolist()]
     np.testing.assert_allclose(r.peak_speed[image], r.peak_speed, rtol=1e-9, atol=1e-12)
     moved = np.isfinite(r.arrival_time)
     assert moved.sum() > len(labels) // 2
     np.testing.assert_allclose(r.arrival_time[image][moved], r.arrival_time[moved], rtol=1e-9)
-    small = analysis.model.lattice.diameters_m < analysis.model.lattice.diameter_m
-    assert np.allclose(analysis.model.lattice.diameters_m[small], interstitial_fit_m(analysis.model.lattice.diameter_m))
+    small = analysis.model.packing.diameters_m < analysis.model.packing.diameter_m
+    assert np.allclose(analysis.model.packing.diameters_m[small], interstitial_fit_m(analysis.model.packing.diameter_m))
     assert {m.name for m in analysis.model.materials} == {"steel316", "brass"}
 
 
@@ -99,12 +99,12 @@ def test_a_packing_file_is_the_packing_it_was_written_from(tmp_path):
     walls and holes, and the same peaks and arrivals on every bead the pulse reaches before it
     could meet a wall (1e-6)."""
     default = RunConfig()
-    lattice = build_lattice(default)
+    lattice = build_packing(default)
     rows = "\n".join(f"{float(x)!r},{float(y)!r},{float(d)!r}" for (x, y), d in zip(lattice.positions_m, lattice.diameters_m))
     (tmp_path / "hexagon.csv").write_text("x,y,diameter\n" + rows + "\n")
     from_file = RunConfig(shape="packing", packing_file=str(tmp_path / "hexagon.csv"), walls="hull",
                           struck_bead=int(lattice.struck))
-    packed = build_lattice(from_file)
+    packed = build_packing(from_file)
     np.testing.assert_allclose(sorted(np.round(w.normal, 12).tolist() for w in packed.walls),
                                sorted(np.round(w.normal, 12).tolist() for w in lattice.walls), atol=1e-12)
     assert sorted(sorted(w.members.tolist()) for w in packed.walls) == sorted(sorted(w.members.tolist())
@@ -156,17 +156,17 @@ def test_a_chains_short_forms_equal_the_lists_typed_out():
               {"diameters_m": [d] * 5 + [small] + [d] * 4, "bead_materials": [""] * 5 + ["brass"] + [""] * 4}))
     for short, typed in pairs:
         a, b = (build_model(RunConfig(shape="chain", beads=10, **keys)) for keys in (short, typed))
-        np.testing.assert_array_equal(a.lattice.positions_m, b.lattice.positions_m)
+        np.testing.assert_array_equal(a.packing.positions_m, b.packing.positions_m)
         np.testing.assert_array_equal(a.masses_kg, b.masses_kg)
         assert [m.name for m in a.materials] == [m.name for m in b.materials]
-        assert a.materials[a.lattice.material_ids[5]].name == "brass"
+        assert a.materials[a.packing.material_ids[5]].name == "brass"
 
 
 def test_a_chains_intruder_mass_follows_its_diameter():
     config = RunConfig(shape="chain", beads=3, diameters_m=[0.02, 0.01, 0.02])
     model = build_model(config)
     assert model.masses_kg[1] == pytest.approx(sphere_mass(0.01, model.bead))
-    np.testing.assert_allclose(model.lattice.positions_m[:, 0], [0.0, 0.015, 0.03])
+    np.testing.assert_allclose(model.packing.positions_m[:, 0], [0.0, 0.015, 0.03])
 
 
 @pytest.mark.parametrize("changes", [
@@ -226,4 +226,4 @@ def test_a_packing_file_is_read_with_its_byte_order_mark_and_from_the_configs_fo
     monkeypatch.chdir(tmp_path)
     runs = plan_sweep(read_base(folder / "base.toml"), [Variation.parse("v0=0.3,0.4")])
     assert {run.config.packing_file for run in runs} == {str(folder / "beads.csv")}
-    assert len(build_model(runs[0].config).lattice) == 2
+    assert len(build_model(runs[0].config).packing) == 2

@@ -23,9 +23,9 @@ def compressed_model():
     """The 4-per-edge experiment with diameters 0-0.1 % too large for their sites: every bead
     overlaps its neighbours and the edge beads overlap their walls (by up to 4.8 µm)."""
     model = build_model(RunConfig(edge_beads=4, impact="striker"))
-    lattice = model.lattice
+    lattice = model.packing
     grown = lattice.diameters_m * (1 + 1e-3 * np.random.default_rng(7).random(len(lattice)))
-    return replace(model, lattice=replace(lattice, diameters_m=grown))
+    return replace(model, packing=replace(lattice, diameters_m=grown))
 
 
 def forces_every_step(directory, pair_lines: str | None, steps: int):
@@ -68,7 +68,7 @@ def test_gran_hertz_history_forces_equal_granular_hertz_walls_included(tmp_path)
     f_granular, t_granular = forces_every_step(granular, GRANULAR_PAIR.format(k=k), 200)
     scale = np.abs(f_granular).max()
     assert scale > 1.0  # overlaps of micrometres: newtons
-    walled = np.unique(np.concatenate([wall.members for wall in model.lattice.walls]))
+    walled = np.unique(np.concatenate([wall.members for wall in model.packing.walls]))
     assert np.abs(f_granular[0, walled]).max() > 0.1 * scale  # the walls push
     np.testing.assert_allclose(f_history, f_granular, rtol=0, atol=1e-12 * scale)
     assert np.all(t_history == 0.0) and np.all(t_granular == 0.0)  # no tangential force in either

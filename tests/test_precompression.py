@@ -8,16 +8,16 @@ from hexdem.errors import HexdemError
 from hexdem.experiments.compare import compare_analyses
 from hexdem.experiments.run import simulate
 from hexdem.model.config import RunConfig
-from hexdem.model.lattice import half_hexagon, hexagon
 from hexdem.model.materials import DELRIN, STEEL_316, hertz_coefficient, hertz_stiffness, sphere_mass
 from hexdem.model.model_builder import build_model
 from hexdem.model.precompression import (
     hole_force,
     longitudinal_sound_speed,
-    precompressed_lattice,
+    precompressed_packing,
     spring_stiffness,
     static_overlap,
 )
+from hexdem.model.triangular import half_hexagon, hexagon
 
 D = 0.01905
 A = float(hertz_coefficient(D))
@@ -46,7 +46,7 @@ def net_forces(lattice, f0):
 @pytest.mark.parametrize("packing", [hexagon(11, D), hexagon(6, D), half_hexagon(21, 11, D)], ids=str)
 @pytest.mark.parametrize("f0", [1.0, 20.0])
 def test_every_contact_carries_the_target_force_in_static_equilibrium(packing, f0):
-    lattice = precompressed_lattice(packing, f0, A, K_WALL)
+    lattice = precompressed_packing(packing, f0, A, K_WALL)
     force, net = net_forces(lattice, f0)
     np.testing.assert_allclose(force, f0, rtol=1e-8)
     assert np.max(np.abs(net)) < 1e-8 * f0

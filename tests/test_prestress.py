@@ -20,10 +20,10 @@ def test_pair_forces_follow_hertz_with_each_contacts_own_radius():
     """Shrink the lattice so that neighbours overlap by δ: every bond carries k sqrt(R_eff) δ^1.5,
     R_eff = r/2 for equal beads."""
     model = build_model(RunConfig())
-    lattice = model.lattice
+    lattice = model.packing
     d, delta = lattice.diameter_m, 1e-6
-    squeezed = replace(model, lattice=replace(lattice, positions_m=lattice.positions_m * (d - delta) / d))
-    i, j, overlap = touching_pairs(squeezed.lattice.positions_m, lattice.diameters_m)
+    squeezed = replace(model, packing=replace(lattice, positions_m=lattice.positions_m * (d - delta) / d))
+    i, j, overlap = touching_pairs(squeezed.packing.positions_m, lattice.diameters_m)
     np.testing.assert_allclose(overlap, delta, rtol=1e-6)
     assert len(i) == 9 * 11**2 - 15 * 11 + 6  # the bonds of a hexagon of 11 beads per edge
     load = prestress(squeezed)
@@ -36,10 +36,10 @@ def test_pair_forces_follow_hertz_with_each_contacts_own_radius():
 
 def test_a_wall_pushed_in_by_delta_loads_each_of_its_beads_by_hertz():
     model = build_model(RunConfig())
-    lattice = model.lattice
+    lattice = model.packing
     delta = 2e-6
     wall = lattice.walls[0]
-    pushed = replace(model, lattice=replace(lattice, walls=(replace(wall, offset_m=wall.offset_m + delta),
+    pushed = replace(model, packing=replace(lattice, walls=(replace(wall, offset_m=wall.offset_m + delta),
                                                             *lattice.walls[1:])))
     load = prestress(pushed)
     per_bead = model.wall_stiffness_pa([0])[0] * np.sqrt(lattice.diameter_m / 2) * delta**1.5

@@ -136,7 +136,7 @@ def test_samples_start_at_zero_every_dump_interval_and_the_run_is_described(tmp_
     assert trajectory.velocities_m_s.shape == (11, model.n_bodies, 2)
     np.testing.assert_array_equal(trajectory.velocities_m_s[0], model.initial_velocities_m_s())
     assert (tmp_path / "deck" / PARAMETERS_NAME).stat().st_size > 0
-    assert trajectory.engine["n_pairs"] == len(model.lattice.bonds())  # a triangular packing's list: its touching pairs
+    assert trajectory.engine["n_pairs"] == len(model.packing.bonds())  # a triangular packing's list: its touching pairs
 
 
 @pytest.mark.parametrize("settings, message", [

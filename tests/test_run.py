@@ -50,7 +50,7 @@ def test_run_movie_animates_the_speed_field_sampled_in_the_run(tmp_path):
         assert movie.n_frames == 60
     analysis = simulate(RunConfig(edge_beads=5, engine="reference", movie=True), tmp_path / "again")
     first = analysis.tracked.field_speeds[0]
-    assert first[analysis.model.lattice.struck] == 0.4 and np.count_nonzero(first) == 1
+    assert first[analysis.model.packing.struck] == 0.4 and np.count_nonzero(first) == 1
     assert len(analysis.tracked.field_times) == 60 and analysis.tracked.field_times[0] == 0.0
 
 
@@ -165,7 +165,7 @@ def test_config_file_sets_parameters(tmp_path):
     path.write_text('edge_beads = 5\nstrike_angle_deg = 30.0\nimpact = "striker"\nunits = "nondimensional"\nv0 = 0.05\n')
     config = RunConfig.from_toml(path)
     model = build_model(config)
-    assert len(model.lattice) == 61 and model.has_striker
+    assert len(model.packing) == 61 and model.has_striker
     np.testing.assert_allclose(model.impact.direction, [np.sqrt(3) / 2, 0.5])
     assert model.impact.speed_m_s == pytest.approx(0.05 * config.unit_system.velocity_m_s)
 

@@ -15,7 +15,7 @@ from hexdem.experiments.sensors import SENSOR_COLUMNS, SENSOR_PEAK_COLUMNS
 from hexdem.experiments.signals import SIGNAL_COLUMNS
 from hexdem.model.config import RunConfig
 from hexdem.model.materials import sphere_mass
-from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.model_builder import build_model, build_packing
 from hexdem.model.run_settings import run_settings
 from hexdem.model.sensors import sensor_beads
 
@@ -49,9 +49,9 @@ def test_sensors_may_name_the_extra_lines():
     misspelt line is refused with the extra line among the known ones."""
     lines = [{"name": "across", "site": [-20, 10], "angle_deg": 90}]
     config = RunConfig(lines=lines, sensors=["across:3", "0:1"])
-    lattice = build_lattice(config)
+    lattice = build_packing(config)
     beads = sensor_beads(config.sensors, lattice)
-    assert list(beads) == ["across:3", "0:1"] and tuple(lattice.indices[beads["across:3"]]) == (-14, 10)
+    assert list(beads) == ["across:3", "0:1"] and tuple(lattice.labels[beads["across:3"]]) == (-14, 10)
     with pytest.raises(HexdemError, match="line one of 0, [+]30, -30, across"):
         build_model(RunConfig(lines=lines, sensors=["acros:3"]))
 

@@ -10,9 +10,9 @@ from hexdem.cli.main import main
 from hexdem.errors import HexdemError
 from hexdem.experiments.snapshots import Snapshots, snapshot_config, snapshot_figure, take_snapshots
 from hexdem.model.config import RunConfig
-from hexdem.model.lattice import hexagon
-from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.model_builder import build_model, build_packing
 from hexdem.model.run_settings import run_settings
+from hexdem.model.triangular import hexagon
 from readable import saved_figure, smallest_text_px
 
 TIMES_S = (1e-4, 2e-4, 3e-4)
@@ -57,7 +57,7 @@ def test_the_front_moves_outward_and_nothing_moves_ahead_of_it(one_and_two_ranks
     every bead is at rest (below 1e-9 V0: the walls touch their beads to round-off, whose
     forces of ~1e-16 N move beads at ~1e-18 m/s)."""
     snapshots = one_and_two_ranks[0]
-    lattice = snapshots.lattice
+    lattice = snapshots.packing
     distance = np.linalg.norm(lattice.positions_m - lattice.positions_m[lattice.struck], axis=1)
     moving = snapshots.speeds > 1e-9 * SMALL_HALF.v0
     reach = np.array([distance[m].max() for m in moving])
@@ -81,7 +81,7 @@ def test_the_command_writes_the_figure_and_its_table(tmp_path):
 def test_the_panels_share_one_colour_bar_readable_in_the_report(monkeypatch, config):
     """Six panels, one colour scale from 0 to the median of their largest speeds with one bar
     (Fig. 4 had six bars of 6-point labels), every text at least 10 px where the report shows it."""
-    lattice = build_lattice(config)
+    lattice = build_packing(config)
     speeds = np.random.default_rng(1).uniform(0.0, 0.05, (6, len(lattice))) * np.arange(1, 7)[:, None]
     snapshots = Snapshots(config, lattice, np.arange(1, 7) * 2e-4, speeds, {})
     fig = saved_figure(monkeypatch, lambda: snapshot_figure(snapshots, build_model(config).walls, "unused.png",

@@ -69,7 +69,7 @@ def test_tracker_reproduces_the_whole_record_definitions(n_samples):
     rng = np.random.default_rng(7)
     times = np.linspace(0.0, 1.2, n_samples)
     model = build_model(RunConfig(edge_beads=4))
-    n = len(model.lattice)
+    n = len(model.packing)
     speeds = _synthetic_speeds(times, n, rng)
     settings = RunSettings(dt_s=times[1], n_steps=n_samples - 1, dump_every=1)
     tracker = PulseTracker(model, settings)
@@ -100,7 +100,7 @@ class MigratingBeads:
         rng = np.random.default_rng(11)
         times = np.linspace(0.0, 1.2, self.n_samples)
         model = build_model(RunConfig(edge_beads=4))
-        n, ranks = len(model.lattice), 1 if comm is None else comm.Get_size()
+        n, ranks = len(model.packing), 1 if comm is None else comm.Get_size()
         speeds = _synthetic_speeds(times, n, rng)
         draws = self.n_samples // self.every + 1
         owners = np.repeat(rng.integers(0, ranks, (draws, n)), self.every, axis=0)
@@ -177,7 +177,7 @@ def test_an_earlier_small_pulse_just_above_half_the_peak_is_the_arrival():
     tracker interpolates linearly at the rounded top of the small pulse (7.80), not 20 samples
     later on the main pulse."""
     model = build_model(RunConfig(edge_beads=2))
-    n = len(model.lattice)
+    n = len(model.packing)
     series = np.zeros(60)
     series[5:12] = (0.3, 0.45, 0.498, 0.5005, 0.49, 0.3, 0.1)
     series[20:49] = np.sin(np.linspace(0.0, np.pi, 29))
@@ -253,4 +253,4 @@ def test_the_dump_carries_each_beads_radius_and_mass_which_mdanalysis_reads(dump
     assert analysis.settings.units.name == "si"
     universe = mda.Universe(str(dump), format="LAMMPSDUMP", additional_columns=["radius"])
     np.testing.assert_allclose(universe.atoms.masses, analysis.model.masses_kg, rtol=1e-12)
-    np.testing.assert_allclose(universe.trajectory.ts.data["radius"], analysis.model.lattice.diameters_m / 2, rtol=1e-15)
+    np.testing.assert_allclose(universe.trajectory.ts.data["radius"], analysis.model.packing.diameters_m / 2, rtol=1e-15)

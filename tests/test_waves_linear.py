@@ -20,7 +20,7 @@ from hexdem.theory.phonons import Lattice2D, cone_slope, sound_speeds
 from hexdem.waves.conical import ConicalSettings, measure_conical
 from hexdem.waves.dispersion import DispersionSettings, band_spread, measure_dispersion, packing_width, taper
 from hexdem.waves.states import bloch_packet, broadband_state
-from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.model_builder import build_model, build_packing
 from hexdem.model.run_settings import run_settings
 
 STEEL_20N = Lattice2D.precompressed(20.0, 0.01905)
@@ -66,7 +66,7 @@ def test_the_resolution_of_a_packing_by_hand():
     falls with the distance from it and is 0 from the inscribed circle's rim on. Near Γ the
     bands are ω = c q, so over a disc of radius r about q the spread is c r for each band."""
     config = DispersionSettings(edge_beads=20).config()
-    positions = build_model(config).lattice.positions_m[:config.n_beads()]
+    positions = build_model(config).packing.positions_m[:config.n_beads()]
     a = Lattice2D.of(config).spacing_m
     width = packing_width(positions)
     assert width == pytest.approx(math.sqrt(3) * 19 * a, rel=1e-9)
@@ -94,7 +94,7 @@ def test_the_recorder_keeps_the_lattice_fourier_sum_and_the_block_energies():
         recorder(Sample(index, index, 0.0, np.array([1, 3]), np.zeros((2, 2)), scaled[[0, 2]]))
         recorder(Sample(index, index, 0.0, np.array([2]), np.zeros((1, 2)), scaled[[1]]))
     waves = recorder.finish()
-    phases = np.exp(-1j * model.lattice.positions_m @ q[0])
+    phases = np.exp(-1j * model.packing.positions_m @ q[0])
     np.testing.assert_allclose(waves.components[1, 0], 2 * phases @ velocities)
     kinetic = 0.5 * model.masses_kg[:3] * np.sum(velocities**2, axis=1)
     np.testing.assert_allclose(waves.block_kinetic_j[0], kinetic * (1 + 4) / 2)
@@ -181,7 +181,7 @@ def test_a_packet_at_the_dirac_point_opens_into_a_ring_at_the_cone_slope(engine,
 
 
 def test_an_initial_state_written_reads_back_bit_for_bit(tmp_path):
-    lattice = build_lattice(RunConfig(edge_beads=4))
+    lattice = build_packing(RunConfig(edge_beads=4))
     velocities, displacements = broadband_state(len(lattice), 1e-3, 3), broadband_state(len(lattice), 1e-9, 4)
     write_initial_state(tmp_path / "state.csv", lattice, velocities, displacements)
     state = read_initial_state(tmp_path / "state.csv", lattice)
@@ -196,7 +196,7 @@ def test_two_ranks_record_what_one_rank_records(tmp_path):
     each rank sums over its own beads and the sums merge at the end, so the plane-wave
     components and the energy blocks agree to round-off (the atoms' order differs)."""
     config = RunConfig(edge_beads=12, precompression_n=20.0, v0=1e-6, steps_per_contact=40, duration=2e-3)
-    write_initial_state(tmp_path / "state.csv", build_lattice(config), broadband_state(config.n_beads(), 5e-4, 2))
+    write_initial_state(tmp_path / "state.csv", build_packing(config), broadband_state(config.n_beads(), 5e-4, 2))
     config = config.replace(initial_state_file=str(tmp_path / "state.csv"), dump_every=4)
     q = STEEL_20N.high_symmetry_points()["K"][None, :] * np.array([[0.3], [1.0]])
     one = record_waves(config, tmp_path / "one", q, block=8, show_progress=False)

@@ -159,7 +159,7 @@ def run(argv=None) -> int:
         except HexdemError as error:
             print(f"basins_and_interfaces: error: {case}: {error}", file=sys.stderr)
             return 2
-        records[case] = {"what": what, "config": text.strip(), "n_beads": len(analysis.model.lattice),
+        records[case] = {"what": what, "config": text.strip(), "n_beads": len(analysis.model.packing),
                          "energy_drift": analysis.results.energy_drift, "wall_time_s": time.perf_counter() - start,
                          "command": f"hexdem run --movie --config {path} --out {out / case}"}
         print(f"[{k + 1}/{len(CASES)}] {case}: {records[case]['n_beads']} beads, "

@@ -119,7 +119,7 @@ def write_packing_file(path: Path, seed: int = 1) -> None:
     undersized by 10 % (rattlers that touch no one until the pulse shakes them) and five of brass."""
     import numpy as np
 
-    from hexdem.model.lattice import hexagon
+    from hexdem.model.triangular import hexagon
 
     rng = np.random.default_rng(seed)
     lattice = hexagon(8, 0.01905)

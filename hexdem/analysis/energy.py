@@ -134,7 +134,7 @@ class EnergyAudit:
         self.masses_kg = model.masses_kg
         self.inertia_kg_m2 = inertia_kg_m2(model)
         self.radii_m = model.diameters_m / 2
-        self.skin_m = PAIR_SKIN_D * model.lattice.diameter_m
+        self.skin_m = PAIR_SKIN_D * model.packing.diameter_m
         self.region_names, self.regions = energy_regions(model)
         gravity = np.zeros(2) if gravity_m_s2 is None else np.asarray(gravity_m_s2, float)
         self.external_n = model.external_forces_n() + self.masses_kg[:, None] * gravity
@@ -243,7 +243,7 @@ def energy_regions(model: GranularModel) -> tuple[list[str], np.ndarray]:
     """(names, (n_bodies,) region of each body): the beads by material, then the strikers, if
     any, as one region of their own (so that what they keep is not counted in the packing)."""
     names = [m.name for m in model.materials[:1 + len(model.extra_materials)]]
-    regions = model.lattice.material_ids
+    regions = model.packing.material_ids
     if model.has_striker:
         names, regions = [*names, "striker"], np.append(regions, np.full(len(model.strikers), len(names)))
     return names, regions

@@ -252,8 +252,8 @@ def draw_lattice(ax, results, model, values, label: str, cmap="viridis", norm=No
     units = UNIT_LABELS[results.units]
     scale = 1.0 / results.length_unit_m
     positions = results.positions
-    diameters = model.lattice.diameters_m * scale
-    ids, names = model.lattice.material_ids, [material.name for material in model.materials]
+    diameters = model.packing.diameters_m * scale
+    ids, names = model.packing.material_ids, [material.name for material in model.materials]
     others = {f"{names[k]} beads": ids == k for k in np.unique(ids) if k > 0}
     circles = bead_map(ax, positions, diameters, values, cmap=cmap, label=label, norm=norm, unmeasured=unmeasured,
                        outlined=others)

@@ -48,10 +48,10 @@ class ImpactAnalysis:
         self.results = r = SimpleNamespace()
         r.units = units.name
         r.length_unit_m = units.length_m
-        r.positions = model.initial_positions_m()[:len(model.lattice)] / units.length_m  # where the beads start
+        r.positions = model.initial_positions_m()[:len(model.packing)] / units.length_m  # where the beads start
         r.peak_speed, r.t_peak, r.arrival_time, r.reach_time = peak_speed, t_peak, arrival_time, reach_time
         r.end_velocity = np.asarray(end_velocity, float)
-        r.lines = model.lattice.lines()
+        r.lines = model.packing.lines()
         r.energy_drift = energy_drift
         r.region_names = energy_regions(model)[0]
         r.region_times, r.region_energies = region_energies
@@ -71,12 +71,12 @@ class ImpactAnalysis:
     def from_trajectory(cls, model: GranularModel, settings: RunSettings, trajectory: Trajectory) -> "ImpactAnalysis":
         units = settings.units
         pulses = pulse_times(trajectory.times_s / units.time_s,
-                             trajectory.speeds_m_s[:, :len(model.lattice)] / units.velocity_m_s,
+                             trajectory.speeds_m_s[:, :len(model.packing)] / units.velocity_m_s,
                              run_noise_floor(model, settings))
         times_s, energies = trajectory.region_energies_j(model, ENERGY_SAMPLES)
         return cls(model, settings, trajectory.engine, pulses.peak_speed, pulses.t_peak, pulses.arrival_time,
                    pulses.reach_time, trajectory.energy_drift(model), (times_s / units.time_s, energies),
-                   trajectory.velocities_m_s[-1, :len(model.lattice)] / units.velocity_m_s)
+                   trajectory.velocities_m_s[-1, :len(model.packing)] / units.velocity_m_s)
 
     def _far_wall_reached(self) -> bool:
         """Did the leading waves cross the packing within the run? They did when every bead they
@@ -94,7 +94,7 @@ class ImpactAnalysis:
         end has not been passed by the front, while one whose speed keeps growing under
         reflections (a precompressed box rings) has."""
         r = self.results
-        members, normals = wall_normals(self.model.walls, self.model.lattice.positions_m)
+        members, normals = wall_normals(self.model.walls, self.model.packing.positions_m)
         facing = []
         for impact in self.model.impacts:
             against = -normals @ impact.direction

@@ -130,7 +130,7 @@ class PulseTracker:
         self.root = comm is None or comm.Get_rank() == 0
         self.several = comm is not None and comm.Get_size() > 1
         total = settings.n_samples
-        self.n_beads, self.n_samples_expected = len(model.lattice), total
+        self.n_beads, self.n_samples_expected = len(model.packing), total
         if threshold_speed is not None and not threshold_speed > 0:
             raise HexdemError(f"the threshold speed must be > 0, got {threshold_speed!r}")
         self.threshold_speed = threshold_speed
@@ -248,7 +248,7 @@ class PulseTracker:
             self.sensors[sample.step // self.sensor_every, self.sensors_here] = np.hstack(
                 [sample.velocities[rows], sample.accelerations[rows]])
         if s in self.field_samples:
-            radii = self.model.lattice.diameters_m[self.ids - 1] / 2 / self.settings.units.length_m
+            radii = self.model.packing.diameters_m[self.ids - 1] / 2 / self.settings.units.length_m
             rims = spins * radii if self.model.laws.tangential else None
             self.field_parts.append((np.searchsorted(self.field_samples, s), self.ids, speeds, rims))
         if s % self.energy_every == 0 or s == self.n_samples_expected - 1:

@@ -64,8 +64,8 @@ class WaveRecorder:
     def __init__(self, model: GranularModel, settings: RunSettings, wave_vectors_m=(), block: int = 0, comm=None,
                  weights=None):
         self.settings, self.comm = settings, comm
-        self.n_beads = len(model.lattice)
-        self.positions_m = model.lattice.positions_m[:self.n_beads].copy()
+        self.n_beads = len(model.packing)
+        self.positions_m = model.packing.positions_m[:self.n_beads].copy()
         vectors = np.asarray(wave_vectors_m, float).reshape(-1, 2)
         self.phases = np.exp(-1j * self.positions_m @ vectors.T)  # (N, Q)
         if weights is not None:

@@ -36,13 +36,13 @@ from pathlib import Path
 import numpy as np
 
 from hexdem.common.checks import is_number, positive_int
-from hexdem.disorder.preparation import Disorder, Preparation, spaced_lattice, walls_for_settling
+from hexdem.disorder.preparation import Disorder, Preparation, spaced_packing, walls_for_settling
 from hexdem.engines.lammps.settling import SETTLED_NAME, read_data_file, read_stage
 from hexdem.errors import HexdemError
 from hexdem.model.config import MIN_STEPS_PER_CONTACT, STEPS_PER_CONTACT, RunConfig
 from hexdem.model.granular import GranularModel, RunSettings
-from hexdem.model.lattice import Lattice
-from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.model_builder import build_model, build_packing
+from hexdem.model.packing import Packing
 from hexdem.model.run_settings import run_settings
 
 RESULT_NAME = "result.npz"
@@ -140,8 +140,8 @@ class EnsembleConfig:
             return base.replace(duration=self.duration_s)
         return base.replace(duration=self.duration_factor * run_settings(base).duration_s)
 
-    def ideal_lattice(self) -> Lattice:
-        return build_lattice(self.run_config(self.velocities_m_s[0]))
+    def ideal_lattice(self) -> Packing:
+        return build_packing(self.run_config(self.velocities_m_s[0]))
 
     def as_dict(self) -> dict:
         return dataclasses.asdict(self)
@@ -208,11 +208,11 @@ class Ensemble:
         """The packing a preparation stage starts from: spaced (compact) or compacted with walls
         (settle; the walls touch it, or stand back by the preparation's slack)."""
         if stage == "compact":
-            spaced = spaced_lattice(self.ideal, self.diameters_m(k), self.config.disorder)
-            return replace(self._base_model, lattice=spaced)
+            spaced = spaced_packing(self.ideal, self.diameters_m(k), self.config.disorder)
+            return replace(self._base_model, packing=spaced)
         compacted = self._stage_state(k, "compact")
         walled = self.ideal.with_geometry(compacted.positions_m, compacted.diameters_m)
-        return replace(self._base_model, lattice=walls_for_settling(walled, self.config.preparation))
+        return replace(self._base_model, packing=walls_for_settling(walled, self.config.preparation))
 
     def _stage_state(self, k: int, stage: str):
         directory = self.stage_dir(k, stage)
@@ -224,16 +224,16 @@ class Ensemble:
                               "rerun with a larger --max-settle-steps")
         return read_data_file(directory / SETTLED_NAME)
 
-    def settled_lattice(self, k: int) -> Lattice:
+    def settled_packing(self, k: int) -> Packing:
         """The settled packing of realization k, with the walls placed after compaction."""
-        walled = self.stage_model(k, "settle").lattice
+        walled = self.stage_model(k, "settle").packing
         settled = self._stage_state(k, "settle")
         return replace(walled, positions_m=settled.positions_m, diameters_m=settled.diameters_m)
 
     def impact_model(self, k: int | None, v: float) -> GranularModel:
         """Realization k (None: the ideal lattice) struck at ``v``."""
         model = build_model(self.config.run_config(v))
-        return model if k is None else replace(model, lattice=self.settled_lattice(k))
+        return model if k is None else replace(model, packing=self.settled_packing(k))
 
     @property
     def gravity_m_s2(self) -> np.ndarray:

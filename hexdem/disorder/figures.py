@@ -55,7 +55,7 @@ def _by_velocity_line(rows, value_columns: slice):
 def fig9_lines(lattice) -> tuple[str, str]:
     """The lines of Fig. 9: :data:`FIG9_LINES` on the triangular lattice; elsewhere the 0° ray and
     the first ray below it (a square's −45°)."""
-    if lattice.ray_angles_deg is None:
+    if lattice.bond_steps:
         return FIG9_LINES
     return "0", next(name for name in lattice.lines() if name.startswith("-"))
 

@@ -79,7 +79,7 @@ def publish_result(ensemble: Ensemble, k: int | None) -> None:
     arrays.update({name: np.array([impact[name] for impact in impacts]) for name in IMPACT_ARRAYS})
     if k is not None:
         model = ensemble.impact_model(k, ensemble.config.velocities_m_s[0])
-        lattice, load = model.lattice, prestress(model)
+        lattice, load = model.packing, prestress(model)
         arrays.update(diameters_m=lattice.diameters_m, positions_m=lattice.positions_m,
                       wall_offsets_m=np.array([w.offset_m for w in lattice.walls]),
                       max_overlap_m=load.max_overlap_m, **load.as_arrays())

@@ -27,7 +27,7 @@ random numbers would depend on the rank count).
    that force on them. The settle's gravity loads a square's rows too: a 15 × 15 square's bend
    to 0.78 mm (10 σ) in stage 2.
 2. ``settle``: the walls are placed touching the compacted packing
-   (:meth:`~hexdem.model.lattice.Lattice.with_geometry`; or ``wall_slack_m`` further out, a
+   (:meth:`~hexdem.model.packing.Packing.with_geometry`; or ``wall_slack_m`` further out, a
    variant without prestress), the 5 N forces are removed, gravity
    g sin(tilt) acts along the strike direction (the set-up's tilt, 5° by default:
    0.855 m/s²), and a ten times weaker drag settles the packing again.
@@ -70,7 +70,8 @@ from hexdem.engines.lammps.deck import gravity_block, walls_block
 from hexdem.engines.lammps.settling import SettlingStage, kinetic_tolerance_j, write_settling_deck
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel
-from hexdem.model.lattice import BOND_STEPS, Lattice
+from hexdem.model.packing import Packing
+from hexdem.model.triangular import BOND_STEPS
 from hexdem.model.units import SI
 
 #: The manufacturer's diameter tolerance of the experiment's beads, tol = 0.0127 mm.
@@ -125,7 +126,7 @@ class Disorder:
         return rng.normal(self.diameter_m, self.sigma, int(n_beads))
 
     def spacing_m(self, diameters_m) -> float:
-        """Lattice spacing at which no two beads overlap: max(d + tol, largest diameter) [m]."""
+        """Packing spacing at which no two beads overlap: max(d + tol, largest diameter) [m]."""
         return max(self.diameter_m + self.tol_m, float(np.max(diameters_m)))
 
 
@@ -181,13 +182,13 @@ class Preparation:
         return kinetic_tolerance_j(masses_kg, self.settled_rms_speed_m_s)
 
 
-def walls_for_settling(compacted: Lattice, preparation: Preparation) -> Lattice:
+def walls_for_settling(compacted: Packing, preparation: Preparation) -> Packing:
     """The compacted packing with the walls of stage 2: touching it, moved back by the slack."""
     walls = tuple(replace(wall, offset_m=wall.offset_m - preparation.wall_slack_m) for wall in compacted.walls)
     return replace(compacted, walls=walls)
 
 
-def edge_directions(lattice: Lattice) -> np.ndarray:
+def edge_directions(lattice: Packing) -> np.ndarray:
     """(N, 2) inward unit vectors of the edge beads (zero for interior beads).
 
     An edge bead misses some of the neighbours a bead of the bulk has; it is pushed away from
@@ -196,10 +197,10 @@ def edge_directions(lattice: Lattice) -> np.ndarray:
     neighbours from the labels; any other packing (square, centered-square) from the geometry
     (:func:`geometric_neighbour_sums`).
     """
-    if lattice.ray_angles_deg is None:
+    if lattice.bond_steps:
         unit = {step: np.array([np.sqrt(3) / 2 * step[1], step[0] / 2]) for step in NEIGHBOURS}
         directions = np.zeros((len(lattice), 2))
-        for i, (m, n) in enumerate(lattice.indices.tolist()):
+        for i, (m, n) in enumerate(lattice.labels.tolist()):
             for dm, dn in NEIGHBOURS:
                 if lattice.index_of(m + dm, n + dn) is None:
                     directions[i] -= unit[(dm, dn)]
@@ -232,7 +233,7 @@ def geometric_neighbour_sums(positions_m, diameters_m) -> np.ndarray:
     return sums
 
 
-def spaced_lattice(lattice: Lattice, diameters_m, disorder: Disorder) -> Lattice:
+def spaced_packing(lattice: Packing, diameters_m, disorder: Disorder) -> Packing:
     """``lattice`` with the given diameters, its positions scaled about the struck bead so that
     nothing overlaps: by :meth:`Disorder.spacing_m` over d, or more where a bead grew by a larger
     share of its own nominal diameter (a centered-square's small interstitials)."""
@@ -246,7 +247,7 @@ def spaced_lattice(lattice: Lattice, diameters_m, disorder: Disorder) -> Lattice
 def _push_block(model: GranularModel, preparation: Preparation, framed: bool) -> str:
     """Constant inward forces on the edge beads, grouped by direction, and (when no frame holds
     the packing, ``framed`` False) fix momentum."""
-    directions = edge_directions(model.lattice)
+    directions = edge_directions(model.packing)
     groups: dict[tuple[float, float], list[int]] = {}
     for i in np.flatnonzero(np.any(directions != 0, axis=1)):
         groups.setdefault(tuple(np.round(directions[i], 9)), []).append(int(i))
@@ -264,7 +265,7 @@ def _push_block(model: GranularModel, preparation: Preparation, framed: bool) ->
 def _stage_blocks(model: GranularModel, stage: str, preparation: Preparation) -> dict:
     """What differs between the stages: walls, loads, damping time, force criterion (None: none)."""
     if stage == "compact":
-        framed = model.lattice.ray_angles_deg is not None
+        framed = not model.packing.bond_steps
         return {"walls": walls_block(model, SI) if framed else
                 "# (none yet: they are placed touching the compacted packing)\n",
                 "loads": _push_block(model, preparation, framed), "damping_s": preparation.compact_damping_s,

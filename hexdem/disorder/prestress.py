@@ -55,7 +55,7 @@ class Prestress:
 
 def prestress(model: GranularModel) -> Prestress:
     """The contact and wall forces of ``model``'s packing as it stands (the striker excluded)."""
-    lattice = model.lattice
+    lattice = model.packing
     radii = lattice.diameters_m / 2
     i, j, overlap = touching_pairs(lattice.positions_m, lattice.diameters_m)
     reduced = radii[i] * radii[j] / (radii[i] + radii[j])

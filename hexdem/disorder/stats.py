@@ -19,7 +19,7 @@ from hexdem.disorder.ensemble import Ensemble, velocity_name
 from hexdem.disorder.preparation import STAGES
 from hexdem.disorder.prestress import PRESTRESS_ARRAYS
 from hexdem.errors import HexdemError
-from hexdem.model.lattice import Lattice
+from hexdem.model.packing import Packing
 
 #: Columns of ``peaks_stats.csv`` (a contract).
 STATS_COLUMNS = ("v_striker", "line", "n", "mean_peak_speed", "std_peak_speed", "count")
@@ -97,7 +97,7 @@ def mean_and_sem(values) -> tuple[float, float]:
     return float(mean), float(std / np.sqrt(count)) if count > 1 else float("nan")
 
 
-def peak_statistics(results: EnsembleResults, lattice: Lattice) -> list[tuple]:
+def peak_statistics(results: EnsembleResults, lattice: Packing) -> list[tuple]:
     """Rows of ``peaks_stats.csv``: mean and sample standard deviation over realizations of
     the peak speed of bead n of each line, for each striker velocity."""
     mean, std, count = _mean_std_count(results.peak_speed)
@@ -106,7 +106,7 @@ def peak_statistics(results: EnsembleResults, lattice: Lattice) -> list[tuple]:
             for n, bead in enumerate(beads)]
 
 
-def ideal_peaks(results: EnsembleResults, lattice: Lattice) -> list[tuple]:
+def ideal_peaks(results: EnsembleResults, lattice: Packing) -> list[tuple]:
     return [(float(v), line, n, float(results.ideal_peak_speed[iv, bead]))
             for iv, v in enumerate(results.velocities_m_s) for line, beads in lattice.lines().items()
             for n, bead in enumerate(beads)]
@@ -118,13 +118,13 @@ def relative_arrivals(results: EnsembleResults, reference: int):
             results.arrival_time - results.arrival_time[:, :, [reference]])
 
 
-def arrival_rows(results: EnsembleResults, lattice: Lattice, reference: int) -> list[tuple]:
+def arrival_rows(results: EnsembleResults, lattice: Packing, reference: int) -> list[tuple]:
     ideal, disordered = relative_arrivals(results, reference)
     mean, std, count = _mean_std_count(disordered)
     return [(float(v), bead + 1, int(m), int(n), float(x), float(y), float(ideal[iv, bead]),
              float(mean[iv, bead]), float(std[iv, bead]), int(count[iv, bead]))
             for iv, v in enumerate(results.velocities_m_s)
-            for bead, ((m, n), (x, y)) in enumerate(zip(lattice.indices, lattice.positions_m))]
+            for bead, ((m, n), (x, y)) in enumerate(zip(lattice.labels, lattice.positions_m))]
 
 
 def mirror_lines(lines) -> list[tuple[str, str]]:
@@ -133,7 +133,7 @@ def mirror_lines(lines) -> list[tuple[str, str]]:
     return [(name, "-" + name[1:]) for name in lines if name.startswith("+") and "-" + name[1:] in lines]
 
 
-def disorder_effect(results: EnsembleResults, lattice: Lattice, measure: str = "peak") -> list[tuple]:
+def disorder_effect(results: EnsembleResults, lattice: Packing, measure: str = "peak") -> list[tuple]:
     """Transmission along each line, disordered / ideal (the paper's claim of Sec. VI-B).
 
     For each realization, the ratio V_n / V_n(ideal) averaged over beads n ≥ 2 of the line

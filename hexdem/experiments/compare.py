@@ -111,7 +111,7 @@ class Tolerances:
             raise HexdemError("the default tolerances need the run's contact time; give peak_rel and arrival_s")
         peak, arrival, growth = expected_error(settings.contact_time_s / settings.dt_s,
                                                damping_coefficient(model.restitution),
-                                               PEAK_ERROR_N2 if model.lattice.ray_angles_deg is None
+                                               PEAK_ERROR_N2 if model.packing.bond_steps
                                                else PLACED_PEAK_ERROR_N2)
         peak_rel = MARGIN * peak if self.peak_rel is None else self.peak_rel
         arrival_s = MARGIN * arrival * settings.contact_time_s if self.arrival_s is None else self.arrival_s

@@ -96,7 +96,7 @@ def study_front_shape(study: FrontStudy, analysis, arrival_times=None):
     """The front's shape in a run of the study (:func:`~hexdem.experiments.run.measure_front_shape`
     with the study's fronts, window and margin, from the radius ``radius_min_d`` on), by the
     half-maximum arrivals or by ``arrival_times``."""
-    lattice = analysis.model.lattice
+    lattice = analysis.model.packing
     distance_d = np.hypot(*(lattice.positions_m - lattice.positions_m[lattice.struck]).T) / lattice.diameter_m
     start = float(np.mean(distance_d <= START_RADIUS_FRACTION * study.radius_min_d))  # fronts from there on
     return measure_front_shape(analysis, study.fronts, geometric=True, window_deg=study.window_deg,

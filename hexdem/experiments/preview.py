@@ -45,7 +45,7 @@ def preview_figure(config: RunConfig, path) -> str:
     one-line description of what was drawn."""
     model = build_model(config)
     run_settings(config, model)  # the checks a run makes of its time step, samples and memory
-    lattice, positions = model.lattice, model.initial_positions_m()
+    lattice, positions = model.packing, model.initial_positions_m()
     diameters, ids = model.diameters_m, model.material_ids
     beads = len(lattice)
     fig, ax = subplots(figsize=(7, 7.2))
@@ -107,7 +107,7 @@ def _draw_impacts(ax, model, positions, diameters, legend) -> None:
     legend.append(Line2D([], [], linestyle="", marker="o", markerfacecolor="none", markeredgecolor=STRUCK_COLOUR,
                          markeredgewidth=2, label="struck bead"))
     bodies = model.impact_bodies()
-    strikers = bodies[bodies >= len(model.lattice)]
+    strikers = bodies[bodies >= len(model.packing)]
     if len(strikers):
         _discs(ax, positions[strikers], diameters[strikers], facecolor="white", edgecolor=STRUCK_COLOUR,
                linewidths=1.5, linestyles="--")

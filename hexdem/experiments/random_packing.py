@@ -44,8 +44,8 @@ from hexdem.engines.lammps.settling import (SETTLED_NAME, SettlingStage, read_da
                                             run_settling_deck, write_settling_deck)
 from hexdem.errors import RunFailed
 from hexdem.model.config import RunConfig
-from hexdem.model.lattice import strike_direction
 from hexdem.model.model_builder import build_model
+from hexdem.model.packing import strike_direction
 from hexdem.model.random_disc import edge_bead, loose_positions, random_diameters
 from hexdem.model.run_settings import run_settings
 
@@ -165,7 +165,7 @@ def prepare_random_packing(config: RunConfig, directory, log=None) -> RunConfig:
                               f"(kinetic energy {result.kinetic_energy_j:.3g} J, largest force "
                               f"{result.max_force_n:.3g} N); see {_kept(deck)}")
         state = read_data_file(deck / SETTLED_NAME)
-        model = replace(model, lattice=model.lattice.with_geometry(state.positions_m, state.diameters_m))
+        model = replace(model, packing=model.packing.with_geometry(state.positions_m, state.diameters_m))
     packed = _write_packing(directory / PACKING_NAME, state.positions_m, state.diameters_m)
     struck = _struck(config, state.positions_m, state.diameters_m)
     log(f"random disc packed: {len(diameters)} beads, area fraction {area_fraction(state):.3f}, "

@@ -83,10 +83,10 @@ def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples
     workdir.mkdir(parents=True, exist_ok=True)
     if config.engine == "lammps":
         write_deck_config(config, workdir)
-    log(f"running {config.engine}: {model.lattice.shape}, {model.n_bodies} bodies, "
+    log(f"running {config.engine}: {model.packing.shape}, {model.n_bodies} bodies, "
         f"{settings.n_steps} steps of {settings.dt_s:.4g} s ({settings.duration_s * 1e3:.4g} ms), "
         f"{config.processes} rank(s), {settings.n_samples} samples analysed in the run")
-    traced = tuple(dict.fromkeys([*(int(bead) for line in trace_lines for bead in model.lattice.line(line)),
+    traced = tuple(dict.fromkeys([*(int(bead) for line in trace_lines for bead in model.packing.line(line)),
                                   *(int(bead) for bead in trace_beads)]))
     frames = movie_samples(settings.n_samples) if config.movie else ()
     job = ImpactJob(model, settings, config.engine, workdir, dump=config.dump, trace_beads=traced,
@@ -129,8 +129,8 @@ def summary(config: RunConfig, analysis: ImpactAnalysis, wall_time_s: float) -> 
         "hexdem_version": version("hexdem"),
         "config": config.shape_dict(),
         "units": r.units,
-        "lattice": {"shape": packing_name(config, analysis.model.lattice), "n_beads": len(analysis.model.lattice),
-                    "struck_bead_id": analysis.model.lattice.struck + 1},
+        "lattice": {"shape": packing_name(config, analysis.model.packing), "n_beads": len(analysis.model.packing),
+                    "struck_bead_id": analysis.model.packing.struck + 1},
         "time_step": settings.dt_s / settings.units.time_s,
         "n_steps": settings.n_steps,
         "duration": settings.duration_s / settings.units.time_s,
@@ -148,7 +148,7 @@ def summary(config: RunConfig, analysis: ImpactAnalysis, wall_time_s: float) -> 
         "rotational_energy_fraction": r.rotational_energy_fraction,
         "far_wall_reached": r.far_wall_reached,
         "beads_per_line": {name: len(beads) for name, beads in r.lines.items()},
-        "impacts": [{"bead_id": int(bead) + 1, "site": [int(v) for v in analysis.model.lattice.indices[bead]],
+        "impacts": [{"bead_id": int(bead) + 1, "site": [int(v) for v in analysis.model.packing.labels[bead]],
                      "v0": impact.speed_m_s / settings.units.velocity_m_s, "angle_deg": float(impact.angle_deg),
                      "kind": "striker" if impact.striker else "velocity"}
                     for bead, impact in zip(analysis.model.struck_beads, analysis.model.impacts)],
@@ -176,8 +176,8 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
     ``summary.json``'s ``skipped_outputs`` and in the ``log``. ``provenance``
     (:func:`~hexdem.experiments.provenance.run_provenance`, taken when the run started) goes into
     ``summary.json`` as its ``provenance``."""
-    from hexdem.analysis import figures as plots  # matplotlib: only where figures are drawn
     from hexdem.analysis.movie import SPIN_LABEL, speed_movie
+    from hexdem.analysis import figures as plots  # matplotlib: only where figures are drawn
 
     log = log or (lambda message: None)
     skipped = unmeasurable_outputs(analysis)
@@ -189,7 +189,7 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
     write_json(out / "summary.json", {**summary(config, analysis, wall_time_s), "skipped_outputs": skipped,
                                         "provenance": provenance})
     r, model = analysis.results, analysis.model
-    v0, name = analysis.v0, packing_name(config, model.lattice)
+    v0, name = analysis.v0, packing_name(config, model.packing)
     impact = f"V₀ = {v0:g} {plots.UNIT_LABELS[r.units]['speed']}"
     plots.arrival_map(r, model, out / "arrival_map.png", title=f"Arrival time, {name}, {impact}")
     plots.peak_map(r, model, v0, out / "peak_map.png", title=f"Peak speed, {name}, {impact}")
@@ -197,7 +197,7 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
         by_line = {name: (np.arange(len(beads)), r.peak_speed[beads]) for name, beads in r.lines.items()}
         plots.peak_decay(by_line, out / "peak_decay.png", r.units, v0)
     if config.sensors:
-        write_sensor_files(analysis, list(sensor_beads(config.sensors, analysis.model.lattice)), out)
+        write_sensor_files(analysis, list(sensor_beads(config.sensors, analysis.model.packing)), out)
     if "front_shape.csv" not in skipped:
         shape = measure_front_shape(analysis)
         write_csv(out / "front_shape.csv", FRONT_SHAPE_COLUMNS, shape.rows())
@@ -219,9 +219,9 @@ def bead_columns(analysis: ImpactAnalysis) -> list:
     {m, n}, position, material, pulse and final velocity."""
     r, model = analysis.results, analysis.model
     names = np.array([material.name for material in model.materials])
-    labels = np.asarray(model.lattice.indices, int)
+    labels = np.asarray(model.packing.labels, int)
     return [np.arange(1, len(labels) + 1), labels[:, 0], labels[:, 1], r.positions[:, 0], r.positions[:, 1],
-            names[model.lattice.material_ids], r.peak_speed, r.t_peak, r.arrival_time, r.peak_angular_speed,
+            names[model.packing.material_ids], r.peak_speed, r.t_peak, r.arrival_time, r.peak_angular_speed,
             r.end_velocity[:, 0], r.end_velocity[:, 1]]
 
 
@@ -246,8 +246,8 @@ def measure_front_shape(analysis: ImpactAnalysis, count: int = 8, geometric: boo
     arrivals) defines the front otherwise, for example by a fixed speed's first crossing."""
     model, r = analysis.model, analysis.results
     arrivals = r.arrival_time if arrival_times is None else np.asarray(arrival_times, float)
-    positions = model.lattice.positions_m / model.lattice.diameter_m
-    origin = positions[model.lattice.struck]
+    positions = model.packing.positions_m / model.packing.diameter_m
+    origin = positions[model.packing.struck]
     try:
         times = front_times(positions, arrivals, origin, count, start_quantile, wall_margin=wall_margin_d,
                             geometric=geometric, window_deg=window_deg)

@@ -28,9 +28,10 @@ from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.errors import HexdemError
 from hexdem.experiments.tracked_run import ImpactJob, track_impact
 from hexdem.model.config import RunConfig
-from hexdem.model.lattice import Lattice, hexagon
-from hexdem.model.model_builder import build_lattice, build_model
+from hexdem.model.model_builder import build_model, build_packing
+from hexdem.model.packing import Packing
 from hexdem.model.run_settings import run_settings
+from hexdem.model.triangular import hexagon
 
 #: Default snapshot times [ms]: at V_striker = 0.4 m/s the leading wave reaches the far wall
 #: of the hexagon after about 0.95 ms, that of the half-hexagon after about 2.5 ms.
@@ -64,7 +65,7 @@ class Snapshots:
     """Bead speeds [m/s] ``speeds`` (T, N) at ``times_s`` (T,) of the run of ``config``."""
 
     config: RunConfig
-    lattice: Lattice
+    packing: Packing
     times_s: np.ndarray
     speeds: np.ndarray
     engine: dict
@@ -81,25 +82,25 @@ def take_snapshots(config: RunConfig, times_s, directory) -> Snapshots:
     job = ImpactJob(model, settings, "lammps", Path(directory), dump=config.dump, field_samples=tuple(samples))
     analysis = track_impact(job, config.ranks, launcher=config.launcher)
     tracked = analysis.tracked
-    return Snapshots(config, model.lattice, tracked.field_times * settings.units.time_s, tracked.field_speeds,
+    return Snapshots(config, model.packing, tracked.field_times * settings.units.time_s, tracked.field_speeds,
                      analysis.engine)
 
 
 def snapshot_rows(snapshots: Snapshots) -> list[tuple]:
-    lattice = snapshots.lattice
+    lattice = snapshots.packing
     return [(float(t), bead + 1, int(m), int(n), float(x), float(y), float(speed))
             for t, speeds in zip(snapshots.times_s, snapshots.speeds)
-            for bead, ((m, n), (x, y), speed) in enumerate(zip(lattice.indices, lattice.positions_m, speeds))]
+            for bead, ((m, n), (x, y), speed) in enumerate(zip(lattice.labels, lattice.positions_m, speeds))]
 
 
-def snapshot_figure(snapshots: Snapshots, walls, path, outline: Lattice | None = None) -> None:
+def snapshot_figure(snapshots: Snapshots, walls, path, outline: Packing | None = None) -> None:
     """Bead-speed maps, one panel per time, at most three to a row, walls drawn; ``outline``: a
     smaller packing whose walls are drawn dashed (Fig. 4). The panels share one colour scale
     and its one bar, from 0 to the median of the panels' largest speeds: the pulse's slow decay
     shows, and the few faster beads of the first panels, by the striker, take the top colour
     (the bar's arrow). Sized so that its smallest text is at least 10 px in the report."""
 
-    lattice, config = snapshots.lattice, snapshots.config
+    lattice, config = snapshots.packing, snapshots.config
     count = len(snapshots.times_s)
     aspect = np.ptp(lattice.positions_m[:, 1]) / max(np.ptp(lattice.positions_m[:, 0]), lattice.diameter_m)
     columns = min(3, count)
@@ -138,7 +139,7 @@ def run_snapshots(config: RunConfig, times_s, out, outline_edge: int | None = No
     outline = hexagon(outline_edge, config.diameter_m) if outline_edge else None
     out = ensure_writable_dir(out)
     start = time.perf_counter()
-    log(f"{build_lattice(config).shape}, striker at {config.v0:g} m/s, {config.ranks} rank(s), "
+    log(f"{build_packing(config).shape}, striker at {config.v0:g} m/s, {config.ranks} rank(s), "
         f"{len(times_s)} snapshots up to {max(times_s) * 1e3:g} ms")
     snapshots = take_snapshots(config, times_s, out / "deck")
     name = FIGURE_NAMES.get(config.shape, "snapshots")
@@ -148,9 +149,9 @@ def run_snapshots(config: RunConfig, times_s, out, outline_edge: int | None = No
     engine = snapshots.engine
     write_json(out / "snapshots.json", {
         "hexdem_version": version("hexdem"), "config": snapshots.config.shape_dict(),
-        "times_s": snapshots.times_s.tolist(), "n_beads": len(snapshots.lattice),
+        "times_s": snapshots.times_s.tolist(), "n_beads": len(snapshots.packing),
         "lammps_version": engine["version"], "ranks": engine["ranks"], "lammps_wall_time_s": engine["wall_time_s"],
-        "atom_steps_per_s": (len(snapshots.lattice) + 1) * settings.n_steps / engine["wall_time_s"],
+        "atom_steps_per_s": (len(snapshots.packing) + 1) * settings.n_steps / engine["wall_time_s"],
         "wall_time_s": time.perf_counter() - start})
     log(f"LAMMPS {engine['wall_time_s']:.1f} s on {engine['ranks']} rank(s); results in {out}")
     return snapshots

@@ -60,7 +60,7 @@ def record_waves(config: RunConfig, workdir, wave_vectors_m=(), block: int = 0, 
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
     if log is not None:
-        log(f"running {config.engine}: {len(model.lattice)} beads, {settings.n_steps} steps of "
+        log(f"running {config.engine}: {len(model.packing)} beads, {settings.n_steps} steps of "
             f"{settings.dt_s:.4g} s, {settings.n_samples} samples recorded")
     job = WaveJob(model, settings, config.engine, workdir, tuple(map(tuple, np.asarray(wave_vectors_m, float).reshape(-1, 2))),
                   block, show_progress, tuple(map(float, weights)))

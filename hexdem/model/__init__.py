@@ -1,1 +1,1 @@
-"""The physical model: lattice geometry, materials, units, the Hertz law, the model an engine integrates, and the run configuration."""
+"""The physical model: packings and their builders, materials, units, the Hertz law, the model an engine integrates, and the run configuration."""

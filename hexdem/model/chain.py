@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from hexdem.errors import HexdemError
-from hexdem.model.lattice import Lattice, unit_vector
+from hexdem.model.packing import Packing, unit_vector
 from hexdem.model.placed import placed_packing
 
 
@@ -27,7 +27,7 @@ def chain_beads(beads) -> int:
     return int(beads)
 
 
-def chain(beads: int, diameter_m: float, angle_deg: float = 0.0, diameters_m=(), struck=(0, 0)) -> Lattice:
+def chain(beads: int, diameter_m: float, angle_deg: float = 0.0, diameters_m=(), struck=(0, 0)) -> Packing:
     """``beads`` touching beads along ``angle_deg``, each of ``diameter_m`` or of its own size in
     ``diameters_m`` (one per bead, or empty), struck at the bead labelled ``struck`` ({0, k}: bead k)."""
     beads = chain_beads(beads)

@@ -185,7 +185,7 @@ class RunConfig:
         """Beads of the packing counted without building it, less the vacancies: 3N(N − 1) + 1
         for a hexagon with N per edge, S(3S − 1)/2 for a half-hexagon with short edges of S;
         None for the other shapes (count the built lattice,
-        :func:`~hexdem.model.model_builder.build_lattice`)."""
+        :func:`~hexdem.model.model_builder.build_packing`)."""
         if self.shape == "hexagon":
             return 3 * self.edge_beads * (self.edge_beads - 1) + 1 - len(self.vacancies)
         if self.shape == "half-hexagon":

@@ -19,8 +19,8 @@ from hexdem.errors import HexdemError
 from hexdem.model.contact_law import NO_FRICTION, ContactLaws, Friction
 from hexdem.model.dissipation import check_restitution, damping_coefficient
 from hexdem.model.initial_state import InitialState
-from hexdem.model.lattice import Lattice, strike_direction, unit_vector
 from hexdem.model.materials import DELRIN, STEEL_316, Material
+from hexdem.model.packing import Packing, strike_direction, unit_vector
 from hexdem.model.units import SI, UnitSystem
 
 
@@ -32,7 +32,7 @@ class Impact:
     V0 is given to the struck bead (the paper's numerics); True: a striker sphere moving
     at V0 hits it (the experiment), of ``striker_material`` (None: the beads' material) and
     diameter ``striker_diameter_m`` (None: the nominal d). ``bead``: the index of the struck
-    bead (None: the lattice's struck bead, on the paper's edge, where the angle must point
+    bead (None: the packing's struck bead, on the paper's edge, where the angle must point
     into the packing, |angle| < 90°).
     """
 
@@ -66,7 +66,7 @@ STRIKER_OVERLAP_D = 1e-6
 
 @dataclass(frozen=True)
 class GranularModel:
-    """Lattice, materials and impacts of one simulation (SI units).
+    """Packing, materials and impacts of one simulation (SI units).
 
     ``wall`` is the wall-lining material, or None for a packing without walls;
     ``restitution`` and ``wall_restitution`` the coefficients of restitution of bead–bead and
@@ -77,7 +77,7 @@ class GranularModel:
     whose mass is ``sensor_mass_factor`` times a plain bead's (the accelerometer inside).
 
     Materials: bead material id 0 is ``bead``, ids 1, 2, … are ``extra_materials`` (the
-    lattice's ``material_ids`` say which bead is which); then the strikers' own materials.
+    packing's ``material_ids`` say which bead is which); then the strikers' own materials.
     Every contact is Hertz's with the pair's own E* and R_eff (:meth:`contact_stiffness_pa`);
     ``friction`` adds Mindlin's tangential force and the bodies' rotation (:attr:`laws`).
 
@@ -86,7 +86,7 @@ class GranularModel:
     t = 0 besides them (:mod:`hexdem.model.initial_state`; None: at rest where packed).
     """
 
-    lattice: Lattice
+    packing: Packing
     impact: Impact
     bead: Material = STEEL_316
     wall: Material | None = DELRIN
@@ -105,16 +105,16 @@ class GranularModel:
         check_restitution("wall_restitution", self.wall_restitution)
         if not (is_number(self.sensor_mass_factor) and self.sensor_mass_factor > 0):
             raise HexdemError(f"sensor_mass_factor must be > 0, got {self.sensor_mass_factor!r}")
-        if len(self.lattice) and self.lattice.material_ids.max() > len(self.extra_materials):
-            raise HexdemError(f"bead material id {self.lattice.material_ids.max()} has no material "
+        if len(self.packing) and self.packing.material_ids.max() > len(self.extra_materials):
+            raise HexdemError(f"bead material id {self.packing.material_ids.max()} has no material "
                               f"({1 + len(self.extra_materials)} given)")
         beads = self.struck_beads
-        outside = [int(b) for b in beads if not 0 <= b < len(self.lattice)]
+        outside = [int(b) for b in beads if not 0 <= b < len(self.packing)]
         if outside:
-            raise HexdemError(f"an impact strikes bead index {outside[0]}, not in the packing of {len(self.lattice)}")
+            raise HexdemError(f"an impact strikes bead index {outside[0]}, not in the packing of {len(self.packing)}")
         struck, counts = np.unique(beads, return_counts=True)
         if counts.max() > 1:
-            twice = self.lattice.indices[struck[counts.argmax()]]
+            twice = self.packing.labels[struck[counts.argmax()]]
             raise HexdemError(f"two impacts strike the same bead {{{twice[0]}, {twice[1]}}}")
         if self.has_striker:
             self._check_strikers_clear()
@@ -122,17 +122,17 @@ class GranularModel:
     def _check_strikers_clear(self) -> None:
         """Refuse a striker that starts inside another body (it must come from outside the packing)."""
         positions, radii = self.initial_positions_m(), self.diameters_m / 2
-        n_beads = len(self.lattice)
+        n_beads = len(self.packing)
         for k, body in enumerate(range(n_beads, self.n_bodies)):
             gaps = np.linalg.norm(positions - positions[body], axis=1) - radii - radii[body]
             gaps[body] = np.inf
             worst = int(np.argmin(gaps))
-            if gaps[worst] < -STRIKER_OVERLAP_D * self.lattice.diameter_m:
-                bead = self.lattice.indices[self.struck_beads[self._striker_impacts[k]]]
-                other = (f"bead {{{self.lattice.indices[worst][0]}, {self.lattice.indices[worst][1]}}}"
+            if gaps[worst] < -STRIKER_OVERLAP_D * self.packing.diameter_m:
+                bead = self.packing.labels[self.struck_beads[self._striker_impacts[k]]]
+                other = (f"bead {{{self.packing.labels[worst][0]}, {self.packing.labels[worst][1]}}}"
                          if worst < n_beads else "another striker")
                 raise HexdemError(f"the striker of the impact on bead {{{bead[0]}, {bead[1]}}} would start inside "
-                                  f"{other} ({-gaps[worst] / self.lattice.diameter_m:.3g} d overlap): strike from "
+                                  f"{other} ({-gaps[worst] / self.packing.diameter_m:.3g} d overlap): strike from "
                                   "outside the packing, or use a velocity impact")
 
     @property
@@ -143,7 +143,7 @@ class GranularModel:
     @property
     def struck_beads(self) -> np.ndarray:
         """(n_impacts,) the bead index each impact strikes."""
-        return np.array([self.lattice.struck if i.bead is None else i.bead for i in self.impacts], dtype=int)
+        return np.array([self.packing.struck if i.bead is None else i.bead for i in self.impacts], dtype=int)
 
     @property
     def _striker_impacts(self) -> list[int]:
@@ -163,7 +163,7 @@ class GranularModel:
     def external_forces_n(self) -> np.ndarray:
         """(n_bodies, 2) constant forces [N] on the bodies: the held force on the struck bead."""
         forces = np.zeros((self.n_bodies, 2))
-        forces[self.lattice.struck] = self.held_force_n
+        forces[self.packing.struck] = self.held_force_n
         return forces
 
     @property
@@ -183,12 +183,12 @@ class GranularModel:
     @property
     def n_bodies(self) -> int:
         """Beads plus the strikers (the strikers are the last bodies)."""
-        return len(self.lattice) + len(self.strikers)
+        return len(self.packing) + len(self.strikers)
 
     @property
     def diameters_m(self) -> np.ndarray:
-        strikers = [s.striker_diameter_m or self.lattice.diameter_m for s in self.strikers]
-        return np.concatenate([self.lattice.diameters_m, strikers])
+        strikers = [s.striker_diameter_m or self.packing.diameter_m for s in self.strikers]
+        return np.concatenate([self.packing.diameters_m, strikers])
 
     @property
     def _striker_materials(self) -> tuple[Material, ...]:
@@ -206,7 +206,7 @@ class GranularModel:
         first = 1 + len(self.extra_materials)
         own = {m: first + k for k, m in enumerate(self._striker_materials)}
         strikers = [own.get(s.striker_material, 0) for s in self.strikers]
-        return np.append(self.lattice.material_ids, np.array(strikers, dtype=int))
+        return np.append(self.packing.material_ids, np.array(strikers, dtype=int))
 
     @property
     def densities_kg_m3(self) -> np.ndarray:
@@ -260,11 +260,11 @@ class GranularModel:
 
     @property
     def walls(self):
-        return self.lattice.walls if self.wall is not None else ()
+        return self.packing.walls if self.wall is not None else ()
 
     def impact_bodies(self) -> np.ndarray:
         """(n_impacts,) the body each impact sets moving: its striker, or its bead."""
-        bodies, striker = self.struck_beads.copy(), len(self.lattice)
+        bodies, striker = self.struck_beads.copy(), len(self.packing)
         for k in self._striker_impacts:
             bodies[k], striker = striker, striker + 1
         return bodies
@@ -272,10 +272,10 @@ class GranularModel:
     def initial_positions_m(self) -> np.ndarray:
         """(n_bodies, 2) positions at t = 0 (the packed ones, moved by the initial state's
         displacements); each striker touches its bead, as packed, from outside."""
-        pos = self.lattice.positions_m
+        pos = self.packing.positions_m
         beads, diameters = self.struck_beads, self.diameters_m
         strikers = [pos[beads[k]] - (diameters[beads[k]] + diameters[body]) / 2 * self.impacts[k].direction
-                    for body, k in enumerate(self._striker_impacts, start=len(self.lattice))]
+                    for body, k in enumerate(self._striker_impacts, start=len(self.packing))]
         moved = pos if self.initial_state is None else pos + self.initial_state.displacements_m
         return np.vstack([moved, *strikers]) if strikers else moved.copy()
 
@@ -284,7 +284,7 @@ class GranularModel:
         striker, or on its bead."""
         vel = np.zeros((self.n_bodies, 2))
         if self.initial_state is not None:
-            vel[:len(self.lattice)] = self.initial_state.velocities_m_s
+            vel[:len(self.packing)] = self.initial_state.velocities_m_s
         for impact, body in zip(self.impacts, self.impact_bodies()):
             vel[body] += impact.speed_m_s * impact.direction
         return vel

@@ -26,7 +26,7 @@ from typing import TypedDict
 
 from hexdem.errors import HexdemError
 from hexdem.model.granular import Impact
-from hexdem.model.lattice import HOLE_COSINE, Lattice, facing_edge, unit_vector, with_holes
+from hexdem.model.packing import HOLE_COSINE, Packing, facing_edge, unit_vector, with_holes
 
 
 
@@ -97,19 +97,19 @@ def struck_site(specs: list[ImpactSpec]) -> tuple[int, int]:
     return specs[0].site if specs[0].site is not None else (0, 0)
 
 
-def resolve_impacts(specs: list[ImpactSpec], lattice: Lattice, velocity_scale_m_s: float, material) -> list[Impact]:
-    """The model's :class:`Impact` s of ``specs`` on ``lattice`` (an edge: one per bead of it);
+def resolve_impacts(specs: list[ImpactSpec], packing: Packing, velocity_scale_m_s: float, material) -> list[Impact]:
+    """The model's :class:`Impact` s of ``specs`` on ``packing`` (an edge: one per bead of it);
     ``velocity_scale_m_s`` converts the run's speeds to m/s and ``material(name)`` finds a
     material."""
     impacts = []
     for k, spec in enumerate(specs):
         if spec.site is not None:
-            bead = lattice.index_of(*spec.site)
+            bead = packing.index_of(*spec.site)
             if bead is None:
                 raise HexdemError(f"impact {k}: site {{{spec.site[0]}, {spec.site[1]}}} is not a bead of the packing")
             beads, angle = [bead], spec.angle_deg
         else:
-            beads = facing_edge(lattice, unit_vector(spec.edge_deg))[1]  # the beads a wall there would touch
+            beads = facing_edge(packing, unit_vector(spec.edge_deg))[1]  # the beads a wall there would touch
             if len(beads) < 2:
                 raise HexdemError(f"impact {k}: the packing has no flat edge whose inward normal points at "
                                   f"{spec.edge_deg:g}° (one bead there); use the angle of a wall, e.g. 0")
@@ -120,22 +120,22 @@ def resolve_impacts(specs: list[ImpactSpec], lattice: Lattice, velocity_scale_m_
     return impacts
 
 
-def _wall_members(lattice: Lattice) -> set[int]:
-    return {int(b) for wall in lattice.walls for b in wall.members}
+def _wall_members(packing: Packing) -> set[int]:
+    return {int(b) for wall in packing.walls for b in wall.members}
 
 
-def cut_holes(lattice: Lattice, impacts: list[Impact]) -> tuple[Lattice, set[int]]:
-    """(``lattice`` (its walls whole, :func:`~hexdem.model.lattice.without_hole`) with a hole for
+def cut_holes(packing: Packing, impacts: list[Impact]) -> tuple[Packing, set[int]]:
+    """(``packing`` (its walls whole, :func:`~hexdem.model.packing.without_hole`) with a hole for
     the bead of each of ``impacts`` (:func:`resolve_impacts`'s, each naming its bead) in every
     wall it is pushed through, the beads that left every wall). An
     impact on a wall bead that points out through that wall (within 60° of its outward normal;
     a corner bead may still be pushed along or against its other wall) is refused."""
     beads = [impact.bead for impact in impacts]
     for impact, bead in zip(impacts, beads):
-        for wall in lattice.walls:
-            if bead in wall.members and wall.normals_at(lattice.positions_m[[bead]])[0] @ impact.direction < -HOLE_COSINE:
-                m, n = lattice.indices[bead]
+        for wall in packing.walls:
+            if bead in wall.members and wall.normals_at(packing.positions_m[[bead]])[0] @ impact.direction < -HOLE_COSINE:
+                m, n = packing.labels[bead]
                 raise HexdemError(f"the impact on bead {{{m}, {n}}} at {impact.angle_deg:g}° points out of the packing "
                                   f"through {wall.name}: strike it inwards")
-    holed = with_holes(lattice, beads, [impact.direction for impact in impacts])
-    return holed, _wall_members(lattice) - _wall_members(holed)
+    holed = with_holes(packing, beads, [impact.direction for impact in impacts])
+    return holed, _wall_members(packing) - _wall_members(holed)

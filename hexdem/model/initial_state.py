@@ -23,7 +23,7 @@ import numpy as np
 
 from hexdem.common.io import read_text, write_csv
 from hexdem.errors import HexdemError
-from hexdem.model.lattice import Lattice
+from hexdem.model.packing import Packing
 
 #: The accepted headers.
 HEADERS = (("m", "n", "vx", "vy"), ("m", "n", "vx", "vy", "dx", "dy"))
@@ -37,8 +37,8 @@ class InitialState:
     displacements_m: np.ndarray
 
 
-def read_initial_state(path, lattice: Lattice) -> InitialState:
-    """The state in the CSV at ``path`` for the beads of ``lattice`` (see the module docstring)."""
+def read_initial_state(path, packing: Packing) -> InitialState:
+    """The state in the CSV at ``path`` for the beads of ``packing`` (see the module docstring)."""
     path = Path(path)
     name = f"initial_state_file {path}"
     lines = [line for line in read_text(path, "initial_state_file").splitlines() if line.strip()]
@@ -46,7 +46,7 @@ def read_initial_state(path, lattice: Lattice) -> InitialState:
     header = tuple(cell.strip() for cell in rows[0]) if rows else ()
     if header not in HEADERS:
         raise HexdemError(f"{name}: the header must be m,n,vx,vy or m,n,vx,vy,dx,dy, got {','.join(header) or 'nothing'}")
-    n = len(lattice)
+    n = len(packing)
     velocities, displacements, seen = np.zeros((n, 2)), np.zeros((n, 2)), set()
     for number, row in enumerate(rows[1:], start=2):
         if len(row) != len(header):
@@ -58,7 +58,7 @@ def read_initial_state(path, lattice: Lattice) -> InitialState:
             raise HexdemError(f"{name}, line {number}: m and n must be integers and the rest numbers") from None
         if not all(math.isfinite(v) for v in values):
             raise HexdemError(f"{name}, line {number}: the values must be finite numbers")
-        bead = lattice.index_of(m, k)
+        bead = packing.index_of(m, k)
         if bead is None:
             raise HexdemError(f"{name}, line {number}: site {{{m}, {k}}} is not a bead of the packing")
         if bead in seen:
@@ -66,23 +66,23 @@ def read_initial_state(path, lattice: Lattice) -> InitialState:
         seen.add(bead)
         velocities[bead] = values[:2]
         if len(values) == 4:
-            if math.hypot(*values[2:]) >= lattice.diameters_m[bead] / 2:
+            if math.hypot(*values[2:]) >= packing.diameters_m[bead] / 2:
                 raise HexdemError(f"{name}, line {number}: a displacement of half a diameter or more would put "
                                   f"bead {{{m}, {k}}} inside its neighbours")
             displacements[bead] = values[2:]
     return InitialState(velocities, displacements)
 
 
-def write_initial_state(path, lattice: Lattice, velocities_m_s, displacements_m=None) -> None:
-    """Write (N, 2) ``velocities_m_s`` and optionally ``displacements_m`` of ``lattice``'s beads
+def write_initial_state(path, packing: Packing, velocities_m_s, displacements_m=None) -> None:
+    """Write (N, 2) ``velocities_m_s`` and optionally ``displacements_m`` of ``packing``'s beads
     as an ``initial_state_file`` (atomically), every bead on its own line, full precision."""
     columns = [np.asarray(velocities_m_s, float)]
     if displacements_m is not None:
         columns.append(np.asarray(displacements_m, float))
-    if any(column.shape != (len(lattice), 2) for column in columns):
-        raise HexdemError(f"an initial state needs ({len(lattice)}, 2) arrays for the packing's beads, got "
+    if any(column.shape != (len(packing), 2) for column in columns):
+        raise HexdemError(f"an initial state needs ({len(packing)}, 2) arrays for the packing's beads, got "
                           f"{' and '.join(str(column.shape) for column in columns)}")
     header = HEADERS[len(columns) - 1]
     rows = [[m, n, *(repr(float(value)) for value in values)]
-            for (m, n), values in zip(lattice.indices.tolist(), np.hstack(columns))]
+            for (m, n), values in zip(packing.labels.tolist(), np.hstack(columns))]
     write_csv(path, header, rows)

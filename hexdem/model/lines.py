@@ -2,7 +2,7 @@
 
 A configuration's ``lines`` is a list of tables ``{name = "up", site = [m, n], angle_deg = 90}``:
 the beads from site {m, n} on, one lattice step at a time along ``angle_deg`` (a multiple of
-30°, :data:`~hexdem.model.lattice.DIRECTION_STEPS`), until the packing ends. The paper's ``0``,
+30°, :data:`~hexdem.model.triangular.DIRECTION_STEPS`), until the packing ends. The paper's ``0``,
 ``+30`` and ``-30`` from the struck bead are always there, first.
 """
 
@@ -12,7 +12,8 @@ from dataclasses import replace
 from typing import TypedDict
 
 from hexdem.errors import HexdemError
-from hexdem.model.lattice import DIRECTION_STEPS, LINE_STEPS, Lattice
+from hexdem.model.packing import Packing
+from hexdem.model.triangular import DIRECTION_STEPS
 
 
 class LineTable(TypedDict, total=False):
@@ -26,9 +27,9 @@ class LineTable(TypedDict, total=False):
 LINE_KEYS = tuple(LineTable.__annotations__)
 
 
-def with_lines(lattice: Lattice, entries) -> Lattice:
-    """``lattice`` with the observation lines of ``entries`` (tables of :data:`LINE_KEYS`)."""
-    lines, names = [], set(LINE_STEPS)
+def with_lines(packing: Packing, entries) -> Packing:
+    """``packing`` with the observation lines of ``entries`` (tables of :data:`LINE_KEYS`) after its own."""
+    lines, names = [], {name for name, _, _ in packing.label_lines}
     for k, entry in enumerate(entries):
         if sorted(entry) != sorted(LINE_KEYS):
             raise HexdemError(f"line {k} must be a table {{name = \"up\", site = [m, n], angle_deg = 90}} with "
@@ -36,11 +37,11 @@ def with_lines(lattice: Lattice, entries) -> Lattice:
         name, site, angle = entry["name"], entry["site"], entry["angle_deg"]
         if not name or name in names:
             raise HexdemError(f"line {k}: name {name!r} must be a new, non-empty string (taken: {', '.join(sorted(names))})")
-        if lattice.index_of(*site) is None:
+        if packing.index_of(*site) is None:
             raise HexdemError(f"line {name}: site {site!r} is not a bead [m, n] of the packing")
         if angle not in DIRECTION_STEPS:
             raise HexdemError(f"line {name}: angle_deg {angle!r} is not a lattice direction; use one of "
                               f"{', '.join(str(a) for a in DIRECTION_STEPS)}")
         names.add(name)
         lines.append((name, (int(site[0]), int(site[1])), DIRECTION_STEPS[int(angle)]))
-    return replace(lattice, extra_lines=tuple(lines))
+    return replace(packing, label_lines=packing.label_lines + tuple(lines))

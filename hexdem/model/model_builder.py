@@ -2,7 +2,7 @@
 
 :class:`~hexdem.model.config.RunConfig` is the schema: it holds the keys and checks each of
 them. This module builds from it, as ASE's builders make an ``Atoms`` apart from what is done
-with it: the shape's packing (:func:`~hexdem.model.packing_builders.build_packing`), less the
+with it: the shape's packing (:func:`~hexdem.model.packing_builders.shape_packing`), less the
 ``vacancies`` and with the extra observation ``lines``; the materials of its regions; the
 precompressed geometry (:mod:`hexdem.model.precompression`); the impacts and the holes they
 cut in the walls; the initial state; and the sensors. The time step and the run's length
@@ -16,31 +16,32 @@ from hexdem.model.contact_law import Friction
 from hexdem.model.granular import GranularModel, Impact
 from hexdem.model.impacts import cut_holes, resolve_impacts, struck_site
 from hexdem.model.initial_state import read_initial_state
-from hexdem.model.lattice import Lattice, without_hole, without_sites
 from hexdem.model.lines import with_lines
 from hexdem.model.materials import hertz_coefficient, hertz_stiffness
-from hexdem.model.packing_builders import PLACED_SHAPES, BuiltPacking, build_packing
-from hexdem.model.precompression import hole_force, precompressed_lattice
+from hexdem.model.packing import Packing, without_hole
+from hexdem.model.packing_builders import PLACED_SHAPES, BuiltPacking, shape_packing
+from hexdem.model.precompression import hole_force, precompressed_packing
 from hexdem.model.regions import assign_materials
 from hexdem.model.sensors import sensor_beads
+from hexdem.model.triangular import without_sites
 
 
 def configured_packing(config) -> BuiltPacking:
     """The packing of ``config`` (a :class:`~hexdem.model.config.RunConfig`): its ``shape``'s,
     less the ``vacancies``, struck at the first impact's site, with the extra observation
     ``lines``, and the material regions of its builder."""
-    built = build_packing(config, struck_site(config.impact_specs()))
-    lattice = without_hole(built.lattice) if config.impacts else built.lattice  # each impact cuts its own
-    lattice = without_sites(lattice, config.vacancies) if config.vacancies else lattice
-    return BuiltPacking(with_lines(lattice, config.lines) if config.lines else lattice, built.regions)
+    built = shape_packing(config, struck_site(config.impact_specs()))
+    packing = without_hole(built.packing) if config.impacts else built.packing  # each impact cuts its own
+    packing = without_sites(packing, config.vacancies) if config.vacancies else packing
+    return BuiltPacking(with_lines(packing, config.lines) if config.lines else packing, built.regions)
 
 
-def build_lattice(config) -> Lattice:
+def build_packing(config) -> Packing:
     """The packing of :func:`configured_packing`, without its material regions."""
-    return configured_packing(config).lattice
+    return configured_packing(config).packing
 
 
-def _precompressed(config, lattice: Lattice, extra, bead, wall) -> tuple[Lattice, tuple[float, float]]:
+def _precompressed(config, packing: Packing, extra, bead, wall) -> tuple[Packing, tuple[float, float]]:
     """The packing squeezed by ``precompression_n`` and the force that holds the struck bead in
     its hole (:mod:`hexdem.model.precompression`), after checking that the packing allows it."""
     if extra:
@@ -53,8 +54,8 @@ def _precompressed(config, lattice: Lattice, extra, bead, wall) -> tuple[Lattice
         raise HexdemError(f"precompression is built for flat-walled basins (hexagon, half-hexagon, triangle, "
                           f"parallelogram), not shape = {config.shape!r}")
     coefficient = float(hertz_coefficient(config.diameter_m, bead))
-    lattice = precompressed_lattice(lattice, config.precompression_n, coefficient, hertz_stiffness(bead, wall))
-    return lattice, tuple(float(f) for f in hole_force(lattice, config.precompression_n))
+    packing = precompressed_packing(packing, config.precompression_n, coefficient, hertz_stiffness(bead, wall))
+    return packing, tuple(float(f) for f in hole_force(packing, config.precompression_n))
 
 
 def build_model(config) -> GranularModel:
@@ -62,33 +63,33 @@ def build_model(config) -> GranularModel:
     wall = None if config.wall_material == "none" else config.material(config.wall_material)
     bead, held = config.material(config.bead_material), (0.0, 0.0)
     built = configured_packing(config)
-    if len(built.lattice) < 2 and not built.lattice.walls:
-        raise HexdemError(f"{built.lattice.shape}: a packing needs at least 2 beads, or 1 bead and a wall to rebound "
+    if len(built.packing) < 2 and not built.packing.walls:
+        raise HexdemError(f"{built.packing.shape}: a packing needs at least 2 beads, or 1 bead and a wall to rebound "
                           "from; a lone free bead carries no wave")
-    lattice, extra = assign_materials(built.lattice, built.regions + config.regions, bead, config.material)
+    packing, extra = assign_materials(built.packing, built.regions + config.regions, bead, config.material)
     if config.precompression_n > 0:
-        lattice, held = _precompressed(config, lattice, extra, bead, wall)
-    impacts = model_impacts(config, lattice)
+        packing, held = _precompressed(config, packing, extra, bead, wall)
+    impacts = model_impacts(config, packing)
     if config.impacts:
-        holed, opened = cut_holes(lattice, impacts)
+        holed, opened = cut_holes(packing, impacts)
         if config.precompression_n > 0:
-            if opened - {lattice.struck}:
+            if opened - {packing.struck}:
                 raise HexdemError("a precompressed packing holds only the first impact's bead in a hole of its "
                                   "wall; strike the other beads inside the packing")
-            held = held if lattice.struck in opened else (0.0, 0.0)
-        lattice = holed
-    state = None if config.initial_state_file is None else read_initial_state(config.initial_state_file, lattice)
-    return GranularModel(lattice, impacts[0], bead, wall, config.restitution, config.effective_wall_restitution,
-                         held, tuple(sensor_beads(config.sensors, lattice).values()), config.sensor_mass_factor,
+            held = held if packing.struck in opened else (0.0, 0.0)
+        packing = holed
+    state = None if config.initial_state_file is None else read_initial_state(config.initial_state_file, packing)
+    return GranularModel(packing, impacts[0], bead, wall, config.restitution, config.effective_wall_restitution,
+                         held, tuple(sensor_beads(config.sensors, packing).values()), config.sensor_mass_factor,
                          extra, tuple(impacts[1:]),
                          Friction.of(config.friction, config.wall_friction, config.rolling_friction), state)
 
 
-def model_impacts(config, lattice: Lattice) -> list[Impact]:
+def model_impacts(config, packing: Packing) -> list[Impact]:
     """The model's impacts: the paper's single one on the struck bead, or those of ``impacts``."""
     if not config.impacts:
         striker = None if config.striker_material is None else config.material(config.striker_material)
-        bead = lattice.struck if config.shape == "chain" else None  # a chain's way in is along it, at any angle
+        bead = packing.struck if config.shape == "chain" else None  # a chain's way in is along it, at any angle
         return [Impact(config.v0 * config.unit_system.velocity_m_s, config.strike_direction_deg,
                        config.impact == "striker", bead, striker, config.striker_diameter_m)]
-    return resolve_impacts(config.impact_specs(), lattice, config.unit_system.velocity_m_s, config.material)
+    return resolve_impacts(config.impact_specs(), packing, config.unit_system.velocity_m_s, config.material)

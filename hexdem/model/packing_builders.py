@@ -2,7 +2,7 @@
 
 The triangular shapes (``hexagon``, ``half-hexagon``, ``half-disc``, ``triangle``,
 ``parallelogram``, ``disc``, ``sites``) place beads on the paper's lattice
-(:mod:`hexdem.model.lattice`, :mod:`hexdem.model.sites`). The others place them themselves:
+(:mod:`hexdem.model.triangular`, :mod:`hexdem.model.sites`). The others place them themselves:
 
 * ``square`` (``rows``, ``columns``) and ``centered-square`` (also ``interstitial_diameter_m``,
   None: the size that touches the four corners, and ``interstitial_material``, None: the beads'),
@@ -33,11 +33,11 @@ import numpy as np
 
 from hexdem.errors import HexdemError
 from hexdem.model.chain import chain, chain_beads
-from hexdem.model.lattice import (Lattice, disc, half_disc, half_hexagon, hexagon, parallelogram, strike_direction,
-                                  triangle)
+from hexdem.model.packing import Packing, strike_direction
 from hexdem.model.packing_file import packing_from_file, read_packing_rows
 from hexdem.model.sites import read_sites
 from hexdem.model.square_crystals import centered_square, square
+from hexdem.model.triangular import disc, half_disc, half_hexagon, hexagon, parallelogram, triangle
 
 TRIANGULAR_SHAPES = ("hexagon", "half-hexagon", "half-disc", "triangle", "parallelogram", "disc", "sites")
 PLACED_SHAPES = ("square", "centered-square", "chain", "packing")
@@ -109,16 +109,16 @@ def check_shape_keys(config) -> None:
 class BuiltPacking:
     """A shape's packing and the material ``regions`` its builder sets (tables {material, sites})."""
 
-    lattice: Lattice
+    packing: Packing
     regions: tuple = ()
 
 
-def material_regions(lattice: Lattice, names) -> tuple:
-    """Regions {material, sites} giving each bead of ``lattice`` its name in ``names`` (one per
+def material_regions(packing: Packing, names) -> tuple:
+    """Regions {material, sites} giving each bead of ``packing`` its name in ``names`` (one per
     bead; an empty name keeps the beads' material)."""
     names = np.asarray(names, dtype=object)
     return tuple({"material": str(name), "sites": tuple(tuple(int(v) for v in label)
-                                                         for label in lattice.indices[names == name])}
+                                                         for label in packing.labels[names == name])}
                  for name in dict.fromkeys(names.tolist()) if name)
 
 
@@ -145,30 +145,30 @@ def _chain(config, struck) -> BuiltPacking:
                               f"bead from 0 to {beads - 1} and a diameter_m or a material, got {intruder!r}")
         sizes[bead] = intruder.get("diameter_m", sizes[bead])
         names[bead] = intruder.get("material", names[bead])
-    lattice = chain(beads, config.diameter_m, config.angle_deg, sizes, struck)
-    return BuiltPacking(lattice, material_regions(lattice, names))
+    packing = chain(beads, config.diameter_m, config.angle_deg, sizes, struck)
+    return BuiltPacking(packing, material_regions(packing, names))
 
 
 def _centered_square(config, struck) -> BuiltPacking:
-    lattice, interstitials = centered_square(config.rows, config.columns, config.diameter_m,
+    packing, interstitials = centered_square(config.rows, config.columns, config.diameter_m,
                                              config.interstitial_diameter_m, struck)
     if config.interstitial_material is None:
-        return BuiltPacking(lattice)
-    names = np.full(len(lattice), "", dtype=object)
+        return BuiltPacking(packing)
+    names = np.full(len(packing), "", dtype=object)
     names[interstitials] = config.interstitial_material
-    return BuiltPacking(lattice, material_regions(lattice, names))
+    return BuiltPacking(packing, material_regions(packing, names))
 
 
 def _packing_file(config) -> BuiltPacking:
     if config.packing_file is None:
         raise HexdemError('shape = "packing" needs packing_file = "beads.csv" (header x,y,diameter[,material])')
     beads = read_packing_rows(config.packing_file)
-    lattice = packing_from_file(config.packing_file, beads, config.diameter_m, config.struck_bead, config.walls,
+    packing = packing_from_file(config.packing_file, beads, config.diameter_m, config.struck_bead, config.walls,
                                 strike_direction(config.strike_direction_deg))
-    return BuiltPacking(lattice, material_regions(lattice, beads.materials))
+    return BuiltPacking(packing, material_regions(packing, beads.materials))
 
 
-def build_packing(config, struck) -> BuiltPacking:
+def shape_packing(config, struck) -> BuiltPacking:
     """The packing of ``config``'s ``shape`` (a :class:`~hexdem.model.config.RunConfig`), struck
     at the bead labelled ``struck`` (a packing file: at its ``struck_bead``)."""
     builders = {

@@ -18,7 +18,7 @@ import numpy as np
 
 from hexdem.common.io import read_text
 from hexdem.errors import HexdemError
-from hexdem.model.lattice import Lattice, touching_walls, with_holes
+from hexdem.model.packing import Packing, touching_walls, with_holes
 from hexdem.model.placed import placed_packing
 
 WALLS = ("none", "hull")
@@ -71,7 +71,7 @@ def hull_normals(positions_m) -> list[np.ndarray]:
 
 
 def packing_from_file(path, beads: PackingRows, diameter_m: float, struck_bead: int, walls: str,
-                      strike_direction) -> Lattice:
+                      strike_direction) -> Packing:
     """The packing of the ``beads`` read from ``packing_file`` ``path`` (:func:`read_packing_rows`;
     nominal ``diameter_m``), struck at row ``struck_bead`` along the unit vector
     ``strike_direction``, with ``walls``."""

@@ -1,6 +1,6 @@
 """A packing from placed beads: labels, positions and diameters given, walls found from them.
 
-The triangular shapes place their beads on the paper's lattice (:func:`~hexdem.model.lattice.from_sites`);
+The triangular shapes place their beads on the paper's lattice (:func:`~hexdem.model.triangular.from_sites`);
 every other builder (square and centered-square crystals, chains, measured positions) places them
 itself and calls :func:`placed_packing`, which checks them, finds the struck bead by its label
 and puts flat walls touching the packing. Contacts are not stored: both engines find them from
@@ -14,7 +14,7 @@ from dataclasses import replace
 import numpy as np
 
 from hexdem.errors import HexdemError
-from hexdem.model.lattice import Lattice, touching_walls, unit_vector
+from hexdem.model.packing import Packing, touching_walls, unit_vector
 
 #: Beads may overlap by at most this fraction of the smaller diameter at rest (round-off of
 #: measured or computed positions); more is a packing that would explode.
@@ -58,11 +58,11 @@ def check_extent(positions_m, diameters_m, what: str) -> None:
 
 
 def placed_packing(labels, positions_m, diameters_m, diameter_m: float, wall_angles_deg, shape: str, struck,
-                   ray_angles_deg) -> Lattice:
+                   rays_deg) -> Packing:
     """The packing of beads labelled ``labels`` (N, 2) int at ``positions_m`` (N, 2) [m] with
     ``diameters_m`` (N,) [m] (nominal ``diameter_m``), struck at the bead labelled ``struck``,
     inside flat walls touching it whose inward normals point at ``wall_angles_deg`` (the one at
-    0° has the struck bead's hole), its lines the rays at ``ray_angles_deg``."""
+    0° has the struck bead's hole), its lines the rays at ``rays_deg``."""
     labels = np.asarray(labels, dtype=int).reshape(-1, 2)
     positions, diameters = np.asarray(positions_m, float).reshape(-1, 2), np.asarray(diameters_m, float)
     if not len(labels):
@@ -78,6 +78,6 @@ def placed_packing(labels, positions_m, diameters_m, diameter_m: float, wall_ang
     hit = np.flatnonzero(np.all(labels == np.asarray(struck, dtype=int), axis=1))
     if not len(hit):
         raise HexdemError(f"{shape}: the struck bead {tuple(int(v) for v in struck)} is not in the packing")
-    lattice = Lattice(indices=labels, positions_m=positions, diameters_m=diameters, diameter_m=float(diameter_m),
-                      struck=int(hit[0]), walls=(), shape=shape, ray_angles_deg=tuple(float(a) for a in ray_angles_deg))
-    return replace(lattice, walls=touching_walls(lattice, [unit_vector(a) for a in wall_angles_deg]))
+    packing = Packing(labels=labels, positions_m=positions, diameters_m=diameters, diameter_m=float(diameter_m),
+                      struck=int(hit[0]), walls=(), shape=shape, rays_deg=tuple(float(a) for a in rays_deg))
+    return replace(packing, walls=touching_walls(packing, [unit_vector(a) for a in wall_angles_deg]))

@@ -41,7 +41,8 @@ from dataclasses import replace
 import numpy as np
 
 from hexdem.errors import HexdemError
-from hexdem.model.lattice import BOND_STEPS, Lattice
+from hexdem.model.packing import Packing
+from hexdem.model.triangular import BOND_STEPS
 from hexdem.model.walls import Wall
 
 #: A precompression may squeeze each contact by less than this fraction of a diameter: from half a
@@ -84,42 +85,42 @@ def longitudinal_sound_speed(force_n: float, coefficient: float, mass_kg: float,
     return math.sqrt(9.0 / 8.0) * spacing_m * math.sqrt(spring_stiffness(force_n, coefficient) / mass_kg)
 
 
-def missing_contact_forces(lattice: Lattice, force_n: float) -> np.ndarray:
+def missing_contact_forces(packing: Packing, force_n: float) -> np.ndarray:
     """(N, 2) force [N] that each bead's missing neighbours would push it with, f0 Σ (−u)."""
-    forces = np.zeros((len(lattice), 2))
-    for b, (m, n) in enumerate(lattice.indices.tolist()):
+    forces = np.zeros((len(packing), 2))
+    for b, (m, n) in enumerate(packing.labels.tolist()):
         for step in NEIGHBOURS:
-            if lattice.index_of(m + step[0], n + step[1]) is None:
+            if packing.index_of(m + step[0], n + step[1]) is None:
                 forces[b] -= force_n * _unit(step)
     return forces
 
 
-def _wall_loads(lattice: Lattice, needed: np.ndarray) -> dict[tuple[int, int], float]:
+def _wall_loads(packing: Packing, needed: np.ndarray) -> dict[tuple[int, int], float]:
     """{(wall index, bead): normal force [N] the wall must give the bead}: one wall takes the
     bead's whole need along its normal, two walls (a corner) share it."""
     touching: dict[int, list[int]] = {}
-    for w, wall in enumerate(lattice.walls):
+    for w, wall in enumerate(packing.walls):
         for bead in wall.members.tolist():
             touching.setdefault(bead, []).append(w)
     loads = {}
     for bead, walls in touching.items():
-        normals = np.array([lattice.walls[w].normal for w in walls]).T
+        normals = np.array([packing.walls[w].normal for w in walls]).T
         share = np.linalg.lstsq(normals, needed[bead], rcond=None)[0]
         loads.update({(w, bead): float(f) for w, f in zip(walls, share)})
     return loads
 
 
-def precompressed_lattice(lattice: Lattice, force_n: float, pair_coefficient: float,
-                          wall_stiffness_pa: float) -> Lattice:
-    r"""The ideal ``lattice`` (equal beads) in static equilibrium with every contact at ``force_n``
+def precompressed_packing(packing: Packing, force_n: float, pair_coefficient: float,
+                          wall_stiffness_pa: float) -> Packing:
+    r"""The ideal ``packing`` (equal beads) in static equilibrium with every contact at ``force_n``
     [N] (steps 1 and 2): shrunk about the struck bead, each wall split into planes that meet
     their members at the overlap that gives them their missing contacts' force.
     ``pair_coefficient`` A [:math:`\mathrm{N/m^{1.5}}`]; ``wall_stiffness_pa`` k_n,wall
     (:math:`A_w = k_{n,\text{wall}} \sqrt{R}`)."""
-    d = lattice.diameter_m
-    centre = lattice.positions_m[lattice.struck]
+    d = packing.diameter_m
+    centre = packing.positions_m[packing.struck]
     scale = (d - checked_static_overlap(force_n, pair_coefficient, d)) / d
-    shrunk = lattice.with_geometry(centre + (lattice.positions_m - centre) * scale, lattice.diameters_m)
+    shrunk = packing.with_geometry(centre + (packing.positions_m - centre) * scale, packing.diameters_m)
     loads = _wall_loads(shrunk, missing_contact_forces(shrunk, force_n))
     walls = []
     for w, wall in enumerate(shrunk.walls):
@@ -135,7 +136,7 @@ def precompressed_lattice(lattice: Lattice, force_n: float, pair_coefficient: fl
     return replace(shrunk, walls=tuple(walls))
 
 
-def hole_force(lattice: Lattice, force_n: float) -> np.ndarray:
+def hole_force(packing: Packing, force_n: float) -> np.ndarray:
     """(2,) force [N] on the struck bead from its missing wall: its missing contacts' force (√3 f0
     along +x for a bead in the middle of a straight edge)."""
-    return missing_contact_forces(lattice, force_n)[lattice.struck]
+    return missing_contact_forces(packing, force_n)[packing.struck]

@@ -6,7 +6,7 @@ whose centres lie within :data:`RAY_HALF_WIDTH_D` bead diameters of the ray, ahe
 bead, ordered by their distance from it; the struck bead is bead 0 of every ray. A line's name
 is its angle, signed: ``"0"``, ``"+45"``, ``"-45"``, ``"+90"``. On the triangular lattice the
 paper's ``"0"``, ``"+30"`` and ``"-30"`` are these same rays, and keep their lattice definition
-(:meth:`~hexdem.model.lattice.Lattice.line`).
+(:meth:`~hexdem.model.packing.Packing.line`).
 """
 
 from __future__ import annotations

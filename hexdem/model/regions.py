@@ -15,8 +15,8 @@ from typing import TypedDict
 import numpy as np
 
 from hexdem.errors import HexdemError
-from hexdem.model.lattice import Lattice
 from hexdem.model.materials import Material
+from hexdem.model.packing import Packing
 
 
 
@@ -36,7 +36,7 @@ BOUNDS = {"x_min_d": (0, True), "x_max_d": (0, False), "y_min_d": (1, True), "y_
 KEYS = set(RegionTable.__annotations__)
 
 
-def _selected(lattice: Lattice, region: dict, k: int) -> np.ndarray:
+def _selected(packing: Packing, region: dict, k: int) -> np.ndarray:
     """(N,) bool: the beads region ``k`` selects."""
     unknown = sorted(set(region) - KEYS)
     if unknown or "material" not in region:
@@ -44,16 +44,16 @@ def _selected(lattice: Lattice, region: dict, k: int) -> np.ndarray:
                           + f"a region is material = NAME with sites and/or {', '.join(BOUNDS)}")
     if not set(region) - {"material"}:
         raise HexdemError(f"region {k} selects nothing: give sites = [[m, n], ...] and/or {', '.join(BOUNDS)}")
-    chosen = np.ones(len(lattice), dtype=bool)
+    chosen = np.ones(len(packing), dtype=bool)
     if "sites" in region:
         sites = region["sites"]
-        missing = [tuple(s) for s in sites if lattice.index_of(*s) is None]
+        missing = [tuple(s) for s in sites if packing.index_of(*s) is None]
         if missing:
             raise HexdemError(f"region {k}: site {{{missing[0][0]}, {missing[0][1]}}} is not in the packing")
-        listed = np.zeros(len(lattice), dtype=bool)
-        listed[[lattice.index_of(*s) for s in sites]] = True
+        listed = np.zeros(len(packing), dtype=bool)
+        listed[[packing.index_of(*s) for s in sites]] = True
         chosen &= listed
-    relative = (lattice.positions_m - lattice.positions_m[lattice.struck]) / lattice.diameter_m
+    relative = (packing.positions_m - packing.positions_m[packing.struck]) / packing.diameter_m
     for key, (axis, lower) in BOUNDS.items():
         if key in region:
             value = region[key]
@@ -63,13 +63,13 @@ def _selected(lattice: Lattice, region: dict, k: int) -> np.ndarray:
     return chosen
 
 
-def assign_materials(lattice: Lattice, regions, bead: Material, lookup) -> tuple[Lattice, tuple[Material, ...]]:
-    """``lattice`` with the material ids the ``regions`` give, and the materials beyond ``bead``
+def assign_materials(packing: Packing, regions, bead: Material, lookup) -> tuple[Packing, tuple[Material, ...]]:
+    """``packing`` with the material ids the ``regions`` give, and the materials beyond ``bead``
     by id (1, 2, …, in order of first use); ``lookup(name)`` finds a material by name."""
     extra: list[Material] = []
-    ids = lattice.material_ids.copy()
+    ids = packing.material_ids.copy()
     for k, region in enumerate(regions):
-        chosen = _selected(lattice, region, k)
+        chosen = _selected(packing, region, k)
         material = lookup(region["material"])
         if material != bead and material not in extra:
             extra.append(material)
@@ -79,4 +79,4 @@ def assign_materials(lattice: Lattice, regions, bead: Material, lookup) -> tuple
     table = np.arange(len(extra) + 1)
     table[list(renumber)] = list(renumber.values())
     ids = table[ids]
-    return replace(lattice, material_ids=ids), tuple(used)
+    return replace(packing, material_ids=ids), tuple(used)

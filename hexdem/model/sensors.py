@@ -8,16 +8,16 @@ A sensor is ``"line:n"``, bead n of an observation line (one of the paper's ``0`
 from __future__ import annotations
 
 from hexdem.errors import HexdemError
-from hexdem.model.lattice import Lattice
+from hexdem.model.packing import Packing
 
 
-def sensor_beads(sensors, lattice: Lattice) -> dict[str, int]:
-    """{label: bead index} of ``sensors`` on ``lattice``, in the order given."""
-    beads, lines = {}, lattice.lines() if sensors else {}
+def sensor_beads(sensors, packing: Packing) -> dict[str, int]:
+    """{label: bead index} of ``sensors`` on ``packing``, in the order given."""
+    beads, lines = {}, packing.lines() if sensors else {}
     for sensor in sensors:
         if isinstance(sensor, int) and not isinstance(sensor, bool):
-            if not 1 <= sensor <= len(lattice):
-                raise HexdemError(f"sensor bead id {sensor} is not in the packing (ids 1 to {len(lattice)})")
+            if not 1 <= sensor <= len(packing):
+                raise HexdemError(f"sensor bead id {sensor} is not in the packing (ids 1 to {len(packing)})")
             beads[str(sensor)] = sensor - 1
             continue
         name, _, n = str(sensor).partition(":")

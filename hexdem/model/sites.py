@@ -2,7 +2,7 @@
 
 ``sites_file`` is a CSV with columns ``m,n`` (a header line, then one site per line) or a TOML
 file with ``sites = [[m, n], …]``. The struck bead is {0, 0} (or the first impact's site); flat walls touch the packing at
-the inward-normal angles given (:func:`~hexdem.model.lattice.from_sites`), none by default.
+the inward-normal angles given (:func:`~hexdem.model.triangular.from_sites`), none by default.
 """
 
 from __future__ import annotations
@@ -16,8 +16,9 @@ import numpy as np
 
 from hexdem.common.io import read_text
 from hexdem.errors import HexdemError
-from hexdem.model.lattice import Lattice, from_sites
+from hexdem.model.packing import Packing
 from hexdem.model.placed import check_extent
+from hexdem.model.triangular import from_sites
 
 
 def _sites_from_file(path: Path) -> list:
@@ -39,7 +40,7 @@ def _sites_from_file(path: Path) -> list:
         raise HexdemError(f"sites_file {path}: every line after the header must be two integers m,n") from None
 
 
-def read_sites(sites, sites_file, diameter_m: float, walls_deg=(), struck=(0, 0)) -> Lattice:
+def read_sites(sites, sites_file, diameter_m: float, walls_deg=(), struck=(0, 0)) -> Packing:
     """The packing of ``sites`` (pairs [m, n]) or of the sites in ``sites_file`` (exactly one of
     the two), with flat walls at the inward-normal angles ``walls_deg``, struck at ``struck``."""
     if bool(sites) == bool(sites_file):

@@ -22,7 +22,7 @@ import math
 import numpy as np
 
 from hexdem.errors import HexdemError
-from hexdem.model.lattice import Lattice
+from hexdem.model.packing import Packing
 from hexdem.model.placed import placed_packing
 
 #: The square basin's walls (inward normals) and the lines of a square packing (rays from the struck bead).
@@ -43,7 +43,7 @@ def _grid_size(rows, columns) -> tuple[int, int]:
     return int(rows), int(columns)
 
 
-def square(rows: int, columns: int, diameter_m: float, struck=(0, 0)) -> Lattice:
+def square(rows: int, columns: int, diameter_m: float, struck=(0, 0)) -> Packing:
     """``rows`` × ``columns`` touching beads of ``diameter_m`` on a square grid; the struck bead
     {0, 0} in the middle of the left column (the lower middle for an even count)."""
     rows, columns = _grid_size(rows, columns)
@@ -60,7 +60,7 @@ def interstitial_fit_m(diameter_m: float) -> float:
 
 
 def centered_square(rows: int, columns: int, diameter_m: float, interstitial_diameter_m: float | None = None,
-                    struck=(0, 0)) -> tuple[Lattice, np.ndarray]:
+                    struck=(0, 0)) -> tuple[Packing, np.ndarray]:
     """(packing, interstitial bead indices): ``rows`` × ``columns`` corner beads of ``diameter_m``
     and one interstitial of ``interstitial_diameter_m`` (None: :func:`interstitial_fit_m`) in each
     of the (rows − 1)(columns − 1) cells."""

@@ -65,7 +65,7 @@ def pair_contact_time_s(a: Material, da: float, b: Material, db: float, speed_m_
 def sized_bodies(model) -> tuple[tuple[Material, float], ...]:
     """(material, smallest diameter [m]) of each bead material of the :class:`~hexdem.model.granular.GranularModel`
     ``model``: the smallest beads of a material touch the shortest (t_c ∝ d at a given speed)."""
-    diameters, ids = model.lattice.diameters_m, model.material_ids[:len(model.lattice)]
+    diameters, ids = model.packing.diameters_m, model.material_ids[:len(model.packing)]
     return tuple((model.materials[k], float(diameters[ids == k].min())) for k in np.unique(ids))
 
 
@@ -103,10 +103,10 @@ LAYER_ROUND_OFF = 1e-9
 def own_contact_times_s(model) -> dict[int, float]:
     """{material id: the Hertz contact time [s] of two beads of that material and the nominal
     diameter meeting at the first impact's speed}, for the packing's bead materials."""
-    lattice, speed, d = model.lattice, model.impacts[0].speed_m_s, model.lattice.diameter_m
+    packing, speed, d = model.packing, model.impacts[0].speed_m_s, model.packing.diameter_m
     return {int(k): float(contact_time(float(sphere_mass(d, model.materials[k])) / 2,
                                        float(hertz_coefficient(d, model.materials[k])), speed))
-            for k in np.unique(model.material_ids[:len(lattice)])}
+            for k in np.unique(model.material_ids[:len(packing)])}
 
 
 def crossing_time_s(model, linear_contact_s: float | None = None) -> float:
@@ -121,15 +121,15 @@ def crossing_time_s(model, linear_contact_s: float | None = None) -> float:
     precompressed packing's ``linear_contact_s`` (its linearized contact's half period) replaces
     the Hertz time, scaled alike. For a packing of one material this is the layer count times
     the two-bead contact time. The largest over the impacts."""
-    lattice = model.lattice
+    packing = model.packing
     own = own_contact_times_s(model)
     fastest = min(own.values())
-    pace = np.vectorize(own.get, otypes=[float])(model.material_ids[:len(lattice)])  # each bead's material's
+    pace = np.vectorize(own.get, otypes=[float])(model.material_ids[:len(packing)])  # each bead's material's
     scale = 1.0 if linear_contact_s is None else linear_contact_s / fastest
-    layer_m = math.sqrt(3) / 2 * lattice.diameter_m
+    layer_m = math.sqrt(3) / 2 * packing.diameter_m
     times = []
     for bead, impact in zip(model.struck_beads, model.impacts):
-        depth = (lattice.positions_m - lattice.positions_m[bead]) @ impact.direction
+        depth = (packing.positions_m - packing.positions_m[bead]) @ impact.direction
         count = math.ceil(float(depth.max()) / layer_m)
         layers = np.ceil(depth / layer_m - LAYER_ROUND_OFF).astype(int)  # a bead on a layer's line is in it
         ahead = (layers > 0) & (layers <= count)
@@ -146,7 +146,7 @@ def wall_contact_time_s(model) -> float:
     (mass m against a rigid body, A = k_n sqrt(r)); 0 without walls."""
     walls = [0.0]
     if model.walls:
-        masses, radii = model.masses_kg, model.lattice.radii_m
+        masses, radii = model.masses_kg, model.packing.radii_m
         for bead, impact in zip(model.struck_beads, model.impacts):
             coefficient = float(model.wall_stiffness_pa([bead])[0]) * math.sqrt(radii[bead])
             walls.append(float(contact_time(masses[bead], coefficient, impact.speed_m_s)))
@@ -169,11 +169,11 @@ def solitary_crossing_time_s(model, contact_s: float, wall_contact_s: float) -> 
     that wall contact, and a layer's transit, to come back: the 15 × 15 steel square's last bead
     peaks 0.53 ms after the strike, its neighbour meets the reflection at 0.74 ms, and this gives
     0.68 ms."""
-    lattice = model.lattice
-    fastest = max(chain_speed_scale_m_s(model.materials[k]) for k in np.unique(model.material_ids[:len(lattice)]))
+    packing = model.packing
+    fastest = max(chain_speed_scale_m_s(model.materials[k]) for k in np.unique(model.material_ids[:len(packing)]))
     times = []
     for bead, impact in zip(model.struck_beads, model.impacts):
-        depth_m = float(np.max((lattice.positions_m - lattice.positions_m[bead]) @ impact.direction))
+        depth_m = float(np.max((packing.positions_m - packing.positions_m[bead]) @ impact.direction))
         times.append(depth_m / solitary_speed_m_s(fastest, impact.speed_m_s))
     far_end_s = wall_contact_s / 2 if model.walls else contact_s
     return max(times) + max(far_end_s, contact_s) + contact_s
@@ -184,8 +184,8 @@ def striker_launch_s(model) -> float:
     material touch (0 for strikers no slower: the pulse a soft striker launches needs that much
     more time to enter the packing)."""
     own, struck, ids = own_contact_times_s(model), model.struck_beads, model.material_ids
-    extra = [pair_contact_time_s(model.materials[ids[struck[k]]], float(model.lattice.diameters_m[struck[k]]),
+    extra = [pair_contact_time_s(model.materials[ids[struck[k]]], float(model.packing.diameters_m[struck[k]]),
                                  impact.striker_material or model.bead,
-                                 impact.striker_diameter_m or model.lattice.diameter_m, impact.speed_m_s)
+                                 impact.striker_diameter_m or model.packing.diameter_m, impact.speed_m_s)
              - own[int(ids[struck[k]])] for k, impact in enumerate(model.impacts) if impact.striker]
     return max([0.0, *extra])

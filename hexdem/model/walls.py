@@ -1,7 +1,7 @@
 """The walls of a basin: flat walls and the curved wall of a disc, each with the geometry that
 both engines' sphere–wall Hertz contacts need (gap, inward normal, contact radius, curvature).
 
-Each wall lists its ``members``, the beads that can touch it (:func:`~hexdem.model.lattice.touching_walls`
+Each wall lists its ``members``, the beads that can touch it (:func:`~hexdem.model.packing.touching_walls`
 places them).
 """
 

@@ -34,8 +34,8 @@ import numpy as np
 
 from hexdem.analysis.pulse_shape import collapse_residuals, power_law, profiles, pulse_shapes, reference_profile
 from hexdem.experiments.front_study import FrontStudy
-from hexdem.model.lattice import Lattice
-from hexdem.model.model_builder import build_lattice
+from hexdem.model.model_builder import build_packing
+from hexdem.model.packing import Packing
 
 #: The rays followed, degrees from the strike direction (the two lattice lines and between).
 RAYS_DEG = (0.0, 15.0, 30.0)
@@ -68,7 +68,7 @@ class SelfSimilarityStudy:
         return asdict(self)
 
 
-def ray_beads(lattice: Lattice, angle_deg: float, radius_min_d: float, radius_max_d: float) -> np.ndarray:
+def ray_beads(lattice: Packing, angle_deg: float, radius_min_d: float, radius_max_d: float) -> np.ndarray:
     """Indices of the beads nearest the points of the ray at ``angle_deg`` from the struck bead,
     one every diameter from ``radius_min_d`` to ``radius_max_d`` (each bead once, in order of
     distance)."""
@@ -141,7 +141,7 @@ def run_study_packing(study: SelfSimilarityStudy, name: str, workdir, log=None) 
     from hexdem.experiments.run import simulate
 
     config = study.front.configs()[name]
-    lattice = build_lattice(config)
+    lattice = build_packing(config)
     rays = {f"{angle:g}": ray_beads(lattice, angle, study.radius_min_d, study.radius_max_d[name]) for angle in RAYS_DEG}
     traced = [int(b) for beads in rays.values() for b in beads]
     analysis = simulate(config, workdir, log, trace_beads=traced)

@@ -82,7 +82,7 @@ def measure_chain(analysis, window: tuple[int, int] = WINDOW) -> ChainWave:
     if last >= len(beads):
         raise HexdemError(f"the window {first}..{last} goes beyond the chain's {len(beads)} beads")
     n = np.arange(first, last + 1)
-    diameter = analysis.model.lattice.diameter_m
+    diameter = analysis.model.packing.diameter_m
     arrival, peak = r.arrival_time[beads[n]], r.peak_speed[beads[n]]
     if not np.all(np.isfinite(arrival)):
         raise HexdemError("the pulse did not reach every bead of the window: the run was too short")

@@ -312,7 +312,7 @@ def _impact_speed_m_s(analysis) -> float:
 def _nondimensional_units(analysis):
     from hexdem.model.units import nondimensional
 
-    return nondimensional(analysis.model.lattice.diameter_m, analysis.model.bead)
+    return nondimensional(analysis.model.packing.diameter_m, analysis.model.bead)
 
 
 def pulse_speed_table(analysis, line: str = "+30") -> dict:

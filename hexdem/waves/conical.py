@@ -206,7 +206,7 @@ def _run_packet(settings: ConicalSettings, config: RunConfig, model: GranularMod
                 omega: float, centre, log, show_progress) -> PacketRun:
     """Write the packet's state on ``model``'s (precompressed) positions, run ``config`` from it
     and record its energy blocks."""
-    lattice, theory = model.lattice, settings.theory()
+    lattice, theory = model.packing, settings.theory()
     width = settings.width_d * config.diameter_m
     velocities, displacements = bloch_packet(lattice.positions_m, centre, width, wave_vector, polarization,
                                              omega, settings.speed_m_s)
@@ -241,7 +241,7 @@ def measure_conical(settings: ConicalSettings, workdir, log=None, show_progress:
     workdir = Path(workdir)
     theory, config = settings.theory(), settings.config()
     model = build_model(config)
-    centre = model.lattice.positions_m.mean(axis=0)
+    centre = model.packing.positions_m.mean(axis=0)
     k_point = theory.high_symmetry_points()["K"]
     dirac = _run_packet(settings, config, model, workdir / "dirac", k_point, CIRCULAR, theory.dirac_frequency(), centre,
                         log, show_progress)

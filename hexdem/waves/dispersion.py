@@ -225,13 +225,13 @@ def measure_dispersion(settings: DispersionSettings, workdir, log=None, show_pro
     theory, config = settings.theory(), settings.config()
     model = build_model(config)
     state = workdir / "initial_state.csv"
-    write_initial_state(state, model.lattice, broadband_state(len(model.lattice), settings.speed_m_s, settings.seed))
+    write_initial_state(state, model.packing, broadband_state(len(model.packing), settings.speed_m_s, settings.seed))
     position, vectors, omega = band_path(theory, settings.points_per_segment)
     every = steps_per_sample(run_settings(config, model).dt_s, 2 * math.pi / omega.max(), settings.samples_per_period)
     config = config.replace(initial_state_file=str(state), dump_every=every)
     inside = np.linalg.norm(vectors, axis=1) > 0
     position, vectors, omega = position[inside], vectors[inside], omega[inside]
-    positions = model.lattice.positions_m[:len(model.lattice)]
+    positions = model.packing.positions_m[:len(model.packing)]
     recorded = record_waves(config, workdir / "run", vectors, log=log, show_progress=show_progress,
                             weights=taper(positions))
     spectrum_omega, power = power_spectrum(recorded.times_s, branch_signals(recorded.components,

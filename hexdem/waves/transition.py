@@ -255,7 +255,7 @@ def front_measures(analysis, settings: TransitionSettings) -> tuple[float, float
     if fitted.sum() < 3:
         return sixfold, math.nan
     slope = np.polyfit(time[fitted] * analysis.settings.units.time_s, radius[fitted], 1)[0]
-    return sixfold, float(slope * analysis.model.lattice.diameter_m)
+    return sixfold, float(slope * analysis.model.packing.diameter_m)
 
 
 def run_transition(settings: TransitionSettings, workdir, log=None) -> TransitionMap:

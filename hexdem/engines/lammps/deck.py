@@ -65,7 +65,7 @@ def _fmt(value: float) -> str:
 def _striker_type_materials(model: GranularModel) -> list[int]:
     """The material ids of the strikers' atom types: one per material the strikers are of, in
     order of first use (one type, of the beads' material, when there is no striker)."""
-    return list(dict.fromkeys(model.material_ids[len(model.lattice):].tolist())) or [0]
+    return list(dict.fromkeys(model.material_ids[len(model.packing):].tolist())) or [0]
 
 
 def atom_types(model: GranularModel) -> np.ndarray:
@@ -73,8 +73,8 @@ def atom_types(model: GranularModel) -> np.ndarray:
     own types (2 for the paper's one material)."""
     first = 2 + len(model.extra_materials)
     striker_type = {material: first + k for k, material in enumerate(_striker_type_materials(model))}
-    strikers = [striker_type[m] for m in model.material_ids[len(model.lattice):].tolist()]
-    return np.append(model.lattice.material_ids + 1, np.array(strikers, dtype=int))
+    strikers = [striker_type[m] for m in model.material_ids[len(model.packing):].tolist()]
+    return np.append(model.packing.material_ids + 1, np.array(strikers, dtype=int))
 
 
 def type_materials(model: GranularModel) -> list[int]:
@@ -92,7 +92,7 @@ def data_file(model: GranularModel, units: UnitSystem) -> str:
     margin = 2.0 * diam.max()
     lo, hi = pos.min(axis=0) - margin, pos.max(axis=0) + margin
     types = atom_types(model)
-    lines = [f"hexdem data file: {model.lattice.shape}", "",
+    lines = [f"hexdem data file: {model.packing.shape}", "",
              f"{model.n_bodies} atoms", f"{len(type_materials(model))} atom types", "",
              f"{_fmt(lo[0])} {_fmt(hi[0])} xlo xhi", f"{_fmt(lo[1])} {_fmt(hi[1])} ylo yhi",
              f"{_fmt(-diam.max())} {_fmt(diam.max())} zlo zhi", "", "Atoms # sphere", ""]
@@ -120,7 +120,7 @@ def walls_block(model: GranularModel, units: UnitSystem) -> str:
     for wall in model.walls:
         if isinstance(wall, CurvedWall):  # its Hertz law: LAMMPS's own contact radius of a cylinder
             centre = np.asarray(wall.centre_m) / units.length_m
-            height = CYLINDER_HALF_HEIGHT_D * model.lattice.diameter_m / units.length_m  # the 2D beads at z = 0
+            height = CYLINDER_HALF_HEIGHT_D * model.packing.diameter_m / units.length_m  # the 2D beads at z = 0
             region = (f"cylinder z {_fmt(centre[0])} {_fmt(centre[1])} {_fmt(wall.radius_m / units.length_m)} "
                       f"{_fmt(-height)} {_fmt(height)} side in")
         else:
@@ -199,7 +199,7 @@ def granular_block(model: GranularModel, units: UnitSystem) -> str:
         damping_note="undamped" if model.restitution == 1.0 else f"Tsuji damping, restitution {model.restitution}",
         tangential_note=(f"Mindlin tangential force, mu = {friction.friction} (walls {friction.wall_friction})"
                          if model.laws.tangential else "no tangential force"),
-        skin=_fmt(0.1 * model.lattice.diameter_m / units.length_m))
+        skin=_fmt(0.1 * model.packing.diameter_m / units.length_m))
 
 
 def integrator(model: GranularModel) -> str:
@@ -227,7 +227,7 @@ def held_force_block(model: GranularModel, units: UnitSystem) -> str:
     force = np.asarray(model.held_force_n) / units.force_n
     if not force.any():
         return ""
-    return (f"group           hole id {model.lattice.struck + 1}\n"
+    return (f"group           hole id {model.packing.struck + 1}\n"
             f"fix             hole hole addforce {_fmt(force[0])} {_fmt(force[1])} 0.0\n")
 
 
@@ -248,7 +248,7 @@ def impact_block(model: GranularModel, units: UnitSystem) -> str:
 
 def _impact_title(model: GranularModel, impact) -> str:
     """One impact in the deck's title line."""
-    where = "" if impact.bead is None else " on bead {%d, %d}" % tuple(model.lattice.indices[impact.bead])
+    where = "" if impact.bead is None else " on bead {%d, %d}" % tuple(model.packing.labels[impact.bead])
     how = " by a striker" if impact.striker else ("" if where else " on the struck bead")
     return f"V0 = {impact.speed_m_s} m/s at {impact.angle_deg} deg{how}{where}"
 
@@ -267,7 +267,7 @@ def render_input(model: GranularModel, settings: RunSettings, gravity_m_s2=None)
         raise HexdemError(f"the deck needs {groups} LAMMPS groups (walls by material, impacts by distinct velocity), "
                           f"more than LAMMPS's {MAX_GROUPS}: give the impacts fewer distinct velocities")
     return template("impact.in").substitute(
-        title=f"{model.lattice.shape}, " + ("; ".join(_impact_title(model, impact) for impact in model.impacts)
+        title=f"{model.packing.shape}, " + ("; ".join(_impact_title(model, impact) for impact in model.impacts)
                                              if len(model.impacts) <= 3 else f"{len(model.impacts)} impacts"),
         units_note=note, granular=granular_block(model, units), walls=walls, body_force=body_force,
         impacts=impacts, integrator=integrator(model), dt=_fmt(settings.dt_s / units.time_s),

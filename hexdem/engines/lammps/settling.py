@@ -65,7 +65,7 @@ def write_settling_deck(model: GranularModel, stage: SettlingStage, directory) -
     its impact is not part of the deck) into ``directory``; returns the directory."""
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
-    masses = model.masses_kg[:len(model.lattice)]
+    masses = model.masses_kg[:len(model.packing)]
     kinetic = repr(kinetic_tolerance_j(masses, stage.settled_rms_speed_m_s))
     condition = f"c_kinetic<{kinetic}"
     note = f"kinetic energy below {kinetic} J (rms bead speed {stage.settled_rms_speed_m_s!r} m/s)"
@@ -74,7 +74,7 @@ def write_settling_deck(model: GranularModel, stage: SettlingStage, directory) -
         condition = f"({condition})&&(fmax<{force!r})"
         note += f"\n# and no net force component above {force!r} N"
     text = template("settle.in").substitute(
-        stage=stage.name, purpose=stage.purpose, title=f"{model.lattice.shape}, {len(model.lattice)} beads",
+        stage=stage.name, purpose=stage.purpose, title=f"{model.packing.shape}, {len(model.packing)} beads",
         loads_note=stage.loads_note, granular=granular_block(model, SI), integrator=integrator(model),
         walls=stage.walls, loads=stage.loads, damping_time=repr(stage.damping_s),
         gamma=repr(float(masses.mean()) / stage.damping_s), max_step=repr(stage.max_step_m),

@@ -77,7 +77,7 @@ def wall_geometry(model: GranularModel):
     member: n the inward normal at the bead's rest position (its position at t = 0), curvature 1/ρ
     with ρ the distance from there to a curved wall's centre (0 for a plane), R_eff the Hertz
     contact radius."""
-    lattice, walls = model.lattice, model.walls
+    lattice, walls = model.packing, model.walls
     positions, radii = model.initial_positions_m()[:len(lattice)], lattice.radii_m
     beads, normals = wall_normals(walls, positions)
     gaps = np.concatenate([np.zeros(0)] + [wall.gaps_m(positions[wall.members], radii[wall.members]) for wall in walls])

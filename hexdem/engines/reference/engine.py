@@ -178,7 +178,7 @@ class ReferenceEngine:
                   "units": units.name, "wall_time_s": time.perf_counter() - begin, "n_pairs": n_pairs,
                   "n_list_builds": system.pairs.builds, "skin": system.pairs.skin,
                   "n_wall_contacts": system.n_wall_contacts}
-        write_json(directory / PARAMETERS_NAME, {**engine, "model": model.lattice.shape, "n_bodies": model.n_bodies,
+        write_json(directory / PARAMETERS_NAME, {**engine, "model": model.packing.shape, "n_bodies": model.n_bodies,
                                                  "time_step": dt, "n_steps": settings.n_steps,
                                                  "dump_every": settings.dump_every,
                                                  "unit_scales_si": {"length_m": units.length_m,

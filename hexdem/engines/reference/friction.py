@@ -49,7 +49,7 @@ def _wall_fields(model: GranularModel, units: UnitSystem) -> dict:
     return dict(wall_cell=beads.astype(np.int64), wall_nx=normals[:, 0].copy(), wall_ny=normals[:, 1].copy(),
                 wall_gap=gaps / units.length_m, wall_curvature=curvature * units.length_m, wall_stiffness=stiffness,
                 wall_damping=damping, wall_tangential=coefficient(table("tangential_stiffness_pa"), r_eff, units),
-                wall_mu=table("friction"), wall_radius=model.lattice.radii_m[beads] / units.length_m)
+                wall_mu=table("friction"), wall_radius=model.packing.radii_m[beads] / units.length_m)
 
 
 @dataclass
