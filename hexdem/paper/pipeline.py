@@ -69,7 +69,8 @@ def _snapshots(settings: PaperSettings, out: Path, shape: str) -> dict:
 
     long_edge, short_edge = settings.half_hexagon
     half = shape == "half-hexagon"
-    config = RunConfig(shape=shape, long_edge=long_edge, short_edge=short_edge, impact="striker", v0=0.4,
+    edges = {"long_edge": long_edge, "short_edge": short_edge} if half else {}  # (a hexagon refuses them)
+    config = RunConfig(shape=shape, **edges, impact="striker", v0=0.4,
                        ranks=settings.workers if half else 1, launcher=settings.launcher,
                        steps_per_contact=settings.steps_per_contact)
     times_ms = QUICK_FIG4_TIMES_MS if half and settings.quick else DEFAULT_TIMES_MS[shape]
