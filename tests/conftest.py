@@ -57,11 +57,15 @@ def launcher(tmp_path_factory):
 @pytest.fixture(scope="session")
 def paper_quick(tmp_path_factory, launcher):
     """``hexdem paper --quick --launcher`` once per session (about two minutes): its output
-    directory (every MPI job it started is in the launcher's log)."""
+    directory. Every MPI job it started is in the launcher's log, which the session's other tests
+    share: the paper's own jobs are also kept beside the output, in ``launched.log``."""
     from hexdem.cli.main import main
 
     out = tmp_path_factory.mktemp("paper") / "out"
+    log = launcher[1]
+    before = len(log.read_text().splitlines()) if log.exists() else 0
     assert main(["paper", "--out", str(out), "--quick", "--launcher", launcher[0]]) == 0
+    (out.parent / "launched.log").write_text("".join(f"{job}\n" for job in log.read_text().splitlines()[before:]))
     return out
 
 

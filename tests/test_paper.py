@@ -107,11 +107,11 @@ def test_a_rerun_resumes_without_recomputing(quick, capsys):
     assert {p.name: p.stat().st_mtime_ns for p in sorted((quick / "parts").glob("*.json"))} == before
 
 
-def test_every_mpi_job_of_the_paper_went_through_the_launcher(quick, launcher):
+def test_every_mpi_job_of_the_paper_went_through_the_launcher(quick):
     """Fig. 3 on 1 rank and Fig. 4 on 2, each run of the V0 sweep, each of the ensembles'
-    preparation decks and impacts on one rank (the launcher's log also holds the jobs of
-    test_launcher.py)."""
-    jobs = launcher[1].read_text().splitlines()
+    preparation decks and impacts on one rank: the jobs the paper's run started (the session's
+    launcher log also holds other tests' jobs)."""
+    jobs = (quick.parent / "launched.log").read_text().splitlines()
     for folder, ranks in (("fig3", 1), ("fig4", 2)):
         assert [job.split()[:2] for job in jobs if f"{quick}/{folder}/" in job] == [["-n", str(ranks)]], folder
     impacts = [job for job in jobs if f"{quick}/disorder/sigma6tol/" in job and "/v0." in job]
