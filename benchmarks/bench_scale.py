@@ -1,6 +1,7 @@
 """hexdem at scale: a large run stage by stage, each MPI rank's peak memory and the analysis's collectives.
 
-Usage: python benchmarks/bench_scale.py [--edges 100,200] [--ranks 1,2,4,8] [--duration 1e-4] [--before REV] [--quick]
+Usage: python benchmarks/bench_scale.py [--edges 100,200] [--ranks 1,2,4,8] [--duration 1e-4] [--before REV]
+[--repeat K] [--quick]
 
 For a hexagon of each of ``--edges`` beads per edge (100: 29,701 beads; 200: 119,401; 578:
 1,000,519), run ``--duration`` seconds (default 1e-4) on each of ``--ranks`` rank counts (more ranks
@@ -34,7 +35,8 @@ share of the loop <= :data:`SHARE_TARGET` at 29,701 and 119,401 beads on 1 and 2
 :data:`MANY_RANKS_SHARE_TARGET` from :data:`MANY_RANKS` ranks on (a machine of that many cores); end
 to end <= :data:`END_TO_END_FACTOR` × the bare loop + :data:`END_TO_END_OFFSET_S` at 29,701 beads on 2
 ranks; a million beads' result files and figures <= :data:`MILLION_RESULTS_S`.
-``--quick``: hexagons of 5 and 7 per edge for 0.2 ms on 1 and 2 ranks (the same code path, seconds).
+``--repeat K``: each row's times are the medians of K rounds (hexdem, before, bare; one machine's
+load varies by 10 to 50 % between runs a minute apart). ``--quick``: hexagons of 5 and 7 per edge for 0.2 ms on 1 and 2 ranks (the same code path, seconds).
 """
 
 from __future__ import annotations
@@ -127,9 +129,11 @@ def results_span_s(out: Path) -> float:
     return max(stamps) - (out / "peaks.csv").stat().st_mtime
 
 
-def measure(config: RunConfig, ranks: int, work: Path, before: Path | None = None) -> dict:
+def measure(config: RunConfig, ranks: int, work: Path, before: Path | None = None, repeat: int = 1) -> dict:
     """One row: the stages, each process's peak memory and the collectives of ``config`` on ``ranks``;
-    with ``before`` (an earlier version's package tree), that version's loop and end to end too."""
+    with ``before`` (an earlier version's package tree), that version's loop and end to end too. The
+    times are medians of ``repeat`` rounds, each round hexdem, then the earlier version, then the
+    bare loop (so that a slow spell of the machine falls on all three alike)."""
     config = config.replace(ranks=ranks)
     tag = f"{config.edge_beads}-{ranks}"
     start = time.perf_counter()
@@ -140,28 +144,38 @@ def measure(config: RunConfig, ranks: int, work: Path, before: Path | None = Non
     written = time.perf_counter()
     out = work / f"hexdem-{tag}"
     config_file = write_config(config, work / f"{tag}.toml")
-    watched = run_watched(hexdem_command("run", "--config", str(config_file), "--out", str(out), "--ranks", str(ranks)),
-                          cwd=work).check(f"hexdem run ({tag})")
-    summary = json.loads((out / "summary.json").read_text())
-    log = out / "deck" / "log.lammps"
+    rounds: dict[str, list[float]] = {}
+    for _ in range(repeat):
+        watched = run_watched(hexdem_command("run", "--config", str(config_file), "--out", str(out), "--ranks",
+                                             str(ranks)), cwd=work).check(f"hexdem run ({tag})")
+        summary = json.loads((out / "summary.json").read_text())
+        log = out / "deck" / "log.lammps"
+        times = {"hexdem loop": loop_time_s(log), "run": summary["wall_time_s"], "results": results_span_s(out),
+                 "wall": watched.wall_s}
+        if before is not None:
+            earlier = work / f"before-{tag}"
+            times["before wall"] = run_watched(hexdem_command("run", "--config", str(config_file), "--out",
+                                                              str(earlier), "--ranks", str(ranks)), cwd=work,
+                                               env=hexdem_env(before)).check(f"hexdem run before ({tag})").wall_s
+            times["before loop"] = loop_time_s(earlier / "deck" / "log.lammps")
+            shutil.rmtree(earlier)
+        run_bare(deck, ranks, NOOUTPUT_NAME)
+        times["bare loop"] = loop_time_s(deck.log_path)
+        for name, seconds in times.items():
+            rounds.setdefault(name, []).append(seconds)
+        print(f"  {model.n_bodies} beads on {ranks} rank(s), round {len(rounds['wall'])}: "
+              + ", ".join(f"{name} {seconds:.2f} s" for name, seconds in times.items()), flush=True)
+        if len(rounds["wall"]) < repeat:
+            shutil.rmtree(out)
     rank_peaks = sorted((rss for pid, (name, rss) in watched.peaks.items()
                          if name.startswith("python") and (pid != watched.pid or ranks == 1)), reverse=True)
     row = {"beads": model.n_bodies, "steps": settings.n_steps, "model": built - start, "data file": written - built,
-           "hexdem loop": loop_time_s(log), "run": summary["wall_time_s"], "results": results_span_s(out),
-           "wall": watched.wall_s, "largest": watched.peak_per_process, "ranks rss": rank_peaks,
+           **{name: float(np.median(seconds)) for name, seconds in rounds.items()},
+           "largest": watched.peak_per_process, "ranks rss": rank_peaks,
            "cli rss": watched.peaks.get(watched.pid, ("", 0))[1], "collectives": summary["collectives"],
            "rebuilds": neighbour_builds(log), "audited": audited_samples(out / "energy_regions.csv"),
            "tables": {name: read_table(out / name) for name in TABLES}}
     shutil.rmtree(out)
-    if before is not None:
-        earlier = work / f"before-{tag}"
-        row["before wall"] = run_watched(hexdem_command("run", "--config", str(config_file), "--out", str(earlier),
-                                                        "--ranks", str(ranks)), cwd=work, env=hexdem_env(before)
-                                         ).check(f"hexdem run before ({tag})").wall_s
-        row["before loop"] = loop_time_s(earlier / "deck" / "log.lammps")
-        shutil.rmtree(earlier)
-    run_bare(deck, ranks, NOOUTPUT_NAME)
-    row["bare loop"] = loop_time_s(deck.log_path)
     shutil.rmtree(deck.directory)
     return row
 
@@ -172,10 +186,12 @@ def main() -> None:
     parser.add_argument("--ranks", type=parse_list, default=[1, 2, 4, 8], help="rank counts (default 1,2,4,8)")
     parser.add_argument("--duration", type=float, default=1e-4, help="simulated time [s] (default 1e-4)")
     parser.add_argument("--before", help="also time hexdem of this revision (or unpacked package tree) side by side")
+    parser.add_argument("--repeat", type=int, default=1, help="rounds per row; its times are their medians (default 1)")
     parser.add_argument("--quick", action="store_true", help="5- and 7-per-edge hexagons for 0.2 ms on 1 and 2 ranks")
     args = parser.parse_args()
     edges, ranks, duration = ([5, 7], [1, 2], 2e-4) if args.quick else (args.edges, args.ranks, args.duration)
-    print(f"machine: {describe()}; load average {os.getloadavg()[0]:.2f}", flush=True)
+    print(f"machine: {describe()}; load average {os.getloadavg()[0]:.2f}; times: medians of {args.repeat} round(s)",
+          flush=True)
     work = Path(tempfile.mkdtemp(prefix="hexdem-bench-scale-"))
     results = {}
     try:
@@ -187,7 +203,7 @@ def main() -> None:
         for edge in edges:
             for n in ranks:
                 results[edge, n] = r = measure(RunConfig(shape="hexagon", edge_beads=edge, duration=duration), n, work,
-                                               before)
+                                               before, args.repeat)
                 print(f"  measured {r['beads']} beads on {n} rank(s): end to end {r['wall']:.1f} s, "
                       f"largest process {r['largest'] / MB:.0f} MB", flush=True)
     finally:

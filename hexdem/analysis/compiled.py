@@ -9,7 +9,7 @@ indexes arrays of beads and pairs, which at 29,701 beads cost about 300 ns per b
 the tracker and 480 ns per bead per audited sample for the audit, where one compiled pass over a
 bead's few numbers takes a few nanoseconds. Loading numba and these kernels (cached on disk,
 ``cache=True``) costs about half a second, more than the whole analysis of a small run, so the
-analysis uses them only for ranks that hold at least :data:`~hexdem.analysis.tracker.COMPILED_BEADS`
+analysis uses them only for ranks that hold at least :data:`~hexdem.common.compiled.COMPILED_BEADS`
 beads.
 
 Compiled without fast-math, so that each operation is IEEE-exact, as NumPy's.
@@ -20,12 +20,35 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import float64, int64, njit
 
-_jit = njit(cache=True, error_model="numpy")
+#: The argument types of the kernels: C-ordered float64 and int64 arrays of one and two axes.
+F1, F2, I1, I2 = float64[::1], float64[:, ::1], int64[::1], int64[:, ::1]
 
 
-@_jit
+def _jit(*argument_types):
+    """Compiled as the module docstring says, for ``argument_types``: declared, each kernel's machine
+    code loads from numba's disk cache as this module loads (in the background, see
+    :func:`~hexdem.common.compiled.load_in_background`), not at the run's first sample, where loading
+    the tracker's first two kernels took 0.6 s of each rank (29,701 beads on 2 ranks, under cProfile).
+    Arguments of other types still work: numba compiles for them at their first call."""
+    return njit([argument_types], cache=True, error_model="numpy")
+
+
+@njit(cache=True, error_model="numpy")
+def open_window(window, index, after, ring, b, v, s):
+    """Row ``b``'s window centred on its sample ``s`` of speed ``v``
+    (:func:`~hexdem.analysis.tracker_kernel._open`)."""
+    for j in range(3):
+        window[b, j] = ring[b, (s - 3 + j) % 3] if s - 3 + j >= 0 else np.nan
+    window[b, 3] = v
+    for j in range(4, 7):
+        window[b, j] = np.nan
+    index[b] = s
+    after[b] = 0
+
+
+@_jit(F1, int64, float64, float64, F2, F1, I1, F2, I1, I1, I1, I2, F2, F2, F2, I2, F2, F2, F2, F2, I1, I1)
 def update_pulses(speeds, s, q, rival_ratio, ring, peak, peak_index, window, after, start, length, rec_index, rec_value,
                   rec_prev, rec_prev2, first_index, first_value, first_prev, first_prev2, rival, rival_index,
                   rival_after):
@@ -96,20 +119,7 @@ def update_pulses(speeds, s, q, rival_ratio, ring, peak, peak_index, window, aft
     return complete[:count]
 
 
-@_jit
-def open_window(window, index, after, ring, b, v, s):
-    """Row ``b``'s window centred on its sample ``s`` of speed ``v``
-    (:func:`~hexdem.analysis.tracker_kernel._open`)."""
-    for j in range(3):
-        window[b, j] = ring[b, (s - 3 + j) % 3] if s - 3 + j >= 0 else np.nan
-    window[b, 3] = v
-    for j in range(4, 7):
-        window[b, j] = np.nan
-    index[b] = s
-    after[b] = 0
-
-
-@_jit
+@_jit(F2, I1, I1, F1, F1, I1, I1, int64)
 def pair_contact_energies(positions, i, j, contact_m, coefficient, region_i, region_j, n_regions):
     r"""(R,) Hertz energy [J] of the touching candidate pairs ``i``, ``j`` (rows of ``positions``):
     :math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}\, δ^{5/2}` each, δ = ``contact_m`` (the pair's sum of radii) less
@@ -136,7 +146,7 @@ def pair_contact_energies(positions, i, j, contact_m, coefficient, region_i, reg
     return contact
 
 
-@_jit
+@_jit(F2, F2, F1, F1, F1, I1, F2, F2, int64)
 def body_energies(positions, velocities, spins, masses, inertia, regions, start, external, n_regions):
     """The audited bodies' own terms of :meth:`~hexdem.analysis.energy.EnergyAudit.part`, one pass
     over their rows: ``positions``, ``velocities``, ``spins`` (ω_z, empty for spheres that do not
@@ -157,7 +167,7 @@ def body_energies(positions, velocities, spins, masses, inertia, regions, start,
     return translational, rotational, kinetic, work
 
 
-@_jit
+@_jit(F2, F2, float64)
 def moved_beyond(positions, listed_at, distance) -> bool:
     """Whether a row of ``positions`` lies more than ``distance`` from the same row of ``listed_at``."""
     limit = distance * distance
@@ -169,7 +179,7 @@ def moved_beyond(positions, listed_at, distance) -> bool:
     return False
 
 
-@_jit
+@_jit(F2, I1, F1, F2)
 def bead_speeds(velocities, rows, speeds, end_velocity):
     """The speeds ``|v|`` of the sample's rows ``rows`` into ``speeds``, and their velocities into ``end_velocity``
     (``np.hypot``'s arithmetic, C's hypot)."""

@@ -36,8 +36,6 @@ snapshot fields each rank took, onto rank 0 in one collective; rank 0 alone retu
 
 from __future__ import annotations
 
-import importlib
-import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -45,6 +43,7 @@ import numpy as np
 from hexdem.analysis.energy import EnergyAudit, energy_error, energy_regions, energy_scale_j
 from hexdem.analysis.peaks import noise_floor, refine_peak, refine_peaks
 from hexdem.analysis.tracker_kernel import RIVAL_RATIO, PulseState
+from hexdem.common.compiled import load_in_background, runs_compiled
 from hexdem.engines.sampling import Sample
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel, RunSettings
@@ -56,13 +55,6 @@ ENERGY_SAMPLES = 100
 #: a striker, a precompressed packing, a half-hexagon and a slow 30° strike (16 slots differ on the
 #: precompressed one, whose long precursor climbs in many small steps).
 RECORD_CAPACITY = 32
-#: From this many beads per rank on, the tracker and its energy audit take their samples through
-#: compiled kernels (:mod:`hexdem.analysis.compiled`, loaded while the engine starts); below, through
-#: NumPy. The default run (331 beads) stays below: its whole analysis costs less than numba's
-#: start-up (about 0.5 s). A rank of 1,856 beads (29,701 on 16 ranks) is above: its NumPy
-#: analysis pays the fixed cost of some 50 array operations at every sample. The two give the same
-#: results.
-COMPILED_BEADS = 1000
 
 
 @dataclass(frozen=True)
@@ -146,9 +138,9 @@ class PulseTracker:
         self.field_samples = np.asarray(sorted(field_samples), dtype=np.int64)
         self.field_parts = []
         self.energy_every = max(1, (total - 1) // ENERGY_SAMPLES)
-        self.compiled = -(-self.n_beads // (1 if comm is None else comm.Get_size())) >= COMPILED_BEADS
-        if self.compiled:  # numba loads while the engine starts (LAMMPS's set-up leaves Python free)
-            threading.Thread(target=importlib.import_module, args=("hexdem.analysis.compiled",), daemon=True).start()
+        self.compiled = runs_compiled(self.n_beads, 1 if comm is None else comm.Get_size())
+        if self.compiled:
+            load_in_background("hexdem.analysis.compiled")
         self.audit = EnergyAudit(model, gravity_m_s2, self.compiled)
         self.energies, self.energy_times, self.impact_energy, self.region_energies = [], [], None, []
         self.rotational_energies = []

@@ -32,7 +32,9 @@ from pathlib import Path
 
 import numpy as np
 
+from hexdem.common.compiled import load_in_background, runs_compiled
 from hexdem.common.job_failure import abort_job
+from hexdem.common.memory import keep_freed_memory
 from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.deck import Deck
 from hexdem.engines.lammps.library import load_lammps
@@ -76,6 +78,9 @@ class _Stream:
         self.bar = progress_bar(deck.settings.n_steps, "LAMMPS", unit="step") if show_progress else None
         self.error: BaseException | None = None
         self.builds = None  # neighbour list builds at the previous sample (None: it came before this run)
+        self.compiled = runs_compiled(deck.n_atoms, 1 if comm is None else comm.Get_size())
+        if self.compiled:
+            load_in_background("hexdem.engines.lammps.full_step")
 
     def per_atom(self, name: str, n: int, columns: int = 3) -> np.ndarray:
         """A view of per-atom property ``name`` of the first ``n`` local atoms, (n, columns) or (n,)
@@ -128,8 +133,15 @@ class _Stream:
             return
         try:  # (``tag`` and ``x``: the ids and positions of the local atoms, handed over by LAMMPS)
             force, mass = self.forces_and_masses(nlocal)
-            velocities = self.per_atom("v", nlocal)[:, :2] + (0.5 * self.dt / mass)[:, None] * force
-            ids, positions = tag.astype(np.int64), x[:, :2].copy()
+            if self.compiled:
+                from hexdem.engines.lammps.full_step import full_step_state  # numba: only for large ranks
+
+                positions, velocities = full_step_state(x, self.per_atom("v", nlocal), self.per_atom("f", nlocal),
+                                                        mass, 0.5 * self.dt)
+            else:
+                velocities = self.per_atom("v", nlocal)[:, :2] + (0.5 * self.dt / mass)[:, None] * force
+                positions = x[:, :2].copy()
+            ids = tag.astype(np.int64)
             sensed = self.sensor_every and step % self.sensor_every == 0
             accelerations = force / mass[:, None] if sensed else None
             builds = self.lmp.get_thermo("nbuild")
@@ -175,6 +187,7 @@ def run_streaming(deck: Deck, on_sample, comm=None, dump: bool = False, show_pro
     ranks = 1 if comm is None else comm.Get_size()
     root = comm is None or comm.Get_rank() == 0
     start = time.perf_counter()
+    keep_freed_memory()
     with working_directory(deck.directory):
         lmp = start_lammps(deck.directory, comm)
         stream = None
