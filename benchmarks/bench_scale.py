@@ -18,6 +18,9 @@ than cores is fine for memory and collective counts, not for times):
   (``summary.json``), the neighbour-list rebuilds (LAMMPS's log) and the audited samples;
 * **bare LAMMPS**: ``mpiexec -n N lmp -in in.nooutput`` of the same deck without its output
   section, the yardstick: the analysis's share of the loop is hexdem's loop / the bare loop − 1;
+* **the callbacks by LAMMPS's own timer**: the slowest rank's "Modify" time (the fixes, ``fix
+  external``'s call into hexdem among them) less the bare deck's, and its share of the rest of
+  hexdem's loop: the same share measured inside one run, free of the loop's spread between runs;
 * **peak RSS per process** (:func:`harness.run_watched`): the ``hexdem run`` process (which
   also writes the results and figures) and each MPI rank, read from ``/proc``;
 * **the same results on every rank count**: ``peaks.csv`` and ``beads.csv`` of each rank count
@@ -89,6 +92,12 @@ def neighbour_builds(log: Path) -> int:
     return sum(int(n) for n in re.findall(r"Neighbor list builds = (\d+)", log.read_text()))
 
 
+def modify_time_s(log: Path) -> float:
+    """The slowest rank's "Modify" time [s] over the runs of a LAMMPS log (its timing breakdown: the
+    fixes' time, hexdem's sampling callback included, as ``fix external`` calls it in ``post_force``)."""
+    return sum(float(t) for t in re.findall(r"^Modify\s*\|\s*\S+\s*\|\s*\S+\s*\|\s*(\S+)", log.read_text(), re.M))
+
+
 def audited_samples(table: Path) -> int:
     """The samples the energy audit measured: the distinct times of ``energy_regions.csv``."""
     with open(table, newline="") as fh:
@@ -150,8 +159,8 @@ def measure(config: RunConfig, ranks: int, work: Path, before: Path | None = Non
                                              str(ranks)), cwd=work).check(f"hexdem run ({tag})")
         summary = json.loads((out / "summary.json").read_text())
         log = out / "deck" / "log.lammps"
-        times = {"hexdem loop": loop_time_s(log), "run": summary["wall_time_s"], "results": results_span_s(out),
-                 "wall": watched.wall_s}
+        times = {"hexdem loop": loop_time_s(log), "hexdem modify": modify_time_s(log), "run": summary["wall_time_s"],
+                 "results": results_span_s(out), "wall": watched.wall_s}
         if before is not None:
             earlier = work / f"before-{tag}"
             times["before wall"] = run_watched(hexdem_command("run", "--config", str(config_file), "--out",
@@ -160,7 +169,7 @@ def measure(config: RunConfig, ranks: int, work: Path, before: Path | None = Non
             times["before loop"] = loop_time_s(earlier / "deck" / "log.lammps")
             shutil.rmtree(earlier)
         run_bare(deck, ranks, NOOUTPUT_NAME)
-        times["bare loop"] = loop_time_s(deck.log_path)
+        times["bare loop"], times["bare modify"] = loop_time_s(deck.log_path), modify_time_s(deck.log_path)
         for name, seconds in times.items():
             rounds.setdefault(name, []).append(seconds)
         print(f"  {model.n_bodies} beads on {ranks} rank(s), round {len(rounds['wall'])}: "
@@ -217,6 +226,14 @@ def main() -> None:
               f"{r['run']:>8.2f} {r['results']:>11.2f} {r['wall']:>14.2f}")
     print("(analysis: hexdem's loop / bare loop - 1; run: summary.json's wall_time_s, to the result files; "
           "results: the result tables and figures)")
+    print("the sampling callbacks by LAMMPS's own timer (slowest rank's Modify: hexdem's less the bare deck's), "
+          "and their share of the rest of hexdem's loop")
+    print(f"{'beads':>9} {'ranks':>5} {'modify hexdem [s]':>17} {'modify bare [s]':>15} {'callbacks [s]':>13} "
+          f"{'callback share':>14}")
+    for (edge, n), r in results.items():
+        callbacks = r["hexdem modify"] - r["bare modify"]
+        print(f"{r['beads']:>9,} {n:>5} {r['hexdem modify']:>17.2f} {r['bare modify']:>15.2f} {callbacks:>13.2f} "
+              f"{callbacks / (r['hexdem loop'] - callbacks):>14.2f}")
     if args.before is not None:
         print(f"before ({args.before}) and now, side by side on the same deck and bare loop")
         print(f"{'beads':>9} {'ranks':>5} {'bare loop [s]':>13} {'loop before':>11} {'loop now':>8} "

@@ -29,7 +29,7 @@ F1, F2, I1, I2 = float64[::1], float64[:, ::1], int64[::1], int64[:, ::1]
 def _jit(*argument_types):
     """Compiled as the module docstring says, for ``argument_types``: declared, each kernel's machine
     code loads from numba's disk cache as this module loads (in the background, see
-    :func:`~hexdem.common.compiled.load_in_background`), not at the run's first sample, where loading
+    :func:`~hexdem.common.preload.load_in_background`), not at the run's first sample, where loading
     the tracker's first two kernels took 0.6 s of each rank (29,701 beads on 2 ranks, under cProfile).
     Arguments of other types still work: numba compiles for them at their first call."""
     return njit([argument_types], cache=True, error_model="numpy")

@@ -43,7 +43,8 @@ import numpy as np
 from hexdem.analysis.energy import EnergyAudit, energy_error, energy_regions, energy_scale_j
 from hexdem.analysis.peaks import noise_floor, refine_peak, refine_peaks
 from hexdem.analysis.tracker_kernel import RIVAL_RATIO, PulseState
-from hexdem.common.compiled import load_in_background, runs_compiled
+from hexdem.common.compiled import runs_compiled
+from hexdem.common.preload import load_in_background
 from hexdem.engines.sampling import Sample
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel, RunSettings
@@ -139,8 +140,8 @@ class PulseTracker:
         self.field_parts = []
         self.energy_every = max(1, (total - 1) // ENERGY_SAMPLES)
         self.compiled = runs_compiled(self.n_beads, 1 if comm is None else comm.Get_size())
-        if self.compiled:
-            load_in_background("hexdem.analysis.compiled")
+        # what the first sample needs loads while the engine starts: the kernels, the audit's pair search
+        load_in_background(*(["hexdem.analysis.compiled"] if self.compiled else []), "scipy.spatial")
         self.audit = EnergyAudit(model, gravity_m_s2, self.compiled)
         self.energies, self.energy_times, self.impact_energy, self.region_energies = [], [], None, []
         self.rotational_energies = []

@@ -5,13 +5,10 @@ The kernels themselves (:mod:`hexdem.analysis.compiled` for the tracker and its 
 :mod:`hexdem.engines.lammps.full_step` for the samples LAMMPS hands over) import numba, which with
 their on-disk cache costs about half a second to load: more than the whole analysis of a small
 run. So a run decides once, from its bodies per rank, and a run that uses them loads them in the
-background while the engine starts (LAMMPS's set-up leaves Python free).
+background while the engine starts (:func:`~hexdem.common.preload.load_in_background`).
 """
 
 from __future__ import annotations
-
-import importlib
-import threading
 
 #: From this many bodies per rank on, the samples and their analysis go through compiled kernels;
 #: below, through NumPy. The default run (331 beads) stays below; a rank of 1,856 beads (29,701 on
@@ -25,7 +22,3 @@ def runs_compiled(n_bodies: int, ranks: int = 1) -> bool:
     largest rank share, ⌈n_bodies / ranks⌉, holds at least :data:`COMPILED_BEADS`."""
     return -(-n_bodies // ranks) >= COMPILED_BEADS
 
-
-def load_in_background(module: str) -> None:
-    """Import ``module`` (a kernels' module) in a daemon thread: its first use then finds it loaded."""
-    threading.Thread(target=importlib.import_module, args=(module,), daemon=True).start()

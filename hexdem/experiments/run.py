@@ -33,6 +33,7 @@ from hexdem.analysis.impact import PEAK_COLUMNS, ImpactAnalysis
 from hexdem.analysis.movie import movie_samples
 from hexdem.common.io import staged_directory, write_csv, write_csv_columns, write_json
 from hexdem.common.machine import free_disk_bytes
+from hexdem.common.preload import load_in_background
 from hexdem.errors import HexdemError, RunFailed
 from hexdem.experiments.deck_config import write_deck_config
 from hexdem.experiments.provenance import run_provenance
@@ -259,6 +260,7 @@ def measure_front_shape(analysis: ImpactAnalysis, count: int = 8, geometric: boo
 def run_experiment(config: RunConfig, out, log=None) -> ImpactAnalysis:
     """Run ``config`` and publish its result files in ``out`` (see module docstring)."""
     log = log or (lambda message: print(f"hexdem: {message}", file=sys.stderr))
+    load_in_background("hexdem.analysis.figures", "scipy.spatial")  # the results' figures, while the run goes
     with staged_directory(out, STAGING_PREFIX) as staging:
         try:
             start, provenance = time.perf_counter(), run_provenance()

@@ -32,9 +32,10 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.common.compiled import load_in_background, runs_compiled
+from hexdem.common.compiled import runs_compiled
 from hexdem.common.job_failure import abort_job
 from hexdem.common.memory import keep_freed_memory
+from hexdem.common.preload import load_in_background
 from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.deck import Deck
 from hexdem.engines.lammps.library import load_lammps
