@@ -13,7 +13,10 @@ creeping by round-off (1e-17 m/s a sample, as LAMMPS leaves them), positions on 
 * **NumPy**: today's NumPy path (ranks below :data:`~hexdem.common.compiled.COMPILED_BEADS`);
 * **compiled**: today's compiled kernels (:mod:`hexdem.analysis.compiled`), after a warm-up.
 
-Per part, in ns per bead per sample: the **tracker** (the observer less its audit), the
+Per part, in ns per bead per sample: the **samples** (the driver's full-step positions and
+velocities from LAMMPS's (n, 3) arrays, :func:`~hexdem.engines.lammps.driver.full_step`; before,
+freed memory went back to the system, now a run keeps it, :mod:`hexdem.common.memory`), the
+**tracker** (the observer less its audit), the
 **audit** (per audited sample, :data:`~hexdem.analysis.tracker.ENERGY_SAMPLES` of them), the
 **gathering** (:meth:`~hexdem.analysis.tracker.PulseTracker.finish`: each bead's results, per bead),
 and the **result files** (tables and figures, :func:`~hexdem.experiments.run.write_results`, in s).
@@ -35,6 +38,8 @@ from machine import describe
 import hexdem.common.compiled as compiled_module
 from hexdem.analysis.impact import ImpactAnalysis
 from hexdem.analysis.tracker import PulseTracker
+from hexdem.common.memory import keep_freed_memory
+from hexdem.engines.lammps.driver import full_step
 from hexdem.engines.sampling import Sample
 from hexdem.experiments.run import write_results
 from hexdem.model.config import RunConfig
@@ -91,10 +96,17 @@ def measure(model, settings, way: str, samples, out: Path) -> dict:
     positions, velocities = samples
     ids = np.arange(1, model.n_bodies + 1)
     order = np.argsort(positions[:, 0] // (10 * model.packing.diameter_m) * 1e6 + positions[:, 1])  # LAMMPS's bins
-    observed = 0.0
+    atoms = {name: np.zeros((model.n_bodies, 3)) for name in ("x", "v", "f")}  # LAMMPS's per-atom arrays
+    atoms["x"][:, :2], masses = positions[order], model.masses_kg[order]
+    observed = taken = 0.0
     for s in range(settings.n_samples):
+        atoms["v"][:, :2] = velocities(s)[order]
+        start = time.perf_counter()
+        positions_now, velocities_now = full_step(atoms["x"], atoms["v"], atoms["f"], masses, settings.dt_s,
+                                                  way == "compiled")
+        taken += time.perf_counter() - start
         sample = Sample(s, s * settings.dump_every, s * settings.dt_s * settings.dump_every, ids[order],
-                        positions[order], velocities(s)[order], migrated=s == 0)
+                        positions_now, velocities_now, migrated=s == 0)
         start = time.perf_counter()
         tracker(sample)
         observed += time.perf_counter() - start
@@ -106,7 +118,8 @@ def measure(model, settings, way: str, samples, out: Path) -> dict:
     write_results(RunConfig(), analysis, out, 0.0, {}, lambda message: None)
     written = time.perf_counter() - start
     n, samples_count = len(model.packing), settings.n_samples
-    return {"tracker": (observed - audit.seconds) / (n * samples_count) * 1e9,
+    return {"samples": taken / (n * samples_count) * 1e9,
+            "tracker": (observed - audit.seconds) / (n * samples_count) * 1e9,
             "audit": audit.seconds / (n * audit.calls) * 1e9, "gathering": gathered / n * 1e9,
             "result files": written, "peaks": tracked.peak_speed, "energies": tracked.region_energies}
 
@@ -127,7 +140,11 @@ def main() -> None:
                                contact_time_s=20 * interval_s)
         samples = synthetic_samples(model, n_samples, interval_s)
         measure(model, settings, "compiled", samples, Path(tempfile.mkdtemp()))  # warm-up: numba, imports, caches
-        results = {way: measure(model, settings, way, samples, Path(tempfile.mkdtemp())) for way in WAYS}
+        results = {}
+        for way in WAYS:  # before: freed memory returned to the system, as it was; now it is kept, as runs do
+            if way != "before":
+                keep_freed_memory()
+            results[way] = measure(model, settings, way, samples, Path(tempfile.mkdtemp()))
         now, compiled = results["NumPy"], results["compiled"]
         np.testing.assert_array_equal(compiled["peaks"], now["peaks"])
         np.testing.assert_allclose(compiled["energies"], now["energies"], rtol=1e-12)
@@ -137,7 +154,7 @@ def main() -> None:
           "(audit: per audited sample; gathering: per bead, once), result files [s]")
     print(f"{'beads':>9} {'part':>12} " + " ".join(f"{way:>10}" for way in WAYS) + f" {'before / compiled':>17}")
     for beads, results in rows:
-        for part in ("tracker", "audit", "gathering", "result files"):
+        for part in ("samples", "tracker", "audit", "gathering", "result files"):
             values = [results[way][part] for way in WAYS]
             print(f"{beads:>9,} {part:>12} " + " ".join(f"{v:>10.3g}" for v in values)
                   + f" {values[0] / values[2]:>17.1f}")

@@ -39,7 +39,8 @@ share of the loop <= :data:`SHARE_TARGET` at 29,701 and 119,401 beads on 1 and 2
 to end <= :data:`END_TO_END_FACTOR` × the bare loop + :data:`END_TO_END_OFFSET_S` at 29,701 beads on 2
 ranks; a million beads' result files and figures <= :data:`MILLION_RESULTS_S`.
 ``--repeat K``: each row's times are the medians of K rounds (hexdem, before, bare; one machine's
-load varies by 10 to 50 % between runs a minute apart). ``--quick``: hexagons of 5 and 7 per edge for 0.2 ms on 1 and 2 ranks (the same code path, seconds).
+load varies by 10 to 50 % between runs a minute apart). ``--quick``: hexagons of 5 and 7 per edge
+for 0.2 ms on 1 and 2 ranks (the same code path, seconds).
 """
 
 from __future__ import annotations

@@ -18,7 +18,7 @@ sys.path.insert(0, str(BENCHMARKS))
 from baseline import BEFORE  # noqa: E402  (the revision the benchmarks compare with)
 #: Words each benchmark's printed table must contain (headers, row names, the target line).
 EXPECTED = {
-    "bench_analysis.py": ("beads", "part", "before", "NumPy", "compiled", "before / compiled", "tracker", "audit",
+    "bench_analysis.py": ("beads", "part", "before", "NumPy", "compiled", "before / compiled", "samples", "tracker", "audit",
                           "gathering", "result files"),
     "bench_accuracy.py": ("case", "engine", "steps/τ", "peak error", "arrival [µs]", "energy drift", "order",
                           "wall [s]", "lammps", "reference", "target at 140 steps per contact"),

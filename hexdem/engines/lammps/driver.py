@@ -68,6 +68,17 @@ def split_deck(text: str) -> tuple[str, str]:
     return setup, "\n".join(commands) + "\n"
 
 
+def full_step(positions, velocities, forces, masses, dt: float, compiled: bool = False):
+    """((n, 2) positions, (n, 2) full-step velocities v + (dt/2) f/m) of LAMMPS's (n, 3) per-atom
+    ``positions``, half-step ``velocities`` and ``forces`` of the atoms of ``masses`` (n,): by NumPy,
+    or in one compiled pass (:func:`~hexdem.engines.lammps.full_step.full_step_state`, the same bits)."""
+    if compiled:
+        from hexdem.engines.lammps.full_step import full_step_state  # numba: only for large ranks
+
+        return full_step_state(positions, velocities, forces, masses, 0.5 * dt)
+    return positions[:, :2].copy(), velocities[:, :2] + (0.5 * dt / masses)[:, None] * forces[:, :2]
+
+
 class _Stream:
     """The ``fix external`` callback: full-step samples of the local atoms (with their spins ω_z
     when ``spins``), with progress."""
@@ -134,14 +145,8 @@ class _Stream:
             return
         try:  # (``tag`` and ``x``: the ids and positions of the local atoms, handed over by LAMMPS)
             force, mass = self.forces_and_masses(nlocal)
-            if self.compiled:
-                from hexdem.engines.lammps.full_step import full_step_state  # numba: only for large ranks
-
-                positions, velocities = full_step_state(x, self.per_atom("v", nlocal), self.per_atom("f", nlocal),
-                                                        mass, 0.5 * self.dt)
-            else:
-                velocities = self.per_atom("v", nlocal)[:, :2] + (0.5 * self.dt / mass)[:, None] * force
-                positions = x[:, :2].copy()
+            positions, velocities = full_step(x, self.per_atom("v", nlocal), self.per_atom("f", nlocal), mass,
+                                              self.dt, self.compiled)
             ids = tag.astype(np.int64)
             sensed = self.sensor_every and step % self.sensor_every == 0
             accelerations = force / mass[:, None] if sensed else None

@@ -2,11 +2,11 @@
 
 At the sampling callback a rank's velocities are at the half step; the sample holds the full
 step's, v(t) = v(t − dt/2) + (dt/2) f/m (see :mod:`hexdem.engines.lammps.driver`). NumPy takes
-them, with the positions' copy, in five passes over strided (n, 3) arrays: 1.9 ms a sample at
-29,701 beads, against 0.08 ms in one pass. The arithmetic is NumPy's, operation by operation
-(compiled without fast-math), so the two give the same bits. Its argument types are declared, so
-that its machine code loads with this module (in the background, as
-:mod:`hexdem.analysis.compiled`'s does).
+them, with the positions' copy, in five passes over strided (n, 3) arrays: 0.9 ms a sample at
+29,701 beads as it was, against 0.12 ms in one pass into kept memory (the "samples" part of
+``benchmarks/bench_analysis.py``). The arithmetic is NumPy's, operation by operation (compiled
+without fast-math), so the two give the same bits. Its argument types are declared, so that its
+machine code loads with this module (in the background, as :mod:`hexdem.analysis.compiled`'s does).
 """
 
 from __future__ import annotations
