@@ -12,7 +12,9 @@ when velocities are at the half step. It completes them exactly as ``fix nve``'s
 integration is about to, v(t) = v(t − dt/2) + (dt/2) f/m, with the total force (``fix
 external`` is defined after every other force fix, walls and gravity included). Measured on
 the default deck: bit-identical to reading the velocities between chunked ``run`` commands.
-A frictional model's spins are completed alike from the torques (``fix nve/sphere``).
+A frictional model's spins are completed alike from the torques (``fix nve/sphere``). The fix
+adds no force of its own: LAMMPS leaves its force array unset, so the fix adds it only at the
+set-up's step 0, whose call sets it to zero.
 
 On several ranks the same driver runs in every rank of ``comm`` (an ``mpi4py``
 communicator, under ``mpiexec``): each rank sees its own atoms, with the positions of its ghost
@@ -141,7 +143,10 @@ class _Stream:
                               self.angular_velocities(len(ids)), True, *self.ghosts(len(ids))))
 
     def __call__(self, caller, step, nlocal, tag, x, fexternal) -> None:
-        if step == 0 or self.error is not None:
+        if step == 0:  # the set-up's call: the one step that adds fexternal (see run_streaming), made zero
+            fexternal[:] = 0.0
+            return
+        if self.error is not None:
             return
         try:  # (``tag`` and ``x``: the ids and positions of the local atoms, handed over by LAMMPS)
             force, mass = self.forces_and_masses(nlocal)
@@ -201,7 +206,10 @@ def run_streaming(deck: Deck, on_sample, comm=None, dump: bool = False, show_pro
             _lammps(deck, lmp.commands_string, setup + (output if dump else ""))
             stream = _Stream(lmp, deck, on_sample, show_progress and root, comm, spins)
             stream.initial()
-            _lammps(deck, lmp.command, f"fix {STREAM_FIX} all external pf/callback {deck.settings.dump_every} 1")
+            # a callback every dump_every steps; its forces (none) are added only at step 0, whose call zeroes
+            # them: LAMMPS leaves the array unset, and adding it at every step cost a pass over the atoms
+            _lammps(deck, lmp.command, f"fix {STREAM_FIX} all external pf/callback {deck.settings.dump_every} "
+                                       f"{deck.settings.n_steps + 1}")
             lmp.set_fix_external_callback(STREAM_FIX, stream, None)
             _lammps(deck, lmp.command, f"run {deck.settings.n_steps}")
         finally:
