@@ -27,11 +27,12 @@ only when it rebuilds its neighbour lists, which a sample says:
 :attr:`~hexdem.engines.sampling.Sample.migrated`), the rows are laid out anew before the sample
 is taken: the beads a rank kept keep their rows, and each bead that left hands its row to its new
 owner in one collective (only those beads' rows travel). A sample at which nothing can have
-migrated takes no collective. The energy audit sums each rank's part
+migrated takes no collective, and neither does the energy audit: each rank keeps its part
 (:meth:`~hexdem.analysis.energy.EnergyAudit.part`: its own bodies, with its ghosts for the
-contacts that cross ranks) onto rank 0 in one small Reduce per audited sample. :meth:`finish`
-works out each bead's results on its owner and gathers them, with the traces, sensors and
-snapshot fields each rank took, onto rank 0 in one collective; rank 0 alone returns the results.
+contacts that cross ranks) of each audited sample (a Reduce per audited sample made every rank
+wait there for the slowest). :meth:`finish` works out each bead's results on its owner and
+gathers them, with the traces, sensors, snapshot fields and audit parts each rank took, onto rank
+0 in one collective, where the parts are summed; rank 0 alone returns the results.
 """
 
 from __future__ import annotations
@@ -40,7 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hexdem.analysis.energy import EnergyAudit, energy_error, energy_regions, energy_scale_j
+from hexdem.analysis.energy import EnergyAudit, energy_error, energy_scale_j
 from hexdem.analysis.peaks import noise_floor, refine_peak, refine_peaks
 from hexdem.analysis.tracker_kernel import RIVAL_RATIO, PulseState
 from hexdem.common.compiled import runs_compiled
@@ -143,8 +144,7 @@ class PulseTracker:
         # what the first sample needs loads while the engine starts: the kernels, the audit's pair search
         load_in_background(*(["hexdem.analysis.compiled"] if self.compiled else []), "scipy.spatial")
         self.audit = EnergyAudit(model, gravity_m_s2, self.compiled)
-        self.energies, self.energy_times, self.impact_energy, self.region_energies = [], [], None, []
-        self.rotational_energies = []
+        self.energy_times, self.audit_parts = [], []
         self.count = 0
         self.collectives = 0
 
@@ -260,29 +260,16 @@ class PulseTracker:
 
     def _audit(self, sample: Sample) -> None:
         """This rank's part of the energy audit (its bodies, with its ghosts' positions for the
-        contacts that cross to another rank), summed onto rank 0 in one small Reduce."""
+        contacts that cross to another rank), kept until :meth:`finish` sums the ranks' parts."""
         units = self.settings.units
         bodies, positions = sample.ids - 1, sample.positions
         if sample.ghost_ids is not None:
             bodies = np.concatenate([bodies, sample.ghost_ids - 1])
             positions = np.concatenate([positions, sample.ghost_positions])
         angular = None if sample.angular_velocities is None else sample.angular_velocities / units.time_s
-        part = self.audit.part(bodies, len(sample.ids), positions * units.length_m,
-                               sample.velocities * units.velocity_m_s, angular)
-        if self.comm is not None and self.comm.Get_size() > 1:
-            from mpi4py import MPI
-
-            whole = np.empty_like(part) if self.root else None
-            self._collective("Reduce", part, whole, op=MPI.SUM, root=0)
-            part = whole
-        if self.root:
-            energy, translational, rotational, by_region = part[0], part[1], part[2], part[3:]
-            if self.impact_energy is None:
-                self.impact_energy = translational + self._displacement_energy_j()
-            self.energies.append(float(energy))
-            self.region_energies.append(by_region.reshape(len(self.audit.region_names), 2))
-            self.rotational_energies.append(float(rotational))
-            self.energy_times.append(sample.time)
+        self.audit_parts.append(self.audit.part(bodies, len(sample.ids), positions * units.length_m,
+                                                sample.velocities * units.velocity_m_s, angular))
+        self.energy_times.append(sample.time)
 
     def _displacement_energy_j(self) -> float:
         """The contact energy [J] the initial state's displacements add to the packed state's:
@@ -326,9 +313,10 @@ class PulseTracker:
 
     def finish(self) -> TrackedPulses | None:
         """The results on rank 0 (None on the other ranks); see :class:`TrackedPulses`. Each rank
-        works out its own beads' results; rank 0 gathers them, with the traces, sensors and snapshot
-        fields each rank took, in one collective."""
-        mine = (self.ids, self._own_results(), self.traces, self.sensors, self.field_parts)
+        works out its own beads' results; rank 0 gathers them, with the traces, sensors, snapshot
+        fields and audit parts each rank took, in one collective, and sums the audit parts."""
+        audited = np.array(self.audit_parts).reshape(len(self.energy_times), -1)
+        mine = (self.ids, self._own_results(), self.traces, self.sensors, self.field_parts, audited)
         parts = self._collective("gather", mine, root=0) if self.several else [mine]
         if not self.root:
             return None
@@ -336,7 +324,9 @@ class PulseTracker:
         traces, sensors = self.traces, self.sensors
         fields = np.full((len(self.field_samples), self.n_beads), np.nan)
         rim_fields = np.full((len(self.field_samples) if self.model.laws.tangential else 0, self.n_beads), np.nan)
-        for ids, results, their_traces, their_sensors, their_fields in parts:
+        sums = np.zeros_like(audited)  # the ranks' audit parts, summed in rank order
+        for ids, results, their_traces, their_sensors, their_fields, their_audit in parts:
+            sums += their_audit
             beads[ids - 1] = results
             traces = np.where(np.isnan(traces), their_traces, traces)
             sensors = np.where(np.isnan(sensors), their_sensors, sensors)
@@ -345,13 +335,14 @@ class PulseTracker:
                 if rims is not None:
                     rim_fields[slot, field_ids - 1] = rims
         interval = self.settings.dump_every * self.settings.dt_s / self.settings.units.time_s
-        scale = energy_scale_j(self.energies, self.impact_energy)
+        energies, translational, rotational = sums[:, 0], sums[:, 1], sums[:, 2]
+        region_energies = sums[:, 3:].reshape(len(self.energy_times), len(self.audit.region_names), 2)
+        impact_energy = translational[0] + self._displacement_energy_j()
+        scale = energy_scale_j(energies, impact_energy)
         return TrackedPulses(peak_speed=beads[:, 0], t_peak=beads[:, 1], arrival_time=beads[:, 2], reach_time=beads[:, 3],
-                             energy_drift=energy_error(self.energies, self.impact_energy, self.model.dissipative),
-                             energy_lost=(self.energies[0] - self.energies[-1]) / scale,
-                             energy_times=np.array(self.energy_times),
-                             region_energies=np.array(self.region_energies).reshape(
-                                 len(self.energy_times), len(energy_regions(self.model)[0]), 2),
+                             energy_drift=energy_error(energies, impact_energy, self.model.dissipative),
+                             energy_lost=(energies[0] - energies[-1]) / scale,
+                             energy_times=np.array(self.energy_times), region_energies=region_energies,
                              n_samples=self.count, trace_beads=self.trace_beads,
                              trace_times=np.arange(self.count) * interval, trace_speeds=traces[:self.count],
                              field_times=self.field_samples * interval, field_speeds=fields,
@@ -359,7 +350,7 @@ class PulseTracker:
                              sensor_times=np.arange(len(sensors)) * self.sensor_every * self.settings.dt_s
                              / self.settings.units.time_s, sensor_states=sensors,
                              peak_angular_speed=beads[:, 5], end_velocity=beads[:, 6:8],
-                             rotational_energy_fraction=rotational_share(self.rotational_energies, self.region_energies),
+                             rotational_energy_fraction=rotational_share(rotational, region_energies),
                              collectives=self.collectives)
 
 
