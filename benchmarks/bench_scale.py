@@ -18,6 +18,9 @@ than cores is fine for memory and collective counts, not for times):
   (``summary.json``), the neighbour-list rebuilds (LAMMPS's log) and the audited samples;
 * **bare LAMMPS**: ``mpiexec -n N lmp -in in.nooutput`` of the same deck without its output
   section, the yardstick: the analysis's share of the loop is hexdem's loop / the bare loop − 1;
+* **the analysis part by part inside the run**: ``summary.json``'s ``analysis_cpu_s`` (each part's
+  CPU time, summed over the ranks) per bead, the tracker per sample, the audit per audited sample,
+  the gathering once: measured on any rank count, more ranks than cores included;
 * **the callbacks by LAMMPS's own timer**: the slowest rank's "Modify" time (the fixes, ``fix
   external``'s call into hexdem among them) less the bare deck's, and its share of the rest of
   hexdem's loop: the same share measured inside one run, free of the loop's spread between runs;
@@ -183,6 +186,7 @@ def measure(config: RunConfig, ranks: int, work: Path, before: Path | None = Non
            **{name: float(np.median(seconds)) for name, seconds in rounds.items()},
            "largest": watched.peak_per_process, "ranks rss": rank_peaks,
            "cli rss": watched.peaks.get(watched.pid, ("", 0))[1], "collectives": summary["collectives"],
+           "cpu": summary["analysis_cpu_s"], "samples": summary["n_samples"],
            "rebuilds": neighbour_builds(log), "audited": audited_samples(out / "energy_regions.csv"),
            "tables": {name: read_table(out / name) for name in TABLES}}
     shutil.rmtree(out)
@@ -235,6 +239,13 @@ def main() -> None:
         callbacks = r["hexdem modify"] - r["bare modify"]
         print(f"{r['beads']:>9,} {n:>5} {r['hexdem modify']:>17.2f} {r['bare modify']:>15.2f} {callbacks:>13.2f} "
               f"{callbacks / (r['hexdem loop'] - callbacks):>14.2f}")
+    print("the analysis part by part inside the run (summary.json's analysis_cpu_s, CPU time summed over the ranks), "
+          "per bead: tracker per sample, audit per audited sample, gathering once [ns]")
+    print(f"{'beads':>9} {'ranks':>5} {'tracker':>8} {'audit':>8} {'gathering':>9}")
+    for (edge, n), r in results.items():
+        per_bead = 1e9 / r["beads"]
+        print(f"{r['beads']:>9,} {n:>5} {r['cpu']['tracker'] * per_bead / r['samples']:>8.1f} "
+              f"{r['cpu']['audit'] * per_bead / r['audited']:>8.1f} {r['cpu']['gathering'] * per_bead:>9.0f}")
     if args.before is not None:
         print(f"before ({args.before}) and now, side by side on the same deck and bare loop")
         print(f"{'beads':>9} {'ranks':>5} {'bare loop [s]':>13} {'loop before':>11} {'loop now':>8} "

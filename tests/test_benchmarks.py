@@ -31,7 +31,7 @@ EXPECTED = {
                           "version", "compact", "settle", "impacts", "target <= 60 s"),
     "bench_scale.py": ("beads", "ranks", "model [s]", "data file [s]", "bare loop [s]", "hexdem loop [s]", "analysis",
                        "run [s]", "results [s]", "end-to-end [s]", "largest process [MB]", "peak RSS per rank [MB]",
-                       "collectives", "rebuilds", "audited", "target collectives", "target per-rank memory",
+                       "collectives", "rebuilds", "audited", "part by part inside the run", "gathering", "target collectives", "target per-rank memory",
                        "target largest process", "target results"),
     "bench_study.py": ("executor", "runs [s]", "start-up and end [s]", "a run, in-process", "overhead per run [s]",
                        "process pool", "Parsl (HighThroughputExecutor, local)", "Parsl's overhead per run over the pool's",

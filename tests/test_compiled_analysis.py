@@ -51,3 +51,17 @@ def test_freed_memory_is_kept_where_the_c_library_can():
     from hexdem.common.memory import keep_freed_memory
 
     assert keep_freed_memory() is (platform.libc_ver()[0] == "glibc")
+
+
+def test_background_loading_loads_what_it_can_and_prints_nothing():
+    """What a run preloads is there when it is first used; a module that cannot load is left to its
+    first use, which reports it, and the background thread prints no traceback."""
+    import subprocess
+    import sys
+
+    code = ("import sys, threading; from hexdem.common.preload import load_in_background; "
+            "load_in_background('colorsys', 'hexdem_no_such_module'); "
+            "[t.join() for t in threading.enumerate() if t is not threading.main_thread()]; "
+            "print('colorsys' in sys.modules)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == "True" and done.stderr == ""

@@ -26,6 +26,9 @@ def test_default_run_writes_the_contracted_files(default_run):
     assert summary["lattice"]["n_beads"] == 331
     assert summary["lammps_version"].startswith("LAMMPS")
     assert summary["far_wall_reached"] is True
+    cpu_s = summary["analysis_cpu_s"]  # the analysis's own CPU time, a share of the engine's run
+    assert sorted(cpu_s) == ["audit", "gathering", "tracker"] and cpu_s["tracker"] > 0 and cpu_s["audit"] > 0
+    assert sum(cpu_s.values()) < summary["engine_wall_time_s"]
     assert not (out / "movie.gif").exists(), "no movie unless asked for"
     header, beads = read_csv(out / "beads.csv")
     assert header == BEAD_COLUMNS and len(beads) == 331

@@ -37,7 +37,8 @@ gathers them, with the traces, sensors, snapshot fields and audit parts each ran
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import time
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -78,7 +79,9 @@ class TrackedPulses:
     not turn); ``sensor_times`` (K,) and
     ``sensor_states`` (K, n_sensors, 4): vx, vy, ax, ay of the model's sensor beads every
     ``settings.sensor_every`` steps. ``collectives`` the MPI collective operations the tracker took
-    part in (each rank takes part in the same ones; 0 on one rank). ``peak_angular_speed`` (N,) each bead's largest |ω_z| (0 for
+    part in (each rank takes part in the same ones; 0 on one rank). ``analysis_cpu_s`` the CPU time [s]
+    of each part of the analysis, summed over the ranks: ``tracker`` (each sample's update),
+    ``audit`` (the energy audit), ``gathering`` (each bead's results at the end). ``peak_angular_speed`` (N,) each bead's largest |ω_z| (0 for
     spheres that do not turn); ``rotational_energy_fraction`` the largest share of the kinetic and
     contact energy held in rotation at the audited times; ``end_velocity`` (N, 2) each bead's
     velocity at the last sample (a rebound's outgoing velocity).
@@ -106,6 +109,7 @@ class TrackedPulses:
     rotational_energy_fraction: float
     end_velocity: np.ndarray
     collectives: int = 0
+    analysis_cpu_s: dict = field(default_factory=dict)
 
 
 class PulseTracker:
@@ -147,6 +151,7 @@ class PulseTracker:
         self.energy_times, self.audit_parts = [], []
         self.count = 0
         self.collectives = 0
+        self.cpu_s = {"tracker": 0.0, "audit": 0.0, "gathering": 0.0}  # this rank's thread CPU time per part
 
     def _collective(self, name: str, *args, **kwargs):
         """``comm.<name>(*args, **kwargs)``, counted in :attr:`TrackedPulses.collectives`: every
@@ -211,6 +216,11 @@ class PulseTracker:
 
     # ---- observing
     def __call__(self, sample: Sample) -> None:
+        start, audited = time.thread_time(), self.cpu_s["audit"]
+        self._observe(sample)
+        self.cpu_s["tracker"] += time.thread_time() - start - (self.cpu_s["audit"] - audited)
+
+    def _observe(self, sample: Sample) -> None:
         s = sample.index
         if sample.migrated:
             self._arrange(sample)
@@ -261,6 +271,7 @@ class PulseTracker:
     def _audit(self, sample: Sample) -> None:
         """This rank's part of the energy audit (its bodies, with its ghosts' positions for the
         contacts that cross to another rank), kept until :meth:`finish` sums the ranks' parts."""
+        start = time.thread_time()
         units = self.settings.units
         bodies, positions = sample.ids - 1, sample.positions
         if sample.ghost_ids is not None:
@@ -270,6 +281,7 @@ class PulseTracker:
         self.audit_parts.append(self.audit.part(bodies, len(sample.ids), positions * units.length_m,
                                                 sample.velocities * units.velocity_m_s, angular))
         self.energy_times.append(sample.time)
+        self.cpu_s["audit"] += time.thread_time() - start
 
     def _displacement_energy_j(self) -> float:
         """The contact energy [J] the initial state's displacements add to the packed state's:
@@ -315,8 +327,11 @@ class PulseTracker:
         """The results on rank 0 (None on the other ranks); see :class:`TrackedPulses`. Each rank
         works out its own beads' results; rank 0 gathers them, with the traces, sensors, snapshot
         fields and audit parts each rank took, in one collective, and sums the audit parts."""
+        start = time.thread_time()
+        own = self._own_results()
+        self.cpu_s["gathering"] = time.thread_time() - start
         audited = np.array(self.audit_parts).reshape(len(self.energy_times), -1)
-        mine = (self.ids, self._own_results(), self.traces, self.sensors, self.field_parts, audited)
+        mine = (self.ids, own, self.traces, self.sensors, self.field_parts, audited, self.cpu_s)
         parts = self._collective("gather", mine, root=0) if self.several else [mine]
         if not self.root:
             return None
@@ -325,8 +340,10 @@ class PulseTracker:
         fields = np.full((len(self.field_samples), self.n_beads), np.nan)
         rim_fields = np.full((len(self.field_samples) if self.model.laws.tangential else 0, self.n_beads), np.nan)
         sums = np.zeros_like(audited)  # the ranks' audit parts, summed in rank order
-        for ids, results, their_traces, their_sensors, their_fields, their_audit in parts:
+        cpu_s = dict.fromkeys(self.cpu_s, 0.0)
+        for ids, results, their_traces, their_sensors, their_fields, their_audit, their_cpu_s in parts:
             sums += their_audit
+            cpu_s = {part: cpu_s[part] + seconds for part, seconds in their_cpu_s.items()}
             beads[ids - 1] = results
             traces = np.where(np.isnan(traces), their_traces, traces)
             sensors = np.where(np.isnan(sensors), their_sensors, sensors)
@@ -351,7 +368,7 @@ class PulseTracker:
                              / self.settings.units.time_s, sensor_states=sensors,
                              peak_angular_speed=beads[:, 5], end_velocity=beads[:, 6:8],
                              rotational_energy_fraction=rotational_share(rotational, region_energies),
-                             collectives=self.collectives)
+                             collectives=self.collectives, analysis_cpu_s=cpu_s)
 
 
 def run_noise_floor(model: GranularModel, settings: RunSettings) -> float:

@@ -14,10 +14,15 @@ import threading
 
 def load_in_background(*modules: str) -> None:
     """Import ``modules``, in order, in a daemon thread: their first use then finds them loaded
-    (or waits for the import under way, as any import of a module being imported does)."""
+    (or waits for the import under way, as any import of a module being imported does). A module
+    that fails to load is left for its first use, which imports it again and reports the error
+    where it can be handled (a thread's exception would only print a traceback)."""
 
     def load():
         for module in modules:
-            importlib.import_module(module)
+            try:
+                importlib.import_module(module)
+            except Exception:
+                return
 
     threading.Thread(target=load, daemon=True).start()

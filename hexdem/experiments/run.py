@@ -142,6 +142,7 @@ def summary(config: RunConfig, analysis: ImpactAnalysis, wall_time_s: float) -> 
         "lammps_version": engine.get("version") if engine.get("name") == "lammps" else None,
         "ranks": engine.get("ranks"),
         "collectives": analysis.tracked.collectives if analysis.tracked is not None else None,
+        "analysis_cpu_s": analysis.tracked.analysis_cpu_s if analysis.tracked is not None else None,
         "engine_wall_time_s": engine.get("wall_time_s"),
         "wall_time_s": wall_time_s,
         "energy_drift": r.energy_drift,
