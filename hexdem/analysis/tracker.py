@@ -144,7 +144,7 @@ class PulseTracker:
         self.field_samples = np.asarray(sorted(field_samples), dtype=np.int64)
         self.field_parts = []
         self.energy_every = max(1, (total - 1) // ENERGY_SAMPLES)
-        self.compiled = runs_compiled(self.n_beads, 1 if comm is None else comm.Get_size())
+        self.compiled = runs_compiled(model.n_bodies, 1 if comm is None else comm.Get_size())
         # what the first sample needs loads while the engine starts: the kernels, the audit's pair search
         load_in_background(*(["hexdem.analysis.compiled"] if self.compiled else []), "scipy.spatial")
         self.audit = EnergyAudit(model, gravity_m_s2, self.compiled)

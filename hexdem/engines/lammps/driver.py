@@ -129,8 +129,8 @@ class _Stream:
         return omega
 
     def forces_and_masses(self, n: int):
-        """(n, 2) forces and (n,) masses of the first ``n`` local atoms."""
-        return self.per_atom("f", n)[:, :2], self.per_atom("rmass", n, 0)
+        """(n, 3) forces and (n,) masses of the first ``n`` local atoms."""
+        return self.per_atom("f", n), self.per_atom("rmass", n, 0)
 
     def initial(self) -> None:
         self.lmp.command("run 0 post no")  # distributes the atoms, finds the ghosts, computes the forces at t = 0
@@ -138,7 +138,7 @@ class _Stream:
         accelerations = None
         if self.sensor_every:
             force, mass = self.forces_and_masses(len(ids))
-            accelerations = force / mass[:, None]
+            accelerations = force[:, :2] / mass[:, None]
         self.on_sample(Sample(0, 0, 0.0, ids, positions, velocities, accelerations,
                               self.angular_velocities(len(ids)), True, *self.ghosts(len(ids))))
 
@@ -150,11 +150,10 @@ class _Stream:
             return
         try:  # (``tag`` and ``x``: the ids and positions of the local atoms, handed over by LAMMPS)
             force, mass = self.forces_and_masses(nlocal)
-            positions, velocities = full_step(x, self.per_atom("v", nlocal), self.per_atom("f", nlocal), mass,
-                                              self.dt, self.compiled)
+            positions, velocities = full_step(x, self.per_atom("v", nlocal), force, mass, self.dt, self.compiled)
             ids = tag.astype(np.int64)
             sensed = self.sensor_every and step % self.sensor_every == 0
-            accelerations = force / mass[:, None] if sensed else None
+            accelerations = force[:, :2] / mass[:, None] if sensed else None
             builds = self.lmp.get_thermo("nbuild")
             migrated, self.builds = builds != self.builds, builds
             self.on_sample(Sample(step // self.every, int(step), step * self.dt, ids, positions, velocities,
