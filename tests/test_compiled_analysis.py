@@ -7,8 +7,10 @@ import numpy as np
 import pytest
 
 import hexdem.common.compiled as compiled
+from hexdem.analysis.energy import EnergyAudit, _pair_constants, _pair_contacts, _pairs, _wall_constants, _wall_contacts
 from hexdem.experiments.run import simulate
 from hexdem.model.config import RunConfig
+from hexdem.model.model_builder import build_model
 
 RUNS = {
     "hexagon": {"edge_beads": 8},
@@ -26,9 +28,45 @@ def test_the_compiled_kernels_give_the_numpy_results(tmp_path, monkeypatch, chan
     compiled_run = simulate(config, tmp_path / "compiled").tracked
     for name in ("peak_speed", "t_peak", "arrival_time", "reach_time", "end_velocity", "peak_angular_speed"):
         np.testing.assert_array_equal(getattr(compiled_run, name), getattr(numpy_run, name), err_msg=name)
-    np.testing.assert_allclose(compiled_run.region_energies, numpy_run.region_energies, rtol=1e-12, atol=0)
+    # the two ways round each overlap δ (a difference of coordinates ~10 D) differently, by ~1e-15 D (the
+    # compiled walls take n·x term by term, NumPy's BLAS as it likes): a contact's energy ∝ δ^{5/2} moves by
+    # 2.5e-15 D / δ of itself, under 1e-9 for δ ≥ 1e-5 D, and smaller overlaps hold little of the run's
+    # energy, which the audit's figures are read against
+    np.testing.assert_allclose(compiled_run.region_energies, numpy_run.region_energies, rtol=0,
+                               atol=1e-9 * numpy_run.region_energies[0].sum())
     assert compiled_run.energy_drift == pytest.approx(numpy_run.energy_drift, rel=1e-6, abs=1e-12)
     assert compiled_run.rotational_energy_fraction == pytest.approx(numpy_run.rotational_energy_fraction, rel=1e-9)
+
+
+@pytest.mark.parametrize("changes", [{"edge_beads": 6}, {"shape": "disc", "radius_beads": 5},
+                                     {"edge_beads": 5, "regions": ({"material": "brass", "x_min_d": 2.0},)}],
+                         ids=["flat walls", "curved wall", "two materials"])
+def test_the_compiled_audit_is_the_numpy_audit_of_a_squeezed_packing(changes):
+    """Every body pushed outwards by a ten-thousandth of its distance from the centre, then moved at
+    random by up to 1e-5 of a diameter: the beads along the walls overlap them and some pairs
+    overlap, so both the wall and the pair sums count, on a share of the bodies with the rest as
+    ghosts (in a random order).
+
+    The two ways round differently only in the overlaps δ, differences of coordinates |x| up to
+    X: each δ within a few ulps of X, 8 ε X, so each contact's energy within its force
+    k √R δ^{3/2} (dU/dδ) times that."""
+    model = build_model(RunConfig(**changes))
+    rng = np.random.default_rng(0)
+    start = model.initial_positions_m()
+    squeezed = start + 1e-4 * (start - start.mean(axis=0)) + 1e-5 * model.packing.diameter_m * rng.uniform(
+        -1, 1, start.shape)
+    velocities, bodies, n_own = rng.standard_normal(start.shape), rng.permutation(model.n_bodies), model.n_bodies // 2
+    radii = model.diameters_m / 2
+    pairs = _pair_contacts(squeezed, radii, _pair_constants(model, *_pairs(squeezed, 2 * radii.max()), radii))[2:]
+    walls = [wall[1:] for wall in _wall_contacts(squeezed, _wall_constants(model))]
+    assert sum(len(wall[0]) for wall in walls) > 0
+    forces_n = sum(np.sum(k * np.sqrt(r_eff) * overlap**1.5) for k, r_eff, overlap in [pairs, *walls])
+    numpy_part, compiled_part = (EnergyAudit(model, compiled=way).part(bodies, n_own, squeezed[bodies],
+                                                                       velocities[bodies[:n_own]])
+                                 for way in (False, True))
+    assert np.all(numpy_part[4::2] > 0)  # each region's contact energy
+    overlap_round_off_m = 8 * np.finfo(float).eps * np.abs(squeezed).max()
+    np.testing.assert_allclose(compiled_part, numpy_part, rtol=1e-13, atol=forces_n * overlap_round_off_m)
 
 
 def test_the_compiled_sample_is_the_numpy_full_step_to_the_bit():

@@ -127,23 +127,52 @@ def pair_contact_energies(positions, i, j, contact_m, coefficient, region_i, reg
     regions ``region_i``, ``region_j`` (−1: a ghost, not audited here):
     :func:`~hexdem.analysis.energy._pair_energies_j`, summed in its order (the i sides' halves, pair by
     pair, then the j sides'). :math:`δ^{5/2}` is taken as δ² √δ, within an ulp of NumPy's power and a
-    third quicker."""
+    third quicker. A pair apart adds +0 rather than being skipped, which leaves every sum as it was: at
+    rest, ahead of a pulse, whether a pair touches is round-off's coin toss, which a branch mispredicts
+    (16 ns a pair at 29,701 beads against 6.5 without the branch)."""
     sides = np.zeros((2, n_regions))
     for p in range(len(i)):
         a, b = i[p], j[p]
         dx = positions[a, 0] - positions[b, 0]
         dy = positions[a, 1] - positions[b, 1]
-        overlap = contact_m[p] - math.sqrt(dx * dx + dy * dy)
-        if overlap > 0:
-            half = coefficient[p] * (overlap * overlap * math.sqrt(overlap)) / 2
-            if region_i[p] >= 0:
-                sides[0, region_i[p]] += half
-            if region_j[p] >= 0:
-                sides[1, region_j[p]] += half
+        overlap = max(contact_m[p] - math.sqrt(dx * dx + dy * dy), 0.0)
+        half = coefficient[p] * (overlap * overlap * math.sqrt(overlap)) / 2
+        if region_i[p] >= 0:
+            sides[0, region_i[p]] += half
+        if region_j[p] >= 0:
+            sides[1, region_j[p]] += half
     contact = np.zeros(n_regions)
     contact += sides[0]
     contact += sides[1]
     return contact
+
+
+@_jit(F2, I1, I1, F2, F1, I1, F1, F1, I1, F1)
+def add_wall_energies(positions, bounds, curved, points, lengths, rows, radii, coefficient, regions, contact):
+    r"""Add to ``contact`` (R,) the Hertz energy [J] of the wall contacts of the rows ``rows`` of
+    ``positions``, wall by wall: wall ``w``'s members are ``bounds[w]`` to ``bounds[w + 1]`` of the
+    member arrays; a flat wall {x : n·x = ``lengths[w]``} of normal n = ``points[w]``, or (``curved[w]``)
+    the inside of the circle of centre ``points[w]`` and radius ``lengths[w]``. A member of radius
+    r = ``radii`` overlapping its wall by δ > 0 stores ``coefficient`` × δ^{5/2} (one apart adds +0, see
+    :func:`pair_contact_energies`)
+    (:math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}`, δ^{5/2} as δ² √δ), added to its region ``regions``:
+    :func:`~hexdem.analysis.energy._add_wall_energies_j` (its gaps from
+    :meth:`~hexdem.model.walls.Wall.gaps_m`, :meth:`~hexdem.model.walls.CurvedWall.gaps_m`), summed in its
+    order, member by member within a wall, then wall by wall."""
+    wall_sum = np.zeros(len(contact))
+    for w in range(len(bounds) - 1):
+        wall_sum[:] = 0.0
+        for e in range(bounds[w], bounds[w + 1]):
+            x, y = positions[rows[e], 0], positions[rows[e], 1]
+            if curved[w]:
+                dx, dy = x - points[w, 0], y - points[w, 1]
+                depth = -(lengths[w] - math.sqrt(dx * dx + dy * dy) - radii[e])
+            else:
+                depth = -(x * points[w, 0] + y * points[w, 1] - radii[e] - lengths[w])
+            depth = max(depth, 0.0)
+            wall_sum[regions[e]] += coefficient[e] * (depth * depth * math.sqrt(depth))
+        for k in range(len(contact)):
+            contact[k] += wall_sum[k]
 
 
 @_jit(F2, F2, F1, F1, F1, I1, F2, F2, int64)

@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from hexdem.model.granular import GranularModel
+from hexdem.model.walls import CurvedWall
 
 #: Candidate pairs are found within contact distance + this many bead diameters, and found
 #: again once a body has moved half of it (a Verlet list).
@@ -84,6 +85,32 @@ def _wall_contacts(positions_m, walls) -> list[tuple]:
     return contacts
 
 
+def _wall_geometry(wall) -> tuple[int, tuple[float, float], float]:
+    """(curved, point, length [m]) of a wall: (0, its normal, its offset) for a flat
+    :class:`~hexdem.model.walls.Wall`, (1, its centre, its radius) for a
+    :class:`~hexdem.model.walls.CurvedWall`."""
+    if isinstance(wall, CurvedWall):
+        return 1, wall.centre_m, wall.radius_m
+    return 0, wall.normal, wall.offset_m
+
+
+def _wall_rows(walls, regions) -> tuple:
+    r"""The walls of :func:`_wall_constants` as :func:`~hexdem.analysis.compiled.add_wall_energies`
+    reads them: per wall where its members start and end in the member arrays and its
+    :func:`_wall_geometry`; per member its row, radius, :math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}` and
+    its row's region (``regions``, by row)."""
+    bounds = np.cumsum([0, *(len(wall[1]) for wall in walls)])
+    curved, points, lengths = zip(*(_wall_geometry(wall[0]) for wall in walls)) if walls else ((), (), ())
+
+    def joined(k: int, dtype=float) -> np.ndarray:
+        return np.concatenate([np.zeros(0, dtype), *(np.asarray(wall[k], dtype) for wall in walls)])
+
+    rows = joined(1, np.int64)
+    return (bounds.astype(np.int64), np.array(curved, np.int64), np.array(points, float).reshape(-1, 2),
+            np.array(lengths, float), rows, joined(3), 0.4 * joined(2) * np.sqrt(joined(4)),
+            regions[rows].astype(np.int64))
+
+
 def _wall_energy_j(walls) -> float:
     """Hertz energy [J] of the wall contacts (:func:`_wall_contacts`), wall by wall."""
     return sum((hertz_energy_j(*wall[1:]) for wall in walls), 0.0)
@@ -143,12 +170,12 @@ class EnergyAudit:
         self.compiled = compiled
         self._listed, self._listed_at, self._candidates, self._walls, self._rows = None, None, None, None, None
 
-    def _contacts(self, bodies, n_own: int, positions_m):
-        """(candidate pairs, walls) among the rows of ``positions_m`` (bodies ``bodies``, the first
-        ``n_own`` audited) with an audited body: the candidates (i, j, k_n, R_eff) of rows within
-        contact distance and the skin, kept from one search to the next until a body has moved half
-        the skin (:func:`_pair_constants`), the walls per wall (rows, k_n, R_eff, δ) of the audited
-        members that touch it."""
+    def _list_contacts(self, bodies, n_own: int, positions_m) -> None:
+        """List the candidates among the rows of ``positions_m`` (bodies ``bodies``, the first
+        ``n_own`` audited) with an audited body, unless the list at hand still holds: the candidates
+        (i, j, k_n, R_eff) of rows within contact distance and the skin, kept from one search to the
+        next until a body has moved half the skin (:func:`_pair_constants`), and the walls' audited
+        members (:func:`_wall_constants`)."""
         listed = self._listed is not None and n_own == self._listed[1] and np.array_equal(bodies, self._listed[0])
         if not listed or self._moved_beyond(positions_m, self.skin_m / 2):
             self._listed, self._listed_at = (bodies.copy(), n_own), positions_m.copy()
@@ -159,13 +186,13 @@ class EnergyAudit:
             self._walls = _wall_constants(self.model, bodies[:n_own])
             if self.compiled:
                 self._rows = self._row_constants(bodies, n_own)
-        return self._candidates, _wall_contacts(positions_m, self._walls)
 
     def _row_constants(self, bodies, n_own: int) -> tuple:
         r"""What the compiled kernels read of the listed rows, laid out once per list (see
         :mod:`hexdem.analysis.compiled`): per candidate pair its sum of radii, its
         :math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}` and the regions of its two rows (−1 for a ghost); per audited
-        row its body's mass, inertia, region, start position and constant force."""
+        row its body's mass, inertia, region, start position and constant force; the walls' audited
+        members (:func:`_wall_rows`)."""
         i, j, stiffness, r_eff = self._candidates
         regions = self.regions[bodies]
         own = np.where(np.arange(len(bodies)) < n_own, regions, -1)
@@ -173,7 +200,7 @@ class EnergyAudit:
         audited = bodies[:n_own]
         rows = (self.masses_kg[audited], self.inertia_kg_m2[audited], regions[:n_own], self.start_m[audited],
                 self.external_n[audited])
-        return pairs, rows
+        return pairs, rows, _wall_rows(self._walls, regions)
 
     def _moved_beyond(self, positions_m, distance_m: float) -> bool:
         """Whether a body has moved more than ``distance_m`` since the candidates were listed."""
@@ -186,18 +213,20 @@ class EnergyAudit:
     def _contact_energies_j(self, bodies, n_own: int, positions_m) -> np.ndarray:
         """(R,) contact energy [J] of each region of the audited bodies (:func:`_pair_energies_j`, then
         :func:`_add_wall_energies_j`),
-        by the compiled kernel (:func:`~hexdem.analysis.compiled.pair_contact_energies`) where the
-        audit was made ``compiled``, else by NumPy: the same sums."""
-        candidates, walls = self._contacts(bodies, n_own, positions_m)
+        by the compiled kernels (:func:`~hexdem.analysis.compiled.pair_contact_energies`,
+        :func:`~hexdem.analysis.compiled.add_wall_energies`) where the audit was made ``compiled``,
+        else by NumPy: the same sums."""
+        self._list_contacts(bodies, n_own, positions_m)
         n_regions = len(self.region_names)
         if self.compiled:
-            from hexdem.analysis.compiled import pair_contact_energies  # numba: only for large ranks
+            from hexdem.analysis.compiled import add_wall_energies, pair_contact_energies  # numba: only for large ranks
 
             contact = pair_contact_energies(positions_m, *self._rows[0], n_regions)
-        else:
-            contact = _pair_energies_j(_pair_contacts(positions_m, self.radii_m[bodies], candidates),
-                                       self.regions[bodies], n_regions, n_own)
-        _add_wall_energies_j(contact, walls, self.regions[bodies], n_regions)
+            add_wall_energies(positions_m, *self._rows[2], contact)
+            return contact
+        contact = _pair_energies_j(_pair_contacts(positions_m, self.radii_m[bodies], self._candidates),
+                                   self.regions[bodies], n_regions, n_own)
+        _add_wall_energies_j(contact, _wall_contacts(positions_m, self._walls), self.regions[bodies], n_regions)
         return contact
 
     def part(self, bodies, n_own: int, positions_m, velocities_m_s, angular_velocities_s=None) -> np.ndarray:
