@@ -39,6 +39,7 @@ from hexdem.common.job_failure import abort_job
 from hexdem.common.memory import keep_freed_memory
 from hexdem.common.preload import load_in_background
 from hexdem.common.progress import progress_bar
+from hexdem.engines.lammps.c_interface import AtomViews, add_sampling_fix
 from hexdem.engines.lammps.deck import Deck
 from hexdem.engines.lammps.library import load_lammps
 from hexdem.engines.lammps.runner import RunInfo, lammps_failure, log_version
@@ -83,38 +84,36 @@ def full_step(positions, velocities, forces, masses, dt: float, compiled: bool =
 
 class _Stream:
     """The ``fix external`` callback: full-step samples of the local atoms (with their spins ω_z
-    when ``spins``), with progress."""
+    when ``spins``), with progress. It reads LAMMPS's arrays through views kept between samples
+    (:class:`~hexdem.engines.lammps.c_interface.AtomViews`), the positions and ids with the ghosts'
+    rows after the rank's own."""
 
     def __init__(self, lmp, deck: Deck, on_sample, show_progress: bool, comm=None, spins: bool = False):
         self.lmp, self.on_sample, self.comm, self.spins = lmp, on_sample, comm, spins
+        self.views = AtomViews(lmp)
         self.every, self.dt = deck.settings.dump_every, float(lmp.extract_global("dt"))
         self.sensor_every = deck.settings.sensor_every
         self.bar = progress_bar(deck.settings.n_steps, "LAMMPS", unit="step") if show_progress else None
         self.error: BaseException | None = None
         self.builds = None  # neighbour list builds at the previous sample (None: it came before this run)
+        self.nghost = 0
         self.compiled = runs_compiled(deck.n_atoms, 1 if comm is None else comm.Get_size())
         if self.compiled:
             load_in_background("hexdem.engines.lammps.full_step")
 
-    def per_atom(self, name: str, n: int, columns: int = 3) -> np.ndarray:
-        """A view of per-atom property ``name`` of the first ``n`` local atoms, (n, columns) or (n,)
-        for ``columns = 0``. The shape and type are given, so the wrapper asks LAMMPS nothing
-        more than the pointer (autodetection took three more library calls per array)."""
-        lammps = load_lammps()
-        if columns:
-            return self.lmp.numpy.extract_atom(name, lammps.LAMMPS_DOUBLE_2D, n, columns)
-        return self.lmp.numpy.extract_atom(name, lammps.LAMMPS_DOUBLE, n)
+    def with_ghosts(self, name: str, nlocal: int, columns: int = 0) -> np.ndarray:
+        """Per-atom array ``name`` of the local atoms and then the ghosts (:meth:`AtomViews.__call__`)."""
+        return self.views(name, nlocal + self.nghost, columns)
 
     def local_state(self):
         n = self.lmp.extract_global("nlocal")
-        ids = np.array(self.lmp.numpy.extract_atom("id")[:n], dtype=np.int64)
-        return ids, self.per_atom("x", n)[:, :2].copy(), self.per_atom("v", n)[:, :2].copy()
+        self.nghost = self.lmp.extract_global("nghost")
+        ids = self.with_ghosts("id", n)[:n].astype(np.int64)
+        return ids, self.with_ghosts("x", n, 3)[:n, :2].copy(), self.views("v", n, 3)[:, :2].copy()
 
     def ghosts(self, nlocal: int):
         """(ids, (g, 2) positions) of this rank's ghost atoms."""
-        n = nlocal + self.lmp.extract_global("nghost")
-        ids = np.array(self.lmp.numpy.extract_atom("id", nelem=n)[nlocal:n], dtype=np.int64)
-        return ids, self.per_atom("x", n)[nlocal:, :2].copy()
+        return self.with_ghosts("id", nlocal)[nlocal:].astype(np.int64), self.with_ghosts("x", nlocal, 3)[nlocal:, :2].copy()
 
     def angular_velocities(self, n: int, mass=None) -> np.ndarray | None:
         """(n,) ω_z of the first ``n`` local atoms, or None for spheres that do not turn. Given their
@@ -122,15 +121,15 @@ class _Stream:
         I = (2/5) m r² as ``fix nve/sphere`` has it."""
         if not self.spins:
             return None
-        omega = self.per_atom("omega", n)[:, 2].copy()
+        omega = self.views("omega", n, 3)[:, 2].copy()
         if mass is not None:
-            inertia = 0.4 * mass * self.per_atom("radius", n, 0) ** 2
-            omega += 0.5 * self.dt * self.per_atom("torque", n)[:, 2] / inertia
+            inertia = 0.4 * mass * self.views("radius", n) ** 2
+            omega += 0.5 * self.dt * self.views("torque", n, 3)[:, 2] / inertia
         return omega
 
     def forces_and_masses(self, n: int):
         """(n, 3) forces and (n,) masses of the first ``n`` local atoms."""
-        return self.per_atom("f", n), self.per_atom("rmass", n, 0)
+        return self.views("f", n, 3), self.views("rmass", n)
 
     def initial(self) -> None:
         self.lmp.command("run 0 post no")  # distributes the atoms, finds the ghosts, computes the forces at t = 0
@@ -142,20 +141,20 @@ class _Stream:
         self.on_sample(Sample(0, 0, 0.0, ids, positions, velocities, accelerations,
                               self.angular_velocities(len(ids)), True, *self.ghosts(len(ids))))
 
-    def __call__(self, caller, step, nlocal, tag, x, fexternal) -> None:
-        if step == 0:  # the set-up's call: the one step that adds fexternal (see run_streaming), made zero
-            fexternal[:] = 0.0
-            return
+    def __call__(self, step: int, nlocal: int) -> None:
         if self.error is not None:
             return
-        try:  # (``tag`` and ``x``: the ids and positions of the local atoms, handed over by LAMMPS)
-            force, mass = self.forces_and_masses(nlocal)
-            positions, velocities = full_step(x, self.per_atom("v", nlocal), force, mass, self.dt, self.compiled)
-            ids = tag.astype(np.int64)
-            sensed = self.sensor_every and step % self.sensor_every == 0
-            accelerations = force[:, :2] / mass[:, None] if sensed else None
+        try:
             builds = self.lmp.get_thermo("nbuild")
             migrated, self.builds = builds != self.builds, builds
+            if migrated:  # LAMMPS finds the ghosts again only when it rebuilds its lists
+                self.nghost = self.lmp.extract_global("nghost")
+            force, mass = self.forces_and_masses(nlocal)
+            positions, velocities = full_step(self.with_ghosts("x", nlocal, 3)[:nlocal], self.views("v", nlocal, 3), force,
+                                              mass, self.dt, self.compiled)
+            ids = self.with_ghosts("id", nlocal)[:nlocal].astype(np.int64)
+            sensed = self.sensor_every and step % self.sensor_every == 0
+            accelerations = force[:, :2] / mass[:, None] if sensed else None
             self.on_sample(Sample(step // self.every, int(step), step * self.dt, ids, positions, velocities,
                                   accelerations, self.angular_velocities(nlocal, mass), migrated, *self.ghosts(nlocal)))
             if self.bar is not None:
@@ -205,11 +204,8 @@ def run_streaming(deck: Deck, on_sample, comm=None, dump: bool = False, show_pro
             _lammps(deck, lmp.commands_string, setup + (output if dump else ""))
             stream = _Stream(lmp, deck, on_sample, show_progress and root, comm, spins)
             stream.initial()
-            # a callback every dump_every steps; its forces (none) are added only at step 0, whose call zeroes
-            # them: LAMMPS leaves the array unset, and adding it at every step cost a pass over the atoms
-            _lammps(deck, lmp.command, f"fix {STREAM_FIX} all external pf/callback {deck.settings.dump_every} "
-                                       f"{deck.settings.n_steps + 1}")
-            lmp.set_fix_external_callback(STREAM_FIX, stream, None)
+            add_sampling_fix(lmp, STREAM_FIX, deck.settings.dump_every, deck.settings.n_steps, stream,
+                             lambda text: _lammps(deck, lmp.command, text))
             _lammps(deck, lmp.command, f"run {deck.settings.n_steps}")
         finally:
             if stream is not None and stream.bar is not None:
