@@ -8,9 +8,13 @@ import pytest
 
 import hexdem.common.compiled as compiled
 from hexdem.analysis.energy import EnergyAudit, _pair_constants, _pair_contacts, _pairs, _wall_constants, _wall_contacts
+from hexdem.analysis.tracker import PulseTracker
+from hexdem.engines.sampling import Sample
+from hexdem.errors import HexdemError
 from hexdem.experiments.run import simulate
 from hexdem.model.config import RunConfig
 from hexdem.model.model_builder import build_model
+from hexdem.model.run_settings import run_settings
 
 RUNS = {
     "hexagon": {"edge_beads": 8},
@@ -103,3 +107,21 @@ def test_background_loading_loads_what_it_can_and_prints_nothing():
             "print('colorsys' in sys.modules)")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert done.stdout.strip() == "True" and done.stderr == ""
+
+
+@pytest.mark.parametrize("compiled_beads", [10**9, 1], ids=["NumPy", "compiled"])
+def test_a_sample_that_reorders_the_bodies_unannounced_is_refused(monkeypatch, compiled_beads):
+    """A sample's rows are the previous sample's bodies in the same order unless it says that they
+    may have migrated: both ways refuse one that swaps two rows without saying so."""
+    monkeypatch.setattr(compiled, "COMPILED_BEADS", compiled_beads)
+    config = RunConfig(edge_beads=4)
+    model = build_model(config)
+    tracker = PulseTracker(model, run_settings(config, model))
+    ids, positions = np.arange(1, model.n_bodies + 1), model.initial_positions_m()
+    velocities = np.zeros_like(positions)
+    tracker(Sample(0, 0, 0.0, ids, positions, velocities, migrated=True))
+    tracker(Sample(1, 7, 1e-6, ids, positions, velocities, migrated=False))
+    swapped = ids.copy()
+    swapped[[0, 1]] = swapped[[1, 0]]
+    with pytest.raises(HexdemError, match="sample 2 reordered the bodies of rank 0 without saying"):
+        tracker(Sample(2, 14, 2e-6, swapped, positions, velocities, migrated=False))

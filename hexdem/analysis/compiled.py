@@ -208,12 +208,19 @@ def moved_beyond(positions, listed_at, distance) -> bool:
     return False
 
 
-@_jit(F2, I1, F1, F2)
-def bead_speeds(velocities, rows, speeds, end_velocity):
-    """The speeds ``|v|`` of the sample's rows ``rows`` into ``speeds``, and their velocities into ``end_velocity``
-    (``np.hypot``'s arithmetic, C's hypot)."""
+@_jit(I1, I1, F2, I1, F1, F2)
+def sample_speeds(ids, previous_ids, velocities, rows, speeds, end_velocity) -> bool:
+    """The speeds ``|v|`` of the sample's rows ``rows`` into ``speeds``, and their velocities into
+    ``end_velocity`` (``np.hypot``'s arithmetic, C's hypot); returns whether the sample's body ids
+    ``ids`` are ``previous_ids`` (``np.array_equal``), in the same pass."""
     for k in range(len(rows)):
         vx, vy = velocities[rows[k], 0], velocities[rows[k], 1]
         speeds[k] = math.hypot(vx, vy)
         end_velocity[k, 0] = vx
         end_velocity[k, 1] = vy
+    if len(ids) != len(previous_ids):
+        return False
+    for r in range(len(ids)):
+        if ids[r] != previous_ids[r]:
+            return False
+    return True

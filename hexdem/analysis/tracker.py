@@ -142,6 +142,7 @@ class PulseTracker:
         n_sensed = settings.n_steps // settings.sensor_every + 1 if settings.sensor_every else 0
         self.sensors = np.full((n_sensed, len(self.sensor_beads), 4), np.nan)
         self.field_samples = np.asarray(sorted(field_samples), dtype=np.int64)
+        self.field_set = frozenset(self.field_samples.tolist())
         self.field_parts = []
         self.energy_every = max(1, (total - 1) // ENERGY_SAMPLES)
         self.compiled = runs_compiled(model.n_bodies, 1 if comm is None else comm.Get_size())
@@ -224,23 +225,15 @@ class PulseTracker:
         s = sample.index
         if sample.migrated:
             self._arrange(sample)
-        elif not np.array_equal(sample.ids, self.sample_ids):
-            raise HexdemError(f"sample {s} reordered the bodies of rank {0 if self.comm is None else self.comm.Get_rank()} "
-                              "without saying that they may have migrated")
-        index = np.arange(len(self.ids))
+        speeds = self._speeds(sample)
         if self.compiled:
-            from hexdem.analysis.compiled import bead_speeds, update_pulses  # numba: only for large ranks
+            from hexdem.analysis.compiled import update_pulses  # numba: only for large ranks
 
-            speeds = np.empty(len(self.ids))
-            bead_speeds(sample.velocities, self.bead_rows, speeds, self.end_velocity)
             self.pulses.challenge(update_pulses(speeds, s, self.pulses.q, RIVAL_RATIO, *self.pulses.sample_arrays()))
         else:
-            velocities = sample.velocities[self.bead_rows]
-            speeds = np.hypot(velocities[:, 0], velocities[:, 1])
-            self.pulses.update(index, speeds, s)
-            self.end_velocity[:] = velocities
+            self.pulses.update(np.arange(len(self.ids)), speeds, s)
         if self.threshold_speed is not None:
-            self._cross_threshold(index, speeds, s)
+            self._cross_threshold(np.arange(len(self.ids)), speeds, s)
         spins = None if sample.angular_velocities is None else np.abs(sample.angular_velocities[self.bead_rows])
         if spins is not None:
             np.maximum(self.peak_spin, spins, out=self.peak_spin)
@@ -250,13 +243,34 @@ class PulseTracker:
             rows = self.bead_rows[self.sensor_rows]
             self.sensors[sample.step // self.sensor_every, self.sensors_here] = np.hstack(
                 [sample.velocities[rows], sample.accelerations[rows]])
-        if s in self.field_samples:
+        if s in self.field_set:
             radii = self.model.packing.diameters_m[self.ids - 1] / 2 / self.settings.units.length_m
             rims = spins * radii if self.model.laws.tangential else None
             self.field_parts.append((np.searchsorted(self.field_samples, s), self.ids, speeds, rims))
         if s % self.energy_every == 0 or s == self.n_samples_expected - 1:
             self._audit(sample)
         self.count = s + 1
+
+    def _speeds(self, sample: Sample) -> np.ndarray:
+        """The speeds of this rank's beads in ``sample``, whose velocities become their last seen
+        (:attr:`end_velocity`), once the sample's bodies are found to be those of the previous sample,
+        in the same order, unless it says that they may have migrated (and :meth:`_arrange` laid them
+        out): in one compiled pass on large ranks."""
+        if self.compiled:
+            from hexdem.analysis.compiled import sample_speeds  # numba: only for large ranks
+
+            speeds = np.empty(len(self.ids))
+            same = sample_speeds(np.asarray(sample.ids, np.int64), self.sample_ids, sample.velocities, self.bead_rows,
+                                 speeds, self.end_velocity)
+        else:
+            same = np.array_equal(sample.ids, self.sample_ids)
+            velocities = sample.velocities[self.bead_rows]
+            speeds = np.hypot(velocities[:, 0], velocities[:, 1])
+            self.end_velocity[:] = velocities
+        if not same:
+            raise HexdemError(f"sample {sample.index} reordered the bodies of rank "
+                              f"{0 if self.comm is None else self.comm.Get_rank()} without saying that they may have migrated")
+        return speeds
 
     def _cross_threshold(self, index: np.ndarray, speeds: np.ndarray, s: int) -> None:
         """Record, as a fractional sample index, where each bead's speed first reached the
