@@ -55,7 +55,7 @@ def run(args) -> None:
     if args.run is not None:
         if args.parsl is not None:
             raise HexdemError("--run I runs here, without --parsl")
-        run = sweep.run_single(out, args.run, args.ranks_per_run, args.launcher)
+        run = sweep.run_single(out, runs, args.run, args.ranks_per_run, args.launcher)
         print(f"hexdem sweep: run {args.run} ({run.name}) done", flush=True)
     elif args.collect:
         sweep.collect(out, runs, variations)

@@ -150,12 +150,13 @@ def run_study(out: Path, runs: list[SweepRun], workers: int = 1, parsl=None, ran
         bar.close()
 
 
-def run_single(out, index: int, ranks: int | None = None, launcher: str | None = None) -> SweepRun:
-    """Run run ``index`` (from 0, in the plan's order) of the study planned in ``out`` in this
-    process, whatever it left before; a failure is recorded and raised."""
+def run_single(out, runs: list[SweepRun], index: int, ranks: int | None = None,
+               launcher: str | None = None) -> SweepRun:
+    """Run run ``index`` (from 0, in the plan's order) of ``runs``, the study planned in ``out``
+    (:func:`planned_study`), in this process, whatever it left before; a failure is recorded and
+    raised."""
     check_options(ranks=ranks, launcher=launcher)
     out = Path(out)
-    runs, _ = planned_study(out)
     if not 0 <= index < len(runs):
         raise HexdemError(f"--run {index}: {out} plans runs 0 to {len(runs) - 1}")
     run = runs[index]
