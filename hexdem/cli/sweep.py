@@ -40,6 +40,7 @@ def add_arguments(parser) -> None:
 
 def run(args) -> None:
     from hexdem.experiments import sweep
+    from hexdem.experiments.executors import check_study_options
 
     if args.study is None:
         if args.run is not None or args.collect:
@@ -60,7 +61,7 @@ def run(args) -> None:
     elif args.collect:
         sweep.collect(out, runs, variations)
     else:
-        sweep.check_options(args.workers, args.parsl, args.ranks_per_run, args.launcher)
+        check_study_options(args.workers, args.parsl, args.launcher, args.ranks_per_run)
         sweep.run_study(out, runs, args.workers, args.parsl, args.ranks_per_run, args.launcher)
         sweep.collect(out, runs, variations)
 

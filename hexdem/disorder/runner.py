@@ -17,18 +17,16 @@ import sys
 import time
 from pathlib import Path
 
-from hexdem.common.checks import positive_int
 from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
-from hexdem.common.progress import progress_bar
 from hexdem.disorder.ensemble import MANIFEST_NAME, PHASE_LABELS, Ensemble, EnsembleConfig
 from hexdem.disorder.figures import fitted_laws
 from hexdem.disorder.impacts import impact_done, impact_task, publish_result
 from hexdem.disorder.preparation import STAGES, write_stage_deck
 from hexdem.disorder.sharing import adopt_preparation, adopt_ideal_impacts
 from hexdem.disorder.stats import write_statistics
-from hexdem.engines.lammps.standalone import is_done, launcher_command, run_deck
+from hexdem.engines.lammps.standalone import is_done, run_deck
 from hexdem.errors import HexdemError
-from hexdem.experiments.executors import describe, load_parsl_config, run_tasks, study_executor
+from hexdem.experiments.executors import check_study_options, describe, run_phase
 
 
 def _check_manifest(out: Path, config: EnsembleConfig) -> dict:
@@ -58,19 +56,14 @@ def _pending_impacts(ensemble: Ensemble, groups) -> list[tuple[int | None, float
 
 def _run_phase(name: str, tasks: dict, workers: int, parsl, on_done=None) -> None:
     """Run the phase ``name``'s ``tasks`` {what: (fn, *args)}, one task of the study executor
-    each, calling ``on_done()`` as each finishes; the tasks that failed are named at the end."""
-    if not tasks:
-        return
+    each (:func:`~hexdem.experiments.executors.run_phase`), calling ``on_done()`` as each
+    finishes; the tasks that failed are named at the end."""
     failed = []
-    bar = progress_bar(len(tasks), PHASE_LABELS[name], unit="deck")
-    with study_executor(min(workers, len(tasks)), parsl) as executor:
-        for what, _, error in run_tasks(executor, tasks):
-            if error is not None:
-                failed.append(f"{what}: {describe(error)}")
-            if on_done is not None:
-                on_done()
-            bar.update(1)
-    bar.close()
+    for what, error in run_phase(tasks, workers, parsl, PHASE_LABELS[name], "deck"):
+        if error is not None:
+            failed.append(f"{what}: {describe(error)}")
+        if on_done is not None:
+            on_done()
     if failed:
         raise HexdemError(f"{len(failed)} of {len(tasks)} {name} decks failed (rerun to run them again); "
                           f"{'; '.join(failed)}")
@@ -87,11 +80,7 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
     than run again (:mod:`hexdem.disorder.sharing`).
     """
     log = log or (lambda message: print(f"hexdem ensemble: {message}", file=sys.stderr, flush=True))
-    positive_int("--workers", workers)
-    if launcher is not None:
-        launcher_command(launcher)  # refused before anything is written into out
-    if parsl is not None:
-        load_parsl_config(parsl)
+    check_study_options(workers, parsl, launcher)
     laws = fitted_laws(scaling_json, config.disorder.diameter_m) if scaling_json else {}
     out = ensure_writable_dir(out)
     ensemble = Ensemble(config, out)

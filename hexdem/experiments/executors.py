@@ -30,7 +30,8 @@ from multiprocessing import get_context
 from pathlib import Path
 
 from hexdem.common.checks import positive_int
-from hexdem.engines.lammps.standalone import die_with_parent
+from hexdem.common.progress import progress_bar
+from hexdem.engines.lammps.standalone import die_with_parent, launcher_command
 from hexdem.errors import HexdemError
 
 #: Times a task of the local pool is submitted again after it failed.
@@ -113,6 +114,18 @@ class ParslExecutor(Executor):
         self._dfk.cleanup()
 
 
+def check_study_options(workers: int = 1, parsl=None, launcher: str | None = None, ranks: int | None = None) -> None:
+    """Refuse a study's bad running options in one line, before anything is written: ``--workers``,
+    a sweep's ``--ranks-per-run`` (``ranks``), ``--launcher`` and the ``--parsl`` file."""
+    positive_int("--workers", workers)
+    if ranks is not None:
+        positive_int("--ranks-per-run", ranks)
+    if launcher is not None:
+        launcher_command(launcher)
+    if parsl is not None:
+        load_parsl_config(parsl)
+
+
 @contextmanager
 def study_executor(workers: int, parsl=None):
     """The executor of a study's runs: Parsl with the configuration file ``parsl``, else a
@@ -145,3 +158,20 @@ def run_tasks(executor, tasks: dict):
                 futures[executor.submit(*tasks[key])] = key
             else:
                 yield key, None if error is not None else future.result(), error
+
+
+def run_phase(tasks: dict, workers: int, parsl, label: str, unit: str, done_before: int = 0):
+    """Run ``tasks`` (``{key: (fn, *args)}``: a sweep's runs, an ensemble's decks of one stage), one
+    task of the study executor each, behind a progress bar ``label`` counting ``unit`` s from
+    ``done_before`` (those a previous command finished); yield (key, error) as each finishes
+    (``error``: None, or the exception of its last try), so that the caller records a failure and
+    the others go on. Without tasks nothing starts."""
+    if not tasks:
+        return
+    bar = progress_bar(done_before + len(tasks), label, unit=unit)
+    bar.update(done_before)
+    with study_executor(min(workers, len(tasks)), parsl) as executor:
+        for key, _, error in run_tasks(executor, tasks):
+            yield key, error
+            bar.update(1)
+    bar.close()

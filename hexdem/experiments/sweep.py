@@ -33,12 +33,9 @@ import shutil
 import sys
 from pathlib import Path
 
-from hexdem.common.checks import positive_int
 from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
-from hexdem.common.progress import progress_bar
-from hexdem.engines.lammps.standalone import launcher_command
 from hexdem.errors import HexdemError, RunFailed
-from hexdem.experiments.executors import describe, load_parsl_config, run_tasks, study_executor
+from hexdem.experiments.executors import check_study_options, describe, run_phase
 from hexdem.experiments.sweep_plan import SweepRun, Variation, plan_sweep
 
 PLAN_NAME = "sweep.json"
@@ -134,20 +131,13 @@ def run_study(out: Path, runs: list[SweepRun], workers: int = 1, parsl=None, ran
         todo = [run for run in runs if not run_dir(out, run).is_dir()]
         where = f"on Parsl ({parsl})" if parsl is not None else f"{min(workers, max(len(todo), 1))} at once"
         log(f"{len(runs)} runs ({len(runs) - len(todo)} done before), {where}")
-        if not todo:
-            return
         for run in todo:
             failure_path(out, run).unlink(missing_ok=True)
-        bar = progress_bar(len(runs), "hexdem sweep", unit="run")
-        bar.update(len(runs) - len(todo))
-        with study_executor(min(workers, len(todo)), parsl) as executor:
-            named = {run.name: run for run in todo}
-            tasks = {name: (run_one, run, out, ranks, launcher) for name, run in named.items()}
-            for name, _, error in run_tasks(executor, tasks):
-                if error is not None:
-                    log(f"run {name} failed: {_record_failure(out, named[name], error)}")
-                bar.update(1)
-        bar.close()
+        named = {run.name: run for run in todo}
+        tasks = {name: (run_one, run, out, ranks, launcher) for name, run in named.items()}
+        for name, error in run_phase(tasks, workers, parsl, "hexdem sweep", "run", done_before=len(runs) - len(todo)):
+            if error is not None:
+                log(f"run {name} failed: {_record_failure(out, named[name], error)}")
 
 
 def run_single(out, runs: list[SweepRun], index: int, ranks: int | None = None,
@@ -155,7 +145,7 @@ def run_single(out, runs: list[SweepRun], index: int, ranks: int | None = None,
     """Run run ``index`` (from 0, in the plan's order) of ``runs``, the study planned in ``out``
     (:func:`planned_study`), in this process, whatever it left before; a failure is recorded and
     raised."""
-    check_options(ranks=ranks, launcher=launcher)
+    check_study_options(ranks=ranks, launcher=launcher)
     out = Path(out)
     if not 0 <= index < len(runs):
         raise HexdemError(f"--run {index}: {out} plans runs 0 to {len(runs) - 1}")
@@ -194,22 +184,11 @@ def _log(message: str) -> None:
     print(f"hexdem sweep: {message}", file=sys.stderr, flush=True)
 
 
-def check_options(workers: int = 1, parsl=None, ranks: int | None = None, launcher: str | None = None) -> None:
-    """Refuse bad running options in one line, before anything is written."""
-    positive_int("--workers", workers)
-    if ranks is not None:
-        positive_int("--ranks-per-run", ranks)
-    if launcher is not None:
-        launcher_command(launcher)
-    if parsl is not None:
-        load_parsl_config(parsl)
-
-
 def run_sweep(base: dict, variations: list[Variation], out, workers: int = 1, parsl=None, ranks: int | None = None,
               launcher: str | None = None, source: str = "the base configuration", log=None) -> list[tuple]:
     """Plan (or resume) the sweep into ``out``, run it and write its table and figure; the table's
     rows. An error names the runs that failed, after the table is written."""
-    check_options(workers, parsl, ranks, launcher)
+    check_study_options(workers, parsl, launcher, ranks)
     runs = plan_study(base, variations, out, source)
     out = Path(out)
     run_study(out, runs, workers, parsl, ranks, launcher, log)
