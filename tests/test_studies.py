@@ -1,10 +1,13 @@
 """Studies on an executor (hexdem.experiments.executors): a real Parsl HighThroughputExecutor on
 this machine survives a worker killed mid-run and gives the serial sweep's runs; a failed run is
 recorded and the others finish; runs of two ranks each; one run at a time of a planned study
-(a job array's task) and the table collected after; bad input in one line."""
+(a job array's task) and the table collected after; bad input in one line; a --parsl file runs
+once a command, an ensemble's phases sharing the one Parsl it starts."""
 
+import shutil
 import threading
 import time
+from pathlib import Path
 
 import psutil
 import pytest
@@ -172,6 +175,68 @@ def test_a_bad_parsl_file_is_one_line_before_anything_is_written(tmp_path, capsy
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and f"--parsl {path}" in lines[0] and message in lines[0], lines
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("command", ["ensemble", "scaling", "paper"])
+def test_every_studys_bad_parsl_file_is_refused_before_anything_is_written(tmp_path, capsys, command):
+    path, out = tmp_path / "parsl.py", tmp_path / "out"
+    assert main([command, "--out", str(out), "--parsl", str(path)]) == 3
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and f"--parsl {path}: no such file" in lines[0], lines
+    assert not out.exists()
+
+
+def traced_parsl_config(tmp_path):
+    """The local Parsl configuration file, which also appends a line to ``loaded.log`` beside itself
+    each time it runs; (its path, that log)."""
+    path = Path(parsl_config(tmp_path))
+    path.write_text("from pathlib import Path\n"
+                    "with open(Path(__file__).with_name('loaded.log'), 'a') as log:\n    log.write('loaded\\n')\n"
+                    + path.read_text())
+    return str(path), tmp_path / "loaded.log"
+
+
+def test_a_sweeps_parsl_file_runs_once_a_command(tmp_path):
+    """A --parsl file is Python with whatever effects its author gave it: a sweep, planned or
+    resumed, runs it once, its check and its runs together."""
+    path, trace = traced_parsl_config(tmp_path)
+    out = tmp_path / "out"
+    assert sweep(tmp_path, "--vary", "v0=0.2,0.3", "--out", str(out), "--parsl", path) == 0
+    assert trace.read_text() == "loaded\n"
+    shutil.rmtree(out / "runs" / "v0=0.3")
+    assert main(["sweep", str(out), "--parsl", path]) == 0
+    assert trace.read_text() == "loaded\n" * 2
+    assert (out / "runs" / "v0=0.3" / "peaks.csv").exists()
+
+
+def test_an_ensembles_phases_share_one_run_of_its_parsl_file(tmp_path):
+    """hexdem ensemble runs its --parsl file once, and its compaction, settling and impacts all
+    run on the one Parsl that the file's configuration starts."""
+    path, trace = traced_parsl_config(tmp_path)
+    out = tmp_path / "ensemble"
+    assert main(["ensemble", "--out", str(out), "--edge-beads", "4", "--velocities", "0.4", "--realizations", "1",
+                 "--parsl", path]) == 0
+    assert trace.read_text() == "loaded\n"
+    assert (out / "peaks_stats.csv").exists()
+
+
+def test_studies_inside_a_commands_parsl_session_share_its_parsl(tmp_path):
+    """hexdem paper's way: each study holds the session its command holds around them all; one
+    Parsl serves them, cleaned up when the command's hold ends."""
+    from hexdem.experiments.executors import holding, parsl_session, study_executor
+
+    path = tmp_path / "threads.py"
+    path.write_text("from parsl.config import Config\nfrom parsl.executors import ThreadPoolExecutor\n"
+                    "config = Config(executors=[ThreadPoolExecutor(max_threads=2)], "
+                    f"run_dir={str(tmp_path / 'runinfo')!r})\n")
+    session, used = parsl_session(str(path)), []
+    with holding(session):
+        for study in range(2):
+            with holding(parsl_session(session)), study_executor(1, session) as executor:
+                assert executor.submit(abs, -study).result() == study
+                used.append(executor)
+        assert not used[0]._dfk.cleanup_called
+    assert used[0] is used[1] and used[0]._dfk.cleanup_called
 
 
 def test_the_local_pools_processes_end_with_a_killed_study(tmp_path):

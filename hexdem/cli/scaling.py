@@ -44,6 +44,7 @@ def add_arguments(parser) -> None:
 
 def run(args) -> None:
     from hexdem.common.io import ensure_writable_dir
+    from hexdem.experiments.executors import parsl_session
     from hexdem.theory.outputs import write_outputs
     from hexdem.theory.sweep import SweepSettings, run_sweep
 
@@ -51,8 +52,9 @@ def run(args) -> None:
                              steps_per_contact=args.steps_per_contact, duration_contacts=args.duration,
                              engine=args.engine, workers=args.workers, launcher=args.launcher,
                              parsl=args.parsl)
+    parsl = parsl_session(args.parsl)  # a bad file is refused before the output directory is made
     ensure_writable_dir(args.out)
-    summary = write_outputs(run_sweep(settings), args.out, kind=args.fit)
+    summary = write_outputs(run_sweep(settings, parsl=parsl), args.out, kind=args.fit)
     print(f"hexdem scaling: results in {args.out}", file=sys.stderr)
     if args.json:
         print(json.dumps(summary, indent=2))

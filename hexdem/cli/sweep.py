@@ -61,7 +61,7 @@ def run(args) -> None:
     elif args.collect:
         sweep.collect(out, runs, variations)
     else:
-        check_study_options(args.workers, args.parsl, args.launcher, args.ranks_per_run)
+        check_study_options(args.workers, args.launcher, args.ranks_per_run)
         sweep.run_study(out, runs, args.workers, args.parsl, args.ranks_per_run, args.launcher)
         sweep.collect(out, runs, variations)
 

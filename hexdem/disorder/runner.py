@@ -26,7 +26,7 @@ from hexdem.disorder.sharing import adopt_preparation, adopt_ideal_impacts
 from hexdem.disorder.stats import write_statistics
 from hexdem.engines.lammps.standalone import is_done, run_deck
 from hexdem.errors import HexdemError
-from hexdem.experiments.executors import check_study_options, describe, run_phase
+from hexdem.experiments.executors import check_study_options, describe, holding, parsl_session, run_phase
 
 
 def _check_manifest(out: Path, config: EnsembleConfig) -> dict:
@@ -74,17 +74,19 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
     """Run (or resume) the ensemble in ``out`` and write its statistics; returns the summary.
 
     ``workers`` decks run at once in local processes, or on Parsl with the configuration file
-    ``parsl``, each on one rank (started by the MPI launcher ``launcher`` when given);
+    ``parsl`` (or its :class:`~hexdem.experiments.executors.ParslSession`), one Parsl for all the
+    phases, each deck on one rank (started by the MPI launcher ``launcher`` when given);
     ``scaling_json`` adds the fitted laws to Fig. 9;
     ``share_from`` other :class:`Ensemble` s whose identical finished runs are copied rather
     than run again (:mod:`hexdem.disorder.sharing`).
     """
     log = log or (lambda message: print(f"hexdem ensemble: {message}", file=sys.stderr, flush=True))
-    check_study_options(workers, parsl, launcher)
+    check_study_options(workers, launcher)
+    parsl = parsl_session(parsl)
     laws = fitted_laws(scaling_json, config.disorder.diameter_m) if scaling_json else {}
     out = ensure_writable_dir(out)
     ensemble = Ensemble(config, out)
-    with locked_directory(out, "another hexdem ensemble (or its LAMMPS is still shutting down)"):
+    with locked_directory(out, "another hexdem ensemble (or its LAMMPS is still shutting down)"), holding(parsl):
         manifest = _check_manifest(out, config)
         for leftover in list(out.rglob(".*.part")):  # atomic writes and copies cut short by a killed run
             if leftover.is_dir():

@@ -5,11 +5,12 @@ Every study (``hexdem sweep``, ``hexdem ensemble``'s impacts, ``hexdem scaling``
 :class:`concurrent.futures.Executor` that :func:`study_executor` opens:
 
 * by default a :class:`LocalPool` of ``workers`` spawned processes on this machine;
-* with ``parsl`` (the path of a Parsl configuration file that defines ``config``, a
-  :class:`parsl.config.Config`) Parsl's DataFlowKernel of that configuration, behind
+* with ``parsl`` (a :class:`ParslSession` of a Parsl configuration file that defines ``config``,
+  a :class:`parsl.config.Config`) Parsl's DataFlowKernel of that configuration, behind
   :class:`ParslExecutor`, whose ``submit`` returns Parsl's AppFutures (they are
   :class:`concurrent.futures.Future` s). Parsl then places the tasks on whatever its providers
-  reach (a Slurm allocation, a laptop) and retries them as its ``retries`` says.
+  reach (a Slurm allocation, a laptop) and retries them as its ``retries`` says. The file runs
+  once a command and its DataFlowKernel serves all the command's studies (:func:`parsl_session`).
 
 :func:`run_tasks` submits the tasks and yields each one's outcome as it finishes, so that a
 failed task is recorded by the study and the others go on. A task whose local worker process
@@ -25,7 +26,7 @@ import runpy
 import sys
 from concurrent.futures import FIRST_COMPLETED, Executor, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 from multiprocessing import get_context
 from pathlib import Path
 
@@ -114,27 +115,73 @@ class ParslExecutor(Executor):
         self._dfk.cleanup()
 
 
-def check_study_options(workers: int = 1, parsl=None, launcher: str | None = None, ranks: int | None = None) -> None:
+class ParslSession:
+    """A Parsl configuration file (``path``) run once for a command, its ``config``, and the one
+    :class:`ParslExecutor` of that configuration which all the command's studies share: Parsl
+    starts a Config's executors only once, and a file may have effects of its own. The first study
+    with tasks starts the executor; leaving the outermost ``with`` of the session cleans it up, so
+    every study holds the session (:func:`holding`) while it runs, and a command whose studies
+    share one (``hexdem paper``) holds it around them all."""
+
+    def __init__(self, path):
+        self.path = path
+        self.config = load_parsl_config(path)
+        self._executor: ParslExecutor | None = None
+        self._depth = 0
+
+    def executor(self) -> ParslExecutor:
+        """The command's Parsl executor, started at the first call."""
+        if self._executor is None:
+            self._executor = ParslExecutor(self.config)
+        return self._executor
+
+    def __enter__(self) -> ParslSession:
+        self._depth += 1
+        return self
+
+    def __exit__(self, *exc_info) -> None:
+        self._depth -= 1
+        if self._depth == 0 and self._executor is not None:
+            self._executor.shutdown()
+
+
+def parsl_session(parsl) -> ParslSession | None:
+    """The :class:`ParslSession` of ``parsl``: None without Parsl, a session as it is, and a new
+    one for a configuration file's path, whose file runs here, so that a bad file is refused in
+    one line before anything is written."""
+    if parsl is None or isinstance(parsl, ParslSession):
+        return parsl
+    return ParslSession(parsl)
+
+
+def holding(parsl: ParslSession | None):
+    """The context a study runs in: the session ``parsl`` held (see :class:`ParslSession`), or
+    nothing without Parsl."""
+    return nullcontext() if parsl is None else parsl
+
+
+def check_study_options(workers: int = 1, launcher: str | None = None, ranks: int | None = None) -> None:
     """Refuse a study's bad running options in one line, before anything is written: ``--workers``,
-    a sweep's ``--ranks-per-run`` (``ranks``), ``--launcher`` and the ``--parsl`` file."""
+    a sweep's ``--ranks-per-run`` (``ranks``) and ``--launcher`` (``--parsl``: :func:`parsl_session`)."""
     positive_int("--workers", workers)
     if ranks is not None:
         positive_int("--ranks-per-run", ranks)
     if launcher is not None:
         launcher_command(launcher)
-    if parsl is not None:
-        load_parsl_config(parsl)
 
 
 @contextmanager
-def study_executor(workers: int, parsl=None):
-    """The executor of a study's runs: Parsl with the configuration file ``parsl``, else a
-    :class:`LocalPool` of ``workers`` processes; shut down on leaving."""
-    executor = ParslExecutor(load_parsl_config(parsl)) if parsl is not None else LocalPool(workers)
+def study_executor(workers: int, parsl: ParslSession | None = None):
+    """The executor of a study's runs: the Parsl executor of the session ``parsl`` (shut down with
+    the session), else a :class:`LocalPool` of ``workers`` processes, shut down on leaving."""
+    if parsl is not None:
+        yield parsl.executor()
+        return
+    pool = LocalPool(workers)
     try:
-        yield executor
+        yield pool
     finally:
-        executor.shutdown(cancel_futures=True)
+        pool.shutdown(cancel_futures=True)
 
 
 def describe(error: BaseException) -> str:
@@ -160,12 +207,12 @@ def run_tasks(executor, tasks: dict):
                 yield key, None if error is not None else future.result(), error
 
 
-def run_phase(tasks: dict, workers: int, parsl, label: str, unit: str, done_before: int = 0):
+def run_phase(tasks: dict, workers: int, parsl: ParslSession | None, label: str, unit: str, done_before: int = 0):
     """Run ``tasks`` (``{key: (fn, *args)}``: a sweep's runs, an ensemble's decks of one stage), one
-    task of the study executor each, behind a progress bar ``label`` counting ``unit`` s from
-    ``done_before`` (those a previous command finished); yield (key, error) as each finishes
-    (``error``: None, or the exception of its last try), so that the caller records a failure and
-    the others go on. Without tasks nothing starts."""
+    task of the study executor each (:func:`study_executor`), behind a progress bar ``label``
+    counting ``unit`` s from ``done_before`` (those a previous command finished); yield (key, error)
+    as each finishes (``error``: None, or the exception of its last try), so that the caller
+    records a failure and the others go on. Without tasks nothing starts."""
     if not tasks:
         return
     bar = progress_bar(done_before + len(tasks), label, unit=unit)

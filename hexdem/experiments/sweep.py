@@ -35,7 +35,7 @@ from pathlib import Path
 
 from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
 from hexdem.errors import HexdemError, RunFailed
-from hexdem.experiments.executors import check_study_options, describe, run_phase
+from hexdem.experiments.executors import check_study_options, describe, holding, parsl_session, run_phase
 from hexdem.experiments.sweep_plan import SweepRun, Variation, plan_sweep
 
 PLAN_NAME = "sweep.json"
@@ -123,13 +123,15 @@ def _record_failure(out: Path, run: SweepRun, error: BaseException) -> str:
 def run_study(out: Path, runs: list[SweepRun], workers: int = 1, parsl=None, ranks: int | None = None,
               launcher: str | None = None, log=None) -> None:
     """Run the runs of ``runs`` that are missing or failed in the study folder ``out``, each one a
-    task of the study executor, recording the failures."""
+    task of the study executor, recording the failures; ``parsl``: a Parsl configuration file, or
+    its :class:`~hexdem.experiments.executors.ParslSession`."""
     log = log or _log
-    with locked_directory(out, "another hexdem sweep"):
+    parsl = parsl_session(parsl)
+    with locked_directory(out, "another hexdem sweep"), holding(parsl):
         for leftover in (out / RUNS_NAME).glob(".*.part"):
             shutil.rmtree(leftover, ignore_errors=True)
         todo = [run for run in runs if not run_dir(out, run).is_dir()]
-        where = f"on Parsl ({parsl})" if parsl is not None else f"{min(workers, max(len(todo), 1))} at once"
+        where = f"on Parsl ({parsl.path})" if parsl is not None else f"{min(workers, max(len(todo), 1))} at once"
         log(f"{len(runs)} runs ({len(runs) - len(todo)} done before), {where}")
         for run in todo:
             failure_path(out, run).unlink(missing_ok=True)
@@ -188,7 +190,8 @@ def run_sweep(base: dict, variations: list[Variation], out, workers: int = 1, pa
               launcher: str | None = None, source: str = "the base configuration", log=None) -> list[tuple]:
     """Plan (or resume) the sweep into ``out``, run it and write its table and figure; the table's
     rows. An error names the runs that failed, after the table is written."""
-    check_study_options(workers, parsl, launcher, ranks)
+    check_study_options(workers, launcher, ranks)
+    parsl = parsl_session(parsl)
     runs = plan_study(base, variations, out, source)
     out = Path(out)
     run_study(out, runs, workers, parsl, ranks, launcher, log)

@@ -86,9 +86,10 @@ def study_ensembles(settings: PaperSettings) -> list[StudyEnsemble]:
     return ensembles + [StudyEnsemble(s, True, (STUDY_VELOCITY_M_S,)) for s in RELAXED_SIGMA_PER_TOL]
 
 
-def run_study_ensemble(entry: StudyEnsemble, settings: PaperSettings, out: Path, scaling_json,
+def run_study_ensemble(entry: StudyEnsemble, settings: PaperSettings, parsl, out: Path, scaling_json,
                        others: list[StudyEnsemble] = ()) -> dict:
-    """Run (or resume) one ensemble of the study into ``out / entry.name``; its summary.
+    """Run (or resume) one ensemble of the study into ``out / entry.name`` (on ``parsl``, the
+    paper's :class:`~hexdem.experiments.executors.ParslSession`, or None); its summary.
 
     What ``others`` (the study's other ensembles, in ``out``) have already run identically,
     the ideal impacts and compactions, is copied rather than run again
@@ -96,7 +97,7 @@ def run_study_ensemble(entry: StudyEnsemble, settings: PaperSettings, out: Path,
     config = entry.config(settings)
     sources = tuple(Ensemble(other.config(settings), out / other.name) for other in others
                     if other != entry and (out / other.name).is_dir())
-    summary = run_ensemble(config, out / entry.name, workers=settings.workers, launcher=settings.launcher, parsl=settings.parsl,
+    summary = run_ensemble(config, out / entry.name, workers=settings.workers, launcher=settings.launcher, parsl=parsl,
                            scaling_json=scaling_json, log=lambda message: None, share_from=sources)
     return {"name": entry.name, "sigma_per_tol": entry.sigma_per_tol, "preparation": entry.preparation_name,
             **{key: summary[key] for key in ("prestress", "this_run", "leading_pulse_defined_fraction",

@@ -73,14 +73,15 @@ def friction_config(mu: float, settings: PaperSettings) -> EnsembleConfig:
     return replace(_paper_config(settings), friction=mu, realizations=settings.friction_realizations)
 
 
-def run_friction_ensemble(mu: float, settings: PaperSettings, out: Path, scaling_json) -> dict:
-    """Run (or resume) the ensemble with friction ``mu`` into ``out / friction / <name>``,
+def run_friction_ensemble(mu: float, settings: PaperSettings, parsl, out: Path, scaling_json) -> dict:
+    """Run (or resume) the ensemble with friction ``mu`` into ``out / friction / <name>`` (on
+    ``parsl``, the paper's :class:`~hexdem.experiments.executors.ParslSession`, or None),
     adopting the paper's σ = 6 tol preparation from ``out / disorder``; its summary."""
     paper = Ensemble(_paper_config(settings), out / "disorder" / FIGURES_ENSEMBLE)
     if not paper.out.is_dir():
         raise HexdemError(f"{paper.out} is missing: the friction study strikes that ensemble's packings")
     summary = run_ensemble(friction_config(mu, settings), out / "friction" / friction_name(mu),
-                           workers=settings.workers, launcher=settings.launcher, parsl=settings.parsl, scaling_json=scaling_json,
+                           workers=settings.workers, launcher=settings.launcher, parsl=parsl, scaling_json=scaling_json,
                            log=lambda message: None, share_from=(paper,))
     return {"name": friction_name(mu), "friction": mu,
             **{key: summary[key] for key in ("this_run", *MEASURES.values())}}

@@ -37,6 +37,7 @@ from pathlib import Path
 from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
 from hexdem.common.progress import progress_bar, silenced
 from hexdem.errors import HexdemError
+from hexdem.experiments.executors import holding, parsl_session
 from hexdem.paper.disorder_study import (
     FIGURES_ENSEMBLE,
     prestress_rows,
@@ -79,13 +80,13 @@ def _snapshots(settings: PaperSettings, out: Path, shape: str) -> dict:
     return json.loads((folder / "snapshots.json").read_text())
 
 
-def _scaling(settings: PaperSettings, out: Path) -> dict:
+def _scaling(settings: PaperSettings, out: Path, parsl) -> dict:
     from hexdem.theory.outputs import write_outputs
     from hexdem.theory.sweep import SweepSettings, run_sweep
 
     sweep = run_sweep(SweepSettings(n_v0=settings.n_v0, workers=settings.workers, launcher=settings.launcher,
                                     parsl=settings.parsl),
-                      log=_quiet)
+                      log=_quiet, parsl=parsl)
     return write_outputs(sweep, out / "scaling")
 
 
@@ -182,18 +183,21 @@ def _check_settings(out: Path, settings: PaperSettings) -> None:
 
 
 def run_paper(settings: PaperSettings, out, log=None) -> dict:
-    """Run (or resume) every part into ``out`` and write the report; returns the parts' summaries."""
+    """Run (or resume) every part into ``out`` and write the report; returns the parts' summaries.
+    The ``settings.parsl`` file runs once, and its Parsl takes the runs of every study."""
     log = log or (lambda message: print(f"hexdem paper: {message}", file=sys.stderr, flush=True))
+    parsl = parsl_session(settings.parsl)
     out = ensure_writable_dir(out)
-    with locked_directory(out, "another hexdem paper"):
+    with locked_directory(out, "another hexdem paper"), holding(parsl):
         _check_settings(out, settings)
-        summaries, wall_time_s = _run_parts(settings, out)
+        summaries, wall_time_s = _run_parts(settings, out, parsl)
     log(f"report in {out / 'report.html'} ({wall_time_s:.0f} s)")
     return summaries
 
 
-def _run_parts(settings: PaperSettings, out: Path) -> tuple[dict, float]:
-    """Every part in order (skipping the finished ones), then the report; (summaries, wall time [s])."""
+def _run_parts(settings: PaperSettings, out: Path, parsl) -> tuple[dict, float]:
+    """Every part in order (skipping the finished ones), then the report; (summaries, wall time [s]).
+    ``parsl``: the :class:`~hexdem.experiments.executors.ParslSession` of ``settings.parsl``."""
     from hexdem.paper.report import write_report
 
     scaling_json = out / "scaling" / "scaling.json"
@@ -204,10 +208,10 @@ def _run_parts(settings: PaperSettings, out: Path) -> tuple[dict, float]:
              ("fig3", "Fig. 3 snapshots", (), lambda: _snapshots(settings, out, "hexagon")),
              ("fig4", "Fig. 4 snapshots", (), lambda: _snapshots(settings, out, "half-hexagon")),
              ("scaling", f"V0 sweep ({settings.n_v0} values) and laws, Figs. 6-7", (),
-              lambda: _scaling(settings, out)),
+              lambda: _scaling(settings, out, parsl)),
              ("fit_protocols", "fit-protocol search", ("scaling",), lambda: _fit_protocols(out))]
     parts += [(name, f"ensemble {e.name}", ("scaling",),
-               lambda e=e: run_study_ensemble(e, settings, out / "disorder", scaling_json, ensembles))
+               lambda e=e: run_study_ensemble(e, settings, parsl, out / "disorder", scaling_json, ensembles))
               for name, e in zip(ensemble_parts, ensembles)]
     study_parts = [name for name, e in zip(ensemble_parts, ensembles) if e.sigma_per_tol in SIGMA_PER_TOL]
     parts.append(("disorder", "disorder study and verdict", tuple(study_parts),
@@ -217,7 +221,7 @@ def _run_parts(settings: PaperSettings, out: Path) -> tuple[dict, float]:
     paper_part = f"disorder-{FIGURES_ENSEMBLE}"
     friction_parts = [f"friction-{friction_name(mu)}" for mu in FRICTIONS]
     parts += [(name, f"ensemble with friction μ = {mu:g}", (paper_part,),
-               lambda mu=mu: run_friction_ensemble(mu, settings, out, scaling_json))
+               lambda mu=mu: run_friction_ensemble(mu, settings, parsl, out, scaling_json))
               for name, mu in zip(friction_parts, FRICTIONS)]
     parts.append(("friction", "friction and rotation study", (paper_part, *friction_parts),
                   lambda: _friction_summary(settings, {mu: summaries[name] for name, mu in

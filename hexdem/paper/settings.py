@@ -11,7 +11,6 @@ from dataclasses import asdict, dataclass
 from hexdem.common.checks import positive_int
 from hexdem.disorder.ensemble import check_impact_steps
 from hexdem.disorder.preparation import TOLERANCE_M
-from hexdem.experiments.executors import load_parsl_config
 from hexdem.model.config import STEPS_PER_CONTACT
 
 #: Disorder strengths σ / tol of the disorder study (the paper's is 6).
@@ -41,7 +40,8 @@ class PaperSettings:
     Fig. 4) at once; ``launcher``: the MPI launcher command that starts them
     (None: this environment's ``mpiexec``); ``parsl``: a Parsl configuration file that takes
     the runs of the studies (the scaling sweep, the ensembles' impacts) instead of local
-    processes (:mod:`hexdem.experiments.executors`);
+    processes (:mod:`hexdem.experiments.executors`; :func:`~hexdem.paper.pipeline.run_paper`
+    runs it);
     ``steps_per_contact`` the time step of the LAMMPS impacts (snapshots, ensembles), τ/this:
     the sweep keeps its own 140 (:class:`~hexdem.theory.sweep.SweepSettings`).
 
@@ -59,8 +59,6 @@ class PaperSettings:
 
     def __post_init__(self):
         positive_int("--workers", self.workers)
-        if self.parsl is not None:
-            load_parsl_config(self.parsl)
         check_impact_steps("--steps-per-contact", self.steps_per_contact)
 
     @property

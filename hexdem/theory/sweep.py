@@ -24,7 +24,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from hexdem.errors import HexdemError
-from hexdem.experiments.executors import describe, load_parsl_config, run_tasks, study_executor
+from hexdem.experiments.executors import describe, holding, parsl_session, run_tasks, study_executor
 from hexdem.theory.scaling import DEFAULT_LAST, Combination, CombinationFit, fit_combination
 from hexdem.model.run_settings import contact_time_s
 
@@ -41,8 +41,8 @@ class SweepSettings:
     τ(V₀)/this; ``samples_per_contact``: output samples per τ(V₀); ``duration_contacts``: run
     length in τ(V₀); ``engine``: "reference" or "lammps"; ``workers``: runs at once in local
     processes; ``parsl``: a Parsl configuration file that takes the runs instead
-    (:mod:`hexdem.experiments.executors`); ``launcher``: the MPI launcher command that starts
-    each run's rank (e.g. ``"srun"``; None: in the worker's process).
+    (:mod:`hexdem.experiments.executors`; :func:`run_sweep` runs it); ``launcher``: the MPI
+    launcher command that starts each run's rank (e.g. ``"srun"``; None: in the worker's process).
     """
 
     v0_min: float = 0.01
@@ -66,8 +66,6 @@ class SweepSettings:
             raise HexdemError("need steps_per_contact >= samples_per_contact >= 5")
         if self.workers < 1:
             raise HexdemError(f"workers must be >= 1, got {self.workers}")
-        if self.parsl is not None:
-            load_parsl_config(self.parsl)
         if self.last < 3:
             raise HexdemError(f"the last bead of the windows must be >= 3, got {self.last}")
 
@@ -159,29 +157,33 @@ class Sweep:
         return fit_combination(combination, self.v0, peaks, last, kind)
 
 
-def run_sweep(settings: SweepSettings, log=None) -> Sweep:
+def run_sweep(settings: SweepSettings, log=None, parsl=None) -> Sweep:
     """All runs of the sweep (both strike angles), ``settings.workers`` at a time, with
-    progress on ``log`` (default: stderr)."""
+    progress on ``log`` (default: stderr); ``parsl``: the
+    :class:`~hexdem.experiments.executors.ParslSession` of ``settings.parsl`` when the caller
+    has run that file already (None: it runs here)."""
     log = log or (lambda message: print(f"hexdem scaling: {message}", file=sys.stderr, flush=True))
     jobs = [(strike, i, v0) for strike in STRIKES_DEG for i, v0 in enumerate(settings.v0)]
+    parsl = parsl_session(settings.parsl if parsl is None else parsl)
     sweep, start = Sweep(settings), time.perf_counter()
     where = f"on Parsl ({settings.parsl})" if settings.parsl is not None else f"{settings.workers} workers"
     log(f"{len(jobs)} runs ({settings.engine}, hexagon {settings.hexagon_edge} per edge, no walls, {where})")
-    for done, (key, result) in enumerate(_results(settings, jobs), 1):
-        sweep.runs[key] = result
-        log(f"[{done}/{len(jobs)}] strike {result.strike_deg:g} deg, V0 = {result.v0:.4g}: "
-            f"{result.wall_time_s:.1f} s, energy drift {result.energy_drift:.1e}")
+    with holding(parsl):
+        for done, (key, result) in enumerate(_results(settings, jobs, parsl), 1):
+            sweep.runs[key] = result
+            log(f"[{done}/{len(jobs)}] strike {result.strike_deg:g} deg, V0 = {result.v0:.4g}: "
+                f"{result.wall_time_s:.1f} s, energy drift {result.energy_drift:.1e}")
     sweep.wall_time_s = time.perf_counter() - start
     return sweep
 
 
-def _results(settings: SweepSettings, jobs):
+def _results(settings: SweepSettings, jobs, parsl):
     """Yield ((strike, i), RunPeaks) as runs finish, each run a task of the study executor
-    (local processes: callers' scripts need an ``if __name__ == "__main__":`` guard); the runs
-    that failed are named at the end."""
+    (local processes: callers' scripts need an ``if __name__ == "__main__":`` guard; Parsl: the
+    session ``parsl``); the runs that failed are named at the end."""
     tasks = {(strike, i): (run_one, settings, v0, strike) for strike, i, v0 in jobs}
     failed = []
-    with study_executor(min(settings.workers, len(jobs)), settings.parsl) as executor:
+    with study_executor(min(settings.workers, len(jobs)), parsl) as executor:
         for (strike, i), result, error in run_tasks(executor, tasks):
             if error is None:
                 yield (strike, i), result
