@@ -96,7 +96,10 @@ UNMEASURED_STYLES = {
 OUTLINE_COLOURS = ("#00c8ff", "#3cdc3c", "#ff3cc8", "#0050ff")
 
 
-def _circles(ax, positions, diameters, **style) -> EllipseCollection:
+def bead_circles(ax, positions, diameters, **style) -> EllipseCollection:
+    """Circles of the true ``diameters`` (in ``ax``'s data units) centred at ``positions``, one
+    collection drawn in ``style`` (edges 0.2 pt wide unless ``linewidths`` says), for the caller to
+    colour and add: the bead maps' beads and the preview's bodies."""
     return EllipseCollection(diameters, diameters, np.zeros(len(diameters)), units="xy", offsets=positions,
                              offset_transform=ax.transData, **{"linewidths": 0.2, **style})
 
@@ -202,7 +205,7 @@ def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=No
 def _circle_beads(ax, positions, diameters, values, coloured, groups: dict, outlined: dict, cmap, norm, clim):
     """The beads as true-size circles (see :func:`bead_map`); returns their collection and the
     legend's patches."""
-    circles = _circles(ax, positions[coloured], diameters[coloured], norm=norm, cmap=colormaps[cmap], edgecolor="k")
+    circles = bead_circles(ax, positions[coloured], diameters[coloured], norm=norm, cmap=colormaps[cmap], edgecolor="k")
     circles.set_array(values[coloured])
     if clim is not None:
         circles.set_clim(*clim)
@@ -210,11 +213,11 @@ def _circle_beads(ax, positions, diameters, values, coloured, groups: dict, outl
     legend = []
     for name, beads in groups.items():
         if np.any(beads):
-            ax.add_collection(_circles(ax, positions[beads], diameters[beads], **UNMEASURED_STYLES[name]))
+            ax.add_collection(bead_circles(ax, positions[beads], diameters[beads], **UNMEASURED_STYLES[name]))
             legend.append(Patch(label=name, **UNMEASURED_STYLES[name]))
     for (name, beads), colour in zip(outlined.items(), OUTLINE_COLOURS):
         ring = {"facecolor": "none", "edgecolor": colour}
-        ax.add_collection(_circles(ax, positions[beads], diameters[beads] * 0.9, **ring, linewidths=1.6))
+        ax.add_collection(bead_circles(ax, positions[beads], diameters[beads] * 0.9, **ring, linewidths=1.6))
         legend.append(Patch(label=name, linewidth=1.6, **ring))
     return circles, legend
 

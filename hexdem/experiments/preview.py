@@ -14,11 +14,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from matplotlib.collections import EllipseCollection
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from hexdem.analysis.figures import draw_walls, save, set_title, subplots
+from hexdem.analysis.figures import bead_circles, draw_walls, save, set_title, subplots
 from hexdem.common.io import staged_directory
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
@@ -33,11 +32,6 @@ STRUCK_COLOUR, LINE_COLOUR, WALL_COLOUR = "#d62728", "#1f4e9c", "0.15"
 ARROW_LENGTH_D, ARROW_GAP_D = 2.5, 0.15
 #: An observation line's name stands this many diameters beyond its last bead's centre, outside the packing.
 LABEL_BEYOND_D = 1.4
-
-
-def _discs(ax, positions, diameters, **style) -> None:
-    ax.add_collection(EllipseCollection(diameters, diameters, np.zeros(len(diameters)), units="xy",
-                                        offsets=positions, offset_transform=ax.transData, **style))
 
 
 def preview_figure(config: RunConfig, path) -> str:
@@ -55,7 +49,8 @@ def preview_figure(config: RunConfig, path) -> str:
         body = np.flatnonzero(ids[:beads] == k)
         if len(body):
             colour = MATERIAL_COLOURS[k % len(MATERIAL_COLOURS)]
-            _discs(ax, positions[body], diameters[body], facecolor=colour, edgecolor="0.3", linewidths=0.4)
+            ax.add_collection(bead_circles(ax, positions[body], diameters[body], facecolor=colour, edgecolor="0.3",
+                                           linewidths=0.4))
             legend.append(Patch(facecolor=colour, edgecolor="0.3", label=f"{material.name} ({len(body)})"))
     if model.walls:
         draw_walls(ax, model.walls, positions[:beads], diameters[:beads] / 2, color=WALL_COLOUR, linewidth=2.5)
@@ -103,14 +98,15 @@ def _draw_impacts(ax, model, positions, diameters, legend) -> None:
     """Each struck bead ringed, its striker (if any) dashed where it starts, and an arrow of the
     impact's direction ending just short of the body it sets moving."""
     struck = model.struck_beads
-    _discs(ax, positions[struck], diameters[struck], facecolor="none", edgecolor=STRUCK_COLOUR, linewidths=2.0)
+    ax.add_collection(bead_circles(ax, positions[struck], diameters[struck], facecolor="none",
+                                   edgecolor=STRUCK_COLOUR, linewidths=2.0))
     legend.append(Line2D([], [], linestyle="", marker="o", markerfacecolor="none", markeredgecolor=STRUCK_COLOUR,
                          markeredgewidth=2, label="struck bead"))
     bodies = model.impact_bodies()
     strikers = bodies[bodies >= len(model.packing)]
     if len(strikers):
-        _discs(ax, positions[strikers], diameters[strikers], facecolor="white", edgecolor=STRUCK_COLOUR,
-               linewidths=1.5, linestyles="--")
+        ax.add_collection(bead_circles(ax, positions[strikers], diameters[strikers], facecolor="white",
+                                       edgecolor=STRUCK_COLOUR, linewidths=1.5, linestyles="--"))
         legend.append(Line2D([], [], linestyle="", marker="o", markerfacecolor="white", markeredgecolor=STRUCK_COLOUR,
                              label="striker"))
     for impact, body in zip(model.impacts, bodies):
