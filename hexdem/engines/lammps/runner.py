@@ -63,12 +63,20 @@ def lammps_failure(directory: Path, output: str) -> RunFailed:
                        f"{error_line(log if 'ERROR' in log else output)}")
 
 
+def lmp_command(launcher: list[str], ranks: int, input_name: str = DECK_NAME) -> list[str]:
+    """``launcher -n ranks lmp -in input_name`` (``launcher``: the MPI launcher's words; ``lmp``:
+    this environment's), LAMMPS logging to ``log.lammps`` and printing nothing: a deck run as a
+    user runs it by hand (:func:`run_bare`, and
+    :func:`~hexdem.engines.lammps.standalone.run_deck` with a launcher)."""
+    return [*launcher, "-n", str(ranks), environment_command("lmp"), "-in", input_name,
+            "-log", "log.lammps", "-screen", "none", "-nocite"]
+
+
 def run_bare(deck: Deck, ranks: int = 1, input_name: str = DECK_NAME) -> RunInfo:
     """Run a deck as a user would by hand, ``mpiexec -n ranks lmp -in input_name`` (both from
     this environment), with no Python in the loop: the yardstick of hexdem's own runs."""
     ranks = positive_int("--ranks", ranks)
-    command = [environment_command("mpiexec"), "-n", str(ranks), environment_command("lmp"),
-               "-in", input_name, "-screen", "none", "-log", "log.lammps", "-nocite"]
+    command = lmp_command([environment_command("mpiexec")], ranks, input_name)
     start = time.perf_counter()
     done = subprocess.run(command, cwd=deck.directory, capture_output=True, text=True)
     if done.returncode != 0:

@@ -22,9 +22,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-from hexdem.engines.lammps.deck import DECK_NAME
 from hexdem.engines.lammps.library import environment_command
-from hexdem.engines.lammps.runner import lammps_failure
+from hexdem.engines.lammps.runner import lammps_failure, lmp_command
 from hexdem.engines.lammps.settling import run_settling_deck
 from hexdem.errors import HexdemError
 
@@ -73,8 +72,7 @@ def run_deck(directory, launcher: str | None = None) -> None:
     if launcher is None:
         run_settling_deck(directory)
     else:
-        command = [*launcher_command(launcher), "-n", "1", environment_command("lmp"), "-in", DECK_NAME,
-                   "-log", "log.lammps", "-screen", "none", "-nocite"]
+        command = lmp_command(launcher_command(launcher), 1)
         try:
             done = subprocess.run(command, cwd=directory, capture_output=True, text=True,
                                   preexec_fn=functools.partial(die_with_parent, os.getpid()))
