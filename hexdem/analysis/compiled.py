@@ -208,6 +208,38 @@ def moved_beyond(positions, listed_at, distance) -> bool:
     return False
 
 
+@_jit(F2, F2, F1, F2, float64, I1, I1, F1, F1, I1, I1, F1, F1, I1, F2, F2, I1, I1, F2, F1, I1, F1, F1, I1, int64)
+def audit_part(positions, velocities, spins, listed_at, distance, i, j, contact_m, coefficient, region_i, region_j,
+               masses, inertia, regions, start, external, bounds, curved, points, lengths, rows, radii,
+               wall_coefficient, wall_regions, n_regions):
+    """:meth:`~hexdem.analysis.energy.EnergyAudit.part` of a rank in one call: empty if a row of
+    ``positions`` lies more than ``distance`` from where the contacts were listed (``listed_at``,
+    :func:`moved_beyond`: the caller lists them again), else the sums [total energy, translational and
+    rotational kinetic, then each region's kinetic and contact energy] [J] of the audited rows (the
+    first ``len(masses)``) with ``velocities`` and ``spins``: the pairs' halves
+    (:func:`pair_contact_energies`), then the walls' contacts (:func:`add_wall_energies`), the
+    bodies' own terms (:func:`body_energies`); the total sums the regions' energies as NumPy sums a
+    few numbers (the first, plus the rest in order), less the constant forces' work. The arguments
+    after ``distance`` are :meth:`~hexdem.analysis.energy.EnergyAudit._row_constants`'s."""
+    if moved_beyond(positions, listed_at, distance):
+        return np.empty(0)
+    contact = pair_contact_energies(positions, i, j, contact_m, coefficient, region_i, region_j, n_regions)
+    add_wall_energies(positions, bounds, curved, points, lengths, rows, radii, wall_coefficient, wall_regions, contact)
+    translational, rotational, kinetic, work = body_energies(positions, velocities, spins, masses, inertia, regions,
+                                                             start, external, n_regions)
+    sums = np.empty(3 + 2 * n_regions)
+    for r in range(n_regions):
+        sums[3 + 2 * r] = kinetic[r]
+        sums[4 + 2 * r] = contact[r]
+    rest = 0.0
+    for k in range(4, len(sums)):
+        rest += sums[k]
+    sums[0] = (sums[3] + rest) - work
+    sums[1] = translational
+    sums[2] = rotational
+    return sums
+
+
 @_jit(I1, I1, F2, I1, F1, F2)
 def sample_speeds(ids, previous_ids, velocities, rows, speeds, end_velocity) -> bool:
     """The speeds ``|v|`` of the sample's rows ``rows`` into ``speeds``, and their velocities into

@@ -169,27 +169,32 @@ class EnergyAudit:
         self.everybody = np.arange(model.n_bodies)
         self.compiled = compiled
         self._listed, self._listed_at, self._candidates, self._walls, self._rows = None, None, None, None, None
+        self._no_spins = np.zeros(0)
 
-    def _list_contacts(self, bodies, n_own: int, positions_m) -> None:
-        """List the candidates among the rows of ``positions_m`` (bodies ``bodies``, the first
-        ``n_own`` audited) with an audited body, unless the list at hand still holds: the candidates
-        (i, j, k_n, R_eff) of rows within contact distance and the skin, kept from one search to the
-        next until a body has moved half the skin (:func:`_pair_constants`), and the walls' audited
-        members (:func:`_wall_constants`)."""
-        listed = self._listed is not None and n_own == self._listed[1] and np.array_equal(bodies, self._listed[0])
-        if not listed or self._moved_beyond(positions_m, self.skin_m / 2):
-            self._listed, self._listed_at = (bodies.copy(), n_own), positions_m.copy()
-            i, j = _pairs(positions_m, 2 * self.radii_m.max() + self.skin_m)
-            keep = (i < n_own) | (j < n_own)
-            i, j = i[keep], j[keep]
-            self._candidates = (i, j, *_pair_constants(self.model, bodies[i], bodies[j], self.radii_m)[2:])
-            self._walls = _wall_constants(self.model, bodies[:n_own])
-            if self.compiled:
-                self._rows = self._row_constants(bodies, n_own)
+    def _listed_for(self, bodies, n_own: int) -> bool:
+        """Whether the contacts at hand were listed for ``bodies`` with the first ``n_own`` audited
+        (the very array, kept by :meth:`_list`, or an equal one)."""
+        if self._listed is None or n_own != self._listed[1]:
+            return False
+        return bodies is self._listed[0] or np.array_equal(bodies, self._listed[0])
+
+    def _list(self, bodies, n_own: int, positions_m) -> None:
+        """List the candidates among the rows of ``positions_m`` (bodies ``bodies``, the first ``n_own``
+        audited) with an audited body: the candidates (i, j, k_n, R_eff) of rows within contact
+        distance and the skin (:func:`_pair_constants`), kept from one search to the next until a body
+        has moved half the skin, and the walls' audited members (:func:`_wall_constants`)."""
+        self._listed, self._listed_at = (bodies, n_own), positions_m.copy()
+        i, j = _pairs(positions_m, 2 * self.radii_m.max() + self.skin_m)
+        keep = (i < n_own) | (j < n_own)
+        i, j = i[keep], j[keep]
+        self._candidates = (i, j, *_pair_constants(self.model, bodies[i], bodies[j], self.radii_m)[2:])
+        self._walls = _wall_constants(self.model, bodies[:n_own])
+        if self.compiled:
+            self._rows = self._row_constants(bodies, n_own)
 
     def _row_constants(self, bodies, n_own: int) -> tuple:
-        r"""What the compiled kernels read of the listed rows, laid out once per list (see
-        :mod:`hexdem.analysis.compiled`): per candidate pair its sum of radii, its
+        r"""What :func:`~hexdem.analysis.compiled.audit_part` reads of the listed rows, laid out once
+        per list (see :mod:`hexdem.analysis.compiled`): per candidate pair its sum of radii, its
         :math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}` and the regions of its two rows (−1 for a ghost); per audited
         row its body's mass, inertia, region, start position and constant force; the walls' audited
         members (:func:`_wall_rows`)."""
@@ -200,57 +205,57 @@ class EnergyAudit:
         audited = bodies[:n_own]
         rows = (self.masses_kg[audited], self.inertia_kg_m2[audited], regions[:n_own], self.start_m[audited],
                 self.external_n[audited])
-        return pairs, rows, _wall_rows(self._walls, regions)
-
-    def _moved_beyond(self, positions_m, distance_m: float) -> bool:
-        """Whether a body has moved more than ``distance_m`` since the candidates were listed."""
-        if self.compiled:
-            from hexdem.analysis.compiled import moved_beyond  # numba: only for large ranks
-
-            return moved_beyond(positions_m, self._listed_at, distance_m)
-        return np.max(np.linalg.norm(positions_m - self._listed_at, axis=1)) > distance_m
-
-    def _contact_energies_j(self, bodies, n_own: int, positions_m) -> np.ndarray:
-        """(R,) contact energy [J] of each region of the audited bodies (:func:`_pair_energies_j`, then
-        :func:`_add_wall_energies_j`),
-        by the compiled kernels (:func:`~hexdem.analysis.compiled.pair_contact_energies`,
-        :func:`~hexdem.analysis.compiled.add_wall_energies`) where the audit was made ``compiled``,
-        else by NumPy: the same sums."""
-        self._list_contacts(bodies, n_own, positions_m)
-        n_regions = len(self.region_names)
-        if self.compiled:
-            from hexdem.analysis.compiled import add_wall_energies, pair_contact_energies  # numba: only for large ranks
-
-            contact = pair_contact_energies(positions_m, *self._rows[0], n_regions)
-            add_wall_energies(positions_m, *self._rows[2], contact)
-            return contact
-        contact = _pair_energies_j(_pair_contacts(positions_m, self.radii_m[bodies], self._candidates),
-                                   self.regions[bodies], n_regions, n_own)
-        _add_wall_energies_j(contact, _wall_contacts(positions_m, self._walls), self.regions[bodies], n_regions)
-        return contact
+        return (*pairs, *rows, *_wall_rows(self._walls, regions))
 
     def part(self, bodies, n_own: int, positions_m, velocities_m_s, angular_velocities_s=None) -> np.ndarray:
         """The audit's sums over the bodies ``bodies[:n_own]`` (indices; the rest are ghosts, see the
         class docstring) at ``positions_m`` (len(bodies), 2), ``velocities_m_s`` and spins ω_z
         (n_own,) [rad/s] (None: spheres that do not turn): [total energy, translational kinetic,
         rotational kinetic, then the (R, 2) kinetic and contact energy of each
-        :func:`energy_regions` region, flattened] [J], to be summed over the ranks."""
+        :func:`energy_regions` region, flattened] [J], to be summed over the ranks.
+
+        ``bodies`` is kept, not copied, with the contacts listed for it: a caller that passes the
+        same array again for the same bodies (and never changes it) spares the audit comparing them."""
         bodies, positions_m = np.asarray(bodies), np.asarray(positions_m, float)
-        contact = self._contact_energies_j(bodies, n_own, positions_m)
+        velocities_m_s = np.asarray(velocities_m_s, float)
+        if self.compiled:
+            return self._compiled_part(bodies, n_own, positions_m, velocities_m_s, angular_velocities_s)
+        if not self._listed_for(bodies, n_own) or self._moved_beyond(positions_m, self.skin_m / 2):
+            self._list(bodies, n_own, positions_m)
+        contact = _pair_energies_j(_pair_contacts(positions_m, self.radii_m[bodies], self._candidates),
+                                   self.regions[bodies], len(self.region_names), n_own)
+        _add_wall_energies_j(contact, _wall_contacts(positions_m, self._walls), self.regions[bodies],
+                             len(self.region_names))
         translational, rotational, kinetic, external = self._body_energies_j(
-            bodies[:n_own], positions_m[:n_own], np.asarray(velocities_m_s, float), angular_velocities_s)
+            bodies[:n_own], positions_m[:n_own], velocities_m_s, angular_velocities_s)
         by_region = np.column_stack([kinetic, contact])
         return np.concatenate([[float(np.sum(by_region)) - external, translational, rotational], by_region.ravel()])
+
+    def _compiled_part(self, bodies, n_own: int, positions_m, velocities_m_s, angular_velocities_s) -> np.ndarray:
+        """:meth:`part` in one compiled pass (:func:`~hexdem.analysis.compiled.audit_part`), which first
+        checks that no body has moved half the skin since the contacts were listed (else they are
+        listed again and the pass repeated)."""
+        from hexdem.analysis.compiled import audit_part  # numba: only for large ranks
+
+        spins = self._no_spins if angular_velocities_s is None else np.asarray(angular_velocities_s, float)
+        if not self._listed_for(bodies, n_own):
+            self._list(bodies, n_own, positions_m)
+        sums = audit_part(positions_m, velocities_m_s, spins, self._listed_at, self.skin_m / 2, *self._rows,
+                          len(self.region_names))
+        if not len(sums):
+            self._list(bodies, n_own, positions_m)
+            sums = audit_part(positions_m, velocities_m_s, spins, self._listed_at, self.skin_m / 2, *self._rows,
+                              len(self.region_names))
+        return sums
+
+    def _moved_beyond(self, positions_m, distance_m: float) -> bool:
+        """Whether a body has moved more than ``distance_m`` since the candidates were listed."""
+        return np.max(np.linalg.norm(positions_m - self._listed_at, axis=1)) > distance_m
 
     def _body_energies_j(self, own, positions_m, velocities_m_s, angular_velocities_s) -> tuple:
         """(translational and rotational kinetic energy [J], (R,) kinetic energy [J] of each region, the
         work [J] of the constant forces) of the audited bodies ``own`` at ``positions_m`` with
         ``velocities_m_s`` and spins (None: spheres that do not turn)."""
-        if self.compiled:
-            from hexdem.analysis.compiled import body_energies  # numba: only for large ranks
-
-            spins = np.zeros(0) if angular_velocities_s is None else np.asarray(angular_velocities_s, float)
-            return body_energies(positions_m, velocities_m_s, spins, *self._rows[1], len(self.region_names))
         translational = 0.5 * self.masses_kg[own] * np.sum(velocities_m_s**2, axis=1)
         rotational = (np.zeros(len(own)) if angular_velocities_s is None
                       else 0.5 * self.inertia_kg_m2[own] * np.asarray(angular_velocities_s, float) ** 2)

@@ -112,6 +112,11 @@ class TrackedPulses:
     analysis_cpu_s: dict = field(default_factory=dict)
 
 
+def _in_si(values: np.ndarray, unit: float) -> np.ndarray:
+    """``values`` in a unit of ``unit`` SI units, in SI: the array itself for SI units (× 1 is exact)."""
+    return values if unit == 1.0 else values * unit
+
+
 class PulseTracker:
     """Observer of one run's samples (see the module docstring).
 
@@ -149,6 +154,7 @@ class PulseTracker:
         # what the first sample needs loads while the engine starts: the kernels, the audit's pair search
         load_in_background(*(["hexdem.analysis.compiled"] if self.compiled else []), "scipy.spatial")
         self.audit = EnergyAudit(model, gravity_m_s2, self.compiled)
+        self.audit_bodies = None  # the bodies of this rank's audited rows, own then ghosts, since the last migration
         self.energy_times, self.audit_parts = [], []
         self.count = 0
         self.collectives = 0
@@ -225,6 +231,7 @@ class PulseTracker:
         s = sample.index
         if sample.migrated:
             self._arrange(sample)
+            self.audit_bodies = None
         speeds = self._speeds(sample)
         if self.compiled:
             from hexdem.analysis.compiled import update_pulses  # numba: only for large ranks
@@ -287,13 +294,15 @@ class PulseTracker:
         contacts that cross to another rank), kept until :meth:`finish` sums the ranks' parts."""
         start = time.thread_time()
         units = self.settings.units
-        bodies, positions = sample.ids - 1, sample.positions
+        if self.audit_bodies is None:  # (the same array until the bodies may have migrated, see EnergyAudit.part)
+            ids = sample.ids if sample.ghost_ids is None else np.concatenate([sample.ids, sample.ghost_ids])
+            self.audit_bodies = ids - 1
+        positions = sample.positions
         if sample.ghost_ids is not None:
-            bodies = np.concatenate([bodies, sample.ghost_ids - 1])
             positions = np.concatenate([positions, sample.ghost_positions])
         angular = None if sample.angular_velocities is None else sample.angular_velocities / units.time_s
-        self.audit_parts.append(self.audit.part(bodies, len(sample.ids), positions * units.length_m,
-                                                sample.velocities * units.velocity_m_s, angular))
+        self.audit_parts.append(self.audit.part(self.audit_bodies, len(sample.ids), _in_si(positions, units.length_m),
+                                                _in_si(sample.velocities, units.velocity_m_s), angular))
         self.energy_times.append(sample.time)
         self.cpu_s["audit"] += time.thread_time() - start
 
