@@ -24,6 +24,8 @@ _EXTRACT_ATOM = ctypes.CFUNCTYPE(ctypes.c_void_p, ctypes.c_void_p, ctypes.c_char
 _CALLBACK = ctypes.CFUNCTYPE(None, ctypes.py_object, ctypes.c_int64, ctypes.c_int, ctypes.c_void_p,
                              ctypes.c_void_p, ctypes.c_void_p)
 _SET_CALLBACK = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_char_p, _CALLBACK, ctypes.py_object)
+#: ``lammps_get_thermo(handle, keyword)``: a thermo keyword's current value.
+_GET_THERMO = ctypes.CFUNCTYPE(ctypes.c_double, ctypes.c_void_p, ctypes.c_char_p)
 #: The C ``tagint`` of LAMMPS's atom ids, by its size in bytes (``extract_setting("tagint")``).
 _TAG_TYPES = {4: np.int32, 8: np.int64}
 
@@ -49,6 +51,13 @@ class AtomViews:
         if kept is None or kept[0] != address or kept[1] != n:
             kept = self._kept[(name, columns)] = (address, n, _view(address, n, columns, dtype))
         return kept[2]
+
+
+def neighbour_builds(lmp):
+    """A function of no argument giving the neighbour-list builds of ``lmp``'s current run so far
+    (the thermo keyword ``nbuild``, read on this rank without communication)."""
+    get_thermo, handle = _GET_THERMO(("lammps_get_thermo", lmp.lib)), lmp.lmp
+    return lambda: get_thermo(handle, b"nbuild")
 
 
 def _view(address: int | None, n: int, columns: int, dtype) -> np.ndarray:

@@ -39,7 +39,7 @@ from hexdem.common.job_failure import abort_job
 from hexdem.common.memory import keep_freed_memory
 from hexdem.common.preload import load_in_background
 from hexdem.common.progress import progress_bar
-from hexdem.engines.lammps.c_interface import AtomViews, add_sampling_fix
+from hexdem.engines.lammps.c_interface import AtomViews, add_sampling_fix, neighbour_builds
 from hexdem.engines.lammps.deck import Deck
 from hexdem.engines.lammps.library import load_lammps
 from hexdem.engines.lammps.runner import RunInfo, lammps_failure, log_version
@@ -84,79 +84,82 @@ def full_step(positions, velocities, forces, masses, dt: float, compiled: bool =
 
 class _Stream:
     """The ``fix external`` callback: full-step samples of the local atoms (with their spins ω_z
-    when ``spins``), with progress. It reads LAMMPS's arrays through views kept between samples
-    (:class:`~hexdem.engines.lammps.c_interface.AtomViews`), the positions and ids with the ghosts'
-    rows after the rank's own."""
+    when ``spins``), with progress.
+
+    It reads LAMMPS's arrays through views (:class:`~hexdem.engines.lammps.c_interface.AtomViews`)
+    taken again only when LAMMPS has rebuilt its neighbour lists: LAMMPS reallocates its per-atom
+    arrays (growing them as atoms arrive), moves atoms between ranks, sorts them and lists the ghosts
+    only then, so between two rebuilds a rank's atom count, its ghosts' ids and every array's place in
+    memory stay as they are. The positions and ids hold the ghosts' rows after the rank's own."""
+
+    #: The per-atom arrays a sample reads, with their columns (0: a vector) and whether they reach
+    #: into the ghosts' rows; ω, τ and the radii only for spheres that turn.
+    ARRAYS = {"x": (3, True), "id": (0, True), "v": (3, False), "f": (3, False), "rmass": (0, False)}
+    SPIN_ARRAYS = {"omega": (3, False), "torque": (3, False), "radius": (0, False)}
 
     def __init__(self, lmp, deck: Deck, on_sample, show_progress: bool, comm=None, spins: bool = False):
         self.lmp, self.on_sample, self.comm, self.spins = lmp, on_sample, comm, spins
-        self.views = AtomViews(lmp)
+        self.views, self.builds_now = AtomViews(lmp), neighbour_builds(lmp)
         self.every, self.dt = deck.settings.dump_every, float(lmp.extract_global("dt"))
         self.sensor_every = deck.settings.sensor_every
         self.bar = progress_bar(deck.settings.n_steps, "LAMMPS", unit="step") if show_progress else None
         self.error: BaseException | None = None
         self.builds = None  # neighbour list builds at the previous sample (None: it came before this run)
-        self.nghost = 0
+        self.arrays: dict[str, np.ndarray] = {}
+        self.ghost_ids = np.zeros(0, dtype=np.int64)
         self.compiled = runs_compiled(deck.n_atoms, 1 if comm is None else comm.Get_size())
         if self.compiled:
             load_in_background("hexdem.engines.lammps.full_step")
 
-    def with_ghosts(self, name: str, nlocal: int, columns: int = 0) -> np.ndarray:
-        """Per-atom array ``name`` of the local atoms and then the ghosts (:meth:`AtomViews.__call__`)."""
-        return self.views(name, nlocal + self.nghost, columns)
+    def take_arrays(self, nlocal: int) -> None:
+        """Views of the arrays a sample reads, for ``nlocal`` atoms and the ghosts LAMMPS has now, and
+        the ghosts' ids."""
+        n = nlocal + self.lmp.extract_global("nghost")
+        wanted = {**self.ARRAYS, **(self.SPIN_ARRAYS if self.spins else {})}
+        self.arrays = {name: self.views(name, n if ghosts else nlocal, columns)
+                       for name, (columns, ghosts) in wanted.items()}
+        self.ghost_ids = self.arrays["id"][nlocal:].astype(np.int64)
 
-    def local_state(self):
-        n = self.lmp.extract_global("nlocal")
-        self.nghost = self.lmp.extract_global("nghost")
-        ids = self.with_ghosts("id", n)[:n].astype(np.int64)
-        return ids, self.with_ghosts("x", n, 3)[:n, :2].copy(), self.views("v", n, 3)[:, :2].copy()
-
-    def ghosts(self, nlocal: int):
-        """(ids, (g, 2) positions) of this rank's ghost atoms."""
-        return self.with_ghosts("id", nlocal)[nlocal:].astype(np.int64), self.with_ghosts("x", nlocal, 3)[nlocal:, :2].copy()
-
-    def angular_velocities(self, n: int, mass=None) -> np.ndarray | None:
-        """(n,) ω_z of the first ``n`` local atoms, or None for spheres that do not turn. Given their
-        ``mass``, completed to the full step as the velocities are: ω(t) = ω(t − dt/2) + (dt/2) τ_z / I,
-        I = (2/5) m r² as ``fix nve/sphere`` has it."""
+    def angular_velocities(self, n: int, full_step: bool = True) -> np.ndarray | None:
+        """(n,) ω_z of the ``n`` local atoms, or None for spheres that do not turn; at the full step,
+        completed as the velocities are, ω(t) = ω(t − dt/2) + (dt/2) τ_z / I, I = (2/5) m r² as ``fix
+        nve/sphere`` has it (else as LAMMPS holds them: before the run's first step)."""
         if not self.spins:
             return None
-        omega = self.views("omega", n, 3)[:, 2].copy()
-        if mass is not None:
-            inertia = 0.4 * mass * self.views("radius", n) ** 2
-            omega += 0.5 * self.dt * self.views("torque", n, 3)[:, 2] / inertia
+        omega = self.arrays["omega"][:, 2].copy()
+        if full_step:
+            inertia = 0.4 * self.arrays["rmass"] * self.arrays["radius"] ** 2
+            omega += 0.5 * self.dt * self.arrays["torque"][:, 2] / inertia
         return omega
 
-    def forces_and_masses(self, n: int):
-        """(n, 3) forces and (n,) masses of the first ``n`` local atoms."""
-        return self.views("f", n, 3), self.views("rmass", n)
+    def sample(self, index: int, step: int, nlocal: int, migrated: bool, positions, velocities) -> Sample:
+        """The :class:`~hexdem.engines.sampling.Sample` of the ``nlocal`` local atoms at ``step``, at
+        ``positions`` with ``velocities`` (n, 2), their accelerations at the sensors' steps."""
+        x, force, mass = self.arrays["x"], self.arrays["f"], self.arrays["rmass"]
+        sensed = bool(self.sensor_every) and step % self.sensor_every == 0
+        accelerations = force[:, :2] / mass[:, None] if sensed else None
+        return Sample(index, step, step * self.dt, self.arrays["id"][:nlocal].astype(np.int64), positions, velocities,
+                      accelerations, self.angular_velocities(nlocal, step > 0), migrated, self.ghost_ids,
+                      x[nlocal:, :2].copy())
 
     def initial(self) -> None:
         self.lmp.command("run 0 post no")  # distributes the atoms, finds the ghosts, computes the forces at t = 0
-        ids, positions, velocities = self.local_state()
-        accelerations = None
-        if self.sensor_every:
-            force, mass = self.forces_and_masses(len(ids))
-            accelerations = force[:, :2] / mass[:, None]
-        self.on_sample(Sample(0, 0, 0.0, ids, positions, velocities, accelerations,
-                              self.angular_velocities(len(ids)), True, *self.ghosts(len(ids))))
+        nlocal = self.lmp.extract_global("nlocal")
+        self.take_arrays(nlocal)
+        self.on_sample(self.sample(0, 0, nlocal, True, self.arrays["x"][:nlocal, :2].copy(),
+                                   self.arrays["v"][:, :2].copy()))
 
     def __call__(self, step: int, nlocal: int) -> None:
         if self.error is not None:
             return
         try:
-            builds = self.lmp.get_thermo("nbuild")
+            builds = self.builds_now()
             migrated, self.builds = builds != self.builds, builds
-            if migrated:  # LAMMPS finds the ghosts again only when it rebuilds its lists
-                self.nghost = self.lmp.extract_global("nghost")
-            force, mass = self.forces_and_masses(nlocal)
-            positions, velocities = full_step(self.with_ghosts("x", nlocal, 3)[:nlocal], self.views("v", nlocal, 3), force,
-                                              mass, self.dt, self.compiled)
-            ids = self.with_ghosts("id", nlocal)[:nlocal].astype(np.int64)
-            sensed = self.sensor_every and step % self.sensor_every == 0
-            accelerations = force[:, :2] / mass[:, None] if sensed else None
-            self.on_sample(Sample(step // self.every, int(step), step * self.dt, ids, positions, velocities,
-                                  accelerations, self.angular_velocities(nlocal, mass), migrated, *self.ghosts(nlocal)))
+            if migrated:
+                self.take_arrays(nlocal)
+            positions, velocities = full_step(self.arrays["x"][:nlocal], self.arrays["v"], self.arrays["f"],
+                                              self.arrays["rmass"], self.dt, self.compiled)
+            self.on_sample(self.sample(step // self.every, int(step), nlocal, migrated, positions, velocities))
             if self.bar is not None:
                 self.bar.update(int(step) - self.bar.n)
         except BaseException as exc:  # a ctypes callback cannot raise: keep it for after the run
