@@ -31,11 +31,17 @@ def _jit(*argument_types):
     code loads from numba's disk cache as this module loads (in the background, see
     :func:`~hexdem.common.preload.load_in_background`), not at the run's first sample, where loading
     the tracker's first two kernels took 0.6 s of each rank (29,701 beads on 2 ranks, under cProfile).
-    Arguments of other types still work: numba compiles for them at their first call."""
+    Arguments of other types still work: numba compiles for them at their first call. Loading each
+    declared kernel takes about 60 ms, so only those that Python calls are declared; the kernels they
+    call (:data:`_inner`) are compiled into them."""
     return njit([argument_types], cache=True, error_model="numpy")
 
 
-@njit(cache=True, error_model="numpy")
+#: A kernel called only from other kernels: compiled into each caller, and loaded with it.
+_inner = njit(cache=True, error_model="numpy")
+
+
+@_inner
 def open_window(window, index, after, ring, b, v, s):
     """Row ``b``'s window centred on its sample ``s`` of speed ``v``
     (:func:`~hexdem.analysis.tracker_kernel._open`)."""
@@ -119,7 +125,7 @@ def update_pulses(speeds, s, q, rival_ratio, ring, peak, peak_index, window, aft
     return complete[:count]
 
 
-@_jit(F2, I1, I1, F1, F1, I1, I1, int64)
+@_inner
 def pair_contact_energies(positions, i, j, contact_m, coefficient, region_i, region_j, n_regions):
     r"""(R,) Hertz energy [J] of the touching candidate pairs ``i``, ``j`` (rows of ``positions``):
     :math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}\, δ^{5/2}` each, δ = ``contact_m`` (the pair's sum of radii) less
@@ -147,7 +153,7 @@ def pair_contact_energies(positions, i, j, contact_m, coefficient, region_i, reg
     return contact
 
 
-@_jit(F2, I1, I1, F2, F1, I1, F1, F1, I1, F1)
+@_inner
 def add_wall_energies(positions, bounds, curved, points, lengths, rows, radii, coefficient, regions, contact):
     r"""Add to ``contact`` (R,) the Hertz energy [J] of the wall contacts of the rows ``rows`` of
     ``positions``, wall by wall: wall ``w``'s members are ``bounds[w]`` to ``bounds[w + 1]`` of the
@@ -175,7 +181,7 @@ def add_wall_energies(positions, bounds, curved, points, lengths, rows, radii, c
             contact[k] += wall_sum[k]
 
 
-@_jit(F2, F2, F1, F1, F1, I1, F2, F2, int64)
+@_inner
 def body_energies(positions, velocities, spins, masses, inertia, regions, start, external, n_regions):
     """The audited bodies' own terms of :meth:`~hexdem.analysis.energy.EnergyAudit.part`, one pass
     over their rows: ``positions``, ``velocities``, ``spins`` (ω_z, empty for spheres that do not
@@ -196,7 +202,7 @@ def body_energies(positions, velocities, spins, masses, inertia, regions, start,
     return translational, rotational, kinetic, work
 
 
-@_jit(F2, F2, float64)
+@_inner
 def moved_beyond(positions, listed_at, distance) -> bool:
     """Whether a row of ``positions`` lies more than ``distance`` from the same row of ``listed_at``."""
     limit = distance * distance
