@@ -2,6 +2,6 @@
 
 import sys
 
-from hexdem.cli.main import main
+from hexdem.cli.main import command
 
-sys.exit(main())
+sys.exit(command())

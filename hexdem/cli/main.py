@@ -16,6 +16,7 @@ import importlib
 import sys
 
 from hexdem.cli.version import VersionAction
+from hexdem.common.process_end import skip_final_collections
 from hexdem.errors import HexdemError, RunFailed
 
 #: Exit status → what it means (also in the CLI reference).
@@ -76,5 +77,13 @@ def main(argv=None) -> int:
     return 0
 
 
+def command() -> int:
+    """The ``hexdem`` command: :func:`main` in a process that ends with it (see
+    :mod:`hexdem.common.process_end`)."""
+    code = main()
+    skip_final_collections()
+    return code
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(command())

@@ -27,6 +27,7 @@ from pathlib import Path
 from hexdem.common.checks import positive_int
 from hexdem.common.io import atomic_path
 from hexdem.common.job_failure import ERROR_FILE_VARIABLE, abort_job
+from hexdem.common.process_end import skip_final_collections
 from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.library import load_lammps
 from hexdem.engines.lammps.standalone import die_with_parent, launcher_command
@@ -117,6 +118,7 @@ def _rank_main(job_path: Path) -> None:
     if comm.Get_rank() == 0:
         with atomic_path(job_path.parent / RESULT_NAME) as tmp:
             tmp.write_bytes(pickle.dumps(result))
+    skip_final_collections()
 
 
 if __name__ == "__main__":
