@@ -335,3 +335,11 @@ def energy_error(energies_j, impact_energy_j: float, dissipative: bool = False) 
     if dissipative:
         return float(np.max(energies_j - np.minimum.accumulate(energies_j)) / scale)
     return float(np.max(np.abs(energies_j - energies_j[0])) / scale)
+
+
+def rotational_share(rotational_j, region_energies_j) -> float:
+    """The largest share of the kinetic and contact energy (the regions' sum) held in rotation,
+    over the audited times (0 where there is no energy)."""
+    totals = np.array([np.sum(energies) for energies in region_energies_j])
+    shares = np.divide(rotational_j, totals, out=np.zeros(len(totals)), where=totals > 0)
+    return float(shares.max(initial=0.0))

@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from hexdem.analysis.energy import EnergyAudit, energy_error, energy_scale_j
+from hexdem.analysis.energy import EnergyAudit, energy_error, energy_scale_j, rotational_share
 from hexdem.analysis.peaks import noise_floor, refine_peak, refine_peaks
 from hexdem.analysis.tracker_kernel import RIVAL_RATIO, PulseState
 from hexdem.common.compiled import runs_compiled
@@ -50,6 +50,7 @@ from hexdem.common.preload import load_in_background
 from hexdem.engines.sampling import Sample
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel, RunSettings
+from hexdem.model.units import in_si
 
 #: About this many evenly spaced samples enter the energy audit (the first and last always).
 ENERGY_SAMPLES = 100
@@ -110,11 +111,6 @@ class TrackedPulses:
     end_velocity: np.ndarray
     collectives: int = 0
     analysis_cpu_s: dict = field(default_factory=dict)
-
-
-def _in_si(values: np.ndarray, unit: float) -> np.ndarray:
-    """``values`` in a unit of ``unit`` SI units, in SI: the array itself for SI units (× 1 is exact)."""
-    return values if unit == 1.0 else values * unit
 
 
 class PulseTracker:
@@ -301,8 +297,8 @@ class PulseTracker:
         if sample.ghost_ids is not None:
             positions = np.concatenate([positions, sample.ghost_positions])
         angular = None if sample.angular_velocities is None else sample.angular_velocities / units.time_s
-        self.audit_parts.append(self.audit.part(self.audit_bodies, len(sample.ids), _in_si(positions, units.length_m),
-                                                _in_si(sample.velocities, units.velocity_m_s), angular))
+        self.audit_parts.append(self.audit.part(self.audit_bodies, len(sample.ids), in_si(positions, units.length_m),
+                                                in_si(sample.velocities, units.velocity_m_s), angular))
         self.energy_times.append(sample.time)
         self.cpu_s["audit"] += time.thread_time() - start
 
@@ -399,11 +395,3 @@ def run_noise_floor(model: GranularModel, settings: RunSettings) -> float:
     fastest body at t = 0 (an impact's V₀, or the initial state's fastest bead)."""
     fastest_m_s = float(np.max(np.linalg.norm(model.initial_velocities_m_s(), axis=1), initial=0.0))
     return noise_floor(fastest_m_s / settings.units.velocity_m_s)
-
-
-def rotational_share(rotational_j, region_energies_j) -> float:
-    """The largest share of the kinetic and contact energy (the regions' sum) held in rotation,
-    over the audited times (0 where there is no energy)."""
-    totals = np.array([np.sum(energies) for energies in region_energies_j])
-    shares = np.divide(rotational_j, totals, out=np.zeros(len(totals)), where=totals > 0)
-    return float(shares.max(initial=0.0))

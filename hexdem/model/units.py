@@ -72,3 +72,8 @@ def to_nondimensional_velocity(v_m_s, diameter_m: float, mat: Material = STEEL_3
 def to_physical_velocity(v, diameter_m: float, mat: Material = STEEL_316):
     """The inverse of :func:`to_nondimensional_velocity` [m/s]."""
     return np.asarray(v) * nondimensional(diameter_m, mat).velocity_m_s
+
+
+def in_si(values: np.ndarray, unit: float) -> np.ndarray:
+    """``values`` in units of ``unit`` SI units, in SI: the array itself for SI units (× 1 is exact)."""
+    return values if unit == 1.0 else values * unit
