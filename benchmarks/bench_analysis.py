@@ -147,7 +147,9 @@ def main() -> None:
             results[way] = measure(model, settings, way, samples, Path(tempfile.mkdtemp()))
         now, compiled = results["NumPy"], results["compiled"]
         np.testing.assert_array_equal(compiled["peaks"], now["peaks"])
-        np.testing.assert_allclose(compiled["energies"], now["energies"], rtol=1e-12)
+        # the two ways round the overlaps (differences of coordinates) differently: within 1e-9 of the energy
+        # the audit's figures are read against (as tests/test_compiled_analysis.py derives)
+        np.testing.assert_allclose(compiled["energies"], now["energies"], rtol=0, atol=1e-9 * now["energies"][0].sum())
         rows.append((len(model.packing), results))
         print(f"  measured {len(model.packing):,} beads", flush=True)
     print(f"in-run analysis of one rank, {n_samples} synthetic samples: ns per bead per sample "
