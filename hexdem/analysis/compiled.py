@@ -159,9 +159,9 @@ def add_wall_energies(positions, bounds, curved, points, lengths, rows, radii, c
     ``positions``, wall by wall: wall ``w``'s members are ``bounds[w]`` to ``bounds[w + 1]`` of the
     member arrays; a flat wall {x : n·x = ``lengths[w]``} of normal n = ``points[w]``, or (``curved[w]``)
     the inside of the circle of centre ``points[w]`` and radius ``lengths[w]``. A member of radius
-    r = ``radii`` overlapping its wall by δ > 0 stores ``coefficient`` × δ^{5/2} (one apart adds +0, see
-    :func:`pair_contact_energies`)
-    (:math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}`, δ^{5/2} as δ² √δ), added to its region ``regions``:
+    r = ``radii`` overlapping its wall by δ > 0 stores ``coefficient`` (:math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}`)
+    × :math:`δ^{5/2}`, taken as δ² √δ (one apart adds +0, see :func:`pair_contact_energies`), added to its
+    region ``regions``:
     :func:`~hexdem.analysis.energy._add_wall_energies_j` (its gaps from
     :meth:`~hexdem.model.walls.Wall.gaps_m`, :meth:`~hexdem.model.walls.CurvedWall.gaps_m`), summed in its
     order, member by member within a wall, then wall by wall."""
