@@ -11,11 +11,13 @@ import pytest
 
 from hexdem.analysis.dump import read_dump
 from hexdem.cli.main import main
+from hexdem.common.checks import positive_int
+from hexdem.common.job_failure import reported_error
 from hexdem.engines.lammps import deck, library
 from hexdem.engines.lammps.deck import write_deck
 from hexdem.engines.lammps.driver import run_streaming
 from hexdem.engines.lammps.runner import run_bare
-from hexdem.errors import HexdemError
+from hexdem.errors import HexdemError, RunFailed
 from hexdem.experiments.parallel import run_on_ranks
 from hexdem.experiments.run import run_experiment
 from hexdem.model.config import RunConfig
@@ -275,7 +277,22 @@ def test_an_observer_failing_on_two_ranks_is_one_line(tmp_path, capfd):
     message reaches the user through job.error."""
     config = RunConfig(edge_beads=3)
     rendered = write_deck(build_model(config), run_settings(config), tmp_path / "deck")
-    with pytest.raises(HexdemError, match="TypeError: object of type 'Sample' has no len") as info:
+    with pytest.raises(RunFailed, match="TypeError: object of type 'Sample' has no len") as info:
         run_on_ranks(functools.partial(run_streaming, rendered, len), 2, tmp_path / "job")
     assert "\n" not in str(info.value)
     assert "Traceback" not in capfd.readouterr().err
+
+
+def test_a_rank_that_refuses_its_input_is_a_refusal_and_a_failing_one_a_failed_run(tmp_path):
+    """The kind of a rank's error reaches the launching process with its message: a
+    :class:`HexdemError` stays a refusal (the command's status 3), anything else is a failed run
+    (:class:`RunFailed`, status 4)."""
+    config = RunConfig(edge_beads=3)
+    rendered = write_deck(build_model(config), run_settings(config), tmp_path / "deck")
+    refusing = functools.partial(run_streaming, rendered, functools.partial(positive_int, "--beads"))
+    with pytest.raises(HexdemError, match="--beads must be a positive integer, got Sample") as info:
+        run_on_ranks(refusing, 2, tmp_path / "job")
+    assert not isinstance(info.value, RunFailed)
+    assert reported_error("LAMMPS failed on in.hexdem: ERROR: Lost atoms\nfailed\n").args == (
+        "LAMMPS failed on in.hexdem: ERROR: Lost atoms",)
+    assert isinstance(reported_error("a report without its kind\n"), RunFailed)

@@ -38,7 +38,7 @@ import numpy as np
 from hexdem.common.checks import is_number, positive_int
 from hexdem.disorder.preparation import Disorder, Preparation, spaced_packing, walls_for_settling
 from hexdem.engines.lammps.settling import SETTLED_NAME, read_data_file, read_stage
-from hexdem.errors import HexdemError
+from hexdem.errors import HexdemError, RunFailed
 from hexdem.model.config import MIN_STEPS_PER_CONTACT, STEPS_PER_CONTACT, RunConfig
 from hexdem.model.granular import GranularModel, RunSettings
 from hexdem.model.model_builder import build_model, build_packing
@@ -218,7 +218,7 @@ class Ensemble:
         directory = self.stage_dir(k, stage)
         result = read_stage(directory)
         if not result.settled:
-            raise HexdemError(f"realization {k}: stage {stage!r} did not settle in {result.steps} steps "
+            raise RunFailed(f"realization {k}: stage {stage!r} did not settle in {result.steps} steps "
                               f"(kinetic energy {result.kinetic_energy_j:.3g} J, tolerance {result.tolerance_j:.3g} J; "
                               f"largest force {result.max_force_n:.3g} N, tolerance {result.force_tolerance_n:.3g} N); "
                               "rerun with a larger --max-settle-steps")

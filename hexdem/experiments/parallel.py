@@ -26,12 +26,12 @@ from pathlib import Path
 
 from hexdem.common.checks import positive_int
 from hexdem.common.io import atomic_path
-from hexdem.common.job_failure import ERROR_FILE_VARIABLE, abort_job
+from hexdem.common.job_failure import ERROR_FILE_VARIABLE, abort_job, reported_error
 from hexdem.common.process_end import skip_final_collections
 from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.library import load_lammps
 from hexdem.engines.lammps.standalone import die_with_parent, launcher_command
-from hexdem.errors import HexdemError
+from hexdem.errors import HexdemError, RunFailed
 
 JOB_NAME, RESULT_NAME, ERROR_NAME = "job.pickle", "job.result.pickle", "job.error"
 #: Seconds between looks at a running job's progress.
@@ -93,9 +93,9 @@ def run_on_ranks(job, ranks: int, directory, launcher: str | None = None, progre
     if done.returncode != 0 or not paths[RESULT_NAME].exists():
         reported = paths[ERROR_NAME].read_text().strip() if paths[ERROR_NAME].exists() else ""
         if reported:
-            raise HexdemError(reported)
-        raise HexdemError(f"the MPI job on {ranks} ranks failed (exit status {done.returncode}): "
-                          f"{(done.stdout.strip().splitlines() or ['no output'])[-1]}")
+            raise reported_error(reported)
+        raise RunFailed(f"the MPI job on {ranks} ranks failed (exit status {done.returncode}): "
+                        f"{(done.stdout.strip().splitlines() or ['no output'])[-1]}")
     result = pickle.loads(paths[RESULT_NAME].read_bytes())
     for name in (JOB_NAME, RESULT_NAME):
         paths[name].unlink()

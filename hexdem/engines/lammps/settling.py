@@ -19,7 +19,7 @@ import numpy as np
 from hexdem.engines.lammps.deck import DATA_NAME, DECK_NAME, data_file, granular_block, integrator, template
 from hexdem.engines.lammps.driver import start_lammps, working_directory
 from hexdem.engines.lammps.runner import lammps_failure
-from hexdem.errors import HexdemError
+from hexdem.errors import RunFailed
 from hexdem.model.granular import GranularModel
 from hexdem.model.units import SI
 
@@ -129,7 +129,7 @@ def read_stage(directory) -> StageResult:
                            float(values["tolerance_j"]), float(values["max_force_n"]),
                            float(values["force_tolerance_n"]))
     except (OSError, KeyError, ValueError):
-        raise HexdemError(f"{path} is missing or unreadable: the settling deck did not finish") from None
+        raise RunFailed(f"{path} is missing or unreadable: the settling deck did not finish") from None
 
 
 @dataclass(frozen=True)
@@ -162,6 +162,6 @@ def read_data_file(path) -> DataFileState:
         if atoms is None or len(atoms) != count or (velocities is not None and len(velocities) != count):
             raise ValueError
     except (OSError, StopIteration, ValueError):
-        raise HexdemError(f"{path} is not a complete LAMMPS data file") from None
+        raise RunFailed(f"{path} is not a complete LAMMPS data file") from None
     return DataFileState(diameters_m=atoms[:, 2], positions_m=atoms[:, 4:6],
                          velocities_m_s=np.zeros((count, 2)) if velocities is None else velocities[:, 1:3])
