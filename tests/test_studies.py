@@ -4,7 +4,9 @@ recorded and the others finish; runs of two ranks each; one run at a time of a p
 (a job array's task) and the table collected after; bad input in one line; a --parsl file runs
 once a command, an ensemble's phases sharing the one Parsl it starts."""
 
+import json
 import shutil
+import sys
 import threading
 import time
 from pathlib import Path
@@ -88,6 +90,8 @@ def test_parsl_survives_a_killed_worker_with_the_serial_sweeps_runs(serial, tmp_
     assert [row["status"] for row in rows] == ["done"] * 8
     assert peaks_of(out) == peaks_of(serial)
     assert not list((out / "runs").glob(".*"))
+    for summary in (out / "runs").glob("*/summary.json"):  # the study's command, not the Parsl worker's
+        assert json.loads(summary.read_text())["provenance"]["command"] == sys.argv, summary
 
 
 def test_a_failed_run_is_recorded_and_the_others_finish(tmp_path, capsys):

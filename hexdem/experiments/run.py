@@ -258,13 +258,15 @@ def measure_front_shape(analysis: ImpactAnalysis, count: int = 8, geometric: boo
     return front_shape(positions, arrivals, origin, times, wall_margin=wall_margin_d, window_deg=window_deg)
 
 
-def run_experiment(config: RunConfig, out, log=None) -> ImpactAnalysis:
-    """Run ``config`` and publish its result files in ``out`` (see module docstring)."""
+def run_experiment(config: RunConfig, out, log=None, command=None) -> ImpactAnalysis:
+    """Run ``config`` and publish its result files in ``out`` (see module docstring); ``command``:
+    the argument vector that asked for the run, for its provenance (default: this process's; a
+    study's worker is handed the study's)."""
     log = log or (lambda message: print(f"hexdem: {message}", file=sys.stderr))
     load_in_background("hexdem.analysis.figures", "scipy.spatial")  # the results' figures, while the run goes
     with staged_directory(out, STAGING_PREFIX) as staging:
         try:
-            start, provenance = time.perf_counter(), run_provenance()
+            start, provenance = time.perf_counter(), run_provenance(command)
             prepared = prepare_random_packing(config, staging / "preparation", log)
             check_dump_space(prepared, Path(out))
             analysis = simulate(prepared, staging / "deck", log)

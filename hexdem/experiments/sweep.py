@@ -59,9 +59,10 @@ def run_status(out: Path, run: SweepRun) -> tuple[str, str]:
     return ("failed", failed.read_text().strip()) if failed.exists() else ("missing", "")
 
 
-def run_one(run: SweepRun, out: Path, ranks: int | None = None, launcher: str | None = None) -> None:
+def run_one(run: SweepRun, out: Path, ranks: int | None = None, launcher: str | None = None, command=None) -> None:
     """Run ``run`` (on ``ranks`` ranks started by ``launcher``, when given) in its part directory
-    and rename it into place when every file is written; a run that fails leaves no directory."""
+    and rename it into place when every file is written; a run that fails leaves no directory.
+    ``command``: the study's argument vector, its runs' provenance (default: this process's)."""
     from hexdem.experiments.run import run_experiment
 
     config = run.config.replace(**{key: value for key, value in (("ranks", ranks), ("launcher", launcher))
@@ -70,7 +71,7 @@ def run_one(run: SweepRun, out: Path, ranks: int | None = None, launcher: str | 
     partial = final.with_name(f".{final.name}.part")
     shutil.rmtree(partial, ignore_errors=True)
     try:
-        run_experiment(config, partial, log=lambda message: None)
+        run_experiment(config, partial, log=lambda message: None, command=command)
     except BaseException:
         shutil.rmtree(partial, ignore_errors=True)
         raise
@@ -136,7 +137,7 @@ def run_study(out: Path, runs: list[SweepRun], workers: int = 1, parsl=None, ran
         for run in todo:
             failure_path(out, run).unlink(missing_ok=True)
         named = {run.name: run for run in todo}
-        tasks = {name: (run_one, run, out, ranks, launcher) for name, run in named.items()}
+        tasks = {name: (run_one, run, out, ranks, launcher, list(sys.argv)) for name, run in named.items()}
         for name, error in run_phase(tasks, workers, parsl, "hexdem sweep", "run", done_before=len(runs) - len(todo)):
             if error is not None:
                 log(f"run {name} failed: {_record_failure(out, named[name], error)}")
