@@ -238,14 +238,17 @@ class EnergyAudit:
         from hexdem.analysis.compiled import audit_part  # numba: only for large ranks
 
         spins = self._no_spins if angular_velocities_s is None else np.asarray(angular_velocities_s, float)
+
+        def measure() -> np.ndarray:
+            return audit_part(positions_m, velocities_m_s, spins, self._listed_at, self.skin_m / 2, *self._rows,
+                              len(self.region_names))
+
         if not self._listed_for(bodies, n_own):
             self._list(bodies, n_own, positions_m)
-        sums = audit_part(positions_m, velocities_m_s, spins, self._listed_at, self.skin_m / 2, *self._rows,
-                          len(self.region_names))
+        sums = measure()
         if not len(sums):
             self._list(bodies, n_own, positions_m)
-            sums = audit_part(positions_m, velocities_m_s, spins, self._listed_at, self.skin_m / 2, *self._rows,
-                              len(self.region_names))
+            sums = measure()
         return sums
 
     def _moved_beyond(self, positions_m, distance_m: float) -> bool:
