@@ -219,9 +219,9 @@ class Ensemble:
         result = read_stage(directory)
         if not result.settled:
             raise RunFailed(f"realization {k}: stage {stage!r} did not settle in {result.steps} steps "
-                              f"(kinetic energy {result.kinetic_energy_j:.3g} J, tolerance {result.tolerance_j:.3g} J; "
-                              f"largest force {result.max_force_n:.3g} N, tolerance {result.force_tolerance_n:.3g} N); "
-                              "rerun with a larger --max-settle-steps")
+                            f"(kinetic energy {result.kinetic_energy_j:.3g} J, tolerance {result.tolerance_j:.3g} J; "
+                            f"largest force {result.max_force_n:.3g} N, tolerance {result.force_tolerance_n:.3g} N); "
+                            "rerun with a larger --max-settle-steps")
         return read_data_file(directory / SETTLED_NAME)
 
     def settled_packing(self, k: int) -> Packing:
