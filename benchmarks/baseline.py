@@ -24,21 +24,30 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def baseline_tree(work: Path, revision: str = BEFORE) -> Path | None:
     """The package of ``revision`` unpacked under ``work`` (its ``lammps_inputs`` link made a
-    copy) and warmed up, or None when this clone does not hold that revision (a shallow clone).
+    copy; a revision with C kernels, ``hexdem/common/kernels``, installed there by pip, which
+    builds them) and warmed up, or None when this clone does not hold that revision (a shallow
+    clone).
 
     The warm-up, a small ``hexdem run``, fills the unpacked package's numba cache as a user's
     first run would, so that no timed run of the earlier version compiles its kernels."""
-    target = Path(work) / f"hexdem-{revision}"
-    archive = subprocess.run(["git", "-C", str(ROOT), "archive", revision, "hexdem", "lammps_inputs"],
-                             capture_output=True, check=False)
+    source = Path(work) / f"source-{revision}"
+    archive = subprocess.run(["git", "-C", str(ROOT), "archive", revision, "hexdem", "lammps_inputs", "pyproject.toml",
+                              "README.md"], capture_output=True, check=False)
     if archive.returncode != 0:
         return None
-    target.mkdir(parents=True)
-    subprocess.run(["tar", "-x", "-C", str(target)], input=archive.stdout, check=True)
-    inputs = target / "hexdem" / "lammps_inputs"
-    if inputs.is_symlink():
-        inputs.unlink()
-        shutil.copytree(target / "lammps_inputs", inputs)
+    source.mkdir(parents=True)
+    subprocess.run(["tar", "-x", "-C", str(source)], input=archive.stdout, check=True)
+    target = Path(work) / f"hexdem-{revision}"
+    if (source / "hexdem" / "common" / "kernels").is_dir():
+        subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", str(target), str(source)],
+                       capture_output=True, check=True)
+    else:
+        target.mkdir()
+        shutil.move(source / "hexdem", target / "hexdem")
+        inputs = target / "hexdem" / "lammps_inputs"
+        if inputs.is_symlink():
+            inputs.unlink()
+            shutil.copytree(source / "lammps_inputs", inputs)
     config = target / "warm-up.toml"
     config.write_text("edge_beads = 4\nduration = 1e-4\n")
     subprocess.run(hexdem_command("run", "--config", str(config), "--out", str(target / "warm-up")), cwd=target,

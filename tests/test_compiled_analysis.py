@@ -86,6 +86,24 @@ def test_the_compiled_sample_is_the_numpy_full_step_to_the_bit():
     np.testing.assert_array_equal(velocities, v[:, :2] + (half_dt / mass)[:, None] * f[:, :2])
 
 
+def test_the_kernels_refuse_arrays_they_cannot_read_and_indices_outside_them():
+    """The C kernels read raw memory: an array of another type, order or shape is a TypeError, and
+    a row index outside its array an IndexError, never a read or write past the array's end."""
+    from hexdem.analysis.compiled import sample_speeds
+
+    velocities, ids = np.ones((4, 2)), np.arange(4)
+    speeds, end_velocity = np.empty(4), np.empty((4, 2))
+    assert sample_speeds(ids, ids, velocities, ids, speeds, end_velocity)
+    np.testing.assert_array_equal(speeds, np.full(4, np.sqrt(2)))
+    for wrong in (velocities.astype(np.float32), np.ones((4, 3)), np.asfortranarray(np.ones((4, 2)))[::2]):
+        with pytest.raises(TypeError):
+            sample_speeds(ids, ids, wrong, ids[:2], speeds, end_velocity)
+    with pytest.raises(TypeError):
+        sample_speeds(ids, ids, velocities, ids, np.empty(3), end_velocity)  # too short for its rows
+    with pytest.raises(IndexError):
+        sample_speeds(ids, ids, velocities, np.array([0, 4]), speeds, end_velocity)
+
+
 def test_freed_memory_is_kept_where_the_c_library_can():
     """glibc's ``mallopt`` takes both thresholds; another C library changes nothing and says so."""
     import platform

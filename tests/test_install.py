@@ -7,6 +7,7 @@ import json
 import subprocess
 import sys
 import zipfile
+from importlib.machinery import EXTENSION_SUFFIXES
 from pathlib import Path
 
 import pytest
@@ -63,6 +64,8 @@ def test_wheel_holds_every_module_and_template(wheel):
                  if path.suffix in (".in", ".py")}
     assert "hexdem/paper/pipeline.py" in modules and "hexdem/lammps_inputs/impact.in" in templates
     assert sorted(modules - names) == [] and sorted(templates - names) == []
+    # the in-run analysis's C kernels, built by pip for this Python
+    assert any(f"hexdem/common/_kernels{suffix}" in names for suffix in EXTENSION_SUFFIXES)
 
 
 def test_run_on_two_ranks_from_any_directory(installed, cwd, tmp_path):

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from hexdem.analysis.compiled import audit_part
 from hexdem.model.granular import GranularModel
 from hexdem.model.walls import CurvedWall
 
@@ -235,8 +236,6 @@ class EnergyAudit:
         """:meth:`part` in one compiled pass (:func:`~hexdem.analysis.compiled.audit_part`), which first
         checks that no body has moved half the skin since the contacts were listed (else they are
         listed again and the pass repeated)."""
-        from hexdem.analysis.compiled import audit_part  # numba: only for large ranks
-
         spins = self._no_spins if angular_velocities_s is None else np.asarray(angular_velocities_s, float)
 
         def measure() -> np.ndarray:

@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from hexdem.analysis.compiled import sample_speeds, update_pulses
 from hexdem.analysis.energy import EnergyAudit, energy_error, energy_scale_j, rotational_share
 from hexdem.analysis.peaks import noise_floor, refine_peak, refine_peaks
 from hexdem.analysis.tracker_kernel import RIVAL_RATIO, PulseState
@@ -147,8 +148,7 @@ class PulseTracker:
         self.field_parts = []
         self.energy_every = max(1, (total - 1) // ENERGY_SAMPLES)
         self.compiled = runs_compiled(model.n_bodies, 1 if comm is None else comm.Get_size())
-        # what the first sample needs loads while the engine starts: the kernels, the audit's pair search
-        load_in_background(*(["hexdem.analysis.compiled"] if self.compiled else []), "scipy.spatial")
+        load_in_background("scipy.spatial")  # the audit's pair search, while the engine starts
         self.audit = EnergyAudit(model, gravity_m_s2, self.compiled)
         self.audit_bodies = None  # the bodies of this rank's audited rows, own then ghosts, since the last migration
         self.energy_times, self.audit_parts = [], []
@@ -230,8 +230,6 @@ class PulseTracker:
             self.audit_bodies = None
         speeds = self._speeds(sample)
         if self.compiled:
-            from hexdem.analysis.compiled import update_pulses  # numba: only for large ranks
-
             self.pulses.challenge(update_pulses(speeds, s, self.pulses.q, RIVAL_RATIO, *self.pulses.sample_arrays()))
         else:
             self.pulses.update(np.arange(len(self.ids)), speeds, s)
@@ -260,8 +258,6 @@ class PulseTracker:
         in the same order, unless it says that they may have migrated (and :meth:`_arrange` laid them
         out): in one compiled pass on large ranks."""
         if self.compiled:
-            from hexdem.analysis.compiled import sample_speeds  # numba: only for large ranks
-
             speeds = np.empty(len(self.ids))
             same = sample_speeds(np.asarray(sample.ids, np.int64), self.sample_ids, sample.velocities, self.bead_rows,
                                  speeds, self.end_velocity)

@@ -1,9 +1,8 @@
 """Load modules in the background, while the process waits on something that leaves Python free.
 
 An import holds the interpreter; LAMMPS's set-up and run (a foreign call, which releases it) and
-a launched MPI job (a child process) do not. What a run will need later, the compiled kernels of
-its samples (:mod:`hexdem.common.compiled`) or the figures of its results, loads then instead of
-on the run's critical path.
+a launched MPI job (a child process) do not. What a run will need later, the audit's pair search
+or the figures of its results, loads then instead of on the run's critical path.
 """
 
 from __future__ import annotations

@@ -37,10 +37,10 @@ import numpy as np
 from hexdem.common.compiled import runs_compiled
 from hexdem.common.job_failure import abort_job
 from hexdem.common.memory import keep_freed_memory
-from hexdem.common.preload import load_in_background
 from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.c_interface import AtomViews, add_sampling_fix, neighbour_builds
 from hexdem.engines.lammps.deck import Deck
+from hexdem.engines.lammps.full_step import full_step_state
 from hexdem.engines.lammps.library import load_lammps
 from hexdem.engines.lammps.runner import RunInfo, lammps_failure, log_version
 from hexdem.engines.sampling import Sample
@@ -76,8 +76,6 @@ def full_step(positions, velocities, forces, masses, dt: float, compiled: bool =
     ``positions``, half-step ``velocities`` and ``forces`` of the atoms of ``masses`` (n,): by NumPy,
     or in one compiled pass (:func:`~hexdem.engines.lammps.full_step.full_step_state`, the same bits)."""
     if compiled:
-        from hexdem.engines.lammps.full_step import full_step_state  # numba: only for large ranks
-
         return full_step_state(positions, velocities, forces, masses, 0.5 * dt)
     return positions[:, :2].copy(), velocities[:, :2] + (0.5 * dt / masses)[:, None] * forces[:, :2]
 
@@ -108,8 +106,6 @@ class _Stream:
         self.arrays: dict[str, np.ndarray] = {}
         self.ghost_ids = np.zeros(0, dtype=np.int64)
         self.compiled = runs_compiled(deck.n_atoms, 1 if comm is None else comm.Get_size())
-        if self.compiled:
-            load_in_background("hexdem.engines.lammps.full_step")
 
     def take_arrays(self, nlocal: int) -> None:
         """Views of the arrays a sample reads, for ``nlocal`` atoms and the ghosts LAMMPS has now, and

@@ -1,0 +1,74 @@
+/* The in-run analysis's per-sample arithmetic, compiled: plain C over a rank's rows, without
+ * Python (module.c binds them to Python). Each computes what hexdem's NumPy code computes, in the
+ * same order and without fast-math or contracted multiply-adds, so that every operation rounds as
+ * NumPy's does (see hexdem/analysis/compiled.py). Arrays are C-ordered; (n, k) arrays are n rows of
+ * k numbers. A kernel that finds an index outside its array returns -1 and leaves its outputs
+ * incomplete. */
+#ifndef HEXDEM_KERNELS_H
+#define HEXDEM_KERNELS_H
+
+#include <stdint.h>
+
+/* The full-step sample of LAMMPS's first n rows of (., 3) positions, half-step velocities and
+ * forces: x (n, 2) the positions, v (n, 2) = velocities + (half_dt / masses) forces. */
+void full_step_state(int64_t n, const double *positions, const double *velocities, const double *forces,
+                     const double *masses, double half_dt, double *x, double *v);
+
+/* The speeds |v| (C's hypot, as np.hypot) of the n_rows rows `rows` of velocities (n_velocities, 2)
+ * into speeds, and their velocities into end_velocity (n_rows, 2). Returns 1 if ids (n_ids) equal
+ * previous_ids (n_previous), else 0; -1 for a row outside velocities. */
+int sample_speeds(int64_t n_ids, const int64_t *ids, int64_t n_previous, const int64_t *previous_ids,
+                  int64_t n_velocities, const double *velocities, int64_t n_rows, const int64_t *rows,
+                  double *speeds, double *end_velocity);
+
+/* The pulse tracker's state for n rows, each row's arrays as hexdem.analysis.tracker_kernel.PulseState
+ * keeps them (capacity: the record ladders' length). */
+typedef struct {
+    int64_t n, capacity;
+    double *ring, *peak;             /* (n, 3), (n) */
+    int64_t *peak_index;             /* (n) */
+    double *window;                  /* (n, 7) */
+    int64_t *after, *start, *length; /* (n) each */
+    int64_t *rec_index;              /* (n, capacity) */
+    double *rec_value, *rec_prev, *rec_prev2;
+    int64_t *first_index;            /* (n, capacity) */
+    double *first_value, *first_prev, *first_prev2;
+    double *rival;                   /* (n, 7) */
+    int64_t *rival_index, *rival_after;
+} PulseArrays;
+
+/* PulseState.update of every row but its refinement, row b taking speeds[b] as its sample s.
+ * Writes the rows whose rival window is complete into complete (n) and returns their count. */
+int64_t update_pulses(const double *speeds, int64_t s, double q, double rival_ratio, PulseArrays *state,
+                      int64_t *complete);
+
+/* What the energy audit reads of a rank's rows (hexdem.analysis.energy.EnergyAudit._row_constants). */
+typedef struct {
+    int64_t n_rows;                  /* rows of positions and listed_at */
+    const double *positions, *listed_at, *velocities, *spins; /* (n_rows, 2) twice, (n_own, 2), (n_own or 0) */
+    int64_t n_spins;
+    double distance;
+    int64_t n_pairs;
+    const int64_t *i, *j;
+    const double *contact_m, *coefficient;
+    const int64_t *region_i, *region_j;
+    int64_t n_own;
+    const double *masses, *inertia;
+    const int64_t *regions;
+    const double *start, *external;  /* (n_own, 2) each */
+    int64_t n_walls;
+    const int64_t *bounds, *curved;  /* (n_walls + 1), (n_walls) */
+    const double *points, *lengths;  /* (n_walls, 2), (n_walls) */
+    const int64_t *rows;
+    const double *radii, *wall_coefficient;
+    const int64_t *wall_regions;     /* (bounds[n_walls]) each, with rows, radii, wall_coefficient */
+    int64_t n_regions;
+} AuditRows;
+
+/* EnergyAudit.part of a rank: 0 if a row of positions lies more than distance from listed_at (the
+ * caller lists the contacts again), else 1 with sums (3 + 2 n_regions) = [total energy,
+ * translational and rotational kinetic, then each region's kinetic and contact energy] [J];
+ * -1 for an index outside its array, -2 when memory runs out. */
+int audit_part(const AuditRows *rows, double *sums);
+
+#endif
