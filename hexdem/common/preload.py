@@ -10,6 +10,9 @@ from __future__ import annotations
 import importlib
 import threading
 
+#: The loading threads started and not yet joined.
+_LOADING: list[threading.Thread] = []
+
 
 def load_in_background(*modules: str) -> None:
     """Import ``modules``, in order, in a daemon thread: their first use then finds them loaded
@@ -24,4 +27,13 @@ def load_in_background(*modules: str) -> None:
             except Exception:
                 return
 
-    threading.Thread(target=load, daemon=True).start()
+    thread = threading.Thread(target=load, daemon=True)
+    _LOADING.append(thread)
+    thread.start()
+
+
+def finish_background_loading() -> None:
+    """Wait until every module asked of :func:`load_in_background` has loaded (or failed to): a
+    process forked while another thread imports would hold that import's lock forever."""
+    while _LOADING:
+        _LOADING.pop().join()

@@ -31,12 +31,13 @@ import numpy as np
 from hexdem.analysis.front_shape import FRONT_SHAPE_COLUMNS, FrontShape, front_shape, front_times, front_unmeasurable
 from hexdem.analysis.impact import PEAK_COLUMNS, ImpactAnalysis
 from hexdem.analysis.movie import movie_samples
+from hexdem.common.forked import run_shared
 from hexdem.common.io import staged_directory, write_csv, write_csv_columns, write_json
 from hexdem.common.machine import free_disk_bytes
 from hexdem.common.preload import load_in_background
 from hexdem.errors import HexdemError, RunFailed
 from hexdem.experiments.deck_config import write_deck_config
-from hexdem.experiments.provenance import run_provenance
+from hexdem.experiments.provenance import started_provenance
 from hexdem.experiments.random_packing import packing_name, prepare_random_packing
 from hexdem.experiments.sensors import write_sensor_files
 from hexdem.experiments.tracked_run import ImpactJob, track_impact
@@ -192,28 +193,38 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
                                         "provenance": provenance})
     r, model = analysis.results, analysis.model
     v0, name = analysis.v0, packing_name(config, model.packing)
-    impact = f"V₀ = {v0:g} {plots.UNIT_LABELS[r.units]['speed']}"
-    plots.arrival_map(r, model, out / "arrival_map.png", title=f"Arrival time, {name}, {impact}")
-    plots.peak_map(r, model, v0, out / "peak_map.png", title=f"Peak speed, {name}, {impact}")
-    if "peak_decay.png" not in skipped:
-        by_line = {name: (np.arange(len(beads)), r.peak_speed[beads]) for name, beads in r.lines.items()}
-        plots.peak_decay(by_line, out / "peak_decay.png", r.units, v0)
     if config.sensors:
         write_sensor_files(analysis, list(sensor_beads(config.sensors, analysis.model.packing)), out)
-    if "front_shape.csv" not in skipped:
-        shape = measure_front_shape(analysis)
-        write_csv(out / "front_shape.csv", FRONT_SHAPE_COLUMNS, shape.rows())
-        plots.front_shape_figure({name: shape}, out / "front_shape.png")
     write_csv(out / "energy_regions.csv", ENERGY_REGION_COLUMNS, energy_region_rows(r))
+    impact = f"V₀ = {v0:g} {plots.UNIT_LABELS[r.units]['speed']}"
+    jobs = [lambda: plots.arrival_map(r, model, out / "arrival_map.png", title=f"Arrival time, {name}, {impact}"),
+            lambda: plots.peak_map(r, model, v0, out / "peak_map.png", title=f"Peak speed, {name}, {impact}")]
+    if "peak_decay.png" not in skipped:
+        by_line = {name: (np.arange(len(beads)), r.peak_speed[beads]) for name, beads in r.lines.items()}
+        jobs.append(lambda: plots.peak_decay(by_line, out / "peak_decay.png", r.units, v0))
+    if "front_shape.csv" not in skipped:
+        jobs.append(lambda: write_front_shape(analysis, name, out))
     if analysis.model.extra_materials:
-        plots.energy_regions_figure(r, out / "energy_regions.png",
-                                    title=f"Where the energy is, {', '.join(r.region_names)}")
+        jobs.append(lambda: plots.energy_regions_figure(r, out / "energy_regions.png",
+                                                        title=f"Where the energy is, {', '.join(r.region_names)}"))
     tracked = analysis.tracked
     if config.movie and tracked is not None and len(tracked.field_times):  # (a dump read back has no fields)
-        speed_movie(r, model, tracked.field_times, tracked.field_speeds, v0, out / "movie.gif", title=name)
+        jobs.append(lambda: speed_movie(r, model, tracked.field_times, tracked.field_speeds, v0, out / "movie.gif",
+                                        title=name))
         if len(tracked.field_rim_speeds):
-            speed_movie(r, model, tracked.field_times, tracked.field_rim_speeds, v0, out / "spin_movie.gif",
-                        title=name, label=SPIN_LABEL)
+            jobs.append(lambda: speed_movie(r, model, tracked.field_times, tracked.field_rim_speeds, v0,
+                                            out / "spin_movie.gif", title=name, label=SPIN_LABEL))
+    run_shared(jobs)  # the figures and what they draw on two cores, where the machine has them
+
+
+def write_front_shape(analysis: ImpactAnalysis, name: str, out: Path) -> None:
+    """``front_shape.csv`` and ``front_shape.png`` (:func:`measure_front_shape`) in ``out``; ``name``:
+    the packing's, for the figure's legend."""
+    from hexdem.analysis import figures as plots
+
+    shape = measure_front_shape(analysis)
+    write_csv(out / "front_shape.csv", FRONT_SHAPE_COLUMNS, shape.rows())
+    plots.front_shape_figure({name: shape}, out / "front_shape.png")
 
 
 def bead_columns(analysis: ImpactAnalysis) -> list:
@@ -266,11 +277,11 @@ def run_experiment(config: RunConfig, out, log=None, command=None) -> ImpactAnal
     load_in_background("hexdem.analysis.figures", "scipy.spatial")  # the results' figures, while the run goes
     with staged_directory(out, STAGING_PREFIX) as staging:
         try:
-            start, provenance = time.perf_counter(), run_provenance(command)
+            start, provenance = time.perf_counter(), started_provenance(command)
             prepared = prepare_random_packing(config, staging / "preparation", log)
             check_dump_space(prepared, Path(out))
             analysis = simulate(prepared, staging / "deck", log)
-            write_results(config, analysis, staging, time.perf_counter() - start, provenance, log)
+            write_results(config, analysis, staging, time.perf_counter() - start, provenance(), log)
         except HexdemError as exc:
             kept = _keep_failed_deck(staging / "deck")
             if kept is None:

@@ -1,0 +1,78 @@
+"""Independent jobs shared with a forked child process, on a machine with a core to spare.
+
+A run's result figures are drawn after the engine has finished, one after another, each from
+a fraction of a second to a second, while the run's other cores sit idle (29,701 beads on 2
+ranks: 1.4 s for four figures, 0.6 s of it the first). :func:`run_shared` hands every other job
+to a child process forked from this one, which holds everything the jobs read (the results,
+matplotlib and its fonts) without copying it, and runs the rest here.
+"""
+
+from __future__ import annotations
+
+import os
+import pickle
+import signal
+import sys
+from collections.abc import Callable, Sequence
+
+from hexdem.common.preload import finish_background_loading
+from hexdem.errors import HexdemError
+
+
+def spare_cores() -> bool:
+    """Whether this process may run on more than one core, and the platform forks."""
+    return hasattr(os, "fork") and hasattr(os, "sched_getaffinity") and len(os.sched_getaffinity(0)) > 1
+
+
+def run_shared(jobs: Sequence[Callable[[], None]]) -> None:
+    """Run ``jobs`` (functions of no arguments, each writing its own files): the second, fourth, …
+    in a child process forked from this one when :func:`spare_cores`, the others here; else all
+    here, in order. An exception of either side is raised here once both have stopped, this side's
+    first (the child's is sent back through a pipe; a child that dies of a signal is a
+    :class:`~hexdem.errors.HexdemError`)."""
+    if len(jobs) < 2 or not spare_cores():
+        for job in jobs:
+            job()
+        return
+    finish_background_loading()
+    sys.stdout.flush()
+    sys.stderr.flush()
+    reader, writer = os.pipe()
+    child = os.fork()
+    if child == 0:
+        os.close(reader)
+        _run_child(jobs[1::2], writer)
+    os.close(writer)
+    try:
+        for job in jobs[0::2]:
+            job()
+    except BaseException:
+        os.kill(child, signal.SIGTERM)
+        raise
+    finally:
+        with os.fdopen(reader, "rb") as pipe:
+            report = pipe.read()
+        _, status = os.waitpid(child, 0)
+    if report:
+        raise pickle.loads(report)
+    if status != 0:
+        raise HexdemError(f"a process drawing results ended with status {os.waitstatus_to_exitcode(status)}")
+
+
+def _run_child(jobs, writer: int) -> None:
+    """The child's side of :func:`run_shared`: its jobs, then an exit that runs nothing of the
+    parent's (no exit handlers, no buffers flushed twice); an exception goes to ``writer`` pickled."""
+    status = 0
+    try:
+        for job in jobs:
+            job()
+    except BaseException as exc:  # the parent raises it
+        status = 1
+        try:
+            report = pickle.dumps(exc)
+        except Exception:
+            report = pickle.dumps(HexdemError(f"{type(exc).__name__}: {exc}"))
+        with os.fdopen(writer, "wb") as pipe:
+            pipe.write(report)
+    finally:
+        os._exit(status)
