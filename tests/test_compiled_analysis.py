@@ -86,6 +86,28 @@ def test_the_compiled_sample_is_the_numpy_full_step_to_the_bit():
     np.testing.assert_array_equal(velocities, v[:, :2] + (half_dt / mass)[:, None] * f[:, :2])
 
 
+@pytest.mark.parametrize("count, spread, cutoff", [(0, 1.0, 1.0), (1, 1.0, 1.0), (2, 0.0, 0.5), (3000, 50.0, 1.1),
+                                                  (2000, 1.0, 0.1)], ids=["none", "one", "two at one place",
+                                                                         "sparse", "dense"])
+def test_the_compiled_pair_search_finds_the_pairs_of_scipys_tree(count, spread, cutoff):
+    """Every pair within the cutoff, each once with i < j, as ``cKDTree.query_pairs`` finds them; a
+    body knocked a billion cutoffs away (LAMMPS's shrink-wrapped box keeps it) neither hides a pair
+    nor makes the search a quadratic one."""
+    from scipy.spatial import cKDTree
+
+    from hexdem.analysis.compiled import pairs_within
+
+    positions = np.random.default_rng(count).uniform(0, spread, (count, 2))
+    if count > 2:
+        positions[-1] = (1e9, -1e9)
+    i, j = pairs_within(positions, cutoff)
+    found = sorted(zip(i.tolist(), j.tolist()))
+    assert found == sorted(map(tuple, cKDTree(positions).query_pairs(cutoff, output_type="ndarray").tolist()))
+    assert all(a < b for a, b in found) and (count < 3000 or len(found) > count)
+    with pytest.raises(ValueError, match="not finite"):
+        pairs_within(np.array([[0.0, 0.0], [np.nan, 1.0]]), cutoff)
+
+
 def test_the_kernels_refuse_arrays_they_cannot_read_and_indices_outside_them():
     """The C kernels read raw memory: an array of another type, order or shape is a TypeError, and
     a row index outside its array an IndexError, never a read or write past the array's end."""

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hexdem.analysis.compiled import audit_part
+from hexdem.analysis.compiled import audit_part, pairs_within
 from hexdem.model.granular import GranularModel
 from hexdem.model.walls import CurvedWall
 
@@ -182,10 +182,11 @@ class EnergyAudit:
     def _list(self, bodies, n_own: int, positions_m) -> None:
         """List the candidates among the rows of ``positions_m`` (bodies ``bodies``, the first ``n_own``
         audited) with an audited body: the candidates (i, j, k_n, R_eff) of rows within contact
-        distance and the skin (:func:`_pair_constants`), kept from one search to the next until a body
+        distance and the skin (:func:`_pair_constants`; found by scipy's tree, or compiled on large ranks,
+        :func:`~hexdem.analysis.compiled.pairs_within`), kept from one search to the next until a body
         has moved half the skin, and the walls' audited members (:func:`_wall_constants`)."""
         self._listed, self._listed_at = (bodies, n_own), positions_m.copy()
-        i, j = _pairs(positions_m, 2 * self.radii_m.max() + self.skin_m)
+        i, j = (pairs_within if self.compiled else _pairs)(positions_m, 2 * self.radii_m.max() + self.skin_m)
         keep = (i < n_own) | (j < n_own)
         i, j = i[keep], j[keep]
         self._candidates = (i, j, *_pair_constants(self.model, bodies[i], bodies[j], self.radii_m)[2:])

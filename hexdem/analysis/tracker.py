@@ -148,7 +148,8 @@ class PulseTracker:
         self.field_parts = []
         self.energy_every = max(1, (total - 1) // ENERGY_SAMPLES)
         self.compiled = runs_compiled(model.n_bodies, 1 if comm is None else comm.Get_size())
-        load_in_background("scipy.spatial")  # the audit's pair search, while the engine starts
+        if not self.compiled:  # the NumPy audit's pair search, while the engine starts
+            load_in_background("scipy.spatial")
         self.audit = EnergyAudit(model, gravity_m_s2, self.compiled)
         self.audit_bodies = None  # the bodies of this rank's audited rows, own then ghosts, since the last migration
         self.energy_times, self.audit_parts = [], []

@@ -21,6 +21,12 @@ int sample_speeds(int64_t n_ids, const int64_t *ids, int64_t n_previous, const i
                   int64_t n_velocities, const double *velocities, int64_t n_rows, const int64_t *rows,
                   double *speeds, double *end_velocity);
 
+/* The pairs (i[k] < j[k]) of the n points of positions (n, 2) within cutoff of each other
+ * (|x_i − x_j|² ≤ cutoff²), found by a cell list, in the cells' order. Writes the first `capacity`
+ * into i and j and returns how many there are (call again with room for them all); -1 when memory
+ * runs out, -2 for a position or cutoff that is not finite. */
+int64_t pairs_within(int64_t n, const double *positions, double cutoff, int64_t capacity, int64_t *i, int64_t *j);
+
 /* The pulse tracker's state for n rows, each row's arrays as hexdem.analysis.tracker_kernel.PulseState
  * keeps them (capacity: the record ladders' length). */
 typedef struct {

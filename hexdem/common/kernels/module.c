@@ -245,7 +245,37 @@ fail:
     return NULL;
 }
 
+static PyObject *py_pairs_within(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    Held held = {.count = 0};
+    const double *positions;
+    int64_t *i, *j;
+    Py_ssize_t n, capacity;
+    if (!count_ok(nargs, 4, "pairs_within"))
+        return NULL;
+    TAKE(0, 'd', 2, 0, 0, &positions, &n);
+    TAKE(2, 'q', 0, 1, 0, &i, &capacity);
+    TAKE(3, 'q', 0, 1, capacity, &j, NULL);
+    double cutoff = PyFloat_AsDouble(args[1]);
+    if (cutoff == -1.0 && PyErr_Occurred())
+        goto fail;
+    int64_t found = pairs_within(n, positions, cutoff, capacity, i, j);
+    release(&held);
+    if (found == -1)
+        return PyErr_NoMemory();
+    if (found == -2) {
+        PyErr_SetString(PyExc_ValueError, "pairs_within: a position or the cutoff is not finite");
+        return NULL;
+    }
+    return PyLong_FromLongLong(found);
+fail:
+    release(&held);
+    return NULL;
+}
+
 static PyMethodDef methods[] = {
+    {"pairs_within", (PyCFunction)(void (*)(void))py_pairs_within, METH_FASTCALL,
+     "pairs_within(positions, cutoff, i, j) -> the count of pairs within cutoff, the first len(i) written into i, j."},
     {"full_step_state", (PyCFunction)(void (*)(void))py_full_step_state, METH_FASTCALL,
      "full_step_state(positions, velocities, forces, masses, half_dt, x, v): the full-step sample into x, v."},
     {"sample_speeds", (PyCFunction)(void (*)(void))py_sample_speeds, METH_FASTCALL,
