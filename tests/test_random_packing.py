@@ -142,6 +142,18 @@ def test_both_engines_agree_on_a_struck_random_disc(compared):
     assert comparison.n_checked >= 8
 
 
+def test_each_engines_run_of_a_compared_random_disc_names_it(compared):
+    """Both engines strike the one packing, and their runs' titles and summaries name it as a direct
+    run's do (they said 'packing of packing.csv')."""
+    import json
+
+    out, _ = compared
+    for engine in ("lammps", "reference"):
+        summary = json.loads((out / engine / "summary.json").read_text())
+        assert summary["lattice"]["shape"] == f"random disc of {summary['lattice']['n_beads']} beads (seed 1)"
+        assert summary["config"]["shape"] == "random" and summary["engine"] == engine
+
+
 def test_a_random_discs_summary_says_what_it_is_and_lists_its_own_keys(tmp_path):
     """Its titles and summary name a random disc of N beads (they said 'packing of packing.csv'),
     and summary.json's config holds the keys of a random disc, not a hexagon's edge_beads."""

@@ -251,7 +251,8 @@ def run_comparison(config: RunConfig, out, log=None, tolerances: Tolerances = To
     fresh = [path for path in (out / "preparation", *(out / name for name in ENGINE_NAMES)) if not path.exists()]
     try:
         prepared = prepare_random_packing(config, out / "preparation", log=log)  # one packing for both engines
-        analyses = {name: run_experiment(prepared.replace(engine=name), out / name, log) for name in ENGINE_NAMES}
+        analyses = {name: run_experiment(config.replace(engine=name), out / name, log,
+                                         prepared=prepared.replace(engine=name)) for name in ENGINE_NAMES}
     except BaseException:
         for path in fresh:
             shutil.rmtree(path, ignore_errors=True)

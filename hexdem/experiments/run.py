@@ -269,16 +269,19 @@ def measure_front_shape(analysis: ImpactAnalysis, count: int = 8, geometric: boo
     return front_shape(positions, arrivals, origin, times, wall_margin=wall_margin_d, window_deg=window_deg)
 
 
-def run_experiment(config: RunConfig, out, log=None, command=None) -> ImpactAnalysis:
+def run_experiment(config: RunConfig, out, log=None, command=None, prepared: RunConfig | None = None) -> ImpactAnalysis:
     """Run ``config`` and publish its result files in ``out`` (see module docstring); ``command``:
     the argument vector that asked for the run, for its provenance (default: this process's; a
-    study's worker is handed the study's)."""
+    study's worker is handed the study's); ``prepared``: ``config``'s random disc packed already
+    (the configuration that strikes it, :func:`prepare_random_packing`), for runs that share one
+    packing, which their titles and ``summary.json`` still name as ``config``'s."""
     log = log or (lambda message: print(f"hexdem: {message}", file=sys.stderr))
     load_in_background("hexdem.analysis.figures", "scipy.spatial")  # the results' figures, while the run goes
     with staged_directory(out, STAGING_PREFIX) as staging:
         try:
             start, provenance = time.perf_counter(), started_provenance(command)
-            prepared = prepare_random_packing(config, staging / "preparation", log)
+            if prepared is None:
+                prepared = prepare_random_packing(config, staging / "preparation", log)
             check_dump_space(prepared, Path(out))
             analysis = simulate(prepared, staging / "deck", log)
             write_results(config, analysis, staging, time.perf_counter() - start, provenance(), log)
