@@ -43,7 +43,8 @@ maximum rises at that sample (beads at rest never do: their samples stay below t
 and the refinement on the few whose rival window completes (a local maximum within
 :data:`~hexdem.analysis.peaks.PEAK_OVERSHOOT` of the running maximum).
 Every step is a NumPy operation over those beads, on small ranks; a large rank
-(:data:`~hexdem.common.compiled.COMPILED_BEADS`) runs the same update compiled (:func:`~hexdem.analysis.compiled.update_pulses`).
+(:data:`~hexdem.common.compiled.COMPILED_BEADS`) runs the same update compiled
+(:func:`~hexdem.analysis.compiled.update_pulses`).
 """
 
 from __future__ import annotations

@@ -2,8 +2,8 @@
 
 At its end the interpreter collects every object it still holds, cycles and all; numba's and
 scipy's many objects made that 0.45 s of each MPI rank's end and of the ``hexdem`` command's
-(measured here: ``import numba``, then exit; numba then compiled the in-run kernels), time that a run on N ranks waited
-for before its results were written. A process that is about to end needs no memory back, so the
+(measured here: ``import numba``, then exit, when numba compiled the in-run kernels), time that a
+run on N ranks waited for before its results were written. A process that is about to end needs no memory back, so the
 places where hexdem's processes end move what they hold out of the collector's reach first
 (``gc.freeze``); the memory goes back to the system with the process.
 """

@@ -33,6 +33,14 @@ static int64_t first_at(const Entry *entries, int64_t m, int64_t y, int64_t x)
     return low;
 }
 
+/* The entries of cell (y, x) among the m sorted ones: range[0] to range[1] − 1 (none: equal). */
+static void cell_range(const Entry *entries, int64_t m, int64_t y, int64_t x, int64_t range[2])
+{
+    range[0] = first_at(entries, m, y, x);
+    for (range[1] = range[0]; range[1] < m && entries[range[1]].y == y && entries[range[1]].x == x;)
+        range[1]++;
+}
+
 int64_t pairs_within(int64_t n, const double *positions, double cutoff, int64_t capacity, int64_t *i, int64_t *j)
 {
     double low[2] = {INFINITY, INFINITY}, high[2] = {-INFINITY, -INFINITY};
@@ -62,22 +70,20 @@ int64_t pairs_within(int64_t n, const double *positions, double cutoff, int64_t 
     }
     qsort(entries, (size_t)n, sizeof(Entry), by_cell);
     const double limit = cutoff * cutoff;
-    /* each point with those after it in its cell, and with the cells ahead: right, and the three above */
+    /* each point with those after it in its cell, and with the cells ahead: right, and the three
+     * above, whose entries are found once a cell */
     static const int64_t ahead[4][2] = {{0, 1}, {1, -1}, {1, 0}, {1, 1}};
-    int64_t found = 0, cell_end = 0;
+    int64_t found = 0, own[2] = {0, 0}, near[4][2];
     for (int64_t p = 0; p < n; p++) {
-        if (p == cell_end)
-            for (cell_end = p + 1; cell_end < n && entries[cell_end].y == entries[p].y && entries[cell_end].x == entries[p].x;)
-                cell_end++;
+        if (p == own[1]) {
+            int64_t y = entries[p].y, x = entries[p].x;
+            cell_range(entries, n, y, x, own);
+            for (int k = 0; k < 4; k++)
+                cell_range(entries, n, y + ahead[k][0], x + ahead[k][1], near[k]);
+        }
         int64_t a = entries[p].point;
         for (int k = -1; k < 4; k++) {
-            int64_t q = p + 1, last = cell_end;
-            if (k >= 0) {
-                int64_t y = entries[p].y + ahead[k][0], x = entries[p].x + ahead[k][1];
-                q = first_at(entries, n, y, x);
-                for (last = q; last < n && entries[last].y == y && entries[last].x == x;)
-                    last++;
-            }
+            int64_t q = k < 0 ? p + 1 : near[k][0], last = k < 0 ? own[1] : near[k][1];
             for (; q < last; q++) {
                 int64_t b = entries[q].point;
                 double dx = positions[2 * a] - positions[2 * b], dy = positions[2 * a + 1] - positions[2 * b + 1];
