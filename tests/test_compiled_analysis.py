@@ -149,6 +149,29 @@ def test_background_loading_loads_what_it_can_and_prints_nothing():
     assert done.stdout.strip() == "True" and done.stderr == ""
 
 
+def test_an_in_process_runs_loop_waits_for_what_loads_in_the_background(tmp_path, monkeypatch):
+    """The sampling callbacks need the interpreter that a background import holds: an in-process
+    run finishes the loading before its loop, so that no sample of the loop finds it under way."""
+    import sys
+
+    from hexdem.common.preload import load_in_background
+    from hexdem.engines.lammps.deck import write_deck
+    from hexdem.engines.lammps.driver import run_streaming
+
+    (tmp_path / "hexdem_slow_module.py").write_text("import time\ntime.sleep(1.0)\nLOADED = True\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    config = RunConfig(edge_beads=3, duration=1e-4)
+    deck = write_deck(build_model(config), run_settings(config), tmp_path / "deck")
+    loading = []
+
+    def observe(sample):
+        loading.append(not hasattr(sys.modules.get("hexdem_slow_module"), "LOADED"))
+
+    load_in_background("hexdem_slow_module")
+    run_streaming(deck, observe, show_progress=False)
+    assert len(loading) > 2 and not any(loading[1:]), loading  # (the set-up's sample 0 may still find it)
+
+
 @pytest.mark.parametrize("compiled_beads", [10**9, 1], ids=["NumPy", "compiled"])
 def test_a_sample_that_reorders_the_bodies_unannounced_is_refused(monkeypatch, compiled_beads):
     """A sample's rows are the previous sample's bodies in the same order unless it says that they

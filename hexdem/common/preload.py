@@ -1,8 +1,10 @@
 """Load modules in the background, while the process waits on something that leaves Python free.
 
-An import holds the interpreter; LAMMPS's set-up and run (a foreign call, which releases it) and
-a launched MPI job (a child process) do not. What a run will need later, the audit's pair search
-or the figures of its results, loads then instead of on the run's critical path.
+An import holds the interpreter; LAMMPS's set-up (a foreign call, which releases it) and a
+launched MPI job (a child process) do not. What a run will need later, the audit's pair search
+or the figures of its results, loads then instead of on the run's critical path. An in-process
+run's loop calls back into Python at every sample, so it waits for the loading to finish first
+(:func:`finish_background_loading`).
 """
 
 from __future__ import annotations

@@ -23,6 +23,12 @@ Each sample says whether atoms may have changed ranks since the previous one: LA
 (and reorders) atoms only when it rebuilds its neighbour lists, on every rank at the same step,
 and counts the rebuilds (the thermo keyword ``nbuild``, read locally without communication),
 so a sample whose count is unchanged keeps every rank's atoms and their order.
+
+**The loop has the interpreter to itself.** In-process, the run waits for the modules still
+loading in the background (:mod:`hexdem.common.preload`) before its loop: each callback needs the
+interpreter an import holds, and waited for it up to 5 ms (Python's switch interval) at each
+NumPy call that lets it go. At 29,701 beads on one rank this took the loop from 1.10 to 0.95 of
+the bare loop's and the run end to end from 10.65 to 9.84 s.
 """
 
 from __future__ import annotations
@@ -37,6 +43,7 @@ import numpy as np
 from hexdem.common.compiled import runs_compiled
 from hexdem.common.job_failure import abort_job
 from hexdem.common.memory import keep_freed_memory
+from hexdem.common.preload import finish_background_loading
 from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.c_interface import AtomViews, add_sampling_fix, neighbour_builds
 from hexdem.engines.lammps.deck import Deck
@@ -205,6 +212,8 @@ def run_streaming(deck: Deck, on_sample, comm=None, dump: bool = False, show_pro
             stream.initial()
             add_sampling_fix(lmp, STREAM_FIX, deck.settings.dump_every, deck.settings.n_steps, stream,
                              lambda text: _lammps(deck, lmp.command, text))
+            if comm is None:  # the callbacks need the interpreter that a background import holds
+                finish_background_loading()
             _lammps(deck, lmp.command, f"run {deck.settings.n_steps}")
         finally:
             if stream is not None and stream.bar is not None:
