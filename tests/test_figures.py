@@ -114,3 +114,26 @@ def test_no_figure_text_is_raw_notation():
                 if RAW_NOTATION.search(re.sub(r"\$[^$]*\$", "", text)):
                     raw.append(f"{path.name}:{node.lineno}: {text}")
     assert len(FIGURE_MODULES) > 15 and not raw, raw
+
+
+def test_the_maps_of_a_large_run_share_the_tiling_found_before_they_are_drawn(tmp_path):
+    """``write_results`` finds the pixel tiling once (``tile_lattice``) before its maps are drawn
+    in separate processes: the arrival and peak maps then find the very tiling, not one each."""
+    from types import SimpleNamespace
+
+    from hexdem.analysis import figures
+    from hexdem.model.config import RunConfig
+    from hexdem.model.model_builder import build_model
+
+    model = build_model(RunConfig(edge_beads=60))
+    assert model.n_bodies > PIXEL_MAP_BEADS
+    d = model.packing.diameter_m
+    x = model.packing.positions_m[:, 0] / d
+    results = SimpleNamespace(positions=model.packing.positions_m / d, length_unit_m=d, units="nondimensional",
+                              arrival_time=x - x.min(), peak_speed=np.exp(-np.abs(x) / 30))
+    figures._pixel_tiling.cache_clear()
+    figures.tile_lattice(results, model)
+    figures.arrival_map(results, model, tmp_path / "arrival_map.png")
+    figures.peak_map(results, model, 1.0, tmp_path / "peak_map.png")
+    found = figures._pixel_tiling.cache_info()
+    assert (found.misses, found.hits) == (1, 2)

@@ -143,6 +143,16 @@ def _pixel_tiling(positions_bytes: bytes, diameters_bytes: bytes) -> tuple[np.nd
     return bead, (low[0], low[0] + shape[0] * step, low[1], low[1] + shape[1] * step)
 
 
+def tile_lattice(results, model) -> None:
+    """Find the pixel tiling that :func:`draw_lattice` rasterizes the beads of ``results`` on
+    (:func:`_pixel_tiling`, kept for the maps that follow), where they are many enough for one: the
+    result's maps, drawn in processes forked after this, then share one search on every core rather
+    than each making its own at once."""
+    positions, diameters = _lattice_beads(results, model)
+    if len(diameters) > PIXEL_MAP_BEADS:
+        _pixel_tiling(np.ascontiguousarray(positions, float).tobytes(), np.ascontiguousarray(diameters, float).tobytes())
+
+
 def _pixel_beads(ax, positions, diameters, values, coloured, groups: dict, outlined: dict, cmap, norm, clim):
     """The beads rasterized (:func:`_pixel_tiling`): a pixel takes its bead's value; an unmeasured
     bead's pixels take its grey (:data:`PIXEL_UNMEASURED`), and each ring group's region is
@@ -247,6 +257,11 @@ def unmeasured_beads(results) -> dict:
     return {"still rising at the run's end": np.isnan(peaks), "never moved": peaks == 0}
 
 
+def _lattice_beads(results, model) -> tuple[np.ndarray, np.ndarray]:
+    """The beads' positions and diameters in the run's length unit, as the lattice maps draw them."""
+    return results.positions, model.packing.diameters_m * (1.0 / results.length_unit_m)
+
+
 def draw_lattice(ax, results, model, values, label: str, cmap="viridis", norm=None, marker_colour="w",
                  unmeasured=None):
     """The packing's beads coloured by ``values`` (one per bead, in the run's units), its walls,
@@ -254,8 +269,7 @@ def draw_lattice(ax, results, model, values, label: str, cmap="viridis", norm=No
     mappable. ``unmeasured`` as for :func:`bead_map`."""
     units = UNIT_LABELS[results.units]
     scale = 1.0 / results.length_unit_m
-    positions = results.positions
-    diameters = model.packing.diameters_m * scale
+    positions, diameters = _lattice_beads(results, model)
     ids, names = model.packing.material_ids, [material.name for material in model.materials]
     others = {f"{names[k]} beads": ids == k for k in np.unique(ids) if k > 0}
     circles = bead_map(ax, positions, diameters, values, cmap=cmap, label=label, norm=norm, unmeasured=unmeasured,

@@ -214,6 +214,7 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
         if len(tracked.field_rim_speeds):
             jobs.append(lambda: speed_movie(r, model, tracked.field_times, tracked.field_rim_speeds, v0,
                                             out / "spin_movie.gif", title=name, label=SPIN_LABEL))
+    plots.tile_lattice(r, model)  # once for both maps, before they part
     run_shared(jobs)  # the figures and what they draw on two cores, where the machine has them
 
 
