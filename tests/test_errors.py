@@ -95,6 +95,16 @@ def kept_deck(message: str) -> Path:
     ('shape = "chain"\nedge_beads = 5', 'edge_beads describes shape = "hexagon", "triangle" or "parallelogram"'),
     ('materials = ["brass"]', "a chain's material per bead goes in bead_materials"),
     ('shape = "chain"\nwall_friction = 0.3', 'wall_friction describes shape = "hexagon", "half-hexagon", '),
+    ('striker_material = "brass"', 'striker_material does nothing: no impact is a striker (impact = "velocity"); '
+                                   'set impact = "striker" or remove it'),
+    ('striker_diameter_m = 0.01\n[[impacts]]\nsite = [0, 0]\nkind = "velocity"',
+     "striker_diameter_m does nothing: no impact is a striker"),
+    ("sensor_rate_hz = 1e6", "sensor_rate_hz does nothing: there are no sensors; add sensors or remove it"),
+    ("sensor_mass_factor = 2.0", "sensor_mass_factor does nothing: there are no sensors"),
+    ('wall_material = "none"\nwall_restitution = 0.9',
+     'wall_restitution does nothing: the packing has no walls (wall_material = "none"); name a wall material'),
+    ('shape = "random"\nwall_material = "brass"',
+     'wall_material does nothing: the packing has no walls (walls = "none"); set walls = "hull" or remove it'),
     ('shape = "chain"\nangle_deg = 180.0\nstrike_angle_deg = 0.0',
      "strike angle 0.0° does not point into the packing, which lies at 180° from its struck bead"),
 ])
@@ -296,3 +306,17 @@ def test_a_rank_that_refuses_its_input_is_a_refusal_and_a_failing_one_a_failed_r
     assert reported_error("LAMMPS failed on in.hexdem: ERROR: Lost atoms\nfailed\n").args == (
         "LAMMPS failed on in.hexdem: ERROR: Lost atoms",)
     assert isinstance(reported_error("a report without its kind\n"), RunFailed)
+
+
+@pytest.mark.parametrize("keys", [
+    {"impact": "striker", "striker_material": "brass", "striker_diameter_m": 0.01},
+    {"impacts": ({"site": (0, 0), "kind": "striker"},), "striker_material": "brass"},
+    {"sensors": ("0:1",), "sensor_rate_hz": 1e6, "sensor_mass_factor": 2.0},
+    {"wall_material": "none"},
+    {"shape": "random", "walls": "hull", "wall_material": "brass", "wall_restitution": 0.9, "wall_friction": 0.2},
+    {"shape": "random", "wall_material": "none"},
+], ids=["striker", "a striker among the impacts", "sensors", "no walls", "a random disc's hull", "none, said twice"])
+def test_the_keys_refused_where_idle_are_taken_where_they_act(keys):
+    """The other side of the refusals above: each key is taken where what the others say makes it act."""
+    config = RunConfig(**keys)
+    assert all(getattr(config, key) == value for key, value in keys.items())
