@@ -105,6 +105,9 @@ def kept_deck(message: str) -> Path:
      'wall_restitution does nothing: the packing has no walls (wall_material = "none"); name a wall material'),
     ('shape = "random"\nwall_material = "brass"',
      'wall_material does nothing: the packing has no walls (walls = "none"); set walls = "hull" or remove it'),
+    ('engine = "reference"\nranks = 2', 'ranks does nothing: the reference engine runs in one process and writes no '
+                                       'dump (engine = "reference"); use engine = "lammps" or remove it'),
+    ('engine = "reference"\ndump = true', "dump does nothing: the reference engine runs in one process"),
     ('shape = "chain"\nangle_deg = 180.0\nstrike_angle_deg = 0.0',
      "strike angle 0.0° does not point into the packing, which lies at 180° from its struck bead"),
 ])
@@ -315,8 +318,22 @@ def test_a_rank_that_refuses_its_input_is_a_refusal_and_a_failing_one_a_failed_r
     {"wall_material": "none"},
     {"shape": "random", "walls": "hull", "wall_material": "brass", "wall_restitution": 0.9, "wall_friction": 0.2},
     {"shape": "random", "wall_material": "none"},
-], ids=["striker", "a striker among the impacts", "sensors", "no walls", "a random disc's hull", "none, said twice"])
+    {"engine": "reference", "launcher": "mpiexec"},
+    {"ranks": 2, "dump": True},
+], ids=["striker", "a striker among the impacts", "sensors", "no walls", "a random disc's hull", "none, said twice",
+        "a launched reference run", "LAMMPS's ranks and dump"])
 def test_the_keys_refused_where_idle_are_taken_where_they_act(keys):
     """The other side of the refusals above: each key is taken where what the others say makes it act."""
     config = RunConfig(**keys)
     assert all(getattr(config, key) == value for key, value in keys.items())
+
+
+def test_a_configuration_handed_to_both_engines_keeps_lammps_keys_for_lammps_alone():
+    """``hexdem compare`` and sweeps that vary ``engine`` run one configuration on both engines:
+    LAMMPS keeps its ranks and dump, the reference engine takes one process and no dump."""
+    from hexdem.model.unused_keys import on_engine
+
+    config = RunConfig(ranks=2, dump=True, launcher="mpiexec")
+    lammps, reference = on_engine(config, "lammps"), on_engine(config, "reference")
+    assert (lammps.engine, lammps.ranks, lammps.dump, lammps.launcher) == ("lammps", 2, True, "mpiexec")
+    assert (reference.engine, reference.ranks, reference.dump, reference.launcher) == ("reference", 1, False, "mpiexec")

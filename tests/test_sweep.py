@@ -159,12 +159,14 @@ def test_nested_keys_change_one_part_of_a_table_or_list():
 
 
 def test_each_run_reaches_its_rank_through_the_launcher(tmp_path, launcher):
-    """--launcher starts each run's ranks (as "srun" would inside an allocation); the reference
-    engine's runs go the same way, one process each."""
+    """--launcher starts each run's ranks (as "srun" would inside an allocation), --ranks-per-run of
+    them for a LAMMPS run; the reference engine's runs go the same way, one process each."""
     out = tmp_path / "out"
-    assert sweep(tmp_path, "--vary", "v0=0.2,0.4", "--vary", "engine=reference", "--out", str(out),
-                 "--workers", "2", "--launcher", launcher[0]) == 0
-    jobs = [job for job in launcher[1].read_text().splitlines() if f"{out}/runs/" in job]
-    assert [job.split()[:2] for job in jobs] == [["-n", "1"]] * 2
+    assert sweep(tmp_path, "--vary", "engine=lammps,reference", "--out", str(out), "--workers", "2",
+                 "--ranks-per-run", "2", "--launcher", launcher[0]) == 0
+    jobs = {job.split(f"{out}/runs/.")[1].split(".part/")[0]: job.split()[:2]  # (each run in .NAME.part)
+            for job in launcher[1].read_text().splitlines() if f"{out}/runs/" in job}
+    assert jobs == {"engine=lammps": ["-n", "2"], "engine=reference": ["-n", "1"]}
     _, rows = read_csv(out / "sweep.csv")
-    assert [json.loads((out / r["run"] / "summary.json").read_text())["engine"] for r in rows] == ["reference"] * 2
+    summaries = [json.loads((out / r["run"] / "summary.json").read_text()) for r in rows]
+    assert [(s["engine"], s["ranks"]) for s in summaries] == [("lammps", 2), ("reference", 1)]

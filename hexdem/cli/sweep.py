@@ -34,7 +34,8 @@ def add_arguments(parser) -> None:
     parser.add_argument("--workers", type=int, default=1, metavar="N", help="runs at once, locally (default 1)")
     add_parsl(parser)
     parser.add_argument("--ranks-per-run", type=int, metavar="K",
-                        help="MPI ranks of each run (default: the configuration's ranks, 1)")
+                        help="MPI ranks of each LAMMPS run (default: the configuration's ranks, 1; "
+                             "the reference engine's runs take one)")
     add_launcher(parser, "-n K python -P -m hexdem.experiments.parallel JOB for each run")
 
 

@@ -34,6 +34,7 @@ from hexdem.experiments.run import run_experiment
 from hexdem.model.config import RunConfig
 from hexdem.model.dissipation import damping_coefficient
 from hexdem.model.granular import GranularModel, RunSettings
+from hexdem.model.unused_keys import on_engine
 
 ENGINE_NAMES = ("lammps", "reference")
 #: Markers of the lines in the figure, in the order of the packing's lines.
@@ -251,8 +252,8 @@ def run_comparison(config: RunConfig, out, log=None, tolerances: Tolerances = To
     fresh = [path for path in (out / "preparation", *(out / name for name in ENGINE_NAMES)) if not path.exists()]
     try:
         prepared = prepare_random_packing(config, out / "preparation", log=log)  # one packing for both engines
-        analyses = {name: run_experiment(config.replace(engine=name), out / name, log,
-                                         prepared=prepared.replace(engine=name)) for name in ENGINE_NAMES}
+        analyses = {name: run_experiment(on_engine(config, name), out / name, log,
+                                         prepared=on_engine(prepared, name)) for name in ENGINE_NAMES}
     except BaseException:
         for path in fresh:
             shutil.rmtree(path, ignore_errors=True)

@@ -60,11 +60,13 @@ def run_status(out: Path, run: SweepRun) -> tuple[str, str]:
 
 
 def run_one(run: SweepRun, out: Path, ranks: int | None = None, launcher: str | None = None, command=None) -> None:
-    """Run ``run`` (on ``ranks`` ranks started by ``launcher``, when given) in its part directory
-    and rename it into place when every file is written; a run that fails leaves no directory.
-    ``command``: the study's argument vector, its runs' provenance (default: this process's)."""
+    """Run ``run`` (on ``ranks`` ranks started by ``launcher``, when given; a run on the reference
+    engine on one, in one process) in its part directory and rename it into place when every file
+    is written; a run that fails leaves no directory. ``command``: the study's argument vector, its
+    runs' provenance (default: this process's)."""
     from hexdem.experiments.run import run_experiment
 
+    ranks = ranks if run.config.engine == "lammps" else None
     config = run.config.replace(**{key: value for key, value in (("ranks", ranks), ("launcher", launcher))
                                    if value is not None})
     final = run_dir(out, run)
