@@ -19,6 +19,7 @@ import numpy as np
 from hexdem.analysis.impact import ImpactAnalysis
 from hexdem.experiments.run import run_experiment, simulate
 from hexdem.model.config import RunConfig
+from hexdem.model.unused_keys import check_unused_keys
 from hexdem.theory import tca as _tca
 from hexdem.theory.scaling import COMBINATIONS, CombinationFit
 from hexdem.theory.sweep import SweepSettings, run_sweep
@@ -69,9 +70,12 @@ def simulate_impact(config: RunConfig | None = None, out=None, verbose: bool = F
     applied (RunConfig field names, e.g. ``edge_beads=7, v0=0.7``).
 
     Nothing is written unless ``out`` is given; then ``out`` receives the files of ``hexdem
-    run`` (deck, ``peaks.csv``, ``summary.json``, figures). ``verbose`` prints progress.
+    run`` (deck, ``peaks.csv``, ``summary.json``, figures). ``verbose`` prints progress. A key that
+    the others leave without effect is refused, as ``hexdem run`` refuses it
+    (:func:`~hexdem.model.unused_keys.check_unused_keys`).
     """
     config = (config or RunConfig()).replace(**changes)
+    check_unused_keys(config)
     log = (lambda message: print(f"hexdem: {message}", file=sys.stderr)) if verbose else (lambda message: None)
     if out is not None:
         return ImpactResult.of(run_experiment(config, out, log))

@@ -98,7 +98,7 @@ def kept_deck(message: str) -> Path:
     ('striker_material = "brass"', 'striker_material does nothing: no impact is a striker (impact = "velocity"); '
                                    'set impact = "striker" or remove it'),
     ('striker_diameter_m = 0.01\n[[impacts]]\nsite = [0, 0]\nkind = "velocity"',
-     "striker_diameter_m does nothing: no impact is a striker"),
+     'striker_diameter_m does nothing: no [[impacts]] table is a striker; set kind = "striker" on one'),
     ("sensor_rate_hz = 1e6", "sensor_rate_hz does nothing: there are no sensors; add sensors or remove it"),
     ("sensor_mass_factor = 2.0", "sensor_mass_factor does nothing: there are no sensors"),
     ('wall_material = "none"\nwall_restitution = 0.9',
@@ -324,8 +324,46 @@ def test_a_rank_that_refuses_its_input_is_a_refusal_and_a_failing_one_a_failed_r
         "a launched reference run", "LAMMPS's ranks and dump"])
 def test_the_keys_refused_where_idle_are_taken_where_they_act(keys):
     """The other side of the refusals above: each key is taken where what the others say makes it act."""
+    from hexdem.model.unused_keys import check_unused_keys, set_idle_keys
+
     config = RunConfig(**keys)
-    assert all(getattr(config, key) == value for key, value in keys.items())
+    assert set_idle_keys(config) == {}
+    check_unused_keys(config)
+
+
+def test_a_striker_key_left_idle_by_the_impact_tables_names_them():
+    """With [[impacts]] tables, each table's kind decides: the refusal points at the tables, not at
+    the run-wide ``impact`` they override."""
+    from hexdem.model.unused_keys import check_unused_keys
+
+    config = RunConfig(impact="striker", striker_material="brass", impacts=({"site": (0, 0), "kind": "velocity"},))
+    with pytest.raises(HexdemError, match=r'^striker_material does nothing: no \[\[impacts\]\] table is a striker; '
+                                          r'set kind = "striker" on one or remove it$'):
+        check_unused_keys(config)
+
+
+def test_derived_configurations_may_leave_a_users_key_idle():
+    """A random disc is packed on a configuration stripped of its walls, impacts and sensors: what the
+    user's configuration uses, the stripped one leaves idle, and is not refused for it."""
+    from hexdem.model.unused_keys import check_unused_keys, set_idle_keys
+
+    user = RunConfig(shape="random", walls="hull", wall_material="brass", sensors=("0:1",), sensor_rate_hz=1e6)
+    check_unused_keys(user)
+    stripped = user.replace(walls="none", sensors=())
+    assert set(set_idle_keys(stripped)) == {"wall_material", "sensor_rate_hz"}
+
+
+def test_compare_checks_a_files_keys_as_lammps_takes_them(tmp_path):
+    """``hexdem compare`` ignores the file's engine: a file for the reference engine with --ranks 2
+    is taken, its LAMMPS side on 2 ranks (the reference side takes one, ``on_engine``)."""
+    from hexdem.cli.main import build_parser
+    from hexdem.cli.run import config_from_args
+
+    path = tmp_path / "reference.toml"
+    path.write_text('engine = "reference"\n')
+    args = build_parser(["compare"]).parse_args(["compare", "--config", str(path), "--ranks", "2"])
+    config = config_from_args(args)
+    assert (config.engine, config.ranks) == ("lammps", 2)
 
 
 def test_a_configuration_handed_to_both_engines_keeps_lammps_keys_for_lammps_alone():
@@ -337,3 +375,10 @@ def test_a_configuration_handed_to_both_engines_keeps_lammps_keys_for_lammps_alo
     lammps, reference = on_engine(config, "lammps"), on_engine(config, "reference")
     assert (lammps.engine, lammps.ranks, lammps.dump, lammps.launcher) == ("lammps", 2, True, "mpiexec")
     assert (reference.engine, reference.ranks, reference.dump, reference.launcher) == ("reference", 1, False, "mpiexec")
+
+
+def test_the_python_api_refuses_an_idle_key_as_the_command_does():
+    from hexdem.api import simulate_impact
+
+    with pytest.raises(HexdemError, match="^sensor_rate_hz does nothing: there are no sensors; add sensors or remove it$"):
+        simulate_impact(sensor_rate_hz=1e6)

@@ -10,6 +10,7 @@ import pytest
 from conftest import read_csv
 
 from hexdem.cli.main import main
+from hexdem.errors import HexdemError
 from hexdem.experiments.sweep_plan import Variation, plan_sweep
 from hexdem.experiments.sweep_table import SUMMARY_COLUMNS, decay_exponent
 
@@ -170,3 +171,14 @@ def test_each_run_reaches_its_rank_through_the_launcher(tmp_path, launcher):
     _, rows = read_csv(out / "sweep.csv")
     summaries = [json.loads((out / r["run"] / "summary.json").read_text()) for r in rows]
     assert [(s["engine"], s["ranks"]) for s in summaries] == [("lammps", 2), ("reference", 1)]
+
+
+def test_a_key_idle_in_some_runs_of_a_sweep_is_kept_and_one_idle_in_all_is_refused():
+    """A sweep over velocity and striker impacts keeps the base's striker_material (the striker runs
+    use it); a sweep that never strikes with a striker refuses it, naming the sweep."""
+    base = {"impact": "striker", "striker_material": "brass"}
+    runs = plan_sweep(base, [Variation.parse("impact=velocity,striker")])
+    assert [run.config.striker_material for run in runs] == ["brass", "brass"]
+    with pytest.raises(HexdemError, match="^striker_material does nothing in any run of the sweep: no impact is a "
+                                          "striker"):
+        plan_sweep({"striker_material": "brass"}, [Variation.parse("v0=0.3,0.4")])

@@ -24,7 +24,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--arrival-rate", type=float, metavar="FRACTION",
                         help="its growth per second of the bead's arrival time (default: likewise, 5.3e-5 at 140 "
                         "steps per contact; 0 when --arrival-tol is given)")
-    parser.set_defaults(engine=None, dump=None, movie=None)
+    parser.set_defaults(engine="lammps", dump=None, movie=None)  # (the file's engine is checked as LAMMPS's)
 
 
 def run(args) -> None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from hexdem.cli.options import add_launcher
 from hexdem.model.config import ENGINES, RunConfig
+from hexdem.model.unused_keys import check_unused_keys
 
 
 def add_arguments(parser) -> None:
@@ -21,12 +22,15 @@ def add_arguments(parser) -> None:
 
 
 def config_from_args(args) -> RunConfig:
-    """The config file (or the defaults) with command-line overrides applied."""
+    """The config file (or the defaults) with command-line overrides applied, refused if it sets a
+    key that its other keys leave without effect (:func:`~hexdem.model.unused_keys.check_unused_keys`)."""
     config = RunConfig.from_toml(args.config) if args.config else RunConfig()
     overrides = {key: value for key, value in (("ranks", args.ranks), ("engine", args.engine),
                                                ("dump", args.dump), ("movie", args.movie),
                                                ("launcher", args.launcher)) if value is not None}
-    return config.replace(**overrides)
+    config = config.replace(**overrides)
+    check_unused_keys(config)
+    return config
 
 
 def run(args) -> None:

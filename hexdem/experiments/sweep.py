@@ -37,6 +37,7 @@ from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
 from hexdem.errors import HexdemError, RunFailed
 from hexdem.experiments.executors import check_study_options, describe, holding, parsl_session, run_phase
 from hexdem.experiments.sweep_plan import SweepRun, Variation, plan_sweep
+from hexdem.model.unused_keys import on_engine
 
 PLAN_NAME = "sweep.json"
 RUNS_NAME = "runs"
@@ -67,8 +68,8 @@ def run_one(run: SweepRun, out: Path, ranks: int | None = None, launcher: str | 
     from hexdem.experiments.run import run_experiment
 
     ranks = ranks if run.config.engine == "lammps" else None
-    config = run.config.replace(**{key: value for key, value in (("ranks", ranks), ("launcher", launcher))
-                                   if value is not None})
+    config = on_engine(run.config, run.config.engine).replace(
+        **{key: value for key, value in (("ranks", ranks), ("launcher", launcher)) if value is not None})
     final = run_dir(out, run)
     partial = final.with_name(f".{final.name}.part")
     shutil.rmtree(partial, ignore_errors=True)

@@ -32,6 +32,7 @@ from hexdem.experiments.random_packing import check_random_run
 from hexdem.model.config import RunConfig, read_config_table
 from hexdem.model.packing_builders import PREPARED_SHAPES
 from hexdem.model.run_settings import run_settings
+from hexdem.model.unused_keys import check_unused_in_every
 
 #: Characters kept as they are in a run's directory name.
 NAME_CHARACTERS = re.compile(r"[^A-Za-z0-9._=,+-]")
@@ -146,6 +147,7 @@ def plan_sweep(base: dict, variations: list[Variation], source: str = "the base 
                               f"once); leave ranks at 1, got {config.ranks}")
         runs.append(SweepRun(name, {variation.key: variation.values[i] for variation, i in zip(variations, chosen)},
                              config))
+    check_unused_in_every([run.config for run in runs])
     names = [run.name for run in runs]
     if len(set(names)) != len(names):
         raise HexdemError("--vary: two runs would share a directory name; use values that differ in letters, "

@@ -32,7 +32,6 @@ from hexdem.model.packing_builders import SHAPE_KEYS, SHAPES, IntruderTable, che
 from hexdem.model.random_disc import DENSE_FRACTION, check_random_disc
 from hexdem.model.regions import RegionTable
 from hexdem.model.units import SI, UnitSystem, nondimensional
-from hexdem.model.unused_keys import check_unused_keys
 
 IMPACTS = ("velocity", "striker")
 UNITS = ("si", "nondimensional")
@@ -181,7 +180,6 @@ class RunConfig:
             check_random_disc(self.radius_m, self.diameter_m, self.diameter_spread, self.seed)
         self._check_size()
         Friction.of(self.friction, self.wall_friction, self.rolling_friction)  # refuses a bad coefficient
-        check_unused_keys(self)
 
     def n_beads(self) -> int | None:
         """Beads of the packing counted without building it, less the vacancies: 3N(N − 1) + 1

@@ -4,8 +4,11 @@
 shape. These keys describe the shape, but what another key says makes them do nothing: a
 striker's material when no impact is a striker, a sampling rate without sensors, a wall's
 material or restitution where the packing has no walls, MPI ranks or a dump on the reference
-engine. Each is refused when it is set (differs
-from its default), in one line that names the key, the key that leaves it idle, and both ways out.
+engine. A configuration a user gives (``hexdem run``, ``hexdem compare``) is refused when it sets
+one (:func:`check_unused_keys`), and a sweep when every one of its runs does
+(:func:`check_unused_in_every`), in one line that names the key, the key that leaves it idle, and
+both ways out. The configurations hexdem derives from a user's (a random disc's packing run, a
+deck read back, the reference side of a comparison, :func:`on_engine`) are not checked.
 """
 
 from __future__ import annotations
@@ -30,8 +33,9 @@ def idle_keys(config) -> dict[str, str]:
     :class:`~hexdem.model.config.RunConfig`) that its other keys leave without effect, set or not."""
     idle = {}
     if not any(spec.striker for spec in config.impact_specs()):
-        idle.update(dict.fromkeys(STRIKER_KEYS, f'no impact is a striker (impact = "{config.impact}"); set '
-                                                'impact = "striker" or remove it'))
+        how = ('no [[impacts]] table is a striker; set kind = "striker" on one' if config.impacts else
+               f'no impact is a striker (impact = "{config.impact}"); set impact = "striker"')
+        idle.update(dict.fromkeys(STRIKER_KEYS, f"{how} or remove it"))
     if config.engine == "reference":
         idle.update(dict.fromkeys(LAMMPS_KEYS, 'the reference engine runs in one process and writes no dump '
                                                '(engine = "reference"); use engine = "lammps" or remove it'))
@@ -46,18 +50,37 @@ def idle_keys(config) -> dict[str, str]:
     return idle
 
 
-def check_unused_keys(config) -> None:
-    """Refuse, in one line, the first key of ``config`` that is set (not its default, nor
-    ``"none"`` for a wall material where there are no walls) and that its other keys leave without
-    effect (:func:`idle_keys`)."""
-    idle = idle_keys(config)
+def set_idle_keys(config) -> dict[str, str]:
+    """:func:`idle_keys` less those left at their default (and a wall material of ``"none"``, which
+    says the same as no walls), in the order of the configuration's fields."""
+    idle, found = idle_keys(config), {}
     for field in dataclasses.fields(config):
         if field.name not in idle:
             continue
         default = field.default_factory() if field.default is dataclasses.MISSING else field.default
         value = getattr(config, field.name)
         if value != default and not (field.name == "wall_material" and value == "none"):
-            raise HexdemError(f"{field.name} does nothing: {idle[field.name]}")
+            found[field.name] = idle[field.name]
+    return found
+
+
+def check_unused_keys(config) -> None:
+    """Refuse, in one line, the first key that ``config`` sets and its other keys leave without
+    effect (:func:`set_idle_keys`): the check of a configuration a user gives (``hexdem run``,
+    ``hexdem compare``). Configurations that hexdem derives from one (a random disc's packing run,
+    a deck read back) are not checked: they may leave a key idle that the user's configuration uses."""
+    for key, why in set_idle_keys(config).items():
+        raise HexdemError(f"{key} does nothing: {why}")
+
+
+def check_unused_in_every(configs) -> None:
+    """Refuse, in one line, the first key that every one of ``configs`` (a sweep's runs) sets and
+    leaves without effect: a key idle in some runs only acts in the others (a sweep that varies
+    ``impact`` over velocity and striker keeps its ``striker_material``)."""
+    idle = [set_idle_keys(config) for config in configs]
+    for key, why in (idle[0] if idle else {}).items():
+        if all(key in found for found in idle[1:]):
+            raise HexdemError(f"{key} does nothing in any run of the sweep: {why}")
 
 
 def on_engine(config, engine: str):

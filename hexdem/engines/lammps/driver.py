@@ -24,8 +24,8 @@ Each sample says whether atoms may have changed ranks since the previous one: LA
 and counts the rebuilds (the thermo keyword ``nbuild``, read locally without communication),
 so a sample whose count is unchanged keeps every rank's atoms and their order.
 
-**The loop has the interpreter to itself.** In-process, the run waits for the modules still
-loading in the background (:mod:`hexdem.common.preload`) before its loop: each callback needs the
+**The loop has the interpreter to itself.** The run waits for the modules still loading in
+the background (:mod:`hexdem.common.preload`) before its loop: each callback needs the
 interpreter an import holds, and waited for it up to 5 ms (Python's switch interval) at each
 NumPy call that lets it go. At 29,701 beads on one rank this took the loop from 1.10 to 0.95 of
 the bare loop's and the run end to end from 10.65 to 9.84 s.
@@ -212,8 +212,7 @@ def run_streaming(deck: Deck, on_sample, comm=None, dump: bool = False, show_pro
             stream.initial()
             add_sampling_fix(lmp, STREAM_FIX, deck.settings.dump_every, deck.settings.n_steps, stream,
                              lambda text: _lammps(deck, lmp.command, text))
-            if comm is None:  # the callbacks need the interpreter that a background import holds
-                finish_background_loading()
+            finish_background_loading()  # the callbacks need the interpreter that a background import holds
             _lammps(deck, lmp.command, f"run {deck.settings.n_steps}")
         finally:
             if stream is not None and stream.bar is not None:
