@@ -101,6 +101,24 @@ def test_a_stage_that_does_not_settle_is_kept_where_its_message_says(tmp_path, m
     assert not (tmp_path / "out").exists()
 
 
+def test_a_settling_deck_that_lammps_refuses_is_kept_where_its_message_says(tmp_path, monkeypatch, capsys):
+    """LAMMPS failing on a stage's deck (here made to by its runner) is the run's one-line failure,
+    naming the deck where it was kept."""
+    from hexdem.errors import RunFailed
+
+    def refuse(deck):
+        raise RunFailed(f"LAMMPS failed on {deck / DECK_NAME}: ERROR: Lost atoms")
+
+    monkeypatch.setattr(random_packing, "run_settling_deck", refuse)
+    (tmp_path / "random.toml").write_text('shape = "random"\nradius_m = 0.06\nseed = 1\n')
+    assert main(["run", "--config", str(tmp_path / "random.toml"), "--out", str(tmp_path / "out")]) == 4
+    error = [line for line in capsys.readouterr().err.splitlines() if "error" in line]
+    assert len(error) == 1 and "ERROR: Lost atoms" in error[0] and "Traceback" not in error[0], error
+    kept = Path(error[0].split("LAMMPS failed on ", 1)[1].split(":", 1)[0])
+    assert kept.is_file() and "hexdem-failed-" in str(kept)
+    assert not (tmp_path / "out").exists()
+
+
 @pytest.fixture(scope="module")
 def compared(tmp_path_factory):
     out = tmp_path_factory.mktemp("random")

@@ -42,7 +42,7 @@ import numpy as np
 from hexdem.common.io import write_csv
 from hexdem.engines.lammps.settling import (SETTLED_NAME, SettlingStage, read_data_file, read_stage,
                                             run_settling_deck, write_settling_deck)
-from hexdem.errors import RunFailed
+from hexdem.errors import HexdemError, RunFailed
 from hexdem.model.config import RunConfig
 from hexdem.model.model_builder import build_model
 from hexdem.model.packing import strike_direction
