@@ -277,6 +277,14 @@ class RunConfig:
     def as_dict(self) -> dict:
         return dataclasses.asdict(self)
 
+    def set_keys(self) -> list[str]:
+        """The keys this configuration sets, those whose value differs from their default, in the
+        fields' order: the keys that may be refused for describing another shape
+        (:func:`~hexdem.model.packing_builders.check_shape_keys`) or for doing nothing
+        (:mod:`~hexdem.model.unused_keys`)."""
+        return [field.name for field in dataclasses.fields(self) if getattr(self, field.name) != (
+            field.default_factory() if field.default is dataclasses.MISSING else field.default)]
+
     def shape_dict(self) -> dict:
         """:meth:`as_dict` less the keys that describe other shapes (:data:`SHAPE_KEYS`): the keys
         that apply to this run, which ``summary.json`` records."""

@@ -25,7 +25,6 @@ key is silently ignored (:func:`check_shape_keys`).
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 from typing import TypedDict
 
@@ -96,13 +95,11 @@ class IntruderTable(TypedDict, total=False):
 def check_shape_keys(config) -> None:
     """Refuse a key of :data:`SHAPE_KEYS` set (different from its default) on a shape it does
     not describe, in one line naming the key and the shape."""
-    for field in dataclasses.fields(config):
-        shapes = SHAPE_KEYS.get(field.name, (config.shape,))
-        default = field.default_factory() if field.default is dataclasses.MISSING else field.default
-        if config.shape not in shapes and getattr(config, field.name) != default:
+    for key in config.set_keys():
+        shapes = SHAPE_KEYS.get(key, (config.shape,))
+        if config.shape not in shapes:
             named = " or ".join(", ".join(f'"{shape}"' for shape in shapes).rsplit(", ", 1))
-            raise HexdemError(f"{field.name} describes shape = {named}, not {config.shape!r}: remove it or change "
-                              "the shape")
+            raise HexdemError(f"{key} describes shape = {named}, not {config.shape!r}: remove it or change the shape")
 
 
 @dataclass(frozen=True)

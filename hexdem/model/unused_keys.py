@@ -13,8 +13,6 @@ deck read back, the reference side of a comparison, :func:`on_engine`) are not c
 
 from __future__ import annotations
 
-import dataclasses
-
 from hexdem.errors import HexdemError
 
 #: The striker's keys: they act only where an impact is a striker.
@@ -53,15 +51,9 @@ def idle_keys(config) -> dict[str, str]:
 def set_idle_keys(config) -> dict[str, str]:
     """:func:`idle_keys` less those left at their default (and a wall material of ``"none"``, which
     says the same as no walls), in the order of the configuration's fields."""
-    idle, found = idle_keys(config), {}
-    for field in dataclasses.fields(config):
-        if field.name not in idle:
-            continue
-        default = field.default_factory() if field.default is dataclasses.MISSING else field.default
-        value = getattr(config, field.name)
-        if value != default and not (field.name == "wall_material" and value == "none"):
-            found[field.name] = idle[field.name]
-    return found
+    idle = idle_keys(config)
+    return {key: idle[key] for key in config.set_keys()
+            if key in idle and not (key == "wall_material" and config.wall_material == "none")}
 
 
 def check_unused_keys(config) -> None:
