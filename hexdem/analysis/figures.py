@@ -150,15 +150,19 @@ def tile_lattice(results, model) -> None:
     than each making its own at once."""
     positions, diameters = _lattice_beads(results, model)
     if len(diameters) > PIXEL_MAP_BEADS:
-        _pixel_tiling(np.ascontiguousarray(positions, float).tobytes(), np.ascontiguousarray(diameters, float).tobytes())
+        _tiling_of(positions, diameters)
+
+
+def _tiling_of(positions, diameters) -> tuple[np.ndarray, tuple]:
+    """:func:`_pixel_tiling` of the beads at ``positions`` of ``diameters``, found once for the same beads."""
+    return _pixel_tiling(np.ascontiguousarray(positions, float).tobytes(), np.ascontiguousarray(diameters, float).tobytes())
 
 
 def _pixel_beads(ax, positions, diameters, values, coloured, groups: dict, outlined: dict, cmap, norm, clim):
     """The beads rasterized (:func:`_pixel_tiling`): a pixel takes its bead's value; an unmeasured
     bead's pixels take its grey (:data:`PIXEL_UNMEASURED`), and each ring group's region is
     outlined by a contour of its pixels. Returns the image and the legend's patches."""
-    bead, extent = _pixel_tiling(np.ascontiguousarray(positions, float).tobytes(),
-                                 np.ascontiguousarray(diameters, float).tobytes())
+    bead, extent = _tiling_of(positions, diameters)
     covered = bead >= 0
     legend = []
     for name, beads in groups.items():
