@@ -67,9 +67,9 @@ def run_one(run: SweepRun, out: Path, ranks: int | None = None, launcher: str | 
     runs' provenance (default: this process's)."""
     from hexdem.experiments.run import run_experiment
 
-    ranks = ranks if run.config.engine == "lammps" else None
-    config = on_engine(run.config, run.config.engine).replace(
-        **{key: value for key, value in (("ranks", ranks), ("launcher", launcher)) if value is not None})
+    chosen = run.config.replace(**{key: value for key, value in (("ranks", ranks), ("launcher", launcher))
+                                   if value is not None})
+    config = on_engine(chosen, chosen.engine)
     final = run_dir(out, run)
     partial = final.with_name(f".{final.name}.part")
     shutil.rmtree(partial, ignore_errors=True)
