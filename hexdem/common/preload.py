@@ -2,8 +2,8 @@
 
 An import holds the interpreter; LAMMPS's set-up (a foreign call, which releases it) and a
 launched MPI job (a child process) do not. What a run will need later, the audit's pair search
-or the figures of its results, loads then instead of on the run's critical path. An in-process
-run's loop calls back into Python at every sample, so it waits for the loading to finish first
+or the figures of its results, loads then instead of on the run's critical path. A run's loop
+calls back into Python at every sample, so it waits for the loading to finish first
 (:func:`finish_background_loading`).
 """
 
