@@ -148,9 +148,8 @@ def tile_lattice(results, model) -> None:
     (:func:`_pixel_tiling`, kept for the maps that follow), where they are many enough for one: the
     result's maps, drawn in processes forked after this, then share one search on every core rather
     than each making its own at once."""
-    positions, diameters = _lattice_beads(results, model)
-    if len(diameters) > PIXEL_MAP_BEADS:
-        _tiling_of(positions, diameters)
+    if len(model.packing.diameters_m) > PIXEL_MAP_BEADS:
+        _tiling_of(*_lattice_beads(results, model))
 
 
 def _tiling_of(positions, diameters) -> tuple[np.ndarray, tuple]:
