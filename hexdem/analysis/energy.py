@@ -174,10 +174,15 @@ class EnergyAudit:
 
     def _listed_for(self, bodies, n_own: int) -> bool:
         """Whether the contacts at hand were listed for ``bodies`` with the first ``n_own`` audited
-        (the very array, kept by :meth:`_list`, or an equal one)."""
+        (the very array, kept by :meth:`_list`, or an equal one, which is kept in its place: the
+        next call with it spares the comparison)."""
         if self._listed is None or n_own != self._listed[1]:
             return False
-        return bodies is self._listed[0] or np.array_equal(bodies, self._listed[0])
+        if bodies is not self._listed[0]:
+            if not np.array_equal(bodies, self._listed[0]):
+                return False
+            self._listed = (bodies, n_own)
+        return True
 
     def _list(self, bodies, n_own: int, positions_m) -> None:
         """List the candidates among the rows of ``positions_m`` (bodies ``bodies``, the first ``n_own``
