@@ -9,6 +9,7 @@ import pytest
 import hexdem.common.compiled as compiled
 from hexdem.analysis.energy import EnergyAudit, _pair_constants, _pair_contacts, _pairs, _wall_constants, _wall_contacts
 from hexdem.analysis.tracker import PulseTracker
+from hexdem.analysis.tracker_kernel import RIVAL_RATIO, PulseState
 from hexdem.engines.sampling import Sample
 from hexdem.errors import HexdemError
 from hexdem.experiments.run import simulate
@@ -111,19 +112,76 @@ def test_the_compiled_pair_search_finds_the_pairs_of_scipys_tree(count, spread, 
 def test_the_kernels_refuse_arrays_they_cannot_read_and_indices_outside_them():
     """The C kernels read raw memory: an array of another type, order or shape is a TypeError, and
     a row index outside its array an IndexError, never a read or write past the array's end."""
-    from hexdem.analysis.compiled import sample_speeds
+    from hexdem.analysis.compiled import sample_pulses
 
     velocities, ids = np.ones((4, 2)), np.arange(4)
     speeds, end_velocity = np.empty(4), np.empty((4, 2))
-    assert sample_speeds(ids, ids, velocities, ids, speeds, end_velocity)
+
+    def take(velocities=velocities, rows=ids, speeds=speeds, previous=ids, n=4):
+        state = PulseState(n, 8, 0.0)
+        return sample_pulses(ids, previous, velocities, rows, end_velocity, speeds, 0, state.q, RIVAL_RATIO,
+                             *state.sample_arrays())
+
+    assert len(take()) == 0
     np.testing.assert_array_equal(speeds, np.full(4, np.sqrt(2)))
+    assert take(previous=ids[::-1].copy()) is None  # other bodies than the previous sample's
     for wrong in (velocities.astype(np.float32), np.ones((4, 3)), np.asfortranarray(np.ones((4, 2)))[::2]):
         with pytest.raises(TypeError):
-            sample_speeds(ids, ids, wrong, ids[:2], speeds, end_velocity)
+            take(velocities=wrong, rows=ids[:2], speeds=speeds[:2], n=2)
     with pytest.raises(TypeError):
-        sample_speeds(ids, ids, velocities, ids, np.empty(3), end_velocity)  # too short for its rows
+        take(speeds=np.empty(3))  # neither empty nor long enough for its rows
     with pytest.raises(IndexError):
-        sample_speeds(ids, ids, velocities, np.array([0, 4]), speeds, end_velocity)
+        take(rows=np.array([0, 4]), speeds=speeds[:2], n=2)
+
+
+@pytest.mark.parametrize("speeds_wanted", [False, True], ids=["speeds left", "speeds wanted"])
+def test_the_compiled_sample_is_the_numpy_update_of_np_hypots_speeds(speeds_wanted):
+    """Pulses of random heights passing random beads, with noise, round-off creep, samples a ulp
+    around the running maximum and its rival margin, and a bead that never moves: the compiled
+    pass (which takes most speeds only when a window needs them) leaves the state, sample by
+    sample, as the NumPy update of ``np.hypot``'s speeds leaves it, to the bit, every speed it
+    reports included; a slot it left as a velocity holds that velocity."""
+    from hexdem.analysis.compiled import sample_pulses
+
+    rng = np.random.default_rng(11)
+    n, samples = 400, 160
+    directions = rng.uniform(0, 2 * np.pi, n)
+    arrival, height = rng.uniform(0, samples, n), rng.uniform(0.2, 2.0, n)
+    t = np.arange(samples)[:, None]
+    size = height * np.exp(-0.5 * ((t - arrival) / 3.0) ** 2) * (1 + 0.3 * np.sin(0.9 * t))
+    size += 1e-17 * rng.uniform(size=(samples, n))  # creep at round-off
+    size[:, 0] = 0.0  # a bead that never moves
+    velocities = np.stack([size * np.cos(directions), size * np.sin(directions)], axis=2)
+    near = rng.integers(1, samples, 40)  # samples a few ulps about a bead's running maximum, and about its rival margin
+    for k, s in enumerate(near):
+        bead = 1 + k
+        largest = np.hypot(*velocities[:s, bead].T).max()
+        level = largest / RIVAL_RATIO if k % 2 else largest
+        velocities[s, bead] = np.array([np.cos(directions[bead]), np.sin(directions[bead])]) * level * (1 + (k % 5 - 2) * 1e-16)
+    floor = 1e-12
+    numpy_state, compiled_state = PulseState(n, 8, floor), PulseState(n, 8, floor)
+    ids, rows, end_velocity = np.arange(n), np.arange(n), np.empty((n, 2))
+    for s in range(samples):
+        speeds = np.hypot(velocities[s, :, 0], velocities[s, :, 1])
+        numpy_state.update(rows, speeds, s)
+        taken = np.empty(n if speeds_wanted else 0)
+        compiled_state.challenge(sample_pulses(ids, ids, np.ascontiguousarray(velocities[s]), rows, end_velocity, taken,
+                                               s, compiled_state.q, RIVAL_RATIO, *compiled_state.sample_arrays()))
+        np.testing.assert_array_equal(end_velocity, velocities[s])
+        if speeds_wanted:
+            np.testing.assert_array_equal(taken, speeds)
+        ring = compiled_state.ring.copy()
+        left = ring == -1.0
+        assert speeds_wanted is not left.any()
+        kept = compiled_state.ring_velocity.reshape(n, 3, 2)[left]
+        ring[left] = np.hypot(kept[:, 0], kept[:, 1])
+        np.testing.assert_array_equal(ring, numpy_state.ring, err_msg=f"sample {s}")
+        for name, (numpy_array, compiled_array) in enumerate(zip(numpy_state.arrays()[1:-4], compiled_state.arrays()[1:-4])):
+            np.testing.assert_array_equal(compiled_array, numpy_array, err_msg=f"array {name + 1}, sample {s}")
+        for numpy_array, compiled_array in zip(numpy_state.arrays()[-3:], compiled_state.arrays()[-3:]):
+            np.testing.assert_array_equal(compiled_array, numpy_array, err_msg=f"sample {s}")
+    assert (numpy_state.peak_index[1:] >= 0).all() and numpy_state.peak_index[0] == -1  # every moving bead peaked
+    assert np.isfinite(numpy_state.best_peak).sum() >= 10  # and rivals were refined on both sides
 
 
 def test_freed_memory_is_kept_where_the_c_library_can():

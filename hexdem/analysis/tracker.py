@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from hexdem.analysis.compiled import sample_speeds, update_pulses
+from hexdem.analysis.compiled import sample_pulses
 from hexdem.analysis.energy import EnergyAudit, energy_error, energy_scale_j, rotational_share
 from hexdem.analysis.peaks import noise_floor, refine_peak, refine_peaks
 from hexdem.analysis.tracker_kernel import RIVAL_RATIO, PulseState
@@ -229,18 +229,15 @@ class PulseTracker:
         if sample.migrated:
             self._arrange(sample)
             self.audit_bodies = None
-        speeds = self._speeds(sample)
-        if self.compiled:
-            self.pulses.challenge(update_pulses(speeds, s, self.pulses.q, RIVAL_RATIO, *self.pulses.sample_arrays()))
-        else:
-            self.pulses.update(np.arange(len(self.ids)), speeds, s)
+        speeds = self._take_sample(sample)
         if self.threshold_speed is not None:
             self._cross_threshold(np.arange(len(self.ids)), speeds, s)
         spins = None if sample.angular_velocities is None else np.abs(sample.angular_velocities[self.bead_rows])
         if spins is not None:
             np.maximum(self.peak_spin, spins, out=self.peak_spin)
         if len(self.trace_beads):
-            self.traces[s, self.trace_here] = speeds[self.trace_rows]
+            self.traces[s, self.trace_here] = (np.hypot(*self.end_velocity[self.trace_rows].T) if speeds is None
+                                               else speeds[self.trace_rows])
         if self.sensor_every and sample.step % self.sensor_every == 0 and len(self.sensor_beads):
             rows = self.bead_rows[self.sensor_rows]
             self.sensors[sample.step // self.sensor_every, self.sensors_here] = np.hstack(
@@ -253,23 +250,29 @@ class PulseTracker:
             self._audit(sample)
         self.count = s + 1
 
-    def _speeds(self, sample: Sample) -> np.ndarray:
-        """The speeds of this rank's beads in ``sample``, whose velocities become their last seen
-        (:attr:`end_velocity`), once the sample's bodies are found to be those of the previous sample,
-        in the same order, unless it says that they may have migrated (and :meth:`_arrange` laid them
-        out): in one compiled pass on large ranks."""
+    def _take_sample(self, sample: Sample) -> np.ndarray | None:
+        """Take ``sample`` into the pulse state, once its bodies are found to be those of the
+        previous sample, in the same order, unless it says that they may have migrated (and
+        :meth:`_arrange` laid them out); their velocities become the beads' last seen
+        (:attr:`end_velocity`). Returns the beads' speeds; on large ranks, one compiled pass
+        (:func:`~hexdem.analysis.compiled.sample_pulses`) that takes most speeds only when the
+        tracker needs them, and returns None unless the whole sample's speeds are wanted (a
+        threshold's crossings, a speed field)."""
+        s, wanted = sample.index, self.threshold_speed is not None or sample.index in self.field_set
         if self.compiled:
-            speeds = np.empty(len(self.ids))
-            same = sample_speeds(np.asarray(sample.ids, np.int64), self.sample_ids, sample.velocities, self.bead_rows,
-                                 speeds, self.end_velocity)
-        else:
-            same = np.array_equal(sample.ids, self.sample_ids)
-            velocities = sample.velocities[self.bead_rows]
-            speeds = np.hypot(velocities[:, 0], velocities[:, 1])
-            self.end_velocity[:] = velocities
-        if not same:
-            raise HexdemError(f"sample {sample.index} reordered the bodies of rank "
+            speeds = np.empty(len(self.ids) if wanted else 0)
+            complete = sample_pulses(np.asarray(sample.ids, np.int64), self.sample_ids, sample.velocities,
+                                     self.bead_rows, self.end_velocity, speeds, s, self.pulses.q, RIVAL_RATIO,
+                                     *self.pulses.sample_arrays())
+        if not (complete is not None if self.compiled else np.array_equal(sample.ids, self.sample_ids)):
+            raise HexdemError(f"sample {s} reordered the bodies of rank "
                               f"{0 if self.comm is None else self.comm.Get_rank()} without saying that they may have migrated")
+        if self.compiled:
+            self.pulses.challenge(complete)
+            return speeds if wanted else None
+        self.end_velocity[:] = sample.velocities[self.bead_rows]
+        speeds = np.hypot(self.end_velocity[:, 0], self.end_velocity[:, 1])
+        self.pulses.update(np.arange(len(self.ids)), speeds, s)
         return speeds
 
     def _cross_threshold(self, index: np.ndarray, speeds: np.ndarray, s: int) -> None:

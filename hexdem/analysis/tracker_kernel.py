@@ -33,7 +33,9 @@ For every bead it keeps, in fixed-size arrays, exactly what the definitions of
   own slot and the crossing is exact. The one inexact case is a separate earlier pulse whose
   peak lies within a rung above both L and the slot's first record.
 
-Sample s of a bead is its s-th sample; ``ring`` holds its last three samples. Each bead's
+Sample s of a bead is its s-th sample; ``ring`` holds its last three samples (the compiled
+update may keep a sample there as its velocity, in ``ring_velocity``, with −1 for its speed,
+until a window needs it). Each bead's
 ladder is a circular buffer of the C slots from ``start``: dropping records moves ``start``
 instead of copying the slots.
 
@@ -44,7 +46,8 @@ and the refinement on the few whose rival window completes (a local maximum with
 :data:`~hexdem.analysis.peaks.PEAK_OVERSHOOT` of the running maximum).
 Every step is a NumPy operation over those beads, on small ranks; a large rank
 (:data:`~hexdem.common.compiled.COMPILED_BEADS`) runs the same update compiled
-(:func:`~hexdem.analysis.compiled.update_pulses`).
+(:func:`~hexdem.analysis.compiled.sample_pulses`), which takes most
+beads' speeds only when a window needs them.
 """
 
 from __future__ import annotations
@@ -90,15 +93,17 @@ class PulseState:
         self.rival = np.full((n, 7), np.nan)
         self.rival_index = np.full(n, -1, dtype=np.int64)
         self.rival_after = np.full(n, 3, dtype=np.int64)  # 3: no rival open
+        self.ring_velocity = np.zeros((n, 6))  # the compiled update's ring slots as velocities (vx, vy)
         self.best_peak = np.full(n, -np.inf)
         self.best_index = np.zeros(n, dtype=np.int64)
         self.best_offset = np.zeros(n)
 
     def sample_arrays(self) -> list[np.ndarray]:
-        """The state arrays a sample updates (those of :func:`~hexdem.analysis.compiled.update_pulses`)."""
+        """The state arrays a sample updates (those of :func:`~hexdem.analysis.compiled.sample_pulses`; the
+        NumPy update leaves ``ring_velocity`` as it is)."""
         return [self.ring, self.peak, self.peak_index, self.window, self.after, self.start, self.length, self.rec_index,
                 self.rec_value, self.rec_prev, self.rec_prev2, self.first_index, self.first_value, self.first_prev,
-                self.first_prev2, self.rival, self.rival_index, self.rival_after]
+                self.first_prev2, self.rival, self.rival_index, self.rival_after, self.ring_velocity]
 
     def arrays(self) -> list[np.ndarray]:
         """Every state array (for merging the beads' states across MPI ranks): the sample's and the

@@ -14,13 +14,6 @@
 void full_step_state(int64_t n, const double *positions, const double *velocities, const double *forces,
                      const double *masses, double half_dt, double *x, double *v);
 
-/* The speeds |v| (C's hypot, as np.hypot) of the n_rows rows `rows` of velocities (n_velocities, 2)
- * into speeds, and their velocities into end_velocity (n_rows, 2). Returns 1 if ids (n_ids) equal
- * previous_ids (n_previous), else 0; -1 for a row outside velocities. */
-int sample_speeds(int64_t n_ids, const int64_t *ids, int64_t n_previous, const int64_t *previous_ids,
-                  int64_t n_velocities, const double *velocities, int64_t n_rows, const int64_t *rows,
-                  double *speeds, double *end_velocity);
-
 /* The pairs (i[k] < j[k]) of the n points of positions (n, 2) within cutoff of each other
  * (|x_i − x_j|² ≤ cutoff²), found by a cell list, in the cells' order. Writes the first `capacity`
  * into i and j and returns how many there are (call again with room for them all); -1 when memory
@@ -41,11 +34,27 @@ typedef struct {
     double *first_value, *first_prev, *first_prev2;
     double *rival;                   /* (n, 7) */
     int64_t *rival_index, *rival_after;
+    double *ring_velocity;           /* (n, 3, 2): the velocity of a ring slot whose speed is not taken (-1) */
 } PulseArrays;
 
-/* PulseState.update of every row but its refinement, row b taking speeds[b] as its sample s.
- * Writes the rows whose rival window is complete into complete (n) and returns their count. */
-int64_t update_pulses(const double *speeds, int64_t s, double q, double rival_ratio, PulseArrays *state,
+/* A sample as the tracker reads it: its body ids (n_ids) and the previous sample's (n_previous),
+ * its velocities (n_velocities, 2) and the rows of them that are the tracker's rows (the
+ * PulseArrays' n); written: each row's velocity into end_velocity (n, 2) and, unless speeds is
+ * NULL, its speed into speeds (n). */
+typedef struct {
+    int64_t n_ids, n_previous, n_velocities;
+    const int64_t *ids, *previous_ids, *rows;
+    const double *velocities;
+    double *end_velocity, *speeds;
+} SampleRows;
+
+/* PulseState.update of every row but its refinement, row b taking as its sample s the speed
+ * |v| (C's hypot, as np.hypot) of its velocity v. A row whose |v| lies clearly below its running
+ * maximum divided by rival_ratio, with no window open, only enters its ring, whose slot keeps v
+ * and the speed -1 until a window needs it: its hypot is not taken (unless speeds is wanted).
+ * Writes the rows whose rival window is complete into complete (n) and returns their count;
+ * -2 if the sample's ids are not the previous sample's, -1 for a row outside the velocities. */
+int64_t sample_pulses(const SampleRows *sample, int64_t s, double q, double rival_ratio, PulseArrays *state,
                       int64_t *complete);
 
 /* What the energy audit reads of a rank's rows (hexdem.analysis.energy.EnergyAudit._row_constants). */

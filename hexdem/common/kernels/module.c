@@ -105,74 +105,67 @@ fail:
     return NULL;
 }
 
-static PyObject *py_sample_speeds(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+static PyObject *py_sample_pulses(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     Held held = {.count = 0};
-    const int64_t *ids, *previous_ids, *rows;
-    const double *velocities;
-    double *speeds, *end_velocity;
-    Py_ssize_t n_ids, n_previous, n_velocities, n_rows;
-    if (!count_ok(nargs, 6, "sample_speeds"))
-        return NULL;
-    TAKE(0, 'q', 0, 0, 0, &ids, &n_ids);
-    TAKE(1, 'q', 0, 0, 0, &previous_ids, &n_previous);
-    TAKE(2, 'd', 2, 0, 0, &velocities, &n_velocities);
-    TAKE(3, 'q', 0, 0, 0, &rows, &n_rows);
-    TAKE(4, 'd', 0, 1, n_rows, &speeds, NULL);
-    TAKE(5, 'd', 2, 1, n_rows, &end_velocity, NULL);
-    int same = sample_speeds(n_ids, ids, n_previous, previous_ids, n_velocities, velocities, n_rows, rows, speeds,
-                             end_velocity);
-    release(&held);
-    if (same < 0)
-        return index_error("sample_speeds");
-    return PyBool_FromLong(same);
-fail:
-    release(&held);
-    return NULL;
-}
-
-static PyObject *py_update_pulses(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
-{
-    Held held = {.count = 0};
+    SampleRows x;
     PulseArrays a;
-    const double *speeds;
     int64_t *complete;
-    Py_ssize_t n, capacity;
-    if (!count_ok(nargs, 23, "update_pulses"))
+    Py_ssize_t n_ids, n_previous, n_velocities, n, n_speeds, capacity;
+    if (!count_ok(nargs, 29, "sample_pulses"))
         return NULL;
-    TAKE(0, 'd', 0, 0, 0, &speeds, &n);
-    if (take(&held, args, 12, 'd', -1, 1, n, (void **)&a.rec_value, NULL, &capacity) != 0)
+    TAKE(0, 'q', 0, 0, 0, &x.ids, &n_ids);
+    TAKE(1, 'q', 0, 0, 0, &x.previous_ids, &n_previous);
+    TAKE(2, 'd', 2, 0, 0, &x.velocities, &n_velocities);
+    TAKE(3, 'q', 0, 0, 0, &x.rows, &n);
+    TAKE(4, 'd', 2, 1, n, &x.end_velocity, NULL);
+    TAKE(5, 'd', 0, 1, 0, &x.speeds, &n_speeds);
+    if (n_speeds != 0 && n_speeds < n) {
+        PyErr_SetString(PyExc_TypeError, "sample_pulses: speeds neither empty nor one a row");
+        goto fail;
+    }
+    if (n_speeds == 0)
+        x.speeds = NULL;
+    x.n_ids = n_ids;
+    x.n_previous = n_previous;
+    x.n_velocities = n_velocities;
+    if (take(&held, args, 17, 'd', -1, 1, n, (void **)&a.rec_value, NULL, &capacity) != 0)
         goto fail;
     if (capacity < 1) {
-        PyErr_SetString(PyExc_TypeError, "update_pulses: record ladders of no length");
+        PyErr_SetString(PyExc_TypeError, "sample_pulses: record ladders of no length");
         goto fail;
     }
     a.n = n;
     a.capacity = capacity;
-    TAKE(4, 'd', 3, 1, n, &a.ring, NULL);
-    TAKE(5, 'd', 0, 1, n, &a.peak, NULL);
-    TAKE(6, 'q', 0, 1, n, &a.peak_index, NULL);
-    TAKE(7, 'd', 7, 1, n, &a.window, NULL);
-    TAKE(8, 'q', 0, 1, n, &a.after, NULL);
-    TAKE(9, 'q', 0, 1, n, &a.start, NULL);
-    TAKE(10, 'q', 0, 1, n, &a.length, NULL);
-    TAKE(11, 'q', (int)capacity, 1, n, &a.rec_index, NULL);
-    TAKE(13, 'd', (int)capacity, 1, n, &a.rec_prev, NULL);
-    TAKE(14, 'd', (int)capacity, 1, n, &a.rec_prev2, NULL);
-    TAKE(15, 'q', (int)capacity, 1, n, &a.first_index, NULL);
-    TAKE(16, 'd', (int)capacity, 1, n, &a.first_value, NULL);
-    TAKE(17, 'd', (int)capacity, 1, n, &a.first_prev, NULL);
-    TAKE(18, 'd', (int)capacity, 1, n, &a.first_prev2, NULL);
-    TAKE(19, 'd', 7, 1, n, &a.rival, NULL);
-    TAKE(20, 'q', 0, 1, n, &a.rival_index, NULL);
-    TAKE(21, 'q', 0, 1, n, &a.rival_after, NULL);
-    TAKE(22, 'q', 0, 1, n, &complete, NULL);
-    long long s = PyLong_AsLongLong(args[1]);
-    double q = PyFloat_AsDouble(args[2]), rival_ratio = PyFloat_AsDouble(args[3]);
+    TAKE(9, 'd', 3, 1, n, &a.ring, NULL);
+    TAKE(10, 'd', 0, 1, n, &a.peak, NULL);
+    TAKE(11, 'q', 0, 1, n, &a.peak_index, NULL);
+    TAKE(12, 'd', 7, 1, n, &a.window, NULL);
+    TAKE(13, 'q', 0, 1, n, &a.after, NULL);
+    TAKE(14, 'q', 0, 1, n, &a.start, NULL);
+    TAKE(15, 'q', 0, 1, n, &a.length, NULL);
+    TAKE(16, 'q', (int)capacity, 1, n, &a.rec_index, NULL);
+    TAKE(18, 'd', (int)capacity, 1, n, &a.rec_prev, NULL);
+    TAKE(19, 'd', (int)capacity, 1, n, &a.rec_prev2, NULL);
+    TAKE(20, 'q', (int)capacity, 1, n, &a.first_index, NULL);
+    TAKE(21, 'd', (int)capacity, 1, n, &a.first_value, NULL);
+    TAKE(22, 'd', (int)capacity, 1, n, &a.first_prev, NULL);
+    TAKE(23, 'd', (int)capacity, 1, n, &a.first_prev2, NULL);
+    TAKE(24, 'd', 7, 1, n, &a.rival, NULL);
+    TAKE(25, 'q', 0, 1, n, &a.rival_index, NULL);
+    TAKE(26, 'q', 0, 1, n, &a.rival_after, NULL);
+    TAKE(27, 'd', 6, 1, n, &a.ring_velocity, NULL);
+    TAKE(28, 'q', 0, 1, n, &complete, NULL);
+    long long s = PyLong_AsLongLong(args[6]);
+    double q = PyFloat_AsDouble(args[7]), rival_ratio = PyFloat_AsDouble(args[8]);
     if (PyErr_Occurred())
         goto fail;
-    int64_t count = update_pulses(speeds, s, q, rival_ratio, &a, complete);
+    int64_t count = sample_pulses(&x, s, q, rival_ratio, &a, complete);
     release(&held);
+    if (count == -1)
+        return index_error("sample_pulses");
+    if (count == -2)
+        Py_RETURN_NONE;
     return PyLong_FromLongLong(count);
 fail:
     release(&held);
@@ -278,10 +271,9 @@ static PyMethodDef methods[] = {
      "pairs_within(positions, cutoff, i, j) -> the count of pairs within cutoff, the first len(i) written into i, j."},
     {"full_step_state", (PyCFunction)(void (*)(void))py_full_step_state, METH_FASTCALL,
      "full_step_state(positions, velocities, forces, masses, half_dt, x, v): the full-step sample into x, v."},
-    {"sample_speeds", (PyCFunction)(void (*)(void))py_sample_speeds, METH_FASTCALL,
-     "sample_speeds(ids, previous_ids, velocities, rows, speeds, end_velocity) -> whether ids are previous_ids."},
-    {"update_pulses", (PyCFunction)(void (*)(void))py_update_pulses, METH_FASTCALL,
-     "update_pulses(speeds, s, q, rival_ratio, *state_arrays, complete) -> the count of rows written into complete."},
+    {"sample_pulses", (PyCFunction)(void (*)(void))py_sample_pulses, METH_FASTCALL,
+     "sample_pulses(ids, previous_ids, velocities, rows, end_velocity, speeds, s, q, rival_ratio, *state_arrays, "
+     "complete) -> the count of rows written into complete, or None if ids are not previous_ids."},
     {"audit_part", (PyCFunction)(void (*)(void))py_audit_part, METH_FASTCALL,
      "audit_part(positions, velocities, spins, listed_at, distance, *row_constants, n_regions, sums) -> "
      "False if the contacts must be listed again, else True with sums written."},
