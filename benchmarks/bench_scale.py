@@ -285,10 +285,11 @@ def main() -> None:
               f"{'<=' if r['collectives'] <= bound else '>'} {bound} (rebuilds + audited + {COLLECTIVES_BESIDE}): "
               f"{'met' if r['collectives'] <= bound else 'NOT met'}")
     for edge in edges:
-        peaks = [max(results[edge, n]["ranks rss"]) for n in ranks]
+        rising = sorted(ranks)  # (the order of --ranks is the order of the runs, not of the target)
+        peaks = [max(results[edge, n]["ranks rss"]) for n in rising]
         falling = all(b < a for a, b in zip(peaks, peaks[1:]))
         print(f"target per-rank memory falls with ranks, {results[edge, ranks[0]]['beads']:,} beads: largest rank "
-              f"{' -> '.join(f'{p / MB:.0f}' for p in peaks)} MB on {', '.join(map(str, ranks))} ranks: "
+              f"{' -> '.join(f'{p / MB:.0f}' for p in peaks)} MB on {', '.join(map(str, rising))} ranks: "
               f"{'met' if falling else 'NOT met'}")
     for (edge, n), r in results.items():
         if n == ranks[0]:
