@@ -184,6 +184,45 @@ def test_the_compiled_sample_is_the_numpy_update_of_np_hypots_speeds(speeds_want
     assert np.isfinite(numpy_state.best_peak).sum() >= 10  # and rivals were refined on both sides
 
 
+def test_beads_whose_rows_move_keep_the_speeds_their_ring_left_untaken(monkeypatch):
+    """The compiled tracker leaves most ring slots as velocities (their speeds untaken); when a
+    sample says its bodies may have migrated and lists them in another order, every bead's state,
+    those slots included, moves with it. Two pulses pass each bead, the second the larger: the
+    window of its new maximum reads the slots of the calm samples before it. Fed once in the
+    bodies' order and once reordered every seventh sample: the same results, and the NumPy
+    tracker's, to the bit."""
+    config = RunConfig(edge_beads=6)
+    model = build_model(config)
+    settings = run_settings(config, model)
+    rng = np.random.default_rng(5)
+    n, samples = model.n_bodies, settings.n_samples
+    first, height = rng.uniform(0, samples / 2, n), rng.uniform(0.05, 0.2, n)
+    second, rise = first + rng.uniform(10, samples / 2, n), rng.uniform(1.2, 2.0, n)
+    t = np.arange(samples)[:, None]
+    size = height * (np.exp(-0.5 * ((t - first) / 1.5) ** 2) + rise * np.exp(-0.5 * ((t - second) / 1.5) ** 2)) + 1e-17
+    direction = rng.uniform(0, 2 * np.pi, n)
+    velocities = np.stack([size * np.cos(direction), size * np.sin(direction)], axis=2)
+    ids, positions = np.arange(1, n + 1), model.initial_positions_m()
+
+    def tracked(compiled_beads, reorder):
+        monkeypatch.setattr(compiled, "COMPILED_BEADS", compiled_beads)
+        tracker = PulseTracker(model, settings, trace_beads=(0, n // 2))
+        order = np.arange(n)
+        for s in range(samples):
+            moved = s == 0 or (reorder and s % 7 == 0)
+            if moved and s:
+                order = rng.permutation(n)
+            tracker(Sample(s, s * settings.dump_every, 0.0, ids[order], positions[order],
+                           np.ascontiguousarray(velocities[s, order]), migrated=moved))
+        return tracker.finish()
+
+    numpy_run, in_order, reordered = tracked(10**9, False), tracked(1, False), tracked(1, True)
+    assert np.isfinite(numpy_run.arrival_time).mean() > 0.9  # pulses passed nearly every bead
+    for run in (in_order, reordered):
+        for name in ("peak_speed", "t_peak", "arrival_time", "reach_time", "end_velocity", "trace_speeds"):
+            np.testing.assert_array_equal(getattr(run, name), getattr(numpy_run, name), err_msg=name)
+
+
 def test_freed_memory_is_kept_where_the_c_library_can():
     """glibc's ``mallopt`` takes both thresholds; another C library changes nothing and says so."""
     import platform
