@@ -18,11 +18,19 @@ from hexdem.model.triangular import hexagon
 D, V0 = 0.01905, 0.4
 
 
+@pytest.hookimpl(tryfirst=True)  # before pytest-xdist's own, which reads the groups
 def pytest_collection_modifyitems(items):
-    """Every test that needs the session's ``hexdem paper --quick`` (two minutes) is ``slow``."""
+    """Every test that needs the session's ``hexdem paper --quick`` (two minutes) is ``slow``. Under
+    ``pytest -n N --dist loadgroup`` (pytest-xdist, as CI runs the suite) those tests share one
+    worker, which runs the paper once (a test that asks for the paper as it runs carries the
+    ``paper_quick`` group itself), and every other file's tests share one, which builds the file's
+    fixtures (a docs build, a wheel's install) once."""
     for item in items:
         if "paper_quick" in getattr(item, "fixturenames", ()):
             item.add_marker(pytest.mark.slow)
+            item.add_marker(pytest.mark.xdist_group("paper_quick"))
+        elif item.get_closest_marker("xdist_group") is None:
+            item.add_marker(pytest.mark.xdist_group(item.path.stem))
 
 
 @pytest.fixture(scope="session")

@@ -48,16 +48,16 @@ def has_revision(revision: str) -> bool:
     return subprocess.run(["git", "-C", str(ROOT), "cat-file", "-e", f"{revision}^{{commit}}"],
                           capture_output=True, check=False).returncode == 0
 
-#: The quick runs of a minute or more (the paper's reads the session's paper run).
-SLOW = ("bench_paper.py", "bench_scale.py")
+#: The marks of the quick runs of a minute or more: the paper's reads the session's paper run, on
+#: the worker that runs it (conftest.py).
+SLOW = {"bench_paper.py": (pytest.mark.slow, pytest.mark.xdist_group("paper_quick")), "bench_scale.py": (pytest.mark.slow,)}
 
 
 def test_every_benchmark_is_checked():
     assert sorted(path.name for path in BENCHMARKS.glob("bench_*.py")) == sorted(EXPECTED)
 
 
-@pytest.mark.parametrize("script", [pytest.param(script, marks=pytest.mark.slow) if script in SLOW else script
-                                    for script in sorted(EXPECTED)])
+@pytest.mark.parametrize("script", [pytest.param(script, marks=SLOW.get(script, ())) for script in sorted(EXPECTED)])
 def test_quick_benchmark_runs(script, request):
     # the paper benchmark reports on the session's quick paper run instead of a second one
     extra = ["--out", str(request.getfixturevalue("paper_quick"))] if script == "bench_paper.py" else []
