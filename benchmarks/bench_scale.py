@@ -241,8 +241,8 @@ def main() -> None:
         print(f"{r['beads']:>9,} {n:>5} {r['steps']:>6} {r['model']:>9.2f} {r['data file']:>13.2f} "
               f"{r['bare loop']:>13.2f} {r['hexdem loop']:>15.2f} {r['hexdem share']:>8.2f} "
               f"{r['run']:>8.2f} {r['results']:>11.2f} {r['wall']:>14.2f}")
-    print("(analysis: the median of the rounds' hexdem loop / bare loop - 1; run: summary.json's wall_time_s, to the result files; "
-          "results: the result tables and figures)")
+    print("(analysis: the median of the rounds' hexdem loop / bare loop - 1; run: summary.json's wall_time_s, "
+          "to the result files; results: the result tables and figures)")
     print("the sampling callbacks by LAMMPS's own timer (slowest rank's Modify: hexdem's less the bare deck's), "
           "and their share of the rest of hexdem's loop")
     print(f"{'beads':>9} {'ranks':>5} {'modify hexdem [s]':>17} {'modify bare [s]':>15} {'callbacks [s]':>13} "

@@ -251,29 +251,32 @@ class PulseTracker:
         self.count = s + 1
 
     def _take_sample(self, sample: Sample) -> np.ndarray | None:
-        """Take ``sample`` into the pulse state, once its bodies are found to be those of the
-        previous sample, in the same order, unless it says that they may have migrated (and
-        :meth:`_arrange` laid them out); their velocities become the beads' last seen
-        (:attr:`end_velocity`). Returns the beads' speeds; on large ranks, one compiled pass
-        (:func:`~hexdem.analysis.compiled.sample_pulses`) that takes most speeds only when the
-        tracker needs them, and returns None unless the whole sample's speeds are wanted (a
-        threshold's crossings, a speed field)."""
-        s, wanted = sample.index, self.threshold_speed is not None or sample.index in self.field_set
-        if self.compiled:
-            speeds = np.empty(len(self.ids) if wanted else 0)
-            complete = sample_pulses(np.asarray(sample.ids, np.int64), self.sample_ids, sample.velocities,
-                                     self.bead_rows, self.end_velocity, speeds, s, self.pulses.q, RIVAL_RATIO,
-                                     *self.pulses.sample_arrays())
-        if not (complete is not None if self.compiled else np.array_equal(sample.ids, self.sample_ids)):
-            raise HexdemError(f"sample {s} reordered the bodies of rank "
+        """Take ``sample`` into the pulse state once its bodies are found to be the previous sample's,
+        in order (laid out by :meth:`_arrange` where it says they may have migrated); their velocities
+        become the beads' last seen (:attr:`end_velocity`). Returns the beads' speeds; on large ranks
+        (one compiled pass, :func:`~hexdem.analysis.compiled.sample_pulses`, which takes most speeds
+        only when the tracker needs them) None, unless the whole sample's are wanted (a threshold's
+        crossings, a speed field)."""
+        s = sample.index
+        if not self.compiled:
+            self._check_order(sample, np.array_equal(sample.ids, self.sample_ids))
+            self.end_velocity[:] = sample.velocities[self.bead_rows]
+            speeds = np.hypot(self.end_velocity[:, 0], self.end_velocity[:, 1])
+            self.pulses.update(np.arange(len(self.ids)), speeds, s)
+            return speeds
+        wanted = self.threshold_speed is not None or s in self.field_set
+        speeds = np.empty(len(self.ids) if wanted else 0)
+        complete = sample_pulses(np.asarray(sample.ids, np.int64), self.sample_ids, sample.velocities, self.bead_rows,
+                                 self.end_velocity, speeds, s, self.pulses.q, RIVAL_RATIO, *self.pulses.sample_arrays())
+        self._check_order(sample, complete is not None)
+        self.pulses.challenge(complete)
+        return speeds if wanted else None
+
+    def _check_order(self, sample: Sample, same: bool) -> None:
+        """Refuse ``sample`` unless its bodies are found to be the previous sample's, in order (``same``)."""
+        if not same:
+            raise HexdemError(f"sample {sample.index} reordered the bodies of rank "
                               f"{0 if self.comm is None else self.comm.Get_rank()} without saying that they may have migrated")
-        if self.compiled:
-            self.pulses.challenge(complete)
-            return speeds if wanted else None
-        self.end_velocity[:] = sample.velocities[self.bead_rows]
-        speeds = np.hypot(self.end_velocity[:, 0], self.end_velocity[:, 1])
-        self.pulses.update(np.arange(len(self.ids)), speeds, s)
-        return speeds
 
     def _cross_threshold(self, index: np.ndarray, speeds: np.ndarray, s: int) -> None:
         """Record, as a fractional sample index, where each bead's speed first reached the

@@ -34,7 +34,7 @@ typedef struct {
     double *first_value, *first_prev, *first_prev2;
     double *rival;                   /* (n, 7) */
     int64_t *rival_index, *rival_after;
-    double *ring_velocity;           /* (n, 3, 2): the velocity of a ring slot whose speed is not taken (-1) */
+    double *ring_velocity;           /* (n, 6): each ring slot's (vx, vy), read where its speed is not taken (-1) */
 } PulseArrays;
 
 /* A sample as the tracker reads it: its body ids (n_ids) and the previous sample's (n_previous),
