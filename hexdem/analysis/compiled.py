@@ -44,13 +44,14 @@ def sample_pulses(ids, previous_ids, velocities, rows, end_velocity, speeds, s: 
     """Sample ``s`` into the tracker's state, in one pass: row ``b`` takes the speed ``|v|`` of its velocity
     ``v = velocities[rows[b]]`` (C's hypot, as ``np.hypot``) as its sample, as
     :meth:`~hexdem.analysis.tracker_kernel.PulseState.update` takes it, but for the refinement
-    (``state``: the state's :meth:`~hexdem.analysis.tracker_kernel.PulseState.sample_arrays`, updated in
+    (``state``: the state's :meth:`~hexdem.analysis.tracker_kernel.PulseState.kernel_arrays`, updated in
     place; ``rival_ratio``: :data:`~hexdem.analysis.tracker_kernel.RIVAL_RATIO`). Each row's ``v`` goes
     into ``end_velocity`` and, unless ``speeds`` is empty, its speed into ``speeds``.
 
     Most rows, at most samples, lie clearly below their running maximum (by more than the
-    rival's margin, at a relative 1e-9) with no window open: such a row's sample only enters its
-    ring, as its velocity (``ring_velocity``, the speed −1), and its hypot, the pass's dearest
+    rival's margin, at a relative 1e-9) with no window open (its sum of squares below its
+    ``lazy_below``, which the pass keeps): such a row's sample only enters its ring, as its
+    velocity (``ring_velocity``, the speed −1), and its hypot, the pass's dearest
     arithmetic (20 ns against 1.5 for the squares' sum), is taken only if a window comes to
     need it. With ``speeds`` wanted, every row's is taken.
 

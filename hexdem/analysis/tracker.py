@@ -267,7 +267,7 @@ class PulseTracker:
         wanted = self.threshold_speed is not None or s in self.field_set
         speeds = np.empty(len(self.ids) if wanted else 0)
         complete = sample_pulses(np.asarray(sample.ids, np.int64), self.sample_ids, sample.velocities, self.bead_rows,
-                                 self.end_velocity, speeds, s, self.pulses.q, RIVAL_RATIO, *self.pulses.sample_arrays())
+                                 self.end_velocity, speeds, s, self.pulses.q, RIVAL_RATIO, *self.pulses.kernel_arrays())
         self._check_order(sample, complete is not None)
         self.pulses.challenge(complete)
         return speeds if wanted else None

@@ -33,9 +33,12 @@ For every bead it keeps, in fixed-size arrays, exactly what the definitions of
   own slot and the crossing is exact. The one inexact case is a separate earlier pulse whose
   peak lies within a rung above both L and the slot's first record.
 
-Sample s of a bead is its s-th sample; ``ring`` holds its last three samples (the compiled
-update may keep a sample there as its velocity, in ``ring_velocity``, with −1 for its speed,
-until a window needs it). Each bead's
+Sample s of a bead is its s-th sample; ``ring`` holds its last three samples, stored slot by
+slot (``ring_slots``), so that a sample writes one contiguous row where, bead by bead, it would
+touch every cache line of the ring. The compiled update may keep a sample there as its velocity,
+in ``ring_velocity`` (slot by slot too), with −1 for its speed, until a window needs it; it
+decides so from one number a bead, ``lazy_below``: the sum of squares below which a sample can
+neither be a new maximum nor open a rival while no window is open (−1 while one is). Each bead's
 ladder is a circular buffer of the C slots from ``start``: dropping records moves ``start``
 instead of copying the slots.
 
@@ -59,6 +62,9 @@ from hexdem.analysis.peaks import PEAK_OVERSHOOT, may_overtake, refine_peaks
 #: A local maximum of the samples this many times the running maximum or above may overtake it
 #: (:func:`~hexdem.analysis.peaks.may_overtake`; the compiled update takes it as an argument).
 RIVAL_RATIO = 1 + PEAK_OVERSHOOT
+#: The state arrays a sample updates, bead first, in the order of the compiled update's arguments.
+SAMPLED = ("ring", "peak", "peak_index", "window", "after", "start", "length", "rec_index", "rec_value", "rec_prev",
+           "rec_prev2", "first_index", "first_value", "first_prev", "first_prev2", "rival", "rival_index", "rival_after")
 
 
 def rung(capacity: int) -> float:
@@ -75,7 +81,8 @@ class PulseState:
 
     def __init__(self, n: int, capacity: int, floor: float = 0.0):
         self.q = rung(capacity)
-        self.ring = np.zeros((n, 3))
+        self.ring_slots = np.zeros((3, n))  # slot by slot: a sample writes one contiguous row of it
+        self.ring = self.ring_slots.T  # (n, 3), bead first as every other array
         self.peak = np.full(n, float(floor))
         self.peak_index = np.full(n, -1, dtype=np.int64)
         self.window = np.full((n, 7), np.nan)
@@ -93,22 +100,26 @@ class PulseState:
         self.rival = np.full((n, 7), np.nan)
         self.rival_index = np.full(n, -1, dtype=np.int64)
         self.rival_after = np.full(n, 3, dtype=np.int64)  # 3: no rival open
-        self.ring_velocity = np.zeros((n, 6))  # the compiled update's ring slots as velocities (vx, vy)
+        # the compiled update's: its ring slots as velocities (vx, vy), slot by slot, and each bead's
+        # sum of squares below which a sample only enters the ring (-1: none)
+        self.velocity_slots = np.zeros((3, 2 * n))
+        self.ring_velocity = self.velocity_slots.reshape(3, n, 2).transpose(1, 0, 2)  # (n, 3, 2)
+        self.lazy_below = np.full(n, -1.0)
         self.best_peak = np.full(n, -np.inf)
         self.best_index = np.zeros(n, dtype=np.int64)
         self.best_offset = np.zeros(n)
 
-    def sample_arrays(self) -> list[np.ndarray]:
-        """The state arrays a sample updates (those of :func:`~hexdem.analysis.compiled.sample_pulses`; the
-        NumPy update leaves ``ring_velocity`` as it is)."""
-        return [self.ring, self.peak, self.peak_index, self.window, self.after, self.start, self.length, self.rec_index,
-                self.rec_value, self.rec_prev, self.rec_prev2, self.first_index, self.first_value, self.first_prev,
-                self.first_prev2, self.rival, self.rival_index, self.rival_after, self.ring_velocity]
-
     def arrays(self) -> list[np.ndarray]:
-        """Every state array (for merging the beads' states across MPI ranks): the sample's and the
-        best refined rival's peak, sample index and offset from it (in samples)."""
-        return [*self.sample_arrays(), self.best_peak, self.best_index, self.best_offset]
+        """Every state array, bead first (for merging the beads' states across MPI ranks): those a
+        sample updates (:data:`SAMPLED`), the compiled update's own, and the best refined rival's
+        peak, sample index and offset from it (in samples)."""
+        return [*(getattr(self, name) for name in SAMPLED), self.ring_velocity, self.lazy_below, self.best_peak,
+                self.best_index, self.best_offset]
+
+    def kernel_arrays(self) -> list[np.ndarray]:
+        """The arrays :func:`~hexdem.analysis.compiled.sample_pulses` updates, as it reads them: the ring
+        and its velocities slot by slot, then the rest of :data:`SAMPLED`, then ``lazy_below``."""
+        return [self.ring_slots, *(getattr(self, name) for name in SAMPLED[1:]), self.velocity_slots, self.lazy_below]
 
     def update(self, beads, speeds, s: int) -> None:
         """Take sample ``s`` (speeds of ``beads``, distinct) into the state, in place."""

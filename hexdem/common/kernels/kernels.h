@@ -21,10 +21,10 @@ void full_step_state(int64_t n, const double *positions, const double *velocitie
 int64_t pairs_within(int64_t n, const double *positions, double cutoff, int64_t capacity, int64_t *i, int64_t *j);
 
 /* The pulse tracker's state for n rows, each row's arrays as hexdem.analysis.tracker_kernel.PulseState
- * keeps them (capacity: the record ladders' length). */
+ * keeps them (capacity: the record ladders' length); the ring and its velocities slot by slot. */
 typedef struct {
     int64_t n, capacity;
-    double *ring, *peak;             /* (n, 3), (n) */
+    double *ring, *peak;             /* (3, n), (n) */
     int64_t *peak_index;             /* (n) */
     double *window;                  /* (n, 7) */
     int64_t *after, *start, *length; /* (n) each */
@@ -34,7 +34,8 @@ typedef struct {
     double *first_value, *first_prev, *first_prev2;
     double *rival;                   /* (n, 7) */
     int64_t *rival_index, *rival_after;
-    double *ring_velocity;           /* (n, 6): each ring slot's (vx, vy), read where its speed is not taken (-1) */
+    double *ring_velocity;           /* (3, n, 2): each ring slot's (vx, vy), read where its speed is not taken (-1) */
+    double *lazy_below;              /* (n): the sum of squares below which a sample only enters the ring */
 } PulseArrays;
 
 /* A sample as the tracker reads it: its body ids (n_ids) and the previous sample's (n_previous),
@@ -50,8 +51,9 @@ typedef struct {
 
 /* PulseState.update of every row but its refinement, row b taking as its sample s the speed
  * |v| (C's hypot, as np.hypot) of its velocity v. A row whose |v| lies clearly below its running
- * maximum divided by rival_ratio, with no window open, only enters its ring, whose slot keeps v
- * and the speed -1 until a window needs it: its hypot is not taken (unless speeds is wanted).
+ * maximum divided by rival_ratio, with no window open (vx² + vy² below its lazy_below, which the
+ * pass keeps), only enters its ring, whose slot keeps v and the speed -1 until a window needs it:
+ * its hypot is not taken (unless speeds is wanted).
  * Writes the rows whose rival window is complete into complete (n) and returns their count;
  * -2 if the sample's ids are not the previous sample's, -1 for a row outside the velocities. */
 int64_t sample_pulses(const SampleRows *sample, int64_t s, double q, double rival_ratio, PulseArrays *state,

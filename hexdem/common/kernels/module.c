@@ -80,6 +80,20 @@ static PyObject *index_error(const char *name)
     if (take(&held, args, position, kind, columns, writable, min_rows, (void **)(data), rows, NULL) != 0)  \
         goto fail;
 
+/* Argument `position` as a writable C-ordered float64 array of a ring's 3 slots, each of `width`
+ * numbers: (3, width) exactly, the kernel's stride between slots. */
+static int take_slots(Held *held, PyObject *const *args, int position, Py_ssize_t width, double **data)
+{
+    Py_ssize_t rows, columns;
+    if (take(held, args, position, 'd', -1, 1, 3, (void **)data, &rows, &columns) != 0)
+        return -1;
+    if (rows != 3 || columns != width) {
+        PyErr_Format(PyExc_TypeError, "argument %d: expected float64 (3, %zd)", position + 1, width);
+        return -1;
+    }
+    return 0;
+}
+
 static PyObject *py_full_step_state(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     Held held = {.count = 0};
@@ -112,7 +126,7 @@ static PyObject *py_sample_pulses(PyObject *self, PyObject *const *args, Py_ssiz
     PulseArrays a;
     int64_t *complete;
     Py_ssize_t n_ids, n_previous, n_velocities, n, n_speeds, capacity;
-    if (!count_ok(nargs, 29, "sample_pulses"))
+    if (!count_ok(nargs, 30, "sample_pulses"))
         return NULL;
     TAKE(0, 'q', 0, 0, 0, &x.ids, &n_ids);
     TAKE(1, 'q', 0, 0, 0, &x.previous_ids, &n_previous);
@@ -137,7 +151,8 @@ static PyObject *py_sample_pulses(PyObject *self, PyObject *const *args, Py_ssiz
     }
     a.n = n;
     a.capacity = capacity;
-    TAKE(9, 'd', 3, 1, n, &a.ring, NULL);
+    if (take_slots(&held, args, 9, n, &a.ring) != 0 || take_slots(&held, args, 27, 2 * n, &a.ring_velocity) != 0)
+        goto fail;
     TAKE(10, 'd', 0, 1, n, &a.peak, NULL);
     TAKE(11, 'q', 0, 1, n, &a.peak_index, NULL);
     TAKE(12, 'd', 7, 1, n, &a.window, NULL);
@@ -154,8 +169,8 @@ static PyObject *py_sample_pulses(PyObject *self, PyObject *const *args, Py_ssiz
     TAKE(24, 'd', 7, 1, n, &a.rival, NULL);
     TAKE(25, 'q', 0, 1, n, &a.rival_index, NULL);
     TAKE(26, 'q', 0, 1, n, &a.rival_after, NULL);
-    TAKE(27, 'd', 6, 1, n, &a.ring_velocity, NULL);
-    TAKE(28, 'q', 0, 1, n, &complete, NULL);
+    TAKE(28, 'd', 0, 1, n, &a.lazy_below, NULL);
+    TAKE(29, 'q', 0, 1, n, &complete, NULL);
     long long s = PyLong_AsLongLong(args[6]);
     double q = PyFloat_AsDouble(args[7]), rival_ratio = PyFloat_AsDouble(args[8]);
     if (PyErr_Occurred())

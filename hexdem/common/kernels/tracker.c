@@ -8,19 +8,30 @@
 /* A ring slot whose speed is not taken yet: ring_velocity holds the velocity it is C's hypot of. */
 #define LAZY (-1.0)
 /* A bead whose sample s² = vx² + vy² lies below (peak / rival_ratio)² by more than CLEAR_MARGIN's
- * relative 1e-9 (any libm's hypot lies within a few ulps, 1e-15, of |v|; s² and the squares
- * within a few more) neither overtakes its running maximum nor opens a rival, for certain; a
- * peak of at least CLEAR_PEAK keeps both squares far above the subnormal numbers. */
+ * relative 1e-9 (any libm's hypot lies within a few ulps, 1e-15, of |v|; s², the squares and
+ * their quotient within a few more) neither overtakes its running maximum nor opens a rival, for
+ * certain; a peak of at least CLEAR_PEAK keeps both squares far above the subnormal numbers. */
 #define CLEAR_MARGIN (1.0 - 1e-9)
 #define CLEAR_PEAK 1e-100
 
 /* The speed in slot k of row b's ring. */
 static double ring_speed(const PulseArrays *a, int64_t b, int64_t k)
 {
-    double v = a->ring[3 * b + k];
+    double v = a->ring[k * a->n + b];
     if (v == LAZY)
-        return hypot(a->ring_velocity[6 * b + 2 * k], a->ring_velocity[6 * b + 2 * k + 1]);
+        return hypot(a->ring_velocity[2 * (k * a->n + b)], a->ring_velocity[2 * (k * a->n + b) + 1]);
     return v;
+}
+
+/* The sum of squares vx² + vy² below which a sample of row b can neither overtake its running
+ * maximum nor open a rival, while no window is open: (peak / rival_ratio)² less CLEAR_MARGIN's
+ * relative 1e-9 (clear: rival_ratio²); -1 (none) while a window is open or below CLEAR_PEAK. */
+static double lazy_below(const PulseArrays *a, int64_t b, double clear)
+{
+    double peak = a->peak[b];
+    if (a->after[b] >= 3 && a->rival_after[b] >= 3 && peak >= CLEAR_PEAK)
+        return peak * peak * CLEAR_MARGIN / clear;
+    return -1.0;
 }
 
 /* Window w (7 numbers) centred on sample s of speed v, from row b's ring of the last three
@@ -131,6 +142,7 @@ int64_t sample_pulses(const SampleRows *sample, int64_t s, double q, double riva
     const PulseArrays arrays = *state; /* a copy, which no store into the arrays can change */
     const PulseArrays *a = &arrays;
     const double clear = rival_ratio * rival_ratio;
+    double *ring = a->ring + (s % 3) * a->n, *velocity = a->ring_velocity + 2 * (s % 3) * a->n; /* slot s % 3 */
     int64_t count = 0;
     for (int64_t b = 0; b < a->n; b++) {
         int64_t row = sample->rows[b];
@@ -139,22 +151,21 @@ int64_t sample_pulses(const SampleRows *sample, int64_t s, double q, double riva
         double vx = sample->velocities[2 * row], vy = sample->velocities[2 * row + 1];
         sample->end_velocity[2 * b] = vx;
         sample->end_velocity[2 * b + 1] = vy;
-        double peak = a->peak[b];
-        if (sample->speeds == NULL && a->after[b] >= 3 && a->rival_after[b] >= 3 && peak >= CLEAR_PEAK
-            && (vx * vx + vy * vy) * clear < peak * peak * CLEAR_MARGIN) {
-            a->ring[3 * b + s % 3] = LAZY;
-            a->ring_velocity[6 * b + 2 * (s % 3)] = vx;
-            a->ring_velocity[6 * b + 2 * (s % 3) + 1] = vy;
+        if (sample->speeds == NULL && vx * vx + vy * vy < a->lazy_below[b]) {
+            ring[b] = LAZY;
+            velocity[2 * b] = vx;
+            velocity[2 * b + 1] = vy;
             continue;
         }
         double v = hypot(vx, vy);
         if (sample->speeds != NULL)
             sample->speeds[b] = v;
-        if (v > peak)
+        if (v > a->peak[b])
             count += new_maximum(a, b, v, s, q, complete + count);
         else
             count += calm_sample(a, b, v, s, rival_ratio, complete + count);
-        a->ring[3 * b + s % 3] = v;
+        ring[b] = v;
+        a->lazy_below[b] = lazy_below(a, b, clear);
     }
     return count;
 }
