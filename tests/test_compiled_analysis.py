@@ -43,14 +43,15 @@ def test_the_compiled_kernels_give_the_numpy_results(tmp_path, monkeypatch, chan
     assert compiled_run.rotational_energy_fraction == pytest.approx(numpy_run.rotational_energy_fraction, rel=1e-9)
 
 
-@pytest.mark.parametrize("changes", [{"edge_beads": 6}, {"shape": "disc", "radius_beads": 5},
-                                     {"edge_beads": 5, "regions": ({"material": "brass", "x_min_d": 2.0},)}],
-                         ids=["flat walls", "curved wall", "two materials"])
-def test_the_compiled_audit_is_the_numpy_audit_of_a_squeezed_packing(changes):
+@pytest.mark.parametrize("changes, gravity_m_s2", [({"edge_beads": 6}, None), ({"shape": "disc", "radius_beads": 5}, None),
+                                                   ({"edge_beads": 5, "regions": ({"material": "brass", "x_min_d": 2.0},)},
+                                                    None), ({"edge_beads": 6}, (3.0, -9.81))],
+                         ids=["flat walls", "curved wall", "two materials", "gravity"])
+def test_the_compiled_audit_is_the_numpy_audit_of_a_squeezed_packing(changes, gravity_m_s2):
     """Every body pushed outwards by a ten-thousandth of its distance from the centre, then moved at
     random by up to 1e-5 of a diameter: the beads along the walls overlap them and some pairs
     overlap, so both the wall and the pair sums count, on a share of the bodies with the rest as
-    ghosts (in a random order).
+    ghosts (in a random order); with gravity, its work on the moved bodies counts too.
 
     The two ways round differently only in the overlaps δ, differences of coordinates |x| up to
     X: each δ within a few ulps of X, 8 ε X, so each contact's energy within its force
@@ -66,8 +67,8 @@ def test_the_compiled_audit_is_the_numpy_audit_of_a_squeezed_packing(changes):
     walls = [wall[1:] for wall in _wall_contacts(squeezed, _wall_constants(model))]
     assert sum(len(wall[0]) for wall in walls) > 0
     forces_n = sum(np.sum(k * np.sqrt(r_eff) * overlap**1.5) for k, r_eff, overlap in [pairs, *walls])
-    numpy_part, compiled_part = (EnergyAudit(model, compiled=way).part(bodies, n_own, squeezed[bodies],
-                                                                       velocities[bodies[:n_own]])
+    numpy_part, compiled_part = (EnergyAudit(model, gravity_m_s2, compiled=way).part(bodies, n_own, squeezed[bodies],
+                                                                                     velocities[bodies[:n_own]])
                                  for way in (False, True))
     assert np.all(numpy_part[4::2] > 0)  # each region's contact energy
     overlap_round_off_m = 8 * np.finfo(float).eps * np.abs(squeezed).max()
