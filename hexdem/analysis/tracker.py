@@ -297,7 +297,7 @@ class PulseTracker:
             ids = sample.ids if sample.ghost_ids is None else np.concatenate([sample.ids, sample.ghost_ids])
             self.audit_bodies = ids - 1
         positions = sample.positions
-        if sample.ghost_ids is not None:
+        if sample.ghost_ids is not None and len(sample.ghost_ids):
             positions = np.concatenate([positions, sample.ghost_positions])
         angular = None if sample.angular_velocities is None else sample.angular_velocities / units.time_s
         self.audit_parts.append(self.audit.part(self.audit_bodies, len(sample.ids), in_si(positions, units.length_m),
