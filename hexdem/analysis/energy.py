@@ -201,21 +201,17 @@ class EnergyAudit:
 
     def _row_constants(self, bodies, n_own: int) -> tuple:
         r"""What :func:`~hexdem.analysis.compiled.audit_part` reads of the listed rows, laid out once
-        per list (see :mod:`hexdem.analysis.compiled`): per candidate pair its rows, its sum of radii, its
+        per list (see :mod:`hexdem.analysis.compiled`): per candidate pair its sum of radii, its
         :math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}` and the regions of its two rows (−1 for a ghost); per audited
-        row its body's mass, inertia, region, start position and constant force (neither where no
-        body feels one: their work is then 0); the walls' audited members (:func:`_wall_rows`). Rows and
-        regions are 32-bit (a rank holds fewer than 2³¹ rows): the audit's pass reads its pairs'
-        numbers from memory at every audited sample, 32 bytes a pair where 64-bit ones took 48."""
+        row its body's mass, inertia, region, start position and constant force; the walls' audited
+        members (:func:`_wall_rows`)."""
         i, j, stiffness, r_eff = self._candidates
-        regions = self.regions[bodies].astype(np.int32)
-        own = np.where(np.arange(len(bodies)) < n_own, regions, np.int32(-1))
-        pairs = (i.astype(np.int32), j.astype(np.int32), self.radii_m[bodies[i]] + self.radii_m[bodies[j]],
-                 0.4 * stiffness * np.sqrt(r_eff), own[i], own[j])
+        regions = self.regions[bodies]
+        own = np.where(np.arange(len(bodies)) < n_own, regions, -1)
+        pairs = (i, j, self.radii_m[bodies[i]] + self.radii_m[bodies[j]], 0.4 * stiffness * np.sqrt(r_eff), own[i], own[j])
         audited = bodies[:n_own]
-        forced = audited if self.external_n[audited].any() else audited[:0]
-        rows = (self.masses_kg[audited], self.inertia_kg_m2[audited], regions[:n_own], self.start_m[forced],
-                self.external_n[forced])
+        rows = (self.masses_kg[audited], self.inertia_kg_m2[audited], regions[:n_own], self.start_m[audited],
+                self.external_n[audited])
         return (*pairs, *rows, *_wall_rows(self._walls, regions))
 
     def part(self, bodies, n_own: int, positions_m, velocities_m_s, angular_velocities_s=None) -> np.ndarray:

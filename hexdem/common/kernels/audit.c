@@ -85,8 +85,7 @@ static int add_wall_energies(const AuditRows *a, double *wall_sum, double *conta
 }
 
 /* The audited rows' own terms, row by row: translational and rotational kinetic energy, each
- * region's kinetic energy (n_regions) and the work Σ F·u of the constant forces since start (0
- * without any: each term would be a zero). */
+ * region's kinetic energy (n_regions) and the work Σ F·u of the constant forces since start. */
 static int body_energies(const AuditRows *a, double *translational, double *rotational, double *kinetic,
                          double *work)
 {
@@ -103,9 +102,8 @@ static int body_energies(const AuditRows *a, double *translational, double *rota
         moving_sum += moving;
         turning_sum += turning;
         kinetic[region] += moving + turning;
-        if (a->n_external)
-            done += (a->positions[2 * r] - a->start[2 * r]) * a->external[2 * r]
-                    + (a->positions[2 * r + 1] - a->start[2 * r + 1]) * a->external[2 * r + 1];
+        done += (a->positions[2 * r] - a->start[2 * r]) * a->external[2 * r]
+                + (a->positions[2 * r + 1] - a->start[2 * r + 1]) * a->external[2 * r + 1];
     }
     *translational = moving_sum;
     *rotational = turning_sum;

@@ -66,14 +66,13 @@ typedef struct {
     int64_t n_spins;
     double distance;
     int64_t n_pairs;
-    const int32_t *i, *j;
+    const int64_t *i, *j;
     const double *contact_m, *coefficient;
-    const int32_t *region_i, *region_j;
+    const int64_t *region_i, *region_j;
     int64_t n_own;
     const double *masses, *inertia;
-    const int32_t *regions;
-    int64_t n_external;              /* n_own, or 0: no constant force, whose work is then 0 */
-    const double *start, *external;  /* (n_external, 2) each */
+    const int64_t *regions;
+    const double *start, *external;  /* (n_own, 2) each */
     int64_t n_walls;
     const int64_t *bounds, *curved;  /* (n_walls + 1), (n_walls) */
     const double *points, *lengths;  /* (n_walls, 2), (n_walls) */

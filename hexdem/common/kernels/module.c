@@ -22,22 +22,18 @@ static void release(Held *held)
     held->count = 0;
 }
 
-/* Whether a buffer's format is of `kind`: a native 8-byte float ('d'), 8-byte integer ('q': 'l' or
- * 'q') or 4-byte integer ('i': 'i', or 'l' where a long has 4 bytes). */
+/* Whether a buffer's format is a native 8-byte float ('d') or integer ('l', 'q'). */
 static int has_type(const Py_buffer *view, char kind)
 {
     const char *format = view->format ? view->format : "B";
     if (*format == '@' || *format == '=')
         format++;
-    if (view->itemsize != (kind == 'i' ? 4 : 8) || strlen(format) != 1)
+    if (view->itemsize != 8 || strlen(format) != 1)
         return 0;
-    if (kind == 'd')
-        return *format == 'd';
-    return *format == kind || (*format == 'l' && (Py_ssize_t)sizeof(long) == view->itemsize)
-           || (kind == 'q' && *format == 'q');
+    return kind == 'd' ? *format == 'd' : (*format == 'l' || *format == 'q');
 }
 
-/* Argument `position` as a C-ordered array of kind 'd' (float64), 'q' (int64) or 'i' (int32) with `columns`
+/* Argument `position` as a C-ordered array of kind 'd' (float64) or 'q' (int64) with `columns`
  * numbers a row (0: one axis; -1: two axes of any width, written into *columns_out), at least
  * `min_rows` rows, writable if `writable`; its data and rows into *data and *rows. */
 static int take(Held *held, PyObject *const *args, int position, char kind, int columns, int writable,
@@ -55,8 +51,7 @@ static int take(Held *held, PyObject *const *args, int position, char kind, int 
     if (!has_type(view, kind) || view->ndim != ndim || (columns > 0 && view->shape[1] != columns)
         || view->shape[0] < min_rows) {
         PyErr_Format(PyExc_TypeError, "argument %d: expected %s %s of at least %zd rows", position + 1,
-                     kind == 'd' ? "float64" : kind == 'i' ? "int32" : "int64", ndim == 1 ? "(n,)" : "(n, k)",
-                     min_rows);
+                     kind == 'd' ? "float64" : "int64", ndim == 1 ? "(n,)" : "(n, k)", min_rows);
         return -1;
     }
     *data = view->buf;
@@ -197,7 +192,7 @@ static PyObject *py_audit_part(PyObject *self, PyObject *const *args, Py_ssize_t
     Held held = {.count = 0};
     AuditRows a;
     double *sums;
-    Py_ssize_t n_rows, n_own, n_spins, n_external, n_pairs, n_walls, n_members;
+    Py_ssize_t n_rows, n_own, n_spins, n_pairs, n_walls, n_members;
     if (!count_ok(nargs, 26, "audit_part"))
         return NULL;
     a.n_regions = PyLong_AsLongLong(args[24]);
@@ -213,16 +208,16 @@ static PyObject *py_audit_part(PyObject *self, PyObject *const *args, Py_ssize_t
     TAKE(11, 'd', 0, 0, 0, &a.masses, &n_own);
     TAKE(1, 'd', 2, 0, n_own, &a.velocities, NULL);
     TAKE(2, 'd', 0, 0, 0, &a.spins, &n_spins);
-    TAKE(5, 'i', 0, 0, 0, &a.i, &n_pairs);
-    TAKE(6, 'i', 0, 0, n_pairs, &a.j, NULL);
+    TAKE(5, 'q', 0, 0, 0, &a.i, &n_pairs);
+    TAKE(6, 'q', 0, 0, n_pairs, &a.j, NULL);
     TAKE(7, 'd', 0, 0, n_pairs, &a.contact_m, NULL);
     TAKE(8, 'd', 0, 0, n_pairs, &a.coefficient, NULL);
-    TAKE(9, 'i', 0, 0, n_pairs, &a.region_i, NULL);
-    TAKE(10, 'i', 0, 0, n_pairs, &a.region_j, NULL);
+    TAKE(9, 'q', 0, 0, n_pairs, &a.region_i, NULL);
+    TAKE(10, 'q', 0, 0, n_pairs, &a.region_j, NULL);
     TAKE(12, 'd', 0, 0, n_own, &a.inertia, NULL);
-    TAKE(13, 'i', 0, 0, n_own, &a.regions, NULL);
-    TAKE(15, 'd', 2, 0, 0, &a.external, &n_external);
-    TAKE(14, 'd', 2, 0, n_external, &a.start, NULL);
+    TAKE(13, 'q', 0, 0, n_own, &a.regions, NULL);
+    TAKE(14, 'd', 2, 0, n_own, &a.start, NULL);
+    TAKE(15, 'd', 2, 0, n_own, &a.external, NULL);
     TAKE(17, 'q', 0, 0, 0, &a.curved, &n_walls);
     TAKE(16, 'q', 0, 0, n_walls + 1, &a.bounds, NULL);
     TAKE(18, 'd', 2, 0, n_walls, &a.points, NULL);
@@ -236,10 +231,6 @@ static PyObject *py_audit_part(PyObject *self, PyObject *const *args, Py_ssize_t
         PyErr_SetString(PyExc_TypeError, "audit_part: fewer spins than audited rows");
         goto fail;
     }
-    if (n_external && n_external < n_own) {
-        PyErr_SetString(PyExc_TypeError, "audit_part: fewer constant forces than audited rows");
-        goto fail;
-    }
     for (Py_ssize_t w = 0; w < n_walls; w++)
         if (a.bounds[w] < 0 || a.bounds[w] > a.bounds[w + 1] || a.bounds[w + 1] > n_members) {
             release(&held);
@@ -247,7 +238,6 @@ static PyObject *py_audit_part(PyObject *self, PyObject *const *args, Py_ssize_t
         }
     a.n_rows = n_rows;
     a.n_spins = n_spins;
-    a.n_external = n_external;
     a.n_own = n_own;
     a.n_pairs = n_pairs;
     a.n_walls = n_walls;
