@@ -19,10 +19,6 @@ than cores is fine for memory and collective counts, not for times):
 * **bare LAMMPS**: ``mpiexec -n N lmp -in in.nooutput`` of the same deck without its output
   section, the yardstick: the analysis's share of the loop is hexdem's loop / the bare loop − 1,
   each round's loop over that round's bare loop (with ``--repeat``, the median of the rounds');
-* **the job alone**: the same run, ranks and analysis launched by a process that only waits for
-  them (:func:`~hexdem.experiments.run.simulate` from ``python -c``), without the ``hexdem run``
-  process's loading of its figure libraries beside the ranks: its loop's share is the in-run
-  analysis's alone, where the command's loading takes a core from a rank (as many ranks as cores);
 * **the analysis part by part inside the run**: ``summary.json``'s ``analysis_cpu_s`` (each part's
   CPU time, summed over the ranks) per bead, the tracker per sample, the audit per audited sample,
   the gathering once: measured on any rank count, more ranks than cores included;
@@ -60,7 +56,6 @@ import json
 import os
 import re
 import shutil
-import sys
 import tempfile
 import time
 from pathlib import Path
@@ -157,14 +152,6 @@ def paired_share(loops_s, bare_loops_s) -> float:
     return float(np.median(np.asarray(loops_s) / np.asarray(bare_loops_s))) - 1
 
 
-def alone_command(config_file: Path, directory: Path) -> list[str]:
-    """The run of ``config_file`` in ``directory`` by :func:`~hexdem.experiments.run.simulate` (its ranks,
-    LAMMPS and the in-run analysis, no result files) from a process that loads nothing while it runs."""
-    code = ("import sys; from hexdem.experiments.run import simulate; from hexdem.model.config import RunConfig; "
-            "simulate(RunConfig.from_toml(sys.argv[1]), sys.argv[2])")
-    return [sys.executable, "-c", code, str(config_file), str(directory)]
-
-
 def measure(config: RunConfig, ranks: int, work: Path, before: Path | None = None, repeat: int = 1) -> dict:
     """One row: the stages, each process's peak memory and the collectives of ``config`` on ``ranks``;
     with ``before`` (an earlier version's package tree), that version's loop and end to end too. The
@@ -195,10 +182,6 @@ def measure(config: RunConfig, ranks: int, work: Path, before: Path | None = Non
                                                env=hexdem_env(before)).check(f"hexdem run before ({tag})").wall_s
             times["before loop"] = loop_time_s(earlier / "deck" / "log.lammps")
             shutil.rmtree(earlier)
-        alone = work / f"alone-{tag}"
-        run_watched(alone_command(config_file, alone), cwd=work).check(f"the job alone ({tag})")
-        times["alone loop"] = loop_time_s(alone / "log.lammps")
-        shutil.rmtree(alone)
         run_bare(deck, ranks, NOOUTPUT_NAME)
         times["bare loop"], times["bare modify"] = loop_time_s(deck.log_path), modify_time_s(deck.log_path)
         for name, seconds in times.items():
@@ -212,7 +195,7 @@ def measure(config: RunConfig, ranks: int, work: Path, before: Path | None = Non
     row = {"beads": model.n_bodies, "steps": settings.n_steps, "model": built - start, "data file": written - built,
            **{name: float(np.median(seconds)) for name, seconds in rounds.items()},
            **{f"{way}share": paired_share(rounds[f"{way}loop"], rounds["bare loop"])
-              for way in ("hexdem ", "before ", "alone ") if f"{way}loop" in rounds},
+              for way in ("hexdem ", "before ") if f"{way}loop" in rounds},
            "largest": watched.peak_per_process, "ranks rss": rank_peaks,
            "cli rss": watched.peaks.get(watched.pid, ("", 0))[1], "collectives": summary["collectives"],
            "cpu": summary["analysis_cpu_s"], "samples": summary["n_samples"],
@@ -260,12 +243,6 @@ def main() -> None:
               f"{r['run']:>8.2f} {r['results']:>11.2f} {r['wall']:>14.2f}")
     print("(analysis: the median of the rounds' hexdem loop / bare loop - 1; run: summary.json's wall_time_s, "
           "to the result files; results: the result tables and figures)")
-    print("the same job alone (its ranks and in-run analysis, launched by a process that loads nothing beside them)")
-    print(f"{'beads':>9} {'ranks':>5} {'bare loop [s]':>13} {'loop alone [s]':>14} {'analysis alone':>14} "
-          f"{'hexdem run':>10}")
-    for (edge, n), r in results.items():
-        print(f"{r['beads']:>9,} {n:>5} {r['bare loop']:>13.2f} {r['alone loop']:>14.2f} {r['alone share']:>14.2f} "
-              f"{r['hexdem share']:>10.2f}")
     print("the sampling callbacks by LAMMPS's own timer (slowest rank's Modify: hexdem's less the bare deck's), "
           "and their share of the rest of hexdem's loop")
     print(f"{'beads':>9} {'ranks':>5} {'modify hexdem [s]':>17} {'modify bare [s]':>15} {'callbacks [s]':>13} "
@@ -295,8 +272,7 @@ def main() -> None:
             continue
         share = r["hexdem share"]
         print(f"target analysis share, {r['beads']:,} beads on {n} rank(s): {share:.3f} "
-              f"{'<=' if share <= limit else '>'} {limit:g}: {'met' if share <= limit else 'NOT met'} "
-              f"(the job alone: {r['alone share']:.3f})")
+              f"{'<=' if share <= limit else '>'} {limit:g}: {'met' if share <= limit else 'NOT met'}")
     beads, n = END_TO_END_RUN
     row = next((r for (edge, m), r in results.items() if r["beads"] == beads and m == n), None)
     if row is not None:
