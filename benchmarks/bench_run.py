@@ -4,7 +4,8 @@ Usage: python benchmarks/bench_run.py [--repeats 5] [--before REV] [--quick]
 
 Renders the default ``hexdem run`` deck once, with ``in.nooutput`` beside it (the deck's
 set-up and its ``run``, no dump: LAMMPS's bare work, no Python in the loop). Then, after a
-discarded warm-up, it alternates, so that all see the same machine load:
+discarded warm-up, it alternates, so that all see the same machine load (the two versions'
+``hexdem run`` in turn first, so that neither always follows the other):
 
 * ``hexdem run`` (CLI): ``python -m hexdem.cli.main run`` in a subprocess, Python start-up and
   imports included;
@@ -78,6 +79,13 @@ def timed_cli(config_path: Path, out: Path, tree: Path | None = None) -> tuple[f
     return wall, json.loads((out / "summary.json").read_text())
 
 
+def time_before(config_path: Path, out: Path, tree: Path, times: dict) -> None:
+    """Time the version unpacked at ``tree`` once into ``times`` ("before": end to end, "before loop")."""
+    times["before"].append(timed_cli(config_path, out, tree)[0])
+    times["before loop"].append(loop_time_s(out / "deck" / "log.lammps"))
+    shutil.rmtree(out)
+
+
 def timed_python(code: str) -> float:
     """Wall time of ``python -c CODE``."""
     start = time.perf_counter()
@@ -105,6 +113,9 @@ def main() -> None:
         t = {key: [] for key in ("cli", "cli loop", "cli summary", "cli engine", "before", "before loop", "inproc",
                                  "inproc loop", "stream loop", "floor", "import", "bare", "bare loop")}
         for repeat in range(repeats):
+            before_first = before is not None and repeat % 2 == 1  # neither version always runs first
+            if before_first:
+                time_before(config_path, work / f"before-{repeat}", before, t)
             out = work / f"cli-{repeat}"
             wall, summary = timed_cli(config_path, out)
             if (out / "deck" / DECK_NAME).read_text() != deck.input_path.read_text():
@@ -114,11 +125,8 @@ def main() -> None:
             t["cli summary"].append(summary.get("wall_time_s", math.nan))
             t["cli engine"].append(summary.get("engine_wall_time_s", math.nan))
             shutil.rmtree(out)
-            if before is not None:
-                out = work / f"before-{repeat}"
-                t["before"].append(timed_cli(config_path, out, before)[0])
-                t["before loop"].append(loop_time_s(out / "deck" / "log.lammps"))
-                shutil.rmtree(out)
+            if before is not None and not before_first:
+                time_before(config_path, work / f"before-{repeat}", before, t)
             out = work / f"inproc-{repeat}"
             start = time.perf_counter()
             run_experiment(config, out, log=quiet)

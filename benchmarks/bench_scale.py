@@ -42,9 +42,9 @@ share of the loop <= :data:`SHARE_TARGET` at 29,701 and 119,401 beads on 1 and 2
 :data:`MANY_RANKS_SHARE_TARGET` from :data:`MANY_RANKS` ranks on (a machine of that many cores); end
 to end <= :data:`END_TO_END_FACTOR` × the bare loop + :data:`END_TO_END_OFFSET_S` at 29,701 beads on 2
 ranks; a million beads' result files and figures <= :data:`MILLION_RESULTS_S`.
-``--repeat K``: each row's times are the medians of K rounds (hexdem, before, bare; one machine's
-load varies by 10 to 50 % between runs a minute apart), its shares the medians of the rounds'
-own shares. ``--quick``: hexagons of 5 and 7 per edge
+``--repeat K``: each row's times are the medians of K rounds (hexdem and before, the one first
+in one round and the other in the next, then bare; one machine's load varies by 10 to 50 %
+between runs a minute apart), its shares the medians of the rounds' own shares. ``--quick``: hexagons of 5 and 7 per edge
 for 0.2 ms on 1 and 2 ranks (the same code path, seconds).
 """
 
@@ -152,11 +152,22 @@ def paired_share(loops_s, bare_loops_s) -> float:
     return float(np.median(np.asarray(loops_s) / np.asarray(bare_loops_s))) - 1
 
 
+def run_before(config_file: Path, ranks: int, work: Path, tag: str, before: Path) -> dict:
+    """The earlier version's ``hexdem run`` of ``config_file``: its end to end ("before wall") and loop."""
+    earlier = work / f"before-{tag}"
+    wall = run_watched(hexdem_command("run", "--config", str(config_file), "--out", str(earlier), "--ranks", str(ranks)),
+                       cwd=work, env=hexdem_env(before)).check(f"hexdem run before ({tag})").wall_s
+    loop = loop_time_s(earlier / "deck" / "log.lammps")
+    shutil.rmtree(earlier)
+    return {"before wall": wall, "before loop": loop}
+
+
 def measure(config: RunConfig, ranks: int, work: Path, before: Path | None = None, repeat: int = 1) -> dict:
     """One row: the stages, each process's peak memory and the collectives of ``config`` on ``ranks``;
     with ``before`` (an earlier version's package tree), that version's loop and end to end too. The
-    times are medians of ``repeat`` rounds, each round hexdem, then the earlier version, then the
-    bare loop (so that a slow spell of the machine falls on all three alike)."""
+    times are medians of ``repeat`` rounds, each round hexdem and the earlier version (in turn
+    first, so that neither always follows the bare loop), then the bare loop (so that a slow
+    spell of the machine falls on all three alike)."""
     config = config.replace(ranks=ranks)
     tag = f"{config.edge_beads}-{ranks}"
     start = time.perf_counter()
@@ -168,7 +179,9 @@ def measure(config: RunConfig, ranks: int, work: Path, before: Path | None = Non
     out = work / f"hexdem-{tag}"
     config_file = write_config(config, work / f"{tag}.toml")
     rounds: dict[str, list[float]] = {}
-    for _ in range(repeat):
+    for round_index in range(repeat):
+        before_first = before is not None and round_index % 2 == 1
+        earlier = run_before(config_file, ranks, work, tag, before) if before_first else {}
         watched = run_watched(hexdem_command("run", "--config", str(config_file), "--out", str(out), "--ranks",
                                              str(ranks)), cwd=work).check(f"hexdem run ({tag})")
         summary = json.loads((out / "summary.json").read_text())
@@ -176,12 +189,7 @@ def measure(config: RunConfig, ranks: int, work: Path, before: Path | None = Non
         times = {"hexdem loop": loop_time_s(log), "hexdem modify": modify_time_s(log), "run": summary["wall_time_s"],
                  "results": results_span_s(out), "wall": watched.wall_s}
         if before is not None:
-            earlier = work / f"before-{tag}"
-            times["before wall"] = run_watched(hexdem_command("run", "--config", str(config_file), "--out",
-                                                              str(earlier), "--ranks", str(ranks)), cwd=work,
-                                               env=hexdem_env(before)).check(f"hexdem run before ({tag})").wall_s
-            times["before loop"] = loop_time_s(earlier / "deck" / "log.lammps")
-            shutil.rmtree(earlier)
+            times.update(earlier or run_before(config_file, ranks, work, tag, before))
         run_bare(deck, ranks, NOOUTPUT_NAME)
         times["bare loop"], times["bare modify"] = loop_time_s(deck.log_path), modify_time_s(deck.log_path)
         for name, seconds in times.items():
