@@ -293,12 +293,10 @@ class PulseTracker:
         contacts that cross to another rank), kept until :meth:`finish` sums the ranks' parts."""
         start = time.thread_time()
         units = self.settings.units
+        ghosts = sample.ghost_ids is not None and len(sample.ghost_ids) > 0
         if self.audit_bodies is None:  # (the same array until the bodies may have migrated, see EnergyAudit.part)
-            ids = sample.ids if sample.ghost_ids is None else np.concatenate([sample.ids, sample.ghost_ids])
-            self.audit_bodies = ids - 1
-        positions = sample.positions
-        if sample.ghost_ids is not None and len(sample.ghost_ids):
-            positions = np.concatenate([positions, sample.ghost_positions])
+            self.audit_bodies = (np.concatenate([sample.ids, sample.ghost_ids]) if ghosts else sample.ids) - 1
+        positions = np.concatenate([sample.positions, sample.ghost_positions]) if ghosts else sample.positions
         angular = None if sample.angular_velocities is None else sample.angular_velocities / units.time_s
         self.audit_parts.append(self.audit.part(self.audit_bodies, len(sample.ids), in_si(positions, units.length_m),
                                                 in_si(sample.velocities, units.velocity_m_s), angular))
