@@ -25,6 +25,11 @@ than cores is fine for memory and collective counts, not for times):
 * **the callbacks by LAMMPS's own timer**: the slowest rank's "Modify" time (the fixes, ``fix
   external``'s call into hexdem among them) less the bare deck's, and its share of the rest of
   hexdem's loop: the same share measured inside one run, free of the loop's spread between runs;
+* **where the loop's excess lies**: each section of LAMMPS's timing breakdown (its average over
+  the ranks, which sum to the loop), hexdem's less the bare deck's. Beside the callbacks
+  ("Modify"), a rank slowed by anything else (another process on its core, caches its neighbour
+  left cold) keeps the others waiting in "Comm", and data that a callback pushed out of the caches
+  comes back in "Pair";
 * **peak RSS per process** (:func:`harness.run_watched`): the ``hexdem run`` process (which
   also writes the results and figures) and each MPI rank, read from ``/proc``;
 * **the same results on every rank count**: ``peaks.csv`` and ``beads.csv`` of each rank count
@@ -98,10 +103,18 @@ def neighbour_builds(log: Path) -> int:
     return sum(int(n) for n in re.findall(r"Neighbor list builds = (\d+)", log.read_text()))
 
 
-def modify_time_s(log: Path) -> float:
-    """The slowest rank's "Modify" time [s] over the runs of a LAMMPS log (its timing breakdown: the
+#: The sections of LAMMPS's timing breakdown, which sum to its loop time.
+SECTIONS = ("Pair", "Neigh", "Comm", "Output", "Modify", "Other")
+
+
+def section_times_s(log: Path) -> dict[str, float]:
+    """Each section's time [s] over the runs of a LAMMPS log, from its timing breakdown: the ranks'
+    average (``Other`` has no other), and as ``"slowest Modify"`` the slowest rank's "Modify" (the
     fixes' time, hexdem's sampling callback included, as ``fix external`` calls it in ``post_force``)."""
-    return sum(float(t) for t in re.findall(r"^Modify\s*\|\s*\S+\s*\|\s*\S+\s*\|\s*(\S+)", log.read_text(), re.M))
+    text = log.read_text()
+    times = {name: sum(float(t) for t in re.findall(rf"^{name}\s*\|[^|]*\|\s*(\S+)", text, re.M)) for name in SECTIONS}
+    times["slowest Modify"] = sum(float(t) for t in re.findall(r"^Modify\s*\|[^|]*\|[^|]*\|\s*(\S+)", text, re.M))
+    return times
 
 
 def audited_samples(table: Path) -> int:
@@ -186,16 +199,18 @@ def measure(config: RunConfig, ranks: int, work: Path, before: Path | None = Non
                                              str(ranks)), cwd=work).check(f"hexdem run ({tag})")
         summary = json.loads((out / "summary.json").read_text())
         log = out / "deck" / "log.lammps"
-        times = {"hexdem loop": loop_time_s(log), "hexdem modify": modify_time_s(log), "run": summary["wall_time_s"],
-                 "results": results_span_s(out), "wall": watched.wall_s}
+        times = {"hexdem loop": loop_time_s(log), **{f"hexdem {name}": t for name, t in section_times_s(log).items()},
+                 "run": summary["wall_time_s"], "results": results_span_s(out), "wall": watched.wall_s}
         if before is not None:
             times.update(earlier or run_before(config_file, ranks, work, tag, before))
         run_bare(deck, ranks, NOOUTPUT_NAME)
-        times["bare loop"], times["bare modify"] = loop_time_s(deck.log_path), modify_time_s(deck.log_path)
+        times["bare loop"] = loop_time_s(deck.log_path)
+        times.update({f"bare {name}": t for name, t in section_times_s(deck.log_path).items()})
         for name, seconds in times.items():
             rounds.setdefault(name, []).append(seconds)
         print(f"  {model.n_bodies} beads on {ranks} rank(s), round {len(rounds['wall'])}: "
-              + ", ".join(f"{name} {seconds:.2f} s" for name, seconds in times.items()), flush=True)
+              + ", ".join(f"{name} {seconds:.2f} s" for name, seconds in times.items()
+                          if name.rsplit(" ", 1)[-1] not in SECTIONS), flush=True)
         if len(rounds["wall"]) < repeat:
             shutil.rmtree(out)
     rank_peaks = sorted((rss for pid, (name, rss) in watched.peaks.items()
@@ -256,9 +271,15 @@ def main() -> None:
     print(f"{'beads':>9} {'ranks':>5} {'modify hexdem [s]':>17} {'modify bare [s]':>15} {'callbacks [s]':>13} "
           f"{'callback share':>14}")
     for (edge, n), r in results.items():
-        callbacks = r["hexdem modify"] - r["bare modify"]
-        print(f"{r['beads']:>9,} {n:>5} {r['hexdem modify']:>17.2f} {r['bare modify']:>15.2f} {callbacks:>13.2f} "
-              f"{callbacks / (r['hexdem loop'] - callbacks):>14.2f}")
+        callbacks = r["hexdem slowest Modify"] - r["bare slowest Modify"]
+        print(f"{r['beads']:>9,} {n:>5} {r['hexdem slowest Modify']:>17.2f} {r['bare slowest Modify']:>15.2f} "
+              f"{callbacks:>13.2f} {callbacks / (r['hexdem loop'] - callbacks):>14.2f}")
+    print("where hexdem's loop exceeds the bare loop: each section of LAMMPS's timing breakdown (the ranks' average), "
+          "hexdem's less the bare deck's [s]")
+    print(f"{'beads':>9} {'ranks':>5} {'loop':>6} " + " ".join(f"{name:>7}" for name in SECTIONS))
+    for (edge, n), r in results.items():
+        print(f"{r['beads']:>9,} {n:>5} {r['hexdem loop'] - r['bare loop']:>6.2f} "
+              + " ".join(f"{r[f'hexdem {name}'] - r[f'bare {name}']:>7.2f}" for name in SECTIONS))
     print("the analysis part by part inside the run (summary.json's analysis_cpu_s, CPU time summed over the ranks), "
           "per bead: tracker per sample, audit per audited sample, gathering once [ns]")
     print(f"{'beads':>9} {'ranks':>5} {'tracker':>8} {'audit':>8} {'gathering':>9}")
