@@ -10,7 +10,7 @@ creeping by round-off (1e-17 m/s a sample, as LAMMPS leaves them), positions on 
 
 * **before**: the NumPy tracker without the noise floor (every creeping bead takes the path of a
   new maximum, as before round-off stopped counting as motion) and the NumPy audit;
-* **NumPy**: today's NumPy path (ranks below :data:`~hexdem.common.compiled.COMPILED_BEADS`);
+* **NumPy**: today's NumPy code, which defines the kernels' results (:data:`~hexdem.common.compiled.COMPILED` False);
 * **compiled**: today's compiled kernels (:mod:`hexdem.analysis.compiled`), after a warm-up.
 
 Per part, in ns per bead per sample: the **samples** (the driver's full-step positions and
@@ -88,7 +88,7 @@ class Timed:
 
 def measure(model, settings, way: str, samples, out: Path) -> dict:
     """One way's parts (see the module docstring) over ``samples``."""
-    compiled_module.COMPILED_BEADS = 1 if way == "compiled" else 10**12
+    compiled_module.COMPILED = way == "compiled"
     tracker = PulseTracker(model, settings)
     if way == "before":
         tracker.floor = 0.0

@@ -6,7 +6,9 @@ NumPy in pairs)."""
 import numpy as np
 import pytest
 
+import hexdem.analysis.tracker as tracker_module
 import hexdem.common.compiled as compiled
+from hexdem.analysis.compiled import sample_pulses
 from hexdem.analysis.energy import EnergyAudit, _pair_constants, _pair_contacts, _pairs, _wall_constants, _wall_contacts
 from hexdem.analysis.tracker import PulseTracker
 from hexdem.analysis.tracker_kernel import RIVAL_RATIO, SAMPLED, PulseState
@@ -22,15 +24,23 @@ RUNS = {
     "striker, friction, brass region": {"edge_beads": 7, "impact": "striker", "friction": 0.3,
                                         "regions": ({"material": "brass", "x_min_d": 3.0},)},
     "square": {"shape": "square", "rows": 9, "columns": 9},
+    "chain with an intruder": {"shape": "chain", "beads": 20, "duration": 1e-3,
+                               "intruders": ({"bead": 10, "diameter_m": 0.009525},)},
+    "disc": {"shape": "disc", "radius_beads": 6},
 }
 
 
 @pytest.mark.parametrize("changes", RUNS.values(), ids=RUNS)
 def test_the_compiled_kernels_give_the_numpy_results(tmp_path, monkeypatch, changes):
     config = RunConfig(**changes)
+    passes = []  # the compiled tracker's passes, so that each run is known to have taken its way
+    monkeypatch.setattr(tracker_module, "sample_pulses", lambda *args: passes.append(1) or sample_pulses(*args))
+    monkeypatch.setattr(compiled, "COMPILED", False)
     numpy_run = simulate(config, tmp_path / "numpy").tracked
-    monkeypatch.setattr(compiled, "COMPILED_BEADS", 1)
+    assert not passes
+    monkeypatch.setattr(compiled, "COMPILED", True)
     compiled_run = simulate(config, tmp_path / "compiled").tracked
+    assert len(passes) == compiled_run.n_samples
     for name in ("peak_speed", "t_peak", "arrival_time", "reach_time", "end_velocity", "peak_angular_speed"):
         np.testing.assert_array_equal(getattr(compiled_run, name), getattr(numpy_run, name), err_msg=name)
     # the two ways round each overlap δ (a difference of coordinates ~10 D) differently, by ~1e-15 D (the
@@ -206,8 +216,8 @@ def test_beads_whose_rows_move_keep_the_speeds_their_ring_left_untaken(monkeypat
     velocities = np.stack([size * np.cos(direction), size * np.sin(direction)], axis=2)
     ids, positions = np.arange(1, n + 1), model.initial_positions_m()
 
-    def tracked(compiled_beads, reorder):
-        monkeypatch.setattr(compiled, "COMPILED_BEADS", compiled_beads)
+    def tracked(compiled_way, reorder):
+        monkeypatch.setattr(compiled, "COMPILED", compiled_way)
         tracker = PulseTracker(model, settings, trace_beads=(0, n // 2))
         order = np.arange(n)
         for s in range(samples):
@@ -218,7 +228,7 @@ def test_beads_whose_rows_move_keep_the_speeds_their_ring_left_untaken(monkeypat
                            np.ascontiguousarray(velocities[s, order]), migrated=moved))
         return tracker.finish()
 
-    numpy_run, in_order, reordered = tracked(10**9, False), tracked(1, False), tracked(1, True)
+    numpy_run, in_order, reordered = tracked(False, False), tracked(True, False), tracked(True, True)
     assert np.isfinite(numpy_run.arrival_time).mean() > 0.9  # pulses passed nearly every bead
     for run in (in_order, reordered):
         for name in ("peak_speed", "t_peak", "arrival_time", "reach_time", "end_velocity", "trace_speeds"):
@@ -271,11 +281,11 @@ def test_an_in_process_runs_loop_waits_for_what_loads_in_the_background(tmp_path
     assert len(loading) > 2 and not any(loading[1:]), loading  # (the set-up's sample 0 may still find it)
 
 
-@pytest.mark.parametrize("compiled_beads", [10**9, 1], ids=["NumPy", "compiled"])
-def test_a_sample_that_reorders_the_bodies_unannounced_is_refused(monkeypatch, compiled_beads):
+@pytest.mark.parametrize("compiled_way", [False, True], ids=["NumPy", "compiled"])
+def test_a_sample_that_reorders_the_bodies_unannounced_is_refused(monkeypatch, compiled_way):
     """A sample's rows are the previous sample's bodies in the same order unless it says that they
     may have migrated: both ways refuse one that swaps two rows without saying so."""
-    monkeypatch.setattr(compiled, "COMPILED_BEADS", compiled_beads)
+    monkeypatch.setattr(compiled, "COMPILED", compiled_way)
     config = RunConfig(edge_beads=4)
     model = build_model(config)
     tracker = PulseTracker(model, run_settings(config, model))

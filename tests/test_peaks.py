@@ -99,8 +99,8 @@ def test_the_peak_is_the_largest_maximum_of_the_interpolant(monkeypatch, narrow_
     assert whole.arrival_time[0] == pytest.approx(fine[np.argmax(dense >= 0.5 * whole.peak_speed[0])], abs=0.05)
     assert refine_peak(times, speeds) == (whole.t_peak[0], whole.peak_speed[0])
     paths = []
-    for compiled_beads in (compiled.COMPILED_BEADS, 1):
-        monkeypatch.setattr(compiled, "COMPILED_BEADS", compiled_beads)
+    for compiled_way in (False, True):
+        monkeypatch.setattr(compiled, "COMPILED", compiled_way)
         paths.append(tracked_speeds(times, np.column_stack([speeds, speeds[::-1]])))
     for name in ("peak_speed", "t_peak", "arrival_time", "reach_time"):
         np.testing.assert_array_equal(getattr(paths[1], name), getattr(paths[0], name), err_msg=name)

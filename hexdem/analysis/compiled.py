@@ -13,9 +13,8 @@ bead's few numbers takes a few nanoseconds.
 Compiled without fast-math or contracted multiply-adds, so that each operation rounds as
 NumPy's does. C rather than numba: loading numba and its cached kernels took 0.7 to 0.8 s of
 each MPI rank's start (29,701 beads on 2 ranks of a 2-core machine, where no core is left to
-hide it), as much as the analysis of the whole run; the C kernels load in a millisecond. A
-large rank uses them (:data:`~hexdem.common.compiled.COMPILED_BEADS`); the others keep the
-NumPy code, whose results they reproduce.
+hide it), as much as the analysis of the whole run; the C kernels load in a millisecond. Every
+run uses them (:mod:`hexdem.common.compiled`); the NumPy code defines their results.
 """
 
 from __future__ import annotations

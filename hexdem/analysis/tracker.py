@@ -147,7 +147,7 @@ class PulseTracker:
         self.field_set = frozenset(self.field_samples.tolist())
         self.field_parts = []
         self.energy_every = max(1, (total - 1) // ENERGY_SAMPLES)
-        self.compiled = runs_compiled(model.n_bodies, 1 if comm is None else comm.Get_size())
+        self.compiled = runs_compiled()
         if not self.compiled:  # the NumPy audit's pair search, while the engine starts
             load_in_background("scipy.spatial")
         self.audit = EnergyAudit(model, gravity_m_s2, self.compiled)

@@ -47,10 +47,9 @@ new maximum, the peak window); the ladder's bookkeeping runs on the few beads wh
 maximum rises at that sample (beads at rest never do: their samples stay below the noise floor),
 and the refinement on the few whose rival window completes (a local maximum within
 :data:`~hexdem.analysis.peaks.PEAK_OVERSHOOT` of the running maximum).
-Every step is a NumPy operation over those beads, on small ranks; a large rank
-(:data:`~hexdem.common.compiled.COMPILED_BEADS`) runs the same update compiled
-(:func:`~hexdem.analysis.compiled.sample_pulses`), which takes most
-beads' speeds only when a window needs them.
+Every step is a NumPy operation over those beads. Runs take the same update compiled
+(:func:`~hexdem.analysis.compiled.sample_pulses`, :mod:`hexdem.common.compiled`), which takes most
+beads' speeds only when a window needs them; this code defines its results.
 """
 
 from __future__ import annotations

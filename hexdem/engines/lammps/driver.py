@@ -112,7 +112,7 @@ class _Stream:
         self.builds = None  # neighbour list builds at the previous sample (None: it came before this run)
         self.arrays: dict[str, np.ndarray] = {}
         self.ghost_ids = np.zeros(0, dtype=np.int64)
-        self.compiled = runs_compiled(deck.n_atoms, 1 if comm is None else comm.Get_size())
+        self.compiled = runs_compiled()
 
     def take_arrays(self, nlocal: int) -> None:
         """Views of the arrays a sample reads, for ``nlocal`` atoms and the ghosts LAMMPS has now, and
