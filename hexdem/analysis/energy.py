@@ -96,8 +96,8 @@ def _wall_geometry(wall) -> tuple[int, tuple[float, float], float]:
 
 
 def _wall_rows(walls, regions) -> tuple:
-    r"""The walls of :func:`_wall_constants` as :func:`~hexdem.analysis.compiled.add_wall_energies`
-    reads them: per wall where its members start and end in the member arrays and its
+    r"""The walls of :func:`_wall_constants` as :func:`~hexdem.analysis.compiled.audit_part` reads
+    them: per wall where its members start and end in the member arrays and its
     :func:`_wall_geometry`; per member its row, radius, :math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}` and
     its row's region (``regions``, by row)."""
     bounds = np.cumsum([0, *(len(wall[1]) for wall in walls)])
@@ -187,8 +187,8 @@ class EnergyAudit:
     def _list(self, bodies, n_own: int, positions_m) -> None:
         """List the candidates among the rows of ``positions_m`` (bodies ``bodies``, the first ``n_own``
         audited) with an audited body: the candidates (i, j, k_n, R_eff) of rows within contact
-        distance and the skin (:func:`_pair_constants`; found by scipy's tree, or compiled on large ranks,
-        :func:`~hexdem.analysis.compiled.pairs_within`), kept from one search to the next until a body
+        distance and the skin (:func:`_pair_constants`; found compiled, :func:`~hexdem.analysis.compiled.pairs_within`,
+        or by scipy's tree on the NumPy way), kept from one search to the next until a body
         has moved half the skin, and the walls' audited members (:func:`_wall_constants`)."""
         self._listed, self._listed_at = (bodies, n_own), positions_m.copy()
         i, j = (pairs_within if self.compiled else _pairs)(positions_m, 2 * self.radii_m.max() + self.skin_m)

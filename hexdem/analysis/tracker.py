@@ -253,10 +253,10 @@ class PulseTracker:
     def _take_sample(self, sample: Sample) -> np.ndarray | None:
         """Take ``sample`` into the pulse state once its bodies are found to be the previous sample's,
         in order (laid out by :meth:`_arrange` where it says they may have migrated); their velocities
-        become the beads' last seen (:attr:`end_velocity`). Returns the beads' speeds; on large ranks
-        (one compiled pass, :func:`~hexdem.analysis.compiled.sample_pulses`, which takes most speeds
-        only when the tracker needs them) None, unless the whole sample's are wanted (a threshold's
-        crossings, a speed field)."""
+        become the beads' last seen (:attr:`end_velocity`). Returns the beads' speeds; compiled (one
+        pass, :func:`~hexdem.analysis.compiled.sample_pulses`, which takes most speeds only when the
+        tracker needs them) None, unless the whole sample's are wanted (a threshold's crossings, a
+        speed field)."""
         s = sample.index
         if not self.compiled:
             self._check_order(sample, np.array_equal(sample.ids, self.sample_ids))

@@ -1,4 +1,4 @@
-"""The samples LAMMPS hands over, taken in one compiled pass on large ranks.
+"""The samples LAMMPS hands over, taken in one compiled pass.
 
 At the sampling callback a rank's velocities are at the half step; the sample holds the full
 step's, v(t) = v(t − dt/2) + (dt/2) f/m (see :mod:`hexdem.engines.lammps.driver`). NumPy takes
