@@ -11,7 +11,7 @@ import hexdem
 
 PACKAGE = Path(hexdem.__file__).parent
 #: Layers in the direction data flows; a module may import only from its own layer or lower ones.
-LAYERS = ("errors", "common", "model", "engines", "analysis", "experiments", "theory", "waves", "disorder", "paper", "api", "cli",
+LAYERS = ("errors", "common", "model", "engines", "analysis", "experiments", "theory", "waves", "disorder", "calibration", "paper", "api", "cli",
           "__main__")
 MAX_LINES = 400
 

@@ -41,6 +41,7 @@ COMMANDS = {
     "ensemble": ("hexdem.cli.ensemble", "weakly disordered ensembles with striker impacts (Sec. VI)"),
     "snapshots": ("hexdem.cli.snapshots", "wavefront speed maps at chosen times (Figs. 3 and 4)"),
     "sweep": ("hexdem.cli.sweep", "a study of any run-config keys, each run a full result directory"),
+    "calibrate": ("hexdem.cli.calibrate", "the model's parameters from measured sensor records, with uncertainties"),
     "paper": ("hexdem.cli.paper", "the whole paper: every published number beside hexdem's, in one report"),
 }
 

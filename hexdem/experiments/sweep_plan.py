@@ -77,28 +77,29 @@ def toml_value(text: str):
         return text
 
 
-def _step(container, step: str, path: str):
+def _step(container, step: str, path: str, option: str):
     if isinstance(container, list):
         if not re.fullmatch(r"[0-9]+", step) or int(step) >= len(container):
-            raise HexdemError(f"--vary {path}: the base configuration has no item {step} "
+            raise HexdemError(f"{option} {path}: the base configuration has no item {step} "
                               f"(it has {len(container)})")
         return int(step)
     if isinstance(container, dict):
         return step
-    raise HexdemError(f"--vary {path}: {step!r} is inside a value that is neither a table nor a list")
+    raise HexdemError(f"{option} {path}: {step!r} is inside a value that is neither a table nor a list")
 
 
-def with_value(data: dict, path: str, value) -> dict:
-    """A copy of the configuration ``data`` with the dotted ``path`` set to ``value``."""
+def with_value(data: dict, path: str, value, option: str = "--vary") -> dict:
+    """A copy of the configuration ``data`` with the dotted ``path`` set to ``value``; errors name
+    the path as the command-line ``option`` that gave it."""
     changed = copy.deepcopy(data)
     steps = path.split(".")
     container = changed
     for step in steps[:-1]:
-        index = _step(container, step, path)
+        index = _step(container, step, path, option)
         if isinstance(container, dict) and index not in container:
-            raise HexdemError(f"--vary {path}: the base configuration has no {step!r} to change a part of")
+            raise HexdemError(f"{option} {path}: the base configuration has no {step!r} to change a part of")
         container = container[index]
-    container[_step(container, steps[-1], path)] = value
+    container[_step(container, steps[-1], path, option)] = value
     return changed
 
 

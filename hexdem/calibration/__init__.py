@@ -1,0 +1,2 @@
+"""Calibration from measurements: the model's parameters, with uncertainties, from sensor records
+(``hexdem calibrate``). Priors → simulations → emulator → posterior, one module each."""

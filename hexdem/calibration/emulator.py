@@ -1,0 +1,95 @@
+"""A Gaussian-process emulator of a record's observables over the unit cube of the priors.
+
+Each observable gets its own process: a linear trend fitted by least squares, and a zero-mean
+Gaussian process on the residuals with the Matérn 5/2 kernel
+
+    k(x, x') = s² (1 + √5 r + 5 r²/3) exp(−√5 r),   r² = Σ_j (x_j − x'_j)² / ℓ_j²,
+
+plus a nugget τ² for the simulations' own round-off and sampling jitter. The hyperparameters
+(ℓ_j, s², τ²) maximize the residuals' log marginal likelihood (Rasmussen & Williams, eq. 2.30).
+The prediction at x is the trend plus the posterior mean, with the posterior variance
+(eqs. 2.25-2.26): the emulator says where it is unsure, and the calibration's likelihood adds
+that variance to the data's, so that a coarse emulator widens the posterior rather than
+narrowing it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.linalg import cho_factor, cho_solve, solve_triangular
+from scipy.optimize import minimize
+
+#: Bounds of log ℓ (unit-cube widths), log s² and log τ² of the standardized residuals.
+LOG_BOUNDS = {"length": (np.log(0.02), np.log(20.0)), "signal": (np.log(1e-4), np.log(1e2)),
+              "nugget": (np.log(1e-10), np.log(1e-1))}
+
+
+def matern52(a, b, lengths) -> np.ndarray:
+    """The Matérn 5/2 correlation between the rows of ``a`` (n, p) and ``b`` (k, p)."""
+    d = (a[:, None, :] - b[None, :, :]) / lengths
+    r = np.sqrt(np.maximum(np.sum(d * d, axis=-1), 0.0))
+    return (1.0 + np.sqrt(5.0) * r + 5.0 / 3.0 * r * r) * np.exp(-np.sqrt(5.0) * r)
+
+
+def _design(x) -> np.ndarray:
+    return np.column_stack([np.ones(len(x)), x])
+
+
+class _Process:
+    """One observable's trend and residual process, fitted to (x, y)."""
+
+    def __init__(self, x, y):
+        self.x = x
+        self.beta = np.linalg.lstsq(_design(x), y, rcond=None)[0]
+        residual = y - _design(x) @ self.beta
+        self.scale = float(np.std(residual)) or 1.0
+        self.z = residual / self.scale
+        self.theta = self._optimize()
+        lengths, signal, nugget = self._unpack(self.theta)
+        k = signal * matern52(x, x, lengths) + nugget * np.eye(len(x))
+        self.factor = cho_factor(k, lower=True)
+        self.alpha = cho_solve(self.factor, self.z)
+        self.lengths, self.signal = lengths, signal
+
+    def _unpack(self, theta):
+        p = self.x.shape[1]
+        return np.exp(theta[:p]), np.exp(theta[p]), np.exp(theta[p + 1])
+
+    def _negative_log_likelihood(self, theta) -> float:
+        lengths, signal, nugget = self._unpack(theta)
+        k = signal * matern52(self.x, self.x, lengths) + (nugget + 1e-12) * np.eye(len(self.x))
+        try:
+            factor = cho_factor(k, lower=True)
+        except np.linalg.LinAlgError:
+            return 1e25
+        alpha = cho_solve(factor, self.z)
+        return float(0.5 * self.z @ alpha + np.sum(np.log(np.diag(factor[0]))))
+
+    def _optimize(self) -> np.ndarray:
+        p = self.x.shape[1]
+        bounds = [LOG_BOUNDS["length"]] * p + [LOG_BOUNDS["signal"], LOG_BOUNDS["nugget"]]
+        starts = [np.r_[np.full(p, np.log(length)), 0.0, np.log(1e-4)] for length in (0.3, 1.0)]
+        fits = [minimize(self._negative_log_likelihood, start, method="L-BFGS-B", bounds=bounds) for start in starts]
+        return min(fits, key=lambda fit: fit.fun).x
+
+    def predict(self, xs) -> tuple[np.ndarray, np.ndarray]:
+        kstar = self.signal * matern52(xs, self.x, self.lengths)
+        mean = _design(xs) @ self.beta + self.scale * (kstar @ self.alpha)
+        v = solve_triangular(self.factor[0], kstar.T, lower=True)
+        var = np.maximum(self.signal - np.sum(v * v, axis=0), 0.0)
+        return mean, self.scale**2 * var
+
+
+class Emulator:
+    """Gaussian processes of every observable, fitted to simulations at unit-cube points ``x``
+    (n, p) with observables ``y`` (n, m)."""
+
+    def __init__(self, x, y):
+        x, y = np.asarray(x, float), np.asarray(y, float)
+        self.processes = [_Process(x, y[:, j]) for j in range(y.shape[1])]
+
+    def predict(self, xs) -> tuple[np.ndarray, np.ndarray]:
+        """(mean (k, m), variance (k, m)) of the observables at unit-cube points ``xs`` (k, p)."""
+        xs = np.atleast_2d(np.asarray(xs, float))
+        means, variances = zip(*(process.predict(xs) for process in self.processes))
+        return np.column_stack(means), np.column_stack(variances)

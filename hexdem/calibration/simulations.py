@@ -1,0 +1,139 @@
+"""The calibration's model of a measurement: the run of the base configuration with the
+parameters drawn, reduced to the observables of its sensors.
+
+Every simulation is one task of the study executor (:mod:`~hexdem.experiments.executors`) and
+has a folder of its own, ``DIR/simulations/NNNN`` (``-kK`` for the K-th packing), that holds
+``parameters.json`` (the values set), ``observables.json`` (the reduced record,
+:func:`~hexdem.calibration.observables.reduce_record`) and the run's LAMMPS deck. It is made in
+``.NNNN.part`` and renamed into place once complete, so that a folder that exists is a finished
+simulation: a calibration run again (after ``kill -9``, say) finds it, checks that its
+parameters are the planned ones, and does not repeat it. No figures are drawn and no result
+files written: a worker loads Python and LAMMPS once and runs one impact after another.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from hexdem.calibration.observables import observation_names, reduce_record
+from hexdem.calibration.priors import Prior
+from hexdem.common.io import write_json
+from hexdem.common.progress import silenced
+from hexdem.common.typecheck import type_at
+from hexdem.errors import HexdemError
+from hexdem.experiments.sweep_plan import with_value
+from hexdem.model.config import RunConfig
+from hexdem.model.run_settings import run_settings
+
+SIMULATIONS = "simulations"
+#: Values inside a prior's support at which every configuration is built before anything runs.
+CHECKED_QUANTILES = (0.0, 0.5, 1.0)
+
+
+@dataclass(frozen=True)
+class Problem:
+    """What a calibration simulates: the base configuration table ``base``, the ``priors`` of
+    the parameters it draws and the ``realizations`` (packings) per parameter set."""
+
+    base: dict
+    priors: tuple[Prior, ...]
+    realizations: int = 1
+
+    @property
+    def keys(self) -> list[str]:
+        return [prior.key for prior in self.priors]
+
+    def config(self, values) -> RunConfig:
+        """The run configuration with the parameters ``values`` (in the priors' order) set."""
+        data = self.base
+        for prior, value in zip(self.priors, values):
+            kind = type_at(RunConfig, prior.key)
+            data = with_value(data, prior.key, int(round(value)) if kind is int else float(value), option="--prior")
+        return RunConfig.from_dict(data, source="the calibrated configuration")
+
+    @property
+    def sensors(self) -> list[str]:
+        return [str(sensor) for sensor in RunConfig.from_dict(self.base, source="--config").sensors]
+
+    @property
+    def names(self) -> list[str]:
+        return observation_names(self.sensors)
+
+
+def check_problem(problem: Problem) -> None:
+    """Refuse, in one line and before anything runs, a base configuration without sensors, a
+    prior on a key that is not a number of the configuration, and a prior whose support leaves
+    the key's valid range (each configuration is built at the support's ends and middle)."""
+    base = RunConfig.from_dict(problem.base, source="--config")
+    if not base.sensors:
+        raise HexdemError("--config: a calibration compares sensor records; list the measured sensors in the "
+                          "configuration's sensors")
+    if base.engine != "lammps" or base.ranks != 1:
+        raise HexdemError("--config: a calibration runs each simulation on one LAMMPS rank of its own (--workers "
+                          "runs several at once); leave engine and ranks at their defaults")
+    for prior in problem.priors:
+        kind = type_at(RunConfig, prior.key)
+        if kind is None or kind is bool or not any(t in (int, float) for t in (kind, *getattr(kind, "__args__", ()))):
+            raise HexdemError(f"--prior {prior.key}: not a numeric key of the run configuration")
+        if kind is int and prior.kind != "uniform":
+            raise HexdemError(f"--prior {prior.key}: an integer key takes uniform(a, b)")
+    for quantile in CHECKED_QUANTILES:
+        values = [float(prior.from_unit(min(max(quantile, 1e-9), 1 - 1e-9))) for prior in problem.priors]
+        try:
+            run_settings(problem.config(values))
+        except HexdemError as exc:
+            named = ", ".join(f"{prior.key} = {value:.6g}" for prior, value in zip(problem.priors, values))
+            raise HexdemError(f"--prior: the configuration with {named} (inside the priors) is refused: {exc}") from None
+
+
+def simulation_name(index: int, realization: int, realizations: int) -> str:
+    return f"{index:04d}" if realizations == 1 else f"{index:04d}-k{realization}"
+
+
+def finished(folder: Path, values) -> np.ndarray | None:
+    """The observables of the finished simulation in ``folder``, or None if it has not run; a
+    folder that holds other parameters is refused (the study folder holds another calibration)."""
+    path = folder / "observables.json"
+    if not path.is_file():
+        return None
+    stored = json.loads((folder / "parameters.json").read_text())["values"]
+    if not np.allclose(stored, values, rtol=1e-12, atol=0.0):
+        raise HexdemError(f"{folder} holds a simulation of other parameters: {folder.parent.parent} holds another "
+                          "calibration; rerun the same command to resume it, or choose another --out")
+    return np.array(json.loads(path.read_text())["observables"])
+
+
+def simulate_point(problem: Problem, values, folder) -> list[float]:
+    """Run the configuration of ``values`` in ``folder`` (made via a ``.part`` folder) and return
+    its observables; a task of the study executor."""
+    from hexdem.experiments.run import simulate
+
+    folder = Path(folder)
+    if (done := finished(folder, values)) is not None:
+        return done.tolist()
+    partial = folder.with_name(f".{folder.name}.part")
+    shutil.rmtree(partial, ignore_errors=True)
+    partial.mkdir(parents=True)
+    try:
+        config = problem.config(values)
+        write_json(partial / "parameters.json", {"keys": problem.keys, "values": [float(v) for v in values]})
+        with silenced():
+            analysis = simulate(config, partial / "deck")
+        units, tracked = analysis.settings.units, analysis.tracked
+        times = tracked.sensor_times * units.time_s
+        accelerations = np.moveaxis(tracked.sensor_states[:, :, 2:4], 1, 0) * (units.length_m / units.time_s**2)
+        observables = reduce_record(times, accelerations)
+        write_json(partial / "observables.json", {"names": problem.names, "observables": observables.tolist(),
+                                                  "engine_wall_time_s": analysis.engine.get("wall_time_s", math.nan)})
+        os.replace(partial, folder)
+    except BaseException:
+        shutil.rmtree(partial, ignore_errors=True)
+        raise
+    return observables.tolist()

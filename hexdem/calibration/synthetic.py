@@ -1,0 +1,46 @@
+"""Synthetic experiments: accelerometer records of a known truth, as a lab would record them.
+
+A record is the run of a configuration at a time step ``finer`` times shorter than a
+calibration's runs take, its sensors' accelerations sampled at their rate (500 kS/s, the paper's
+acquisition), after a quiet pre-trigger lead-in, with white accelerometer noise and an unknown
+clock offset. A calibration given such records does not fit a model to its own output: its runs
+integrate at another step and sample at other instants.
+"""
+
+from __future__ import annotations
+
+import tempfile
+
+import numpy as np
+
+from hexdem.calibration.observables import MEASURED_COLUMNS
+from hexdem.common.io import write_csv
+from hexdem.common.progress import silenced
+from hexdem.model.config import RunConfig
+
+#: The pre-trigger lead-in a record keeps before the impact [s].
+LEAD_IN_S = 100e-6
+
+
+def synthetic_rows(config: RunConfig, record: str, noise_m_s2: float, offset_s: float, rng, finer: int = 2) -> list:
+    """Rows ``sensor,time,ax,ay,record`` of one synthetic record of ``config``."""
+    from hexdem.experiments.run import simulate
+
+    fine = config.replace(steps_per_contact=config.steps_per_contact * finer)
+    with tempfile.TemporaryDirectory() as workdir, silenced():
+        analysis = simulate(fine, workdir)
+    units, tracked = analysis.settings.units, analysis.tracked
+    times = tracked.sensor_times * units.time_s
+    accelerations = tracked.sensor_states[:, :, 2:4] * (units.length_m / units.time_s**2)
+    interval = 1.0 / config.sensor_rate_hz
+    lead = np.arange(-round(LEAD_IN_S / interval), 0) * interval
+    times = np.concatenate([lead, times]) + offset_s
+    accelerations = np.concatenate([np.zeros((len(lead), *accelerations.shape[1:])), accelerations])
+    accelerations = accelerations + rng.normal(0.0, noise_m_s2, accelerations.shape)
+    return [(str(sensor), float(t), float(a[s, 0]), float(a[s, 1]), record)
+            for s, sensor in enumerate(config.sensors) for t, a in zip(times, accelerations)]
+
+
+def write_measured(path, rows) -> None:
+    """A measured file of ``rows`` (:func:`synthetic_rows`), as ``hexdem calibrate`` reads it."""
+    write_csv(path, (*MEASURED_COLUMNS, "record"), rows)

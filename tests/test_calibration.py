@@ -1,0 +1,196 @@
+"""``hexdem calibrate``: its statistics against analytic posteriors, its reduction against analytic
+pulses, its refusals, and a whole calibration on synthetic records resumed after ``kill -9``."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+from scipy import stats
+from scipy.stats import qmc
+
+from hexdem.calibration import inference
+from hexdem.calibration.emulator import Emulator
+from hexdem.calibration.observables import Record, noise_covariance, reduce_record
+from hexdem.calibration.priors import NORMAL_TAIL, Prior
+from hexdem.calibration.report import summarize
+from hexdem.calibration.synthetic import synthetic_rows, write_measured
+from hexdem.cli.main import main
+from hexdem.model.config import RunConfig
+
+TINY = {"edge_beads": 5, "sensors": ["0:1", "0:3"]}
+TINY_TOML = 'edge_beads = 5\nsensors = ["0:1", "0:3"]\n'
+TRUE_V0 = 0.43
+
+
+def test_priors_map_the_unit_cube_onto_their_distributions():
+    uniform, loguniform = Prior("v0", "uniform", 0.2, 0.7), Prior("x", "loguniform", 1e8, 1e12)
+    normal = Prior("y", "normal", 3.0, 0.5)
+    assert uniform.from_unit(0.5) == pytest.approx(0.45)
+    assert loguniform.from_unit(0.5) == pytest.approx(1e10)  # the median of a log-uniform is √(ab)
+    assert normal.from_unit(0.5) == pytest.approx(3.0)
+    assert normal.from_unit(stats.norm.cdf(1.0)) == pytest.approx(3.5, rel=1e-3)
+    assert normal.support == (3.0 - NORMAL_TAIL * 0.5, 3.0 + NORMAL_TAIL * 0.5)
+    values = np.array([0.25, 0.5, 0.66])
+    assert uniform.from_unit(uniform.to_unit(values)) == pytest.approx(values)
+
+
+def test_the_emulator_interpolates_a_smooth_response_and_knows_its_error():
+    def response(u):
+        return np.column_stack([np.sin(3 * u[:, 0]) + u[:, 1] ** 2, np.exp(u[:, 0] - u[:, 1])])
+
+    train = qmc.LatinHypercube(2, seed=1).random(40)
+    test = qmc.LatinHypercube(2, seed=2).random(200)
+    mean, variance = Emulator(train, response(train)).predict(test)
+    error = mean - response(test)
+    assert np.max(np.abs(error)) < 5e-3
+    z = error / np.sqrt(variance + 1e-30)
+    assert np.mean(np.abs(z) < 3.0) > 0.9  # its variance is an honest error bar, not a guess
+
+
+def test_a_linear_gaussian_model_gives_the_analytic_posterior():
+    """y = A u + b with Gaussian noise and a prior that is flat where the likelihood lives: the
+    posterior is N(m, S), S = (Aᵀ Σ⁻¹ A)⁻¹, m = S Aᵀ Σ⁻¹ (y − b) (two records: their sum)."""
+    a, b = np.array([[2.0, 1.0], [0.5, -1.5], [1.0, 1.0]]), np.array([0.1, 0.2, -0.3])
+    noise = np.diag([0.02, 0.03, 0.025]) ** 2
+    truth = np.array([0.45, 0.55])
+    rng = np.random.default_rng(3)
+    records = np.array([a @ truth + b + rng.multivariate_normal(np.zeros(3), noise) for _ in range(2)])
+    data = inference.Data(records, np.array([noise, noise]), ("a", "b", "c"))
+    points = inference.design(2, 30, seed=4)
+    observables = (points @ a.T + b)[:, None, :]
+    fit = inference.fit_stage(data, points, observables, seed=5)
+    precision = 2 * a.T @ np.linalg.inv(noise) @ a
+    covariance = np.linalg.inv(precision)
+    mean = covariance @ a.T @ np.linalg.inv(noise) @ (records - b).sum(axis=0)
+    sd = np.sqrt(np.diag(covariance))
+    assert np.abs(fit.samples.mean(axis=0) - mean) == pytest.approx(0, abs=0.15 * sd.min())
+    assert fit.samples.std(axis=0) == pytest.approx(sd, rel=0.12)
+    assert np.corrcoef(fit.samples, rowvar=False)[0, 1] == pytest.approx(
+        covariance[0, 1] / sd.prod(), abs=0.08)
+
+
+def test_correlated_parameters_are_reported_as_trading_off():
+    rng = np.random.default_rng(0)
+    x = rng.uniform(0.3, 0.6, 4000)
+    samples = np.column_stack([x, 1.0 - x + rng.normal(0, 0.005, x.size)])
+    priors = [Prior("v0", "uniform", 0.2, 0.7), Prior("restitution", "uniform", 0.3, 0.99)]
+    notes = summarize(priors, samples)["identifiability"]
+    assert any("v0 and restitution trade off" in note for note in notes)
+
+
+def pulse_record(noise: float, rng) -> tuple[Record, float, float]:
+    """Two sensors whose velocity is V sin²(π (t − t_s)/T) on [t_s, t_s + T]: peak V, half-maximum
+    arrival t_s + T/4; their accelerations sampled at 500 kS/s, with white noise."""
+    times = np.arange(600) * 2e-6
+    peaks, starts, width = (0.1, 0.05), (300e-6, 700e-6), 80e-6
+    channels = []
+    for peak, start in zip(peaks, starts):
+        phase = np.clip((times - start) / width, 0, 1)
+        a = peak * np.pi / width * np.sin(2 * np.pi * phase) * ((phase > 0) & (phase < 1))
+        channels.append(np.column_stack([a, np.zeros_like(a)]) + rng.normal(0, noise, (len(times), 2)))
+    return Record("0", times, np.array(channels)), np.log(peaks[1]), (starts[1] - starts[0]) / 1e-6
+
+
+def test_a_record_reduces_to_its_pulses_peaks_and_relative_arrival():
+    record, log_peak, arrival = pulse_record(0.0, np.random.default_rng(0))
+    observed = reduce_record(record.times, record.accelerations)
+    # trapezoids under a sine of angular frequency ω sampled every h fall short by (ω h)²/12 of its integral
+    shortfall = (2 * np.pi * 2e-6 / 80e-6) ** 2 / 12
+    assert observed[1] == pytest.approx(log_peak - shortfall, abs=0.1 * shortfall)
+    assert observed[2] == pytest.approx(arrival, abs=0.05)  # µs, against a 2 µs sampling interval
+
+
+def test_the_accelerometer_noise_is_measured_on_the_quiet_lead_in():
+    record, _, _ = pulse_record(20.0, np.random.default_rng(1))
+    covariance, level = noise_covariance(record, ["a", "b"], seed=0)
+    assert level == pytest.approx(20.0, rel=0.15)
+    assert np.all(np.linalg.eigvalsh(covariance) > 0)
+
+
+@pytest.fixture(scope="module")
+def measured(tmp_path_factory):
+    """A synthetic record of the tiny case at v0 = TRUE_V0: twice finer step, noise, clock offset."""
+    folder = tmp_path_factory.mktemp("measured")
+    config = RunConfig.from_dict(TINY | {"v0": TRUE_V0})
+    write_measured(folder / "data.csv", synthetic_rows(config, "0", 5.0, 2.345e-3, np.random.default_rng(7)))
+    (folder / "base.toml").write_text(TINY_TOML)
+    return folder
+
+
+def lines_of(path):
+    return path.read_text().splitlines()
+
+
+def damaged(measured, tmp_path, change) -> str:
+    lines = lines_of(measured / "data.csv")
+    path = tmp_path / "damaged.csv"
+    path.write_text("\n".join(change(lines)) + "\n")
+    return str(path)
+
+
+BAD_INPUT = [
+    (["--prior", "v0=uniform(0.2)"], None, "expected KEY=uniform(a, b)"),
+    (["--prior", "shape=uniform(0, 1)"], None, "not a numeric key"),
+    (["--prior", "edge_beds=uniform(1, 2)"], None, "edge_beds"),
+    (["--prior", "restitution=uniform(0.9, 1.2)"], None, "restitution"),
+    (["--prior", "diameter_m=uniform(-0.01, 0.02)"], None, "diameter_m"),
+    (["--prior", "v0=uniform(0.2, 0.7)", "--budget", "20"], None, "too small"),
+    (["--prior", "v0=uniform(0.2, 0.7)"], lambda lines: [lines[0]] + [l.replace("0:3,", "0:4,", 1) for l in lines[1:]],
+     "not among the configuration's sensors"),
+    (["--prior", "v0=uniform(0.2, 0.7)"], lambda lines: [l for l in lines if not l.startswith("0:3,")],
+     "were not measured"),
+    (["--prior", "v0=uniform(0.2, 0.7)"], lambda lines: lines[:5] + [lines[5].replace(lines[5].split(",")[2], "nan")]
+     + lines[6:], "NaN"),
+    (["--prior", "v0=uniform(0.2, 0.7)"], lambda lines: [lines[0], lines[2], lines[1]] + lines[3:], "do not increase"),
+    (["--prior", "v0=uniform(0.2, 0.7)"], lambda lines: [lines[0]] + [
+        l for l in lines[1:] if float(l.split(",")[1]) < float(lines[1].split(",")[1]) + 2e-4], "pulse"),
+]
+
+
+@pytest.mark.parametrize("options, change, message", BAD_INPUT)
+def test_bad_input_is_one_line_before_any_simulation(measured, tmp_path, capsys, options, change, message):
+    data = str(measured / "data.csv") if change is None else damaged(measured, tmp_path, change)
+    out = tmp_path / "out"
+    code = main(["calibrate", "--config", str(measured / "base.toml"), "--measured", data, "--out", str(out), *options])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 3 and len(err) == 1 and message in err[0], err
+    assert not out.exists()
+
+
+def calibrate_command(measured, out):
+    return [sys.executable, "-m", "hexdem", "calibrate", "--config", str(measured / "base.toml"),
+            "--measured", str(measured / "data.csv"), "--prior", "v0=uniform(0.2, 0.7)", "--budget", "30",
+            "--seed", "3", "--out", str(out)]
+
+
+def finished_simulations(out):
+    folder = out / "simulations"
+    return {p.name: p.stat().st_mtime_ns for p in folder.glob("[0-9]*")} if folder.is_dir() else {}
+
+
+def test_a_calibration_finds_the_truth_and_resumes_after_kill_9_to_the_same_posterior(measured, tmp_path):
+    whole = tmp_path / "whole"
+    subprocess.run(calibrate_command(measured, whole), check=True, capture_output=True)
+    samples = np.loadtxt(whole / "posterior.csv", delimiter=",", skiprows=1)
+    assert np.quantile(samples, 0.05) <= TRUE_V0 <= np.quantile(samples, 0.95)
+    for name in ("calibration.json", "posterior.png", "predictive.png"):
+        assert (whole / name).stat().st_size > 0
+
+    killed = tmp_path / "killed"
+    process = subprocess.Popen(calibrate_command(measured, killed), start_new_session=True,
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 120
+    while len(finished_simulations(killed)) < 8 and process.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    os.killpg(process.pid, signal.SIGKILL)
+    process.wait()
+    before = finished_simulations(killed)
+    assert 8 <= len(before) < 30 and not (killed / "posterior.csv").exists()
+    subprocess.run(calibrate_command(measured, killed), check=True, capture_output=True)
+    after = finished_simulations(killed)
+    assert len(after) == 30 and all(after[name] == stamp for name, stamp in before.items())
+    assert (killed / "posterior.csv").read_bytes() == (whole / "posterior.csv").read_bytes()
