@@ -170,6 +170,8 @@ def test_bad_study_commands_are_one_line(tmp_path, capsys, arguments, message):
     (None, "no such file"),
     ("config = 3\n", "must define config = parsl.config.Config(...), got int"),
     ("import nonexistent_module\n", "the configuration file fails: ModuleNotFoundError"),
+    ("import sys\nsys.exit(0)\n", "the configuration file exits (sys.exit(0))"),
+    ("import sys\nsys.exit(1)\n", "the configuration file exits (sys.exit(1))"),
 ])
 def test_a_bad_parsl_file_is_one_line_before_anything_is_written(tmp_path, capsys, text, message):
     path = tmp_path / "parsl.py"
@@ -178,6 +180,17 @@ def test_a_bad_parsl_file_is_one_line_before_anything_is_written(tmp_path, capsy
     assert sweep(tmp_path, "--vary", "v0=0.2,0.3", "--out", str(tmp_path / "out"), "--parsl", str(path)) == 3
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and f"--parsl {path}" in lines[0] and message in lines[0], lines
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("command", ["sweep", "ensemble", "scaling"])
+def test_workers_and_parsl_together_are_a_usage_error(tmp_path, capsys, command):
+    """--parsl places the runs itself: --workers beside it is refused as argparse refuses a usage
+    error (status 2), not ignored."""
+    with pytest.raises(SystemExit) as stopped:
+        main([command, "--out", str(tmp_path / "out"), "--workers", "2", "--parsl", str(tmp_path / "parsl.py")])
+    assert stopped.value.code == 2
+    assert "--parsl: not allowed with argument --workers" in capsys.readouterr().err
     assert not (tmp_path / "out").exists()
 
 

@@ -75,7 +75,8 @@ def _call(fn, *args, **kwargs):
 
 def load_parsl_config(path):
     """The ``config`` that the Parsl configuration file ``path`` defines; a missing or broken
-    file, or one without a :class:`parsl.config.Config` named ``config``, is one clear line."""
+    file, one that exits, or one without a :class:`parsl.config.Config` named ``config``, is one
+    clear line."""
     try:
         from parsl.config import Config
     except ImportError:
@@ -84,6 +85,9 @@ def load_parsl_config(path):
         raise HexdemError(f"--parsl {path}: no such file")
     try:
         namespace = runpy.run_path(str(path))
+    except SystemExit as exc:  # sys.exit() in the file would end hexdem in silence, with its status
+        raise HexdemError(f"--parsl {path}: the configuration file exits (sys.exit({exc.code!r})) instead of "
+                          "defining config") from None
     except Exception as exc:
         raise HexdemError(f"--parsl {path}: the configuration file fails: {type(exc).__name__}: {exc}") from None
     config = namespace.get("config")

@@ -61,6 +61,9 @@ DUMP_BYTES_PER_ATOM_FRAME = 150
 MAX_ENERGY_DRIFT = 1e-3
 #: A run writes everything into a fresh ``OUT/.hexdem-run-*`` folder and moves it into ``OUT`` at the end.
 STAGING_PREFIX = ".hexdem-run-"
+#: What a finished run warns of, by the name that study tables (``warnings`` columns) give it.
+RUN_WARNINGS = {"far_wall_not_reached": "the leading wave had not reached every bead at the far wall one contact "
+                                        "time before the run ended; increase 'duration'"}
 #: The front is read along each direction until it comes this close to the packing's edge [d]:
 #: the last bead before a wall moves as the wall lets it.
 FRONT_WALL_MARGIN_D = 2.0
@@ -292,10 +295,16 @@ def run_experiment(config: RunConfig, out, log=None, command=None, prepared: Run
                 raise
             raise type(exc)(str(exc).replace(str(staging / "deck"), str(kept))) from None
     log(f"energy drift {analysis.results.energy_drift:.2e}; results in {out}")
-    if not analysis.results.far_wall_reached:
-        log("warning: the leading wave had not reached every bead at the far wall one contact time before the run "
-            "ended; increase 'duration'")
+    for name in run_warnings(analysis.results.far_wall_reached):
+        log(f"warning: {RUN_WARNINGS[name]}")
     return analysis
+
+
+def run_warnings(far_wall_reached: bool) -> list[str]:
+    """The names (:data:`RUN_WARNINGS`) of the warnings of a finished run, from its
+    ``far_wall_reached``: a leading wave cut short gives decay figures that depend on the run's
+    length rather than on the packing."""
+    return [] if far_wall_reached else ["far_wall_not_reached"]
 
 
 def _keep_failed_deck(deck: Path) -> Path | None:

@@ -147,42 +147,52 @@ def run_study(out: Path, runs: list[SweepRun], workers: int = 1, parsl=None, ran
 
 
 def run_single(out, runs: list[SweepRun], index: int, ranks: int | None = None,
-               launcher: str | None = None) -> SweepRun:
+               launcher: str | None = None) -> tuple[SweepRun, bool]:
     """Run run ``index`` (from 0, in the plan's order) of ``runs``, the study planned in ``out``
-    (:func:`planned_study`), in this process, whatever it left before; a failure is recorded and
-    raised."""
+    (:func:`planned_study`), in this process, unless it is done already (a job array's task that
+    is requeued keeps the finished work, as ``hexdem sweep DIR`` does); (the run, whether it ran).
+    A failure is recorded and raised as the run's failure."""
     check_study_options(ranks=ranks, launcher=launcher)
     out = Path(out)
     if not 0 <= index < len(runs):
         raise HexdemError(f"--run {index}: {out} plans runs 0 to {len(runs) - 1}")
     run = runs[index]
-    shutil.rmtree(run_dir(out, run), ignore_errors=True)
+    if run_dir(out, run).is_dir():
+        return run, False
     failure_path(out, run).unlink(missing_ok=True)
     try:
         run_one(run, out, ranks, launcher)
     except Exception as exc:
-        raise HexdemError(f"run {index} ({run.name}) failed: {_record_failure(out, run, exc)}") from None
-    return run
+        raise RunFailed(f"run {index} ({run.name}) failed: {_record_failure(out, run, exc)}") from None
+    return run, True
 
 
 def collect(out: Path, runs: list[SweepRun], variations: list[Variation], log=None) -> list[tuple]:
-    """Write the table and figure of the study in ``out``; its rows. Failed or missing runs are
-    rows without figures, and then an error naming them once the table is written (a
-    :class:`~hexdem.errors.RunFailed`: the study ran, and runs of it did not finish)."""
-    from hexdem.experiments.sweep_table import sweep_figure, write_table
+    """Write the table and figure of the study in ``out``; its rows. The log ends by naming the
+    runs that warned and why. Failed or missing runs are rows without figures, and then an error
+    naming them once the table is written (a :class:`~hexdem.errors.RunFailed`: the study ran,
+    and runs of it did not finish)."""
+    from hexdem.experiments.run import RUN_WARNINGS
+    from hexdem.experiments.sweep_table import sweep_figure, warned_runs, write_table
 
     log = log or _log
     states = [run_status(out, run) for run in runs]
     rows = write_table(out, runs, variations, states)
     sweep_figure(out, runs, variations, rows)
     log(f"results in {out / 'sweep.csv'}")
+    warned = warned_runs(rows)
+    if warned:
+        count = len({cell for cells in warned.values() for cell in cells})
+        reasons = "; ".join(f"{name} in {len(cells)} ({', '.join(Path(cell).name for cell in cells)}): "
+                            f"{RUN_WARNINGS[name]}" for name, cells in warned.items())
+        log(f"{count} of {len(runs)} runs warned (the warnings column of sweep.csv): {reasons}")
     unfinished = {what: [run.name for run, (status, _) in zip(runs, states) if status == what]
                   for what in ("failed", "missing")}
     if any(unfinished.values()):
         parts = [f"{len(names)} {what} ({'; '.join(names)})" for what, names in unfinished.items() if names]
+        where = f"; errors in {out / RUNS_NAME}/NAME{FAILED_SUFFIX}" if unfinished["failed"] else ""
         raise RunFailed(f"{sum(map(len, unfinished.values()))} of {len(runs)} runs did not finish: "
-                          f"{', '.join(parts)}; errors in {out / RUNS_NAME}/NAME{FAILED_SUFFIX}; "
-                          "rerun to run them again")
+                        f"{', '.join(parts)}{where}; rerun to run them")
     return rows
 
 
