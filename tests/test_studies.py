@@ -138,12 +138,28 @@ def test_a_job_arrays_runs_one_at_a_time_then_the_table(serial, tmp_path, capsys
     listed = capsys.readouterr().out.splitlines()
     assert listed == ["0\tv0=0.2,friction=0", "1\tv0=0.3,friction=0"]
     assert main(["sweep", str(out), "--run", "1"]) == 0
+    summary = out / "runs" / "v0=0.3,friction=0" / "summary.json"
+    written = summary.stat().st_mtime_ns, summary.read_text()
+    capsys.readouterr()
+    assert main(["sweep", str(out), "--run", "1"]) == 0  # a requeued task keeps the finished run
+    assert capsys.readouterr().out == "hexdem sweep: run 1 (v0=0.3,friction=0) was done already: kept\n"
+    assert (summary.stat().st_mtime_ns, summary.read_text()) == written
     assert main(["sweep", str(out), "--collect"]) == 4
-    assert "1 missing (v0=0.2,friction=0)" in capsys.readouterr().err
+    error = capsys.readouterr().err.strip().splitlines()[-1]
+    assert "1 missing (v0=0.2,friction=0)" in error and ".failed" not in error  # none failed: no file to point at
     assert main(["sweep", str(out), "--run", "0"]) == 0
     assert main(["sweep", str(out), "--collect"]) == 0
     ours = peaks_of(out)
     assert ours == {run: rows for run, rows in peaks_of(serial).items() if run in ours}
+
+
+def test_a_job_arrays_failed_run_exits_as_a_failed_run(tmp_path, capsys):
+    """--run I of a run whose energy check fails: recorded, and the status of a run that failed (4)."""
+    out = tmp_path / "out"
+    assert sweep(tmp_path, "--vary", "dt=3.5e-6", "--out", str(out), "--plan-only") == 0
+    assert main(["sweep", str(out), "--run", "0"]) == 4
+    assert "run 0 (dt=3.5e-6) failed: energy drift" in capsys.readouterr().err
+    assert "energy drift" in (out / "runs" / "dt=3.5e-6.failed").read_text()
 
 
 @pytest.mark.parametrize("arguments, message", [
@@ -181,6 +197,17 @@ def test_a_bad_parsl_file_is_one_line_before_anything_is_written(tmp_path, capsy
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and f"--parsl {path}" in lines[0] and message in lines[0], lines
     assert not (tmp_path / "out").exists()
+
+
+def test_a_study_whose_tasks_failed_ends_as_they_did():
+    """Tasks that ran and failed (a LAMMPS error, an MPI job whose ranks died, a bug) end the study
+    as a run that failed, exit status 4; only tasks that all refused their input end it as refused, 3."""
+    from hexdem.cli.main import exit_status
+    from hexdem.errors import HexdemError, RunFailed
+    from hexdem.experiments.executors import tasks_failed
+
+    refused, failed, died = HexdemError("no"), RunFailed("LAMMPS failed"), RuntimeError("the MPI job on 2 ranks")
+    assert [exit_status(tasks_failed("m", errors)) for errors in ([refused], [refused, failed], [died])] == [3, 4, 4]
 
 
 @pytest.mark.parametrize("command", ["sweep", "ensemble", "scaling"])

@@ -61,6 +61,12 @@ def build_parser(argv) -> argparse.ArgumentParser:
     return parser
 
 
+def exit_status(error: HexdemError) -> int:
+    """The exit status of a command (or workflow script) that ended with ``error``: a run that
+    failed, or input refused (:data:`EXIT_CODES`)."""
+    return FAILED if isinstance(error, RunFailed) else REFUSED
+
+
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser(argv).parse_args(argv)
@@ -70,7 +76,7 @@ def main(argv=None) -> int:
         if args.traceback:
             raise
         print(f"hexdem: error: {exc}", file=sys.stderr)
-        return FAILED if isinstance(exc, RunFailed) else REFUSED
+        return exit_status(exc)
     except KeyboardInterrupt:
         print("hexdem: interrupted", file=sys.stderr)
         return INTERRUPTED

@@ -33,7 +33,7 @@ from pathlib import Path
 from hexdem.common.checks import positive_int
 from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.standalone import die_with_parent, launcher_command
-from hexdem.errors import HexdemError
+from hexdem.errors import HexdemError, RunFailed
 
 #: Times a task of the local pool is submitted again after it failed.
 LOCAL_RETRIES = 1
@@ -192,6 +192,15 @@ def describe(error: BaseException) -> str:
     """A task's error in one line: hexdem's own message, or the exception's type and message."""
     text = str(error) if isinstance(error, HexdemError) else f"{type(error).__name__}: {error}"
     return " ".join(text.split())
+
+
+def tasks_failed(message: str, errors) -> HexdemError:
+    """The error that ends a study whose tasks failed with ``errors``: a
+    :class:`~hexdem.errors.RunFailed` (exit status 4: a LAMMPS error, a job whose ranks died, an
+    energy check) unless every one of them refused its input (a plain
+    :class:`~hexdem.errors.HexdemError`, exit status 3)."""
+    refused = all(isinstance(error, HexdemError) and not isinstance(error, RunFailed) for error in errors)
+    return (HexdemError if refused else RunFailed)(message)
 
 
 def run_tasks(executor, tasks: dict):
