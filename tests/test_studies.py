@@ -153,6 +153,22 @@ def test_a_job_arrays_runs_one_at_a_time_then_the_table(serial, tmp_path, capsys
     assert ours == {run: rows for run, rows in peaks_of(serial).items() if run in ours}
 
 
+def test_a_failed_runs_tries_keep_one_deck_which_its_error_names(tmp_path, capsys, monkeypatch):
+    """The local pool tries a failed run twice; the deck of its failure is kept in one folder of the
+    temporary directory, which the recorded error names, not one folder a try."""
+    import tempfile
+
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    monkeypatch.setenv("TMPDIR", str(scratch))  # the pool's workers, spawned, read it
+    monkeypatch.setattr(tempfile, "tempdir", None)
+    out = tmp_path / "out"
+    assert sweep(tmp_path, "--vary", "dt=3.5e-6", "--out", str(out)) == 4
+    (kept,) = scratch.glob("hexdem-failed-*")
+    assert f"{kept / 'deck'}" in (out / "runs" / "dt=3.5e-6.failed").read_text()
+    assert (kept / "deck" / "in.hexdem").exists()
+
+
 def test_a_job_arrays_failed_run_exits_as_a_failed_run(tmp_path, capsys):
     """--run I of a run whose energy check fails: recorded, and the status of a run that failed (4)."""
     out = tmp_path / "out"

@@ -14,8 +14,9 @@ path (a shared filesystem).
 ``workers`` local processes, or Parsl with ``--parsl CONFIG.py``. A run takes ``ranks`` MPI
 ranks of its own (``hexdem run --ranks``: ``mpiexec -n K``, or ``launcher``). A run that fails
 is retried (once in the local pool, as Parsl's ``retries`` says with Parsl), then its error is
-written to ``runs/<name>.failed`` and the study goes on; the table marks it ``failed`` and the
-sweep ends with an error naming every run that failed. ``hexdem sweep DIR --run I`` runs run I
+written to ``runs/<name>.failed`` and the study goes on (its deck kept in one folder of the
+temporary directory per run, :func:`failed_deck_path`, which each try replaces); the table marks
+it ``failed`` and the sweep ends with an error naming every run that failed. ``hexdem sweep DIR --run I`` runs run I
 of a planned study alone, in this process, with no executor (one task of a Slurm job array),
 and ``hexdem sweep DIR --collect`` writes the table and figure of whatever has finished.
 
@@ -27,10 +28,12 @@ is read from the runs' files either way. A rerun with another plan is refused ra
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import shutil
 import sys
+import tempfile
 from pathlib import Path
 
 from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
@@ -50,6 +53,16 @@ def run_dir(out: Path, run: SweepRun) -> Path:
 
 def failure_path(out: Path, run: SweepRun) -> Path:
     return out / RUNS_NAME / f"{run.name}{FAILED_SUFFIX}"
+
+
+def failed_deck_path(out: Path, run: SweepRun) -> Path:
+    """Where a failed try of ``run`` keeps its deck, in this machine's temporary directory: one
+    folder per run of the study, which each try replaces, so that the error names the folder of
+    every try there was here."""
+    from hexdem.experiments.run import FAILED_PREFIX
+
+    study = hashlib.sha256(str(Path(out).resolve()).encode()).hexdigest()[:8]
+    return Path(tempfile.gettempdir()) / f"{FAILED_PREFIX}{study}-{run.name}"
 
 
 def run_status(out: Path, run: SweepRun) -> tuple[str, str]:
@@ -74,7 +87,8 @@ def run_one(run: SweepRun, out: Path, ranks: int | None = None, launcher: str | 
     partial = final.with_name(f".{final.name}.part")
     shutil.rmtree(partial, ignore_errors=True)
     try:
-        run_experiment(config, partial, log=lambda message: None, command=command)
+        run_experiment(config, partial, log=lambda message: None, command=command,
+                       failed_deck=failed_deck_path(out, run))
     except BaseException:
         shutil.rmtree(partial, ignore_errors=True)
         raise
