@@ -299,6 +299,18 @@ def test_studies_inside_a_commands_parsl_session_share_its_parsl(tmp_path):
     assert used[0] is used[1] and used[0]._dfk.cleanup_called
 
 
+def test_the_shipped_one_machine_parsl_file_runs_a_sweep_with_its_logs_in_the_study(tmp_path, monkeypatch):
+    """docs/guide/parsl_local.py, as a user copies it: a sweep on it finishes, and Parsl's
+    runinfo/ goes into the study's folder rather than the current directory."""
+    monkeypatch.chdir(tmp_path)
+    shipped = Path(__file__).resolve().parents[1] / "docs" / "guide" / "parsl_local.py"
+    out = tmp_path / "out"
+    assert sweep(tmp_path, "--vary", "v0=0.2", "--out", str(out), "--parsl", str(shipped)) == 0
+    _, rows = read_csv(out / "sweep.csv")
+    assert [row["status"] for row in rows] == ["done"]
+    assert (out / "runinfo").is_dir() and not (tmp_path / "runinfo").exists()
+
+
 def test_two_runs_in_two_threads_of_one_process(tmp_path, monkeypatch):
     """A Parsl ThreadPoolExecutor runs a sweep's runs in threads of this process: with a relative
     --out, each run keeps to its own folder (no run changes the process's working directory,

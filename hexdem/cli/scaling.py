@@ -50,7 +50,7 @@ def run(args) -> None:
                              steps_per_contact=args.steps_per_contact, duration_contacts=args.duration,
                              engine=args.engine, workers=args.workers, launcher=args.launcher,
                              parsl=args.parsl)
-    parsl = parsl_session(args.parsl)  # a bad file is refused before the output directory is made
+    parsl = parsl_session(args.parsl, args.out)  # a bad file is refused before the output directory is made
     ensure_writable_dir(args.out)
     summary = write_outputs(run_sweep(settings, parsl=parsl), args.out, kind=args.fit)
     print(f"hexdem scaling: results in {args.out}", file=sys.stderr)

@@ -83,7 +83,7 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
     """
     log = log or (lambda message: print(f"hexdem ensemble: {message}", file=sys.stderr, flush=True))
     check_study_options(workers, launcher)
-    parsl = parsl_session(parsl)
+    parsl = parsl_session(parsl, out)
     laws = fitted_laws(scaling_json, config.disorder.diameter_m) if scaling_json else {}
     out = ensure_writable_dir(out)
     ensemble = Ensemble(config, out)

@@ -35,6 +35,8 @@ from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.standalone import die_with_parent, launcher_command
 from hexdem.errors import HexdemError, RunFailed
 
+#: Parsl's own default ``run_dir`` (relative to the current directory), where it writes its logs.
+PARSL_RUN_DIR = "runinfo"
 #: Times a task of the local pool is submitted again after it failed.
 LOCAL_RETRIES = 1
 
@@ -127,9 +129,11 @@ class ParslSession:
     every study holds the session (:func:`holding`) while it runs, and a command whose studies
     share one (``hexdem paper``) holds it around them all."""
 
-    def __init__(self, path):
+    def __init__(self, path, folder=None):
         self.path = path
         self.config = load_parsl_config(path)
+        if folder is not None and self.config.run_dir == PARSL_RUN_DIR:
+            self.config.run_dir = str(Path(folder).resolve() / PARSL_RUN_DIR)
         self._executor: ParslExecutor | None = None
         self._depth = 0
 
@@ -149,13 +153,15 @@ class ParslSession:
             self._executor.shutdown()
 
 
-def parsl_session(parsl) -> ParslSession | None:
+def parsl_session(parsl, folder=None) -> ParslSession | None:
     """The :class:`ParslSession` of ``parsl``: None without Parsl, a session as it is, and a new
     one for a configuration file's path, whose file runs here, so that a bad file is refused in
-    one line before anything is written."""
+    one line before anything is written. Parsl keeps its logs in the config's ``run_dir``; left at
+    Parsl's default (``runinfo`` in the current directory), it goes into the study's ``folder``,
+    ``folder/runinfo``."""
     if parsl is None or isinstance(parsl, ParslSession):
         return parsl
-    return ParslSession(parsl)
+    return ParslSession(parsl, folder)
 
 
 def holding(parsl: ParslSession | None):

@@ -144,7 +144,7 @@ def run_study(out: Path, runs: list[SweepRun], workers: int = 1, parsl=None, ran
     task of the study executor, recording the failures; ``parsl``: a Parsl configuration file, or
     its :class:`~hexdem.experiments.executors.ParslSession`."""
     log = log or _log
-    parsl = parsl_session(parsl)
+    parsl = parsl_session(parsl, out)
     with locked_directory(out, "another hexdem sweep"), holding(parsl):
         for leftover in (out / RUNS_NAME).glob(".*.part"):
             shutil.rmtree(leftover, ignore_errors=True)
@@ -219,7 +219,7 @@ def run_sweep(base: dict, variations: list[Variation], out, workers: int = 1, pa
     """Plan (or resume) the sweep into ``out``, run it and write its table and figure; the table's
     rows. An error names the runs that failed, after the table is written."""
     check_study_options(workers, launcher, ranks)
-    parsl = parsl_session(parsl)
+    parsl = parsl_session(parsl, out)
     runs = plan_study(base, variations, out, source)
     out = Path(out)
     run_study(out, runs, workers, parsl, ranks, launcher, log)
