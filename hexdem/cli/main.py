@@ -68,10 +68,14 @@ def exit_status(error: HexdemError) -> int:
 
 
 def main(argv=None) -> int:
-    argv = sys.argv[1:] if argv is None else list(argv)
+    from hexdem.experiments.provenance import running_command
+
+    command = list(sys.argv) if argv is None else ["hexdem", *argv]
+    argv = command[1:]
     args = build_parser(argv).parse_args(argv)
     try:
-        args._module.run(args)
+        with running_command(command):
+            args._module.run(args)
     except HexdemError as exc:
         if args.traceback:
             raise

@@ -39,6 +39,7 @@ from pathlib import Path
 from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
 from hexdem.errors import HexdemError, RunFailed
 from hexdem.experiments.executors import check_study_options, describe, holding, parsl_session, run_phase
+from hexdem.experiments.provenance import user_command
 from hexdem.experiments.sweep_plan import SweepRun, Variation, plan_sweep
 from hexdem.model.unused_keys import on_engine
 
@@ -154,7 +155,7 @@ def run_study(out: Path, runs: list[SweepRun], workers: int = 1, parsl=None, ran
         for run in todo:
             failure_path(out, run).unlink(missing_ok=True)
         named = {run.name: run for run in todo}
-        tasks = {name: (run_one, run, out, ranks, launcher, list(sys.argv)) for name, run in named.items()}
+        tasks = {name: (run_one, run, out, ranks, launcher, user_command()) for name, run in named.items()}
         for name, error in run_phase(tasks, workers, parsl, "hexdem sweep", "run", done_before=len(runs) - len(todo)):
             if error is not None:
                 log(f"run {name} failed: {_record_failure(out, named[name], error)}")
