@@ -224,6 +224,19 @@ def test_bad_input_is_one_clear_line(tmp_path, capsys, options, message):
     assert not out.exists()
 
 
+def test_the_impacts_that_warned_are_named_per_striker_speed():
+    """An impact whose wave had not crossed the packing (far_wall_reached false) warns as a run
+    does; peaks_stats.csv's warnings column names those of each striker speed."""
+    from hexdem.disorder.stats import EnsembleResults, impact_warnings
+
+    reached = np.array([[True, False], [True, True], [False, False]])  # 3 realizations x 2 speeds
+    results = EnsembleResults(np.array([0.2, 0.4]), *[None] * 6,
+                              per_realization={"far_wall_reached": reached,
+                                               "ideal_far_wall_reached": np.array([True, False])})
+    assert impact_warnings(results) == ["far_wall_not_reached (r0002)",
+                                        "far_wall_not_reached (ideal, r0000, r0002)"]
+
+
 def test_a_failing_deck_is_named_with_lammps_error(tmp_path):
     good, bad = tmp_path / "good", tmp_path / "bad"
     for directory, text in ((good, 'print "fine"\n'), (bad, "units si\nbogus_command 1\n")):

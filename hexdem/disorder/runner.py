@@ -138,4 +138,7 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
                                "wall_time_s": {name: round(t, 3) for name, t in wall.items()}}
         write_json(out / MANIFEST_NAME, {**manifest, "config": config.as_dict(), **summary})
         log(f"done ({', '.join(f'{name} {t:.1f} s' for name, t in wall.items())}); results in {out}")
+        for v, warnings in zip(config.velocities_m_s, summary["impact_warnings"]):
+            if warnings:
+                log(f"impacts at {v:g} m/s warned (the warnings column of peaks_stats.csv): {warnings}")
         return summary
