@@ -25,7 +25,7 @@ import numpy as np
 from conftest import D, V0, single_bead
 
 from hexdem.engines.lammps.deck import write_deck
-from hexdem.engines.lammps.driver import split_deck, working_directory
+from hexdem.engines.lammps.driver import in_folder, split_deck
 from hexdem.engines.lammps.library import load_lammps
 from hexdem.engines.reference.friction import FrictionalSystem
 from hexdem.model.contact_law import Friction
@@ -177,8 +177,7 @@ def lammps_deck(model: GranularModel, settings: RunSettings, directory):
     deck = write_deck(model, settings, directory)
     lmp = load_lammps().lammps(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
     try:
-        with working_directory(directory):
-            lmp.commands_string(split_deck(deck.input_path.read_text())[0])
+        lmp.commands_string(in_folder(split_deck(deck.input_path.read_text())[0], directory))
         yield lmp
     finally:
         lmp.close()

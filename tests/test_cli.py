@@ -64,6 +64,31 @@ def test_a_usage_error_exits_with_argparse_status_and_one_line():
         assert done.stderr.strip().splitlines()[-1].startswith("hexdem")
 
 
+#: Words a sentence that gives an exit status must hold, by status: what the table says it means.
+STATUS_WORDS = {2: ("usage", "argparse", "mistyped"), 3: ("refus", "bad input", "disagree"), 4: ("fail",),
+                130: ("interrupt",)}
+
+
+def test_every_pages_exit_statuses_agree_with_the_getting_started_table():
+    """The getting-started table is the reference: it lists the CLI's EXIT_CODES, and every page
+    (README, guides, validation) that gives a status gives one of the table's, in a sentence that
+    says what the table says it means (a sweep whose runs failed exits 4, a run that failed)."""
+    table = (ROOT / "docs" / "getting-started.md").read_text()
+    rows = dict(re.findall(r"^\| (\d+) \| (.+?) \|$", table, flags=re.MULTILINE))
+    assert sorted(map(int, rows)) == sorted(EXIT_CODES)
+    pages = [ROOT / "README.md", *(path for path in (ROOT / "docs").rglob("*.md") if "_generated" not in path.parts)]
+    found = []
+    for page in pages:
+        text = " ".join(page.read_text().split())
+        for sentence in re.split(r"(?<=[.;])\s", text):
+            for status in re.findall(r"(?:exit status|exits with status|exits) (\d+)\b", sentence):
+                found.append((page.name, int(status)))
+                assert status in rows, (page.name, sentence)
+                words = STATUS_WORDS.get(int(status), ())
+                assert not words or any(word in sentence.lower() for word in words), (page.name, status, sentence)
+    assert ("sweeps.md", 4) in found and ("impacts.md", 3) in found
+
+
 def test_a_refused_input_and_a_failed_run_exit_differently_from_a_typo(tmp_path):
     """Refused before running: 3 (tests/test_errors.py holds the cases, and a LAMMPS failure's 4)."""
     (tmp_path / "bad.toml").write_text("v0 = -0.4\n")

@@ -224,6 +224,19 @@ def test_bad_input_is_one_clear_line(tmp_path, capsys, options, message):
     assert not out.exists()
 
 
+def test_the_impacts_that_warned_are_named_per_striker_speed():
+    """An impact whose wave had not crossed the packing (far_wall_reached false) warns as a run
+    does; peaks_stats.csv's warnings column names those of each striker speed."""
+    from hexdem.disorder.stats import EnsembleResults, impact_warnings
+
+    reached = np.array([[True, False], [True, True], [False, False]])  # 3 realizations x 2 speeds
+    results = EnsembleResults(np.array([0.2, 0.4]), *[None] * 6,
+                              per_realization={"far_wall_reached": reached,
+                                               "ideal_far_wall_reached": np.array([True, False])})
+    assert impact_warnings(results) == ["far_wall_not_reached (r0002)",
+                                        "far_wall_not_reached (ideal, r0000, r0002)"]
+
+
 def test_a_failing_deck_is_named_with_lammps_error(tmp_path):
     good, bad = tmp_path / "good", tmp_path / "bad"
     for directory, text in ((good, 'print "fine"\n'), (bad, "units si\nbogus_command 1\n")):
@@ -237,14 +250,16 @@ def test_a_failing_deck_is_named_with_lammps_error(tmp_path):
 
 def test_a_failing_deck_in_an_ensemble_is_named_after_the_others_ran(tmp_path, capsys):
     """A preparation deck that LAMMPS refuses: the phase's other decks still run, and the error
-    names the realization and LAMMPS's message."""
+    names the realization and LAMMPS's message, as a run that failed (exit status 4), not as input
+    refused (3)."""
     from hexdem.disorder.runner import _run_phase
+    from hexdem.errors import RunFailed
 
     decks = [tmp_path / name for name in ("a", "b", "c")]
     for directory, text in zip(decks, ('print "fine"\n', "units si\nbogus_command 1\n", 'print "fine"\n')):
         directory.mkdir()
         (directory / "in.hexdem").write_text(text)
-    with pytest.raises(HexdemError, match=r"1 of 3 compact decks failed .*; realization 1: LAMMPS failed on "
+    with pytest.raises(RunFailed, match=r"1 of 3 compact decks failed .*; realization 1: LAMMPS failed on "
                                           r".*b/in.hexdem: ERROR: Unknown command: bogus_command"):
         _run_phase("compact", {f"realization {k}": (run_deck, deck) for k, deck in enumerate(decks)}, 2, None)
     assert [(deck / DONE_MARKER).exists() for deck in decks] == [True, False, True]

@@ -6,7 +6,6 @@ once a command, an ensemble's phases sharing the one Parsl it starts."""
 
 import json
 import shutil
-import sys
 import threading
 import time
 from pathlib import Path
@@ -91,7 +90,7 @@ def test_parsl_survives_a_killed_worker_with_the_serial_sweeps_runs(serial, tmp_
     assert peaks_of(out) == peaks_of(serial)
     assert not list((out / "runs").glob(".*"))
     for summary in (out / "runs").glob("*/summary.json"):  # the study's command, not the Parsl worker's
-        assert json.loads(summary.read_text())["provenance"]["command"] == sys.argv, summary
+        assert json.loads(summary.read_text())["provenance"]["command"][:2] == ["hexdem", "sweep"], summary
 
 
 def test_a_failed_run_is_recorded_and_the_others_finish(tmp_path, capsys):
@@ -138,12 +137,44 @@ def test_a_job_arrays_runs_one_at_a_time_then_the_table(serial, tmp_path, capsys
     listed = capsys.readouterr().out.splitlines()
     assert listed == ["0\tv0=0.2,friction=0", "1\tv0=0.3,friction=0"]
     assert main(["sweep", str(out), "--run", "1"]) == 0
+    summary = out / "runs" / "v0=0.3,friction=0" / "summary.json"
+    written = summary.stat().st_mtime_ns, summary.read_text()
+    capsys.readouterr()
+    assert main(["sweep", str(out), "--run", "1"]) == 0  # a requeued task keeps the finished run
+    assert capsys.readouterr().out == "hexdem sweep: run 1 (v0=0.3,friction=0) was done already: kept\n"
+    assert (summary.stat().st_mtime_ns, summary.read_text()) == written
     assert main(["sweep", str(out), "--collect"]) == 4
-    assert "1 missing (v0=0.2,friction=0)" in capsys.readouterr().err
+    error = capsys.readouterr().err.strip().splitlines()[-1]
+    assert "1 missing (v0=0.2,friction=0)" in error and ".failed" not in error  # none failed: no file to point at
     assert main(["sweep", str(out), "--run", "0"]) == 0
     assert main(["sweep", str(out), "--collect"]) == 0
     ours = peaks_of(out)
     assert ours == {run: rows for run, rows in peaks_of(serial).items() if run in ours}
+
+
+def test_a_failed_runs_tries_keep_one_deck_which_its_error_names(tmp_path, capsys, monkeypatch):
+    """The local pool tries a failed run twice; the deck of its failure is kept in one folder of the
+    temporary directory, which the recorded error names, not one folder a try."""
+    import tempfile
+
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    monkeypatch.setenv("TMPDIR", str(scratch))  # the pool's workers, spawned, read it
+    monkeypatch.setattr(tempfile, "tempdir", None)
+    out = tmp_path / "out"
+    assert sweep(tmp_path, "--vary", "dt=3.5e-6", "--out", str(out)) == 4
+    (kept,) = scratch.glob("hexdem-failed-*")
+    assert f"{kept / 'deck'}" in (out / "runs" / "dt=3.5e-6.failed").read_text()
+    assert (kept / "deck" / "in.hexdem").exists()
+
+
+def test_a_job_arrays_failed_run_exits_as_a_failed_run(tmp_path, capsys):
+    """--run I of a run whose energy check fails: recorded, and the status of a run that failed (4)."""
+    out = tmp_path / "out"
+    assert sweep(tmp_path, "--vary", "dt=3.5e-6", "--out", str(out), "--plan-only") == 0
+    assert main(["sweep", str(out), "--run", "0"]) == 4
+    assert "run 0 (dt=3.5e-6) failed: energy drift" in capsys.readouterr().err
+    assert "energy drift" in (out / "runs" / "dt=3.5e-6.failed").read_text()
 
 
 @pytest.mark.parametrize("arguments, message", [
@@ -170,6 +201,8 @@ def test_bad_study_commands_are_one_line(tmp_path, capsys, arguments, message):
     (None, "no such file"),
     ("config = 3\n", "must define config = parsl.config.Config(...), got int"),
     ("import nonexistent_module\n", "the configuration file fails: ModuleNotFoundError"),
+    ("import sys\nsys.exit(0)\n", "the configuration file exits (sys.exit(0))"),
+    ("import sys\nsys.exit(1)\n", "the configuration file exits (sys.exit(1))"),
 ])
 def test_a_bad_parsl_file_is_one_line_before_anything_is_written(tmp_path, capsys, text, message):
     path = tmp_path / "parsl.py"
@@ -178,6 +211,28 @@ def test_a_bad_parsl_file_is_one_line_before_anything_is_written(tmp_path, capsy
     assert sweep(tmp_path, "--vary", "v0=0.2,0.3", "--out", str(tmp_path / "out"), "--parsl", str(path)) == 3
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and f"--parsl {path}" in lines[0] and message in lines[0], lines
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_study_whose_tasks_failed_ends_as_they_did():
+    """Tasks that ran and failed (a LAMMPS error, an MPI job whose ranks died, a bug) end the study
+    as a run that failed, exit status 4; only tasks that all refused their input end it as refused, 3."""
+    from hexdem.cli.main import exit_status
+    from hexdem.errors import HexdemError, RunFailed
+    from hexdem.experiments.executors import tasks_failed
+
+    refused, failed, died = HexdemError("no"), RunFailed("LAMMPS failed"), RuntimeError("the MPI job on 2 ranks")
+    assert [exit_status(tasks_failed("m", errors)) for errors in ([refused], [refused, failed], [died])] == [3, 4, 4]
+
+
+@pytest.mark.parametrize("command", ["sweep", "ensemble", "scaling"])
+def test_workers_and_parsl_together_are_a_usage_error(tmp_path, capsys, command):
+    """--parsl places the runs itself: --workers beside it is refused as argparse refuses a usage
+    error (status 2), not ignored."""
+    with pytest.raises(SystemExit) as stopped:
+        main([command, "--out", str(tmp_path / "out"), "--workers", "2", "--parsl", str(tmp_path / "parsl.py")])
+    assert stopped.value.code == 2
+    assert "--parsl: not allowed with argument --workers" in capsys.readouterr().err
     assert not (tmp_path / "out").exists()
 
 
@@ -241,6 +296,41 @@ def test_studies_inside_a_commands_parsl_session_share_its_parsl(tmp_path):
                 used.append(executor)
         assert not used[0]._dfk.cleanup_called
     assert used[0] is used[1] and used[0]._dfk.cleanup_called
+
+
+def test_the_shipped_one_machine_parsl_file_runs_a_sweep_with_its_logs_in_the_study(tmp_path, monkeypatch):
+    """docs/guide/parsl_local.py, as a user copies it: a sweep on it finishes, and Parsl's
+    runinfo/ goes into the study's folder rather than the current directory."""
+    monkeypatch.chdir(tmp_path)
+    shipped = Path(__file__).resolve().parents[1] / "docs" / "guide" / "parsl_local.py"
+    out = tmp_path / "out"
+    assert sweep(tmp_path, "--vary", "v0=0.2", "--out", str(out), "--parsl", str(shipped)) == 0
+    _, rows = read_csv(out / "sweep.csv")
+    assert [row["status"] for row in rows] == ["done"]
+    assert (out / "runinfo").is_dir() and not (tmp_path / "runinfo").exists()
+    summary = json.loads((out / "runs" / "v0=0.2" / "summary.json").read_text())
+    assert summary["provenance"]["command"] == ["hexdem", "sweep", "--config", str(tmp_path / "base.toml"), "--vary",
+                                                "v0=0.2", "--out", str(out), "--parsl", str(shipped)]
+
+
+def test_two_runs_in_two_threads_of_one_process(tmp_path, monkeypatch):
+    """A Parsl ThreadPoolExecutor runs a sweep's runs in threads of this process: with a relative
+    --out, each run keeps to its own folder (no run changes the process's working directory,
+    which the threads share) and gives the runs of a sweep of separate processes."""
+    monkeypatch.chdir(tmp_path)
+    threads = tmp_path / "threads.py"
+    threads.write_text("from parsl.config import Config\nfrom parsl.executors import ThreadPoolExecutor\n"
+                       "config = Config(executors=[ThreadPoolExecutor(max_threads=2)], "
+                       f"run_dir={str(tmp_path / 'runinfo')!r})\n")
+    vary = ["--vary", "v0=0.2,0.3"]
+    assert sweep(tmp_path, *vary, "--out", "out", "--parsl", str(threads)) == 0
+    assert Path.cwd() == tmp_path
+    assert sweep(tmp_path, *vary, "--out", "processes", "--workers", "2") == 0
+    _, rows = read_csv(tmp_path / "out" / "sweep.csv")
+    assert [row["status"] for row in rows] == ["done", "done"] and not list((tmp_path / "out" / "runs").glob(".*"))
+    assert peaks_of(tmp_path / "out") == peaks_of(tmp_path / "processes")
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["base.toml", "out", "processes", "runinfo",
+                                                                 "threads.py"]
 
 
 def test_the_local_pools_processes_end_with_a_killed_study(tmp_path):

@@ -36,9 +36,9 @@ def swept(tmp_path_factory):
 
 def test_the_table_has_a_row_per_run_in_the_plans_order(swept):
     header, rows = read_csv(swept / "sweep.csv")
-    assert header[:4] == ("regions.0.material", "v0", "run", "status") and header[-1] == "error"
-    assert header[4:4 + len(SUMMARY_COLUMNS)] == SUMMARY_COLUMNS
-    assert {(row["status"], row["error"]) for row in rows} == {("done", "")}
+    assert header[:5] == ("regions.0.material", "v0", "run", "status", "warnings") and header[-1] == "error"
+    assert header[5:5 + len(SUMMARY_COLUMNS)] == SUMMARY_COLUMNS
+    assert {(row["status"], row["warnings"], row["error"]) for row in rows} == {("done", "", "")}
     assert [(r["regions.0.material"], float(r["v0"])) for r in rows] == PLAN
     assert {"energy_share_steel316", "energy_share_brass", "energy_share_ptfe", "decay_exponent_0",
             "decay_exponent_+30", "decay_exponent_-30"} <= set(header)
@@ -52,6 +52,35 @@ def test_the_table_has_a_row_per_run_in_the_plans_order(swept):
         shares = float(row["energy_share_steel316"]) + float(row[f"energy_share_{row['regions.0.material']}"])
         assert shares == pytest.approx(1.0, rel=1e-12)
     assert (swept / "sweep.png").stat().st_size > 0
+
+
+def test_runs_that_warned_are_named_in_the_table_the_figure_and_the_last_line(tmp_path, capsys, monkeypatch):
+    """A run cut short before its wave crossed the packing warns on its own (far_wall_reached
+    false); in a study its warning goes into the table's warnings column, is ringed in sweep.png,
+    and the command ends by naming it. The energy panel is the audit's drift on a log axis that
+    holds the round-off floor and the threshold that fails a run."""
+    from hexdem.analysis import figures as plots
+    from hexdem.analysis.energy import ROUND_OFF
+    from hexdem.experiments.run import MAX_ENERGY_DRIFT
+
+    drawn = []
+    monkeypatch.setattr(plots, "save", lambda fig, path: drawn.append(fig))
+    out = tmp_path / "out"
+    assert sweep(tmp_path, "--vary", "duration=1e-4,2e-3", "--out", str(out), base="edge_beads = 4\n") == 0
+    last = capsys.readouterr().err.strip().splitlines()[-1]
+    assert last.startswith("hexdem sweep: 1 of 2 runs warned") and "far_wall_not_reached in 1 (duration=1e-4)" in last
+    assert "increase 'duration'" in last
+    _, rows = read_csv(out / "sweep.csv")
+    assert [(row["warnings"], row["far_wall_reached"]) for row in rows] == [("far_wall_not_reached", "False"),
+                                                                            ("", "True")]
+    (fig,) = drawn
+    energy, decay = fig.axes[:2]
+    for ax in (energy, decay):
+        ringed = [line for line in ax.get_lines() if line.get_markeredgecolor() == "red"]
+        assert [list(line.get_xdata()) for line in ringed] == [[1e-4]]
+    assert energy.get_yscale() == "log" and "drift" in energy.get_ylabel() and "dimensionless" in energy.get_ylabel()
+    low, high = energy.get_ylim()
+    assert low < ROUND_OFF and high > MAX_ENERGY_DRIFT
 
 
 def test_the_table_is_that_of_four_separate_runs(swept, tmp_path):

@@ -69,4 +69,4 @@ def test_the_dirac_point_workflow_refuses_an_unwritable_out_in_one_line(tmp_path
     (tmp_path / "file").write_text("")
     done = subprocess.run([sys.executable, str(DIRAC_WORKFLOW), "--out", str(tmp_path / "file" / "out"), "--quick"],
                           cwd=tmp_path, capture_output=True, text=True, timeout=120)
-    assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1, done.stderr
+    assert done.returncode == 3 and len(done.stderr.strip().splitlines()) == 1, done.stderr  # refused input

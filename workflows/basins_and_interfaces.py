@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from hexdem.analysis.figures import SINGLE_PLOT_MARGINS, save, set_title, subplots
+from hexdem.cli.main import exit_status
 from hexdem.common.io import atomic_path, write_csv, write_json
 from hexdem.errors import HexdemError
 from hexdem.experiments.run import run_experiment
@@ -158,7 +159,7 @@ def run(argv=None) -> int:
             analysis = run_experiment(config, out / case, log=lambda message: None)
         except HexdemError as error:
             print(f"basins_and_interfaces: error: {case}: {error}", file=sys.stderr)
-            return 2
+            return exit_status(error)
         records[case] = {"what": what, "config": text.strip(), "n_beads": len(analysis.model.packing),
                          "energy_drift": analysis.results.energy_drift, "wall_time_s": time.perf_counter() - start,
                          "command": f"hexdem run --movie --config {path} --out {out / case}"}

@@ -20,6 +20,7 @@ import argparse
 import sys
 import time
 
+from hexdem.cli.main import exit_status
 from hexdem.common.io import ensure_writable_dir, write_json
 from hexdem.errors import HexdemError
 from hexdem.waves.study import DiracStudy, run_dirac_study
@@ -45,7 +46,7 @@ def run(argv=None) -> int:
         result = run_dirac_study(study, out, log)
     except HexdemError as exc:
         print(f"dirac_point: error: {exc}", file=sys.stderr)
-        return 2
+        return exit_status(exc)
     wall = time.perf_counter() - start
     write_json(out / "workflow.json", {"command": "python workflows/dirac_point.py " + " ".join(
         sys.argv[1:] if argv is None else argv), "wall_time_s": wall})

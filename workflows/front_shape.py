@@ -22,6 +22,7 @@ import sys
 import time
 from pathlib import Path
 
+from hexdem.cli.main import exit_status
 from hexdem.cli.options import add_launcher
 from hexdem.common.io import write_json
 from hexdem.errors import HexdemError
@@ -47,7 +48,7 @@ def run(argv=None) -> int:
         summary = run_front_study(study, args.out, log=lambda message: print(f"front_shape: {message}", file=sys.stderr))
     except HexdemError as exc:
         print(f"front_shape: error: {exc}", file=sys.stderr)
-        return 2
+        return exit_status(exc)
     wall = time.perf_counter() - start
     write_json(Path(args.out) / "workflow.json", {"command": "python workflows/front_shape.py " + " ".join(
         sys.argv[1:] if argv is None else argv), "wall_time_s": wall})

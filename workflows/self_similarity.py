@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from hexdem.cli.main import exit_status
 from hexdem.cli.options import add_launcher
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.errors import HexdemError
@@ -80,7 +81,7 @@ def run(argv=None) -> int:
         write_page(out, result, chain, rise_verdict)
     except HexdemError as exc:
         print(f"self_similarity: error: {exc}", file=sys.stderr)
-        return 2
+        return exit_status(exc)
     wall = time.perf_counter() - start
     write_json(out / "workflow.json", {"command": "python workflows/self_similarity.py " + " ".join(
         sys.argv[1:] if argv is None else argv), "wall_time_s": wall, "study": study.as_dict()})

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import re
 
-from hexdem.cli.options import add_launcher, add_parsl
+from hexdem.cli.options import add_launcher, add_workers_or_parsl
 from hexdem.common.machine import usable_cpus
 from hexdem.errors import HexdemError
 
@@ -43,10 +43,8 @@ def add_arguments(parser) -> None:
     parser.add_argument("--velocities", default=DEFAULT_VELOCITIES, metavar="V1,V2,...",
                         help=f"striker speeds in m/s (default {DEFAULT_VELOCITIES})")
     parser.add_argument("--seed", type=int, default=0, help="seed of the diameters (default 0)")
-    parser.add_argument("--workers", type=int, default=usable_cpus(), metavar="N",
-                        help="decks (local processes) at once (default: the CPUs this job may use, its CPU "
-                             "affinity as Slurm or taskset set it)")
-    add_parsl(parser)
+    add_workers_or_parsl(parser, usable_cpus(), "decks (local processes) at once (default: the CPUs this job "
+                         "may use, its CPU affinity as Slurm or taskset set it)")
     add_launcher(parser, "-n 1 and each deck's lmp or impact's job")
     parser.add_argument("--shape", default="hexagon", help="packing: hexagon, square or centered-square "
                         "(default hexagon)")

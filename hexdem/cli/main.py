@@ -62,16 +62,26 @@ def build_parser(argv) -> argparse.ArgumentParser:
     return parser
 
 
+def exit_status(error: HexdemError) -> int:
+    """The exit status of a command (or workflow script) that ended with ``error``: a run that
+    failed, or input refused (:data:`EXIT_CODES`)."""
+    return FAILED if isinstance(error, RunFailed) else REFUSED
+
+
 def main(argv=None) -> int:
-    argv = sys.argv[1:] if argv is None else list(argv)
+    from hexdem.experiments.provenance import running_command
+
+    command = list(sys.argv) if argv is None else ["hexdem", *argv]
+    argv = command[1:]
     args = build_parser(argv).parse_args(argv)
     try:
-        args._module.run(args)
+        with running_command(command):
+            args._module.run(args)
     except HexdemError as exc:
         if args.traceback:
             raise
         print(f"hexdem: error: {exc}", file=sys.stderr)
-        return FAILED if isinstance(exc, RunFailed) else REFUSED
+        return exit_status(exc)
     except KeyboardInterrupt:
         print("hexdem: interrupted", file=sys.stderr)
         return INTERRUPTED

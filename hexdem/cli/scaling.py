@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 import sys
 
-from hexdem.cli.options import add_launcher, add_parsl
+from hexdem.cli.options import add_launcher, add_workers_or_parsl
 from hexdem.model.config import ENGINES
 
 
@@ -35,9 +35,7 @@ def add_arguments(parser) -> None:
                         help=f"time step = contact time at V0 / this (default {d.steps_per_contact})")
     parser.add_argument("--duration", type=float, default=d.duration_contacts, metavar="CONTACT_TIMES",
                         help=f"run length in contact times at V0 (default {d.duration_contacts:g})")
-    parser.add_argument("--workers", type=int, default=d.workers,
-                        help=f"runs at once, in local processes (default {d.workers})")
-    add_parsl(parser)
+    add_workers_or_parsl(parser, d.workers, f"runs at once, in local processes (default {d.workers})")
     add_launcher(parser, "-n 1 python -P -m hexdem.experiments.parallel JOB for each run")
     parser.add_argument("--json", action="store_true", help="also print scaling.json to stdout")
 
@@ -52,7 +50,7 @@ def run(args) -> None:
                              steps_per_contact=args.steps_per_contact, duration_contacts=args.duration,
                              engine=args.engine, workers=args.workers, launcher=args.launcher,
                              parsl=args.parsl)
-    parsl = parsl_session(args.parsl)  # a bad file is refused before the output directory is made
+    parsl = parsl_session(args.parsl, args.out)  # a bad file is refused before the output directory is made
     ensure_writable_dir(args.out)
     summary = write_outputs(run_sweep(settings, parsl=parsl), args.out, kind=args.fit)
     print(f"hexdem scaling: results in {args.out}", file=sys.stderr)

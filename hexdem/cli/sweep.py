@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from hexdem.cli.options import add_launcher, add_parsl
+from hexdem.cli.options import add_launcher, add_workers_or_parsl
 from hexdem.errors import HexdemError
 
 
@@ -31,8 +31,7 @@ def add_arguments(parser) -> None:
     single.add_argument("--run", type=int, metavar="I", help="run only run I (from 0) of the study DIR, here")
     single.add_argument("--collect", action="store_true",
                         help="write the table and figure of the study DIR from the runs it holds")
-    parser.add_argument("--workers", type=int, default=1, metavar="N", help="runs at once, locally (default 1)")
-    add_parsl(parser)
+    add_workers_or_parsl(parser, 1, "runs at once, locally (default 1)")
     parser.add_argument("--ranks-per-run", type=int, metavar="K",
                         help="MPI ranks of each LAMMPS run (default: the configuration's ranks, 1; "
                              "the reference engine's runs take one)")
@@ -57,8 +56,8 @@ def run(args) -> None:
     if args.run is not None:
         if args.parsl is not None:
             raise HexdemError("--run I runs here, without --parsl")
-        run = sweep.run_single(out, runs, args.run, args.ranks_per_run, args.launcher)
-        print(f"hexdem sweep: run {args.run} ({run.name}) done", flush=True)
+        run, ran = sweep.run_single(out, runs, args.run, args.ranks_per_run, args.launcher)
+        print(f"hexdem sweep: run {args.run} ({run.name}) {'done' if ran else 'was done already: kept'}", flush=True)
     elif args.collect:
         sweep.collect(out, runs, variations)
     else:

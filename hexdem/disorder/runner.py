@@ -26,7 +26,7 @@ from hexdem.disorder.sharing import adopt_preparation, adopt_ideal_impacts
 from hexdem.disorder.stats import write_statistics
 from hexdem.engines.lammps.standalone import is_done, run_deck
 from hexdem.errors import HexdemError
-from hexdem.experiments.executors import check_study_options, describe, holding, parsl_session, run_phase
+from hexdem.experiments.executors import check_study_options, describe, holding, parsl_session, run_phase, tasks_failed
 
 
 def _check_manifest(out: Path, config: EnsembleConfig) -> dict:
@@ -58,15 +58,16 @@ def _run_phase(name: str, tasks: dict, workers: int, parsl, on_done=None) -> Non
     """Run the phase ``name``'s ``tasks`` {what: (fn, *args)}, one task of the study executor
     each (:func:`~hexdem.experiments.executors.run_phase`), calling ``on_done()`` as each
     finishes; the tasks that failed are named at the end."""
-    failed = []
+    failed, errors = [], []
     for what, error in run_phase(tasks, workers, parsl, PHASE_LABELS[name], "deck"):
         if error is not None:
             failed.append(f"{what}: {describe(error)}")
+            errors.append(error)
         if on_done is not None:
             on_done()
     if failed:
-        raise HexdemError(f"{len(failed)} of {len(tasks)} {name} decks failed (rerun to run them again); "
-                          f"{'; '.join(failed)}")
+        raise tasks_failed(f"{len(failed)} of {len(tasks)} {name} decks failed (rerun to run them again); "
+                           f"{'; '.join(failed)}", errors)
 
 
 def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | None = None, parsl=None,
@@ -82,7 +83,7 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
     """
     log = log or (lambda message: print(f"hexdem ensemble: {message}", file=sys.stderr, flush=True))
     check_study_options(workers, launcher)
-    parsl = parsl_session(parsl)
+    parsl = parsl_session(parsl, out)
     laws = fitted_laws(scaling_json, config.disorder.diameter_m) if scaling_json else {}
     out = ensure_writable_dir(out)
     ensemble = Ensemble(config, out)
@@ -137,4 +138,7 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
                                "wall_time_s": {name: round(t, 3) for name, t in wall.items()}}
         write_json(out / MANIFEST_NAME, {**manifest, "config": config.as_dict(), **summary})
         log(f"done ({', '.join(f'{name} {t:.1f} s' for name, t in wall.items())}); results in {out}")
+        for v, warnings in zip(config.velocities_m_s, summary["impact_warnings"]):
+            if warnings:
+                log(f"impacts at {v:g} m/s warned (the warnings column of peaks_stats.csv): {warnings}")
         return summary

@@ -22,7 +22,7 @@ from hexdem.errors import HexdemError
 from hexdem.model.packing import Packing
 
 #: Columns of ``peaks_stats.csv`` (a contract).
-STATS_COLUMNS = ("v_striker", "line", "n", "mean_peak_speed", "std_peak_speed", "count")
+STATS_COLUMNS = ("v_striker", "line", "n", "mean_peak_speed", "std_peak_speed", "count", "warnings")
 IDEAL_COLUMNS = ("v_striker", "line", "n", "peak_speed")
 ARRIVAL_COLUMNS = ("v_striker", "bead_id", "m", "n", "x", "y", "ideal_relative_arrival",
                    "mean_relative_arrival", "std_relative_arrival", "count")
@@ -77,7 +77,8 @@ def load_results(ensemble: Ensemble) -> EnsembleResults:
                            per_realization={key: np.array([r[key] for r in runs]) for key in runs[0]
                                             if key not in (*stacked, "t_peak")}
                            | {"ideal_energy_drift": ideal["energy_drift"],
-                              "ideal_lammps_s": ideal["impact_lammps_s"]})
+                              "ideal_lammps_s": ideal["impact_lammps_s"],
+                              "ideal_far_wall_reached": ideal["far_wall_reached"]})
 
 
 def _mean_std_count(values: np.ndarray, axis: int = 0):
@@ -97,11 +98,32 @@ def mean_and_sem(values) -> tuple[float, float]:
     return float(mean), float(std / np.sqrt(count)) if count > 1 else float("nan")
 
 
+def impact_warnings(results: EnsembleResults) -> list[str]:
+    """Per striker velocity, the warnings of its impacts (:data:`~hexdem.experiments.run.RUN_WARNINGS`),
+    each with the impacts that carry it (``ideal``, realizations as their folders ``r0003``), e.g.
+    ``far_wall_not_reached (ideal, r0000, r0003)``; empty where none warned."""
+    from hexdem.experiments.run import run_warnings
+
+    everyone = [("ideal", results.per_realization["ideal_far_wall_reached"]),
+                *((f"r{k:04d}", row) for k, row in enumerate(results.per_realization["far_wall_reached"]))]
+    cells = []
+    for iv in range(len(results.velocities_m_s)):
+        warned: dict[str, list[str]] = {}
+        for who, reached in everyone:
+            for name in run_warnings(bool(reached[iv])):
+                warned.setdefault(name, []).append(who)
+        cells.append("; ".join(f"{name} ({', '.join(who)})" for name, who in warned.items()))
+    return cells
+
+
 def peak_statistics(results: EnsembleResults, lattice: Packing) -> list[tuple]:
     """Rows of ``peaks_stats.csv``: mean and sample standard deviation over realizations of
-    the peak speed of bead n of each line, for each striker velocity."""
+    the peak speed of bead n of each line, for each striker velocity, with the warnings of that
+    velocity's impacts (:func:`impact_warnings`): a wave cut short before it crossed the packing
+    has peaks that depend on the run's duration."""
     mean, std, count = _mean_std_count(results.peak_speed)
-    return [(float(v), line, n, float(mean[iv, bead]), float(std[iv, bead]), int(count[iv, bead]))
+    warnings = impact_warnings(results)
+    return [(float(v), line, n, float(mean[iv, bead]), float(std[iv, bead]), int(count[iv, bead]), warnings[iv])
             for iv, v in enumerate(results.velocities_m_s) for line, beads in lattice.lines().items()
             for n, bead in enumerate(beads)]
 
@@ -211,4 +233,5 @@ def write_statistics(ensemble: Ensemble, laws: dict | None = None) -> dict:
         "energy_drift_max": {"disordered": float(np.max(per["energy_drift"])),
                              "ideal": float(np.max(per["ideal_energy_drift"]))},
         "far_wall_reached_fraction": float(np.mean(per["far_wall_reached"])),
+        "impact_warnings": impact_warnings(results),
     }

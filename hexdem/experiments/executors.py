@@ -33,8 +33,10 @@ from pathlib import Path
 from hexdem.common.checks import positive_int
 from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.standalone import die_with_parent, launcher_command
-from hexdem.errors import HexdemError
+from hexdem.errors import HexdemError, RunFailed
 
+#: Parsl's own default ``run_dir`` (relative to the current directory), where it writes its logs.
+PARSL_RUN_DIR = "runinfo"
 #: Times a task of the local pool is submitted again after it failed.
 LOCAL_RETRIES = 1
 
@@ -75,7 +77,8 @@ def _call(fn, *args, **kwargs):
 
 def load_parsl_config(path):
     """The ``config`` that the Parsl configuration file ``path`` defines; a missing or broken
-    file, or one without a :class:`parsl.config.Config` named ``config``, is one clear line."""
+    file, one that exits, or one without a :class:`parsl.config.Config` named ``config``, is one
+    clear line."""
     try:
         from parsl.config import Config
     except ImportError:
@@ -84,6 +87,9 @@ def load_parsl_config(path):
         raise HexdemError(f"--parsl {path}: no such file")
     try:
         namespace = runpy.run_path(str(path))
+    except SystemExit as exc:  # sys.exit() in the file would end hexdem in silence, with its status
+        raise HexdemError(f"--parsl {path}: the configuration file exits (sys.exit({exc.code!r})) instead of "
+                          "defining config") from None
     except Exception as exc:
         raise HexdemError(f"--parsl {path}: the configuration file fails: {type(exc).__name__}: {exc}") from None
     config = namespace.get("config")
@@ -123,9 +129,11 @@ class ParslSession:
     every study holds the session (:func:`holding`) while it runs, and a command whose studies
     share one (``hexdem paper``) holds it around them all."""
 
-    def __init__(self, path):
+    def __init__(self, path, folder=None):
         self.path = path
         self.config = load_parsl_config(path)
+        if folder is not None and self.config.run_dir == PARSL_RUN_DIR:
+            self.config.run_dir = str(Path(folder).resolve() / PARSL_RUN_DIR)
         self._executor: ParslExecutor | None = None
         self._depth = 0
 
@@ -145,13 +153,15 @@ class ParslSession:
             self._executor.shutdown()
 
 
-def parsl_session(parsl) -> ParslSession | None:
+def parsl_session(parsl, folder=None) -> ParslSession | None:
     """The :class:`ParslSession` of ``parsl``: None without Parsl, a session as it is, and a new
     one for a configuration file's path, whose file runs here, so that a bad file is refused in
-    one line before anything is written."""
+    one line before anything is written. Parsl keeps its logs in the config's ``run_dir``; left at
+    Parsl's default (``runinfo`` in the current directory), it goes into the study's ``folder``,
+    ``folder/runinfo``."""
     if parsl is None or isinstance(parsl, ParslSession):
         return parsl
-    return ParslSession(parsl)
+    return ParslSession(parsl, folder)
 
 
 def holding(parsl: ParslSession | None):
@@ -188,6 +198,15 @@ def describe(error: BaseException) -> str:
     """A task's error in one line: hexdem's own message, or the exception's type and message."""
     text = str(error) if isinstance(error, HexdemError) else f"{type(error).__name__}: {error}"
     return " ".join(text.split())
+
+
+def tasks_failed(message: str, errors) -> HexdemError:
+    """The error that ends a study whose tasks failed with ``errors``: a
+    :class:`~hexdem.errors.RunFailed` (exit status 4: a LAMMPS error, a job whose ranks died, an
+    energy check) unless every one of them refused its input (a plain
+    :class:`~hexdem.errors.HexdemError`, exit status 3)."""
+    refused = all(isinstance(error, HexdemError) and not isinstance(error, RunFailed) for error in errors)
+    return (HexdemError if refused else RunFailed)(message)
 
 
 def run_tasks(executor, tasks: dict):

@@ -13,6 +13,7 @@ import subprocess
 import sys
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
+from contextlib import contextmanager
 from datetime import datetime, timezone
 from functools import cache
 from importlib.metadata import version
@@ -51,9 +52,32 @@ def versions() -> dict[str, str | None]:
             "mpi_version": mpi_version(), "python_version": platform.python_version()}
 
 
+#: The command line hexdem is running in this process, as its user gave it (None: the process's own).
+_command: list[str] | None = None
+
+
+@contextmanager
+def running_command(argv):
+    """Within: ``argv`` is the command whose runs record it as their ``command`` (hexdem's CLI
+    sets it, so that a command called from Python, a workflow's step or a test, records itself
+    rather than the Python process's command line, which a study's workers are handed too)."""
+    global _command
+    previous, _command = _command, list(argv)
+    try:
+        yield
+    finally:
+        _command = previous
+
+
+def user_command() -> list[str]:
+    """The command line the user gave: hexdem's command being run (:func:`running_command`), else
+    this process's."""
+    return list(sys.argv if _command is None else _command)
+
+
 def run_provenance(argv=None) -> dict:
-    """The provenance of a run starting now: ``command`` (the argument vector, default this
-    process's), ``host``, ``start_time`` (ISO 8601, UTC) and :func:`versions`."""
+    """The provenance of a run starting now: ``command`` (the argument vector, default
+    :func:`user_command`), ``host``, ``start_time`` (ISO 8601, UTC) and :func:`versions`."""
     return started_provenance(argv)()
 
 
@@ -61,7 +85,7 @@ def started_provenance(argv=None) -> Callable[[], dict]:
     """:func:`run_provenance` of a run starting now, its :func:`versions` looked up in a thread
     while the run goes (three git commands and LAMMPS's and MPI's libraries: 0.17 s, at the start
     of every run from a checkout). Returns the function that gives it, once they are found."""
-    started = {"command": list(sys.argv if argv is None else argv), "host": socket.gethostname(),
+    started = {"command": user_command() if argv is None else list(argv), "host": socket.gethostname(),
                "start_time": datetime.now(timezone.utc).isoformat(timespec="seconds")}
     pool = ThreadPoolExecutor(1)
     found = pool.submit(versions)

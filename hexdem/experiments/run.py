@@ -61,6 +61,11 @@ DUMP_BYTES_PER_ATOM_FRAME = 150
 MAX_ENERGY_DRIFT = 1e-3
 #: A run writes everything into a fresh ``OUT/.hexdem-run-*`` folder and moves it into ``OUT`` at the end.
 STAGING_PREFIX = ".hexdem-run-"
+#: What a finished run warns of, by the name that study tables (``warnings`` columns) give it.
+RUN_WARNINGS = {"far_wall_not_reached": "the leading wave had not reached every bead at the far wall one contact "
+                                        "time before the run ended; increase 'duration'"}
+#: A failed run's deck is kept in a folder of the temporary directory named so.
+FAILED_PREFIX = "hexdem-failed-"
 #: The front is read along each direction until it comes this close to the packing's edge [d]:
 #: the last bead before a wall moves as the wall lets it.
 FRONT_WALL_MARGIN_D = 2.0
@@ -270,12 +275,15 @@ def measure_front_shape(analysis: ImpactAnalysis, count: int = 8, geometric: boo
     return front_shape(positions, arrivals, origin, times, wall_margin=wall_margin_d, window_deg=window_deg)
 
 
-def run_experiment(config: RunConfig, out, log=None, command=None, prepared: RunConfig | None = None) -> ImpactAnalysis:
+def run_experiment(config: RunConfig, out, log=None, command=None, prepared: RunConfig | None = None,
+                   failed_deck=None) -> ImpactAnalysis:
     """Run ``config`` and publish its result files in ``out`` (see module docstring); ``command``:
     the argument vector that asked for the run, for its provenance (default: this process's; a
     study's worker is handed the study's); ``prepared``: ``config``'s random disc packed already
     (the configuration that strikes it, :func:`prepare_random_packing`), for runs that share one
-    packing, which their titles and ``summary.json`` still name as ``config``'s."""
+    packing, which their titles and ``summary.json`` still name as ``config``'s; ``failed_deck``:
+    where a failed run keeps its deck, replacing what an earlier try kept there (default: a fresh
+    ``hexdem-failed-*`` folder of the temporary directory)."""
     log = log or (lambda message: print(f"hexdem: {message}", file=sys.stderr))
     load_in_background("hexdem.analysis.figures", "scipy.spatial")  # the results' figures, while the run goes
     with staged_directory(out, STAGING_PREFIX) as staging:
@@ -287,22 +295,34 @@ def run_experiment(config: RunConfig, out, log=None, command=None, prepared: Run
             analysis = simulate(prepared, staging / "deck", log)
             write_results(config, analysis, staging, time.perf_counter() - start, provenance(), log)
         except HexdemError as exc:
-            kept = _keep_failed_deck(staging / "deck")
+            kept = _keep_failed_deck(staging / "deck", failed_deck)
             if kept is None:
                 raise
             raise type(exc)(str(exc).replace(str(staging / "deck"), str(kept))) from None
     log(f"energy drift {analysis.results.energy_drift:.2e}; results in {out}")
-    if not analysis.results.far_wall_reached:
-        log("warning: the leading wave had not reached every bead at the far wall one contact time before the run "
-            "ended; increase 'duration'")
+    for name in run_warnings(analysis.results.far_wall_reached):
+        log(f"warning: {RUN_WARNINGS[name]}")
     return analysis
 
 
-def _keep_failed_deck(deck: Path) -> Path | None:
-    """Move a failed run's deck (inputs and log) out of ``--out`` into a fresh folder of the system's
-    temporary directory, for inspection; None if the run failed before writing one."""
+def run_warnings(far_wall_reached: bool) -> list[str]:
+    """The names (:data:`RUN_WARNINGS`) of the warnings of a finished run, from its
+    ``far_wall_reached``: a leading wave cut short gives decay figures that depend on the run's
+    length rather than on the packing."""
+    return [] if far_wall_reached else ["far_wall_not_reached"]
+
+
+def _keep_failed_deck(deck: Path, where=None) -> Path | None:
+    """Move a failed run's deck (inputs and log) out of ``--out``, for inspection, to ``where``
+    (what is there is replaced) or into a fresh folder of the system's temporary directory; None
+    if the run failed before writing one."""
     if not deck.exists():
         return None
-    kept = Path(tempfile.mkdtemp(prefix="hexdem-failed-")) / "deck"
+    if where is None:
+        kept = Path(tempfile.mkdtemp(prefix=FAILED_PREFIX)) / "deck"
+    else:
+        kept = Path(where) / "deck"
+        shutil.rmtree(where, ignore_errors=True)
+        kept.parent.mkdir(parents=True)
     shutil.move(str(deck), kept)
     return kept

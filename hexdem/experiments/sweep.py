@@ -14,8 +14,9 @@ path (a shared filesystem).
 ``workers`` local processes, or Parsl with ``--parsl CONFIG.py``. A run takes ``ranks`` MPI
 ranks of its own (``hexdem run --ranks``: ``mpiexec -n K``, or ``launcher``). A run that fails
 is retried (once in the local pool, as Parsl's ``retries`` says with Parsl), then its error is
-written to ``runs/<name>.failed`` and the study goes on; the table marks it ``failed`` and the
-sweep ends with an error naming every run that failed. ``hexdem sweep DIR --run I`` runs run I
+written to ``runs/<name>.failed`` and the study goes on (its deck kept in one folder of the
+temporary directory per run, :func:`failed_deck_path`, which each try replaces); the table marks
+it ``failed`` and the sweep ends with an error naming every run that failed. ``hexdem sweep DIR --run I`` runs run I
 of a planned study alone, in this process, with no executor (one task of a Slurm job array),
 and ``hexdem sweep DIR --collect`` writes the table and figure of whatever has finished.
 
@@ -27,15 +28,18 @@ is read from the runs' files either way. A rerun with another plan is refused ra
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import shutil
 import sys
+import tempfile
 from pathlib import Path
 
 from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
 from hexdem.errors import HexdemError, RunFailed
 from hexdem.experiments.executors import check_study_options, describe, holding, parsl_session, run_phase
+from hexdem.experiments.provenance import user_command
 from hexdem.experiments.sweep_plan import SweepRun, Variation, plan_sweep
 from hexdem.model.unused_keys import on_engine
 
@@ -50,6 +54,16 @@ def run_dir(out: Path, run: SweepRun) -> Path:
 
 def failure_path(out: Path, run: SweepRun) -> Path:
     return out / RUNS_NAME / f"{run.name}{FAILED_SUFFIX}"
+
+
+def failed_deck_path(out: Path, run: SweepRun) -> Path:
+    """Where a failed try of ``run`` keeps its deck, in this machine's temporary directory: one
+    folder per run of the study, which each try replaces, so that the error names the folder of
+    every try there was here."""
+    from hexdem.experiments.run import FAILED_PREFIX
+
+    study = hashlib.sha256(str(Path(out).resolve()).encode()).hexdigest()[:8]
+    return Path(tempfile.gettempdir()) / f"{FAILED_PREFIX}{study}-{run.name}"
 
 
 def run_status(out: Path, run: SweepRun) -> tuple[str, str]:
@@ -74,7 +88,8 @@ def run_one(run: SweepRun, out: Path, ranks: int | None = None, launcher: str | 
     partial = final.with_name(f".{final.name}.part")
     shutil.rmtree(partial, ignore_errors=True)
     try:
-        run_experiment(config, partial, log=lambda message: None, command=command)
+        run_experiment(config, partial, log=lambda message: None, command=command,
+                       failed_deck=failed_deck_path(out, run))
     except BaseException:
         shutil.rmtree(partial, ignore_errors=True)
         raise
@@ -130,7 +145,7 @@ def run_study(out: Path, runs: list[SweepRun], workers: int = 1, parsl=None, ran
     task of the study executor, recording the failures; ``parsl``: a Parsl configuration file, or
     its :class:`~hexdem.experiments.executors.ParslSession`."""
     log = log or _log
-    parsl = parsl_session(parsl)
+    parsl = parsl_session(parsl, out)
     with locked_directory(out, "another hexdem sweep"), holding(parsl):
         for leftover in (out / RUNS_NAME).glob(".*.part"):
             shutil.rmtree(leftover, ignore_errors=True)
@@ -140,49 +155,59 @@ def run_study(out: Path, runs: list[SweepRun], workers: int = 1, parsl=None, ran
         for run in todo:
             failure_path(out, run).unlink(missing_ok=True)
         named = {run.name: run for run in todo}
-        tasks = {name: (run_one, run, out, ranks, launcher, list(sys.argv)) for name, run in named.items()}
+        tasks = {name: (run_one, run, out, ranks, launcher, user_command()) for name, run in named.items()}
         for name, error in run_phase(tasks, workers, parsl, "hexdem sweep", "run", done_before=len(runs) - len(todo)):
             if error is not None:
                 log(f"run {name} failed: {_record_failure(out, named[name], error)}")
 
 
 def run_single(out, runs: list[SweepRun], index: int, ranks: int | None = None,
-               launcher: str | None = None) -> SweepRun:
+               launcher: str | None = None) -> tuple[SweepRun, bool]:
     """Run run ``index`` (from 0, in the plan's order) of ``runs``, the study planned in ``out``
-    (:func:`planned_study`), in this process, whatever it left before; a failure is recorded and
-    raised."""
+    (:func:`planned_study`), in this process, unless it is done already (a job array's task that
+    is requeued keeps the finished work, as ``hexdem sweep DIR`` does); (the run, whether it ran).
+    A failure is recorded and raised as the run's failure."""
     check_study_options(ranks=ranks, launcher=launcher)
     out = Path(out)
     if not 0 <= index < len(runs):
         raise HexdemError(f"--run {index}: {out} plans runs 0 to {len(runs) - 1}")
     run = runs[index]
-    shutil.rmtree(run_dir(out, run), ignore_errors=True)
+    if run_dir(out, run).is_dir():
+        return run, False
     failure_path(out, run).unlink(missing_ok=True)
     try:
         run_one(run, out, ranks, launcher)
     except Exception as exc:
-        raise HexdemError(f"run {index} ({run.name}) failed: {_record_failure(out, run, exc)}") from None
-    return run
+        raise RunFailed(f"run {index} ({run.name}) failed: {_record_failure(out, run, exc)}") from None
+    return run, True
 
 
 def collect(out: Path, runs: list[SweepRun], variations: list[Variation], log=None) -> list[tuple]:
-    """Write the table and figure of the study in ``out``; its rows. Failed or missing runs are
-    rows without figures, and then an error naming them once the table is written (a
-    :class:`~hexdem.errors.RunFailed`: the study ran, and runs of it did not finish)."""
-    from hexdem.experiments.sweep_table import sweep_figure, write_table
+    """Write the table and figure of the study in ``out``; its rows. The log ends by naming the
+    runs that warned and why. Failed or missing runs are rows without figures, and then an error
+    naming them once the table is written (a :class:`~hexdem.errors.RunFailed`: the study ran,
+    and runs of it did not finish)."""
+    from hexdem.experiments.run import RUN_WARNINGS
+    from hexdem.experiments.sweep_table import sweep_figure, warned_runs, write_table
 
     log = log or _log
     states = [run_status(out, run) for run in runs]
     rows = write_table(out, runs, variations, states)
     sweep_figure(out, runs, variations, rows)
     log(f"results in {out / 'sweep.csv'}")
+    warned = warned_runs(rows)
+    if warned:
+        count = len({cell for cells in warned.values() for cell in cells})
+        reasons = "; ".join(f"{name} in {len(cells)} ({', '.join(Path(cell).name for cell in cells)}): "
+                            f"{RUN_WARNINGS[name]}" for name, cells in warned.items())
+        log(f"{count} of {len(runs)} runs warned (the warnings column of sweep.csv): {reasons}")
     unfinished = {what: [run.name for run, (status, _) in zip(runs, states) if status == what]
                   for what in ("failed", "missing")}
     if any(unfinished.values()):
         parts = [f"{len(names)} {what} ({'; '.join(names)})" for what, names in unfinished.items() if names]
+        where = f"; errors in {out / RUNS_NAME}/NAME{FAILED_SUFFIX}" if unfinished["failed"] else ""
         raise RunFailed(f"{sum(map(len, unfinished.values()))} of {len(runs)} runs did not finish: "
-                          f"{', '.join(parts)}; errors in {out / RUNS_NAME}/NAME{FAILED_SUFFIX}; "
-                          "rerun to run them again")
+                        f"{', '.join(parts)}{where}; rerun to run them")
     return rows
 
 
@@ -195,7 +220,7 @@ def run_sweep(base: dict, variations: list[Variation], out, workers: int = 1, pa
     """Plan (or resume) the sweep into ``out``, run it and write its table and figure; the table's
     rows. An error names the runs that failed, after the table is written."""
     check_study_options(workers, launcher, ranks)
-    parsl = parsl_session(parsl)
+    parsl = parsl_session(parsl, out)
     runs = plan_study(base, variations, out, source)
     out = Path(out)
     run_study(out, runs, workers, parsl, ranks, launcher, log)

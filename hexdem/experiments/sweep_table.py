@@ -6,6 +6,10 @@ One row per run, in the plan's order:
 * ``run``: the run's directory, relative to the sweep's;
 * ``status``: ``done``, ``failed`` (its error is in ``runs/<name>.failed`` and in ``error``) or
   ``missing`` (not run yet); the figures of a run that is not done are empty;
+* ``warnings``: the names of the warnings of a finished run
+  (:data:`~hexdem.experiments.run.RUN_WARNINGS`, joined by ``;``), empty if none: a run whose
+  leading wave had not crossed the packing (``far_wall_not_reached``) has decay figures that
+  depend on its duration;
 * :data:`SUMMARY_COLUMNS`, the scalar figures of the run's ``summary.json`` (``n_beads`` is its
   ``lattice.n_beads``);
 * ``energy_share_<region>``: each material region's share of the energy (kinetic and contact)
@@ -66,11 +70,13 @@ def decay_exponents(path: Path) -> dict[str, float]:
     return {line: decay_exponent(*zip(*sorted(pairs))) for line, pairs in lines.items()}
 
 
-def _run_figures(directory: Path) -> tuple[dict, dict, dict]:
+def _run_figures(directory: Path) -> tuple[dict, dict, dict, list[str]]:
+    from hexdem.experiments.run import run_warnings
+
     summary = json.loads((directory / "summary.json").read_text())
     scalars = {key: summary["lattice"]["n_beads"] if key == "n_beads" else summary[key] for key in SUMMARY_COLUMNS}
     return (scalars, final_energy_shares(directory / "energy_regions.csv"),
-            decay_exponents(directory / "peaks.csv"))
+            decay_exponents(directory / "peaks.csv"), run_warnings(summary["far_wall_reached"]))
 
 
 def _first_seen(keys_per_run) -> list[str]:
@@ -83,35 +89,62 @@ def _first_seen(keys_per_run) -> list[str]:
 def write_table(out: Path, runs: list[SweepRun], variations, states) -> list[tuple]:
     """Write ``out / sweep.csv`` (see the module docstring) from the runs' ``states``, a
     (status, error) each; its rows."""
-    empty = (dict.fromkeys(SUMMARY_COLUMNS, ""), {}, {})
+    empty = (dict.fromkeys(SUMMARY_COLUMNS, ""), {}, {}, [])
     figures = [_run_figures(out / "runs" / run.name) if status == "done" else empty
                for run, (status, _) in zip(runs, states)]
-    regions = _first_seen(shares for _, shares, _ in figures)
-    lines = _first_seen(exponents for _, _, exponents in figures)
-    header = (*(v.key for v in variations), "run", "status", *SUMMARY_COLUMNS,
+    regions = _first_seen(shares for _, shares, _, _ in figures)
+    lines = _first_seen(exponents for _, _, exponents, _ in figures)
+    header = (*(v.key for v in variations), "run", "status", "warnings", *SUMMARY_COLUMNS,
               *(f"energy_share_{r}" for r in regions), *(f"decay_exponent_{line}" for line in lines), "error")
     def cell(value):
         return "" if value == "" or not np.isfinite(value) else value
 
-    rows = [(*run.values.values(), f"runs/{run.name}", status, *scalars.values(),
+    rows = [(*run.values.values(), f"runs/{run.name}", status, ";".join(warnings), *scalars.values(),
              *(shares.get(r, "") for r in regions), *(cell(exponents.get(line, "")) for line in lines), error)
-            for run, (status, error), (scalars, shares, exponents) in zip(runs, states, figures)]
+            for run, (status, error), (scalars, shares, exponents, warnings) in zip(runs, states, figures)]
     write_csv(out / "sweep.csv", header, rows)
     return [header, *rows]
 
 
+def warned_runs(rows: list[tuple]) -> dict[str, list[str]]:
+    """{warning name: the runs (their ``run`` cells) that carry it} of the table ``rows``."""
+    header, body = rows[0], rows[1:]
+    warned: dict[str, list[str]] = {}
+    for row in body:
+        cells = dict(zip(header, row))
+        for name in filter(None, cells["warnings"].split(";")):
+            warned.setdefault(name, []).append(cells["run"])
+    return warned
+
+
+def _energy_panel(ax) -> None:
+    """The energy panel's axis: the audit's relative drift on a log scale from the audit's round-off
+    floor to above the threshold that fails a run, so that round-off spread over a factor of a
+    few reads as the flat line it is, not as a trend."""
+    from hexdem.analysis.energy import ROUND_OFF
+    from hexdem.experiments.run import MAX_ENERGY_DRIFT
+
+    ax.set_yscale("log")
+    ax.set_ylim(ROUND_OFF / 10, MAX_ENERGY_DRIFT * 10)
+    ax.axhline(MAX_ENERGY_DRIFT, color="firebrick", ls="--", lw=1, label=f"a run fails above {MAX_ENERGY_DRIFT:g}")
+    ax.axhspan(ROUND_OFF / 10, ROUND_OFF, color="0.85", label=f"audit's round-off floor ({ROUND_OFF:g} of E(0))")
+    ax.set_ylabel("energy drift max|E(t) − E(0)| / K(0)\n(the audit's, dimensionless)")
+
+
 def sweep_figure(out: Path, runs: list[SweepRun], variations, rows: list[tuple]) -> None:
     """``out / sweep.png``: one column of panels per varied key, that key along the x axis and,
-    one row each, the energy lost and the decay exponent of the first observation line; one
-    curve per combination of the other keys (categories, such as materials, are spread evenly
-    along the axis)."""
+    one row each, the energy audit's relative drift (``energy_drift``, on a log scale between
+    the audit's round-off floor and the threshold that fails a run) and the decay exponent of
+    the first observation line; one curve per combination of the other keys (categories, such
+    as materials, are spread evenly along the axis). Runs that warned are ringed in red."""
     from hexdem.analysis import figures as plots
 
     header, body = rows[0], rows[1:]
-    shown = ["energy_lost", *[name for name in header if name.startswith("decay_exponent_")][:1]]
+    shown = ["energy_drift", *[name for name in header if name.startswith("decay_exponent_")][:1]]
     fig, axes = plots.subplots(len(shown), len(variations), figsize=(4.6 * len(variations), 3.4 * len(shown)),
                                squeeze=False, layout="constrained")
     table = [dict(zip(header, row)) for row in body]
+    warned = warned_runs(rows)
     for j, variation in enumerate(variations):
         numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in variation.values)
         position = {text: (value if numeric else i)
@@ -123,15 +156,27 @@ def sweep_figure(out: Path, runs: list[SweepRun], variations, rows: list[tuple])
             groups.setdefault(others, []).append((position[text], row))
         for i, name in enumerate(shown):
             ax = axes[i, j]
+            if name == "energy_drift":
+                _energy_panel(ax)
+            else:
+                ax.set_ylabel(name.replace("_", " "))
+
+            def value(row):
+                return float(row[name]) if row[name] != "" else np.nan
+
             for others, points in groups.items():
-                ax.plot([x for x, _ in points], [float(r[name]) if r[name] != "" else np.nan for _, r in points],
+                ax.plot([x for x, _ in points], [value(r) for _, r in points],
                         "o-", label=", ".join(f"{key} = {value}" for key, value in others) or None)
+            ringed = [(x, value(r)) for points in groups.values() for x, r in points if r["warnings"]]
+            if ringed:
+                ax.plot(*zip(*ringed), "o", ms=13, mfc="none", mec="red", mew=1.5,
+                        label=f"warned: {', '.join(warned)}")
             ax.set_xlabel(variation.key)
-            ax.set_ylabel(name.replace("_", " "))
             ax.grid(True, alpha=0.3)
             if not numeric:
                 ax.set_xticks(range(len(variation.texts)), variation.texts)
-            if len(groups) > 1 and i == 0:
+            if ax.get_legend_handles_labels()[1]:
                 ax.legend(fontsize=7)
-    fig.suptitle(f"hexdem sweep: {len(runs)} runs")
+    warned_count = sum(bool(row["warnings"]) for row in table)
+    fig.suptitle(f"hexdem sweep: {len(runs)} runs" + (f", {warned_count} warned (ringed)" if warned_count else ""))
     plots.save(fig, out / "sweep.png")

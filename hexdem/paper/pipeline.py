@@ -186,7 +186,7 @@ def run_paper(settings: PaperSettings, out, log=None) -> dict:
     """Run (or resume) every part into ``out`` and write the report; returns the parts' summaries.
     The ``settings.parsl`` file runs once, and its Parsl takes the runs of every study."""
     log = log or (lambda message: print(f"hexdem paper: {message}", file=sys.stderr, flush=True))
-    parsl = parsl_session(settings.parsl)
+    parsl = parsl_session(settings.parsl, out)
     out = ensure_writable_dir(out)
     with locked_directory(out, "another hexdem paper"), holding(parsl):
         _check_settings(out, settings)

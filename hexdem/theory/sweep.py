@@ -24,7 +24,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from hexdem.errors import HexdemError
-from hexdem.experiments.executors import describe, holding, parsl_session, run_tasks, study_executor
+from hexdem.experiments.executors import describe, holding, parsl_session, run_tasks, study_executor, tasks_failed
 from hexdem.theory.scaling import DEFAULT_LAST, Combination, CombinationFit, fit_combination
 from hexdem.model.run_settings import contact_time_s
 
@@ -182,12 +182,13 @@ def _results(settings: SweepSettings, jobs, parsl):
     (local processes: callers' scripts need an ``if __name__ == "__main__":`` guard; Parsl: the
     session ``parsl``); the runs that failed are named at the end."""
     tasks = {(strike, i): (run_one, settings, v0, strike) for strike, i, v0 in jobs}
-    failed = []
+    failed, errors = [], []
     with study_executor(min(settings.workers, len(jobs)), parsl) as executor:
         for (strike, i), result, error in run_tasks(executor, tasks):
             if error is None:
                 yield (strike, i), result
             else:
                 failed.append(f"strike {strike:g} deg, V0 = {settings.v0[i]:.4g}: {describe(error)}")
+                errors.append(error)
     if failed:
-        raise HexdemError(f"{len(failed)} of {len(jobs)} runs of the V0 sweep failed; {'; '.join(failed)}")
+        raise tasks_failed(f"{len(failed)} of {len(jobs)} runs of the V0 sweep failed; {'; '.join(failed)}", errors)

@@ -33,9 +33,8 @@ the bare loop's and the run end to end from 10.65 to 9.84 s.
 
 from __future__ import annotations
 
-import os
+import re
 import time
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -46,7 +45,7 @@ from hexdem.common.memory import keep_freed_memory
 from hexdem.common.preload import finish_background_loading
 from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.c_interface import AtomViews, add_sampling_fix, neighbour_builds
-from hexdem.engines.lammps.deck import Deck
+from hexdem.engines.lammps.deck import DATA_NAME, DUMP_NAME, Deck
 from hexdem.engines.lammps.full_step import full_step_state
 from hexdem.engines.lammps.library import load_lammps
 from hexdem.engines.lammps.runner import RunInfo, lammps_failure, log_version
@@ -58,14 +57,16 @@ OUTPUT_MARKER = "# --- output"
 STREAM_FIX = "hexdem_stream"
 
 
-@contextmanager
-def working_directory(path: Path):
-    previous = os.getcwd()
-    os.chdir(path)
-    try:
-        yield
-    finally:
-        os.chdir(previous)
+def in_folder(text: str, directory, names=(DATA_NAME, DUMP_NAME)) -> str:
+    """The deck commands ``text`` with the files ``names`` that they read and write (named relative
+    to the deck's folder, so that the deck reruns by hand from it) named by their absolute paths in
+    ``directory``, quoted (LAMMPS takes a quoted word whole, spaces included). LAMMPS in this
+    process then finds them without a change of the process's working directory, which every
+    thread of the process shares: two runs in two threads of one process (a Parsl
+    ThreadPoolExecutor) each keep to their own folder."""
+    folder = Path(directory).resolve()
+    pattern = re.compile(r"(?<=\s)(" + "|".join(map(re.escape, names)) + r")(?=\s|$)", re.MULTILINE)
+    return pattern.sub(lambda match: f'"{folder / match.group(1)}"', text)
 
 
 def split_deck(text: str) -> tuple[str, str]:
@@ -180,10 +181,11 @@ def _lammps(deck: Deck, call, text: str) -> None:
 
 
 def start_lammps(directory: Path, comm=None):
-    """A LAMMPS instance in this process, run from ``directory`` (the working directory, which
-    holds its log): on the ranks of the mpi4py communicator ``comm``, or on this one alone (None).
-    A failure to start is a one-line :class:`~hexdem.errors.HexdemError`."""
-    lammps, args = load_lammps(), ["-screen", "none", "-log", "log.lammps", "-nocite"]
+    """A LAMMPS instance in this process that logs to ``directory/log.lammps`` (its files are named
+    in ``directory`` by :func:`in_folder`): on the ranks of the mpi4py communicator ``comm``, or on
+    this one alone (None). A failure to start is a one-line :class:`~hexdem.errors.HexdemError`."""
+    log = str(Path(directory).resolve() / "log.lammps")
+    lammps, args = load_lammps(), ["-screen", "none", "-log", log, "-nocite"]
     try:
         return lammps.lammps(cmdargs=args) if comm is None else lammps.lammps(cmdargs=args, comm=comm)
     except Exception as exc:
@@ -203,21 +205,20 @@ def run_streaming(deck: Deck, on_sample, comm=None, dump: bool = False, show_pro
     root = comm is None or comm.Get_rank() == 0
     start = time.perf_counter()
     keep_freed_memory()
-    with working_directory(deck.directory):
-        lmp = start_lammps(deck.directory, comm)
-        stream = None
-        try:
-            _lammps(deck, lmp.commands_string, setup + (output if dump else ""))
-            stream = _Stream(lmp, deck, on_sample, show_progress and root, comm, spins)
-            stream.initial()
-            add_sampling_fix(lmp, STREAM_FIX, deck.settings.dump_every, deck.settings.n_steps, stream,
-                             lambda text: _lammps(deck, lmp.command, text))
-            finish_background_loading()  # the callbacks need the interpreter that a background import holds
-            _lammps(deck, lmp.command, f"run {deck.settings.n_steps}")
-        finally:
-            if stream is not None and stream.bar is not None:
-                stream.bar.close()
-            lmp.close()
+    lmp = start_lammps(deck.directory, comm)
+    stream = None
+    try:
+        _lammps(deck, lmp.commands_string, in_folder(setup + (output if dump else ""), deck.directory))
+        stream = _Stream(lmp, deck, on_sample, show_progress and root, comm, spins)
+        stream.initial()
+        add_sampling_fix(lmp, STREAM_FIX, deck.settings.dump_every, deck.settings.n_steps, stream,
+                         lambda text: _lammps(deck, lmp.command, text))
+        finish_background_loading()  # the callbacks need the interpreter that a background import holds
+        _lammps(deck, lmp.command, f"run {deck.settings.n_steps}")
+    finally:
+        if stream is not None and stream.bar is not None:
+            stream.bar.close()
+        lmp.close()
     if stream.error is not None:
         raise stream.error
     return RunInfo(log_version(deck.log_path), ranks, time.perf_counter() - start)

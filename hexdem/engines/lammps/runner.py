@@ -1,8 +1,10 @@
 """What every way of running a deck shares: its :class:`RunInfo`, LAMMPS's version and error
 line from its log, and the bare run ``mpiexec -n N lmp -in in.hexdem`` of a deck by hand.
 
-LAMMPS runs inside the deck's directory (the deck uses relative paths, so that it can be
-rerun by hand) and writes ``log.lammps`` there. A LAMMPS error becomes a one-line
+A deck names its files relative to its directory, so that it can be rerun by hand from there;
+``lmp`` runs with the directory as its working directory, and LAMMPS inside hexdem's process is
+handed their absolute paths instead (:func:`~hexdem.engines.lammps.driver.in_folder`): the
+process's working directory never changes. Either way LAMMPS writes ``log.lammps`` there. A LAMMPS error becomes a one-line
 :class:`~hexdem.errors.RunFailed` with LAMMPS's own message and the deck path.
 """
 

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from hexdem.engines.lammps.deck import DATA_NAME, DECK_NAME, data_file, granular_block, integrator, template
-from hexdem.engines.lammps.driver import start_lammps, working_directory
+from hexdem.engines.lammps.driver import in_folder, start_lammps
 from hexdem.engines.lammps.runner import lammps_failure
 from hexdem.errors import RunFailed
 from hexdem.model.granular import GranularModel
@@ -89,16 +89,16 @@ def write_settling_deck(model: GranularModel, stage: SettlingStage, directory) -
 
 def run_settling_deck(directory) -> None:
     """Run the settling deck in ``directory`` in this process, on this rank alone, as
-    ``lmp -in in.hexdem`` would."""
+    ``lmp -in in.hexdem`` would from ``directory`` (its files named there, :func:`in_folder`)."""
     directory = Path(directory)
-    with working_directory(directory):
-        lmp = start_lammps(directory)
-        try:
-            lmp.file(DECK_NAME)
-        except Exception as exc:
-            raise lammps_failure(directory, str(exc)) from None
-        finally:
-            lmp.close()
+    text = in_folder((directory / DECK_NAME).read_text(), directory, (DATA_NAME, STATS_NAME, SETTLED_NAME))
+    lmp = start_lammps(directory)
+    try:
+        lmp.commands_string(text)
+    except Exception as exc:
+        raise lammps_failure(directory, str(exc)) from None
+    finally:
+        lmp.close()
 
 
 @dataclass(frozen=True)
