@@ -14,11 +14,13 @@ each written atomically. An output that cannot be measured on the packing (a cha
 front; a single bead no decay along a line) is skipped, and ``summary.json`` says which and why
 (:func:`unmeasurable_outputs`). A failed run leaves nothing in ``OUT`` (an ``OUT`` it created is
 removed again); its inputs and log are kept in a ``hexdem-failed-*`` folder of the system's
-temporary directory, which the error message names.
+temporary directory, which the error message names. A full disk is one line naming ``OUT``, and
+a run stopped by a signal (:mod:`hexdem.common.interrupt`) leaves nothing in ``OUT`` either.
 """
 
 from __future__ import annotations
 
+import errno
 import shutil
 import sys
 import tempfile
@@ -291,6 +293,11 @@ def run_experiment(config: RunConfig, out, log=None, command=None, prepared: Run
             if kept is None:
                 raise
             raise type(exc)(str(exc).replace(str(staging / "deck"), str(kept))) from None
+        except OSError as exc:
+            if exc.errno != errno.ENOSPC:
+                raise
+            raise HexdemError(f"no space left on the device of {out} while writing the run's files; nothing was "
+                              "kept: free some space or choose another --out") from None
     log(f"energy drift {analysis.results.energy_drift:.2e}; results in {out}")
     if not analysis.results.far_wall_reached:
         log("warning: the leading wave had not reached every bead at the far wall one contact time before the run "

@@ -169,6 +169,8 @@ class _Stream:
             self.error = exc
             if self.comm is not None and self.comm.Get_size() > 1:
                 abort_job(self.comm, exc)
+            else:  # the run ends at its next step (a stopped run, Ctrl-C, ends at once)
+                self.lmp.force_timeout()
 
 
 def _lammps(deck: Deck, call, text: str) -> None:
