@@ -94,3 +94,25 @@ def test_a_full_filesystem_is_one_line_and_leaves_nothing(tmp_path):
         assert not any(disk.iterdir())
     finally:
         subprocess.run(["umount", str(disk)], check=True)
+
+
+def test_a_stopped_sweep_keeps_its_finished_runs_and_no_half_run(tmp_path):
+    """SIGTERM while a study's second run is running: the first stays, the second's part folder goes,
+    and the command ends as a stopped run does."""
+    (tmp_path / "base.toml").write_text("edge_beads = 25\nduration = 0.001\n")
+    study, runs = tmp_path / "study", tmp_path / "study" / "runs"
+    process = subprocess.Popen([sys.executable, "-m", "hexdem", "sweep", "--config", str(tmp_path / "base.toml"),
+                                "--vary", "v0=0.2,0.3,0.4", "--workers", "1", "--out", str(study)],
+                               stderr=subprocess.PIPE, text=True, start_new_session=True)
+    deadline = time.monotonic() + 180
+    while not ((runs / "v0=0.2").is_dir() and list(runs.glob(".v0=0.3.part/.hexdem-run-*/deck/log.lammps"))):
+        assert process.poll() is None and time.monotonic() < deadline, process.stderr.read()
+        time.sleep(0.05)
+    start = time.monotonic()
+    process.send_signal(signal.SIGTERM)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 143
+    assert err.strip().splitlines()[-1] == LAST_LINE.format("SIGTERM")
+    assert time.monotonic() - start < 10
+    time.sleep(1)
+    assert sorted(path.name for path in runs.iterdir()) == ["v0=0.2"]

@@ -9,12 +9,15 @@ run ends at its next sample (:mod:`hexdem.engines.lammps.driver`), a run's stagi
 study's half-run are removed (:func:`~hexdem.common.io.staged_directory`). The command then ends
 with one line saying it was interrupted, with the shell's status for the signal, 128 + its
 number (143 for SIGTERM, 130 for SIGINT). A second signal while the first is being cleaned up
-is ignored, so that the clean-up finishes.
+is ignored, so that the clean-up finishes. The signal is also remembered: an exception raised
+where nothing can catch it (a ctypes callback, which ignores it) is raised again by the next
+:func:`raise_if_stopped`, so that a stopped run is never published.
 """
 
 from __future__ import annotations
 
 import signal
+from contextlib import contextmanager
 
 #: The signals that stop a hexdem command.
 STOP_SIGNALS = (signal.SIGTERM, signal.SIGINT)
@@ -38,7 +41,16 @@ class Interrupted(KeyboardInterrupt):
         return 128 + self.signum
 
 
+#: The signals this process has received, first first.
+_received: list[int] = []
+
+
+def _note(signum, frame) -> None:
+    _received.append(signum)
+
+
 def _raise(signum, frame) -> None:
+    _received.append(signum)
     for other in STOP_SIGNALS:  # the first signal is cleaned up after; the next ones wait for it
         signal.signal(other, signal.SIG_IGN)
     raise Interrupted(signum)
@@ -48,3 +60,33 @@ def stop_on_signals() -> None:
     """Make SIGTERM and SIGINT raise :class:`Interrupted` in the main thread (call it there)."""
     for signum in STOP_SIGNALS:
         signal.signal(signum, _raise)
+
+
+def note_signals() -> None:
+    """Make SIGTERM and SIGINT only be remembered, for :func:`raise_if_stopped`: a process that
+    holds nothing to clean up (an idle worker) stops at its next task."""
+    for signum in STOP_SIGNALS:
+        signal.signal(signum, _note)
+
+
+@contextmanager
+def deferred_signals():
+    """Within the block, SIGTERM and SIGINT that would raise :class:`Interrupted` are only
+    remembered, and raised on leaving it: for a block that Python cannot leave cleanly from any
+    point (LAMMPS's run, whose ctypes callbacks ignore an exception raised on their entry), which
+    polls :func:`raise_if_stopped` where it can stop."""
+    ours = [signum for signum in STOP_SIGNALS if signal.getsignal(signum) is _raise]
+    for signum in ours:
+        signal.signal(signum, _note)
+    try:
+        yield
+    finally:
+        for signum in ours:
+            signal.signal(signum, signal.SIG_IGN if _received else _raise)
+    raise_if_stopped()
+
+
+def raise_if_stopped() -> None:
+    """Raise :class:`Interrupted` if this process has received SIGTERM or SIGINT."""
+    if _received:
+        raise Interrupted(_received[0])

@@ -34,6 +34,7 @@ from hexdem.analysis.front_shape import FRONT_SHAPE_COLUMNS, FrontShape, front_s
 from hexdem.analysis.impact import PEAK_COLUMNS, ImpactAnalysis
 from hexdem.analysis.movie import movie_samples
 from hexdem.common.forked import run_shared
+from hexdem.common.interrupt import raise_if_stopped
 from hexdem.common.io import staged_directory, write_csv, write_csv_columns, write_json
 from hexdem.common.machine import free_disk_bytes
 from hexdem.common.preload import load_in_background
@@ -288,6 +289,7 @@ def run_experiment(config: RunConfig, out, log=None, command=None, prepared: Run
             check_dump_space(prepared, Path(out))
             analysis = simulate(prepared, staging / "deck", log)
             write_results(config, analysis, staging, time.perf_counter() - start, provenance(), log)
+            raise_if_stopped()  # a stopped run is never published, even one whose stop was swallowed
         except HexdemError as exc:
             kept = _keep_failed_deck(staging / "deck")
             if kept is None:
