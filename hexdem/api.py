@@ -74,7 +74,7 @@ def simulate_impact(config: RunConfig | None = None, out=None, verbose: bool = F
     the others leave without effect is refused, as ``hexdem run`` refuses it
     (:func:`~hexdem.model.unused_keys.check_unused_keys`).
     """
-    config = (config or RunConfig()).replace(**changes)
+    config = (config or RunConfig()).override(**changes)
     check_unused_keys(config)
     log = (lambda message: print(f"hexdem: {message}", file=sys.stderr)) if verbose else (lambda message: None)
     if out is not None:

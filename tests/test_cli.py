@@ -89,6 +89,17 @@ def test_every_pages_exit_statuses_agree_with_the_getting_started_table():
     assert ("sweeps.md", 4) in found and ("impacts.md", 3) in found
 
 
+def test_an_unknown_option_of_a_command_shows_the_commands_usage():
+    """``hexdem run --outdir x``: run's usage and its own error line, not hexdem's top-level usage;
+    an unknown option before the command stays hexdem's."""
+    done = hexdem_module("run", "--outdir", "x")
+    assert done.returncode == 2
+    assert done.stderr.startswith("usage: hexdem run [-h] [--config FILE.toml]")
+    assert done.stderr.strip().splitlines()[-1] == "hexdem run: error: unrecognized arguments: --outdir x"
+    done = hexdem_module("--outdir", "x", "run")
+    assert done.returncode == 2 and done.stderr.startswith("usage: hexdem [-h]")
+
+
 def test_a_refused_input_and_a_failed_run_exit_differently_from_a_typo(tmp_path):
     """Refused before running: 3 (tests/test_errors.py holds the cases, and a LAMMPS failure's 4)."""
     (tmp_path / "bad.toml").write_text("v0 = -0.4\n")

@@ -57,7 +57,8 @@ def kept_deck(message: str) -> Path:
     ('shape = "pentagon"', "unknown shape 'pentagon'"),
     ("diameter_m = -0.01", "bead diameter must be > 0"),
     ("ranks = 0", "ranks must be a positive integer"),
-    ("velocity = 0.4", "unknown parameter(s) velocity"),
+    ("velocity = 0.4", "unknown parameter velocity; the keys are angle_deg, bead_material, "),
+    ("edge_beds = 7", "unknown parameter edge_beds; did you mean edge_beads"),
     ("v0 = [", "not valid TOML"),
     ('shape = "sites"\nsites = [[0, 0], [2, 0], [0, 0]]', "site {0, 0} is listed twice"),
     ('shape = "sites"\nsites = [[2, 0], [4, 0]]', "the struck site {0, 0} is not in the packing"),
@@ -93,6 +94,12 @@ def kept_deck(message: str) -> Path:
     ('shape = "random"\nstruck_bead = 2', 'struck_bead describes shape = "packing", not \'random\''),
     ("rows = 5", 'rows describes shape = "square" or "centered-square", not \'hexagon\''),
     ('shape = "chain"\nedge_beads = 5', 'edge_beads describes shape = "hexagon", "triangle" or "parallelogram"'),
+    # a key written is set whatever its value, its default included
+    ('shape = "square"\nedge_beads = 11', 'edge_beads describes shape = "hexagon", "triangle" or "parallelogram", '
+                                          "not 'square'"),
+    ('shape = "chain"\nwall_material = "delrin"', 'wall_material describes shape = "hexagon", '),
+    ('engine = "reference"\nranks = 1', "ranks does nothing: the reference engine runs in one process"),
+    ("sensor_rate_hz = 500e3", "sensor_rate_hz does nothing: there are no sensors"),
     ('materials = ["brass"]', "a chain's material per bead goes in bead_materials"),
     ('shape = "chain"\nwall_friction = 0.3', 'wall_friction describes shape = "hexagon", "half-hexagon", '),
     ('striker_material = "brass"', 'striker_material does nothing: no impact is a striker (impact = "velocity"); '

@@ -63,7 +63,8 @@ def test_the_struck_bead_is_the_middle_of_the_edge_facing_the_strike():
 
 @pytest.mark.parametrize("changes, message", [
     ({"diameter_spread": 0.5}, "diameter_spread must be at least 0 and below 0.5"),
-    ({"radius_m": 0.01}, "radius_m must be at least diameter_m"),
+    ({"radius_m": 0.01}, "radius_m must be at least 1.5 diameter_m"),
+    ({"radius_m": D}, r"radius_m must be at least 1.5 diameter_m = 0.028575 m for a random disc \(a middle bead "),
     ({"seed": -1}, "seed must be an integer >= 0"),
     ({"seed": 1.5}, "seed must be an integer"),
 ])
@@ -71,6 +72,22 @@ def test_bad_random_discs_are_one_line_errors(changes, message):
     with pytest.raises(HexdemError, match=message) as error:
         RunConfig(shape="random", **changes)
     assert "\n" not in str(error.value)
+
+
+def test_the_smallest_random_disc_settles_with_a_bead_at_its_centre(tmp_path):
+    """A disc of the smallest radius, 1.5 d (seed 0: 8 beads, one of them brought to the centre), is
+    packed: the pull that flips across the centre shook its middle bead at about 1 mm/s for
+    2,000,000 steps before the pull fell to zero within PULL_CORE_M of the centre. Its beads rest
+    on each other, the middle one among them."""
+    config = RunConfig(shape="random", radius_m=1.5 * D, seed=0)
+    packed = prepare_random_packing(config, tmp_path)
+    table = np.loadtxt(packed.packing_file, delimiter=",", skiprows=1, ndmin=2)
+    positions, diameters = table[:, :2], table[:, 2]
+    middle = np.argmin(np.linalg.norm(positions - positions.mean(axis=0), axis=1))
+    i, j, gap = gaps(positions, diameters)
+    touching = gap < TOUCHING_M
+    assert len(diameters) == 8
+    assert np.sum(touching & ((i == middle) | (j == middle))) >= 3  # held from every side, not only pressed
 
 
 def test_a_random_disc_is_built_only_once_packed():

@@ -5,8 +5,9 @@ Every :class:`~hexdem.errors.HexdemError` is printed as one line, ``hexdem: erro
 ``--traceback`` shows the full traceback instead. The exit status tells what went wrong
 (:data:`EXIT_CODES`): 2 for a usage error (argparse's), 3 for input or an environment that
 hexdem refused (or a check of its results that failed), 4 for a simulation that started and failed
-(:class:`~hexdem.errors.RunFailed`), 130 for an interrupt; 1 is left to an unexpected error,
-a bug, which Python reports with its traceback.
+(:class:`~hexdem.errors.RunFailed`), 130 for an interrupt (SIGINT, Ctrl-C) and 143 for SIGTERM
+(:mod:`hexdem.common.interrupt`); 1 is left to an unexpected error, a bug, which Python reports
+with its traceback.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import importlib
 import sys
 
 from hexdem.cli.version import VersionAction
+from hexdem.common.interrupt import Interrupted, stop_on_signals
 from hexdem.common.process_end import skip_final_collections
 from hexdem.errors import HexdemError, RunFailed
 
@@ -26,7 +28,8 @@ EXIT_CODES = {0: "success", 1: "an unexpected error (a bug: Python prints its tr
                  "disagree), named in one line",
               4: "a simulation that started and failed (LAMMPS stopped, the energy drifted, a packing did not "
                  "settle)",
-              130: "interrupted (Ctrl-C)"}
+              130: "interrupted (Ctrl-C, SIGINT): the run stopped, nothing unfinished kept",
+              143: "stopped (SIGTERM, as kill and batch schedulers send): the run stopped, nothing unfinished kept"}
 REFUSED, FAILED, INTERRUPTED = 3, 4, 130
 
 #: name → (module, one-line help)
@@ -56,6 +59,7 @@ def build_parser(argv) -> argparse.ArgumentParser:
     for name, (module_name, help_text) in COMMANDS.items():
         module = importlib.import_module(module_name) if name == wanted else None
         command = sub.add_parser(name, help=help_text, description=help_text)
+        command.set_defaults(_parser=command)
         if module is not None:
             module.add_arguments(command)
             command.set_defaults(_module=module)
@@ -73,7 +77,11 @@ def main(argv=None) -> int:
 
     command = list(sys.argv) if argv is None else ["hexdem", *argv]
     argv = command[1:]
-    args = build_parser(argv).parse_args(argv)
+    parser = build_parser(argv)
+    args, unknown = parser.parse_known_args(argv)
+    if unknown:  # after the command's name, an unknown option is refused with the command's usage
+        after = argv.index(unknown[0]) > argv.index(args.command)
+        (args._parser if after else parser).error(f"unrecognized arguments: {' '.join(unknown)}")
     try:
         with running_command(command):
             args._module.run(args)
@@ -82,15 +90,18 @@ def main(argv=None) -> int:
             raise
         print(f"hexdem: error: {exc}", file=sys.stderr)
         return exit_status(exc)
-    except KeyboardInterrupt:
-        print("hexdem: interrupted", file=sys.stderr)
-        return INTERRUPTED
+    except KeyboardInterrupt as exc:
+        signal = exc.name if isinstance(exc, Interrupted) else "SIGINT"
+        print(f"hexdem: interrupted by {signal}: the run was stopped and nothing unfinished was kept", file=sys.stderr)
+        return exc.exit_status if isinstance(exc, Interrupted) else INTERRUPTED
     return 0
 
 
 def command() -> int:
     """The ``hexdem`` command: :func:`main` in a process that ends with it (see
-    :mod:`hexdem.common.process_end`)."""
+    :mod:`hexdem.common.process_end`) and that SIGTERM and SIGINT stop
+    (:mod:`hexdem.common.interrupt`)."""
+    stop_on_signals()
     code = main()
     skip_final_collections()
     return code

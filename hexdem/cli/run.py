@@ -28,7 +28,7 @@ def config_from_args(args) -> RunConfig:
     overrides = {key: value for key, value in (("ranks", args.ranks), ("engine", args.engine),
                                                ("dump", args.dump), ("movie", args.movie),
                                                ("launcher", args.launcher)) if value is not None}
-    config = config.replace(**overrides)
+    config = config.override(**overrides)
     check_unused_keys(config)
     return config
 

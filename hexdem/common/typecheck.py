@@ -14,6 +14,7 @@ allowed only where the type says ``| None``.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 import numbers
@@ -25,8 +26,9 @@ from hexdem.errors import HexdemError
 
 @functools.cache
 def declared_types(cls) -> dict:
-    """{key: type} of the annotations of ``cls`` (a dataclass or a TypedDict), resolved."""
-    return typing.get_type_hints(cls)
+    """{key: type} of the annotations of ``cls`` (a dataclass or a TypedDict), resolved; a
+    dataclass's init-only arguments (``InitVar``) are not keys."""
+    return {key: kind for key, kind in typing.get_type_hints(cls).items() if not isinstance(kind, dataclasses.InitVar)}
 
 
 def _is_list(args) -> bool:

@@ -54,4 +54,4 @@ def read_deck_config(deck: Path) -> RunConfig:
     for key in FILE_KEYS:
         if isinstance(data.get(key), str):
             data[key] = str(deck / data[key])  # a copy in the deck (an older deck's absolute path stays)
-    return RunConfig.from_dict(data, source=str(path))
+    return RunConfig.from_dict(data, source=str(path), given=False)  # every key written: only values set

@@ -31,6 +31,7 @@ from multiprocessing import get_context
 from pathlib import Path
 
 from hexdem.common.checks import positive_int
+from hexdem.common.interrupt import note_signals, raise_if_stopped, stop_on_signals
 from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.standalone import die_with_parent, launcher_command
 from hexdem.errors import HexdemError, RunFailed
@@ -44,7 +45,8 @@ LOCAL_RETRIES = 1
 class LocalPool(Executor):
     """A process pool of ``workers`` spawned processes that starts a fresh pool when one of its
     processes died (a broken :class:`ProcessPoolExecutor` takes no more tasks). The processes end
-    with this one (on Linux), so that none keeps writing into a study that was killed."""
+    with this one (on Linux), so that none keeps writing into a study that was killed, and stop
+    as it does on SIGTERM and SIGINT (:mod:`hexdem.common.interrupt`), cleaning up their task."""
 
     retries = LOCAL_RETRIES
 
@@ -54,20 +56,47 @@ class LocalPool(Executor):
 
     def _new(self) -> ProcessPoolExecutor:
         return ProcessPoolExecutor(max_workers=self.workers, mp_context=get_context("spawn"),
-                                   initializer=die_with_parent, initargs=(os.getpid(),))
+                                   initializer=_start_worker, initargs=(os.getpid(),))
 
     def submit(self, fn, /, *args, **kwargs):
         """A future of ``fn`` called with ``args`` and ``kwargs`` in a worker process (a fresh pool
         where a worker died)."""
         try:
-            return self._pool.submit(fn, *args, **kwargs)
+            return self._pool.submit(_worker_task, fn, *args, **kwargs)
         except BrokenProcessPool:
             self._pool.shutdown(wait=False, cancel_futures=True)
             self._pool = self._new()
-            return self._pool.submit(fn, *args, **kwargs)
+            return self._pool.submit(_worker_task, fn, *args, **kwargs)
 
     def shutdown(self, wait=True, *, cancel_futures=False):
         self._pool.shutdown(wait=wait, cancel_futures=cancel_futures)
+
+    def stop(self) -> None:
+        """Send SIGTERM to every worker process: each stops its task, which cleans up after itself."""
+        for process in self._pool._processes.values():
+            process.terminate()
+
+
+def _start_worker(parent_pid: int) -> None:
+    """A worker of a :class:`LocalPool`: it ends with ``parent_pid``; SIGTERM or SIGINT while it
+    holds no task is remembered (:func:`_worker_task`)."""
+    die_with_parent(parent_pid)
+    note_signals()
+
+
+def _worker_task(fn, *args, **kwargs):
+    """``fn(*args, **kwargs)`` in a :class:`LocalPool` worker, which SIGTERM and SIGINT stop
+    (:mod:`hexdem.common.interrupt`): the task cleans up after itself and raises
+    :class:`~hexdem.common.interrupt.Interrupted`, and so does every task queued for the worker
+    after it, without starting; the pool's shutdown then ends the worker."""
+    raise_if_stopped()
+    stop_on_signals()
+    try:
+        result = fn(*args, **kwargs)
+    finally:
+        note_signals()
+    raise_if_stopped()
+    return result
 
 
 def _call(fn, *args, **kwargs):
@@ -190,6 +219,9 @@ def study_executor(workers: int, parsl: ParslSession | None = None):
     pool = LocalPool(workers)
     try:
         yield pool
+    except KeyboardInterrupt:  # the study was stopped (hexdem.common.interrupt): its runs stop too
+        pool.stop()
+        raise
     finally:
         pool.shutdown(cancel_futures=True)
 

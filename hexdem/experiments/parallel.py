@@ -10,7 +10,10 @@ environment: the ``mpich`` wheel's launcher and this Python), which writes rank 
 atomically beside the job. ``-P`` keeps the current directory off ``sys.path``, so that the
 ranks import the hexdem that is installed even when they start inside a source checkout. A failure on any rank is written to ``job.error`` in one line and
 aborts the whole MPI job, so that no rank waits forever in a collective call (a failure inside
-a LAMMPS sampling callback is written there too, through ``HEXDEM_JOB_ERROR``).
+a LAMMPS sampling callback is written there too, through ``HEXDEM_JOB_ERROR``). A run that is
+stopped (SIGTERM, Ctrl-C: :mod:`hexdem.common.interrupt`) stops the launcher, which ends the
+ranks, and waits for them before it goes on stopping, so that no rank writes into a folder the
+run then removes.
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ from __future__ import annotations
 import functools
 import os
 import pickle
+import signal
 import subprocess
 import sys
 import threading
@@ -36,6 +40,8 @@ from hexdem.errors import HexdemError, RunFailed
 JOB_NAME, RESULT_NAME, ERROR_NAME = "job.pickle", "job.result.pickle", "job.error"
 #: Seconds between looks at a running job's progress.
 POLL_S = 0.5
+#: Seconds a stopped MPI launcher is given to end its ranks before it is killed.
+STOP_S = 10.0
 
 
 @contextmanager
@@ -86,24 +92,43 @@ def run_on_ranks(job, ranks: int, directory, launcher: str | None = None, progre
     command = [*prefix, "-n", str(ranks), sys.executable, "-P", "-m", __name__, str(paths[JOB_NAME].resolve())]
     with _progress(progress):
         try:
-            done = subprocess.run(command, stdout=subprocess.PIPE, stderr=None, text=True,
-                                  preexec_fn=functools.partial(die_with_parent, os.getpid()))
+            launched = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=None, text=True,
+                                        preexec_fn=functools.partial(die_with_parent, os.getpid()))
         except OSError as exc:
             raise HexdemError(f"cannot start the MPI launcher {prefix[0]!r}: {exc.strerror}") from None
-    if done.returncode != 0 or not paths[RESULT_NAME].exists():
+        with launched:
+            try:
+                output, _ = launched.communicate()
+            except BaseException:  # stopped (SIGTERM, Ctrl-C: hexdem.common.interrupt): no rank outlives the run
+                _stop(launched)
+                raise
+    if launched.returncode != 0 or not paths[RESULT_NAME].exists():
         reported = paths[ERROR_NAME].read_text().strip() if paths[ERROR_NAME].exists() else ""
         if reported:
             raise reported_error(reported)
-        raise RunFailed(f"the MPI job on {ranks} ranks failed (exit status {done.returncode}): "
-                        f"{(done.stdout.strip().splitlines() or ['no output'])[-1]}")
+        raise RunFailed(f"the MPI job on {ranks} ranks failed (exit status {launched.returncode}): "
+                        f"{(output.strip().splitlines() or ['no output'])[-1]}")
     result = pickle.loads(paths[RESULT_NAME].read_bytes())
     for name in (JOB_NAME, RESULT_NAME):
         paths[name].unlink()
     return result
 
 
+def _stop(launched: subprocess.Popen) -> None:
+    """End the MPI launcher ``launched`` and its ranks, and wait for them: SIGTERM, which the
+    launcher passes on to the ranks, then SIGKILL after :data:`STOP_S` seconds. Its report of the
+    ranks it ended (on its standard output) is read and dropped."""
+    launched.terminate()
+    try:
+        launched.communicate(timeout=STOP_S)
+    except subprocess.TimeoutExpired:
+        launched.kill()
+        launched.communicate()
+
+
 def _rank_main(job_path: Path) -> None:
     """One rank of an MPI job: run it, publish rank 0's result, or report and abort."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)  # Ctrl-C, passed on by the launcher, ends a rank quietly
     load_lammps()  # loads the mpich wheel's MPI library before mpi4py looks for one
     from mpi4py import MPI
 

@@ -14,11 +14,13 @@ each written atomically. An output that cannot be measured on the packing (a cha
 front; a single bead no decay along a line) is skipped, and ``summary.json`` says which and why
 (:func:`unmeasurable_outputs`). A failed run leaves nothing in ``OUT`` (an ``OUT`` it created is
 removed again); its inputs and log are kept in a ``hexdem-failed-*`` folder of the system's
-temporary directory, which the error message names.
+temporary directory, which the error message names. A full disk is one line naming ``OUT``, and
+a run stopped by a signal (:mod:`hexdem.common.interrupt`) leaves nothing in ``OUT`` either.
 """
 
 from __future__ import annotations
 
+import errno
 import shutil
 import sys
 import tempfile
@@ -32,6 +34,7 @@ from hexdem.analysis.front_shape import FRONT_SHAPE_COLUMNS, FrontShape, front_s
 from hexdem.analysis.impact import PEAK_COLUMNS, ImpactAnalysis
 from hexdem.analysis.movie import movie_samples
 from hexdem.common.forked import run_shared
+from hexdem.common.interrupt import raise_if_stopped
 from hexdem.common.io import staged_directory, write_csv, write_csv_columns, write_json
 from hexdem.common.machine import free_disk_bytes
 from hexdem.common.preload import load_in_background
@@ -294,11 +297,17 @@ def run_experiment(config: RunConfig, out, log=None, command=None, prepared: Run
             check_dump_space(prepared, Path(out))
             analysis = simulate(prepared, staging / "deck", log)
             write_results(config, analysis, staging, time.perf_counter() - start, provenance(), log)
+            raise_if_stopped()  # a stopped run is never published, even one whose stop was swallowed
         except HexdemError as exc:
             kept = _keep_failed_deck(staging / "deck", failed_deck)
             if kept is None:
                 raise
             raise type(exc)(str(exc).replace(str(staging / "deck"), str(kept))) from None
+        except OSError as exc:
+            if exc.errno != errno.ENOSPC:
+                raise
+            raise HexdemError(f"no space left on the device of {out} while writing the run's files; nothing was "
+                              "kept: free some space or choose another --out") from None
     log(f"energy drift {analysis.results.energy_drift:.2e}; results in {out}")
     for name in run_warnings(analysis.results.far_wall_reached):
         log(f"warning: {RUN_WARNINGS[name]}")

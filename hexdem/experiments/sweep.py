@@ -24,6 +24,8 @@ and ``hexdem sweep DIR --collect`` writes the table and figure of whatever has f
 is removed if the run fails and renamed into place once all its files are written. A rerun of
 the same command keeps the finished runs and runs the missing and failed ones again; the table
 is read from the runs' files either way. A rerun with another plan is refused rather than mixed.
+A study stopped by SIGTERM or SIGINT (:mod:`hexdem.common.interrupt`) stops its runs and keeps
+the finished ones; no half-run is left.
 """
 
 from __future__ import annotations
@@ -156,9 +158,15 @@ def run_study(out: Path, runs: list[SweepRun], workers: int = 1, parsl=None, ran
             failure_path(out, run).unlink(missing_ok=True)
         named = {run.name: run for run in todo}
         tasks = {name: (run_one, run, out, ranks, launcher, user_command()) for name, run in named.items()}
-        for name, error in run_phase(tasks, workers, parsl, "hexdem sweep", "run", done_before=len(runs) - len(todo)):
-            if error is not None:
-                log(f"run {name} failed: {_record_failure(out, named[name], error)}")
+        try:
+            for name, error in run_phase(tasks, workers, parsl, "hexdem sweep", "run",
+                                         done_before=len(runs) - len(todo)):
+                if error is not None:
+                    log(f"run {name} failed: {_record_failure(out, named[name], error)}")
+        except KeyboardInterrupt:  # stopped: the finished runs stay, a half-run its worker left goes
+            for leftover in (out / RUNS_NAME).glob(".*.part"):
+                shutil.rmtree(leftover, ignore_errors=True)
+            raise
 
 
 def run_single(out, runs: list[SweepRun], index: int, ranks: int | None = None,

@@ -14,6 +14,7 @@ keys are the field names. ``v0``, ``dt`` and ``duration`` are in the run's ``uni
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import math
 from pathlib import Path
 from dataclasses import dataclass
@@ -71,7 +72,8 @@ class RunConfig:
     """One simulation: every key a configuration file may set, each checked against its declared
     type (:mod:`hexdem.common.typecheck`) and its meaning in
     :data:`~hexdem.model.config_keys.KEY_DESCRIPTIONS`. Lengths in m; ``v0``, ``dt``, ``duration``
-    in ``units``. ``dt = None`` takes the contact time
+    in ``units``. ``given``: the keys the user wrote (:meth:`from_dict`, :meth:`override`), each
+    set whatever its value (:meth:`set_keys`). ``dt = None`` takes the contact time
 (:func:`~hexdem.model.run_settings.contact_time_s`) over
     ``steps_per_contact``, shortened so that the default sampling interval, 1/20 of the contact
     time, is whole steps; ``duration = None`` follows the pulse layer by layer from the struck
@@ -137,8 +139,10 @@ class RunConfig:
     radius_m: float = 0.1
     diameter_spread: float = 0.15
     seed: int = 0
+    given: dataclasses.InitVar[frozenset[str]] = frozenset()
 
-    def __post_init__(self):
+    def __post_init__(self, given):
+        object.__setattr__(self, "given", frozenset(given))
         if isinstance(self.materials, (list, tuple)):
             raise HexdemError("materials is a table of this configuration's own materials; a chain's material "
                               "per bead goes in bead_materials = [\"steel316\", \"brass\", ...]")
@@ -264,26 +268,41 @@ class RunConfig:
         return cls.from_dict(read_config_table(path), source=str(path))
 
     @classmethod
-    def from_dict(cls, data: dict, source: str = "config") -> "RunConfig":
-        known = {f.name for f in dataclasses.fields(cls)}
-        unknown = sorted(set(data) - known)
-        if unknown:
-            raise HexdemError(f"{source}: unknown parameter(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}")
-        return cls(**data)
+    def from_dict(cls, data: dict, source: str = "config", given: bool = True) -> "RunConfig":
+        """The configuration of the table ``data`` of keys, each key in it set whatever its value
+        (:meth:`set_keys`); ``given=False`` for a table hexdem wrote with every key (a deck's
+        ``hexdem.json``), whose keys are set where they differ from their defaults. An unknown
+        key is refused in one line that names the nearest known one."""
+        known = [f.name for f in dataclasses.fields(cls)]
+        for key in data:
+            if key not in known:
+                nearest = difflib.get_close_matches(key, known, n=3)
+                hint = (f"did you mean {' or '.join(nearest)}?" if nearest
+                        else f"the keys are {', '.join(sorted(known))}")
+                raise HexdemError(f"{source}: unknown parameter {key}; {hint}")
+        return cls(**data, given=frozenset(data) if given else frozenset())
 
     def replace(self, **changes) -> "RunConfig":
-        return dataclasses.replace(self, **changes)
+        """This configuration with ``changes`` that hexdem makes (a derived run's): a key changed
+        is no longer the user's, and is set only where it differs from its default."""
+        return dataclasses.replace(self, given=self.given - changes.keys(), **changes)
+
+    def override(self, **changes) -> "RunConfig":
+        """This configuration with ``changes`` that the user makes (a command line's options, the
+        Python API's keywords): each key set whatever its value, as if written in the file."""
+        return dataclasses.replace(self, given=self.given | changes.keys(), **changes)
 
     def as_dict(self) -> dict:
         return dataclasses.asdict(self)
 
     def set_keys(self) -> list[str]:
-        """The keys this configuration sets, those whose value differs from their default, in the
-        fields' order: the keys that may be refused for describing another shape
+        """The keys this configuration sets, in the fields' order: those the user wrote
+        (``given``), whatever their value, and those whose value differs from their default. These
+        are the keys that may be refused for describing another shape
         (:func:`~hexdem.model.packing_builders.check_shape_keys`) or for doing nothing
         (:mod:`~hexdem.model.unused_keys`)."""
-        return [field.name for field in dataclasses.fields(self) if getattr(self, field.name) != (
-            field.default_factory() if field.default is dataclasses.MISSING else field.default)]
+        return [field.name for field in dataclasses.fields(self) if field.name in self.given or getattr(
+            self, field.name) != (field.default_factory() if field.default is dataclasses.MISSING else field.default)]
 
     def shape_dict(self) -> dict:
         """:meth:`as_dict` less the keys that describe other shapes (:data:`SHAPE_KEYS`): the keys

@@ -93,8 +93,9 @@ class IntruderTable(TypedDict, total=False):
 
 
 def check_shape_keys(config) -> None:
-    """Refuse a key of :data:`SHAPE_KEYS` set (different from its default) on a shape it does
-    not describe, in one line naming the key and the shape."""
+    """Refuse a key of :data:`SHAPE_KEYS` set (written by the user whatever its value, or
+    different from its default: :meth:`~hexdem.model.config.RunConfig.set_keys`) on a shape it
+    does not describe, in one line naming the key and the shape."""
     for key in config.set_keys():
         shapes = SHAPE_KEYS.get(key, (config.shape,))
         if config.shape not in shapes:

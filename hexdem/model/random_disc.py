@@ -27,6 +27,12 @@ LOOSE_FRACTION = 0.35
 #: Largest ``diameter_spread``: d (1 ± s) must stay positive and within the factor 2 that a
 #: packing's diameters may span around ``diameter_m``.
 MAX_SPREAD = 0.5
+#: Smallest ``radius_m``, in bead diameters: the disc holds a middle bead and the ring of six
+#: that holds it from every side against the compaction's pull to the centre (ring centres one
+#: diameter out, their far edges at 1.5 d), some 7 beads. A disc of one diameter (4 beads) left its
+#: middle bead in a cage of three and did not settle in 2,000,000 steps (seed 0); at 1.5 d, the
+#: discs of seeds 0 to 7 (7 or 8 beads) settled, and at 1.73 d and 2 d those of seeds 0 to 5.
+MIN_RADIUS_D = 1.5
 #: Random tries per bead before the loose start is given up.
 MAX_TRIES = 10_000
 #: A loose bead keeps this gap to every other, as a fraction of their mean diameter.
@@ -38,9 +44,9 @@ def check_random_disc(radius_m: float, diameter_m: float, spread: float, seed: i
     if not 0 <= spread < MAX_SPREAD:
         raise HexdemError(f"diameter_spread must be at least 0 and below {MAX_SPREAD:g} (diameters d (1 ± s)), "
                           f"got {spread!r}")
-    if not radius_m >= diameter_m:
-        raise HexdemError(f"radius_m must be at least diameter_m = {diameter_m:g} m for a random disc, "
-                          f"got {radius_m!r}")
+    if not radius_m >= MIN_RADIUS_D * diameter_m:
+        raise HexdemError(f"radius_m must be at least {MIN_RADIUS_D:g} diameter_m = {MIN_RADIUS_D * diameter_m:g} m "
+                          f"for a random disc (a middle bead and the ring of six that holds it), got {radius_m!r}")
     if seed < 0:
         raise HexdemError(f"seed must be an integer >= 0, got {seed!r}")
 

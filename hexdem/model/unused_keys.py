@@ -49,8 +49,10 @@ def idle_keys(config) -> dict[str, str]:
 
 
 def set_idle_keys(config) -> dict[str, str]:
-    """:func:`idle_keys` less those left at their default (and a wall material of ``"none"``, which
-    says the same as no walls), in the order of the configuration's fields."""
+    """:func:`idle_keys` less those the configuration does not set
+    (:meth:`~hexdem.model.config.RunConfig.set_keys`: a key the user wrote is set whatever its
+    value) and a wall material of ``"none"``, which says the same as no walls; in the order of the
+    configuration's fields."""
     idle = idle_keys(config)
     return {key: idle[key] for key in config.set_keys()
             if key in idle and not (key == "wall_material" and config.wall_material == "none")}

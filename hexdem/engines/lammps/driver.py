@@ -41,6 +41,7 @@ import numpy as np
 
 from hexdem.common.compiled import runs_compiled
 from hexdem.common.job_failure import abort_job
+from hexdem.common.interrupt import deferred_signals, raise_if_stopped
 from hexdem.common.memory import keep_freed_memory
 from hexdem.common.preload import finish_background_loading
 from hexdem.common.progress import progress_bar
@@ -157,6 +158,7 @@ class _Stream:
         if self.error is not None:
             return
         try:
+            raise_if_stopped()  # a stop received during the run (deferred_signals)
             builds = self.builds_now()
             migrated, self.builds = builds != self.builds, builds
             if migrated:
@@ -170,6 +172,8 @@ class _Stream:
             self.error = exc
             if self.comm is not None and self.comm.Get_size() > 1:
                 abort_job(self.comm, exc)
+            else:  # the run ends at its next step (a stopped run, Ctrl-C, ends at once)
+                self.lmp.force_timeout()
 
 
 def _lammps(deck: Deck, call, text: str) -> None:
@@ -214,7 +218,8 @@ def run_streaming(deck: Deck, on_sample, comm=None, dump: bool = False, show_pro
         add_sampling_fix(lmp, STREAM_FIX, deck.settings.dump_every, deck.settings.n_steps, stream,
                          lambda text: _lammps(deck, lmp.command, text))
         finish_background_loading()  # the callbacks need the interpreter that a background import holds
-        _lammps(deck, lmp.command, f"run {deck.settings.n_steps}")
+        with deferred_signals():  # a stop ends the run at its next sample (the callback's raise_if_stopped)
+            _lammps(deck, lmp.command, f"run {deck.settings.n_steps}")
     finally:
         if stream is not None and stream.bar is not None:
             stream.bar.close()
