@@ -74,6 +74,17 @@ def reduce_record(times, accelerations) -> np.ndarray:
     return np.concatenate([np.log(peaks), relative])
 
 
+def at_rest_before(times, accelerations) -> tuple[np.ndarray, np.ndarray]:
+    """A simulated record (``times`` (K,), ``accelerations`` (n, K, 2)), which starts at the impact,
+    preceded by :data:`~hexdem.experiments.signals.BASELINE_SAMPLES` samples at rest: the offset
+    removal then reads the sensors at rest, as it reads a measured record's lead-in, and not the
+    first sensor's pulse, which starts within a few samples of the impact."""
+    interval = times[1] - times[0]
+    lead = times[0] - interval * np.arange(BASELINE_SAMPLES, 0, -1)
+    rest = np.zeros((accelerations.shape[0], BASELINE_SAMPLES, accelerations.shape[2]))
+    return np.concatenate([lead, times]), np.concatenate([rest, accelerations], axis=1)
+
+
 def lead_in(record: Record) -> int:
     """Samples of ``record`` before the pulse's foot at its first sensor (its quiet lead-in)."""
     magnitude = np.hypot(*record.accelerations[0].T)

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.calibration.observables import observation_names, reduce_record
+from hexdem.calibration.observables import at_rest_before, observation_names, reduce_record
 from hexdem.calibration.priors import Prior
 from hexdem.common.io import write_json
 from hexdem.common.progress import silenced
@@ -129,7 +129,7 @@ def simulate_point(problem: Problem, values, folder) -> list[float]:
         units, tracked = analysis.settings.units, analysis.tracked
         times = tracked.sensor_times * units.time_s
         accelerations = np.moveaxis(tracked.sensor_states[:, :, 2:4], 1, 0) * (units.length_m / units.time_s**2)
-        observables = reduce_record(times, accelerations)
+        observables = reduce_record(*at_rest_before(times, accelerations))
         write_json(partial / "observables.json", {"names": problem.names, "observables": observables.tolist(),
                                                   "engine_wall_time_s": analysis.engine.get("wall_time_s", math.nan)})
         os.replace(partial, folder)
