@@ -24,11 +24,15 @@ LOG_BOUNDS = {"length": (np.log(0.02), np.log(20.0)), "signal": (np.log(1e-4), n
               "nugget": (np.log(1e-10), np.log(1e-1))}
 
 
+def matern52_of_distance(r) -> np.ndarray:
+    """The Matérn 5/2 correlation at scaled distance ``r``."""
+    return (1.0 + np.sqrt(5.0) * r + 5.0 / 3.0 * r * r) * np.exp(-np.sqrt(5.0) * r)
+
+
 def matern52(a, b, lengths) -> np.ndarray:
     """The Matérn 5/2 correlation between the rows of ``a`` (n, p) and ``b`` (k, p)."""
     d = (a[:, None, :] - b[None, :, :]) / lengths
-    r = np.sqrt(np.maximum(np.sum(d * d, axis=-1), 0.0))
-    return (1.0 + np.sqrt(5.0) * r + 5.0 / 3.0 * r * r) * np.exp(-np.sqrt(5.0) * r)
+    return matern52_of_distance(np.sqrt(np.sum(d * d, axis=-1)))
 
 
 def _design(x) -> np.ndarray:
@@ -47,8 +51,9 @@ class _Process:
         self.theta = self._optimize()
         lengths, signal, nugget = self._unpack(self.theta)
         k = signal * matern52(x, x, lengths) + nugget * np.eye(len(x))
-        self.factor = cho_factor(k, lower=True)
-        self.alpha = cho_solve(self.factor, self.z)
+        factor = cho_factor(k, lower=True)
+        self.alpha = cho_solve(factor, self.z)
+        self.whitener = solve_triangular(factor[0], np.eye(len(x)), lower=True)
         self.lengths, self.signal = lengths, signal
 
     def _unpack(self, theta):
@@ -72,12 +77,6 @@ class _Process:
         fits = [minimize(self._negative_log_likelihood, start, method="L-BFGS-B", bounds=bounds) for start in starts]
         return min(fits, key=lambda fit: fit.fun).x
 
-    def predict(self, xs) -> tuple[np.ndarray, np.ndarray]:
-        kstar = self.signal * matern52(xs, self.x, self.lengths)
-        mean = _design(xs) @ self.beta + self.scale * (kstar @ self.alpha)
-        v = solve_triangular(self.factor[0], kstar.T, lower=True)
-        var = np.maximum(self.signal - np.sum(v * v, axis=0), 0.0)
-        return mean, self.scale**2 * var
 
 
 class Emulator:
@@ -86,10 +85,22 @@ class Emulator:
 
     def __init__(self, x, y):
         x, y = np.asarray(x, float), np.asarray(y, float)
-        self.processes = [_Process(x, y[:, j]) for j in range(y.shape[1])]
+        processes = [_Process(x, y[:, j]) for j in range(y.shape[1])]
+        self.x = x
+        self.inverse_squared_lengths = np.array([1.0 / p.lengths**2 for p in processes])  # (m, p)
+        self.beta = np.column_stack([p.beta for p in processes])  # (p + 1, m)
+        self.signal = np.array([p.signal for p in processes])
+        self.scale = np.array([p.scale for p in processes])
+        self.weights = np.column_stack([p.signal * p.alpha for p in processes])  # (n, m)
+        self.whiteners = np.array([p.signal * p.whitener for p in processes])  # (m, n, n)
 
     def predict(self, xs) -> tuple[np.ndarray, np.ndarray]:
-        """(mean (k, m), variance (k, m)) of the observables at unit-cube points ``xs`` (k, p)."""
+        """(mean (k, m), variance (k, m)) of the observables at unit-cube points ``xs`` (k, p): every
+        observable's correlations from one table of squared distances."""
         xs = np.atleast_2d(np.asarray(xs, float))
-        means, variances = zip(*(process.predict(xs) for process in self.processes))
-        return np.column_stack(means), np.column_stack(variances)
+        squared = (xs[:, None, :] - self.x[None, :, :]) ** 2  # (k, n, p)
+        correlation = matern52_of_distance(np.sqrt(squared @ self.inverse_squared_lengths.T))  # (k, n, m)
+        mean = _design(xs) @ self.beta + self.scale * np.einsum("knm,nm->km", correlation, self.weights)
+        whitened = np.moveaxis(correlation, 2, 0) @ np.transpose(self.whiteners, (0, 2, 1))  # (m, k, n)
+        variance = np.maximum(self.signal - np.sum(whitened * whitened, axis=-1).T, 0.0)
+        return mean, self.scale**2 * variance

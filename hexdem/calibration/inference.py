@@ -25,9 +25,9 @@ from scipy.stats import qmc
 from hexdem.calibration.emulator import Emulator
 from hexdem.errors import HexdemError
 
-WALKERS = 32
-BURN_IN_STEPS = 600
-KEPT_STEPS = 1000
+WALKERS = 64
+BURN_IN_STEPS = 300
+KEPT_STEPS = 500
 THIN = 10
 #: Prior points at which the emulated posterior is evaluated to start the walkers.
 START_CANDIDATES = 4096
@@ -41,6 +41,11 @@ def initial_points(dimension: int) -> int:
 def round_points(dimension: int) -> int:
     """Simulations of each later stage (drawn from the current posterior)."""
     return 5 * dimension + 5
+
+
+def default_budget(dimension: int) -> int:
+    """Parameter sets of a calibration whose budget is not given: the initial design and four rounds."""
+    return initial_points(dimension) + 4 * round_points(dimension)
 
 
 def stage_sizes(dimension: int, budget: int) -> list[int]:

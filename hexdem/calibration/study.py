@@ -56,8 +56,8 @@ def prepare(base: dict, measured, prior_texts, budget: int | None, seed: int, re
     problem = Problem(base, tuple(priors), realizations)
     check_problem(problem)
     dimension = len(priors)
-    budget = inference.stage_sizes(dimension, 10**9)[0] + 4 * inference.round_points(dimension) if budget is None \
-        else positive_int("--budget", budget)
+    budget = (inference.default_budget(dimension) * realizations if budget is None
+              else positive_int("--budget", budget))
     stages = inference.stage_sizes(dimension, budget // realizations)
     records = read_measured(measured, problem.sensors)
     observed, covariances, noise = [], [], []

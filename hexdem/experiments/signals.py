@@ -65,10 +65,12 @@ def integrate_velocity(times, ax, ay) -> tuple[np.ndarray, np.ndarray]:
 
 
 def pulse(times, vx, vy) -> tuple[float, float]:
-    """(peak speed, half-maximum arrival time) of a velocity record."""
+    """(peak speed, half-maximum arrival time) of a velocity record. Maxima below half the largest
+    sample cannot hold the peak (:func:`~hexdem.analysis.peaks.may_overtake`): that half is the
+    floor, so that a noisy record's lead-in is not refined maximum by maximum."""
     speed = np.hypot(vx, vy)
     k = int(np.argmax(speed))
-    _, peak = refine_peak(times, speed)
+    _, peak = refine_peak(times, speed, floor=0.5 * speed[k])
     return peak, rising_crossing(times[:k + 1], speed[:k + 1], 0.5 * peak)
 
 
