@@ -19,7 +19,8 @@ import numpy as np
 from scipy.linalg import cho_factor, cho_solve, solve_triangular
 from scipy.optimize import minimize
 
-#: Bounds of log ℓ (unit-cube widths), log s² and log τ² of the standardized residuals.
+#: Bounds of log ℓ (unit-cube widths), log s² and log τ² of the standardized residuals (τ²'s
+#: upper bound is the emulator's ``nugget_max``).
 LOG_BOUNDS = {"length": (np.log(0.02), np.log(20.0)), "signal": (np.log(1e-4), np.log(1e2)),
               "nugget": (np.log(1e-10), np.log(1e-1))}
 
@@ -42,8 +43,8 @@ def _design(x) -> np.ndarray:
 class _Process:
     """One observable's trend and residual process, fitted to (x, y)."""
 
-    def __init__(self, x, y):
-        self.x = x
+    def __init__(self, x, y, nugget_max: float):
+        self.x, self.nugget_max = x, nugget_max
         self.beta = np.linalg.lstsq(_design(x), y, rcond=None)[0]
         residual = y - _design(x) @ self.beta
         self.scale = float(np.std(residual)) or 1.0
@@ -72,7 +73,7 @@ class _Process:
 
     def _optimize(self) -> np.ndarray:
         p = self.x.shape[1]
-        bounds = [LOG_BOUNDS["length"]] * p + [LOG_BOUNDS["signal"], LOG_BOUNDS["nugget"]]
+        bounds = [LOG_BOUNDS["length"]] * p + [LOG_BOUNDS["signal"], (LOG_BOUNDS["nugget"][0], np.log(self.nugget_max))]
         starts = [np.r_[np.full(p, np.log(length)), 0.0, np.log(1e-4)] for length in (0.3, 1.0)]
         fits = [minimize(self._negative_log_likelihood, start, method="L-BFGS-B", bounds=bounds) for start in starts]
         return min(fits, key=lambda fit: fit.fun).x
@@ -81,11 +82,13 @@ class _Process:
 
 class Emulator:
     """Gaussian processes of every observable, fitted to simulations at unit-cube points ``x``
-    (n, p) with observables ``y`` (n, m)."""
+    (n, p) with observables ``y`` (n, m); ``nugget_max`` bounds the nugget τ² (a share of the
+    residuals' variance): small for simulations that are smooth in the parameters, larger for
+    noisy outputs."""
 
-    def __init__(self, x, y):
+    def __init__(self, x, y, nugget_max: float = 0.1):
         x, y = np.asarray(x, float), np.asarray(y, float)
-        processes = [_Process(x, y[:, j]) for j in range(y.shape[1])]
+        processes = [_Process(x, y[:, j], nugget_max) for j in range(y.shape[1])]
         self.x = x
         self.inverse_squared_lengths = np.array([1.0 / p.lengths**2 for p in processes])  # (m, p)
         self.beta = np.column_stack([p.beta for p in processes])  # (p + 1, m)

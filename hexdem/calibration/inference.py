@@ -1,11 +1,22 @@
 """Bayesian calibration by an emulator refined where the posterior lies, sampled by emcee.
 
 The posterior of the unit-cube coordinates u of the priors (:mod:`~hexdem.calibration.priors`)
-is p(u | data) ∝ Π_r N(y_r; μ(u), Σ_r + Σ_K + diag s²(u)) on [0, 1]^p: the records y_r
-(:mod:`~hexdem.calibration.observables`) with their noise covariances Σ_r, the emulated mean
-μ(u) of the model's observables and the emulator's own variance s²(u)
-(:mod:`~hexdem.calibration.emulator`), and Σ_K, the spread of the observables between the K
-packings simulated at one parameter set (zero for one packing).
+is p(u | data) ∝ p(y_1, …, y_R | u) on [0, 1]^p, the records y_r
+(:mod:`~hexdem.calibration.observables`) modelled as
+
+    y_r = μ(u) + e + δ_r + ε_r,   e ~ N(0, C(u)),  δ_r ~ N(0, Σ_K(u)),  ε_r ~ N(0, Σ_r):
+
+μ(u) the emulated mean of the model's observables over the K packings simulated at u
+(:mod:`~hexdem.calibration.emulator`); ε_r record r's accelerometer noise; δ_r its packing's
+deviation from the mean, Σ_K(u) the spread between packings (:mod:`~hexdem.calibration.spread`;
+zero on the ideal lattice), independent between records, each record being one packing; and e
+the error of μ(u) itself, common to every record: the emulator's variance s²(u), and Σ_K(u)/K,
+for a mean over K packings is not the mean over all. With D_r = Σ_r + Σ_K, P = Σ_r D_r⁻¹ and
+b = Σ_r D_r⁻¹ (y_r − μ), integrating e out gives
+
+    log p = Σ_r log N(y_r; μ, D_r) − ½ log det(I + C P) + ½ bᵀ (I + C P)⁻¹ C b,
+
+which for one record is log N(y_1; μ, Σ_1 + Σ_K + C).
 
 **Stages.** Stage 0 simulates :func:`initial_points` points of a Latin hypercube over the
 whole prior. Every later stage fits the emulator to all simulations so far, samples its posterior
@@ -23,6 +34,7 @@ import numpy as np
 from scipy.stats import qmc
 
 from hexdem.calibration.emulator import Emulator
+from hexdem.calibration.spread import Spread
 from hexdem.errors import HexdemError
 
 WALKERS = 64
@@ -48,14 +60,16 @@ def default_budget(dimension: int) -> int:
     return initial_points(dimension) + 4 * round_points(dimension)
 
 
-def stage_sizes(dimension: int, budget: int) -> list[int]:
-    """Points simulated at each stage within ``budget`` parameter sets: the initial design, then
-    as many whole rounds as fit; a budget with no room for one round is refused."""
+def stage_sizes(dimension: int, budget: int, realizations: int = 1) -> list[int]:
+    """Points simulated at each stage within ``budget`` parameter sets (each simulated on
+    ``realizations`` packings): the initial design, then as many whole rounds as fit; a budget
+    with no room for one round is refused."""
     first, size = initial_points(dimension), round_points(dimension)
     if budget < first + size:
-        raise HexdemError(f"a budget of {budget} parameter sets is too small for {dimension} parameter(s): the "
-                          f"method needs {first} for its initial design and {size} for each refinement "
-                          f"(at least {first + size})")
+        runs = "" if realizations == 1 else f" ({budget * realizations} simulations on {realizations} packings each)"
+        raise HexdemError(f"a budget of {budget} parameter sets{runs} is too small for {dimension} parameter(s): "
+                          f"the method needs {first} for its initial design and {size} for each refinement "
+                          f"(at least {first + size} parameter sets)")
     return [first] + [size] * ((budget - first) // size)
 
 
@@ -70,10 +84,10 @@ class Data:
 
 
 class Likelihood:
-    """log p(data | u) through ``emulator``, with the packings' spread ``spread`` (m, m)."""
+    """log p(data | u) through ``emulator`` and the packings' ``spread`` (see the module docstring)."""
 
-    def __init__(self, data: Data, emulator: Emulator, spread):
-        self.data, self.emulator, self.spread = data, emulator, np.asarray(spread, float)
+    def __init__(self, data: Data, emulator: Emulator, spread: Spread):
+        self.data, self.emulator, self.spread = data, emulator, spread
 
     def __call__(self, unit) -> np.ndarray:
         unit = np.atleast_2d(unit)
@@ -82,14 +96,19 @@ class Likelihood:
         if not inside.any():
             return result
         mean, variance = self.emulator.predict(unit[inside])
-        total = 0.0
+        spread = self.spread(unit[inside])
+        identity = np.eye(mean.shape[1])
+        common = variance[:, :, None] * identity + spread / self.spread.realizations
+        total, precision, pulled = 0.0, 0.0, 0.0
         for record, covariance in zip(self.data.records, self.data.covariances):
-            cov = covariance + self.spread + variance[:, :, None] * np.eye(len(record))
-            residual = record - mean
-            _, logdet = np.linalg.slogdet(cov)
-            chi2 = np.einsum("ki,ki->k", residual, np.linalg.solve(cov, residual[:, :, None])[:, :, 0])
-            total = total - 0.5 * (chi2 + logdet)
-        result[inside] = total
+            own = covariance + spread
+            solved = np.linalg.solve(own, (record - mean)[:, :, None])[:, :, 0]
+            total = total - 0.5 * (np.einsum("ki,ki->k", record - mean, solved) + np.linalg.slogdet(own)[1])
+            precision = precision + np.linalg.inv(own)
+            pulled = pulled + solved
+        shrink = identity + common @ precision
+        gain = np.linalg.solve(shrink, (common @ pulled[:, :, None]))[:, :, 0]
+        result[inside] = total - 0.5 * np.linalg.slogdet(shrink)[1] + 0.5 * np.einsum("ki,ki->k", pulled, gain)
         return result
 
 
@@ -109,16 +128,6 @@ def sample_posterior(likelihood: Likelihood, dimension: int, seed: int) -> np.nd
     return sampler.get_chain(thin=THIN, flat=True)
 
 
-def pooled_spread(observables: np.ndarray) -> np.ndarray:
-    """Σ_K: the covariance between the K packings of each parameter set, pooled over the sets
-    (observables (n, K, m)); zero for K = 1."""
-    n, k, m = observables.shape
-    if k < 2:
-        return np.zeros((m, m))
-    centred = observables - observables.mean(axis=1, keepdims=True)
-    return np.einsum("nki,nkj->ij", centred, centred) / (n * (k - 1))
-
-
 @dataclass(frozen=True)
 class Fit:
     """One stage's fit: the simulated ``points`` (n, p) and their ``observables`` (n, K, m), the
@@ -128,7 +137,7 @@ class Fit:
     points: np.ndarray
     observables: np.ndarray
     emulator: Emulator
-    spread: np.ndarray
+    spread: Spread
     samples: np.ndarray
 
 
@@ -136,7 +145,7 @@ def fit_stage(data: Data, points, observables, seed: int) -> Fit:
     """Fit the emulator to the simulations and sample the posterior it implies."""
     points, observables = np.asarray(points, float), np.asarray(observables, float)
     emulator = Emulator(points, observables.mean(axis=1))
-    spread = pooled_spread(observables)
+    spread = Spread(points, observables)
     samples = sample_posterior(Likelihood(data, emulator, spread), points.shape[1], seed)
     return Fit(points, observables, emulator, spread, samples)
 

@@ -9,6 +9,10 @@ has a folder of its own, ``DIR/simulations/NNNN`` (``-kK`` for the K-th packing)
 simulation: a calibration run again (after ``kill -9``, say) finds it, checks that its
 parameters are the planned ones, and does not repeat it. No figures are drawn and no result
 files written: a worker loads Python and LAMMPS once and runs one impact after another.
+
+On disordered packings (:attr:`Problem.disordered`), a simulation is packing k's preparation
+(read from the cache of settled packings when another simulation has made it,
+:mod:`~hexdem.calibration.packings`) and its impact under the preparation's gravity.
 """
 
 from __future__ import annotations
@@ -17,12 +21,13 @@ import json
 import math
 import os
 import shutil
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from hexdem.calibration.observables import at_rest_before, observation_names, reduce_record
+from hexdem.calibration.packings import PACKINGS, PAPER_SIGMA_M, SIGMA_KEY, check_disorderable, settled_packing
 from hexdem.calibration.priors import Prior
 from hexdem.common.io import write_json
 from hexdem.common.progress import silenced
@@ -40,20 +45,34 @@ CHECKED_QUANTILES = (0.0, 0.5, 1.0)
 @dataclass(frozen=True)
 class Problem:
     """What a calibration simulates: the base configuration table ``base``, the ``priors`` of
-    the parameters it draws and the ``realizations`` (packings) per parameter set."""
+    the parameters it draws, the ``realizations`` (packings) per parameter set and the
+    ``seed`` of the packings' diameters."""
 
     base: dict
     priors: tuple[Prior, ...]
     realizations: int = 1
+    seed: int = 0
 
     @property
     def keys(self) -> list[str]:
         return [prior.key for prior in self.priors]
 
+    @property
+    def disordered(self) -> bool:
+        """Whether each parameter set is simulated on disordered packings: σ is calibrated, or
+        there are several packings."""
+        return SIGMA_KEY in self.keys or self.realizations > 1
+
+    def sigma_m(self, values) -> float:
+        """σ of the diameters of the parameter set ``values`` [m] (the paper's, if not calibrated)."""
+        return float(values[self.keys.index(SIGMA_KEY)]) if SIGMA_KEY in self.keys else PAPER_SIGMA_M
+
     def config(self, values) -> RunConfig:
         """The run configuration with the parameters ``values`` (in the priors' order) set."""
         data = self.base
         for prior, value in zip(self.priors, values):
+            if prior.key == SIGMA_KEY:
+                continue
             kind = type_at(RunConfig, prior.key)
             data = with_value(data, prior.key, int(round(value)) if kind is int else float(value), option="--prior")
         return RunConfig.from_dict(data, source="the calibrated configuration")
@@ -79,6 +98,11 @@ def check_problem(problem: Problem) -> None:
         raise HexdemError("--config: a calibration runs each simulation on one LAMMPS rank of its own (--workers "
                           "runs several at once); leave engine and ranks at their defaults")
     for prior in problem.priors:
+        if prior.key == SIGMA_KEY:
+            if prior.support[0] < 0:
+                raise HexdemError(f"--prior {SIGMA_KEY}: the standard deviation of the diameters must be >= 0 m, "
+                                  f"but {prior.describe()} reaches {prior.support[0]:.6g} m")
+            continue
         kind = type_at(RunConfig, prior.key)
         if kind is None or kind is bool or not any(t in (int, float) for t in (kind, *getattr(kind, "__args__", ()))):
             raise HexdemError(f"--prior {prior.key}: not a numeric key of the run configuration")
@@ -91,6 +115,9 @@ def check_problem(problem: Problem) -> None:
         except HexdemError as exc:
             named = ", ".join(f"{prior.key} = {value:.6g}" for prior, value in zip(problem.priors, values))
             raise HexdemError(f"--prior: the configuration with {named} (inside the priors) is refused: {exc}") from None
+    if problem.disordered:
+        largest = max((prior.support[1] for prior in problem.priors if prior.key == SIGMA_KEY), default=PAPER_SIGMA_M)
+        check_disorderable(base, largest, problem.realizations, problem.seed)
 
 
 def simulation_name(index: int, realization: int, realizations: int) -> str:
@@ -110,11 +137,38 @@ def finished(folder: Path, values) -> np.ndarray | None:
     return np.array(json.loads(path.read_text())["observables"])
 
 
-def simulate_point(problem: Problem, values, folder) -> list[float]:
-    """Run the configuration of ``values`` in ``folder`` (made via a ``.part`` folder) and return
-    its observables; a task of the study executor."""
+def disordered_impact(config: RunConfig, sigma_m: float, seed: int, realization: int, workdir, packings):
+    """The analysed impact of ``config`` on its packing ``realization`` at σ = ``sigma_m`` from
+    ``seed`` (:func:`~hexdem.calibration.packings.settled_packing`, cached in ``packings``),
+    under the gravity it settled in."""
+    from hexdem.experiments.run import check_energy
+    from hexdem.experiments.tracked_run import ImpactJob, track_impact
+    from hexdem.model.model_builder import build_model
+
+    packing, gravity = settled_packing(config, sigma_m, seed, realization, packings)
+    model = replace(build_model(config), packing=packing)
+    job = ImpactJob(model, run_settings(config), "lammps", Path(workdir), gravity_m_s2=tuple(float(g) for g in gravity),
+                    show_progress=False)
+    analysis = track_impact(job)
+    check_energy(analysis, workdir)
+    return analysis
+
+
+def _impact(problem: Problem, values, realization: int, workdir: Path, packings: Path):
+    """The analysed impact of the parameter set ``values``: on the ideal lattice, or on its
+    packing ``realization``."""
     from hexdem.experiments.run import simulate
 
+    config = problem.config(values)
+    if not problem.disordered:
+        return simulate(config, workdir)
+    return disordered_impact(config, problem.sigma_m(values), problem.seed, realization, workdir, packings)
+
+
+def simulate_point(problem: Problem, values, folder, realization: int = 0) -> list[float]:
+    """Run the parameter set ``values`` (on packing ``realization`` when disordered) in ``folder``
+    (made via a ``.part`` folder; the packings cached beside the study's ``simulations``) and
+    return its observables; a task of the study executor."""
     folder = Path(folder)
     if (done := finished(folder, values)) is not None:
         return done.tolist()
@@ -122,10 +176,9 @@ def simulate_point(problem: Problem, values, folder) -> list[float]:
     shutil.rmtree(partial, ignore_errors=True)
     partial.mkdir(parents=True)
     try:
-        config = problem.config(values)
         write_json(partial / "parameters.json", {"keys": problem.keys, "values": [float(v) for v in values]})
         with silenced():
-            analysis = simulate(config, partial / "deck")
+            analysis = _impact(problem, values, realization, partial / "deck", folder.parent.parent / PACKINGS)
         units, tracked = analysis.settings.units, analysis.tracked
         times = tracked.sensor_times * units.time_s
         accelerations = np.moveaxis(tracked.sensor_states[:, :, 2:4], 1, 0) * (units.length_m / units.time_s**2)

@@ -22,6 +22,7 @@ import numpy as np
 
 from hexdem.calibration import inference, plots
 from hexdem.calibration.observables import noise_covariance, read_measured, reduce_record
+from hexdem.calibration.packings import DISORDER_REALIZATIONS, SIGMA_KEY, on_sigma_levels
 from hexdem.calibration.priors import parse_priors, to_parameters
 from hexdem.calibration.report import summarize, write_posterior
 from hexdem.calibration.simulations import SIMULATIONS, Problem, check_problem, finished, simulate_point, simulation_name
@@ -46,19 +47,32 @@ class Calibration:
     seed: int
 
 
-def prepare(base: dict, measured, prior_texts, budget: int | None, seed: int, realizations: int = 1) -> Calibration:
-    """Every check of the input, in one line each and before any simulation."""
-    priors = parse_priors(prior_texts)
+def _realizations(priors, realizations: int | None) -> int:
+    """Packings per parameter set: as asked, else 1 on the ideal lattice and
+    :data:`~hexdem.calibration.packings.DISORDER_REALIZATIONS` when σ is calibrated, whose
+    spread between packings one packing cannot measure."""
+    calibrates_sigma = any(prior.key == SIGMA_KEY for prior in priors)
+    if realizations is None:
+        return DISORDER_REALIZATIONS if calibrates_sigma else 1
     realizations = positive_int("--realizations", realizations)
-    if realizations != 1:
-        raise HexdemError("--realizations: calibrating over disordered packings is not available yet; the "
-                          "ideal lattice (--realizations 1) is")
-    problem = Problem(base, tuple(priors), realizations)
+    if calibrates_sigma and realizations < 2:
+        raise HexdemError(f"--realizations {realizations}: a prior on {SIGMA_KEY} needs at least 2 packings per "
+                          "parameter set, whose spread the comparison accounts for")
+    return realizations
+
+
+def prepare(base: dict, measured, prior_texts, budget: int | None, seed: int,
+            realizations: int | None = None) -> Calibration:
+    """Every check of the input, in one line each and before any simulation. ``budget`` counts
+    simulations: parameter sets times ``realizations``."""
+    priors = parse_priors(prior_texts)
+    realizations = _realizations(priors, realizations)
+    problem = Problem(base, tuple(priors), realizations, seed)
     check_problem(problem)
     dimension = len(priors)
     budget = (inference.default_budget(dimension) * realizations if budget is None
               else positive_int("--budget", budget))
-    stages = inference.stage_sizes(dimension, budget // realizations)
+    stages = inference.stage_sizes(dimension, budget // realizations, realizations)
     records = read_measured(measured, problem.sensors)
     observed, covariances, noise = [], [], []
     for k, record in enumerate(records):
@@ -103,7 +117,7 @@ def _simulate_stage(calibration: Calibration, unit_points, first_index: int, out
     folders = {(i, k): out / SIMULATIONS / simulation_name(first_index + i, k, problem.realizations)
                for i in range(len(values)) for k in range(problem.realizations)}
     results = {key: finished(folder, values[key[0]]) for key, folder in folders.items()}
-    tasks = {key: (simulate_point, problem, values[key[0]].tolist(), str(folder))
+    tasks = {key: (simulate_point, problem, values[key[0]].tolist(), str(folder), key[1])
              for key, folder in folders.items() if results[key] is None}
     failed = set()
     for key, error in run_phase(tasks, workers, parsl, label, "simulation", done_before=len(folders) - len(tasks)):
@@ -130,6 +144,8 @@ def calibrate(calibration: Calibration, measured, out, workers: int = 1, parsl=N
         for stage, size in enumerate(calibration.stages):
             new = (inference.design(dimension, size, seed) if fit is None
                    else inference.next_points(fit, size, seed + stage))
+            if SIGMA_KEY in problem.keys:
+                new = on_sigma_levels(new, problem.keys.index(SIGMA_KEY))
             label = f"stage {stage + 1}/{len(calibration.stages)}"
             log(f"{label}: {size} parameter set(s) x {problem.realizations} packing(s)"
                 + (" over the prior" if fit is None else " from the posterior"))
@@ -166,7 +182,8 @@ def _write_results(calibration: Calibration, fit: inference.Fit, out: Path, fail
     rng = np.random.default_rng(calibration.seed)
     draws = fit.samples[rng.choice(len(fit.samples), PREDICTIVE_DRAWS)]
     mean, variance = fit.emulator.predict(draws)
-    noise = np.mean(data.covariances, axis=0) + fit.spread
-    predicted = np.array([rng.multivariate_normal(m, noise + np.diag(v)) for m, v in zip(mean, variance)])
+    noise = np.mean(data.covariances, axis=0)
+    spread = fit.spread(draws) * (1 + 1 / problem.realizations)
+    predicted = np.array([rng.multivariate_normal(m, noise + s + np.diag(v)) for m, s, v in zip(mean, spread, variance)])
     plots.predictive(problem.sensors, data.records, data.covariances, predicted, out / "predictive.png")
     return summary

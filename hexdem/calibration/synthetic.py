@@ -4,16 +4,20 @@ A record is the run of a configuration at a time step ``finer`` times shorter th
 calibration's runs take, its sensors' accelerations sampled at their rate (500 kS/s, the paper's
 acquisition), after a quiet pre-trigger lead-in, with white accelerometer noise and an unknown
 clock offset. A calibration given such records does not fit a model to its own output: its runs
-integrate at another step and sample at other instants.
+integrate at another step and sample at other instants. A record of a disordered packing is
+struck on a packing prepared as a calibration prepares its own
+(:mod:`~hexdem.calibration.packings`), from a seed of its own.
 """
 
 from __future__ import annotations
 
 import tempfile
+from pathlib import Path
 
 import numpy as np
 
 from hexdem.calibration.observables import MEASURED_COLUMNS
+from hexdem.calibration.simulations import disordered_impact
 from hexdem.common.io import write_csv
 from hexdem.common.progress import silenced
 from hexdem.model.config import RunConfig
@@ -22,13 +26,17 @@ from hexdem.model.config import RunConfig
 LEAD_IN_S = 100e-6
 
 
-def synthetic_rows(config: RunConfig, record: str, noise_m_s2: float, offset_s: float, rng, finer: int = 2) -> list:
-    """Rows ``sensor,time,ax,ay,record`` of one synthetic record of ``config``."""
+def synthetic_rows(config: RunConfig, record: str, noise_m_s2: float, offset_s: float, rng, finer: int = 2,
+                   disorder: tuple[float, int, int] | None = None, packings=None) -> list:
+    """Rows ``sensor,time,ax,ay,record`` of one synthetic record of ``config``: on the ideal
+    lattice, or with ``disorder`` = (σ [m], seed, k) on that packing, settled in (or read from)
+    the folder ``packings``."""
     from hexdem.experiments.run import simulate
 
     fine = config.replace(steps_per_contact=config.steps_per_contact * finer)
     with tempfile.TemporaryDirectory() as workdir, silenced():
-        analysis = simulate(fine, workdir)
+        analysis = simulate(fine, workdir) if disorder is None else disordered_impact(
+            fine, *disorder, Path(workdir) / "deck", Path(packings or Path(workdir) / "packings"))
     units, tracked = analysis.settings.units, analysis.tracked
     times = tracked.sensor_times * units.time_s
     accelerations = tracked.sensor_states[:, :, 2:4] * (units.length_m / units.time_s**2)

@@ -15,14 +15,20 @@ def add_arguments(parser) -> None:
                              "(one record per impact)")
     parser.add_argument("--prior", action="append", default=[], required=True, metavar="KEY=DIST",
                         help="a calibrated key and its prior: uniform(a, b), loguniform(a, b) or normal(mu, sigma); "
-                             "KEY is a numeric run-config key or a path such as materials.NAME.youngs_modulus_pa "
-                             "(repeat for more keys)")
+                             "KEY is a numeric run-config key, a path such as materials.NAME.youngs_modulus_pa, or "
+                             "diameter_sigma_m, the standard deviation of the bead diameters in m (the disorder of "
+                             "hexdem ensemble; the paper's is 6 tol = 7.62e-5), which simulates every parameter set on "
+                             "disordered packings (repeat for more keys)")
     parser.add_argument("--out", required=True, metavar="DIR",
                         help="posterior.csv, calibration.json, posterior.png, predictive.png and simulations/ (one "
                              "folder per simulation); rerunning the same command resumes it")
-    parser.add_argument("--realizations", type=int, default=1, metavar="K", help="packings per parameter set (default 1)")
+    parser.add_argument("--realizations", type=int, metavar="K",
+                        help="disordered packings per parameter set, prepared as hexdem ensemble prepares them (default: "
+                             "8 with a prior on diameter_sigma_m, else 1, the ideal lattice; with K > 1 and no such "
+                             "prior, sigma is the paper's)")
     parser.add_argument("--budget", type=int, metavar="N",
-                        help="simulations in all (default: 30 per parameter + 30; at least 15 per parameter + 15)")
+                        help="simulations in all, parameter sets times K (default: (30 per parameter + 30) x K; at "
+                             "least (15 per parameter + 15) x K)")
     parser.add_argument("--seed", type=int, default=0, metavar="S",
                         help="seed of every random choice: the same seed gives the same posterior (default 0)")
     parser.add_argument("--workers", type=int, default=1, metavar="N", help="simulations at once, locally (default 1)")
