@@ -33,9 +33,8 @@ def peak_decay(rows_by_line: dict, path, units_name: str, v0: float,
             continue
         style = {"marker": "o", "linestyle": "-"}
         if SIGNED_ANGLE.fullmatch(line):
-            mirror = ("-" if line[0] == "+" else "+") + line[1:]
             style["marker"] = "^" if line[0] == "+" else "v"
-            if line[0] == "-" and mirror in peaks and mirror not in still:
+            if line[0] == "-" and _mirror(line) in peaks and _mirror(line) not in still:
                 style.update(markerfacecolor="none", linestyle="--", markersize=9)
         ax.semilogy(n, np.where(peaks[line] > 0, peaks[line], np.nan), label=f"{line}°", **style)
     handles, labels = ax.get_legend_handles_labels()
@@ -52,12 +51,16 @@ def peak_decay(rows_by_line: dict, path, units_name: str, v0: float,
     return fig
 
 
+def _mirror(line: str) -> str:
+    """The name of the mirror of a line named by a signed angle: "-45" for "+45"."""
+    return ("-" if line[0] == "+" else "+") + line[1:]
+
+
 def _mirrored_names(lines) -> list[str]:
     """``lines``' names, a line and its mirror ("+45", "-45") named once as "±45"."""
     names = []
     for line in lines:
-        mirror = ("-" if line[:1] == "+" else "+") + line[1:]
-        if SIGNED_ANGLE.fullmatch(line) and mirror in lines:
+        if SIGNED_ANGLE.fullmatch(line) and _mirror(line) in lines:
             if line[0] == "+":
                 names.append("±" + line[1:])
         else:

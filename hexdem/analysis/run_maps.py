@@ -56,8 +56,8 @@ def chain_map(results, model, values, along, label: str, cmap="viridis", norm=No
     strip = fig.add_axes((0.0, 0.0, 1.0, 0.1), sharex=profile)
     unmeasured = unmeasured_beads(results)
     norm = norm or Normalize()
-    beads = bead_map(strip, frame, diameters, values, cmap=cmap, norm=norm, unmeasured=unmeasured,
-                     outlined=other_materials(model), colorbar=False)
+    bead_map(strip, frame, diameters, values, cmap=cmap, norm=norm, unmeasured=unmeasured,
+             outlined=other_materials(model), colorbar=False)
     draw_walls(strip, _walls_along(model.walls, origin * results.length_unit_m, along), frame, diameters / 2,
                scale=1.0 / results.length_unit_m)
     strip.plot(*frame[np.unique(model.struck_beads)].T, linestyle="", marker="x", color="k", markersize=7, mew=1.5)
@@ -104,7 +104,7 @@ def arrival_map(results, model, path, title="Wavefront arrival time") -> Figure:
     """Every bead's arrival time on the lattice (like Fig. 8a); the figure (:func:`lattice_map`)."""
     units = UNIT_LABELS[results.units]
     return lattice_map(results, model, results.arrival_time * units["time_scale"], path,
-                f"arrival time [{units['time']}]", title, cmap="viridis_r")
+                       f"arrival time [{units['time']}]", title, cmap="viridis_r")
 
 
 def peak_scale(ratio) -> tuple[float, float]:
@@ -125,4 +125,4 @@ def peak_map(results, model, v0: float, path, title="Peak speed") -> Figure:
     by decades as they spread; :func:`peak_scale`); the figure (:func:`lattice_map`)."""
     ratio = results.peak_speed / v0
     return lattice_map(results, model, ratio, path, "peak speed Vₘₐₓ / V₀", title, cmap="magma",
-                norm=LogNorm(*peak_scale(ratio)))
+                       norm=LogNorm(*peak_scale(ratio)))
