@@ -167,3 +167,17 @@ def test_a_line_drawn_over_its_mirror_stays_visible(tmp_path):
     lines = {line.get_label(): line for line in fig.axes[0].get_lines()}
     assert lines["-45°"].get_linestyle() == "--" and lines["-45°"].get_markerfacecolor() == "none"
     assert lines["+45°"].get_linestyle() == "-" and lines["+45°"].get_markerfacecolor() != "none"
+
+
+def test_a_chain_of_two_beads_is_drawn_no_higher_than_a_strip(tmp_path):
+    """A pair of beads (a listed-sites chain, its wall beside the second bead) is drawn at a scale
+    that keeps its strip low, not two beads blown up to the figure's width; a run in which no bead
+    has a value yet still draws its figure (a log axis of no value cannot be drawn)."""
+    from hexdem.analysis.map_layout import STRIP_IN
+
+    model = build_model(RunConfig(shape="sites", sites=[[0, 0], [2, 0]], site_walls_deg=[0]))
+    for reach in (3.0, 0.5):
+        fig = run_maps.peak_map(pulse(model, reach_d=reach), model, 1.0, tmp_path / "peak_map.png")
+        profile, strip = fig.axes
+        assert strip.get_position().height * fig.get_size_inches()[1] <= STRIP_IN[1] + 1e-9
+        assert profile.get_position().height > 2 * strip.get_position().height

@@ -107,29 +107,29 @@ def fit_map(ax, title: str, colour_bar: bool = True):
 
 
 #: A chain's figure (:func:`fit_chain`) [in]: its width, its profile's height, the gap between the
-#: profile and the chain drawn below it, and the lowest the chain's strip is drawn.
-CHAIN_WIDTH_IN, PROFILE_HEIGHT_IN, CHAIN_GAP_IN, MIN_STRIP_IN = 7.0, 3.0, 0.12, 0.3
+#: profile and the chain drawn below it, and the lowest and highest the chain's strip is drawn.
+CHAIN_WIDTH_IN, PROFILE_HEIGHT_IN, CHAIN_GAP_IN, STRIP_IN = 7.0, 3.0, 0.12, (0.3, 0.8)
 
 
 def fit_chain(profile, strip) -> None:
     """Size a chain's figure and place its two axes, which share their abscissa: ``profile`` (the
     values against the distance along the chain) above ``strip`` (the beads, true size and equal
-    scales), both as wide as the figure allows, the strip as high as its beads are at that scale
-    (no less than :data:`MIN_STRIP_IN`), the legend's row below."""
+    scales), both as wide as the figure allows, the strip as high as its beads are at that scale,
+    within :data:`STRIP_IN` (a chain of a few beads is drawn no higher, centred in a wider range),
+    the legend's row below."""
     fig = profile.figure
     (x0, y0), (x1, y1) = strip.dataLim.get_points()
-    pad = PAD_SHARE * (x1 - x0)
-    x0, x1 = x0 - pad, x1 + pad
+    width, height = (x1 - x0) * (1 + 2 * PAD_SHARE), (y1 - y0) * (1 + 2 * PAD_SHARE)
     axes_w = CHAIN_WIDTH_IN - LEFT_IN - RIGHT_IN / 3
-    scale = axes_w / (x1 - x0)
-    strip_h = max((y1 - y0) * scale * (1 + 2 * PAD_SHARE), MIN_STRIP_IN)
+    scale = min(axes_w / width, STRIP_IN[1] / height)  # inches per data unit
+    strip_h = max(height * scale, STRIP_IN[0])
     bottom = BOTTOM_IN + (LEGEND_IN if fig.legends else 0.0)
     fig_h = bottom + strip_h + CHAIN_GAP_IN + PROFILE_HEIGHT_IN + TOP_IN
     fig.set_size_inches(CHAIN_WIDTH_IN, fig_h)
-    left, width = LEFT_IN / CHAIN_WIDTH_IN, axes_w / CHAIN_WIDTH_IN
-    strip.set_position((left, bottom / fig_h, width, strip_h / fig_h))
-    profile.set_position((left, (bottom + strip_h + CHAIN_GAP_IN) / fig_h, width, PROFILE_HEIGHT_IN / fig_h))
-    profile.set_xlim(x0, x1)
-    centre, half = (y0 + y1) / 2, strip_h / scale / 2
-    strip.set_ylim(centre - half, centre + half)
+    left, fraction = LEFT_IN / CHAIN_WIDTH_IN, axes_w / CHAIN_WIDTH_IN
+    strip.set_position((left, bottom / fig_h, fraction, strip_h / fig_h))
+    profile.set_position((left, (bottom + strip_h + CHAIN_GAP_IN) / fig_h, fraction, PROFILE_HEIGHT_IN / fig_h))
+    centre_x, centre_y = (x0 + x1) / 2, (y0 + y1) / 2
+    profile.set_xlim(centre_x - axes_w / scale / 2, centre_x + axes_w / scale / 2)
+    strip.set_ylim(centre_y - strip_h / scale / 2, centre_y + strip_h / scale / 2)
     strip.set_aspect("equal", adjustable="datalim")

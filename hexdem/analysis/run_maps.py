@@ -68,7 +68,7 @@ def chain_map(results, model, values, along, label: str, cmap="viridis", norm=No
     profile.plot(frame[order, 0], shown, color="0.55", linewidth=1, zorder=1)
     profile.scatter(frame[order, 0], shown, c=shown, cmap=colormaps[cmap], norm=norm, edgecolors="k", linewidths=0.4,
                     zorder=2)
-    if isinstance(norm, LogNorm):
+    if isinstance(norm, LogNorm) and np.any(coloured):  # (a log axis of no value cannot be drawn)
         profile.set_yscale("log")
         plain_log_ticks(profile.yaxis)
     profile.set_ylabel(label)
