@@ -136,7 +136,7 @@ def main() -> None:
         target = max(TARGET_FLOOR_S, TARGET_SHARE * row["run"])
         before_s = f"{row['before']:.2f}" if row["before"] is not None else "–"
         ratio = f"{row['before'] / row['now']:.1f}" if row["before"] is not None else "–"
-        print(f"{row['beads']:>8,} {row['duration'] * 1e3:>14.3g} {row['still']:>11.0%} {row['run']:>8.2f} {before_s:>20} {row['now']:>17.2f} "
+        print(f"{row['beads']:>8,} {row['duration'] * 1e3:>14.3g} {row['still']:>11.1%} {row['run']:>8.2f} {before_s:>20} {row['now']:>17.2f} "
               f"{ratio:>13} {target:>11.2f}  {'met' if row['now'] <= target else 'NOT met'}")
     print(f"target: the result files <= max({TARGET_FLOOR_S:g} s, {TARGET_SHARE:g} x the run) at every size"
           + (f"; before: hexdem at {args.before}" if before is not None else f"; before: {args.before} not in this clone"))
