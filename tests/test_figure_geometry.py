@@ -147,7 +147,8 @@ def test_lines_that_never_moved_are_named_not_drawn_as_drops(tmp_path):
     decay = 0.7 + 0.3 * np.exp(-n)
     still = np.r_[1.0, np.zeros(14)]
     rows = {"0": (n, 0.4 * decay), "+45": (n, 0.4 * still), "-45": (n, 0.4 * still),
-            "+90": (n[:8], 0.4 * still[:8]), "-90": (n[:8], 0.4 * still[:8]), "up": (n, 0.4 * np.r_[decay[:5], np.zeros(10)])}
+            "+90": (n[:8], 0.4 * still[:8]), "-90": (n[:8], 0.4 * still[:8]),
+            "up": (n, 0.4 * np.r_[decay[:5], np.zeros(10)])}
     fig = peak_decay(rows, tmp_path / "peak_decay.png", "si", 0.4)
     ax = fig.axes[0]
     labels = [text.get_text() for text in ax.get_legend().get_texts()]
