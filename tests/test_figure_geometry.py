@@ -58,8 +58,8 @@ def test_a_map_fills_its_canvas_and_its_colour_bar_is_as_tall_as_the_map(name, k
     """The map's axes, as drawn (true aspect applied), span at least half the canvas each way, but
     across a packing four times longer than wide, where they span the canvas along it and the
     canvas is no wider than its margins, colour bar and legend need; the colour bar's top and
-    bottom are the map's, to a pixel; no tick labels overlap; the title stays on the canvas; the
-    figure saved is the canvas measured."""
+    bottom are the map's, to a pixel; no tick labels overlap; the title and the axes' labels stay
+    on the canvas; the figure saved is the canvas measured."""
     model = build_model(PACKINGS[name])
     draw = getattr(run_maps, kind)
     args = (1.0,) if kind == "peak_map" else ()
@@ -75,8 +75,9 @@ def test_a_map_fills_its_canvas_and_its_colour_bar_is_as_tall_as_the_map(name, k
     assert abs(by0 - y0) <= 1 and abs(by1 - y1) <= 1, "the colour bar as tall as the map"
     assert x1 < bx0 < bx1 <= width, "beside the map, on the canvas"
     assert not crowded(ax, renderer) and not crowded(bar, renderer)
-    tx0, _, tx1, ty1 = extent(ax.title, renderer)
-    assert 0 <= tx0 and tx1 <= width and ty1 <= height, "the title on the canvas"
+    for text in (ax.title, ax.xaxis.label, ax.yaxis.label, bar.yaxis.label):
+        tx0, ty0, tx1, ty1 = extent(text, renderer)
+        assert 0 <= tx0 and tx1 <= width and 0 <= ty0 and ty1 <= height, f"{text.get_text()!r} on the canvas"
     from PIL import Image
 
     with Image.open(tmp_path / f"{kind}.png") as image:
@@ -182,3 +183,15 @@ def test_a_chain_of_two_beads_is_drawn_no_higher_than_a_strip(tmp_path):
         profile, strip = fig.axes
         assert strip.get_position().height * fig.get_size_inches()[1] <= STRIP_IN[1] + 1e-9
         assert profile.get_position().height > 2 * strip.get_position().height
+
+
+def test_a_title_wider_than_its_figure_breaks_after_a_comma():
+    """A narrow figure's title is wrapped after its commas, every line within the width, never
+    inside a part ("V₀ = 0.4 m/s" stays whole), the text unchanged."""
+    from hexdem.analysis.map_layout import wrap_title
+
+    title = "Peak speed, parallelogram, 9 per edge, 6 deep, V₀ = 0.4 m/s"
+    lines = wrap_title(title, 40)
+    assert len(lines) == 2 and all(len(line) <= 40 for line in lines)
+    assert " ".join(lines) == title and lines[1].endswith("V₀ = 0.4 m/s")
+    assert wrap_title(title, 200) == [title]

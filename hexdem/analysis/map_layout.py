@@ -10,7 +10,6 @@ strip of two rows no less than :data:`MIN_AXES_HEIGHT_IN` of axes (its y range w
 
 from __future__ import annotations
 
-import textwrap
 from dataclasses import dataclass
 
 import numpy as np
@@ -18,13 +17,13 @@ import numpy as np
 #: The largest axes box a map gets (width, height) [in]: about a page's column at the figures' DPI.
 MAX_AXES_IN = (5.4, 5.0)
 #: The lowest axes box of a map [in]: room for three y tick labels beside a packing of a few rows.
-MIN_AXES_HEIGHT_IN = 1.4
+MIN_AXES_HEIGHT_IN = 1.6
 #: The narrowest figure [in]: room for the legend's two entries below a tall, narrow packing.
 MIN_FIGURE_WIDTH_IN = 4.2
 #: Margins [in]: left (y tick labels and label), bottom (x tick labels and label), top (a title's
 #: first line; each further line adds :data:`TITLE_LINE_IN`), the legend's row below the x label,
 #: and right of the colour bar (its tick labels and label).
-LEFT_IN, BOTTOM_IN, TOP_IN, LEGEND_IN, RIGHT_IN = 0.9, 0.6, 0.4, 0.35, 0.95
+LEFT_IN, BOTTOM_IN, TOP_IN, LEGEND_IN, RIGHT_IN = 0.9, 0.7, 0.4, 0.35, 0.95
 #: A title's line height and its characters' mean width [in] (matplotlib's default font at the
 #: title's 12 pt): a title wider than its figure is wrapped, not cut by the canvas's edges.
 TITLE_LINE_IN, TITLE_CHAR_IN = 0.22, 0.095
@@ -80,7 +79,7 @@ def map_layout(low, high, title: str, legend: bool, colour_bar: bool = True) -> 
     bar_w = BAR_PAD_IN + BAR_WIDTH_IN + RIGHT_IN if colour_bar else RIGHT_IN / 3
     used = LEFT_IN + axes_w + bar_w
     fig_w = max(MIN_FIGURE_WIDTH_IN, used)
-    lines = textwrap.wrap(title, width=int(fig_w / TITLE_CHAR_IN)) or [""]
+    lines = wrap_title(title, int(fig_w / TITLE_CHAR_IN))
     fig_h = bottom + axes_h + TOP_IN + TITLE_LINE_IN * (len(lines) - 1)
     left = (fig_w - used) / 2 + LEFT_IN
     bar_left = left + axes_w + BAR_PAD_IN
@@ -88,6 +87,21 @@ def map_layout(low, high, title: str, legend: bool, colour_bar: bool = True) -> 
                      axes=(left / fig_w, bottom / fig_h, axes_w / fig_w, axes_h / fig_h),
                      bar=(bar_left / fig_w, bottom / fig_h, BAR_WIDTH_IN / fig_w, axes_h / fig_h),
                      xlim=(low[0], high[0]), ylim=(centre_y - half_y, centre_y + half_y))
+
+
+def wrap_title(title: str, width: int) -> list[str]:
+    """``title``'s lines of at most ``width`` characters, broken after its commas (a run's title is
+    "what, packing, impact": a break inside "V₀ = 0.4 m/s" would split the impact); a part longer
+    than a line is a line of its own."""
+    lines = [""]
+    for part in title.split(", "):
+        joined = f"{lines[-1]}, {part}" if lines[-1] else part
+        if len(joined) <= width or not lines[-1]:
+            lines[-1] = joined
+        else:
+            lines[-1] += ","
+            lines.append(part)
+    return lines
 
 
 def fit_map(ax, title: str, colour_bar: bool = True):
