@@ -22,6 +22,8 @@ EXPECTED = {
                           "gathering", "result files"),
     "bench_accuracy.py": ("case", "engine", "steps/τ", "peak error", "arrival [µs]", "energy drift", "order",
                           "wall [s]", "lammps", "reference", "target at 140 steps per contact"),
+    "bench_results.py": ("beads", "never moved", "run [s]", "results, before [s]", "results, now [s]", "before / now",
+                         "target [s]", "target: the result files"),
     "bench_run.py": ("runner", "wall [s]", "loop [s]", "wall / bare loop", "hexdem run (CLI, subprocess)",
                      "run_experiment (in-process)", "bare lmp -in in.nooutput", "import floor", "target end to end",
                      "in-run analysis (now)", "where the CLI's time goes"),

@@ -12,14 +12,16 @@ from matplotlib.colors import LogNorm
 from matplotlib import colormaps
 from matplotlib.colors import to_rgb
 
-from hexdem.analysis.figures import (PIXEL_MAP_BEADS, PIXEL_REACH_D, PIXEL_UNMEASURED, UNMEASURED_STYLES,
-                                     bead_map, subplots)
+from hexdem.analysis.figures import PIXEL_MAP_BEADS, PIXEL_REACH_D, UNMEASURED_GREYS, bead_map, subplots
 from hexdem.model.triangular import hexagon
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_beads_without_a_peak_are_drawn_outside_the_scale_and_named_in_the_legend():
+    """Beads without a value are drawn in greys outside the colour scale, one collection per kind,
+    told apart and named in the legend; never hatched (matplotlib renders a hatch bead by bead: a
+    run where most beads never moved would spend seconds on them)."""
     fig, ax = subplots()
     positions = np.column_stack([np.arange(5.0), np.zeros(5)])
     values = np.array([1.0, np.nan, 0.1, 0.0, np.nan])
@@ -29,17 +31,17 @@ def test_beads_without_a_peak_are_drawn_outside_the_scale_and_named_in_the_legen
     assert list(coloured.get_array()) == [1.0, 0.1], "only measured beads take a colour"
     others = [c for c in ax.collections if c is not coloured]
     assert sorted(len(c.get_offsets()) for c in others) == [1, 1, 1]
-    assert all(collection.get_hatch() for collection in others), "outside the scale: hatched"
-    assert len({collection.get_hatch() for collection in others}) == 3, "told apart"
-    assert not coloured.get_hatch()
-    assert {text.get_text() for text in fig.legends[0].get_texts()} == set(UNMEASURED_STYLES)
+    assert not any(collection.get_hatch() for collection in ax.collections)
+    faces = [tuple(np.round(collection.get_facecolor()[0][:3], 3)) for collection in others]
+    assert sorted(faces) == sorted(tuple(np.round(to_rgb(grey), 3)) for grey in UNMEASURED_GREYS.values()), "told apart"
+    assert {text.get_text() for text in fig.legends[0].get_texts()} == set(UNMEASURED_GREYS)
 
 
 def test_a_large_packing_is_drawn_as_an_image_of_its_beads_values():
     """Above PIXEL_MAP_BEADS beads a map is an image: inside the packing every pixel shows a bead
     (no gap, no moiré), the bead whose centre is nearest (here the value is x, so within
     PIXEL_REACH_D diameters of the pixel's x); the unmeasured beads fill theirs with greys that
-    no colour map holds, named in the legend, and the ringed beads' region is outlined."""
+    no colour map holds (the circles' greys too), named in the legend, and the ringed beads' region is outlined."""
     lattice = hexagon(60, 1.0)
     assert len(lattice) > PIXEL_MAP_BEADS
     x = lattice.positions_m[:, 0]
@@ -56,7 +58,7 @@ def test_a_large_packing_is_drawn_as_an_image_of_its_beads_values():
     inside = (np.hypot(cx - middle[0], cy - middle[1]) < 0.8 * 60) & (cx < 0.8 * x.max() - 1)
     assert np.all(np.isfinite(pixels[inside])), "no gap inside the packing"
     assert np.max(np.abs(pixels[inside] - cx[inside])) <= PIXEL_REACH_D
-    greys = [np.array(to_rgb(colour)) for colour in PIXEL_UNMEASURED.values()]
+    greys = [np.array(to_rgb(colour)) for colour in UNMEASURED_GREYS.values()]
     for name in ("magma", "viridis", "viridis_r", "inferno", "hot_r"):
         table = colormaps[name](np.linspace(0, 1, 256))[:, :3]
         assert min(np.min(np.abs(table - grey).max(axis=1)) for grey in greys) > 0.05, name
@@ -79,7 +81,8 @@ def test_beads_of_other_materials_are_ringed_and_named():
 
 #: Modules that draw the report's and the runs' figures.
 FIGURE_MODULES = sorted({*(ROOT / "hexdem" / "paper").glob("*.py"), *(ROOT / "hexdem").glob("*/figures.py"),
-                         ROOT / "hexdem" / "analysis" / "movie.py", ROOT / "hexdem" / "experiments" / "snapshots.py"})
+                         ROOT / "hexdem" / "analysis" / "movie.py", ROOT / "hexdem" / "analysis" / "decay_figure.py",
+                         ROOT / "hexdem" / "experiments" / "snapshots.py"})
 #: Calls and keywords whose string is text on a figure.
 TEXT_CALLS = {"set_xlabel", "set_ylabel", "set_title", "suptitle", "set_label", "text", "annotate", "legend"}
 TEXT_KEYWORDS = {"label", "title", "xlabel", "ylabel"}
@@ -121,7 +124,7 @@ def test_the_maps_of_a_large_run_share_the_tiling_found_before_they_are_drawn(tm
     in separate processes: the arrival and peak maps then find the very tiling, not one each."""
     from types import SimpleNamespace
 
-    from hexdem.analysis import figures
+    from hexdem.analysis import figures, run_maps
     from hexdem.model.config import RunConfig
     from hexdem.model.model_builder import build_model
 
@@ -133,7 +136,7 @@ def test_the_maps_of_a_large_run_share_the_tiling_found_before_they_are_drawn(tm
                               arrival_time=x - x.min(), peak_speed=np.exp(-np.abs(x) / 30))
     figures._pixel_tiling.cache_clear()
     figures.tile_lattice(results, model)
-    figures.arrival_map(results, model, tmp_path / "arrival_map.png")
-    figures.peak_map(results, model, 1.0, tmp_path / "peak_map.png")
+    run_maps.arrival_map(results, model, tmp_path / "arrival_map.png")
+    run_maps.peak_map(results, model, 1.0, tmp_path / "peak_map.png")
     found = figures._pixel_tiling.cache_info()
     assert (found.misses, found.hits) == (1, 2)

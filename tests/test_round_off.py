@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from hexdem.analysis.figures import peak_scale
+from hexdem.analysis.run_maps import peak_scale
 from hexdem.analysis.peaks import ROUND_OFF_SPEED, noise_floor, pulse_times
 from hexdem.experiments.run import simulate
 from hexdem.model.config import RunConfig

@@ -1,4 +1,5 @@
-"""Figures a researcher would publish: arrival-time and peak maps (Fig. 8) and peak decay (Figs. 6, 9).
+"""Figures a researcher would publish: bead maps and what the other figures share (the run's maps
+are :mod:`hexdem.analysis.run_maps`, its peak decay :mod:`hexdem.analysis.decay_figure`).
 
 Every function draws into a new figure and saves it atomically as PNG. Figures are
 :class:`matplotlib.figure.Figure` objects on the Agg canvas (:func:`subplots`), never
@@ -82,15 +83,18 @@ def save(fig, path) -> None:
         fig.savefig(tmp, format="png", dpi=DPI, pil_kwargs={"compress_level": PNG_COMPRESSION})
 
 
-#: How beads without a value are drawn, outside every colour scale (a colour scale never hatches),
-#: with their legend entry: white, striped for a bead whose pulse was still rising when the run
-#: ended, dotted for one that never moved, crossed for any other bead without a value.
-UNMEASURED_STYLES = {
-    "still rising at the run's end": {"facecolor": "white", "hatch": "////", "edgecolor": "0.45"},
-    "never moved": {"facecolor": "white", "hatch": "..", "edgecolor": "0.45"},
-    "no value": {"facecolor": "white", "hatch": "xx", "edgecolor": "0.45"},
-}
+#: How beads without a value are drawn, outside every colour scale, with their legend entry: in
+#: greys that no colour map used here holds, light for a bead that never moved, mid for one whose
+#: pulse was still rising when the run ended, dark for any other bead without a value. (Hatches
+#: would tell them apart in print too, but matplotlib renders a hatch path by path: in a run where
+#: most beads never moved, the hatched beads cost many times the map.)
+UNMEASURED_GREYS = {"still rising at the run's end": "0.6", "never moved": "0.85", "no value": "0.35"}
+#: The edges of the beads without a value.
+UNMEASURED_EDGE = "0.45"
 
+
+#: A colour bar cut from its axes' right (:func:`colour_bar`): its width and gap, in the axes' width.
+BAR_SIZE, BAR_PAD = "4%", 0.12
 
 #: Ring colours of the beads of other materials, outside every colour map the maps use.
 OUTLINE_COLOURS = ("#00c8ff", "#3cdc3c", "#ff3cc8", "#0050ff")
@@ -116,10 +120,6 @@ MAP_PIXELS = 700
 #: d/√3 = 0.577 d away; drawing each bead's own disc left its gaps as a moiré), while a void
 #: wider than 1.2 d stays white.
 PIXEL_REACH_D = 0.6
-#: How beads without a value fill their pixels on such a map: greys, which no colour map used
-#: here holds (the hatches of :data:`UNMEASURED_STYLES` need a bead larger than a pixel).
-PIXEL_UNMEASURED = {"still rising at the run's end": "0.6", "never moved": "0.85", "no value": "0.35"}
-
 
 @functools.lru_cache(maxsize=1)
 def _pixel_tiling(positions_bytes: bytes, diameters_bytes: bytes) -> tuple[np.ndarray, tuple]:
@@ -149,7 +149,7 @@ def tile_lattice(results, model) -> None:
     result's maps, drawn in processes forked after this, then share one search on every core rather
     than each making its own at once."""
     if len(model.packing.diameters_m) > PIXEL_MAP_BEADS:
-        _tiling_of(*_lattice_beads(results, model))
+        _tiling_of(*lattice_beads(results, model))
 
 
 def _tiling_of(positions, diameters) -> tuple[np.ndarray, tuple]:
@@ -159,7 +159,7 @@ def _tiling_of(positions, diameters) -> tuple[np.ndarray, tuple]:
 
 def _pixel_beads(ax, positions, diameters, values, coloured, groups: dict, outlined: dict, cmap, norm, clim):
     """The beads rasterized (:func:`_pixel_tiling`): a pixel takes its bead's value; an unmeasured
-    bead's pixels take its grey (:data:`PIXEL_UNMEASURED`), and each ring group's region is
+    bead's pixels take its grey (:data:`UNMEASURED_GREYS`), and each ring group's region is
     outlined by a contour of its pixels. Returns the image and the legend's patches."""
     bead, extent = _tiling_of(positions, diameters)
     covered = bead >= 0
@@ -167,9 +167,9 @@ def _pixel_beads(ax, positions, diameters, values, coloured, groups: dict, outli
     for name, beads in groups.items():
         if np.any(beads):
             grey = np.where(covered & beads[bead], 1.0, np.nan)
-            ax.imshow(grey, origin="lower", extent=extent, cmap=ListedColormap([PIXEL_UNMEASURED[name]]),
+            ax.imshow(grey, origin="lower", extent=extent, cmap=ListedColormap([UNMEASURED_GREYS[name]]),
                       interpolation="nearest", vmin=0.0, vmax=1.0)
-            legend.append(Patch(label=name, facecolor=PIXEL_UNMEASURED[name], edgecolor="0.45"))
+            legend.append(Patch(label=name, facecolor=UNMEASURED_GREYS[name], edgecolor=UNMEASURED_EDGE))
     shown = np.where(covered & coloured[bead], values[bead], np.nan)
     image = ax.imshow(shown, origin="lower", extent=extent, cmap=colormaps[cmap], norm=norm, interpolation="nearest")
     if clim is not None:
@@ -184,10 +184,11 @@ def _pixel_beads(ax, positions, diameters, values, coloured, groups: dict, outli
 def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=None, norm=None, unmeasured=None,
              outlined=None, colorbar=True):
     """Beads as true-size circles (one collection, sized in data units) coloured by ``values``
-    through ``norm`` (None: linear), with a colour bar labelled ``label`` unless ``colorbar`` is
-    False (panels that share a scale share one bar); returns the mappable. ``unmeasured``: {name in
-    :data:`UNMEASURED_STYLES`: mask of the beads it describes}, drawn in that style outside the
-    colour scale and named in a legend; any other NaN is drawn as "no value". ``outlined``:
+    through ``norm`` (None: linear), with a colour bar labelled ``label`` (:func:`colour_bar`) unless
+    ``colorbar`` is False (panels that share a scale share one bar; a map laid out by
+    :func:`~hexdem.analysis.map_layout.fit_map` places its own); returns the mappable.
+    ``unmeasured``: {name in :data:`UNMEASURED_GREYS`: mask of the beads it describes}, drawn in
+    its grey outside the colour scale and named in a legend; any other NaN is drawn as "no value". ``outlined``:
     {name: mask} of beads to ring in a colour of :data:`OUTLINE_COLOURS` (a region of another
     material: an interface, intruders), named in the same legend. A packing of more than
     :data:`PIXEL_MAP_BEADS` beads is drawn rasterized instead (:func:`_pixel_beads`)."""
@@ -209,10 +210,22 @@ def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=No
     ax.set_aspect("equal")
     ax.autoscale_view()
     if colorbar:
-        bar = ax.figure.colorbar(mappable, ax=ax, label=label, shrink=0.8)
-        if isinstance(norm, LogNorm):
-            plain_log_ticks(bar.ax.yaxis)
+        colour_bar(mappable, label)
     return mappable
+
+
+def colour_bar(mappable, label: str, cax=None):
+    """The colour bar of ``mappable`` labelled ``label``, in ``cax`` or else in axes cut from the
+    right of ``mappable``'s axes (:func:`~mpl_toolkits.axes_grid1.make_axes_locatable`), as tall
+    as they are drawn, true aspect included; a logarithmic scale's decades in plain text."""
+    if cax is None:
+        from mpl_toolkits.axes_grid1 import make_axes_locatable
+
+        cax = make_axes_locatable(mappable.axes).append_axes("right", size=BAR_SIZE, pad=BAR_PAD)
+    bar = mappable.axes.figure.colorbar(mappable, cax=cax, label=label)
+    if isinstance(mappable.norm, LogNorm):
+        plain_log_ticks(bar.ax.yaxis)
+    return bar
 
 
 def _circle_beads(ax, positions, diameters, values, coloured, groups: dict, outlined: dict, cmap, norm, clim):
@@ -226,8 +239,9 @@ def _circle_beads(ax, positions, diameters, values, coloured, groups: dict, outl
     legend = []
     for name, beads in groups.items():
         if np.any(beads):
-            ax.add_collection(bead_circles(ax, positions[beads], diameters[beads], **UNMEASURED_STYLES[name]))
-            legend.append(Patch(label=name, **UNMEASURED_STYLES[name]))
+            style = {"facecolor": UNMEASURED_GREYS[name], "edgecolor": UNMEASURED_EDGE}
+            ax.add_collection(bead_circles(ax, positions[beads], diameters[beads], **style))
+            legend.append(Patch(label=name, **style))
     for (name, beads), colour in zip(outlined.items(), OUTLINE_COLOURS):
         ring = {"facecolor": "none", "edgecolor": colour}
         ax.add_collection(bead_circles(ax, positions[beads], diameters[beads] * 0.9, **ring, linewidths=1.6))
@@ -253,30 +267,21 @@ def draw_walls(ax, walls, positions, radii, scale=1.0, **style):
         ax.plot(ends[:, 0], ends[:, 1], **{"color": "k", "linewidth": 2, **style})
 
 
-def unmeasured_beads(results) -> dict:
-    """{name: mask} of the beads without a peak (:data:`UNMEASURED_STYLES`): still rising when
-    the run ended (peak NaN), or never moved (peak 0)."""
-    peaks = results.peak_speed
-    return {"still rising at the run's end": np.isnan(peaks), "never moved": peaks == 0}
-
-
-def _lattice_beads(results, model) -> tuple[np.ndarray, np.ndarray]:
+def lattice_beads(results, model) -> tuple[np.ndarray, np.ndarray]:
     """The beads' positions and diameters in the run's length unit, as the lattice maps draw them."""
     return results.positions, model.packing.diameters_m * (1.0 / results.length_unit_m)
 
 
 def draw_lattice(ax, results, model, values, label: str, cmap="viridis", norm=None, marker_colour="w",
-                 unmeasured=None):
+                 unmeasured=None, colorbar=True):
     """The packing's beads coloured by ``values`` (one per bead, in the run's units), its walls,
     its struck beads marked with crosses of ``marker_colour``, axes labelled; returns the beads'
-    mappable. ``unmeasured`` as for :func:`bead_map`."""
+    mappable. ``unmeasured`` and ``colorbar`` as for :func:`bead_map`."""
     units = UNIT_LABELS[results.units]
     scale = 1.0 / results.length_unit_m
-    positions, diameters = _lattice_beads(results, model)
-    ids, names = model.packing.material_ids, [material.name for material in model.materials]
-    others = {f"{names[k]} beads": ids == k for k in np.unique(ids) if k > 0}
+    positions, diameters = lattice_beads(results, model)
     circles = bead_map(ax, positions, diameters, values, cmap=cmap, label=label, norm=norm, unmeasured=unmeasured,
-                       outlined=others)
+                       outlined=other_materials(model), colorbar=colorbar)
     draw_walls(ax, model.walls, positions, diameters / 2, scale=scale)
     struck = positions[np.unique(model.struck_beads)]
     ax.plot(struck[:, 0], struck[:, 1], linestyle="", marker="x", color=marker_colour, markersize=8, mew=2)
@@ -285,61 +290,10 @@ def draw_lattice(ax, results, model, values, label: str, cmap="viridis", norm=No
     return circles
 
 
-def lattice_map(results, model, values, path, label: str, title: str, cmap="viridis", norm=None) -> None:
-    """One value per bead drawn on the lattice (like Fig. 8a), walls drawn, struck beads marked."""
-    fig, ax = subplots(figsize=(7, 6.3))
-    fig.subplots_adjust(left=0.12, right=0.98, bottom=0.13, top=0.94)  # room for the legend below
-    draw_lattice(ax, results, model, values, label, cmap, norm, unmeasured=unmeasured_beads(results))
-    set_title(ax, title)
-    save(fig, path)
-
-
-def arrival_map(results, model, path, title="Wavefront arrival time") -> None:
-    """Every bead's arrival time on the lattice (like Fig. 8a)."""
-    units = UNIT_LABELS[results.units]
-    lattice_map(results, model, results.arrival_time * units["time_scale"], path,
-                f"arrival time [{units['time']}]", title, cmap="viridis_r")
-
-
-def peak_scale(ratio) -> tuple[float, float]:
-    """(bottom, top) of a peak map's logarithmic colour scale for peaks ``ratio`` (over V0; 0 never
-    moved, NaN still rising): it ends at the largest peak and spans at least a decade, widened
-    downward (to 1e-3 at the lowest), so that peaks that barely decay (a square crystal's row) are
-    drawn in the scale's upper colours, not at its dark end."""
-    ratio = np.asarray(ratio, float)
-    moved = ratio[ratio > 0]
-    if not len(moved):
-        return 1e-1, 1.0
-    top = float(np.max(moved))
-    return min(max(float(np.min(moved)), 1e-3), top / 10), top
-
-
-def peak_map(results, model, v0: float, path, title="Peak speed") -> None:
-    """Every bead's peak speed over V0 on the lattice, on a logarithmic scale (the fronts decay
-    by decades as they spread; :func:`peak_scale`)."""
-    ratio = results.peak_speed / v0
-    lattice_map(results, model, ratio, path, "peak speed Vₘₐₓ / V₀", title, cmap="magma",
-                norm=LogNorm(*peak_scale(ratio)))
-
-
-def peak_decay(rows_by_line: dict, path, units_name: str, v0: float, title="Peak speed along the observation lines"):
-    """Peak speed V_n / V0 vs n for each observation line, logarithmic axis."""
-    units = UNIT_LABELS[units_name]
-    fig, ax = subplots(figsize=(6, 4.5))
-    fig.subplots_adjust(**SINGLE_PLOT_MARGINS)
-    # the ±30° lines of a symmetric strike coincide: −30° is drawn open and dashed over +30°'s filled markers
-    styles = {"0": {"marker": "o"}, "+30": {"marker": "^", "markersize": 7},
-              "-30": {"marker": "v", "markerfacecolor": "none", "linestyle": "--", "markersize": 9}}
-    for line, (n, peak) in rows_by_line.items():
-        style = {"marker": "o", "linestyle": "-", **styles.get(line, {})}
-        ax.semilogy(n, np.asarray(peak) / v0, label=f"{line}°", **style)
-    ax.set_xlabel("bead n along the line")
-    ax.set_ylabel(f"Vₙ / V₀   (V₀ = {v0:.4g} {units['speed']})")
-    plain_log_ticks(ax.yaxis)
-    set_title(ax, title)
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(title="observation line")
-    save(fig, path)
+def other_materials(model) -> dict:
+    """{"NAME beads": mask} of the beads of each material but the packing's first, for their rings."""
+    ids, names = model.packing.material_ids, [material.name for material in model.materials]
+    return {f"{names[k]} beads": ids == k for k in np.unique(ids) if k > 0}
 
 
 def energy_regions_figure(results, path, title="Where the energy is") -> None:

@@ -189,6 +189,8 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
     ``summary.json`` as its ``provenance``."""
     from hexdem.analysis.movie import SPIN_LABEL, speed_movie
     from hexdem.analysis import figures as plots  # matplotlib: only where figures are drawn
+    from hexdem.analysis.decay_figure import peak_decay
+    from hexdem.analysis.run_maps import arrival_map, peak_map
 
     log = log or (lambda message: None)
     skipped = unmeasurable_outputs(analysis)
@@ -205,11 +207,11 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
         write_sensor_files(analysis, list(sensor_beads(config.sensors, analysis.model.packing)), out)
     write_csv(out / "energy_regions.csv", ENERGY_REGION_COLUMNS, energy_region_rows(r))
     impact = f"V₀ = {v0:g} {plots.UNIT_LABELS[r.units]['speed']}"
-    jobs = [lambda: plots.arrival_map(r, model, out / "arrival_map.png", title=f"Arrival time, {name}, {impact}"),
-            lambda: plots.peak_map(r, model, v0, out / "peak_map.png", title=f"Peak speed, {name}, {impact}")]
+    jobs = [lambda: arrival_map(r, model, out / "arrival_map.png", title=f"Arrival time, {name}, {impact}"),
+            lambda: peak_map(r, model, v0, out / "peak_map.png", title=f"Peak speed, {name}, {impact}")]
     if "peak_decay.png" not in skipped:
         by_line = {name: (np.arange(len(beads)), r.peak_speed[beads]) for name, beads in r.lines.items()}
-        jobs.append(lambda: plots.peak_decay(by_line, out / "peak_decay.png", r.units, v0))
+        jobs.append(lambda: peak_decay(by_line, out / "peak_decay.png", r.units, v0))
     if "front_shape.csv" not in skipped:
         jobs.append(lambda: write_front_shape(analysis, name, out))
     if analysis.model.extra_materials:
@@ -288,7 +290,7 @@ def run_experiment(config: RunConfig, out, log=None, command=None, prepared: Run
     where a failed run keeps its deck, replacing what an earlier try kept there (default: a fresh
     ``hexdem-failed-*`` folder of the temporary directory)."""
     log = log or (lambda message: print(f"hexdem: {message}", file=sys.stderr))
-    load_in_background("hexdem.analysis.figures", "scipy.spatial")  # the results' figures, while the run goes
+    load_in_background("hexdem.analysis.run_maps", "hexdem.analysis.decay_figure", "scipy.spatial")  # the figures, while it runs
     with staged_directory(out, STAGING_PREFIX) as staging:
         try:
             start, provenance = time.perf_counter(), started_provenance(command)
