@@ -4,7 +4,7 @@
 emcee's chain, thinned). ``calibration.json`` holds, per key, its prior, the posterior's mean,
 median, 5 % and 95 % quantiles and ``width_ratio``, the posterior's 90 % interval over the
 prior's; the posterior's correlations; and ``identifiability``, sentences that say where the data
-cannot tell two parameters apart (|ρ| ≥ :data:`TRADE_OFF_CORRELATION`: they trade off, and only a
+cannot tell two parameters apart (an absolute correlation of :data:`TRADE_OFF_CORRELATION` or more: they trade off, and only a
 combination of them is measured) or barely constrain one (``width_ratio`` ≥
 :data:`UNCONSTRAINED_RATIO`), so that no precision is quoted that the data do not hold.
 """
@@ -15,7 +15,7 @@ import numpy as np
 
 from hexdem.common.io import write_csv_columns
 
-#: |posterior correlation| from which two parameters are reported as trading off.
+#: The absolute posterior correlation from which two parameters are reported as trading off.
 TRADE_OFF_CORRELATION = 0.9
 #: Posterior 90 % width over the prior's from which a parameter is reported as barely constrained.
 UNCONSTRAINED_RATIO = 0.8
