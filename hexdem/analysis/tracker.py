@@ -42,10 +42,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from hexdem.analysis.compiled import sample_pulses
+from hexdem.analysis.compiled import BodiesReordered, bind_pulses, sample_pulses
 from hexdem.analysis.energy import EnergyAudit, energy_error, energy_scale_j, rotational_share
 from hexdem.analysis.peaks import noise_floor, refine_peak, refine_peaks
-from hexdem.analysis.tracker_kernel import RIVAL_RATIO, PulseState
+from hexdem.analysis.tracker_kernel import PulseState
 from hexdem.common.compiled import runs_compiled
 from hexdem.common.preload import load_in_background
 from hexdem.engines.sampling import Sample
@@ -136,6 +136,7 @@ class PulseTracker:
         self.threshold_speed = threshold_speed
         self.floor = run_noise_floor(model, settings)
         self.sample_ids, self.ids = None, np.zeros(0, dtype=np.int64)  # (no sample yet)
+        self.compiled = runs_compiled()
         self._start_rows(0)
         self.trace_beads = np.asarray(trace_beads, dtype=np.int64)
         self.traces = np.full((total, len(self.trace_beads)), np.nan)
@@ -147,7 +148,6 @@ class PulseTracker:
         self.field_set = frozenset(self.field_samples.tolist())
         self.field_parts = []
         self.energy_every = max(1, (total - 1) // ENERGY_SAMPLES)
-        self.compiled = runs_compiled()
         if not self.compiled:  # the NumPy audit's pair search, while the engine starts
             load_in_background("scipy.spatial")
         self.audit = EnergyAudit(model, gravity_m_s2, self.compiled)
@@ -167,6 +167,7 @@ class PulseTracker:
     def _start_rows(self, n: int) -> None:
         """State for ``n`` beads as before their first sample."""
         self.pulses = PulseState(n, RECORD_CAPACITY, self.floor)
+        self.pulse_arrays = bind_pulses(self.pulses) if self.compiled else None
         self.peak_spin, self.end_velocity = np.zeros(n), np.zeros((n, 2))
         self.threshold_index, self.previous_speed = np.full(n, np.nan), np.zeros(n)
 
@@ -266,9 +267,12 @@ class PulseTracker:
             return speeds
         wanted = self.threshold_speed is not None or s in self.field_set
         speeds = np.empty(len(self.ids) if wanted else 0)
-        complete = sample_pulses(np.asarray(sample.ids, np.int64), self.sample_ids, sample.velocities, self.bead_rows,
-                                 self.end_velocity, speeds, s, self.pulses.q, RIVAL_RATIO, *self.pulses.kernel_arrays())
-        self._check_order(sample, complete is not None)
+        try:
+            complete = sample_pulses(self.pulse_arrays, ids=np.asarray(sample.ids, np.int64), previous_ids=self.sample_ids,
+                                     velocities=sample.velocities, rows=self.bead_rows, end_velocity=self.end_velocity,
+                                     speeds=speeds, s=s)
+        except BodiesReordered:
+            self._check_order(sample, False)
         self.pulses.challenge(complete)
         return speeds if wanted else None
 
