@@ -82,16 +82,14 @@ static int take_array(const Table *table, const Field *field, PyObject *value, P
         return -1;
     }
     int fits = has_type(view, field->kind) && view->ndim == field->ndim;
-    Py_ssize_t given[MAX_SIZES];
-    memcpy(given, sizes, sizeof given);
     for (int k = 0; fits && k < field->ndim; k++) {
         const Axis *axis = &field->axes[k];
         Py_ssize_t length = view->shape[k];
-        if (axis->size != NO_SIZE && given[axis->size] < 0) {
-            given[axis->size] = length;
+        if (axis->size != NO_SIZE && sizes[axis->size] < 0) {
+            sizes[axis->size] = length;
             continue;
         }
-        Py_ssize_t wanted = axis_length(axis, given);
+        Py_ssize_t wanted = axis_length(axis, sizes);
         fits = axis->rule == EXACT ? length == wanted
                : axis->rule == AT_LEAST ? length >= wanted
                                         : length == 0 || length >= wanted;
@@ -108,7 +106,6 @@ static int take_array(const Table *table, const Field *field, PyObject *value, P
         PyBuffer_Release(view);
         return -1;
     }
-    memcpy(sizes, given, sizeof given);
     if (field->length_as != NO_SIZE)
         sizes[field->length_as] = view->shape[0];
     *(void **)((char *)target + field->offset) = view->buf;
@@ -143,9 +140,12 @@ void release_views(Py_buffer *views, int *held)
 }
 
 /* The index of the table's field called `name` (-1: none): by identity, as the call's keywords are
- * mostly the interned names, else by value. */
-static int field_named(const Table *table, PyObject *name)
+ * mostly the interned names (first the field at `hint`, a call's keywords mostly being in the
+ * table's order), else by value. */
+static int field_named(const Table *table, PyObject *name, Py_ssize_t hint)
 {
+    if (hint < table->n_fields && name == table->names[hint])
+        return (int)hint;
     for (int f = 0; f < table->n_fields; f++)
         if (name == table->names[f])
             return f;
@@ -158,7 +158,7 @@ static int field_named(const Table *table, PyObject *name)
 }
 
 int bind_arguments(const Table *table, PyObject *const *args, Py_ssize_t nargs, PyObject *kwnames, void *target,
-                Py_buffer *views, int *held, Py_ssize_t *sizes)
+                   Py_buffer *views, int *held, Py_ssize_t *sizes)
 {
     PyObject *values[MAX_FIELDS] = {NULL};
     Py_ssize_t n_given = kwnames ? PyTuple_GET_SIZE(kwnames) : 0;
@@ -167,7 +167,7 @@ int bind_arguments(const Table *table, PyObject *const *args, Py_ssize_t nargs, 
         return -1;
     }
     for (Py_ssize_t k = 0; k < n_given; k++) {
-        int f = field_named(table, PyTuple_GET_ITEM(kwnames, k));
+        int f = field_named(table, PyTuple_GET_ITEM(kwnames, k), k);
         if (f < 0) {
             PyErr_Format(PyExc_TypeError, "%s takes no argument named %R", table->kernel, PyTuple_GET_ITEM(kwnames, k));
             return -1;
