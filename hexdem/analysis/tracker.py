@@ -252,15 +252,15 @@ class PulseTracker:
         self.count = s + 1
 
     def _take_sample(self, sample: Sample) -> np.ndarray | None:
-        """Take ``sample`` into the pulse state once its bodies are found to be the previous sample's,
-        in order (laid out by :meth:`_arrange` where it says they may have migrated); their velocities
-        become the beads' last seen (:attr:`end_velocity`). Returns the beads' speeds; compiled (one
-        pass, :func:`~hexdem.analysis.compiled.sample_pulses`, which takes most speeds only when the
-        tracker needs them) None, unless the whole sample's are wanted (a threshold's crossings, a
-        speed field)."""
+        """Take ``sample`` into the pulse state once its bodies are found to be the previous sample's, in order
+        (laid out by :meth:`_arrange` where it says they may have migrated); their velocities become the beads'
+        last seen (:attr:`end_velocity`). Returns the beads' speeds; compiled (one pass,
+        :func:`~hexdem.analysis.compiled.sample_pulses`, which takes most speeds only when the tracker needs
+        them) None, unless the whole sample's are wanted (a threshold's crossings, a speed field)."""
         s = sample.index
         if not self.compiled:
-            self._check_order(sample, np.array_equal(sample.ids, self.sample_ids))
+            if not np.array_equal(sample.ids, self.sample_ids):
+                raise self._reordered(sample)
             self.end_velocity[:] = sample.velocities[self.bead_rows]
             speeds = np.hypot(self.end_velocity[:, 0], self.end_velocity[:, 1])
             self.pulses.update(np.arange(len(self.ids)), speeds, s)
@@ -268,19 +268,17 @@ class PulseTracker:
         wanted = self.threshold_speed is not None or s in self.field_set
         speeds = np.empty(len(self.ids) if wanted else 0)
         try:
-            complete = sample_pulses(self.pulse_arrays, ids=np.asarray(sample.ids, np.int64), previous_ids=self.sample_ids,
-                                     velocities=sample.velocities, rows=self.bead_rows, end_velocity=self.end_velocity,
-                                     speeds=speeds, s=s)
+            self.pulses.challenge(sample_pulses(self.pulse_arrays, ids=np.asarray(sample.ids, np.int64), s=s, speeds=speeds,
+                                                previous_ids=self.sample_ids, velocities=sample.velocities,
+                                                rows=self.bead_rows, end_velocity=self.end_velocity))
         except BodiesReordered:
-            self._check_order(sample, False)
-        self.pulses.challenge(complete)
+            raise self._reordered(sample) from None
         return speeds if wanted else None
 
-    def _check_order(self, sample: Sample, same: bool) -> None:
-        """Refuse ``sample`` unless its bodies are found to be the previous sample's, in order (``same``)."""
-        if not same:
-            raise HexdemError(f"sample {sample.index} reordered the bodies of rank "
-                              f"{0 if self.comm is None else self.comm.Get_rank()} without saying that they may have migrated")
+    def _reordered(self, sample: Sample) -> HexdemError:
+        """The error for ``sample``, whose bodies are not the previous sample's, in order."""
+        return HexdemError(f"sample {sample.index} reordered the bodies of rank "
+                           f"{0 if self.comm is None else self.comm.Get_rank()} without saying that they may have migrated")
 
     def _cross_threshold(self, index: np.ndarray, speeds: np.ndarray, s: int) -> None:
         """Record, as a fractional sample index, where each bead's speed first reached the

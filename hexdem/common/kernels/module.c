@@ -307,14 +307,14 @@ static PyObject *audit_new(PyTypeObject *type, PyObject *args, PyObject *kwargs)
 
 static PyMethodDef pulses_methods[] = {
     {"sample", (PyCFunction)(void (*)(void))pulses_sample, METH_FASTCALL | METH_KEYWORDS,
-     "sample(*, ids, previous_ids, velocities, rows, end_velocity, speeds, complete, s) -> the count of rows "
-     "written into complete; BodiesReordered if ids are not previous_ids (the state as it was)."},
+     "sample(ids, previous_ids, velocities, rows, end_velocity, speeds, complete, s), all by name -> the count "
+     "of rows written into complete; BodiesReordered if ids are not previous_ids (the state as it was)."},
     {NULL, NULL, 0, NULL},
 };
 
 static PyMethodDef audit_methods[] = {
     {"part", (PyCFunction)(void (*)(void))audit_part_of, METH_FASTCALL | METH_KEYWORDS,
-     "part(*, positions, velocities, spins, sums) -> False if the contacts must be listed again, "
+     "part(positions, velocities, spins, sums), all by name -> False if the contacts must be listed again, "
      "else True with sums written."},
     {NULL, NULL, 0, NULL},
 };
@@ -324,8 +324,8 @@ static PyTypeObject PulsesType = {
     .tp_basicsize = sizeof(PulsesObject),
     .tp_dealloc = bound_dealloc,
     .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "PulseArrays(*, <the state's arrays by name>, q, rival_ratio): the pulse tracker's state, "
-              "its arrays checked and held; sample() takes a sample into it.",
+    .tp_doc = "PulseArrays(the state's arrays, q, rival_ratio), all by name: the pulse tracker's state, its arrays "
+              "checked and held; sample() takes a sample into it.",
     .tp_methods = pulses_methods,
     .tp_new = pulses_new,
 };
@@ -335,17 +335,19 @@ static PyTypeObject AuditType = {
     .tp_basicsize = sizeof(AuditObject),
     .tp_dealloc = bound_dealloc,
     .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "AuditRows(*, listed_at, distance, <the row constants by name>, n_regions): what the energy "
-              "audit reads of a listing, checked and held; part() audits a sample.",
+    .tp_doc = "AuditRows(listed_at, distance, the row constants, n_regions), all by name: what the energy audit "
+              "reads of a listing, checked and held; part() audits a sample.",
     .tp_methods = audit_methods,
     .tp_new = audit_new,
 };
 
 static PyMethodDef methods[] = {
     {"pairs_within", (PyCFunction)(void (*)(void))py_pairs_within, METH_FASTCALL | METH_KEYWORDS,
-     "pairs_within(*, positions, cutoff, i, j) -> the count of pairs within cutoff, the first len(i) written into i, j."},
+     "pairs_within(positions, cutoff, i, j), all by name -> the count of pairs within cutoff, the first len(i) "
+     "written into i, j."},
     {"full_step_state", (PyCFunction)(void (*)(void))py_full_step_state, METH_FASTCALL | METH_KEYWORDS,
-     "full_step_state(*, positions, velocities, forces, masses, half_dt, x, v): the full-step sample into x, v."},
+     "full_step_state(masses, positions, velocities, forces, half_dt, x, v), all by name: the full-step sample "
+     "into x, v."},
     {NULL, NULL, 0, NULL},
 };
 
