@@ -34,7 +34,7 @@ RUNS = {
 def test_the_compiled_kernels_give_the_numpy_results(tmp_path, monkeypatch, changes):
     config = RunConfig(**changes)
     passes = []  # the compiled tracker's passes, so that each run is known to have taken its way
-    monkeypatch.setattr(tracker_module, "sample_pulses", lambda *args: passes.append(1) or sample_pulses(*args))
+    monkeypatch.setattr(tracker_module, "sample_pulses", lambda *args, **named: passes.append(1) or sample_pulses(*args, **named))
     monkeypatch.setattr(compiled, "COMPILED", False)
     numpy_run = simulate(config, tmp_path / "numpy").tracked
     assert not passes
@@ -122,27 +122,63 @@ def test_the_compiled_pair_search_finds_the_pairs_of_scipys_tree(count, spread, 
 
 def test_the_kernels_refuse_arrays_they_cannot_read_and_indices_outside_them():
     """The C kernels read raw memory: an array of another type, order or shape is a TypeError, and
-    a row index outside its array an IndexError, never a read or write past the array's end."""
-    from hexdem.analysis.compiled import sample_pulses
+    a row index outside its array an IndexError, never a read or write past the array's end; a
+    sample whose bodies are not the previous sample's is refused with the state as it was."""
+    from hexdem.analysis.compiled import BodiesReordered, bind_pulses, sample_pulses
 
     velocities, ids = np.ones((4, 2)), np.arange(4)
     speeds, end_velocity = np.empty(4), np.empty((4, 2))
 
     def take(velocities=velocities, rows=ids, speeds=speeds, previous=ids, n=4):
         state = PulseState(n, 8, 0.0)
-        return sample_pulses(ids, previous, velocities, rows, end_velocity, speeds, 0, state.q, RIVAL_RATIO,
-                             *state.kernel_arrays())
+        return sample_pulses(bind_pulses(state), ids=ids, previous_ids=previous, velocities=velocities, rows=rows,
+                             end_velocity=end_velocity[:n], speeds=speeds, s=0)
 
     assert len(take()) == 0
     np.testing.assert_array_equal(speeds, np.full(4, np.sqrt(2)))
-    assert take(previous=ids[::-1].copy()) is None  # other bodies than the previous sample's
+    with pytest.raises(BodiesReordered, match="not previous_ids"):
+        take(previous=ids[::-1].copy())  # other bodies than the previous sample's
     for wrong in (velocities.astype(np.float32), np.ones((4, 3)), np.asfortranarray(np.ones((4, 2)))[::2]):
-        with pytest.raises(TypeError):
+        with pytest.raises(TypeError, match="velocities"):
             take(velocities=wrong, rows=ids[:2], speeds=speeds[:2], n=2)
-    with pytest.raises(TypeError):
+    with pytest.raises(TypeError, match=r"speeds: expected float64 \(0 or >= n,\) = \(4,\), got float64 \(3,\)"):
         take(speeds=np.empty(3))  # neither empty nor long enough for its rows
     with pytest.raises(IndexError):
         take(rows=np.array([0, 4]), speeds=speeds[:2], n=2)
+
+
+def test_the_kernels_take_every_argument_by_name_and_check_it_by_name():
+    """The tracker's state is bound by name: an array of the wrong shape under a name, a missing
+    name, an unknown one or an argument given by position is refused, naming the argument. The
+    arrays the positional binding let through when swapped (``rec_prev``/``rec_prev2``,
+    ``start``/``length``, of one type and shape) cannot be swapped by their order, and each is
+    checked against its own name's type and shape."""
+    from hexdem.common import _kernels
+
+    state = PulseState(5, 8, 0.0)
+    arrays, constants = state.kernel_arrays(), {"q": state.q, "rival_ratio": RIVAL_RATIO}
+    _kernels.PulseArrays(**arrays, **constants)
+    with pytest.raises(TypeError, match="by name"):
+        _kernels.PulseArrays(*arrays.values(), *constants.values())
+    narrow = dict(arrays, rec_prev2=np.zeros((5, 7)))
+    with pytest.raises(TypeError, match=r"rec_prev2: expected float64 \(n, capacity\) = \(5, 8\), got float64 \(5, 7\)"):
+        _kernels.PulseArrays(**narrow, **constants)
+    swapped = dict(arrays, start=state.rec_prev, length=state.start)
+    with pytest.raises(TypeError, match=r"start: expected int64 \(n,\) = \(5,\), got float64 \(5, 8\)"):
+        _kernels.PulseArrays(**swapped, **constants)
+    missing = {name: array for name, array in arrays.items() if name != "length"}
+    with pytest.raises(TypeError, match="missing argument length"):
+        _kernels.PulseArrays(**missing, **constants)
+    with pytest.raises(TypeError, match="no argument named 'rec_prev3'"):
+        _kernels.PulseArrays(**arrays, **constants, rec_prev3=state.rec_prev2)
+    pulses = _kernels.PulseArrays(**arrays, **constants)
+    sample = {"ids": np.arange(5), "previous_ids": np.arange(5), "velocities": np.ones((5, 2)), "rows": np.arange(5),
+              "end_velocity": np.empty((5, 2)), "speeds": np.empty(0), "complete": np.empty(5, np.int64), "s": 0}
+    assert pulses.sample(**sample) == 0
+    with pytest.raises(TypeError, match=r"end_velocity: expected float64 \(n, 2\) = \(5, 2\)"):
+        pulses.sample(**dict(sample, end_velocity=np.empty((4, 2))))
+    with pytest.raises(TypeError, match="PulseArrays.sample: missing argument s"):
+        pulses.sample(**{name: value for name, value in sample.items() if name != "s"})
 
 
 @pytest.mark.parametrize("speeds_wanted", [False, True], ids=["speeds left", "speeds wanted"])
@@ -152,7 +188,7 @@ def test_the_compiled_sample_is_the_numpy_update_of_np_hypots_speeds(speeds_want
     pass (which takes most speeds only when a window needs them) leaves the state, sample by
     sample, as the NumPy update of ``np.hypot``'s speeds leaves it, to the bit, every speed it
     reports included; a slot it left as a velocity holds that velocity."""
-    from hexdem.analysis.compiled import sample_pulses
+    from hexdem.analysis.compiled import bind_pulses, sample_pulses
 
     rng = np.random.default_rng(11)
     n, samples = 400, 160
@@ -171,14 +207,15 @@ def test_the_compiled_sample_is_the_numpy_update_of_np_hypots_speeds(speeds_want
         velocities[s, bead] = np.array([np.cos(directions[bead]), np.sin(directions[bead])]) * level * (1 + (k % 5 - 2) * 1e-16)
     floor = 1e-12
     numpy_state, compiled_state = PulseState(n, 8, floor), PulseState(n, 8, floor)
+    pulses = bind_pulses(compiled_state)
     ids, rows, end_velocity = np.arange(n), np.arange(n), np.empty((n, 2))
     left_slots = 0  # ring slots left as velocities, summed over the samples
     for s in range(samples):
         speeds = np.hypot(velocities[s, :, 0], velocities[s, :, 1])
         numpy_state.update(rows, speeds, s)
         taken = np.empty(n if speeds_wanted else 0)
-        compiled_state.challenge(sample_pulses(ids, ids, np.ascontiguousarray(velocities[s]), rows, end_velocity, taken,
-                                               s, compiled_state.q, RIVAL_RATIO, *compiled_state.kernel_arrays()))
+        compiled_state.challenge(sample_pulses(pulses, ids=ids, previous_ids=ids, velocities=np.ascontiguousarray(velocities[s]),
+                                               rows=rows, end_velocity=end_velocity, speeds=taken, s=s))
         np.testing.assert_array_equal(end_velocity, velocities[s])
         if speeds_wanted:
             np.testing.assert_array_equal(taken, speeds)

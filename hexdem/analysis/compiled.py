@@ -21,7 +21,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from hexdem.analysis.tracker_kernel import RIVAL_RATIO, PulseState
 from hexdem.common import _kernels
+
+#: Raised by :func:`sample_pulses` for a sample whose bodies are not the previous sample's, in order.
+BodiesReordered = _kernels.BodiesReordered
 
 
 def pairs_within(positions, cutoff: float) -> tuple[np.ndarray, np.ndarray]:
@@ -31,21 +35,27 @@ def pairs_within(positions, cutoff: float) -> tuple[np.ndarray, np.ndarray]:
     its start (on 2 ranks of 2 cores, a core's time that LAMMPS's set-up waited for)."""
     positions = np.ascontiguousarray(positions, float)
     i, j = (np.empty(4 * len(positions) + 16, np.int64) for _ in range(2))
-    found = _kernels.pairs_within(positions, cutoff, i, j)
+    found = _kernels.pairs_within(positions=positions, cutoff=cutoff, i=i, j=j)
     if found > len(i):
         i, j = (np.empty(found, np.int64) for _ in range(2))
-        _kernels.pairs_within(positions, cutoff, i, j)
+        _kernels.pairs_within(positions=positions, cutoff=cutoff, i=i, j=j)
     return i[:found], j[:found]
 
 
-def sample_pulses(ids, previous_ids, velocities, rows, end_velocity, speeds, s: int, q: float, rival_ratio: float,
-                  *state) -> np.ndarray | None:
-    """Sample ``s`` into the tracker's state, in one pass: row ``b`` takes the speed ``|v|`` of its velocity
-    ``v = velocities[rows[b]]`` (C's hypot, as ``np.hypot``) as its sample, as
-    :meth:`~hexdem.analysis.tracker_kernel.PulseState.update` takes it, but for the refinement
-    (``state``: the state's :meth:`~hexdem.analysis.tracker_kernel.PulseState.kernel_arrays`, updated in
-    place; ``rival_ratio``: :data:`~hexdem.analysis.tracker_kernel.RIVAL_RATIO`). Each row's ``v`` goes
-    into ``end_velocity`` and, unless ``speeds`` is empty, its speed into ``speeds``.
+def bind_pulses(state: PulseState) -> _kernels.PulseArrays:
+    """The tracker's ``state`` as :func:`sample_pulses` updates it: its arrays
+    (:meth:`~hexdem.analysis.tracker_kernel.PulseState.kernel_arrays`), each checked by name, type and
+    shape and held, its ladder's ratio ``q`` and :data:`~hexdem.analysis.tracker_kernel.RIVAL_RATIO`.
+    A state's arrays are made once, with it: its binding holds for its life."""
+    return _kernels.PulseArrays(**state.kernel_arrays(), q=state.q, rival_ratio=RIVAL_RATIO)
+
+
+def sample_pulses(pulses: _kernels.PulseArrays, *, ids, previous_ids, velocities, rows, end_velocity, speeds,
+                  s: int) -> np.ndarray:
+    """Sample ``s`` into the tracker's state (``pulses``, :func:`bind_pulses`), in one pass: row ``b`` takes the
+    speed ``|v|`` of its velocity ``v = velocities[rows[b]]`` (C's hypot, as ``np.hypot``) as its sample, as
+    :meth:`~hexdem.analysis.tracker_kernel.PulseState.update` takes it, but for the refinement. Each row's
+    ``v`` goes into ``end_velocity`` and, unless ``speeds`` is empty, its speed into ``speeds``.
 
     Most rows, at most samples, lie clearly below their running maximum (by more than the
     rival's margin, at a relative 1e-9) with no window open (its sum of squares below its
@@ -55,20 +65,30 @@ def sample_pulses(ids, previous_ids, velocities, rows, end_velocity, speeds, s: 
     need it. With ``speeds`` wanted, every row's is taken.
 
     Returns the rows whose rival window is complete, for
-    :meth:`~hexdem.analysis.tracker_kernel.PulseState.challenge`; None, with the state as it was, if
-    the sample's body ids ``ids`` are not ``previous_ids`` (``np.array_equal``)."""
+    :meth:`~hexdem.analysis.tracker_kernel.PulseState.challenge`. Raises
+    :class:`BodiesReordered`, with the state as it was, if the sample's body ids ``ids`` are not
+    ``previous_ids`` (``np.array_equal``)."""
     complete = np.empty(len(rows), np.int64)
-    count = _kernels.sample_pulses(ids, previous_ids, velocities, rows, end_velocity, speeds, s, q, rival_ratio,
-                                   *state, complete)
-    return None if count is None else complete[:count]
+    count = pulses.sample(ids=ids, previous_ids=previous_ids, velocities=velocities, rows=rows,
+                          end_velocity=end_velocity, speeds=speeds, complete=complete, s=s)
+    return complete[:count]
 
 
-def audit_part(positions, velocities, spins, listed_at, distance: float, *constants) -> np.ndarray:
-    r""":meth:`~hexdem.analysis.energy.EnergyAudit.part` of a rank in one call: empty if a row of
-    ``positions`` lies more than ``distance`` from where the contacts were listed (``listed_at``; the
-    caller lists them again), else the sums [total energy, translational and rotational kinetic,
-    then each region's kinetic and contact energy] [J] of the audited rows (the first
-    ``len(masses)``) with ``velocities`` and ``spins`` (ω_z, empty for spheres that do not turn):
+def bind_audit(**rows) -> _kernels.AuditRows:
+    """What :func:`audit_part` reads of a listing of the contacts, each array checked by name, type
+    and shape and held: ``listed_at`` (where the rows were when listed) and ``distance`` (how far
+    one may move before they are listed again), the constants of
+    :meth:`~hexdem.analysis.energy.EnergyAudit._row_constants`, and ``n_regions``."""
+    return _kernels.AuditRows(**rows)
+
+
+def audit_part(rows: _kernels.AuditRows, positions, velocities, spins, n_regions: int) -> np.ndarray:
+    r""":meth:`~hexdem.analysis.energy.EnergyAudit.part` of a rank in one call (``rows``: :func:`bind_audit`,
+    for ``n_regions`` regions): empty if a row of ``positions`` lies more than the listing's
+    ``distance`` from where the contacts were listed (the caller lists them again), else the sums
+    [total energy, translational and rotational kinetic, then each region's kinetic and contact
+    energy] [J] of the audited rows (the first ``len(masses)``) with ``velocities`` and ``spins``
+    (ω_z, empty for spheres that do not turn):
 
     * the candidate pairs' Hertz energies :math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}\, δ^{5/2}`, half to each
       of its rows' regions (a ghost's half is not audited here), the i sides' halves pair by pair,
@@ -80,7 +100,6 @@ def audit_part(positions, velocities, spins, listed_at, distance: float, *consta
     * the bodies' own terms (kinetic energies and the constant forces' work), row by row.
 
     The total sums the regions' energies as NumPy sums a few numbers (the first, plus the rest in
-    order), less the constant forces' work. ``constants``: those of
-    :meth:`~hexdem.analysis.energy.EnergyAudit._row_constants`, then the number of regions."""
-    sums = np.empty(3 + 2 * constants[-1])
-    return sums if _kernels.audit_part(positions, velocities, spins, listed_at, distance, *constants, sums) else sums[:0]
+    order), less the constant forces' work."""
+    sums = np.empty(3 + 2 * n_regions)
+    return sums if rows.part(positions=positions, velocities=velocities, spins=spins, sums=sums) else sums[:0]

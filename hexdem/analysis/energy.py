@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hexdem.analysis.compiled import audit_part, pairs_within
+from hexdem.analysis.compiled import audit_part, bind_audit, pairs_within
 from hexdem.model.granular import GranularModel
 from hexdem.model.walls import CurvedWall
 
@@ -95,11 +95,12 @@ def _wall_geometry(wall) -> tuple[int, tuple[float, float], float]:
     return 0, wall.normal, wall.offset_m
 
 
-def _wall_rows(walls, regions) -> tuple:
+def _wall_rows(walls, regions) -> dict[str, np.ndarray]:
     r"""The walls of :func:`_wall_constants` as :func:`~hexdem.analysis.compiled.audit_part` reads
-    them: per wall where its members start and end in the member arrays and its
-    :func:`_wall_geometry`; per member its row, radius, :math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}` and
-    its row's region (``regions``, by row)."""
+    them, by name: per wall where its members start and end in the member arrays (``bounds``) and its
+    :func:`_wall_geometry` (``curved``, ``points``, ``lengths``); per member its row, radius,
+    :math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}` (``wall_coefficient``) and its row's region
+    (``wall_regions``; ``regions``, by row)."""
     bounds = np.cumsum([0, *(len(wall[1]) for wall in walls)])
     curved, points, lengths = zip(*(_wall_geometry(wall[0]) for wall in walls)) if walls else ((), (), ())
 
@@ -107,9 +108,10 @@ def _wall_rows(walls, regions) -> tuple:
         return np.concatenate([np.zeros(0, dtype), *(np.asarray(wall[k], dtype) for wall in walls)])
 
     rows = joined(1, np.int64)
-    return (bounds.astype(np.int64), np.array(curved, np.int64), np.array(points, float).reshape(-1, 2),
-            np.array(lengths, float), rows, joined(3), 0.4 * joined(2) * np.sqrt(joined(4)),
-            regions[rows].astype(np.int64))
+    return {"bounds": bounds.astype(np.int64), "curved": np.array(curved, np.int64),
+            "points": np.array(points, float).reshape(-1, 2), "lengths": np.array(lengths, float), "rows": rows,
+            "radii": joined(3), "wall_coefficient": 0.4 * joined(2) * np.sqrt(joined(4)),
+            "wall_regions": regions[rows].astype(np.int64)}
 
 
 def _wall_energy_j(walls) -> float:
@@ -199,20 +201,22 @@ class EnergyAudit:
         if self.compiled:
             self._rows = self._row_constants(bodies, n_own)
 
-    def _row_constants(self, bodies, n_own: int) -> tuple:
-        r"""What :func:`~hexdem.analysis.compiled.audit_part` reads of the listed rows, laid out once
-        per list (see :mod:`hexdem.analysis.compiled`): per candidate pair its sum of radii, its
-        :math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}` and the regions of its two rows (−1 for a ghost); per audited
-        row its body's mass, inertia, region, start position and constant force; the walls' audited
-        members (:func:`_wall_rows`)."""
+    def _row_constants(self, bodies, n_own: int):
+        r"""What :func:`~hexdem.analysis.compiled.audit_part` reads of the listed rows, laid out and
+        bound once per list (:func:`~hexdem.analysis.compiled.bind_audit`): where they were listed and
+        half the skin; per candidate pair its rows, sum of radii, :math:`\tfrac{2}{5} k_n \sqrt{R_\text{eff}}`
+        and the regions of its two rows (−1 for a ghost); per audited row its body's mass, inertia,
+        region, start position and constant force; the walls' audited members (:func:`_wall_rows`)."""
         i, j, stiffness, r_eff = self._candidates
         regions = self.regions[bodies]
         own = np.where(np.arange(len(bodies)) < n_own, regions, -1)
-        pairs = (i, j, self.radii_m[bodies[i]] + self.radii_m[bodies[j]], 0.4 * stiffness * np.sqrt(r_eff), own[i], own[j])
         audited = bodies[:n_own]
-        rows = (self.masses_kg[audited], self.inertia_kg_m2[audited], regions[:n_own], self.start_m[audited],
-                self.external_n[audited])
-        return (*pairs, *rows, *_wall_rows(self._walls, regions))
+        return bind_audit(listed_at=self._listed_at, distance=self.skin_m / 2, i=i, j=j,
+                          contact_m=self.radii_m[bodies[i]] + self.radii_m[bodies[j]],
+                          coefficient=0.4 * stiffness * np.sqrt(r_eff), region_i=own[i], region_j=own[j],
+                          masses=self.masses_kg[audited], inertia=self.inertia_kg_m2[audited], regions=regions[:n_own],
+                          start=self.start_m[audited], external=self.external_n[audited],
+                          **_wall_rows(self._walls, regions), n_regions=len(self.region_names))
 
     def part(self, bodies, n_own: int, positions_m, velocities_m_s, angular_velocities_s=None) -> np.ndarray:
         """The audit's sums over the bodies ``bodies[:n_own]`` (indices; the rest are ghosts, see the
@@ -245,8 +249,7 @@ class EnergyAudit:
         spins = self._no_spins if angular_velocities_s is None else np.asarray(angular_velocities_s, float)
 
         def measure() -> np.ndarray:
-            return audit_part(positions_m, velocities_m_s, spins, self._listed_at, self.skin_m / 2, *self._rows,
-                              len(self.region_names))
+            return audit_part(self._rows, positions_m, velocities_m_s, spins, len(self.region_names))
 
         if not self._listed_for(bodies, n_own):
             self._list(bodies, n_own, positions_m)

@@ -42,10 +42,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from hexdem.analysis.compiled import sample_pulses
+from hexdem.analysis.compiled import BodiesReordered, bind_pulses, sample_pulses
 from hexdem.analysis.energy import EnergyAudit, energy_error, energy_scale_j, rotational_share
 from hexdem.analysis.peaks import noise_floor, refine_peak, refine_peaks
-from hexdem.analysis.tracker_kernel import RIVAL_RATIO, PulseState
+from hexdem.analysis.tracker_kernel import PulseState
 from hexdem.common.compiled import runs_compiled
 from hexdem.common.preload import load_in_background
 from hexdem.engines.sampling import Sample
@@ -136,6 +136,7 @@ class PulseTracker:
         self.threshold_speed = threshold_speed
         self.floor = run_noise_floor(model, settings)
         self.sample_ids, self.ids = None, np.zeros(0, dtype=np.int64)  # (no sample yet)
+        self.compiled = runs_compiled()
         self._start_rows(0)
         self.trace_beads = np.asarray(trace_beads, dtype=np.int64)
         self.traces = np.full((total, len(self.trace_beads)), np.nan)
@@ -147,7 +148,6 @@ class PulseTracker:
         self.field_set = frozenset(self.field_samples.tolist())
         self.field_parts = []
         self.energy_every = max(1, (total - 1) // ENERGY_SAMPLES)
-        self.compiled = runs_compiled()
         if not self.compiled:  # the NumPy audit's pair search, while the engine starts
             load_in_background("scipy.spatial")
         self.audit = EnergyAudit(model, gravity_m_s2, self.compiled)
@@ -167,6 +167,7 @@ class PulseTracker:
     def _start_rows(self, n: int) -> None:
         """State for ``n`` beads as before their first sample."""
         self.pulses = PulseState(n, RECORD_CAPACITY, self.floor)
+        self.pulse_arrays = bind_pulses(self.pulses) if self.compiled else None
         self.peak_spin, self.end_velocity = np.zeros(n), np.zeros((n, 2))
         self.threshold_index, self.previous_speed = np.full(n, np.nan), np.zeros(n)
 
@@ -251,32 +252,33 @@ class PulseTracker:
         self.count = s + 1
 
     def _take_sample(self, sample: Sample) -> np.ndarray | None:
-        """Take ``sample`` into the pulse state once its bodies are found to be the previous sample's,
-        in order (laid out by :meth:`_arrange` where it says they may have migrated); their velocities
-        become the beads' last seen (:attr:`end_velocity`). Returns the beads' speeds; compiled (one
-        pass, :func:`~hexdem.analysis.compiled.sample_pulses`, which takes most speeds only when the
-        tracker needs them) None, unless the whole sample's are wanted (a threshold's crossings, a
-        speed field)."""
+        """Take ``sample`` into the pulse state once its bodies are found to be the previous sample's, in order
+        (laid out by :meth:`_arrange` where it says they may have migrated); their velocities become the beads'
+        last seen (:attr:`end_velocity`). Returns the beads' speeds; compiled (one pass,
+        :func:`~hexdem.analysis.compiled.sample_pulses`, which takes most speeds only when the tracker needs
+        them) None, unless the whole sample's are wanted (a threshold's crossings, a speed field)."""
         s = sample.index
         if not self.compiled:
-            self._check_order(sample, np.array_equal(sample.ids, self.sample_ids))
+            if not np.array_equal(sample.ids, self.sample_ids):
+                raise self._reordered(sample)
             self.end_velocity[:] = sample.velocities[self.bead_rows]
             speeds = np.hypot(self.end_velocity[:, 0], self.end_velocity[:, 1])
             self.pulses.update(np.arange(len(self.ids)), speeds, s)
             return speeds
         wanted = self.threshold_speed is not None or s in self.field_set
         speeds = np.empty(len(self.ids) if wanted else 0)
-        complete = sample_pulses(np.asarray(sample.ids, np.int64), self.sample_ids, sample.velocities, self.bead_rows,
-                                 self.end_velocity, speeds, s, self.pulses.q, RIVAL_RATIO, *self.pulses.kernel_arrays())
-        self._check_order(sample, complete is not None)
-        self.pulses.challenge(complete)
+        try:
+            self.pulses.challenge(sample_pulses(self.pulse_arrays, ids=np.asarray(sample.ids, np.int64), s=s, speeds=speeds,
+                                                previous_ids=self.sample_ids, velocities=sample.velocities,
+                                                rows=self.bead_rows, end_velocity=self.end_velocity))
+        except BodiesReordered:
+            raise self._reordered(sample) from None
         return speeds if wanted else None
 
-    def _check_order(self, sample: Sample, same: bool) -> None:
-        """Refuse ``sample`` unless its bodies are found to be the previous sample's, in order (``same``)."""
-        if not same:
-            raise HexdemError(f"sample {sample.index} reordered the bodies of rank "
-                              f"{0 if self.comm is None else self.comm.Get_rank()} without saying that they may have migrated")
+    def _reordered(self, sample: Sample) -> HexdemError:
+        """The error for ``sample``, whose bodies are not the previous sample's, in order."""
+        return HexdemError(f"sample {sample.index} reordered the bodies of rank "
+                           f"{0 if self.comm is None else self.comm.Get_rank()} without saying that they may have migrated")
 
     def _cross_threshold(self, index: np.ndarray, speeds: np.ndarray, s: int) -> None:
         """Record, as a fractional sample index, where each bead's speed first reached the

@@ -61,7 +61,7 @@ from hexdem.analysis.peaks import PEAK_OVERSHOOT, may_overtake, refine_peaks
 #: A local maximum of the samples this many times the running maximum or above may overtake it
 #: (:func:`~hexdem.analysis.peaks.may_overtake`; the compiled update takes it as an argument).
 RIVAL_RATIO = 1 + PEAK_OVERSHOOT
-#: The state arrays a sample updates, bead first, in the order of the compiled update's arguments.
+#: The state arrays a sample updates, bead first.
 SAMPLED = ("ring", "peak", "peak_index", "window", "after", "start", "length", "rec_index", "rec_value", "rec_prev",
            "rec_prev2", "first_index", "first_value", "first_prev", "first_prev2", "rival", "rival_index", "rival_after")
 
@@ -115,10 +115,12 @@ class PulseState:
         return [*(getattr(self, name) for name in SAMPLED), self.ring_velocity, self.lazy_below, self.best_peak,
                 self.best_index, self.best_offset]
 
-    def kernel_arrays(self) -> list[np.ndarray]:
-        """The arrays :func:`~hexdem.analysis.compiled.sample_pulses` updates, as it reads them: the ring
-        and its velocities slot by slot, then the rest of :data:`SAMPLED`, then ``lazy_below``."""
-        return [self.ring_slots, *(getattr(self, name) for name in SAMPLED[1:]), self.velocity_slots, self.lazy_below]
+    def kernel_arrays(self) -> dict[str, np.ndarray]:
+        """The arrays :func:`~hexdem.analysis.compiled.sample_pulses` updates, by name: the ring and
+        its velocities slot by slot (``ring_slots``, ``velocity_slots``), the rest of :data:`SAMPLED`,
+        and ``lazy_below``."""
+        names = ("ring_slots", *SAMPLED[1:], "velocity_slots", "lazy_below")
+        return {name: getattr(self, name) for name in names}
 
     def update(self, beads, speeds, s: int) -> None:
         """Take sample ``s`` (speeds of ``beads``, distinct) into the state, in place."""

@@ -1,9 +1,9 @@
 /* The in-run analysis's per-sample arithmetic, compiled: plain C over a rank's rows, without
- * Python (module.c binds them to Python). Each computes what hexdem's NumPy code computes, in the
- * same order and without fast-math or contracted multiply-adds, so that every operation rounds as
- * NumPy's does (see hexdem/analysis/compiled.py). Arrays are C-ordered; (n, k) arrays are n rows of
- * k numbers. A kernel that finds an index outside its array returns -1 and leaves its outputs
- * incomplete. */
+ * Python (module.c binds them to Python, every argument by name: binding.h). Each computes what
+ * hexdem's NumPy code computes, in the same order and without fast-math or contracted multiply-adds,
+ * so that every operation rounds as NumPy's does (see hexdem/analysis/compiled.py). Arrays are
+ * C-ordered; (n, k) arrays are n rows of k numbers. A kernel that finds an index outside its array
+ * returns -1 and leaves its outputs incomplete. */
 #ifndef HEXDEM_KERNELS_H
 #define HEXDEM_KERNELS_H
 

@@ -1,274 +1,80 @@
-/* hexdem.common._kernels: the kernels of kernels.h as Python functions. Each takes NumPy arrays
- * (or any C-ordered buffers) of float64 and int64 of the shapes kernels.h gives, writes its outputs
- * into arrays it is handed, and raises TypeError for an array of another type, order or shape. */
-#define PY_SSIZE_T_CLEAN
-#include <Python.h>
+/* hexdem.common._kernels: the kernels of kernels.h as Python callables whose every argument is
+ * passed by name and checked by name, type and shape (binding.h): each kernel's table below names
+ * its arguments and the shapes they must have. The tracker's state and the audit's row constants
+ * are bound once (PulseArrays, AuditRows: objects that hold their arrays' buffers), and each sample
+ * passes only its own arrays. */
+#include "binding.h"
+
 #include <string.h>
 
 #include "kernels.h"
 
-#define MAX_ARGUMENTS 32
+/* ---- full_step_state and pairs_within: one call each */
 
-/* The buffers a call holds, released when it returns. */
 typedef struct {
-    Py_buffer views[MAX_ARGUMENTS];
-    int count;
-} Held;
-
-static void release(Held *held)
-{
-    for (int k = 0; k < held->count; k++)
-        PyBuffer_Release(&held->views[k]);
-    held->count = 0;
-}
-
-/* Whether a buffer's format is a native 8-byte float ('d') or integer ('l', 'q'). */
-static int has_type(const Py_buffer *view, char kind)
-{
-    const char *format = view->format ? view->format : "B";
-    if (*format == '@' || *format == '=')
-        format++;
-    if (view->itemsize != 8 || strlen(format) != 1)
-        return 0;
-    return kind == 'd' ? *format == 'd' : (*format == 'l' || *format == 'q');
-}
-
-/* Argument `position` as a C-ordered array of kind 'd' (float64) or 'q' (int64) with `columns`
- * numbers a row (0: one axis; -1: two axes of any width, written into *columns_out), at least
- * `min_rows` rows, writable if `writable`; its data and rows into *data and *rows. */
-static int take(Held *held, PyObject *const *args, int position, char kind, int columns, int writable,
-                Py_ssize_t min_rows, void **data, Py_ssize_t *rows, Py_ssize_t *columns_out)
-{
-    Py_buffer *view = &held->views[held->count];
-    int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable ? PyBUF_WRITABLE : 0);
-    if (PyObject_GetBuffer(args[position], view, flags) != 0) {
-        PyErr_Format(PyExc_TypeError, "argument %d: not a C-ordered%s array", position + 1,
-                     writable ? " writable" : "");
-        return -1;
-    }
-    held->count++;
-    int ndim = columns == 0 ? 1 : 2;
-    if (!has_type(view, kind) || view->ndim != ndim || (columns > 0 && view->shape[1] != columns)
-        || view->shape[0] < min_rows) {
-        PyErr_Format(PyExc_TypeError, "argument %d: expected %s %s of at least %zd rows", position + 1,
-                     kind == 'd' ? "float64" : "int64", ndim == 1 ? "(n,)" : "(n, k)", min_rows);
-        return -1;
-    }
-    *data = view->buf;
-    if (rows)
-        *rows = view->shape[0];
-    if (columns_out)
-        *columns_out = ndim == 2 ? view->shape[1] : 1;
-    return 0;
-}
-
-static int count_ok(Py_ssize_t nargs, Py_ssize_t expected, const char *name)
-{
-    if (nargs == expected)
-        return 1;
-    PyErr_Format(PyExc_TypeError, "%s takes %zd arguments (%zd given)", name, expected, nargs);
-    return 0;
-}
-
-static PyObject *index_error(const char *name)
-{
-    PyErr_Format(PyExc_IndexError, "%s: an index lies outside its array", name);
-    return NULL;
-}
-
-#define TAKE(position, kind, columns, writable, min_rows, data, rows)                                       \
-    if (take(&held, args, position, kind, columns, writable, min_rows, (void **)(data), rows, NULL) != 0)  \
-        goto fail;
-
-/* Argument `position` as a writable C-ordered float64 array of a ring's 3 slots, each of `width`
- * numbers: (3, width) exactly, the kernel's stride between slots. */
-static int take_slots(Held *held, PyObject *const *args, int position, Py_ssize_t width, double **data)
-{
-    Py_ssize_t rows, columns;
-    if (take(held, args, position, 'd', -1, 1, 3, (void **)data, &rows, &columns) != 0)
-        return -1;
-    if (rows != 3 || columns != width) {
-        PyErr_Format(PyExc_TypeError, "argument %d: expected float64 (3, %zd)", position + 1, width);
-        return -1;
-    }
-    return 0;
-}
-
-static PyObject *py_full_step_state(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
-{
-    Held held = {.count = 0};
     const double *positions, *velocities, *forces, *masses;
+    double half_dt;
     double *x, *v;
-    Py_ssize_t n;
-    if (!count_ok(nargs, 7, "full_step_state"))
+} FullStepCall;
+
+enum { FS_N, FS_SIZES };
+_Static_assert(FS_SIZES <= MAX_SIZES, "FS_SIZES: more than MAX_SIZES");
+static const char *const full_step_sizes[] = {"n"};
+static const Field full_step_fields[] = {
+    ARRAY("masses", 'd', FullStepCall, masses, SIZE(FS_N)),
+    ARRAY2("positions", 'd', FullStepCall, positions, SIZE_AT_LEAST(FS_N), FIXED(3)),
+    ARRAY2("velocities", 'd', FullStepCall, velocities, SIZE_AT_LEAST(FS_N), FIXED(3)),
+    ARRAY2("forces", 'd', FullStepCall, forces, SIZE_AT_LEAST(FS_N), FIXED(3)),
+    SCALAR("half_dt", 'f', FullStepCall, half_dt),
+    OUT2("x", 'd', FullStepCall, x, SIZE(FS_N), FIXED(2)),
+    OUT2("v", 'd', FullStepCall, v, SIZE(FS_N), FIXED(2)),
+};
+CHECKED(full_step_fields);
+static Table full_step_table = {"full_step_state", full_step_fields, COUNT(full_step_fields), full_step_sizes, NULL};
+
+static PyObject *py_full_step_state(PyObject *self, PyObject *const *args, Py_ssize_t nargs, PyObject *kwnames)
+{
+    Py_buffer views[COUNT(full_step_fields)];
+    Py_ssize_t sizes[MAX_SIZES];
+    FullStepCall c;
+    int held;
+    fresh_sizes(sizes);
+    if (bind_arguments(&full_step_table, args, nargs, kwnames, &c, views, &held, sizes) != 0)
         return NULL;
-    TAKE(3, 'd', 0, 0, 0, &masses, &n);
-    TAKE(0, 'd', 3, 0, n, &positions, NULL);
-    TAKE(1, 'd', 3, 0, n, &velocities, NULL);
-    TAKE(2, 'd', 3, 0, n, &forces, NULL);
-    TAKE(5, 'd', 2, 1, n, &x, NULL);
-    TAKE(6, 'd', 2, 1, n, &v, NULL);
-    double half_dt = PyFloat_AsDouble(args[4]);
-    if (half_dt == -1.0 && PyErr_Occurred())
-        goto fail;
-    full_step_state(n, positions, velocities, forces, masses, half_dt, x, v);
-    release(&held);
+    full_step_state(sizes[FS_N], c.positions, c.velocities, c.forces, c.masses, c.half_dt, c.x, c.v);
+    release_views(views, &held);
     Py_RETURN_NONE;
-fail:
-    release(&held);
-    return NULL;
 }
 
-static PyObject *py_sample_pulses(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
-{
-    Held held = {.count = 0};
-    SampleRows x;
-    PulseArrays a;
-    int64_t *complete;
-    Py_ssize_t n_ids, n_previous, n_velocities, n, n_speeds, capacity;
-    if (!count_ok(nargs, 30, "sample_pulses"))
-        return NULL;
-    TAKE(0, 'q', 0, 0, 0, &x.ids, &n_ids);
-    TAKE(1, 'q', 0, 0, 0, &x.previous_ids, &n_previous);
-    TAKE(2, 'd', 2, 0, 0, &x.velocities, &n_velocities);
-    TAKE(3, 'q', 0, 0, 0, &x.rows, &n);
-    TAKE(4, 'd', 2, 1, n, &x.end_velocity, NULL);
-    TAKE(5, 'd', 0, 1, 0, &x.speeds, &n_speeds);
-    if (n_speeds != 0 && n_speeds < n) {
-        PyErr_SetString(PyExc_TypeError, "sample_pulses: speeds neither empty nor one a row");
-        goto fail;
-    }
-    if (n_speeds == 0)
-        x.speeds = NULL;
-    x.n_ids = n_ids;
-    x.n_previous = n_previous;
-    x.n_velocities = n_velocities;
-    if (take(&held, args, 17, 'd', -1, 1, n, (void **)&a.rec_value, NULL, &capacity) != 0)
-        goto fail;
-    if (capacity < 1) {
-        PyErr_SetString(PyExc_TypeError, "sample_pulses: record ladders of no length");
-        goto fail;
-    }
-    a.n = n;
-    a.capacity = capacity;
-    if (take_slots(&held, args, 9, n, &a.ring) != 0 || take_slots(&held, args, 27, 2 * n, &a.ring_velocity) != 0)
-        goto fail;
-    TAKE(10, 'd', 0, 1, n, &a.peak, NULL);
-    TAKE(11, 'q', 0, 1, n, &a.peak_index, NULL);
-    TAKE(12, 'd', 7, 1, n, &a.window, NULL);
-    TAKE(13, 'q', 0, 1, n, &a.after, NULL);
-    TAKE(14, 'q', 0, 1, n, &a.start, NULL);
-    TAKE(15, 'q', 0, 1, n, &a.length, NULL);
-    TAKE(16, 'q', (int)capacity, 1, n, &a.rec_index, NULL);
-    TAKE(18, 'd', (int)capacity, 1, n, &a.rec_prev, NULL);
-    TAKE(19, 'd', (int)capacity, 1, n, &a.rec_prev2, NULL);
-    TAKE(20, 'q', (int)capacity, 1, n, &a.first_index, NULL);
-    TAKE(21, 'd', (int)capacity, 1, n, &a.first_value, NULL);
-    TAKE(22, 'd', (int)capacity, 1, n, &a.first_prev, NULL);
-    TAKE(23, 'd', (int)capacity, 1, n, &a.first_prev2, NULL);
-    TAKE(24, 'd', 7, 1, n, &a.rival, NULL);
-    TAKE(25, 'q', 0, 1, n, &a.rival_index, NULL);
-    TAKE(26, 'q', 0, 1, n, &a.rival_after, NULL);
-    TAKE(28, 'd', 0, 1, n, &a.lazy_below, NULL);
-    TAKE(29, 'q', 0, 1, n, &complete, NULL);
-    long long s = PyLong_AsLongLong(args[6]);
-    double q = PyFloat_AsDouble(args[7]), rival_ratio = PyFloat_AsDouble(args[8]);
-    if (PyErr_Occurred())
-        goto fail;
-    int64_t count = sample_pulses(&x, s, q, rival_ratio, &a, complete);
-    release(&held);
-    if (count == -1)
-        return index_error("sample_pulses");
-    if (count == -2)
-        Py_RETURN_NONE;
-    return PyLong_FromLongLong(count);
-fail:
-    release(&held);
-    return NULL;
-}
-
-static PyObject *py_audit_part(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
-{
-    Held held = {.count = 0};
-    AuditRows a;
-    double *sums;
-    Py_ssize_t n_rows, n_own, n_spins, n_pairs, n_walls, n_members;
-    if (!count_ok(nargs, 26, "audit_part"))
-        return NULL;
-    a.n_regions = PyLong_AsLongLong(args[24]);
-    a.distance = PyFloat_AsDouble(args[4]);
-    if (PyErr_Occurred())
-        goto fail;
-    if (a.n_regions < 0) {
-        PyErr_SetString(PyExc_ValueError, "audit_part: a negative count of regions");
-        goto fail;
-    }
-    TAKE(0, 'd', 2, 0, 0, &a.positions, &n_rows);
-    TAKE(3, 'd', 2, 0, n_rows, &a.listed_at, NULL);
-    TAKE(11, 'd', 0, 0, 0, &a.masses, &n_own);
-    TAKE(1, 'd', 2, 0, n_own, &a.velocities, NULL);
-    TAKE(2, 'd', 0, 0, 0, &a.spins, &n_spins);
-    TAKE(5, 'q', 0, 0, 0, &a.i, &n_pairs);
-    TAKE(6, 'q', 0, 0, n_pairs, &a.j, NULL);
-    TAKE(7, 'd', 0, 0, n_pairs, &a.contact_m, NULL);
-    TAKE(8, 'd', 0, 0, n_pairs, &a.coefficient, NULL);
-    TAKE(9, 'q', 0, 0, n_pairs, &a.region_i, NULL);
-    TAKE(10, 'q', 0, 0, n_pairs, &a.region_j, NULL);
-    TAKE(12, 'd', 0, 0, n_own, &a.inertia, NULL);
-    TAKE(13, 'q', 0, 0, n_own, &a.regions, NULL);
-    TAKE(14, 'd', 2, 0, n_own, &a.start, NULL);
-    TAKE(15, 'd', 2, 0, n_own, &a.external, NULL);
-    TAKE(17, 'q', 0, 0, 0, &a.curved, &n_walls);
-    TAKE(16, 'q', 0, 0, n_walls + 1, &a.bounds, NULL);
-    TAKE(18, 'd', 2, 0, n_walls, &a.points, NULL);
-    TAKE(19, 'd', 0, 0, n_walls, &a.lengths, NULL);
-    TAKE(20, 'q', 0, 0, 0, &a.rows, &n_members);
-    TAKE(21, 'd', 0, 0, n_members, &a.radii, NULL);
-    TAKE(22, 'd', 0, 0, n_members, &a.wall_coefficient, NULL);
-    TAKE(23, 'q', 0, 0, n_members, &a.wall_regions, NULL);
-    TAKE(25, 'd', 0, 1, 3 + 2 * a.n_regions, &sums, NULL);
-    if (n_spins && n_spins < n_own) {
-        PyErr_SetString(PyExc_TypeError, "audit_part: fewer spins than audited rows");
-        goto fail;
-    }
-    for (Py_ssize_t w = 0; w < n_walls; w++)
-        if (a.bounds[w] < 0 || a.bounds[w] > a.bounds[w + 1] || a.bounds[w + 1] > n_members) {
-            release(&held);
-            return index_error("audit_part");
-        }
-    a.n_rows = n_rows;
-    a.n_spins = n_spins;
-    a.n_own = n_own;
-    a.n_pairs = n_pairs;
-    a.n_walls = n_walls;
-    int status = audit_part(&a, sums);
-    release(&held);
-    if (status == -1)
-        return index_error("audit_part");
-    if (status == -2)
-        return PyErr_NoMemory();
-    return PyBool_FromLong(status);
-fail:
-    release(&held);
-    return NULL;
-}
-
-static PyObject *py_pairs_within(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
-{
-    Held held = {.count = 0};
+typedef struct {
     const double *positions;
+    double cutoff;
     int64_t *i, *j;
-    Py_ssize_t n, capacity;
-    if (!count_ok(nargs, 4, "pairs_within"))
+} PairsCall;
+
+enum { PW_N, PW_CAPACITY, PW_SIZES };
+_Static_assert(PW_SIZES <= MAX_SIZES, "PW_SIZES: more than MAX_SIZES");
+static const char *const pairs_sizes[] = {"n", "capacity"};
+static const Field pairs_fields[] = {
+    ARRAY2("positions", 'd', PairsCall, positions, SIZE(PW_N), FIXED(2)),
+    SCALAR("cutoff", 'f', PairsCall, cutoff),
+    OUT("i", 'q', PairsCall, i, SIZE(PW_CAPACITY)),
+    OUT("j", 'q', PairsCall, j, SIZE(PW_CAPACITY)),
+};
+CHECKED(pairs_fields);
+static Table pairs_table = {"pairs_within", pairs_fields, COUNT(pairs_fields), pairs_sizes, NULL};
+
+static PyObject *py_pairs_within(PyObject *self, PyObject *const *args, Py_ssize_t nargs, PyObject *kwnames)
+{
+    Py_buffer views[COUNT(pairs_fields)];
+    Py_ssize_t sizes[MAX_SIZES];
+    PairsCall c;
+    int held;
+    fresh_sizes(sizes);
+    if (bind_arguments(&pairs_table, args, nargs, kwnames, &c, views, &held, sizes) != 0)
         return NULL;
-    TAKE(0, 'd', 2, 0, 0, &positions, &n);
-    TAKE(2, 'q', 0, 1, 0, &i, &capacity);
-    TAKE(3, 'q', 0, 1, capacity, &j, NULL);
-    double cutoff = PyFloat_AsDouble(args[1]);
-    if (cutoff == -1.0 && PyErr_Occurred())
-        goto fail;
-    int64_t found = pairs_within(n, positions, cutoff, capacity, i, j);
-    release(&held);
+    int64_t found = pairs_within(sizes[PW_N], c.positions, c.cutoff, sizes[PW_CAPACITY], c.i, c.j);
+    release_views(views, &held);
     if (found == -1)
         return PyErr_NoMemory();
     if (found == -2) {
@@ -276,22 +82,272 @@ static PyObject *py_pairs_within(PyObject *self, PyObject *const *args, Py_ssize
         return NULL;
     }
     return PyLong_FromLongLong(found);
-fail:
-    release(&held);
-    return NULL;
 }
 
+/* ---- PulseArrays: the tracker's state, and its sample */
+
+/* Raised, with the state as it was, for a sample whose ids are not the previous sample's. */
+static PyObject *BodiesReordered;
+
+typedef struct {
+    PulseArrays a;
+    double q, rival_ratio;
+} PulseBinding;
+
+typedef struct {
+    SampleRows x;
+    int64_t *complete;
+    int64_t s;
+} SampleCall;
+
+enum { P_N, P_CAPACITY, P_IDS, P_PREVIOUS, P_VELOCITIES, P_SPEEDS, P_SIZES };
+_Static_assert(P_SIZES <= MAX_SIZES, "P_SIZES: more than MAX_SIZES");
+static const char *const pulse_sizes[] = {"n", "capacity", "n_ids", "n_previous", "n_velocities", "n_speeds"};
+#define P_STATE(name, kind, member) ARRAY(name, kind, PulseBinding, a.member, SIZE(P_N))
+#define P_ROWS(name, kind, columns, member) ARRAY2(name, kind, PulseBinding, a.member, SIZE(P_N), columns)
+static const Field pulse_fields[] = {
+    P_STATE("peak", 'd', peak),
+    P_ROWS("rec_value", 'd', SIZE(P_CAPACITY), rec_value),
+    ARRAY2("ring_slots", 'd', PulseBinding, a.ring, FIXED(3), SIZE(P_N)),
+    ARRAY2("velocity_slots", 'd', PulseBinding, a.ring_velocity, FIXED(3), {P_N, 2, 0, EXACT}),
+    P_STATE("peak_index", 'q', peak_index),
+    P_ROWS("window", 'd', FIXED(7), window),
+    P_STATE("after", 'q', after),
+    P_STATE("start", 'q', start),
+    P_STATE("length", 'q', length),
+    P_ROWS("rec_index", 'q', SIZE(P_CAPACITY), rec_index),
+    P_ROWS("rec_prev", 'd', SIZE(P_CAPACITY), rec_prev),
+    P_ROWS("rec_prev2", 'd', SIZE(P_CAPACITY), rec_prev2),
+    P_ROWS("first_index", 'q', SIZE(P_CAPACITY), first_index),
+    P_ROWS("first_value", 'd', SIZE(P_CAPACITY), first_value),
+    P_ROWS("first_prev", 'd', SIZE(P_CAPACITY), first_prev),
+    P_ROWS("first_prev2", 'd', SIZE(P_CAPACITY), first_prev2),
+    P_ROWS("rival", 'd', FIXED(7), rival),
+    P_STATE("rival_index", 'q', rival_index),
+    P_STATE("rival_after", 'q', rival_after),
+    P_STATE("lazy_below", 'd', lazy_below),
+    SCALAR("q", 'f', PulseBinding, q),
+    SCALAR("rival_ratio", 'f', PulseBinding, rival_ratio),
+};
+static const Field sample_fields[] = {
+    ARRAY("ids", 'q', SampleCall, x.ids, SIZE(P_IDS)),
+    ARRAY("previous_ids", 'q', SampleCall, x.previous_ids, SIZE(P_PREVIOUS)),
+    ARRAY2("velocities", 'd', SampleCall, x.velocities, SIZE(P_VELOCITIES), FIXED(2)),
+    ARRAY("rows", 'q', SampleCall, x.rows, SIZE(P_N)),
+    OUT2("end_velocity", 'd', SampleCall, x.end_velocity, SIZE(P_N), FIXED(2)),
+    {"speeds", 'd', 1, {{P_N, 1, 0, EMPTY_OR_AT_LEAST}, FIXED(0)}, 1, offsetof(SampleCall, x.speeds), P_SPEEDS},
+    OUT("complete", 'q', SampleCall, complete, SIZE(P_N)),
+    SCALAR("s", 'i', SampleCall, s),
+};
+CHECKED(pulse_fields);
+static Table pulse_table = {"PulseArrays", pulse_fields, COUNT(pulse_fields), pulse_sizes, NULL};
+CHECKED(sample_fields);
+static Table sample_table = {"PulseArrays.sample", sample_fields, COUNT(sample_fields), pulse_sizes, NULL};
+
+typedef struct {
+    Bound head;
+    PulseBinding c;
+    Py_buffer views[COUNT(pulse_fields)];
+} PulsesObject;
+
+
+static PyObject *pulses_sample(PyObject *self, PyObject *const *args, Py_ssize_t nargs, PyObject *kwnames)
+{
+    PulsesObject *bound = (PulsesObject *)self;
+    Py_buffer views[COUNT(sample_fields)];
+    Py_ssize_t sizes[MAX_SIZES];
+    SampleCall c;
+    int held;
+    memcpy(sizes, bound->head.sizes, sizeof sizes);
+    if (bind_arguments(&sample_table, args, nargs, kwnames, &c, views, &held, sizes) != 0)
+        return NULL;
+    c.x.n_ids = sizes[P_IDS];
+    c.x.n_previous = sizes[P_PREVIOUS];
+    c.x.n_velocities = sizes[P_VELOCITIES];
+    if (sizes[P_SPEEDS] == 0)
+        c.x.speeds = NULL;
+    int64_t count = sample_pulses(&c.x, c.s, bound->c.q, bound->c.rival_ratio, &bound->c.a, c.complete);
+    release_views(views, &held);
+    if (count == -1)
+        return index_error("PulseArrays.sample");
+    if (count == -2) {
+        PyErr_SetString(BodiesReordered, "PulseArrays.sample: the sample's ids are not previous_ids");
+        return NULL;
+    }
+    return PyLong_FromLongLong(count);
+}
+
+/* ---- AuditRows: the audit's row constants, and a sample's audit */
+
+typedef struct {
+    AuditRows a;
+} AuditBinding;
+
+typedef struct {
+    const double *positions, *velocities, *spins;
+    double *sums;
+} AuditCall;
+
+enum { A_ROWS, A_OWN, A_PAIRS, A_WALLS, A_MEMBERS, A_SPINS, A_SUMS, A_SIZES };
+_Static_assert(A_SIZES <= MAX_SIZES, "A_SIZES: more than MAX_SIZES");
+static const char *const audit_sizes[] = {"n_rows", "n_own", "n_pairs", "n_walls", "n_members", "n_spins", "n_sums"};
+#define A_ARRAY(name, kind, size, member) ARRAY(name, kind, AuditBinding, a.member, SIZE(size))
+static const Field audit_fields[] = {
+    ARRAY2("listed_at", 'd', AuditBinding, a.listed_at, SIZE(A_ROWS), FIXED(2)),
+    SCALAR("distance", 'f', AuditBinding, a.distance),
+    A_ARRAY("i", 'q', A_PAIRS, i),
+    A_ARRAY("j", 'q', A_PAIRS, j),
+    A_ARRAY("contact_m", 'd', A_PAIRS, contact_m),
+    A_ARRAY("coefficient", 'd', A_PAIRS, coefficient),
+    A_ARRAY("region_i", 'q', A_PAIRS, region_i),
+    A_ARRAY("region_j", 'q', A_PAIRS, region_j),
+    A_ARRAY("masses", 'd', A_OWN, masses),
+    A_ARRAY("inertia", 'd', A_OWN, inertia),
+    A_ARRAY("regions", 'q', A_OWN, regions),
+    ARRAY2("start", 'd', AuditBinding, a.start, SIZE(A_OWN), FIXED(2)),
+    ARRAY2("external", 'd', AuditBinding, a.external, SIZE(A_OWN), FIXED(2)),
+    A_ARRAY("curved", 'q', A_WALLS, curved),
+    ARRAY("bounds", 'q', AuditBinding, a.bounds, {A_WALLS, 1, 1, EXACT}),
+    ARRAY2("points", 'd', AuditBinding, a.points, SIZE(A_WALLS), FIXED(2)),
+    A_ARRAY("lengths", 'd', A_WALLS, lengths),
+    A_ARRAY("rows", 'q', A_MEMBERS, rows),
+    A_ARRAY("radii", 'd', A_MEMBERS, radii),
+    A_ARRAY("wall_coefficient", 'd', A_MEMBERS, wall_coefficient),
+    A_ARRAY("wall_regions", 'q', A_MEMBERS, wall_regions),
+    SCALAR("n_regions", 'i', AuditBinding, a.n_regions),
+};
+static const Field part_fields[] = {
+    ARRAY2("positions", 'd', AuditCall, positions, SIZE(A_ROWS), FIXED(2)),
+    ARRAY2("velocities", 'd', AuditCall, velocities, SIZE_AT_LEAST(A_OWN), FIXED(2)),
+    {"spins", 'd', 1, {{A_OWN, 1, 0, EMPTY_OR_AT_LEAST}, FIXED(0)}, 0, offsetof(AuditCall, spins), A_SPINS},
+    OUT("sums", 'd', AuditCall, sums, SIZE(A_SUMS)),
+};
+CHECKED(audit_fields);
+static Table audit_table = {"AuditRows", audit_fields, COUNT(audit_fields), audit_sizes, NULL};
+CHECKED(part_fields);
+static Table part_table = {"AuditRows.part", part_fields, COUNT(part_fields), audit_sizes, NULL};
+
+typedef struct {
+    Bound head;
+    AuditBinding c;
+    Py_buffer views[COUNT(audit_fields)];
+} AuditObject;
+
+static PyObject *audit_part_of(PyObject *self, PyObject *const *args, Py_ssize_t nargs, PyObject *kwnames)
+{
+    AuditObject *bound = (AuditObject *)self;
+    Py_buffer views[COUNT(part_fields)];
+    Py_ssize_t sizes[MAX_SIZES];
+    AuditCall c;
+    int held;
+    memcpy(sizes, bound->head.sizes, sizeof sizes);
+    if (bind_arguments(&part_table, args, nargs, kwnames, &c, views, &held, sizes) != 0)
+        return NULL;
+    if (sizes[A_SUMS] != 3 + 2 * bound->c.a.n_regions) {
+        PyErr_Format(PyExc_TypeError, "AuditRows.part: sums: expected float64 (3 + 2 n_regions,) = (%lld,)",
+                     (long long)(3 + 2 * bound->c.a.n_regions));
+        release_views(views, &held);
+        return NULL;
+    }
+    AuditRows a = bound->c.a;
+    a.positions = c.positions;
+    a.velocities = c.velocities;
+    a.spins = c.spins;
+    a.n_spins = sizes[A_SPINS];
+    int status = audit_part(&a, c.sums);
+    release_views(views, &held);
+    if (status == -1)
+        return index_error("AuditRows.part");
+    if (status == -2)
+        return PyErr_NoMemory();
+    return PyBool_FromLong(status);
+}
+
+static PyObject *pulses_new(PyTypeObject *type, PyObject *args, PyObject *kwargs)
+{
+    PyObject *self = bound_new(type, args, kwargs, &pulse_table, offsetof(PulsesObject, c),
+                               offsetof(PulsesObject, views));
+    if (self && ((PulsesObject *)self)->head.sizes[P_CAPACITY] < 1) {
+        PyErr_SetString(PyExc_TypeError, "PulseArrays: record ladders of no length (capacity 0)");
+        Py_CLEAR(self);
+    }
+    if (self) {
+        PulsesObject *pulses = (PulsesObject *)self;
+        pulses->c.a.n = pulses->head.sizes[P_N];
+        pulses->c.a.capacity = pulses->head.sizes[P_CAPACITY];
+    }
+    return self;
+}
+
+static PyObject *audit_new(PyTypeObject *type, PyObject *args, PyObject *kwargs)
+{
+    PyObject *self = bound_new(type, args, kwargs, &audit_table, offsetof(AuditObject, c),
+                               offsetof(AuditObject, views));
+    if (!self)
+        return NULL;
+    AuditObject *audit = (AuditObject *)self;
+    AuditRows *a = &audit->c.a;
+    const Py_ssize_t *sizes = audit->head.sizes;
+    if (a->n_regions < 0) {
+        PyErr_SetString(PyExc_ValueError, "AuditRows: n_regions: a negative count of regions");
+        Py_DECREF(self);
+        return NULL;
+    }
+    a->n_rows = sizes[A_ROWS];
+    a->n_own = sizes[A_OWN];
+    a->n_pairs = sizes[A_PAIRS];
+    a->n_walls = sizes[A_WALLS];
+    for (Py_ssize_t w = 0; w < a->n_walls; w++)
+        if (a->bounds[w] < 0 || a->bounds[w] > a->bounds[w + 1] || a->bounds[w + 1] > sizes[A_MEMBERS]) {
+            Py_DECREF(self);
+            return index_error("AuditRows: bounds");
+        }
+    return self;
+}
+
+static PyMethodDef pulses_methods[] = {
+    {"sample", (PyCFunction)(void (*)(void))pulses_sample, METH_FASTCALL | METH_KEYWORDS,
+     "sample(ids, previous_ids, velocities, rows, end_velocity, speeds, complete, s), all by name -> the count "
+     "of rows written into complete; BodiesReordered if ids are not previous_ids (the state as it was)."},
+    {NULL, NULL, 0, NULL},
+};
+
+static PyMethodDef audit_methods[] = {
+    {"part", (PyCFunction)(void (*)(void))audit_part_of, METH_FASTCALL | METH_KEYWORDS,
+     "part(positions, velocities, spins, sums), all by name -> False if the contacts must be listed again, "
+     "else True with sums written."},
+    {NULL, NULL, 0, NULL},
+};
+
+static PyTypeObject PulsesType = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "hexdem.common._kernels.PulseArrays",
+    .tp_basicsize = sizeof(PulsesObject),
+    .tp_dealloc = bound_dealloc,
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = "PulseArrays(the state's arrays, q, rival_ratio), all by name: the pulse tracker's state, its arrays "
+              "checked and held; sample() takes a sample into it.",
+    .tp_methods = pulses_methods,
+    .tp_new = pulses_new,
+};
+
+static PyTypeObject AuditType = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "hexdem.common._kernels.AuditRows",
+    .tp_basicsize = sizeof(AuditObject),
+    .tp_dealloc = bound_dealloc,
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = "AuditRows(listed_at, distance, the row constants, n_regions), all by name: what the energy audit "
+              "reads of a listing, checked and held; part() audits a sample.",
+    .tp_methods = audit_methods,
+    .tp_new = audit_new,
+};
+
 static PyMethodDef methods[] = {
-    {"pairs_within", (PyCFunction)(void (*)(void))py_pairs_within, METH_FASTCALL,
-     "pairs_within(positions, cutoff, i, j) -> the count of pairs within cutoff, the first len(i) written into i, j."},
-    {"full_step_state", (PyCFunction)(void (*)(void))py_full_step_state, METH_FASTCALL,
-     "full_step_state(positions, velocities, forces, masses, half_dt, x, v): the full-step sample into x, v."},
-    {"sample_pulses", (PyCFunction)(void (*)(void))py_sample_pulses, METH_FASTCALL,
-     "sample_pulses(ids, previous_ids, velocities, rows, end_velocity, speeds, s, q, rival_ratio, *state_arrays, "
-     "complete) -> the count of rows written into complete, or None if ids are not previous_ids."},
-    {"audit_part", (PyCFunction)(void (*)(void))py_audit_part, METH_FASTCALL,
-     "audit_part(positions, velocities, spins, listed_at, distance, *row_constants, n_regions, sums) -> "
-     "False if the contacts must be listed again, else True with sums written."},
+    {"pairs_within", (PyCFunction)(void (*)(void))py_pairs_within, METH_FASTCALL | METH_KEYWORDS,
+     "pairs_within(positions, cutoff, i, j), all by name -> the count of pairs within cutoff, the first len(i) "
+     "written into i, j."},
+    {"full_step_state", (PyCFunction)(void (*)(void))py_full_step_state, METH_FASTCALL | METH_KEYWORDS,
+     "full_step_state(masses, positions, velocities, forces, half_dt, x, v), all by name: the full-step sample "
+     "into x, v."},
     {NULL, NULL, 0, NULL},
 };
 
@@ -300,5 +356,23 @@ static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_kernels",
 
 PyMODINIT_FUNC PyInit__kernels(void)
 {
-    return PyModule_Create(&module);
+    Table *tables[] = {&full_step_table, &pairs_table, &pulse_table, &sample_table, &audit_table, &part_table};
+    for (size_t t = 0; t < sizeof tables / sizeof tables[0]; t++)
+        if (!tables[t]->names && intern_names(tables[t]) != 0)
+            return NULL;
+    if (PyType_Ready(&PulsesType) < 0 || PyType_Ready(&AuditType) < 0)
+        return NULL;
+    if (!BodiesReordered
+        && !(BodiesReordered = PyErr_NewException("hexdem.common._kernels.BodiesReordered", PyExc_ValueError, NULL)))
+        return NULL;
+    PyObject *m = PyModule_Create(&module);
+    if (!m)
+        return NULL;
+    if (PyModule_AddObjectRef(m, "PulseArrays", (PyObject *)&PulsesType) < 0
+        || PyModule_AddObjectRef(m, "AuditRows", (PyObject *)&AuditType) < 0
+        || PyModule_AddObjectRef(m, "BodiesReordered", BodiesReordered) < 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
+    return m;
 }
