@@ -20,6 +20,11 @@ noise of ``--noise`` m/s² rms and a clock offset drawn in [0, 5] ms
   the next iteration's from a Gaussian mixture fitted to the weighted sets (one component per
   set, the weighted covariance as bandwidth); ``FILTER_ITERATIONS`` iterations.
 
+**A simulation's cost** (``--cost N``): N simulations of the quick case, one after another in
+this process after one to warm up (as a worker runs them), each timed whole (configuration,
+LAMMPS, the sensors' reduction, its folder written) beside its LAMMPS loop (the log's "Loop
+time"); the target: at most the loop plus 0.3 s.
+
 For every truth and method the table gives the simulations, the wall time, each key's 90 %
 interval width over the prior's and whether it holds the truth; the last rows count, per
 method and key, the truths inside their 90 % interval (the target: at least 7 of 10).
@@ -37,11 +42,11 @@ from pathlib import Path
 import numpy as np
 from machine import describe
 
-from hexdem.calibration import inference
 from hexdem.calibration.priors import Prior, to_parameters
-from hexdem.calibration.simulations import simulate_point
+from hexdem.calibration.simulations import Problem, simulate_point
 from hexdem.calibration.study import calibrate, prepare
 from hexdem.calibration.synthetic import synthetic_rows, write_measured
+from hexdem.engines.lammps.standalone import loop_time_s
 from hexdem.experiments.executors import run_phase
 from hexdem.model.config import RunConfig
 
@@ -57,6 +62,7 @@ def truth_record(base: dict, priors, rng, noise: float, path: Path) -> np.ndarra
     truth = to_parameters(priors, unit[None])[0]
     config = RunConfig.from_dict(base | {prior.key: float(v) for prior, v in zip(priors, truth)})
     write_measured(path, synthetic_rows(config, "0", noise, float(rng.uniform(0, 5e-3)), rng))
+    (path.parent / "truth.json").write_text(json.dumps({prior.key: float(v) for prior, v in zip(priors, truth)}))
     return truth
 
 
@@ -96,6 +102,31 @@ def run_filter(calibration, out: Path, workers: int, seed: int) -> tuple[np.ndar
         unit = np.clip(chosen + rng.multivariate_normal(np.zeros(p), bandwidth, FILTER_SAMPLES), 1e-6, 1 - 1e-6)
 
 
+def simulation_cost(count: int, root: Path) -> None:
+    """The table of ``--cost``: each simulation's whole time beside its LAMMPS loop."""
+    base, prior_texts = QUICK_CASE
+    problem = prepare_problem(base, prior_texts)
+    rng = np.random.default_rng(0)
+    print("| simulation | whole s | LAMMPS loop s | whole - loop s |")
+    print("|---|---|---|---|")
+    extra = []
+    for i in range(count + 1):
+        values = to_parameters(problem.priors, rng.random((1, len(problem.priors))))[0]
+        folder = root / f"cost-{i:03d}"
+        start = time.perf_counter()
+        simulate_point(problem, values.tolist(), str(folder))
+        whole = time.perf_counter() - start
+        loop = loop_time_s(folder / "deck" / "log.lammps")
+        if i:
+            extra.append(whole - loop)
+            print(f"| {i} | {whole:.3f} | {loop:.3f} | {whole - loop:.3f} |", flush=True)
+    print(f"median beyond the loop: {np.median(extra):.3f} s (target at most 0.3 s)")
+
+
+def prepare_problem(base: dict, prior_texts) -> Problem:
+    return Problem(base, tuple(Prior.parse(text) for text in prior_texts))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--truths", type=int, default=10)
@@ -105,7 +136,12 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=2026)
     parser.add_argument("--out", help="keep the calibrations here (default: a temporary folder)")
     parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--cost", type=int, metavar="N", help="time N simulations against their LAMMPS loop, only")
     args = parser.parse_args()
+    if args.cost:
+        print(describe())
+        simulation_cost(args.cost, Path(args.out or tempfile.mkdtemp(prefix="hexdem-bench-cost-")))
+        return
     base, prior_texts = TINY_CASE if args.quick else QUICK_CASE
     truths = 1 if args.quick else args.truths
     methods = args.methods.split(",")
