@@ -17,9 +17,9 @@ The Python API (:mod:`hexdem.api`) is available here and imported on first use, 
 import os
 
 #: One BLAS thread. hexdem's linear algebra is small (fits of a few parameters, barycentric
-#: transforms of a few hundred triangles), and OpenBLAS's pool of spinning threads made it 20
-#: times slower whenever the other core was busy (measured: the default run's front-shape
-#: analysis 3.9 s instead of 0.18 s beside a second process; LAMMPS ranks are such processes).
+#: transforms of a few hundred triangles), and OpenBLAS's pool of spinning threads slows it many
+#: times over whenever another process, a LAMMPS rank for one, holds the other core
+#: (docs/validation/benchmarks.md, *Figures behind choices in the code*).
 #: Set here, before NumPy loads its BLAS; a value the user set is kept.
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 

@@ -5,16 +5,13 @@ candidate pairs each, in C (``hexdem/common/kernels``, built when hexdem is inst
 They compute what the NumPy code of :class:`~hexdem.analysis.tracker_kernel.PulseState` and
 :class:`~hexdem.analysis.energy.EnergyAudit` computes, in the same order: the tests hold the
 tracker's results equal to the bit and the energies to round-off (:math:`δ^{5/2}` is taken as
-:math:`δ^2 \sqrt{δ}`; sums run body by body where NumPy's go in pairs). The NumPy code indexes
-arrays of beads and pairs, which at 29,701 beads cost about 300 ns per bead per sample for the
-tracker and 480 ns per bead per audited sample for the audit, where one compiled pass over a
-bead's few numbers takes a few nanoseconds.
+:math:`δ^2 \sqrt{δ}`; sums run body by body where NumPy's go in pairs). The NumPy code defines
+their results; every run uses the kernels (:mod:`hexdem.common.compiled`), since one pass over a
+bead's few numbers costs less than NumPy's indexing of whole arrays at every size.
 
 Compiled without fast-math or contracted multiply-adds, so that each operation rounds as
-NumPy's does. C rather than numba: loading numba and its cached kernels took 0.7 to 0.8 s of
-each MPI rank's start (29,701 beads on 2 ranks of a 2-core machine, where no core is left to
-hide it), as much as the analysis of the whole run; the C kernels load in a millisecond. Every
-run uses them (:mod:`hexdem.common.compiled`); the NumPy code defines their results.
+NumPy's does. C rather than numba because numba's load at each MPI rank's start cost as much as
+the whole run's analysis (measurements: docs/validation/benchmarks.md, *C instead of numba*).
 """
 
 from __future__ import annotations
@@ -30,9 +27,8 @@ BodiesReordered = _kernels.BodiesReordered
 
 def pairs_within(positions, cutoff: float) -> tuple[np.ndarray, np.ndarray]:
     """The pairs ``(i, j)``, i < j, of rows of ``positions`` (n, 2) no farther apart than ``cutoff``:
-    those of :meth:`scipy.spatial.cKDTree.query_pairs` (in another order), by a cell list. A rank
-    that takes this search rather than scipy's does not import ``scipy.spatial``, 0.5 s of CPU at
-    its start (on 2 ranks of 2 cores, a core's time that LAMMPS's set-up waited for)."""
+    those of :meth:`scipy.spatial.cKDTree.query_pairs` (in another order), by a cell list, so that a
+    rank does not import ``scipy.spatial`` at its start."""
     positions = np.ascontiguousarray(positions, float)
     i, j = (np.empty(4 * len(positions) + 16, np.int64) for _ in range(2))
     found = _kernels.pairs_within(positions=positions, cutoff=cutoff, i=i, j=j)
@@ -61,8 +57,7 @@ def sample_pulses(pulses: _kernels.PulseArrays, *, ids, previous_ids, velocities
     rival's margin, at a relative 1e-9) with no window open (its sum of squares below its
     ``lazy_below``, which the pass keeps): such a row's sample only enters its ring, as its
     velocity (``ring_velocity``, the speed −1), and its hypot, the pass's dearest
-    arithmetic (20 ns against 1.5 for the squares' sum), is taken only if a window comes to
-    need it. With ``speeds`` wanted, every row's is taken.
+    arithmetic, is taken only if a window comes to need it. With ``speeds`` wanted, every row's is taken.
 
     Returns the rows whose rival window is complete, for
     :meth:`~hexdem.analysis.tracker_kernel.PulseState.challenge`. Raises
@@ -94,7 +89,7 @@ def audit_part(rows: _kernels.AuditRows, positions, velocities, spins, n_regions
       of its rows' regions (a ghost's half is not audited here), the i sides' halves pair by pair,
       then the j sides' (:func:`~hexdem.analysis.energy._pair_energies_j`); a pair apart adds +0
       rather than being skipped: ahead of a pulse, whether a pair at rest touches is round-off's
-      coin toss, which a branch mispredicted (16 ns a pair at 29,701 beads against 6.5 without it);
+      coin toss, which a branch would mispredict;
     * the walls' contacts, member by member within a wall, then wall by wall
       (:func:`~hexdem.analysis.energy._add_wall_energies_j`), a flat wall's :math:`n \cdot x` term by term;
     * the bodies' own terms (kinetic energies and the constant forces' work), row by row.

@@ -27,7 +27,7 @@ PAIR_SKIN_D = 0.1
 
 
 def _pairs(positions_m, cutoff_m: float) -> tuple[np.ndarray, np.ndarray]:
-    from scipy.spatial import cKDTree  # (0.4 s to import: not on a rank's way to its first sample)
+    from scipy.spatial import cKDTree  # (a slow import: not on a rank's way to its first sample)
 
     i, j = cKDTree(positions_m).query_pairs(cutoff_m, output_type="ndarray").T
     return i, j

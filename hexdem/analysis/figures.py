@@ -4,7 +4,8 @@ are :mod:`hexdem.analysis.run_maps`, its peak decay :mod:`hexdem.analysis.decay_
 Every function draws into a new figure and saves it atomically as PNG. Figures are
 :class:`matplotlib.figure.Figure` objects on the Agg canvas (:func:`subplots`), never
 ``pyplot``: no display is needed, no global state is kept, and a run does not pay for
-importing pyplot and its interactive backends (about 0.5 s).
+importing pyplot and its interactive backends (the times this module's choices save:
+docs/validation/benchmarks.md, *Figures behind choices in the code*).
 """
 
 from __future__ import annotations
@@ -29,8 +30,8 @@ from hexdem.model.walls import CurvedWall
 UNIT_LABELS = {"si": {"length": "m", "speed": "m/s", "time": "ms", "time_scale": 1e3},
                "nondimensional": {"length": "d", "speed": "d/T", "time": "T", "time_scale": 1.0}}
 
-#: Fixed margins of the one-panel figures every run writes: a constrained layout would cost
-#: about a tenth of a second per figure, measured on the default run.
+#: Fixed margins of the one-panel figures every run writes: a constrained layout costs each
+#: figure a layout pass.
 SINGLE_PLOT_MARGINS = {"left": 0.13, "right": 0.97, "bottom": 0.12, "top": 0.92}
 
 
@@ -48,20 +49,20 @@ def decade_label(value: float, position=None) -> str:
 
 def plain_log_ticks(axis) -> None:
     """Label a logarithmic axis in plain text (10⁻², and 2e−02 where minor ticks are labelled),
-    at the ticks matplotlib itself picks: its default labels are mathtext, whose parser costs
-    about a third of a second on a run's first figure (the run's figures carry no other mathtext)."""
+    at the ticks matplotlib itself picks: its default labels are mathtext, whose parser a run's
+    first figure would load (the run's figures carry no other mathtext)."""
     axis.set_major_formatter(FuncFormatter(decade_label))
     axis.set_minor_formatter(LogFormatter(labelOnlyBase=False))
 
 
 def set_title(ax, title: str) -> None:
     """The title at the axes' top, in a fixed place: left to place it itself, matplotlib
-    measures every tick label first (about 0.2 s for a log axis, on every run's figures)."""
+    measures every tick label first."""
     ax.set_title(title, y=1.0)
 
 
 #: PNG compression (zlib level 1 of 9): the figures' flat colours compress nearly as well as at
-#: the default level 6, at a fraction of the encoding time (measured on the default run's maps).
+#: the default level 6, at a fraction of the encoding time.
 PNG_COMPRESSION = 1
 
 
@@ -108,9 +109,8 @@ def bead_circles(ax, positions, diameters, **style) -> EllipseCollection:
                              offset_transform=ax.transData, **{"linewidths": 0.2, **style})
 
 
-#: Above this many beads a map is drawn as an image (:func:`_pixel_beads`): matplotlib draws
-#: circles at about 0.5 ms a bead (14 s a map at 29,701 beads, 40 s at a million), an image of the
-#: same beads takes a second.
+#: Above this many beads a map is drawn as an image (:func:`_pixel_beads`): matplotlib's cost
+#: grows with each circle drawn, an image's with its pixels (docs/validation/benchmarks.md, *At scale*).
 PIXEL_MAP_BEADS = 10_000
 #: Pixels across such a map (about the axes' width at the figures' DPI).
 MAP_PIXELS = 700

@@ -104,8 +104,8 @@ def _checked(positions, arrival_times, origin):
 def linear_field(points, values):
     """f(xi): ``values`` interpolated linearly on the Delaunay triangles of ``points`` (n, 2), NaN
     outside their hull: what ``scipy.interpolate.LinearNDInterpolator`` computes, without
-    importing ``scipy.interpolate`` into every run (nor ``scipy.spatial`` into the modules that import
-    this one: it loads here, 0.4 s)."""
+    importing ``scipy.interpolate`` into every run (nor ``scipy.spatial``, a slow import, into the
+    modules that import this one: it loads here)."""
     from scipy.spatial import Delaunay
 
     triangulation = Delaunay(points)

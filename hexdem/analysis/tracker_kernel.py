@@ -33,23 +33,11 @@ For every bead it keeps, in fixed-size arrays, exactly what the definitions of
   own slot and the crossing is exact. The one inexact case is a separate earlier pulse whose
   peak lies within a rung above both L and the slot's first record.
 
-Sample s of a bead is its s-th sample; ``ring`` holds its last three samples, stored slot by
-slot (``ring_slots``), so that a sample writes one contiguous row where, bead by bead, it would
-touch every cache line of the ring. The compiled update may keep a sample there as its velocity,
-in ``ring_velocity`` (slot by slot too), with −1 for its speed, until a window needs it; it
-decides so from one number a bead, ``lazy_below``: the sum of squares below which a sample can
-neither be a new maximum nor open a rival while no window is open (−1 while one is). Each bead's
-ladder is a circular buffer of the C slots from ``start``: dropping records moves ``start``
-instead of copying the slots.
-
-**Cost.** Most beads, at most samples, only enter the ring (and, for three samples after a
-new maximum, the peak window); the ladder's bookkeeping runs on the few beads whose running
-maximum rises at that sample (beads at rest never do: their samples stay below the noise floor),
-and the refinement on the few whose rival window completes (a local maximum within
-:data:`~hexdem.analysis.peaks.PEAK_OVERSHOOT` of the running maximum).
-Every step is a NumPy operation over those beads. Runs take the same update compiled
-(:func:`~hexdem.analysis.compiled.sample_pulses`, :mod:`hexdem.common.compiled`), which takes most
-beads' speeds only when a window needs them; this code defines its results.
+Most beads, at most samples, only enter the ring (and, for three samples after a new maximum,
+the peak window): the ladder's bookkeeping runs only on beads whose running maximum rises (never
+on beads at rest, whose samples stay below the noise floor), the refinement only on those whose
+rival window completes. This NumPy code defines the results of the compiled update that runs take
+(:func:`~hexdem.analysis.compiled.sample_pulses`, :mod:`hexdem.common.compiled`).
 """
 
 from __future__ import annotations
@@ -76,7 +64,15 @@ class PulseState:
     ``capacity`` slots (module docstring); every array is indexed by bead first. ``floor``: the
     run's noise floor (:func:`~hexdem.analysis.peaks.noise_floor`), the running maximum's start: a
     bead's samples enter it only once they rise above the floor (``peak_index`` stays −1 for a bead
-    that never moved)."""
+    that never moved).
+
+    Sample s of a bead is its s-th sample; ``ring`` holds its last three samples, stored slot by
+    slot (``ring_slots``), so that a sample writes one contiguous row. The compiled update may keep
+    a sample there as its velocity, in ``ring_velocity`` (slot by slot too), with −1 for its speed,
+    until a window needs it; ``lazy_below`` is the sum of squares below which a sample can neither
+    be a new maximum nor open a rival while no window is open (−1 while one is). Each bead's
+    ladder is a circular buffer of the C slots from ``start``: dropping records moves ``start``
+    instead of copying the slots."""
 
     def __init__(self, n: int, capacity: int, floor: float = 0.0):
         self.q = rung(capacity)

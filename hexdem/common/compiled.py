@@ -4,10 +4,9 @@ The kernels (C, ``hexdem/common/kernels``, bound by :mod:`hexdem.analysis.compil
 and its energy audit and :mod:`hexdem.engines.lammps.full_step` for the samples LAMMPS hands over)
 give the NumPy code's peaks, times and velocities to the bit, and its energies to round-off: their
 sums run body by body where NumPy's go in pairs, and an overlap, a small difference of large
-coordinates, rounds its own way. Their fixed cost a sample lies below the NumPy code's at any size
-(one rank, 279 synthetic samples, ``benchmarks/bench_analysis.py``: the tracker 29 µs a sample
-against 171 µs at 7 beads, 43 against 341 µs at 331; the audit 42 against 636 µs at 331), so every
-run takes them, the default run (331 beads) included. The NumPy code stays as their definition,
+coordinates, rounds its own way. Their cost a sample lies below the NumPy code's at every size, so
+every run takes them, the default run (331 beads) included (measurements: ``benchmarks/bench_analysis.py``,
+docs/validation/benchmarks.md, *Every run compiled*). The NumPy code stays as their definition,
 which the tests hold them to (:data:`COMPILED` False).
 """
 

@@ -1,10 +1,10 @@
 """Independent jobs shared with a forked child process, on a machine with a core to spare.
 
 A run's result figures are drawn after the engine has finished, one after another, each from
-a fraction of a second to a second, while the run's other cores sit idle (29,701 beads on 2
-ranks: 1.4 s for four figures, 0.6 s of it the first). :func:`run_shared` hands every other job
-to a child process forked from this one, which holds everything the jobs read (the results,
-matplotlib and its fonts) without copying it, and runs the rest here.
+a fraction of a second to a second, while the run's other cores sit idle
+(docs/validation/benchmarks.md, *Figures behind choices in the code*). :func:`run_shared` hands
+every other job to a child process forked from this one, which holds everything the jobs read
+(the results, matplotlib and its fonts) without copying it, and runs the rest here.
 """
 
 from __future__ import annotations

@@ -112,8 +112,9 @@ def text_columns(columns) -> list[list[str]]:
 
 def _column_text(column: np.ndarray) -> list[str]:
     """``column`` as text (see :func:`text_columns`), each distinct value converted once: a packing's
-    columns hold few (its rows' coordinates, the zeros of the beads that never moved), so a million
-    beads' twelve columns take 0.7 s instead of 3.4 s. Floats are told apart by their bits (0.0 and
+    columns hold few (its rows' coordinates, the zeros of the beads that never moved), so a column takes
+    a fraction of the time of a conversion value by value (docs/validation/benchmarks.md, *The analysis at the
+    engine's speed*). Floats are told apart by their bits (0.0 and
     −0.0 are written apart, as ``repr`` writes them)."""
     if column.dtype.kind == "O":
         return list(map(str, column.tolist()))

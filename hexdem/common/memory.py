@@ -2,12 +2,12 @@
 
 A run hands its analysis a few fresh (n, 2) arrays per sample and frees them after. glibc's
 ``malloc`` serves blocks of 128 kB and more (n ≳ 8,000 beads) by ``mmap`` and unmaps them when
-freed, or trims them off its heap, so the next sample's arrays are faulted in again page by page.
-Measured on a 2-core virtual machine, 29,701 beads: a sample's positions and full-step velocities
-cost 0.86 ms from fresh pages and 0.08 ms from kept memory; the arithmetic itself takes 0.07 ms.
-With both thresholds raised (``mmap`` only above :data:`MMAP_THRESHOLD_BYTES`, trimming only above
-:data:`TRIM_THRESHOLD_BYTES` free at the heap's top) the freed blocks are reused as they are. The
-process's peak memory is what it was: the kept blocks are those the next sample takes again.
+freed, or trims them off its heap, so the next sample's arrays are faulted in again page by page,
+which costs a large sample more than its arithmetic (docs/validation/benchmarks.md, *Figures
+behind choices in the code*). With both thresholds raised (``mmap`` only above
+:data:`MMAP_THRESHOLD_BYTES`, trimming only above :data:`TRIM_THRESHOLD_BYTES` free at the heap's
+top) the freed blocks are reused as they are. The process's peak memory is what it was: the kept
+blocks are those the next sample takes again.
 """
 
 from __future__ import annotations

@@ -1,10 +1,10 @@
 """Ending a hexdem process without the interpreter's last garbage collections.
 
-At its end the interpreter collects every object it still holds, cycles and all; numba's and
-scipy's many objects made that 0.45 s of each MPI rank's end and of the ``hexdem`` command's
-(measured here: ``import numba``, then exit, when numba compiled the in-run kernels), time that a
-run on N ranks waited for before its results were written. A process that is about to end needs no memory back, so the
-places where hexdem's processes end move what they hold out of the collector's reach first
+At its end the interpreter collects every object it still holds, cycles and all: with numba's and
+scipy's many objects loaded, a noticeable time at each MPI rank's end and the ``hexdem`` command's,
+which a run on N ranks waits for before its results are written (docs/validation/benchmarks.md,
+*The analysis at the engine's speed*). A process that is about to end needs no memory back, so
+the places where hexdem's processes end move what they hold out of the collector's reach first
 (``gc.freeze``); the memory goes back to the system with the process.
 """
 

@@ -17,15 +17,10 @@ random numbers would depend on the rank count).
 
    Square and centered-square crystals (:mod:`hexdem.model.square_crystals`; spaced about the
    struck bead, a bead's growth taken relative to its own nominal diameter) are compacted
-   inside the frame of their four walls touching the spaced crystal, with pushes perpendicular
-   to their own edges. A frictionless crystal with disordered diameters has gaps between some
-   neighbours, and its compressed rows buckle sideways into them: at 5 N (and at 0.5 N) a
-   5 × 6 square's rows bent into a zigzag of ±1.6 mm (0.09 d, a step towards the triangular
-   packing), and a centered square did not settle in 10⁶ steps. At
-   :data:`CRYSTAL_PUSH_FORCE_N` = 0.05 N both keep their geometry within the disorder (rows and
-   columns straight to 0.2–0.3 mm, 3–4 σ, on a 5 × 6 square and a 9 × 12 centered square): use
-   that force on them. The settle's gravity loads a square's rows too: a 15 × 15 square's bend
-   to 0.78 mm (10 σ) in stage 2.
+   inside the frame of their four walls touching the spaced crystal, pushed perpendicular to
+   their own edges by :data:`CRYSTAL_PUSH_FORCE_N` = 0.05 N: a frictionless crystal with
+   disordered diameters has gaps between some neighbours, and rows compressed by 5 N buckle
+   sideways into them (the rows' straightness at each force: docs/guide/ensembles.md).
 2. ``settle``: the walls are placed touching the compacted packing
    (:meth:`~hexdem.model.packing.Packing.with_geometry`; or ``wall_slack_m`` further out, a
    variant without prestress), the 5 N forces are removed, gravity

@@ -83,8 +83,9 @@ def run_provenance(argv=None) -> dict:
 
 def started_provenance(argv=None) -> Callable[[], dict]:
     """:func:`run_provenance` of a run starting now, its :func:`versions` looked up in a thread
-    while the run goes (three git commands and LAMMPS's and MPI's libraries: 0.17 s, at the start
-    of every run from a checkout). Returns the function that gives it, once they are found."""
+    while the run goes (three git commands and LAMMPS's and MPI's libraries, which would otherwise
+    delay the start of every run from a checkout). Returns the function that gives it, once they
+    are found."""
     started = {"command": user_command() if argv is None else list(argv), "host": socket.gethostname(),
                "start_time": datetime.now(timezone.utc).isoformat(timespec="seconds")}
     pool = ThreadPoolExecutor(1)

@@ -50,9 +50,8 @@ MIN_STEPS_PER_CONTACT = 20
 #: Memory a run needs on each process, a conservative bound: a fixed part (Python, NumPy, SciPy,
 #: numba, LAMMPS and the plotting libraries loaded), a part per bead that every process holds (the
 #: packing and model, and rank 0's final results) and a part per bead of its own (LAMMPS's atoms
-#: and neighbour lists, the tracker's rows), its share of the beads. benchmarks/bench_scale.py
-#: measured 208 MB per process at 119,401 beads on 8 ranks (464 MB on 2) and 1,337 MB at
-#: 1,000,519 beads on 8: about 6 kB per own bead and 0.5 kB per bead in all.
+#: and neighbour lists, the tracker's rows), its share of the beads. Each part lies above the
+#: peaks ``benchmarks/bench_scale.py`` measures (docs/validation/benchmarks.md, *At scale*).
 MEMORY_BASE_BYTES = 400e6
 MEMORY_PER_BEAD_BYTES = 1e3
 MEMORY_PER_OWN_BEAD_BYTES = 8e3

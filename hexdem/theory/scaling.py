@@ -37,14 +37,8 @@ lies a little below the measured c at the smallest V₀). The sweep's V₀ = 0.0
 41 … 1230 m/s for the paper's steel beads; the experiment's 0.4 m/s is V₀ ≈ 1e−4, where the
 law gives c = b to 4 digits.
 
-**Physical units** (:meth:`ScalingLaw.physical`): replace every V by V/U, :math:`U = d^{5/4} \sqrt{A/M}`
-(end of Sec. V), so m and the V₀-powers of the polynomial pick up powers of 1/U.
-
-**Beyond the paper** (:func:`decay_form_test`). The paper calls the decay a power law but
-fits a geometric law in n. Both are two-parameter straight lines, log V_n against n or
-against log n, so their residual sums of squares compare directly; the residual curvature
-and the drift of the local ratio :math:`V_{n+1}/V_n` (constant for a geometric law, rising
-towards 1 as :math:`(n/(n+1))^p` for a power law) say which one the data follow.
+**Physical units** (:meth:`ScalingLaw.physical`) and **the decay's form** (:func:`decay_form_test`,
+beyond the paper) are stated where they are computed.
 """
 
 from __future__ import annotations
@@ -187,7 +181,9 @@ class ScalingLaw:
         return v0 * self.start_ratio(v0) * self.decay_rate(v0) ** (np.asarray(n) - self.start)
 
     def physical(self, velocity_unit_m_s: float) -> "ScalingLaw":
-        """The same law for V₀ and V_n in m/s: every V becomes V/U."""
+        r"""The same law for V₀ and V_n in m/s: every V becomes V/U, :math:`U = d^{5/4} \sqrt{A/M}`
+        (``velocity_unit_m_s``, end of Sec. V), so m and the V₀-powers of the polynomial pick up
+        powers of 1/U."""
         u = float(velocity_unit_m_s)
         degree = len(self.amplitude) - 1
         amplitude = tuple(p / u ** (degree - k) for k, p in enumerate(self.amplitude))
@@ -330,7 +326,13 @@ class DecayFormTest:
 
 
 def decay_form_test(v, start: int, last: int) -> DecayFormTest:
-    """Compare the geometric and power forms on beads start … last (start ≥ 1) of one line."""
+    r"""Compare the geometric and power forms on beads start … last (start ≥ 1) of one line.
+
+    The paper calls the decay a power law but fits a geometric law in n. Both are two-parameter
+    straight lines, log V_n against n or against log n, so their residual sums of squares compare
+    directly; the residual curvature and the drift of the local ratio :math:`V_{n+1}/V_n` (constant
+    for a geometric law, rising towards 1 as :math:`(n/(n+1))^p` for a power law) say which one the
+    data follow."""
     if start < 1 or last - start < 3:
         raise HexdemError(f"the form test needs 1 <= start and at least 4 beads, got {start}..{last}")
     v = np.asarray(v, float)

@@ -92,7 +92,7 @@ class TransitionSettings:
 
     The defaults are the full study: 41 per edge (4,921 beads; the window is readable to 58 d),
     V0 from 0.1 mm/s to 1 m/s in half decades, uncompressed and from 0.2 to 200 N: δ_impact/δ0
-    from 0.0017 to 270, 45 runs of about 4 s each (3 min in all)."""
+    from 0.0017 to 270: 45 runs."""
 
     edge_beads: int = 41
     forces_n: tuple[float, ...] = (0.0, 0.2, 2.0, 20.0, 200.0)

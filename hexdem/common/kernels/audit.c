@@ -21,8 +21,7 @@ static int moved_beyond(const AuditRows *a)
  * δ² √δ. A pair apart adds +0 rather than being skipped: at rest, ahead of a pulse, whether a pair
  * touches is round-off's coin toss, which a branch mispredicts. max(gap, 0) is written without a
  * condition, as (gap + |gap|) / 2, which is exact (gap + gap doubles gap; gap − gap is +0): with
- * one, GCC skips the arithmetic of a pair apart by a branch, which took the audit from 25 to 60 ns
- * a bead at 29,701 beads. */
+ * one, GCC compiles that branch back in (docs/validation/benchmarks.md, *C instead of numba*). */
 static double hertz(double coefficient, double gap)
 {
     double overlap = 0.5 * (gap + fabs(gap));

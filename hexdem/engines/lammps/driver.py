@@ -10,11 +10,11 @@ written or kept.
 **Full-step velocities.** The callback runs in the force stage of a velocity-Verlet step,
 when velocities are at the half step. It completes them exactly as ``fix nve``'s final
 integration is about to, v(t) = v(t − dt/2) + (dt/2) f/m, with the total force (``fix
-external`` is defined after every other force fix, walls and gravity included). Measured on
-the default deck: bit-identical to reading the velocities between chunked ``run`` commands.
-A frictional model's spins are completed alike from the torques (``fix nve/sphere``). The fix
-adds no force of its own: LAMMPS leaves its force array unset, so the fix adds it only at the
-set-up's step 0, whose call sets it to zero.
+external`` is defined after every other force fix, walls and gravity included), so they are
+the velocities a pause between two ``run`` commands would read. A frictional model's spins are
+completed alike from the torques (``fix nve/sphere``). The fix adds no force of its own: LAMMPS
+leaves its force array unset, so the fix adds it only at the set-up's step 0, whose call sets it
+to zero.
 
 On several ranks the same driver runs in every rank of ``comm`` (an ``mpi4py``
 communicator, under ``mpiexec``): each rank sees its own atoms, with the positions of its ghost
@@ -26,9 +26,8 @@ so a sample whose count is unchanged keeps every rank's atoms and their order.
 
 **The loop has the interpreter to itself.** The run waits for the modules still loading in
 the background (:mod:`hexdem.common.preload`) before its loop: each callback needs the
-interpreter an import holds, and waited for it up to 5 ms (Python's switch interval) at each
-NumPy call that lets it go. At 29,701 beads on one rank this took the loop from 1.10 to 0.95 of
-the bare loop's and the run end to end from 10.65 to 9.84 s.
+interpreter an import holds, and would wait for it at each NumPy call that lets it go
+(measurements: docs/validation/benchmarks.md, *The loop has the interpreter to itself*).
 """
 
 from __future__ import annotations

@@ -1,11 +1,11 @@
 """The samples LAMMPS hands over, taken in one compiled pass.
 
 At the sampling callback a rank's velocities are at the half step; the sample holds the full
-step's, v(t) = v(t − dt/2) + (dt/2) f/m (see :mod:`hexdem.engines.lammps.driver`). NumPy takes
-them, with the positions' copy, in five passes over strided (n, 3) arrays: 0.9 ms a sample at
-29,701 beads as it was, against 0.12 ms in one pass into kept memory (the "samples" part of
-``benchmarks/bench_analysis.py``). The arithmetic is NumPy's, operation by operation (compiled in C
-without fast-math, as :mod:`hexdem.analysis.compiled`'s kernels), so the two give the same bits.
+step's, v(t) = v(t − dt/2) + (dt/2) f/m (see :mod:`hexdem.engines.lammps.driver`). One pass over
+the strided (n, 3) arrays into kept memory takes the positions' copy and the velocities together,
+where NumPy takes five (the "samples" part of ``benchmarks/bench_analysis.py``). The arithmetic
+is NumPy's, operation by operation (compiled in C without fast-math, as
+:mod:`hexdem.analysis.compiled`'s kernels), so the two give the same bits.
 """
 
 from __future__ import annotations

@@ -17,8 +17,8 @@ on in LAMMPS with the contact model the deck writes (:func:`~hexdem.engines.lamm
 ``limit_damping`` included) and compares their rebound with the restitution of the model
 (:func:`~hexdem.model.dissipation.restitution_of`). The restitution depends on α alone, not on the
 speed, the stiffness or the masses, and a wall fix applies the same damping sub-model, so one
-collision per α covers every contact of that α. It takes about 40 ms (2,600 steps of two atoms) and
-is cached per process and per α: a sweep's runs check once.
+collision per α covers every contact of that α. It runs 2,600 steps of two atoms and is cached per
+process and per α: a sweep's runs check once.
 """
 
 from __future__ import annotations

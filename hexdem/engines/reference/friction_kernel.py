@@ -123,7 +123,8 @@ def _pairs(k, x, y, u, w, spin, xi, cap, fx, fy, torque, slip):
 def _wall_depth(k, w, x, y):
     """(depth, n_x, n_y) of wall contact ``w`` at the displacements (x, y): the frictionless kernel's
     overlap and inward normal (exact inside a circle, along the current radius). Its lines stay
-    inline there: calling this from the frictionless kernel made it 20% slower (measured, numba 0.68)."""
+    inline in the frictionless kernel, whose speed the call would cost (docs/validation/benchmarks.md,
+    *Figures behind choices in the code*)."""
     c = k.wall_cell[w]
     nx, ny = k.wall_nx[w], k.wall_ny[w]
     along = x[c] * nx + y[c] * ny
