@@ -332,3 +332,14 @@ def test_a_calibration_finds_the_truth_and_resumes_after_kill_9_to_the_same_post
     after = finished_simulations(killed)
     assert len(after) == 30 and all(after[name] == stamp for name, stamp in before.items())
     assert (killed / "posterior.csv").read_bytes() == (whole / "posterior.csv").read_bytes()
+
+
+def test_walkers_stuck_where_the_posterior_has_no_mass_are_found():
+    """A two-dimensional Gaussian's walkers have log probabilities within a few units of each other
+    (−χ²₂/2: 99.99 % above −9.2); two walkers at −7,000, as stuck walkers sat on a curved ridge, are
+    the only ones flagged."""
+    rng = np.random.default_rng(0)
+    log_probability = -0.5 * rng.chisquare(2, size=(150, 64))
+    assert not inference.stragglers(log_probability, 2).any()
+    log_probability[:, [5, 17]] -= 7000.0
+    assert np.flatnonzero(inference.stragglers(log_probability, 2)).tolist() == [5, 17]

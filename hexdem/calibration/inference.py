@@ -41,6 +41,8 @@ WALKERS = 64
 BURN_IN_STEPS = 300
 KEPT_STEPS = 500
 THIN = 10
+#: How far below the median walker's log probability a walker is a straggler (plus the dimension).
+STRAGGLER_DROP = 10.0
 #: Prior points at which the emulated posterior is evaluated to start the walkers.
 START_CANDIDATES = 4096
 
@@ -113,7 +115,10 @@ class Likelihood:
 
 
 def sample_posterior(likelihood: Likelihood, dimension: int, seed: int) -> np.ndarray:
-    """Unit-cube samples (WALKERS · KEPT_STEPS / THIN, p) of the posterior of ``likelihood``."""
+    """Unit-cube samples (WALKERS · KEPT_STEPS / THIN, p) of the posterior of ``likelihood``: the
+    walkers start at the best of START_CANDIDATES prior points, and after the burn-in every
+    straggler (:func:`stragglers`) restarts beside a walker in the posterior and the burn-in runs
+    again."""
     import emcee
 
     rng = np.random.default_rng(seed)
@@ -123,9 +128,28 @@ def sample_posterior(likelihood: Likelihood, dimension: int, seed: int) -> np.nd
     sampler = emcee.EnsembleSampler(WALKERS, dimension, likelihood, vectorize=True)
     sampler.random_state = np.random.RandomState(int(rng.integers(2**31))).get_state()
     state = sampler.run_mcmc(start, BURN_IN_STEPS)
+    lost = stragglers(sampler.get_log_prob(discard=BURN_IN_STEPS // 2), dimension)
+    if lost.any():
+        coords = state.coords.copy()
+        kept = np.flatnonzero(~lost)
+        coords[lost] = np.clip(coords[rng.choice(kept, lost.sum())] + rng.normal(0.0, 1e-6, (lost.sum(), dimension)),
+                               0.0, 1.0)
+        sampler.reset()
+        state = sampler.run_mcmc(coords, BURN_IN_STEPS)
     sampler.reset()
     sampler.run_mcmc(state, KEPT_STEPS)
     return sampler.get_chain(thin=THIN, flat=True)
+
+
+def stragglers(log_probability, dimension: int) -> np.ndarray:
+    """Walkers stuck where the posterior has no mass: their median log probability over the
+    burn-in's second half (``log_probability`` (steps, walkers)) is more than STRAGGLER_DROP +
+    ``dimension`` below the median walker's, a density e^-(10 + p) of the typical one, where the
+    typical set of a p-dimensional posterior lies within about p/2 of its median. An affine-invariant
+    stretch move brings such a walker back only along straight lines through the others, which a
+    curved ridge of the posterior can cross only where it has no mass."""
+    typical = np.median(log_probability, axis=0)
+    return typical < np.median(typical) - (STRAGGLER_DROP + dimension)
 
 
 @dataclass(frozen=True)
