@@ -22,7 +22,10 @@ which for one record is log N(y_1; μ, Σ_1 + Σ_K + C).
 whole prior. Every later stage fits the emulator to all simulations so far, samples its posterior
 with emcee's affine-invariant ensemble (Goodman & Weare 2010) and simulates
 :func:`round_points` new points drawn from that posterior, so that the emulator is refined where
-the posterior puts its mass. The last fit's posterior is the result. Every random choice derives
+the posterior puts its mass. The last fit's posterior is the result. After stage 0, the
+posterior's most likely sample is also run at half the time step (:func:`step_error`): the runs'
+own integration error enters the likelihood, shared by all records, so that records measured
+without any time step are not fitted more closely than the runs can resolve. Every random choice derives
 from the seed, so the same seed, data and simulations give the same posterior.
 """
 
@@ -88,8 +91,9 @@ class Data:
 class Likelihood:
     """log p(data | u) through ``emulator`` and the packings' ``spread`` (see the module docstring)."""
 
-    def __init__(self, data: Data, emulator: Emulator, spread: Spread):
+    def __init__(self, data: Data, emulator: Emulator, spread: Spread, model_error=None):
         self.data, self.emulator, self.spread = data, emulator, spread
+        self.model_error = 0.0 if model_error is None else np.asarray(model_error, float)
 
     def __call__(self, unit) -> np.ndarray:
         unit = np.atleast_2d(unit)
@@ -100,7 +104,7 @@ class Likelihood:
         mean, variance = self.emulator.predict(unit[inside])
         spread = self.spread(unit[inside])
         identity = np.eye(mean.shape[1])
-        common = variance[:, :, None] * identity + spread / self.spread.realizations
+        common = variance[:, :, None] * identity + spread / self.spread.realizations + self.model_error
         total, precision, pulled = 0.0, 0.0, 0.0
         for record, covariance in zip(self.data.records, self.data.covariances):
             own = covariance + spread
@@ -155,23 +159,37 @@ def stragglers(log_probability, dimension: int) -> np.ndarray:
 @dataclass(frozen=True)
 class Fit:
     """One stage's fit: the simulated ``points`` (n, p) and their ``observables`` (n, K, m), the
-    ``emulator`` of their mean over packings, the packings' ``spread`` and the posterior
-    ``samples`` (unit cube)."""
+    ``emulator`` of their mean over packings, the packings' ``spread``, the posterior
+    ``samples`` (unit cube) and the ``likelihood`` they sample."""
 
     points: np.ndarray
     observables: np.ndarray
     emulator: Emulator
     spread: Spread
     samples: np.ndarray
+    likelihood: Likelihood
 
 
-def fit_stage(data: Data, points, observables, seed: int) -> Fit:
-    """Fit the emulator to the simulations and sample the posterior it implies."""
+def fit_stage(data: Data, points, observables, seed: int, model_error=None) -> Fit:
+    """Fit the emulator to the simulations and sample the posterior it implies (``model_error``:
+    the covariance of the model's own integration error, :func:`step_error`)."""
     points, observables = np.asarray(points, float), np.asarray(observables, float)
     emulator = Emulator(points, observables.mean(axis=1))
     spread = Spread(points, observables)
-    samples = sample_posterior(Likelihood(data, emulator, spread), points.shape[1], seed)
-    return Fit(points, observables, emulator, spread, samples)
+    likelihood = Likelihood(data, emulator, spread, model_error)
+    samples = sample_posterior(likelihood, points.shape[1], seed)
+    return Fit(points, observables, emulator, spread, samples, likelihood)
+
+
+def step_error(coarse, fine) -> np.ndarray:
+    """The covariance of the runs' integration error from one parameter set run at the
+    calibration's time step (``coarse`` observables) and at half of it (``fine``): the error
+    converges at first order in the step (the sensors' samples fall on whole steps), so the runs
+    miss the limit of a vanishing step by about b = 2 (coarse − fine). The likelihood treats b as
+    unknown within its size, the rank-one covariance b bᵀ: a record, measured without any time
+    step, may then sit off the runs by b in either direction."""
+    bias = 2.0 * (np.asarray(coarse, float) - np.asarray(fine, float))
+    return np.outer(bias, bias)
 
 
 def next_points(fit: Fit, count: int, seed: int) -> np.ndarray:

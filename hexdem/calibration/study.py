@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import json
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -28,10 +28,12 @@ from hexdem.calibration.report import summarize, write_posterior
 from hexdem.calibration.simulations import SIMULATIONS, Problem, check_problem, finished, simulate_point, simulation_name
 from hexdem.common.checks import positive_int
 from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
-from hexdem.errors import HexdemError
+from hexdem.errors import HexdemError, RunFailed, one_line
 from hexdem.experiments.executors import check_study_options, holding, parsl_session, run_phase
 
 PLAN_NAME = "calibration-plan.json"
+#: The folder of the time-step check's run (and ``-half-step`` of its run at half the step).
+STEP_CHECK = "step-check"
 #: Posterior predictive draws behind ``predictive.png``.
 PREDICTIVE_DRAWS = 2000
 
@@ -141,6 +143,7 @@ def calibrate(calibration: Calibration, measured, out, workers: int = 1, parsl=N
     with locked_directory(out, "another hexdem calibrate"), holding(parsl):
         _check_plan(out, _plan(calibration, measured))
         points, observables, failed, index, fit = np.empty((0, dimension)), None, 0, 0, None
+        step_check, model_error = None, None
         for stage, size in enumerate(calibration.stages):
             new = (inference.design(dimension, size, seed) if fit is None
                    else inference.next_points(fit, size, seed + stage))
@@ -156,14 +159,39 @@ def calibrate(calibration: Calibration, measured, out, workers: int = 1, parsl=N
             if len(points) < inference.initial_points(dimension) // 2:
                 raise HexdemError(f"{failed} of {index} simulations failed (see {out / SIMULATIONS}); too few are "
                                   "left to calibrate")
-            fit = inference.fit_stage(calibration.data, points, observables, seed + 1000 + stage)
-        summary = _write_results(calibration, fit, out, failed, time.perf_counter() - started)
+            fit = inference.fit_stage(calibration.data, points, observables, seed + 1000 + stage, model_error)
+            if step_check is None:
+                step_check = _check_time_step(calibration, fit, out, workers, parsl)
+                model_error = inference.step_error(step_check["coarse"], step_check["half"])
+                fit = inference.fit_stage(calibration.data, points, observables, seed + 1000 + stage, model_error)
+        summary = _write_results(calibration, fit, out, failed, time.perf_counter() - started, step_check)
     for note in summary["identifiability"]:
         log(f"note: {note}")
     return summary
 
 
-def _write_results(calibration: Calibration, fit: inference.Fit, out: Path, failed: int, seconds: float) -> dict:
+def _check_time_step(calibration: Calibration, fit: inference.Fit, out: Path, workers: int, parsl) -> dict:
+    """The stage-0 posterior's most likely sample run at the calibration's time step and at half
+    of it, on packing 0, two tasks of the study executor (:func:`~hexdem.calibration.inference.step_error`)."""
+    problem = calibration.problem
+    unit = fit.samples[int(np.argmax(fit.likelihood(fit.samples)))][None]
+    if SIGMA_KEY in problem.keys:  # on a level, so that it runs on a packing of the calibration's
+        unit = on_sigma_levels(unit, problem.keys.index(SIGMA_KEY))
+    values = to_parameters(problem.priors, unit)[0].tolist()
+    steps = problem.config(values).steps_per_contact
+    half = replace(problem, base=problem.base | {"steps_per_contact": 2 * steps})
+    folders = {"coarse": out / SIMULATIONS / STEP_CHECK, "half": out / SIMULATIONS / f"{STEP_CHECK}-half-step"}
+    tasks = {name: (simulate_point, run, values, str(folders[name]))
+             for name, run in (("coarse", problem), ("half", half)) if finished(folders[name], values) is None}
+    for name, error in run_phase(tasks, workers, parsl, "time-step check", "simulation"):
+        if error is not None:
+            raise RunFailed(f"the time-step check's run at half the step failed: {one_line(error)}")
+    return {"parameters": dict(zip(problem.keys, values)), "steps_per_contact": [steps, 2 * steps],
+            **{name: finished(folder, values).tolist() for name, folder in folders.items()}}
+
+
+def _write_results(calibration: Calibration, fit: inference.Fit, out: Path, failed: int, seconds: float,
+                   step_check: dict) -> dict:
     problem, data = calibration.problem, calibration.data
     samples = to_parameters(problem.priors, fit.samples)
     write_posterior(out / "posterior.csv", problem.priors, samples)
@@ -175,6 +203,8 @@ def _write_results(calibration: Calibration, fit: inference.Fit, out: Path, fail
     summary["simulations"] = {"parameter_sets": int(sum(calibration.stages)), "realizations": problem.realizations,
                               "runs": int(sum(calibration.stages)) * problem.realizations, "failed": failed,
                               "wall_time_s": seconds}
+    summary["time_step_check"] = step_check | {
+        "bias": (2.0 * (np.array(step_check["coarse"]) - np.array(step_check["half"]))).tolist()}
     summary["data"] = {"records": len(data.records), "sensors": problem.sensors, "observables": list(data.names),
                        "accelerometer_noise_m_s2": list(calibration.noise_m_s2)}
     write_json(out / "calibration.json", summary)
