@@ -26,6 +26,7 @@ import numpy as np
 from hexdem.errors import HexdemError
 from hexdem.experiments.executors import describe, holding, parsl_session, run_tasks, study_executor, tasks_failed
 from hexdem.theory.scaling import DEFAULT_LAST, Combination, CombinationFit, fit_combination
+from hexdem.model.model_builder import build_model
 from hexdem.model.run_settings import contact_time_s
 
 #: Strike angles of the sweep [deg]: each one serves two combinations.
@@ -89,7 +90,7 @@ class SweepSettings:
                          units="nondimensional", v0=float(v0), strike_angle_deg=float(strike_deg),
                          engine=self.engine, dump_every=self.steps_per_contact // self.samples_per_contact,
                          launcher=self.launcher)
-        tau = contact_time_s(base) / base.unit_system.time_s
+        tau = contact_time_s(base, build_model(base)) / base.unit_system.time_s
         return base.replace(dt=tau / self.steps_per_contact, duration=self.duration_contacts * tau)
 
 
