@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from functools import cached_property
+from typing import NamedTuple
 
 import numpy as np
 
@@ -33,7 +34,16 @@ WALL_GROUP_GAP = 0.25
 HOLE_COSINE = 0.5 + 1e-9
 
 
-@dataclass(frozen=True)
+class LabelLine(NamedTuple):
+    """An observation line on the labels: from label ``start`` (None: the struck bead's) on,
+    one label step ``step`` (dm, dn) at a time."""
+
+    name: str
+    start: tuple[int, int] | None
+    step: tuple[int, int]
+
+
+@dataclass(frozen=True, eq=False)
 class Packing:
     """A finite 2D packing of beads: labels, positions, diameters, materials, walls and lines.
 
@@ -43,8 +53,7 @@ class Packing:
     confining walls; ``shape`` a readable description; ``material_ids`` (N,) each bead's material,
     an index into the model's materials (None: all 0, the bead material).
 
-    Lines: ``label_lines``, each (name, start label (None: the struck bead's), step (dm, dn)),
-    holds the beads from the start on, one label step at a time, until the packing ends;
+    Lines: ``label_lines``, each a :class:`LabelLine`, holds the beads from the start on, one label step at a time, until the packing ends;
     ``rays_deg`` the angles from +x of the rays from the struck bead (:mod:`hexdem.model.rays`),
     named by :func:`~hexdem.model.rays.ray_name`. ``bond_steps``: the label steps between touching
     neighbours, each bond once, where the labels say which beads touch (the triangular lattice's
@@ -59,7 +68,7 @@ class Packing:
     walls: tuple[Wall | CurvedWall, ...]
     shape: str
     material_ids: np.ndarray | None = None
-    label_lines: tuple[tuple[str, tuple[int, int] | None, tuple[int, int]], ...] = ()
+    label_lines: tuple[LabelLine, ...] = ()
     rays_deg: tuple[float, ...] = ()
     bond_steps: tuple[tuple[int, int], ...] = ()
 
