@@ -32,8 +32,8 @@ from dataclasses import replace
 import numpy as np
 
 from hexdem.errors import HexdemError
-from hexdem.model.packing import WALL_GROUP_GAP, LabelLine, Packing, touching_walls, unit_vector
-from hexdem.model.walls import CurvedWall
+from hexdem.model.packing import LabelLine, Packing, unit_vector
+from hexdem.model.walls import WALL_GROUP_GAP, CurvedWall, touching_walls
 
 #: The step in (m, n) between consecutive sites along each of the lattice's twelve directions, by
 #: angle from +x [deg]: odd multiples of 30° run along touching beads (spacing d), multiples of
