@@ -35,6 +35,7 @@ from machine import describe
 from hexdem.experiments.compare import ARRIVAL_ERROR_N2, ARRIVAL_GROWTH_N2
 from hexdem.experiments.convergence import CHAIN, arrival_growth, sampling_error, study_time_step
 from hexdem.model.config import STEPS_PER_CONTACT, RunConfig
+from hexdem.model.model_builder import build_model
 from hexdem.model.run_settings import contact_time_s
 
 PEAK_TARGET = 1e-4
@@ -64,7 +65,7 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="small packing, three steps (seconds)")
     args = parser.parse_args()
-    tau_experiment = contact_time_s(RunConfig())
+    tau_experiment = contact_time_s(RunConfig(), build_model(RunConfig()))
     arrival_target = ARRIVAL_TARGET_S / tau_experiment
     print(f"machine: {describe()}")
     print(f"errors against the Richardson extrapolation of each case's two finest runs; default: "
@@ -75,14 +76,15 @@ def main() -> int:
     with tempfile.TemporaryDirectory(prefix="hexdem-accuracy-") as scratch:
         for k, (name, config, steps) in enumerate(cases(args.quick)):
             study = study_time_step(config, steps, f"{scratch}/{k}")
+            contact_s = contact_time_s(config, build_model(config))
             orders = [f"{order:6.2f}" for order in study.observed_orders] + [f"{'-':>6}"] * 2
             for run, order in zip(study.runs, orders):
-                micro = (f"{run.arrival_error_contacts * contact_time_s(config) * 1e6:13.2e}"
+                micro = (f"{run.arrival_error_contacts * contact_s * 1e6:13.2e}"
                          if config.units == "si" else f"{'-':>13}")
                 print(f"{name:<24} {config.engine:<10} {run.steps_per_contact:8d} {run.peak_error:11.2e} {micro} "
                       f"{run.arrival_error_contacts:12.2e} {run.energy_drift:13.2e} {order} {run.wall_time_s:9.2f}")
             default, sampled = study.at(STEPS_PER_CONTACT), sampling_error(config, f"{scratch}/{k}-sampling")
-            sampled_contacts = sampled.arrival_error / (contact_time_s(config) / config.unit_system.time_s)
+            sampled_contacts = sampled.arrival_error / (contact_s / config.unit_system.time_s)
             peak, arrival = default.peak_error + sampled.peak_error, default.arrival_error_contacts + sampled_contacts
             met = peak < PEAK_TARGET and arrival < arrival_target
             verdicts.append(f"{name}, {config.engine}: step + sampling every {sampled.dump_every} steps: peak "

@@ -95,8 +95,8 @@ def bench_ensemble(work: Path, workers: int, options, before: str) -> None:
 
 
 def bench_ranks(work: Path, repeats: int, base: RunConfig, times_s) -> None:
-    config = snapshot_config(base, sorted(times_s))
-    model = build_model(config)
+    model = build_model(base)
+    config = snapshot_config(base, model, sorted(times_s))
     settings = run_settings(config, model)
     atom_steps = model.n_bodies * settings.n_steps
     runners = [(f"hexdem, {ranks} rank{'s' * (ranks > 1)}", "hexdem", ranks) for ranks in (1, 2)]
@@ -108,7 +108,7 @@ def bench_ranks(work: Path, repeats: int, base: RunConfig, times_s) -> None:
             if kind == "hexdem":
                 directory = work / f"hexdem{ranks}-{repeat}"
                 start = time.perf_counter()
-                engine = take_snapshots(base.replace(ranks=ranks), times_s, directory).engine
+                engine = take_snapshots(base.replace(ranks=ranks), model, times_s, directory).engine
                 times[name]["wall"].append(time.perf_counter() - start)
                 times[name]["lammps"].append(engine["wall_time_s"])
                 times[name]["loop"].append(loop_time_s(directory / "log.lammps"))

@@ -19,6 +19,7 @@ class RunFailed(HexdemError):
 
 def one_line(exc: BaseException) -> str:
     """What a failure says to the user in one line: a HexdemError's own message, anything else
-    prefixed with its type (an unexpected error, reported rather than hidden)."""
+    prefixed with its type (an unexpected error, reported rather than hidden); each run of
+    whitespace (line breaks included) one space."""
     message = str(exc) if isinstance(exc, HexdemError) else f"{type(exc).__name__}: {exc}"
-    return message.replace("\n", " ")
+    return " ".join(message.split())

@@ -12,7 +12,9 @@ from hexdem.experiments.run import run_experiment
 from hexdem.model.config import RunConfig
 from hexdem.model.granular import GranularModel, Impact
 from hexdem.model.materials import DELRIN, STEEL_316
+from hexdem.model.model_builder import build_model
 from hexdem.model.packing import Packing
+from hexdem.model.run_settings import contact_time_s, run_settings
 from hexdem.model.triangular import hexagon
 
 D, V0 = 0.01905, 0.4
@@ -103,6 +105,16 @@ def contact_history(times, overlap):
     k = int(np.flatnonzero(overlap[1:] < 0)[0]) + 1
     end = np.interp(0.0, overlap[[k, k - 1]], times[[k, k - 1]])
     return end, refine_peak(times, overlap)[1]
+
+
+def settings_of(config: RunConfig):
+    """The run settings of ``config`` on its own model."""
+    return run_settings(config, build_model(config))
+
+
+def contact_of(config: RunConfig) -> float:
+    """The contact time [s] of ``config`` on its own model."""
+    return contact_time_s(config, build_model(config))
 
 
 def read_csv(path):

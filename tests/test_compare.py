@@ -5,7 +5,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from conftest import V0, disordered_model, read_csv, record
+from conftest import V0, contact_of, disordered_model, read_csv, record, settings_of
 
 from hexdem.analysis.impact import ImpactAnalysis
 from hexdem.cli.main import main
@@ -19,7 +19,6 @@ from hexdem.experiments.run import RESULT_FILES, simulate
 from hexdem.model.config import STEPS_PER_CONTACT, RunConfig
 from hexdem.model.granular import RunSettings
 from hexdem.model.model_builder import build_model
-from hexdem.model.run_settings import contact_time_s, run_settings
 
 SMALL = RunConfig(edge_beads=4)
 
@@ -77,7 +76,7 @@ def test_engines_agree_on_small_lattices(tmp_path, changes):
 def test_engines_agree_with_per_bead_diameters(tmp_path):
     """Per-pair contact distances in both engines' neighbour lists, on every bead."""
     model = disordered_model(seed=3, edge_beads=5)
-    settings = RunSettings(dt_s=1e-7, n_steps=8000, dump_every=20, contact_time_s=contact_time_s(RunConfig()))
+    settings = RunSettings(dt_s=1e-7, n_steps=8000, dump_every=20, contact_time_s=contact_of(RunConfig()))
     tolerances = Tolerances().for_run(model, settings)
     lammps, reference = (ImpactAnalysis.from_trajectory(model, settings, record(engine, model, settings,
                                                                               tmp_path / engine.name)).results
@@ -95,14 +94,14 @@ def test_default_tolerances_follow_lammps_expected_error_at_the_runs_steps_per_c
     order), the arrival in contact times whatever the units, growing with the bead's arrival time,
     larger with bead-bead damping; given values stay, a given arrival tolerance constant."""
     def defaults(config):
-        return Tolerances().for_run(build_model(config), run_settings(config))
+        return Tolerances().for_run(build_model(config), settings_of(config))
 
     coarse, fine = (defaults(SMALL.replace(steps_per_contact=n)) for n in (140, 280))
     assert coarse.peak_rel == pytest.approx(MARGIN * expected_error(140)[0]) == pytest.approx(4 * fine.peak_rel)
     assert coarse.arrival_s == pytest.approx(4 * fine.arrival_s)
     assert coarse.arrival_rate == pytest.approx(MARGIN * expected_error(140)[2]) == pytest.approx(4 * fine.arrival_rate)
     for config in (SMALL, SMALL.replace(units="nondimensional", v0=0.05)):
-        contact = contact_time_s(config)
+        contact = contact_of(config)
         assert defaults(config).arrival_s / contact == pytest.approx(MARGIN * expected_error(140)[1])
         assert defaults(config).arrival(10 * contact) / contact == pytest.approx(
             MARGIN * (expected_error(140)[1] + 10 * expected_error(140)[2]))
@@ -113,7 +112,7 @@ def test_default_tolerances_follow_lammps_expected_error_at_the_runs_steps_per_c
     given = Tolerances(peak_rel=0.01, arrival_s=1e-6)
     assert given.for_run(build_model(SMALL), bare) == replace(given, arrival_rate=0.0)
     assert replace(given, arrival_rate=1e-3).for_run(build_model(SMALL), bare).arrival(1e-3) == pytest.approx(2e-6)
-    assert Tolerances(arrival_rate=0.0).for_run(build_model(SMALL), run_settings(SMALL)).arrival_s == coarse.arrival_s
+    assert Tolerances(arrival_rate=0.0).for_run(build_model(SMALL), settings_of(SMALL)).arrival_s == coarse.arrival_s
     with pytest.raises(HexdemError, match="the default tolerances need the run's contact time"):
         Tolerances(peak_rel=0.01).for_run(build_model(SMALL), bare)
 
@@ -125,7 +124,7 @@ def test_the_arrival_tolerance_grows_with_the_distance_the_pulse_has_travelled(t
     hexagon), and well within each bead's own, which compare.csv lists."""
     comparison = run_comparison(CHAIN, tmp_path, log=lambda message: None)
     assert comparison.agree and comparison.max_arrival_share < 0.5, comparison.verdict()
-    contact = contact_time_s(CHAIN)
+    contact = contact_of(CHAIN)
     assert comparison.max_arrival_diff > MARGIN * 4.0 * contact / STEPS_PER_CONTACT**2
     column = {key: np.array([float(row[key]) for row in read_csv(tmp_path / "compare.csv")[1] if row["line"] == "+30"])
               for key in ("arrival_lammps", "arrival_diff", "arrival_tolerance")}
@@ -143,7 +142,7 @@ def test_a_bead_stiffness_off_by_0_3_percent_in_one_engine_is_caught(tmp_path, c
     """The bias the cross-check exists for (a wrong E* or G* in one engine): the reference run on
     beads 0.3 % stiffer, same step and samples, arrives 0.12 % early (times go as A^(−2/5)),
     beyond the default tolerances, where the same run on the true beads agrees."""
-    model, settings = build_model(config), run_settings(config)
+    model, settings = build_model(config), settings_of(config)
     stiffer = replace(model, bead=replace(model.bead, youngs_modulus_pa=1.003 * model.bead.youngs_modulus_pa))
     runs = (("lammps", LammpsEngine(), model), ("true", ReferenceEngine(), model),
             ("biased", ReferenceEngine(), stiffer))

@@ -5,6 +5,7 @@ NumPy in pairs)."""
 
 import numpy as np
 import pytest
+from conftest import settings_of
 
 import hexdem.analysis.tracker as tracker_module
 import hexdem.common.compiled as compiled
@@ -307,7 +308,7 @@ def test_an_in_process_runs_loop_waits_for_what_loads_in_the_background(tmp_path
     (tmp_path / "hexdem_slow_module.py").write_text("import time\ntime.sleep(1.0)\nLOADED = True\n")
     monkeypatch.syspath_prepend(str(tmp_path))
     config = RunConfig(edge_beads=3, duration=1e-4)
-    deck = write_deck(build_model(config), run_settings(config), tmp_path / "deck")
+    deck = write_deck(build_model(config), settings_of(config), tmp_path / "deck")
     loading = []
 
     def observe(sample):

@@ -8,13 +8,14 @@ import math
 
 import numpy as np
 import pytest
+from conftest import settings_of, contact_of
 
 from hexdem.errors import HexdemError
 from hexdem.experiments.compare import ARRIVAL_ERROR_N2, ARRIVAL_GROWTH_N2, expected_error
 from hexdem.experiments.convergence import (CHAIN, Convergence, arrival_growth, richardson, sampling_error,
                                             steps_config, study_time_step)
 from hexdem.model.config import STEPS_PER_CONTACT, RunConfig
-from hexdem.model.run_settings import SAMPLES_PER_CONTACT, contact_time_s, run_settings
+from hexdem.model.run_settings import SAMPLES_PER_CONTACT
 
 PEAK_TARGET, ARRIVAL_TARGET_S = 1e-4, 0.05e-6
 
@@ -30,10 +31,10 @@ def test_richardson_recovers_the_limit_of_a_power_law_error():
 @pytest.mark.parametrize("steps, dt_steps, every", [(None, 140, 7), (700, 700, 35), (110, 120, 6), (30, 40, 2)])
 def test_the_step_follows_steps_per_contact_and_the_sampling_stays_fixed_in_time(steps, dt_steps, every):
     config = RunConfig() if steps is None else RunConfig(steps_per_contact=steps)
-    settings, tau = run_settings(config), contact_time_s(config)
+    settings, tau = settings_of(config), contact_of(config)
     assert settings.dt_s == pytest.approx(tau / dt_steps, rel=1e-12) and settings.dump_every == every
     assert settings.dt_s * settings.dump_every == pytest.approx(tau / SAMPLES_PER_CONTACT, rel=1e-12)
-    assert settings.duration_s == pytest.approx(run_settings(RunConfig(steps_per_contact=700)).duration_s, rel=1e-3)
+    assert settings.duration_s == pytest.approx(settings_of(RunConfig(steps_per_contact=700)).duration_s, rel=1e-3)
 
 
 def test_too_few_steps_per_contact_is_refused():
@@ -51,7 +52,7 @@ def test_lammps_converges_at_second_order_and_its_default_meets_the_target(confi
     assert all(1.8 < order < 2.2 for order in study.observed_orders), study.observed_orders
     default = study.at(STEPS_PER_CONTACT)
     assert default.peak_error < PEAK_TARGET
-    assert default.arrival_error_contacts < ARRIVAL_TARGET_S / contact_time_s(RunConfig())  # the same in τ
+    assert default.arrival_error_contacts < ARRIVAL_TARGET_S / contact_of(RunConfig())  # the same in τ
     assert default.energy_drift < PEAK_TARGET
     for run in study.runs:  # the accuracy from which hexdem compare's default tolerances follow, bead by bead
         peak, arrival, growth = expected_error(run.steps_per_contact)

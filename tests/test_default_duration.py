@@ -6,13 +6,13 @@ import math
 
 import numpy as np
 import pytest
+from conftest import settings_of
 
 from hexdem.experiments.run import simulate
 from hexdem.model.config import RunConfig
 from hexdem.model.hertz import contact_time
 from hexdem.model.materials import PAPER_DIAMETER_M as D
 from hexdem.model.materials import material
-from hexdem.model.run_settings import run_settings
 
 V0 = 0.4
 BRASS_BEYOND_D = 10.0
@@ -30,7 +30,7 @@ def two_sphere_contact_s(a, b, da: float = D, db: float = D) -> float:
 def test_one_material_keeps_a_contact_time_per_layer():
     """The experiment's hexagon: 20 layers of √3/2 d between the struck edge and the far wall."""
     steel = material("steel316")
-    settings = run_settings(RunConfig())
+    settings = settings_of(RunConfig())
     assert settings.duration_s == pytest.approx(20 * two_sphere_contact_s(steel, steel), abs=settings.dt_s / 2)
 
 
@@ -41,14 +41,14 @@ def test_a_softer_region_is_crossed_at_its_own_pace():
     brass_layers = sum(1 for k in range(1, 21) if k * math.sqrt(3) / 2 >= BRASS_BEYOND_D)
     expected = (20 - brass_layers) * two_sphere_contact_s(steel, steel) + brass_layers * two_sphere_contact_s(brass, brass)
     assert brass_layers == 9
-    settings = run_settings(config)
+    settings = settings_of(config)
     assert settings.duration_s == pytest.approx(expected, abs=settings.dt_s / 2), "a whole number of steps"
 
 
 def test_a_soft_striker_adds_its_longer_contact():
     """A ptfe striker touches the steel bead longer than two steel beads touch: that much more."""
     steel, ptfe = material("steel316"), material("ptfe")
-    soft, plain = (run_settings(RunConfig(impact="striker", **changes)) for changes in ({"striker_material": "ptfe"}, {}))
+    soft, plain = (settings_of(RunConfig(impact="striker", **changes)) for changes in ({"striker_material": "ptfe"}, {}))
     assert soft.duration_s - plain.duration_s == pytest.approx(
         two_sphere_contact_s(ptfe, steel) - two_sphere_contact_s(steel, steel), abs=(soft.dt_s + plain.dt_s) / 2)
 

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import settings_of
 
 from hexdem.analysis.dump import read_dump
 from hexdem.cli.main import main
@@ -22,7 +23,6 @@ from hexdem.experiments.parallel import run_on_ranks
 from hexdem.experiments.run import run_experiment
 from hexdem.model.config import RunConfig
 from hexdem.model.model_builder import build_model
-from hexdem.model.run_settings import run_settings
 
 
 def run_cli(tmp_path, capsys, config_text=None, out=None):
@@ -247,7 +247,7 @@ def test_deck_error_is_reported_with_lammps_message(tmp_path, capfd, ranks):
     """By hand (``lmp -in``) and through the streaming driver on 1 and 2 MPI ranks; the ranks
     that abort print no traceback."""
     config = RunConfig(edge_beads=3)
-    rendered = write_deck(build_model(config), run_settings(config), tmp_path / "deck")
+    rendered = write_deck(build_model(config), settings_of(config), tmp_path / "deck")
     rendered.input_path.write_text(rendered.input_path.read_text().replace("pair_style      gran/hertz/history", "pair_style nonsense"))
     for attempt in (lambda: run_bare(rendered, ranks),
                     lambda: run_on_ranks(functools.partial(run_streaming, rendered, repr), ranks, tmp_path / "job")):
@@ -296,7 +296,7 @@ def test_an_observer_failing_on_two_ranks_is_one_line(tmp_path, capfd):
     """The failing rank aborts the MPI job (the others would wait in a collective call) and its
     message reaches the user through job.error."""
     config = RunConfig(edge_beads=3)
-    rendered = write_deck(build_model(config), run_settings(config), tmp_path / "deck")
+    rendered = write_deck(build_model(config), settings_of(config), tmp_path / "deck")
     with pytest.raises(RunFailed, match="TypeError: object of type 'Sample' has no len") as info:
         run_on_ranks(functools.partial(run_streaming, rendered, len), 2, tmp_path / "job")
     assert "\n" not in str(info.value)
@@ -308,7 +308,7 @@ def test_a_rank_that_refuses_its_input_is_a_refusal_and_a_failing_one_a_failed_r
     :class:`HexdemError` stays a refusal (the command's status 3), anything else is a failed run
     (:class:`RunFailed`, status 4)."""
     config = RunConfig(edge_beads=3)
-    rendered = write_deck(build_model(config), run_settings(config), tmp_path / "deck")
+    rendered = write_deck(build_model(config), settings_of(config), tmp_path / "deck")
     refusing = functools.partial(run_streaming, rendered, functools.partial(positive_int, "--beads"))
     with pytest.raises(HexdemError, match="--beads must be a positive integer, got Sample") as info:
         run_on_ranks(refusing, 2, tmp_path / "job")

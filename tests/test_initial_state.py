@@ -8,13 +8,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import read_csv
+from conftest import contact_of, read_csv, settings_of
 
 from hexdem.cli.main import main
 from hexdem.experiments.run import simulate
 from hexdem.model.config import RunConfig
 from hexdem.model.materials import hertz_coefficient, sphere_mass
-from hexdem.model.run_settings import contact_time_s, run_settings
 from hexdem.model.model_builder import build_model, build_packing
 
 #: Two touching spheres on the +30° line, no walls, the first struck along the line.
@@ -87,8 +86,8 @@ def test_the_time_step_follows_the_fastest_bead_of_the_state(tmp_path):
     (tmp_path / "state.csv").write_text("m,n,vx,vy\n4,0,100.0,0\n")
     base = RunConfig(edge_beads=5)
     fast = base.replace(initial_state_file=str(tmp_path / "state.csv"))
-    assert run_settings(base).dt_s / run_settings(fast).dt_s == pytest.approx(250 ** 0.2, rel=1e-12)
-    assert run_settings(fast).duration_s == pytest.approx(run_settings(base).duration_s, abs=run_settings(base).dt_s)
+    assert settings_of(base).dt_s / settings_of(fast).dt_s == pytest.approx(250 ** 0.2, rel=1e-12)
+    assert settings_of(fast).duration_s == pytest.approx(settings_of(base).duration_s, abs=settings_of(base).dt_s)
     assert simulate(fast, tmp_path / "run").results.energy_drift < 1e-4
 
 
@@ -99,8 +98,8 @@ def test_the_fastest_approach_is_that_of_two_beads_meeting(tmp_path):
     state = tmp_path / "state.csv"
     vx, vy = (float(v) for v in -0.2 * ALONG)
     state.write_text(f"m,n,vx,vy\n1,1,{vx!r},{vy!r}\n")
-    alone = contact_time_s(RunConfig(**PAIR))
-    assert contact_time_s(RunConfig(**PAIR, initial_state_file=str(state))) == pytest.approx(alone * 1.5 ** -0.2,
+    alone = contact_of(RunConfig(**PAIR))
+    assert contact_of(RunConfig(**PAIR, initial_state_file=str(state))) == pytest.approx(alone * 1.5 ** -0.2,
                                                                                               rel=1e-12)
 
 

@@ -200,3 +200,17 @@ def test_disc_holds_every_site_within_its_radius_inside_a_touching_circle():
     assert others.min() == pytest.approx(0.0, abs=1e-12) and lattice.struck not in wall.members
     assert set(wall.members.tolist()) == set(np.flatnonzero(gaps < 0.25).tolist()) - {lattice.struck}
     np.testing.assert_allclose(np.linalg.norm(wall.normals_at(lattice.positions_m[wall.members]), axis=1), 1.0)
+
+
+def test_packings_compare_by_identity_without_raising():
+    """A packing of arrays is the same packing only as the same object: comparing two equal
+    builds neither raises (as the arrays' elementwise == would) nor calls them equal."""
+    packing = hexagon(3, 0.01)
+    assert packing == packing
+    assert packing != hexagon(3, 0.01)
+    assert len({packing, packing, hexagon(3, 0.01)}) == 2
+
+
+def test_label_lines_are_named():
+    line = next(line for line in hexagon(3, 0.01).label_lines if line.name == "+30")
+    assert line.start is None and line.step == line[2]

@@ -4,7 +4,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from conftest import V0, D, contact_history, disordered_model, record, single_bead
+from conftest import D, V0, contact_history, disordered_model, record, settings_of, single_bead
 
 from hexdem.analysis.energy import contact_energy_j
 from hexdem.engines.reference.engine import PARAMETERS_NAME, ReferenceEngine, ReferenceSystem
@@ -17,7 +17,6 @@ from hexdem.model.walls import Wall
 from hexdem.model.materials import DELRIN, STEEL_316, hertz_stiffness, sphere_mass
 from hexdem.model.units import SI, nondimensional
 from hexdem.model.model_builder import build_model
-from hexdem.model.run_settings import run_settings
 
 #: A small experiment: 5 beads per edge (61 beads), everything else the paper's defaults.
 SMALL = RunConfig(edge_beads=5, engine="reference")
@@ -96,9 +95,9 @@ def line_peaks(analysis, line):
 
 def test_halving_the_time_step_changes_peaks_by_less_than_1e_4(tmp_path):
     config = SMALL.replace(strike_angle_deg=30.0)
-    dt = run_settings(config).dt_s
+    dt = settings_of(config).dt_s
     coarse = simulate(config, tmp_path / "dt")
-    fine = simulate(config.replace(dt=dt / 2, dump_every=2 * run_settings(config).dump_every), tmp_path / "dt2")
+    fine = simulate(config.replace(dt=dt / 2, dump_every=2 * settings_of(config).dump_every), tmp_path / "dt2")
     for line in ("0", "+30", "-30"):
         (p1, t1), (p2, t2) = line_peaks(coarse, line), line_peaks(fine, line)
         moving = p1 > 0.01 * config.v0
@@ -120,7 +119,7 @@ def test_nondimensional_run_is_the_scaled_si_run(tmp_path):
     """Eq. (scaling): in A = d = M = 1 the same impact gives the same V_n/V0 and scaled times."""
     si = SMALL.replace(strike_angle_deg=30.0)
     scale = nondimensional(D)
-    settings = run_settings(si)
+    settings = settings_of(si)
     nd = si.replace(units="nondimensional", v0=si.v0 / scale.velocity_m_s, dt=settings.dt_s / scale.time_s,
                     duration=settings.duration_s / scale.time_s)
     a, b = simulate(si, tmp_path / "si"), simulate(nd, tmp_path / "nd")

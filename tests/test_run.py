@@ -180,3 +180,16 @@ def test_ranks_that_own_no_bead_take_part(tmp_path):
     eight = simulate(config.replace(ranks=8), tmp_path / "eight").results
     np.testing.assert_allclose(eight.peak_speed, one.peak_speed, rtol=1e-9)
     np.testing.assert_allclose(eight.arrival_time, one.arrival_time, rtol=1e-9)
+
+
+@pytest.mark.parametrize("dump", [False, True])
+def test_a_run_builds_its_model_once(tmp_path, monkeypatch, dump):
+    """The dump's disk check, the time step and the engine all read the one model the run built
+    (every model is built through ``configured_packing``)."""
+    import hexdem.model.model_builder as builder
+
+    built = []
+    packing = builder.configured_packing
+    monkeypatch.setattr(builder, "configured_packing", lambda config: built.append(config) or packing(config))
+    run_experiment(RunConfig(edge_beads=3, dump=dump), tmp_path / "out", log=lambda message: None)
+    assert len(built) == 1

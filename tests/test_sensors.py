@@ -5,7 +5,7 @@ import json
 
 import numpy as np
 import pytest
-from conftest import read_csv
+from conftest import read_csv, settings_of
 
 from hexdem.cli.main import main
 from hexdem.errors import HexdemError
@@ -16,7 +16,6 @@ from hexdem.experiments.signals import SIGNAL_COLUMNS
 from hexdem.model.config import RunConfig
 from hexdem.model.materials import sphere_mass
 from hexdem.model.model_builder import build_model, build_packing
-from hexdem.model.run_settings import run_settings
 from hexdem.model.sensors import sensor_beads
 
 SENSORS = ["0:1", "+30:3", "-30:5", "0:4"]
@@ -30,10 +29,10 @@ def sensor_run(tmp_path_factory):
 
 
 def test_sensors_are_sampled_exactly_at_the_acquisition_rate():
-    settings = run_settings(CONFIG)
+    settings = settings_of(CONFIG)
     assert settings.dt_s * settings.sensor_every == pytest.approx(1 / 500e3, rel=1e-12)
     assert settings.sensor_every % settings.dump_every == 0
-    assert settings.dt_s <= run_settings(RunConfig(edge_beads=7)).dt_s
+    assert settings.dt_s <= settings_of(RunConfig(edge_beads=7)).dt_s
 
 
 @pytest.mark.parametrize("sensors, message", [

@@ -23,9 +23,10 @@ SMALL_HALF = RunConfig(shape="half-hexagon", long_edge=21, short_edge=11, impact
 @pytest.mark.parametrize("times_ms", [(0.15, 0.3, 0.45, 0.6), (0.25, 1.0), (0.123, 0.5)])
 def test_frames_fall_exactly_on_the_requested_times(times_ms):
     config = RunConfig(impact="striker")
-    snap = snapshot_config(config, [t * 1e-3 for t in times_ms])
-    settings = run_settings(snap)
-    assert settings.dt_s <= run_settings(config).dt_s
+    model = build_model(config)
+    snap = snapshot_config(config, model, [t * 1e-3 for t in times_ms])
+    settings = run_settings(snap, model)
+    assert settings.dt_s <= run_settings(config, model).dt_s
     interval = settings.dt_s * settings.dump_every
     for t in times_ms:
         assert t * 1e-3 / interval == pytest.approx(round(t * 1e-3 / interval), abs=1e-9)
@@ -35,13 +36,15 @@ def test_frames_fall_exactly_on_the_requested_times(times_ms):
 @pytest.mark.parametrize("times", [(), (2e-4, 2e-4), (0.0, 1e-4), (-1e-4,)])
 def test_bad_times_are_refused(times):
     with pytest.raises(HexdemError, match="snapshot times must be distinct and at least 1 µs"):
-        snapshot_config(RunConfig(impact="striker"), times)
+        snapshot_config(RunConfig(impact="striker"), None, times)
 
 
 @pytest.fixture(scope="module")
 def one_and_two_ranks(tmp_path_factory):
     base = tmp_path_factory.mktemp("snapshots")
-    return [take_snapshots(SMALL_HALF.replace(ranks=ranks), TIMES_S, base / f"ranks{ranks}") for ranks in (1, 2)]
+    model = build_model(SMALL_HALF)
+    return [take_snapshots(SMALL_HALF.replace(ranks=ranks), model, TIMES_S, base / f"ranks{ranks}")
+            for ranks in (1, 2)]
 
 
 def test_one_and_two_ranks_give_the_same_speeds(one_and_two_ranks):

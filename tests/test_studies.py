@@ -296,6 +296,41 @@ def test_studies_inside_a_commands_parsl_session_share_its_parsl(tmp_path):
                 used.append(executor)
         assert not used[0]._dfk.cleanup_called
     assert used[0] is used[1] and used[0]._dfk.cleanup_called
+    assert session._executor is None  # a closed session cannot hand out its cleaned-up Parsl again
+
+
+@pytest.mark.parametrize("wait, calls", [(True, ["wait_for_current_tasks", "cleanup"]), (False, ["cleanup"])])
+def test_the_parsl_executors_shutdown_waits_for_its_tasks_only_when_asked(wait, calls):
+    from hexdem.experiments.executors import ParslExecutor
+
+    class Kernel:
+        def __init__(self):
+            self.calls = []
+
+        def __getattr__(self, name):
+            return lambda: self.calls.append(name)
+
+    executor = object.__new__(ParslExecutor)  # its DataFlowKernel alone, without starting Parsl
+    executor._dfk = Kernel()
+    executor.shutdown(wait=wait)
+    assert executor._dfk.calls == calls
+
+
+@pytest.mark.parametrize("retries", [0, 2])
+def test_a_failed_task_is_submitted_again_as_many_times_as_the_retries_given(retries):
+    from concurrent.futures import ThreadPoolExecutor
+
+    from hexdem.experiments.executors import run_tasks
+
+    tries = []
+
+    def fails(key):
+        tries.append(key)
+        raise ValueError(key)
+
+    with ThreadPoolExecutor(1) as executor:
+        (key, result, error), = run_tasks(executor, {"a": (fails, "a")}, retries)
+    assert (key, result, type(error), len(tries)) == ("a", None, ValueError, 1 + retries)
 
 
 def test_the_shipped_one_machine_parsl_file_runs_a_sweep_with_its_logs_in_the_study(tmp_path, monkeypatch):

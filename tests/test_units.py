@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from conftest import contact_of
 
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
@@ -10,7 +11,6 @@ from hexdem.model.materials import (DELRIN, MATERIALS, STEEL_316, Material, effe
                                      sphere_mass)
 from hexdem.model.units import nondimensional, to_nondimensional_velocity, to_physical_velocity
 from hexdem.model.model_builder import build_model
-from hexdem.model.run_settings import contact_time_s
 
 D = 0.01905
 
@@ -58,8 +58,8 @@ def test_a_packing_of_another_material_takes_its_hertz_law_and_mass(name):
     mass = mat.density_kg_m3 * np.pi * D**3 / 6
     a = mat.youngs_modulus_pa * np.sqrt(D) / (3 * (1 - mat.poisson_ratio**2))
     config = RunConfig(bead_material=name, edge_beads=3)
-    assert contact_time_s(config) == pytest.approx(contact_time(mass / 2, a, 0.4), rel=1e-12)
-    assert contact_time_s(config) == pytest.approx(2.9432 * (5 * mass / 2 * 0.4**2 / (4 * a)) ** 0.4 / 0.4, rel=1e-4)
+    assert contact_of(config) == pytest.approx(contact_time(mass / 2, a, 0.4), rel=1e-12)
+    assert contact_of(config) == pytest.approx(2.9432 * (5 * mass / 2 * 0.4**2 / (4 * a)) ** 0.4 / 0.4, rel=1e-4)
     assert build_model(config).masses_kg[0] == pytest.approx(mass)
 
 

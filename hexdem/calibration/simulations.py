@@ -35,6 +35,7 @@ from hexdem.common.typecheck import type_at
 from hexdem.errors import HexdemError
 from hexdem.experiments.sweep_plan import with_value
 from hexdem.model.config import RunConfig
+from hexdem.model.model_builder import build_model
 from hexdem.model.run_settings import run_settings
 
 SIMULATIONS = "simulations"
@@ -111,7 +112,8 @@ def check_problem(problem: Problem) -> None:
     for quantile in CHECKED_QUANTILES:
         values = [float(prior.from_unit(min(max(quantile, 1e-9), 1 - 1e-9))) for prior in problem.priors]
         try:
-            run_settings(problem.config(values))
+            config = problem.config(values)
+            run_settings(config, build_model(config))
         except HexdemError as exc:
             named = ", ".join(f"{prior.key} = {value:.6g}" for prior, value in zip(problem.priors, values))
             raise HexdemError(f"--prior: the configuration with {named} (inside the priors) is refused: {exc}") from None
@@ -143,11 +145,11 @@ def disordered_impact(config: RunConfig, sigma_m: float, seed: int, realization:
     under the gravity it settled in."""
     from hexdem.experiments.run import check_energy
     from hexdem.experiments.tracked_run import ImpactJob, track_impact
-    from hexdem.model.model_builder import build_model
 
     packing, gravity = settled_packing(config, sigma_m, seed, realization, packings)
-    model = replace(build_model(config), packing=packing)
-    job = ImpactJob(model, run_settings(config), "lammps", Path(workdir), gravity_m_s2=tuple(float(g) for g in gravity),
+    nominal = build_model(config)
+    model = replace(nominal, packing=packing)
+    job = ImpactJob(model, run_settings(config, nominal), "lammps", Path(workdir), gravity_m_s2=tuple(float(g) for g in gravity),
                     show_progress=False)
     analysis = track_impact(job)
     check_energy(analysis, workdir)

@@ -138,7 +138,7 @@ class EnsembleConfig:
                          dump_every=self.steps_per_contact // IMPACT_SAMPLES_PER_CONTACT, friction=self.friction)
         if self.duration_s is not None:
             return base.replace(duration=self.duration_s)
-        return base.replace(duration=self.duration_factor * run_settings(base).duration_s)
+        return base.replace(duration=self.duration_factor * run_settings(base, build_model(base)).duration_s)
 
     def ideal_lattice(self) -> Packing:
         return build_packing(self.run_config(self.velocities_m_s[0]))
@@ -196,7 +196,8 @@ class Ensemble:
 
     # ---- models
     def settings(self, v: float) -> RunSettings:
-        return run_settings(self.config.run_config(v))
+        config = self.config.run_config(v)
+        return run_settings(config, build_model(config))
 
     def diameters_m(self, k: int) -> np.ndarray:
         """Realization k's diameters: each bead's nominal one (d, or a centered square's

@@ -25,8 +25,8 @@ from hexdem.disorder.preparation import STAGES, write_stage_deck
 from hexdem.disorder.sharing import adopt_preparation, adopt_ideal_impacts
 from hexdem.disorder.stats import write_statistics
 from hexdem.engines.lammps.standalone import is_done, run_deck
-from hexdem.errors import HexdemError
-from hexdem.experiments.executors import check_study_options, describe, holding, parsl_session, run_phase, tasks_failed
+from hexdem.errors import HexdemError, one_line
+from hexdem.experiments.executors import check_study_options, holding, parsl_session, run_phase, tasks_failed
 
 
 def _check_manifest(out: Path, config: EnsembleConfig) -> dict:
@@ -61,7 +61,7 @@ def _run_phase(name: str, tasks: dict, workers: int, parsl, on_done=None) -> Non
     failed, errors = [], []
     for what, error in run_phase(tasks, workers, parsl, PHASE_LABELS[name], "deck"):
         if error is not None:
-            failed.append(f"{what}: {describe(error)}")
+            failed.append(f"{what}: {one_line(error)}")
             errors.append(error)
         if on_done is not None:
             on_done()

@@ -2,13 +2,14 @@
 
 Engines do not keep trajectories. Every ``settings.dump_every`` steps (step 0 included, as
 a LAMMPS dump would) they hand a :class:`Sample` of the bodies each MPI rank owns to an
-observer, a callable ``on_sample(sample)``. The analysis (a tracker) keeps only what its
+observer (:class:`Observer`). The analysis (a tracker) keeps only what its
 outputs need, so memory grows with the number of beads, never with the run's length.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Protocol, TypeVar
 
 import numpy as np
 
@@ -44,3 +45,21 @@ class Sample:
     ghost_ids: np.ndarray | None = None
     ghost_positions: np.ndarray | None = None
 
+
+
+class Observer(Protocol):
+    """What an engine hands its samples to: called with each :class:`Sample` of the bodies its
+    rank owns, in the order of the run."""
+
+    def __call__(self, sample: Sample) -> None: ...
+
+
+Results = TypeVar("Results", covariant=True)
+
+
+class InRunAnalysis(Observer, Protocol[Results]):
+    """An observer that analyses the run as it goes (a pulse tracker, a wave recorder):
+    ``finish()``, called on every rank after the engine's last sample, gathers the ranks' parts
+    and returns the results on rank 0, None on the other ranks."""
+
+    def finish(self) -> Results | None: ...

@@ -28,6 +28,7 @@ import numpy as np
 
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
+from hexdem.model.model_builder import build_model
 from hexdem.model.run_settings import SAMPLES_PER_CONTACT, run_settings
 
 #: Order of the error in the time step of each engine's integrator.
@@ -167,10 +168,11 @@ class SamplingError:
 def sampling_error(config: RunConfig, workdir) -> SamplingError:
     """The error of the in-run analysis's sampling alone: ``config`` at its own sampling and at
     every step, the same time step and so the same trajectory (see :class:`SamplingError`)."""
-    from hexdem.experiments.run import simulate
+    from hexdem.experiments.run import simulate, simulate_model
 
-    settings = run_settings(config)
-    sampled = simulate(config, Path(workdir) / "sampled").results
+    model = build_model(config)
+    settings = run_settings(config, model)
+    sampled = simulate_model(config, model, Path(workdir) / "sampled").results
     every_step = simulate(config.replace(dt=settings.dt_s / settings.units.time_s, dump_every=1),
                           Path(workdir) / "every-step").results
     beads = measured_beads(every_step, config.v0)

@@ -48,8 +48,6 @@ class LocalPool(Executor):
     with this one (on Linux), so that none keeps writing into a study that was killed, and stop
     as it does on SIGTERM and SIGINT (:mod:`hexdem.common.interrupt`), cleaning up their task."""
 
-    retries = LOCAL_RETRIES
-
     def __init__(self, workers: int):
         self.workers = positive_int("--workers", workers)
         self._pool = self._new()
@@ -132,8 +130,6 @@ class ParslExecutor(Executor):
     """Parsl's DataFlowKernel of ``config`` as an :class:`Executor`: ``submit`` returns an
     AppFuture. Parsl retries failed tasks itself (``config.retries``)."""
 
-    retries = 0
-
     def __init__(self, config):
         from parsl import DataFlowKernel, python_app
 
@@ -147,6 +143,9 @@ class ParslExecutor(Executor):
         return self._app(fn, *args, **kwargs)
 
     def shutdown(self, wait=True, *, cancel_futures=False):
+        """Clean up Parsl's DataFlowKernel, after its tasks have finished if ``wait``."""
+        if wait:
+            self._dfk.wait_for_current_tasks()
         self._dfk.cleanup()
 
 
@@ -179,7 +178,8 @@ class ParslSession:
     def __exit__(self, *exc_info) -> None:
         self._depth -= 1
         if self._depth == 0 and self._executor is not None:
-            self._executor.shutdown()
+            executor, self._executor = self._executor, None
+            executor.shutdown()
 
 
 def parsl_session(parsl, folder=None) -> ParslSession | None:
@@ -226,12 +226,6 @@ def study_executor(workers: int, parsl: ParslSession | None = None):
         pool.shutdown(cancel_futures=True)
 
 
-def describe(error: BaseException) -> str:
-    """A task's error in one line: hexdem's own message, or the exception's type and message."""
-    text = str(error) if isinstance(error, HexdemError) else f"{type(error).__name__}: {error}"
-    return " ".join(text.split())
-
-
 def tasks_failed(message: str, errors) -> HexdemError:
     """The error that ends a study whose tasks failed with ``errors``: a
     :class:`~hexdem.errors.RunFailed` (exit status 4: a LAMMPS error, a job whose ranks died, an
@@ -241,17 +235,24 @@ def tasks_failed(message: str, errors) -> HexdemError:
     return (HexdemError if refused else RunFailed)(message)
 
 
-def run_tasks(executor, tasks: dict):
+def study_retries(parsl: ParslSession | None) -> int:
+    """Times a failed task of the study executor (:func:`study_executor`) is submitted again:
+    :data:`LOCAL_RETRIES` on the local pool, none on Parsl, which retries as its configuration's
+    ``retries`` says."""
+    return LOCAL_RETRIES if parsl is None else 0
+
+
+def run_tasks(executor, tasks: dict, retries: int):
     """Submit ``tasks`` (``{key: (fn, *args)}``) to ``executor``; yield (key, result, error) as each
     finishes (``error``: None, or the exception of its last try), a failed task being submitted
-    again up to ``executor.retries`` times."""
+    again up to ``retries`` times (:func:`study_retries`)."""
     tries = dict.fromkeys(tasks, 0)
     futures = {executor.submit(*task): key for key, task in tasks.items()}
     while futures:
         for future in wait(futures, return_when=FIRST_COMPLETED).done:
             key = futures.pop(future)
             error = future.exception()
-            if error is not None and tries[key] < executor.retries:
+            if error is not None and tries[key] < retries:
                 tries[key] += 1
                 futures[executor.submit(*tasks[key])] = key
             else:
@@ -269,7 +270,7 @@ def run_phase(tasks: dict, workers: int, parsl: ParslSession | None, label: str,
     bar = progress_bar(done_before + len(tasks), label, unit=unit)
     bar.update(done_before)
     with study_executor(min(workers, len(tasks)), parsl) as executor:
-        for key, _, error in run_tasks(executor, tasks):
+        for key, _, error in run_tasks(executor, tasks, study_retries(parsl)):
             yield key, error
             bar.update(1)
     bar.close()

@@ -131,7 +131,8 @@ def check_random_run(config: RunConfig) -> None:
         return
     with tempfile.TemporaryDirectory(prefix="hexdem-loose-") as scratch:
         loose, positions, diameters = _loose_start(config, Path(scratch))
-        run_settings(_packing_config(config, loose, _struck(config, positions, diameters), config.walls))
+        struck = _packing_config(config, loose, _struck(config, positions, diameters), config.walls)
+        run_settings(struck, build_model(struck))
 
 
 def _kept(deck: Path) -> Path:

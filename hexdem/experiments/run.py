@@ -45,6 +45,7 @@ from hexdem.experiments.random_packing import packing_name, prepare_random_packi
 from hexdem.experiments.sensors import write_sensor_files
 from hexdem.experiments.tracked_run import ImpactJob, track_impact
 from hexdem.model.config import RunConfig
+from hexdem.model.granular import GranularModel
 from hexdem.model.model_builder import build_model
 from hexdem.model.run_settings import run_settings
 from hexdem.model.sensors import sensor_beads
@@ -74,9 +75,16 @@ FAILED_PREFIX = "hexdem-failed-"
 FRONT_WALL_MARGIN_D = 2.0
 
 
-def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples=(),
-             trace_beads=(), threshold_speed: float | None = None) -> ImpactAnalysis:
-    """Run ``config`` with its engine in ``workdir``, analysed while it runs (no result files).
+def simulate(config: RunConfig, workdir, log=None, **observed) -> ImpactAnalysis:
+    """:func:`simulate_model` of ``config`` on the model built from it; ``observed``: what to
+    record in the run (:func:`simulate_model`'s ``trace_lines`` and the others)."""
+    return simulate_model(config, build_model(config), workdir, log, **observed)
+
+
+def simulate_model(config: RunConfig, model: GranularModel, workdir, log=None, trace_lines=(), field_samples=(),
+                   trace_beads=(), threshold_speed: float | None = None) -> ImpactAnalysis:
+    """Run ``config``, whose model ``model`` is, with its engine in ``workdir``, analysed while it
+    runs (no result files).
 
     ``trace_lines`` (observation line names) keep the speeds of those lines' beads at every
     sample, and so do ``trace_beads`` (bead indices) for theirs; ``threshold_speed`` (run units)
@@ -87,7 +95,6 @@ def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples
     (:mod:`~hexdem.experiments.deck_config`).
     """
     log = log or (lambda message: None)
-    model = build_model(config)
     settings = run_settings(config, model)
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
@@ -106,11 +113,11 @@ def simulate(config: RunConfig, workdir, log=None, trace_lines=(), field_samples
     return analysis
 
 
-def check_dump_space(config: RunConfig, out: Path) -> None:
-    """Refuse a run whose requested dump would not fit on the disk of ``out``."""
+def check_dump_space(config: RunConfig, model: GranularModel, out: Path) -> None:
+    """Refuse a run of ``config`` (whose model ``model`` is) whose requested dump would not fit on
+    the disk of ``out``."""
     if not (config.dump and config.engine == "lammps"):
         return
-    model = build_model(config)
     needed = DUMP_BYTES_PER_ATOM_FRAME * run_settings(config, model).n_samples * model.n_bodies
     free = free_disk_bytes(out)
     if needed > free:
@@ -296,8 +303,9 @@ def run_experiment(config: RunConfig, out, log=None, command=None, prepared: Run
             start, provenance = time.perf_counter(), started_provenance(command)
             if prepared is None:
                 prepared = prepare_random_packing(config, staging / "preparation", log)
-            check_dump_space(prepared, Path(out))
-            analysis = simulate(prepared, staging / "deck", log)
+            model = build_model(prepared)
+            check_dump_space(prepared, model, Path(out))
+            analysis = simulate_model(prepared, model, staging / "deck", log)
             write_results(config, analysis, staging, time.perf_counter() - start, provenance(), log)
             raise_if_stopped()  # a stopped run is never published, even one whose stop was swallowed
         except HexdemError as exc:

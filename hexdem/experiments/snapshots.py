@@ -28,7 +28,8 @@ from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.errors import HexdemError
 from hexdem.experiments.tracked_run import ImpactJob, track_impact
 from hexdem.model.config import RunConfig
-from hexdem.model.model_builder import build_model, build_packing
+from hexdem.model.granular import GranularModel
+from hexdem.model.model_builder import build_model
 from hexdem.model.packing import Packing
 from hexdem.model.run_settings import run_settings
 from hexdem.model.triangular import hexagon
@@ -41,8 +42,9 @@ FIGURE_NAMES = {"hexagon": "fig3_smallsim", "half-hexagon": "fig4_largesim"}
 SNAPSHOT_COLUMNS = ("time", "bead_id", "m", "n", "x", "y", "speed")
 
 
-def snapshot_config(config: RunConfig, times_s) -> RunConfig:
-    """``config`` with the time step, sampling interval and length that put a sample on every time.
+def snapshot_config(config: RunConfig, model: GranularModel, times_s) -> RunConfig:
+    """``config`` (whose model ``model`` is) with the time step, sampling interval and length that
+    put a sample on every time.
 
     The times' greatest common divisor (whole µs) is split into a whole number of samples no
     longer than the default sampling interval, each a whole number of steps no longer than
@@ -54,7 +56,7 @@ def snapshot_config(config: RunConfig, times_s) -> RunConfig:
     if not micro or min(micro) < 1 or len(set(micro)) != len(micro):
         raise HexdemError(f"snapshot times must be distinct and at least 1 µs, got {list(times_s)}")
     unit_s = math.gcd(*micro) * 1e-6
-    default = run_settings(config)
+    default = run_settings(config, model)
     samples = math.ceil(unit_s / (default.dt_s * default.dump_every))
     every = math.ceil(unit_s / samples / default.dt_s)
     return config.replace(dt=unit_s / (samples * every), duration=max(micro) * 1e-6, dump_every=every)
@@ -71,11 +73,11 @@ class Snapshots:
     engine: dict
 
 
-def take_snapshots(config: RunConfig, times_s, directory) -> Snapshots:
-    """Run ``config`` (striker impact, ideal lattice) in LAMMPS on ``config.ranks`` ranks
-    and keep every bead's speed at ``times_s``, taken inside the run (no dump)."""
-    config = snapshot_config(config, sorted(times_s))
-    model = build_model(config)
+def take_snapshots(config: RunConfig, model: GranularModel, times_s, directory) -> Snapshots:
+    """Run ``config`` (striker impact, ideal lattice; its model ``model``) in LAMMPS on
+    ``config.ranks`` ranks and keep every bead's speed at ``times_s``, taken inside the run (no
+    dump)."""
+    config = snapshot_config(config, model, sorted(times_s))
     settings = run_settings(config, model)
     wanted = np.array([round(t * 1e6) * 1e-6 for t in sorted(times_s)])
     samples = np.rint(wanted / (settings.dump_every * settings.dt_s)).astype(int)
@@ -135,17 +137,18 @@ def run_snapshots(config: RunConfig, times_s, out, outline_edge: int | None = No
     ``outline_edge``: draw the walls of a hexagon with this many beads per edge (Fig. 4: 11).
     """
     log = log or (lambda message: print(f"hexdem snapshots: {message}", file=sys.stderr, flush=True))
-    snapshot_config(config, times_s)
+    model = build_model(config)
+    snapshot_config(config, model, times_s)
     outline = hexagon(outline_edge, config.diameter_m) if outline_edge else None
     out = ensure_writable_dir(out)
     start = time.perf_counter()
-    log(f"{build_packing(config).shape}, striker at {config.v0:g} m/s, {config.ranks} rank(s), "
+    log(f"{model.packing.shape}, striker at {config.v0:g} m/s, {config.ranks} rank(s), "
         f"{len(times_s)} snapshots up to {max(times_s) * 1e3:g} ms")
-    snapshots = take_snapshots(config, times_s, out / "deck")
+    snapshots = take_snapshots(config, model, times_s, out / "deck")
     name = FIGURE_NAMES.get(config.shape, "snapshots")
     write_csv(out / f"{name}.csv", SNAPSHOT_COLUMNS, snapshot_rows(snapshots))
-    snapshot_figure(snapshots, build_model(snapshots.config).walls, out / f"{name}.png", outline)
-    settings = run_settings(snapshots.config)
+    snapshot_figure(snapshots, model.walls, out / f"{name}.png", outline)
+    settings = run_settings(snapshots.config, model)
     engine = snapshots.engine
     write_json(out / "snapshots.json", {
         "hexdem_version": version("hexdem"), "config": snapshots.config.shape_dict(),

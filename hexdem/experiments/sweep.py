@@ -39,8 +39,8 @@ import tempfile
 from pathlib import Path
 
 from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
-from hexdem.errors import HexdemError, RunFailed
-from hexdem.experiments.executors import check_study_options, describe, holding, parsl_session, run_phase
+from hexdem.errors import HexdemError, RunFailed, one_line
+from hexdem.experiments.executors import check_study_options, holding, parsl_session, run_phase
 from hexdem.experiments.provenance import user_command
 from hexdem.experiments.sweep_plan import SweepRun, Variation, plan_sweep
 from hexdem.model.unused_keys import on_engine
@@ -136,7 +136,7 @@ def planned_study(out) -> tuple[list[SweepRun], list[Variation]]:
 
 
 def _record_failure(out: Path, run: SweepRun, error: BaseException) -> str:
-    message = describe(error)
+    message = one_line(error)
     failure_path(out, run).write_text(message + "\n")
     return message
 

@@ -30,6 +30,7 @@ from hexdem.common.typecheck import check_type, type_at
 from hexdem.errors import HexdemError
 from hexdem.experiments.random_packing import check_random_run
 from hexdem.model.config import RunConfig, read_config_table
+from hexdem.model.model_builder import build_model
 from hexdem.model.packing_builders import PREPARED_SHAPES
 from hexdem.model.run_settings import run_settings
 from hexdem.model.unused_keys import check_unused_in_every
@@ -139,7 +140,7 @@ def plan_sweep(base: dict, variations: list[Variation], source: str = "the base 
             if config.shape in PREPARED_SHAPES:  # packed by LAMMPS when it runs: checked on its loose start
                 check_random_run(config)
             else:
-                run_settings(config)
+                run_settings(config, build_model(config))
         except HexdemError as exc:
             message = str(exc)
             raise HexdemError(message if message.startswith(f"run {name}") else f"run {name}: {message}") from None

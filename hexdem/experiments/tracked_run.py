@@ -15,6 +15,7 @@ from hexdem.analysis.tracker import PulseTracker
 from hexdem.engines.lammps.engine import LammpsEngine
 from hexdem.engines.lammps.deck import Deck
 from hexdem.engines.lammps.runner import logged_step
+from hexdem.engines.sampling import InRunAnalysis, Results
 from hexdem.experiments.parallel import run_on_ranks
 from hexdem.model.granular import GranularModel, RunSettings
 
@@ -43,10 +44,16 @@ class ImpactJob:
     def __call__(self, comm):
         tracker = PulseTracker(self.model, self.settings, comm, self.trace_beads, self.field_samples,
                                self.gravity_m_s2, self.threshold_speed)
-        engine = make_engine(self.engine, self.dump, self.gravity_m_s2)
-        description = engine.run(self.model, self.settings, self.directory, tracker, comm, self.show_progress)
-        tracked = tracker.finish()
+        tracked, description = observed_run(make_engine(self.engine, self.dump, self.gravity_m_s2), self, tracker,
+                                            comm)
         return None if tracked is None else (tracked, description)
+
+
+def observed_run(engine, job, analysis: InRunAnalysis[Results], comm) -> tuple[Results | None, dict]:
+    """Run ``job``'s model and settings on ``engine`` in its directory, ``analysis`` observing:
+    (its results, None on the ranks other than 0; the engine's description of the run)."""
+    description = engine.run(job.model, job.settings, job.directory, analysis, comm, job.show_progress)
+    return analysis.finish(), description
 
 
 def make_engine(name: str, dump: bool = False, gravity_m_s2=None):

@@ -15,7 +15,7 @@ import numpy as np
 
 from hexdem.analysis.wave_recorder import RecordedWaves, WaveRecorder
 from hexdem.experiments.parallel import run_on_ranks
-from hexdem.experiments.tracked_run import make_engine
+from hexdem.experiments.tracked_run import make_engine, observed_run
 from hexdem.model.config import RunConfig
 from hexdem.model.granular import GranularModel, RunSettings
 from hexdem.model.model_builder import build_model
@@ -40,8 +40,7 @@ class WaveJob:
     def __call__(self, comm):
         recorder = WaveRecorder(self.model, self.settings, np.asarray(self.wave_vectors_m, float), self.block, comm,
                                 self.weights or None)
-        make_engine(self.engine).run(self.model, self.settings, self.directory, recorder, comm, self.show_progress)
-        return recorder.finish()
+        return observed_run(make_engine(self.engine), self, recorder, comm)[0]
 
 
 def steps_per_sample(dt_s: float, period_s: float, samples_per_period: int) -> int:

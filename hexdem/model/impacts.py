@@ -26,7 +26,8 @@ from typing import TypedDict
 
 from hexdem.errors import HexdemError
 from hexdem.model.granular import Impact
-from hexdem.model.packing import HOLE_COSINE, Packing, facing_edge, unit_vector, with_holes
+from hexdem.model.packing import Packing, unit_vector
+from hexdem.model.walls import facing_edge
 
 
 
@@ -118,24 +119,3 @@ def resolve_impacts(specs: list[ImpactSpec], packing: Packing, velocity_scale_m_
         impacts += [Impact(spec.v0 * velocity_scale_m_s, float(angle), spec.striker, int(bead), striker,
                            spec.striker_diameter_m) for bead in beads]
     return impacts
-
-
-def _wall_members(packing: Packing) -> set[int]:
-    return {int(b) for wall in packing.walls for b in wall.members}
-
-
-def cut_holes(packing: Packing, impacts: list[Impact]) -> tuple[Packing, set[int]]:
-    """(``packing`` (its walls whole, :func:`~hexdem.model.packing.without_hole`) with a hole for
-    the bead of each of ``impacts`` (:func:`resolve_impacts`'s, each naming its bead) in every
-    wall it is pushed through, the beads that left every wall). An
-    impact on a wall bead that points out through that wall (within 60° of its outward normal;
-    a corner bead may still be pushed along or against its other wall) is refused."""
-    beads = [impact.bead for impact in impacts]
-    for impact, bead in zip(impacts, beads):
-        for wall in packing.walls:
-            if bead in wall.members and wall.normals_at(packing.positions_m[[bead]])[0] @ impact.direction < -HOLE_COSINE:
-                m, n = packing.labels[bead]
-                raise HexdemError(f"the impact on bead {{{m}, {n}}} at {impact.angle_deg:g}° points out of the packing "
-                                  f"through {wall.name}: strike it inwards")
-    holed = with_holes(packing, beads, [impact.direction for impact in impacts])
-    return holed, _wall_members(packing) - _wall_members(holed)

@@ -12,7 +12,7 @@ from dataclasses import replace
 from typing import TypedDict
 
 from hexdem.errors import HexdemError
-from hexdem.model.packing import Packing
+from hexdem.model.packing import LabelLine, Packing
 from hexdem.model.triangular import DIRECTION_STEPS
 
 
@@ -43,5 +43,5 @@ def with_lines(packing: Packing, entries) -> Packing:
             raise HexdemError(f"line {name}: angle_deg {angle!r} is not a lattice direction; use one of "
                               f"{', '.join(str(a) for a in DIRECTION_STEPS)}")
         names.add(name)
-        lines.append((name, (int(site[0]), int(site[1])), DIRECTION_STEPS[int(angle)]))
+        lines.append(LabelLine(name, (int(site[0]), int(site[1])), DIRECTION_STEPS[int(angle)]))
     return replace(packing, label_lines=packing.label_lines + tuple(lines))

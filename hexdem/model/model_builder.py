@@ -14,16 +14,17 @@ from __future__ import annotations
 from hexdem.errors import HexdemError
 from hexdem.model.contact_law import Friction
 from hexdem.model.granular import GranularModel, Impact
-from hexdem.model.impacts import cut_holes, resolve_impacts, struck_site
+from hexdem.model.impacts import resolve_impacts, struck_site
 from hexdem.model.initial_state import read_initial_state
 from hexdem.model.lines import with_lines
 from hexdem.model.materials import hertz_coefficient, hertz_stiffness
-from hexdem.model.packing import Packing, without_hole
+from hexdem.model.packing import Packing
 from hexdem.model.packing_builders import PLACED_SHAPES, BuiltPacking, shape_packing
 from hexdem.model.precompression import hole_force, precompressed_packing
 from hexdem.model.regions import assign_materials
 from hexdem.model.sensors import sensor_beads
 from hexdem.model.triangular import without_sites
+from hexdem.model.walls import cut_holes, without_hole
 
 
 def configured_packing(config) -> BuiltPacking:

@@ -19,21 +19,24 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from functools import cached_property
+from typing import NamedTuple
 
 import numpy as np
 
 from hexdem.errors import HexdemError
 from hexdem.model.rays import ray_beads, ray_name
-from hexdem.model.walls import CurvedWall, Wall
+from hexdem.model.walls import CurvedWall, Wall, touching_walls
 
-#: A bead belongs to a wall's contact group when its gap to the wall is below this many d.
-WALL_GROUP_GAP = 0.25
-#: A struck bead sits in a hole of every wall whose inward normal is within 60° of its motion
-#: (the wall it would be pushed through; not the other wall of a corner bead struck along an edge).
-HOLE_COSINE = 0.5 + 1e-9
+class LabelLine(NamedTuple):
+    """An observation line on the labels: from label ``start`` (None: the struck bead's) on,
+    one label step ``step`` (dm, dn) at a time."""
+
+    name: str
+    start: tuple[int, int] | None
+    step: tuple[int, int]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Packing:
     """A finite 2D packing of beads: labels, positions, diameters, materials, walls and lines.
 
@@ -43,8 +46,7 @@ class Packing:
     confining walls; ``shape`` a readable description; ``material_ids`` (N,) each bead's material,
     an index into the model's materials (None: all 0, the bead material).
 
-    Lines: ``label_lines``, each (name, start label (None: the struck bead's), step (dm, dn)),
-    holds the beads from the start on, one label step at a time, until the packing ends;
+    Lines: ``label_lines``, each a :class:`LabelLine`, holds the beads from the start on, one label step at a time, until the packing ends;
     ``rays_deg`` the angles from +x of the rays from the struck bead (:mod:`hexdem.model.rays`),
     named by :func:`~hexdem.model.rays.ray_name`. ``bond_steps``: the label steps between touching
     neighbours, each bond once, where the labels say which beads touch (the triangular lattice's
@@ -59,7 +61,7 @@ class Packing:
     walls: tuple[Wall | CurvedWall, ...]
     shape: str
     material_ids: np.ndarray | None = None
-    label_lines: tuple[tuple[str, tuple[int, int] | None, tuple[int, int]], ...] = ()
+    label_lines: tuple[LabelLine, ...] = ()
     rays_deg: tuple[float, ...] = ()
     bond_steps: tuple[tuple[int, int], ...] = ()
 
@@ -138,57 +140,3 @@ def strike_direction(angle_deg: float) -> np.ndarray:
         raise HexdemError(f"strike angle {angle_deg}° does not point into the packing; "
                           "use an angle in (-90°, 90°), e.g. 0 or 30")
     return unit_vector(angle)
-
-
-def without_hole(packing: Packing) -> Packing:
-    """``packing`` with its struck bead a member of every wall it touches: the walls whole, for
-    impacts that each cut their own hole (:func:`with_holes`)."""
-    bead, walls = packing.struck, []
-    for wall in packing.walls:
-        gap = wall.gaps_m(packing.positions_m[[bead]], packing.radii_m[[bead]])[0]
-        if gap < WALL_GROUP_GAP * packing.diameter_m and bead not in wall.members:
-            wall = replace(wall, members=np.sort(np.append(wall.members, bead)))
-        walls.append(wall)
-    return replace(packing, walls=tuple(walls))
-
-
-def with_holes(packing: Packing, beads, directions) -> Packing:
-    """``packing`` with each of ``beads`` (indices) taken out of the walls it would be pushed
-    through moving along its unit vector of ``directions`` (N, 2): the holes of several impacts.
-    A wall left without members is dropped (an edge struck whole)."""
-    walls = []
-    for wall in packing.walls:
-        members = set(wall.members.tolist())
-        for bead, direction in zip(beads, np.asarray(directions, float).reshape(-1, 2)):
-            if bead in members and wall.normals_at(packing.positions_m[[bead]])[0] @ direction > HOLE_COSINE:
-                members.discard(bead)
-        if members:
-            walls.append(replace(wall, members=np.array(sorted(members), dtype=int)))
-    return replace(packing, walls=tuple(walls))
-
-
-def facing_edge(packing: Packing, normal, hole: int | None = None) -> tuple[float, np.ndarray]:
-    """(offset [m], beads) of the packing's edge facing the inward ``normal``: the extreme of
-    normal·x − r over the beads, and the beads within :data:`WALL_GROUP_GAP` d of it; ``hole``, a
-    bead index, neither counts nor decides where the edge is."""
-    reach = packing.positions_m @ np.asarray(normal) - packing.radii_m
-    if hole is not None:
-        reach[hole] = np.inf
-    offset = float(reach.min())
-    return offset, np.flatnonzero(reach - offset < WALL_GROUP_GAP * packing.diameter_m)
-
-
-def touching_walls(packing: Packing, normals) -> tuple[Wall, ...]:
-    """Flat walls with the given inward normals, each touching the packing without overlap.
-
-    The wall whose normal is +x (the struck edge) has a hole: the struck bead is not a member
-    and, sitting in the hole, does not decide where that wall is (it may protrude when the
-    diameters vary).
-    """
-    walls = []
-    for normal in normals:
-        normal = (float(normal[0]), float(normal[1]))
-        offset, members = facing_edge(packing, normal, packing.struck if np.isclose(normal[0], 1.0) else None)
-        angle = int(round(np.degrees(np.arctan2(normal[1], normal[0]))))
-        walls.append(Wall(f"wall_{angle:03d}".replace("-", "m"), normal, offset, members))
-    return tuple(walls)

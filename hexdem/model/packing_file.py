@@ -18,7 +18,8 @@ import numpy as np
 
 from hexdem.common.io import read_text
 from hexdem.errors import HexdemError
-from hexdem.model.packing import Packing, touching_walls, with_holes
+from hexdem.model.packing import Packing
+from hexdem.model.walls import touching_walls, with_holes
 from hexdem.model.placed import placed_packing
 
 WALLS = ("none", "hull")

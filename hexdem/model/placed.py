@@ -14,7 +14,8 @@ from dataclasses import replace
 import numpy as np
 
 from hexdem.errors import HexdemError
-from hexdem.model.packing import Packing, touching_walls, unit_vector
+from hexdem.model.packing import Packing, unit_vector
+from hexdem.model.walls import touching_walls
 
 #: Beads may overlap by at most this fraction of the smaller diameter at rest (round-off of
 #: measured or computed positions); more is a packing that would explode.

@@ -14,7 +14,6 @@ import math
 from hexdem.errors import HexdemError
 from hexdem.model.config import MIN_STEPS_PER_CONTACT
 from hexdem.model.granular import GranularModel, RunSettings
-from hexdem.model.model_builder import build_model
 from hexdem.model.packing_builders import PLACED_SHAPES, ROW_CRYSTAL_SHAPES
 from hexdem.model.timescale import (crossing_time_s, fastest_approach_m_s, impact_contact_time_s, sized_bodies,
                                     solitary_crossing_time_s, striker_launch_s, wall_contact_time_s)
@@ -28,19 +27,17 @@ MIN_SAMPLES_PER_CONTACT = 4
 MIN_SAMPLES = 10
 
 
-def contact_time_s(config, model: GranularModel | None = None) -> float:
+def contact_time_s(config, model: GranularModel) -> float:
     """The natural time scale of ``config``'s impacts [s]
     (:func:`~hexdem.model.timescale.impact_contact_time_s`): the shortest two-body Hertz contact
-    time at an impact's V0 or at the initial state's fastest approach (read on ``model``, built
-    if not given), or, if shorter, half the period of two beads on the linearized precompressed
-    contact."""
+    time at an impact's V0 or at the initial state's fastest approach (read on ``model``, the
+    model built from ``config``), or, if shorter, half the period of two beads on the linearized
+    precompressed contact."""
     strikers = [(spec.v0 * config.unit_system.velocity_m_s,
                  (config.material(spec.striker_material or config.bead_material),
                   spec.striker_diameter_m or config.diameter_m)
                  if spec.striker and (spec.striker_material is not None or spec.striker_diameter_m is not None)
                  else None) for spec in config.impact_specs()]
-    if model is None and (config.initial_state_file is not None or config.shape in PLACED_SHAPES):
-        model = build_model(config)
     if config.initial_state_file is not None:
         fastest = fastest_approach_m_s(model)
         strikers += [(fastest, striker) for _, striker in strikers]
@@ -89,12 +86,11 @@ def check_sampling(config, settings: RunSettings) -> None:
                           "or lengthen duration")
 
 
-def run_settings(config, model: GranularModel | None = None) -> RunSettings:
+def run_settings(config, model: GranularModel) -> RunSettings:
     """Time step, step count and dump interval of ``config`` in SI, with the defaults resolved
-    on ``model`` (built if not given), checked by :func:`check_sampling`. With sensors, the time
+    on ``model`` (the model built from ``config``), checked by :func:`check_sampling`. With sensors, the time
     step is shortened (at most by one sample's worth) so that a sensor sample is a whole number
     of analysis samples of ``dump_every`` steps."""
-    model = model or build_model(config)
     scale = config.unit_system.time_s
     contact_s = contact_time_s(config, model)
     dt_s, every = step_and_sampling(config, contact_s)

@@ -32,8 +32,8 @@ from dataclasses import replace
 import numpy as np
 
 from hexdem.errors import HexdemError
-from hexdem.model.packing import WALL_GROUP_GAP, Packing, touching_walls, unit_vector
-from hexdem.model.walls import CurvedWall
+from hexdem.model.packing import LabelLine, Packing, unit_vector
+from hexdem.model.walls import WALL_GROUP_GAP, CurvedWall, touching_walls
 
 #: The step in (m, n) between consecutive sites along each of the lattice's twelve directions, by
 #: angle from +x [deg]: odd multiples of 30° run along touching beads (spacing d), multiples of
@@ -45,7 +45,7 @@ LINE_STEPS = {"0": DIRECTION_STEPS[0], "+30": DIRECTION_STEPS[30], "-30": DIRECT
 #: Index offsets of the three neighbours counted once per bond (paper's e₁, e₂, e₃).
 BOND_STEPS = ((2, 0), (1, 1), (-1, 1))
 #: The paper's lines from the struck bead, as a packing holds them (name, start: the struck bead, step).
-PAPER_LINES = tuple((name, None, step) for name, step in LINE_STEPS.items())
+PAPER_LINES = tuple(LabelLine(name, None, step) for name, step in LINE_STEPS.items())
 
 
 def from_sites(labels, diameter_m: float = 1.0, wall_angles_deg=(), shape: str = "listed sites",

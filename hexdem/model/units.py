@@ -41,10 +41,6 @@ class UnitSystem:
         return self.mass_kg * self.length_m / self.time_s**2
 
     @property
-    def energy_j(self) -> float:
-        return self.force_n * self.length_m
-
-    @property
     def stress_pa(self) -> float:
         return self.force_n / self.length_m**2
 

@@ -23,9 +23,11 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from hexdem.errors import HexdemError
-from hexdem.experiments.executors import describe, holding, parsl_session, run_tasks, study_executor, tasks_failed
+from hexdem.errors import HexdemError, one_line
+from hexdem.experiments.executors import (holding, parsl_session, run_tasks, study_executor, study_retries,
+                                          tasks_failed)
 from hexdem.theory.scaling import DEFAULT_LAST, Combination, CombinationFit, fit_combination
+from hexdem.model.model_builder import build_model
 from hexdem.model.run_settings import contact_time_s
 
 #: Strike angles of the sweep [deg]: each one serves two combinations.
@@ -89,7 +91,7 @@ class SweepSettings:
                          units="nondimensional", v0=float(v0), strike_angle_deg=float(strike_deg),
                          engine=self.engine, dump_every=self.steps_per_contact // self.samples_per_contact,
                          launcher=self.launcher)
-        tau = contact_time_s(base) / base.unit_system.time_s
+        tau = contact_time_s(base, build_model(base)) / base.unit_system.time_s
         return base.replace(dt=tau / self.steps_per_contact, duration=self.duration_contacts * tau)
 
 
@@ -184,11 +186,11 @@ def _results(settings: SweepSettings, jobs, parsl):
     tasks = {(strike, i): (run_one, settings, v0, strike) for strike, i, v0 in jobs}
     failed, errors = [], []
     with study_executor(min(settings.workers, len(jobs)), parsl) as executor:
-        for (strike, i), result, error in run_tasks(executor, tasks):
+        for (strike, i), result, error in run_tasks(executor, tasks, study_retries(parsl)):
             if error is None:
                 yield (strike, i), result
             else:
-                failed.append(f"strike {strike:g} deg, V0 = {settings.v0[i]:.4g}: {describe(error)}")
+                failed.append(f"strike {strike:g} deg, V0 = {settings.v0[i]:.4g}: {one_line(error)}")
                 errors.append(error)
     if failed:
         raise tasks_failed(f"{len(failed)} of {len(jobs)} runs of the V0 sweep failed; {'; '.join(failed)}", errors)

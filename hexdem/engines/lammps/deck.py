@@ -50,10 +50,6 @@ class Deck:
         return self.directory / DECK_NAME
 
     @property
-    def dump_path(self) -> Path:
-        return self.directory / DUMP_NAME
-
-    @property
     def log_path(self) -> Path:
         return self.directory / "log.lammps"
 

@@ -49,7 +49,7 @@ from hexdem.engines.lammps.deck import DATA_NAME, DUMP_NAME, Deck
 from hexdem.engines.lammps.full_step import full_step_state
 from hexdem.engines.lammps.library import load_lammps
 from hexdem.engines.lammps.runner import RunInfo, lammps_failure, log_version
-from hexdem.engines.sampling import Sample
+from hexdem.engines.sampling import Observer, Sample
 from hexdem.errors import HexdemError
 
 #: The comment line that opens the output section of hexdem's impact decks.
@@ -103,7 +103,7 @@ class _Stream:
     ARRAYS = {"x": (3, True), "id": (0, True), "v": (3, False), "f": (3, False), "rmass": (0, False)}
     SPIN_ARRAYS = {"omega": (3, False), "torque": (3, False), "radius": (0, False)}
 
-    def __init__(self, lmp, deck: Deck, on_sample, show_progress: bool, comm=None, spins: bool = False):
+    def __init__(self, lmp, deck: Deck, on_sample: Observer, show_progress: bool, comm=None, spins: bool = False):
         self.lmp, self.on_sample, self.comm, self.spins = lmp, on_sample, comm, spins
         self.views, self.builds_now = AtomViews(lmp), neighbour_builds(lmp)
         self.every, self.dt = deck.settings.dump_every, float(lmp.extract_global("dt"))
@@ -195,7 +195,7 @@ def start_lammps(directory: Path, comm=None):
         raise lammps_failure(directory, str(exc)) from None
 
 
-def run_streaming(deck: Deck, on_sample, comm=None, dump: bool = False, show_progress: bool = True,
+def run_streaming(deck: Deck, on_sample: Observer, comm=None, dump: bool = False, show_progress: bool = True,
                   spins: bool = False) -> RunInfo:
     """Run ``deck`` with ``on_sample(sample)`` called at step 0 and every ``dump_every`` steps.
 

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from hexdem.engines.lammps.deck import Deck, write_deck
 from hexdem.engines.lammps.driver import run_streaming
 from hexdem.engines.lammps.tsuji_check import check_tsuji_damping
+from hexdem.engines.sampling import Observer
 from hexdem.model.granular import GranularModel, RunSettings
 
 
@@ -22,7 +23,7 @@ class LammpsEngine:
     gravity_m_s2: tuple[float, float] | None = None
     name = "lammps"
 
-    def run(self, model: GranularModel, settings: RunSettings, directory, on_sample, comm=None,
+    def run(self, model: GranularModel, settings: RunSettings, directory, on_sample: Observer, comm=None,
             show_progress: bool = True) -> dict:
         """Render the deck into ``directory`` (on rank 0 of ``comm``) and run it on every rank of
         ``comm`` (None: this process alone), calling ``on_sample`` with each rank's samples.

@@ -42,7 +42,7 @@ from hexdem.common.progress import progress_bar
 from hexdem.engines.reference.contacts import ListedPairs, PairLaws, coefficient, wall_geometry
 from hexdem.engines.reference.friction import FrictionalSystem
 from hexdem.engines.reference.kernel import KernelArrays, forces, integrate
-from hexdem.engines.sampling import Sample
+from hexdem.engines.sampling import Observer, Sample
 from hexdem.errors import HexdemError
 from hexdem.model.granular import GranularModel, RunSettings
 from hexdem.model.units import UnitSystem
@@ -138,7 +138,7 @@ class ReferenceEngine:
 
     name = "reference"
 
-    def run(self, model: GranularModel, settings: RunSettings, directory, on_sample, comm=None,
+    def run(self, model: GranularModel, settings: RunSettings, directory, on_sample: Observer, comm=None,
             show_progress: bool = True) -> dict:
         """Integrate ``model`` with ``settings``, calling ``on_sample`` with every sample; write
         ``reference.json`` into ``directory``. Returns a description of the run."""
