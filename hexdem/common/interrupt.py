@@ -45,7 +45,8 @@ class Interrupted(KeyboardInterrupt):
 _received: list[int] = []
 
 
-def _note(signum, frame) -> None:
+def remember(signum: int, frame=None) -> None:
+    """Remember the signal ``signum`` for :func:`raise_if_stopped` (a signal handler)."""
     _received.append(signum)
 
 
@@ -62,13 +63,6 @@ def stop_on_signals() -> None:
         signal.signal(signum, _raise)
 
 
-def note_signals() -> None:
-    """Make SIGTERM and SIGINT only be remembered, for :func:`raise_if_stopped`: a process that
-    holds nothing to clean up (an idle worker) stops at its next task."""
-    for signum in STOP_SIGNALS:
-        signal.signal(signum, _note)
-
-
 @contextmanager
 def deferred_signals():
     """Within the block, SIGTERM and SIGINT that would raise :class:`Interrupted` are only
@@ -77,7 +71,7 @@ def deferred_signals():
     polls :func:`raise_if_stopped` where it can stop."""
     ours = [signum for signum in STOP_SIGNALS if signal.getsignal(signum) is _raise]
     for signum in ours:
-        signal.signal(signum, _note)
+        signal.signal(signum, remember)
     try:
         yield
     finally:

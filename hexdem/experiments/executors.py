@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import os
 import runpy
+import signal
 import sys
 from concurrent.futures import FIRST_COMPLETED, Executor, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
@@ -31,7 +32,7 @@ from multiprocessing import get_context
 from pathlib import Path
 
 from hexdem.common.checks import positive_int
-from hexdem.common.interrupt import note_signals, raise_if_stopped, stop_on_signals
+from hexdem.common.interrupt import STOP_SIGNALS, Interrupted, raise_if_stopped, remember, stop_on_signals
 from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.standalone import die_with_parent, launcher_command
 from hexdem.errors import HexdemError, RunFailed
@@ -75,11 +76,30 @@ class LocalPool(Executor):
             process.terminate()
 
 
+#: The process whose :class:`LocalPool` this worker serves (set in the worker).
+_study_pid: int | None = None
+
+
 def _start_worker(parent_pid: int) -> None:
     """A worker of a :class:`LocalPool`: it ends with ``parent_pid``; SIGTERM or SIGINT while it
     holds no task is remembered (:func:`_worker_task`)."""
+    global _study_pid
+    _study_pid = parent_pid
     die_with_parent(parent_pid)
-    note_signals()
+    _idle()
+
+
+def _idle() -> None:
+    """An idle worker remembers SIGTERM and SIGINT for its next task, unless the study is gone (the
+    signal is die_with_parent's): then nothing will come, and it ends at once."""
+    for signum in STOP_SIGNALS:
+        signal.signal(signum, _idle_signal)
+
+
+def _idle_signal(signum, frame) -> None:
+    if os.getppid() != _study_pid:
+        os._exit(128 + signum)
+    remember(signum)
 
 
 def _worker_task(fn, *args, **kwargs):
@@ -91,8 +111,12 @@ def _worker_task(fn, *args, **kwargs):
     stop_on_signals()
     try:
         result = fn(*args, **kwargs)
+    except Interrupted as stop:
+        if os.getppid() != _study_pid:  # the study died (its SIGTERM came from die_with_parent): no one waits
+            os._exit(stop.exit_status)
+        raise
     finally:
-        note_signals()
+        _idle()
     raise_if_stopped()
     return result
 
