@@ -28,13 +28,14 @@ time"); the target: at most the loop plus 0.3 s.
 For every truth and method the table gives the simulations, the wall time, each key's 90 %
 interval width over the prior's and whether it holds the truth; the last rows count, per
 method and key, the truths inside their 90 % interval (the target: at least 7 of 10).
-``--quick``: one truth, a 5-per-edge hexagon with sensors 0:1 and 0:3, ``v0`` alone.
+``--quick``: one truth, a 5-per-edge hexagon with sensors 0:1 and 0:3, ``v0`` alone, 30 simulations.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import tempfile
 import time
 from pathlib import Path
@@ -54,6 +55,8 @@ QUICK_CASE = ({"sensors": ["0:1", "0:3", "0:5", "0:7"]},
               ("restitution=uniform(0.7, 0.99)", "v0=uniform(0.2, 0.7)"))
 TINY_CASE = ({"sensors": ["0:1", "0:3"], "edge_beads": 5}, ("v0=uniform(0.2, 0.7)",))
 FILTER_SAMPLES, FILTER_ITERATIONS = 60, 5
+#: ``--quick``'s budget: the initial design and one refinement.
+QUICK_BUDGET = 30
 
 
 def truth_record(base: dict, priors, rng, noise: float, path: Path) -> np.ndarray:
@@ -139,7 +142,7 @@ def main() -> None:
     parser.add_argument("--cost", type=int, metavar="N", help="time N simulations against their LAMMPS loop, only")
     args = parser.parse_args()
     if args.cost:
-        print(describe())
+        print(f"machine: {describe()}; load average {os.getloadavg()[0]:.2f}", flush=True)
         simulation_cost(args.cost, Path(args.out or tempfile.mkdtemp(prefix="hexdem-bench-cost-")))
         return
     base, prior_texts = TINY_CASE if args.quick else QUICK_CASE
@@ -148,7 +151,7 @@ def main() -> None:
     priors = [Prior.parse(text) for text in prior_texts]
     root = Path(args.out or tempfile.mkdtemp(prefix="hexdem-bench-calibration-"))
     rng = np.random.default_rng(args.seed)
-    print(describe())
+    print(f"machine: {describe()}; load average {os.getloadavg()[0]:.2f}", flush=True)
     print(f"noise {args.noise:g} m/s^2 rms, {truths} truth(s), workers {args.workers}")
     print("| truth | method | " + " | ".join(f"{p.key} true | {p.key} 90 % interval | {p.key} width ratio" for p in priors)
           + " | simulations | wall s |")
@@ -158,7 +161,7 @@ def main() -> None:
         folder = root / f"truth-{t}"
         folder.mkdir(parents=True, exist_ok=True)
         truth = truth_record(base, priors, rng, args.noise, folder / "data.csv")
-        calibration = prepare(base, folder / "data.csv", prior_texts, None, seed=t)
+        calibration = prepare(base, folder / "data.csv", prior_texts, QUICK_BUDGET if args.quick else None, seed=t)
         for method in methods:
             start = time.perf_counter()
             if method == "emulator":
