@@ -30,8 +30,10 @@ from hexdem.errors import HexdemError
 from hexdem.experiments.signals import BASELINE_SAMPLES, integrate_velocity, pulse
 
 MEASURED_COLUMNS = ("sensor", "time", "ax", "ay")
-#: Noisy copies of a record whose reduced observables give its noise covariance.
-BOOTSTRAP_DRAWS = 64
+#: Noisy copies of a record whose reduced observables give its noise covariance: enough that the
+#: estimate's own scatter does not make the likelihood overconfident (with 64, the posterior's spread
+#: along the parameters was 1.2 times the one it claimed; docs/validation/benchmarks.md).
+BOOTSTRAP_DRAWS = 400
 #: The pulse's foot: where the first sensor's acceleration first reaches this share of its peak.
 FOOT_LEVEL = 0.1
 #: Samples before the foot kept out of the quiet lead-in.
