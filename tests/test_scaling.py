@@ -154,3 +154,15 @@ def test_scaling_command_writes_the_four_laws(tmp_path, capsys):
         assert 0.7 < entry["b"] < 1.0, "peaks decay along the line"
     for name in scaling_outputs.OUTPUT_FILES:
         assert (out / name).stat().st_size > 0
+    header = (out / "peaks.csv").read_text().splitlines()[0].split(",")
+    assert header[-1] == "warnings" and summary["sweep"]["runs_that_warned"] == []
+
+
+def test_a_run_whose_fit_window_peaks_within_a_contact_time_of_its_end_warns():
+    """The study's table names a run whose window's last peaks came late (cut short) or never."""
+    assert sweep.window_warnings({"0": np.array([1.0, 2.0]), "+30": np.array([1.5, 6.9])}, 8.0, 1.0) == ()
+    assert sweep.window_warnings({"0": np.array([1.0, 7.2]), "+30": np.array([1.5])}, 8.0, 1.0) == (
+        "window_peak_near_end",)
+    assert sweep.window_warnings({"0": np.array([1.0, np.nan])}, 8.0, 1.0) == ("window_peak_near_end",)
+    late = sweep.run_one(sweep.SweepSettings(last=6, duration_contacts=4.0, workers=1), 0.3, 0.0)
+    assert late.warnings == ("window_peak_near_end",)

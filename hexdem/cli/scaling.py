@@ -53,6 +53,13 @@ def run(args) -> None:
     parsl = parsl_session(args.parsl, args.out)  # a bad file is refused before the output directory is made
     ensure_writable_dir(args.out)
     summary = write_outputs(run_sweep(settings, parsl=parsl), args.out, kind=args.fit)
+    warned = summary["sweep"]["runs_that_warned"]
+    if warned:
+        from hexdem.theory.sweep import SCALING_WARNINGS
+
+        names = sorted({name for run in warned for name in run["warnings"]})
+        print(f"hexdem scaling: {len(warned)} of {len(settings.v0) * 2} runs warned (the warnings column of "
+              f"peaks.csv): {'; '.join(SCALING_WARNINGS[name] for name in names)}", file=sys.stderr)
     print(f"hexdem scaling: results in {args.out}", file=sys.stderr)
     if args.json:
         print(json.dumps(summary, indent=2))

@@ -73,13 +73,16 @@ def write_outputs(sweep: Sweep, out, last: int | None = None, kind: str = "logli
         summary[name]["decay_form"] = decay_form_summary(tests, sweep.v0)
     summary["sweep"] = {**sweep.settings.as_dict(), "v0": sweep.v0.tolist(), "wall_time_s": sweep.wall_time_s,
                         "max_energy_drift": max(run.energy_drift for run in sweep.runs.values()),
-                        "velocity_unit_m_s": unit}
+                        "velocity_unit_m_s": unit,
+                        "runs_that_warned": [{"strike_deg": run.strike_deg, "v0": run.v0, "warnings": list(run.warnings)}
+                                             for run in sweep.runs.values() if run.warnings]}
     write_json(out / "scaling.json", summary)
 
-    peak_rows = [(run.strike_deg, line, run.v0, n, float(v), float(t))
+    peak_rows = [(run.strike_deg, line, run.v0, n, float(v), float(t), " ".join(run.warnings))
                  for run in sorted(sweep.runs.values(), key=lambda r: (r.strike_deg, r.v0))
                  for line in ("0", "+30") for n, (v, t) in enumerate(zip(run.peaks[line], run.t_peak[line]))]
-    write_csv(out / "peaks.csv", ("strike_deg", "line", "v0", "n", "peak_speed", "t_peak"), peak_rows)
+    write_csv(out / "peaks.csv", ("strike_deg", "line", "v0", "n", "peak_speed", "t_peak", "warnings"), peak_rows)
+
     write_csv(out / "decay_fits.csv",
               ("combination", "v0", "c", "c_stderr", "v_start", "v_start_over_v0", "c_law", "v_start_over_v0_law"),
               [(name, v, c, e, vs, vs / v, float(f.law.decay_rate(v)), float(f.law.start_ratio(v)))

@@ -107,6 +107,7 @@ class RunPeaks:
     traces: dict
     energy_drift: float
     wall_time_s: float
+    warnings: tuple[str, ...] = ()
 
 
 def run_one(settings: SweepSettings, v0: float, strike_deg: float) -> RunPeaks:
@@ -123,11 +124,26 @@ def run_one(settings: SweepSettings, v0: float, strike_deg: float) -> RunPeaks:
     for name, beads in lines.items():
         times, speeds = analysis.line_trace(name)
         traces[name] = (times, speeds[:, :len(beads)])
+    t_peak = {name: r.t_peak[beads] for name, beads in lines.items()}
+    end = analysis.settings.duration_s / analysis.settings.units.time_s
+    tau = config.duration / settings.duration_contacts
     return RunPeaks(float(v0), float(strike_deg),
-                    {name: r.peak_speed[beads] for name, beads in lines.items()},
-                    {name: r.t_peak[beads] for name, beads in lines.items()},
-                    traces,
-                    float(r.energy_drift), time.perf_counter() - start)
+                    {name: r.peak_speed[beads] for name, beads in lines.items()}, t_peak, traces,
+                    float(r.energy_drift), time.perf_counter() - start,
+                    window_warnings({name: times[:settings.last + 1] for name, times in t_peak.items()}, end, tau))
+
+
+#: Warnings of a run of the V₀ sweep, by name: what its fits should not be trusted for.
+SCALING_WARNINGS = {"window_peak_near_end": "a bead of the fit window peaked within one contact time of the run's end "
+                                            "(or not at all): its peak may be cut short; raise duration_contacts"}
+
+
+def window_warnings(t_peak: dict, end: float, contact_time: float) -> tuple[str, ...]:
+    """The names (:data:`SCALING_WARNINGS`) of the warnings of a run whose fit-window beads peaked
+    at ``t_peak`` ({line: times}) in a run that ended at ``end`` (both in the run's units)."""
+    times = np.concatenate(list(t_peak.values()))
+    late = ~np.isfinite(times) | (times > end - contact_time)
+    return ("window_peak_near_end",) if late.any() else ()
 
 
 @dataclass
