@@ -31,7 +31,6 @@ path in a tenth of the simulations. (A smaller lattice would not do: in a 5-per-
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 from pathlib import Path

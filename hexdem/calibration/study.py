@@ -13,7 +13,6 @@ asks for something else is refused rather than mixed with it.
 
 from __future__ import annotations
 
-import json
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -27,7 +26,7 @@ from hexdem.calibration.priors import parse_priors, to_parameters
 from hexdem.calibration.report import summarize, write_posterior
 from hexdem.calibration.simulations import SIMULATIONS, Problem, check_problem, finished, simulate_point, simulation_name
 from hexdem.common.checks import positive_int
-from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
+from hexdem.common.io import ensure_writable_dir, keep_plan, locked_directory, write_json
 from hexdem.errors import HexdemError, RunFailed, one_line
 from hexdem.experiments.executors import check_study_options, holding, parsl_session, run_phase
 
@@ -96,20 +95,6 @@ def _plan(calibration: Calibration, measured) -> dict:
             "records": calibration.data.records.tolist()}
 
 
-def _check_plan(out: Path, plan: dict) -> None:
-    path = out / PLAN_NAME
-    if path.exists():
-        try:
-            previous = json.loads(path.read_text())
-        except (OSError, ValueError):
-            raise HexdemError(f"{path} is unreadable: {out} does not hold a hexdem calibration; choose another "
-                              "--out") from None
-        if previous != json.loads(json.dumps(plan)):
-            raise HexdemError(f"{out} holds a calibration of other input; rerun the same command to resume it, or "
-                              "choose another --out")
-    write_json(path, plan)
-
-
 def _simulate_stage(calibration: Calibration, unit_points, first_index: int, out: Path, workers: int, parsl,
                     label: str) -> tuple[np.ndarray, np.ndarray, int]:
     """Simulate ``unit_points`` (those not finished before); (points kept, observables (n, K, m),
@@ -141,7 +126,7 @@ def calibrate(calibration: Calibration, measured, out, workers: int = 1, parsl=N
     dimension = len(problem.priors)
     started = time.perf_counter()
     with locked_directory(out, "another hexdem calibrate"), holding(parsl):
-        _check_plan(out, _plan(calibration, measured))
+        keep_plan(out / PLAN_NAME, _plan(calibration, measured), "calibration")
         points, observables, failed, index, fit = np.empty((0, dimension)), None, 0, 0, None
         step_check, model_error = None, None
         for stage, size in enumerate(calibration.stages):

@@ -171,3 +171,20 @@ def ensure_writable_dir(directory) -> Path:
     except OSError as exc:
         raise HexdemError(f"output directory {directory} is not writable: {exc.strerror}") from None
     return directory
+
+
+def keep_plan(path, plan: dict, study: str) -> None:
+    """Write a study's ``plan`` (JSON) to ``path`` in its folder, or, where the folder holds one
+    already, refuse another in one line: a rerun of the same command resumes the ``study``
+    ("sweep", "calibration"), and one with another plan would mix two studies."""
+    path = Path(path)
+    out = path.parent
+    if path.exists():
+        try:
+            previous = json.loads(path.read_text())
+        except (OSError, ValueError):
+            raise HexdemError(f"{path} is unreadable: {out} does not hold a hexdem {study}; choose another --out") from None
+        if previous != json.loads(json.dumps(plan)):
+            raise HexdemError(f"{out} holds a {study} with another plan; rerun the same command to resume it, "
+                              "or choose another --out")
+    write_json(path, plan)

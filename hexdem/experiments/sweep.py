@@ -38,7 +38,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
+from hexdem.common.io import ensure_writable_dir, keep_plan, locked_directory
 from hexdem.errors import HexdemError, RunFailed, one_line
 from hexdem.experiments.executors import check_study_options, holding, parsl_session, run_phase
 from hexdem.experiments.provenance import user_command
@@ -98,24 +98,11 @@ def run_one(run: SweepRun, out: Path, ranks: int | None = None, launcher: str | 
     os.replace(partial, final)
 
 
-def _check_plan(out: Path, plan: dict) -> None:
-    path = out / PLAN_NAME
-    if path.exists():
-        try:
-            previous = json.loads(path.read_text())
-        except (OSError, ValueError):
-            raise HexdemError(f"{path} is unreadable: {out} does not hold a hexdem sweep; choose another --out") from None
-        if previous != json.loads(json.dumps(plan)):
-            raise HexdemError(f"{out} holds a sweep with another plan; rerun the same command to resume it, "
-                              "or choose another --out")
-    write_json(path, plan)
-
-
 def plan_study(base: dict, variations: list[Variation], out, source: str = "the base configuration") -> list[SweepRun]:
     """Check the sweep and write its plan into ``out`` (a folder made if needed); its runs."""
     runs = plan_sweep(base, variations, source)
     out = ensure_writable_dir(out)
-    _check_plan(out, {"base": base, "vary": {v.key: list(v.texts) for v in variations}})
+    keep_plan(out / PLAN_NAME, {"base": base, "vary": {v.key: list(v.texts) for v in variations}}, "sweep")
     ensure_writable_dir(out / RUNS_NAME)
     return runs
 
