@@ -298,6 +298,13 @@ def test_bad_input_is_one_line_before_any_simulation(measured, tmp_path, capsys,
     assert not out.exists()
 
 
+def test_workers_and_parsl_together_are_a_usage_error(measured, tmp_path, capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(["calibrate", "--measured", str(measured / "data.csv"), "--prior", "v0=uniform(0.2, 0.7)",
+              "--out", str(tmp_path / "out"), "--workers", "2", "--parsl", "config.py"])
+    assert stop.value.code == 2 and "not allowed with argument" in capsys.readouterr().err
+
+
 def calibrate_command(measured, out):
     return [sys.executable, "-m", "hexdem", "calibrate", "--config", str(measured / "base.toml"),
             "--measured", str(measured / "data.csv"), "--prior", "v0=uniform(0.2, 0.7)", "--budget", "30",

@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from hexdem.cli.options import add_parsl
+from hexdem.cli.options import add_workers_or_parsl
 
 
 def add_arguments(parser) -> None:
@@ -31,8 +31,7 @@ def add_arguments(parser) -> None:
                              "least (15 per parameter + 15) x K)")
     parser.add_argument("--seed", type=int, default=0, metavar="S",
                         help="seed of every random choice: the same seed gives the same posterior (default 0)")
-    parser.add_argument("--workers", type=int, default=1, metavar="N", help="simulations at once, locally (default 1)")
-    add_parsl(parser)
+    add_workers_or_parsl(parser, 1, "simulations at once, locally (default 1)")
 
 
 def run(args) -> None:
