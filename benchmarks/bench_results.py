@@ -25,6 +25,7 @@ and 6 per edge for 0.2 ms on one rank, one repeat (the same code path, seconds).
 from __future__ import annotations
 
 import argparse
+import io
 import json
 import os
 import pickle
@@ -68,6 +69,22 @@ def write_once(pickled: Path, out: Path) -> None:
     start = time.perf_counter()
     write_results(config, analysis, out, wall, {}, quiet)
     print(f"{time.perf_counter() - start:.6f}")
+
+
+class _PlainTuples(pickle.Pickler):
+    """A pickler that writes named tuples as plain tuples, which a version without their class
+    (``LabelLine`` came after the revision compared with) reads as it always read them."""
+
+    def reducer_override(self, obj):
+        if isinstance(obj, tuple) and hasattr(obj, "_fields"):
+            return tuple, (tuple(obj),)
+        return NotImplemented
+
+
+def as_plain_tuples(value) -> bytes:
+    buffer = io.BytesIO()
+    _PlainTuples(buffer).dump(value)
+    return buffer.getvalue()
 
 
 def timed_results(pickled: Path, out: Path, tree: Path | None) -> float:
@@ -114,8 +131,9 @@ def main() -> None:
             analysis = run_experiment(config, work / f"run-{edge}", log=quiet)
             wall = json.loads((work / f"run-{edge}" / "summary.json").read_text())["wall_time_s"]
             shutil.rmtree(work / f"run-{edge}")
-            pickled = work / f"analysis-{edge}.pickle"
-            pickled.write_bytes(pickle.dumps((config, analysis, wall)))
+            pickled = {version: work / f"analysis-{edge}-{version}.pickle" for version in ("now", "before")}
+            pickled["now"].write_bytes(pickle.dumps((config, analysis, wall)))
+            pickled["before"].write_bytes(as_plain_tuples((config, analysis, wall)))
             peaks = analysis.results.peak_speed
             times = {"now": [], "before": []}
             for repeat in range(repeats):
@@ -124,7 +142,7 @@ def main() -> None:
                     if version == "before" and before is None:
                         continue
                     tree = before if version == "before" else None
-                    times[version].append(timed_results(pickled, work / f"out-{edge}-{version}", tree))
+                    times[version].append(timed_results(pickled[version], work / f"out-{edge}-{version}", tree))
             rows.append({"edge": edge, "duration": duration, "beads": len(peaks), "still": float((peaks == 0).mean()),
                          "run": wall, **{k: statistics.median(v) if v else None for k, v in times.items()}})
             print(f"... {edge} per edge done", file=sys.stderr, flush=True)
