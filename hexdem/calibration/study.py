@@ -170,7 +170,8 @@ def _check_time_step(calibration: Calibration, fit: inference.Fit, out: Path, wo
              for name, run in (("coarse", problem), ("half", half)) if finished(folders[name], values) is None}
     for name, error in run_phase(tasks, workers, parsl, "time-step check", "simulation"):
         if error is not None:
-            raise RunFailed(f"the time-step check's run at half the step failed: {one_line(error)}")
+            step = "at half the time step" if name == "half" else "at the calibration's time step"
+            raise RunFailed(f"the time-step check's run {step} failed: {one_line(error)}")
     return {"parameters": dict(zip(problem.keys, values)), "steps_per_contact": [steps, 2 * steps],
             **{name: finished(folder, values).tolist() for name, folder in folders.items()}}
 
