@@ -44,7 +44,7 @@ def test_weak_damping_loses_the_energy_of_first_order_perturbation_theory():
 def test_the_damping_gives_back_the_requested_restitution_from_weak_to_strong_damping(restitution, monkeypatch):
     """The inversion holds e(α) to the integration's accuracy in ln e over the whole range, strong
     damping included (e ≈ 1.25/α² there: α ≈ 112 for e = 1e-4), and a calibration's typical e ≥ 0.5
-    costs it at most 5 integrations of the contact, not the 16 of a bracketing search over [0, 20]."""
+    costs it at most 4 integrations of the contact, not the 16 of a bracketing search over [0, 20]."""
     from hexdem.model import dissipation
 
     integrations = []
@@ -52,7 +52,7 @@ def test_the_damping_gives_back_the_requested_restitution_from_weak_to_strong_da
     alpha = dissipation.damping_coefficient.__wrapped__(restitution)
     assert abs(np.log(restitution_of(alpha) / restitution)) <= dissipation.LOG_RESTITUTION_TOLERANCE
     if restitution >= 0.5:
-        assert len(integrations) <= 5
+        assert len(integrations) <= 4
 
 
 def unclipped_restitution(alpha):
