@@ -10,7 +10,7 @@ creeping by round-off (1e-17 m/s a sample, as LAMMPS leaves them), positions on 
 
 * **before**: the NumPy tracker without the noise floor (every creeping bead takes the path of a
   new maximum, as before round-off stopped counting as motion) and the NumPy audit;
-* **NumPy**: today's NumPy code, which defines the kernels' results (:data:`~hexdem.common.compiled.COMPILED` False);
+* **NumPy**: today's NumPy code, which defines the kernels' results (:data:`~hexdem.common.kernel_switch.COMPILED` False);
 * **compiled**: today's compiled kernels (:mod:`hexdem.analysis.compiled`), after a warm-up.
 
 Per part, in ns per bead per sample: the **samples** (the driver's full-step positions and
@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 from machine import describe
 
-import hexdem.common.compiled as compiled_module
+import hexdem.common.kernel_switch as compiled_module
 from hexdem.analysis.impact import ImpactAnalysis
 from hexdem.analysis.tracker import PulseTracker
 from hexdem.common.memory import keep_freed_memory

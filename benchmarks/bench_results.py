@@ -46,7 +46,7 @@ BEFORE = "1802d2f"
 TARGET_FLOOR_S, TARGET_SHARE = 1.5, 0.5
 #: What a run imports before its result files (``run_experiment`` loads them while LAMMPS runs; a
 #: version imports those of them it has).
-PRELOADED = ("hexdem.experiments.run", "hexdem.analysis.figures", "hexdem.analysis.run_maps",
+PRELOADED = ("hexdem.experiments.run", "hexdem.analysis.plotting", "hexdem.analysis.run_maps",
              "hexdem.analysis.decay_figure", "scipy.spatial")
 
 

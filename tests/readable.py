@@ -5,12 +5,12 @@ from __future__ import annotations
 
 from matplotlib.text import Text
 
-from hexdem.analysis import figures as plots
+from hexdem.analysis import plotting as plots
 from hexdem.common.html_page import COLUMN_PX
 
 
 def saved_figure(monkeypatch, draw):
-    """The figure that ``draw()`` hands to :func:`hexdem.analysis.figures.save` (nothing written)."""
+    """The figure that ``draw()`` hands to :func:`hexdem.analysis.plotting.save` (nothing written)."""
     saved = []
     monkeypatch.setattr(plots, "save", lambda fig, path: saved.append(fig))
     draw()

@@ -8,7 +8,7 @@ import pytest
 from conftest import settings_of
 
 import hexdem.analysis.tracker as tracker_module
-import hexdem.common.compiled as compiled
+import hexdem.common.kernel_switch as compiled
 from hexdem.analysis.compiled import sample_pulses
 from hexdem.analysis.energy import EnergyAudit, _pair_constants, _pair_contacts, _pairs, _wall_constants, _wall_contacts
 from hexdem.analysis.tracker import PulseTracker

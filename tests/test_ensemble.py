@@ -267,7 +267,7 @@ def test_a_failing_deck_in_an_ensemble_is_named_after_the_others_ran(tmp_path, c
 
 def test_fitted_laws_follow_the_papers_rule_for_physical_units(tmp_path):
     """eq. (10) with nondimensional coefficients, evaluated in m/s: every V becomes V/U."""
-    from hexdem.disorder.figures import fitted_laws
+    from hexdem.disorder.ensemble_figures import fitted_laws
     from hexdem.model.materials import PAPER_DIAMETER_M
     from hexdem.model.units import nondimensional
 

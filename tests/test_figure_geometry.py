@@ -7,7 +7,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from hexdem.analysis import figures, run_maps
+from hexdem.analysis import plotting, run_maps
 from hexdem.analysis.decay_figure import peak_decay
 from hexdem.analysis.map_layout import chain_direction
 from hexdem.model.config import RunConfig
@@ -81,7 +81,7 @@ def test_a_map_fills_its_canvas_and_its_colour_bar_is_as_tall_as_the_map(name, k
     from PIL import Image
 
     with Image.open(tmp_path / f"{kind}.png") as image:
-        assert np.all(np.abs(np.array(image.size) - fig.get_size_inches() * figures.DPI) <= 1)
+        assert np.all(np.abs(np.array(image.size) - fig.get_size_inches() * plotting.DPI) <= 1)
 
 
 def test_a_wide_packing_gets_a_wide_canvas_and_a_square_one_a_squarer_canvas(tmp_path):

@@ -12,7 +12,7 @@ from matplotlib.colors import LogNorm
 from matplotlib import colormaps
 from matplotlib.colors import to_rgb
 
-from hexdem.analysis.figures import PIXEL_MAP_BEADS, PIXEL_REACH_D, UNMEASURED_GREYS, bead_map, subplots
+from hexdem.analysis.plotting import PIXEL_MAP_BEADS, PIXEL_REACH_D, UNMEASURED_GREYS, bead_map, subplots
 from hexdem.model.triangular import hexagon
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -80,7 +80,8 @@ def test_beads_of_other_materials_are_ringed_and_named():
 
 
 #: Modules that draw the report's and the runs' figures.
-FIGURE_MODULES = sorted({*(ROOT / "hexdem" / "paper").glob("*.py"), *(ROOT / "hexdem").glob("*/figures.py"),
+FIGURE_MODULES = sorted({*(ROOT / "hexdem" / "paper").glob("*.py"), *(ROOT / "hexdem").glob("*/*figures.py"),
+                         ROOT / "hexdem" / "analysis" / "plotting.py",
                          ROOT / "hexdem" / "analysis" / "movie.py", ROOT / "hexdem" / "analysis" / "decay_figure.py",
                          ROOT / "hexdem" / "experiments" / "snapshots.py"})
 #: Calls and keywords whose string is text on a figure.
@@ -124,7 +125,7 @@ def test_the_maps_of_a_large_run_share_the_tiling_found_before_they_are_drawn(tm
     in separate processes: the arrival and peak maps then find the very tiling, not one each."""
     from types import SimpleNamespace
 
-    from hexdem.analysis import figures, run_maps
+    from hexdem.analysis import plotting, run_maps
     from hexdem.model.config import RunConfig
     from hexdem.model.model_builder import build_model
 
@@ -134,9 +135,9 @@ def test_the_maps_of_a_large_run_share_the_tiling_found_before_they_are_drawn(tm
     x = model.packing.positions_m[:, 0] / d
     results = SimpleNamespace(positions=model.packing.positions_m / d, length_unit_m=d, units="nondimensional",
                               arrival_time=x - x.min(), peak_speed=np.exp(-np.abs(x) / 30))
-    figures._pixel_tiling.cache_clear()
-    figures.tile_lattice(results, model)
+    plotting._pixel_tiling.cache_clear()
+    plotting.tile_lattice(results, model)
     run_maps.arrival_map(results, model, tmp_path / "arrival_map.png")
     run_maps.peak_map(results, model, 1.0, tmp_path / "peak_map.png")
-    found = figures._pixel_tiling.cache_info()
+    found = plotting._pixel_tiling.cache_info()
     assert (found.misses, found.hits) == (1, 2)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from hexdem.analysis.figures import front_shape_figure
+from hexdem.analysis.plotting import front_shape_figure
 from hexdem.analysis.front_shape import (
     FRONT_SHAPE_COLUMNS,
     HEXAGON_SIXFOLD,

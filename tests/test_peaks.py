@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-import hexdem.common.compiled as compiled
+import hexdem.common.kernel_switch as compiled
 from hexdem.analysis.peaks import PEAK_OVERSHOOT, pulse_times, refine_peak, refine_peaks
 from hexdem.analysis.tracker import PulseTracker
 from hexdem.engines.sampling import Sample

@@ -59,7 +59,7 @@ def test_runs_that_warned_are_named_in_the_table_the_figure_and_the_last_line(tm
     false); in a study its warning goes into the table's warnings column, is ringed in sweep.png,
     and the command ends by naming it. The energy panel is the audit's drift on a log axis that
     holds the round-off floor and the threshold that fails a run."""
-    from hexdem.analysis import figures as plots
+    from hexdem.analysis import plotting as plots
     from hexdem.analysis.energy import ROUND_OFF
     from hexdem.experiments.run import MAX_ENERGY_DRIFT
 

@@ -33,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.analysis.figures import SINGLE_PLOT_MARGINS, save, set_title, subplots
+from hexdem.analysis.plotting import SINGLE_PLOT_MARGINS, save, set_title, subplots
 from hexdem.cli.main import exit_status
 from hexdem.common.io import atomic_path, write_csv, write_json
 from hexdem.errors import HexdemError

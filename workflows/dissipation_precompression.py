@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 from record import WorkflowRecord
 
-from hexdem.analysis.figures import save, subplots
+from hexdem.analysis.plotting import save, subplots
 from hexdem.common.io import write_csv
 from hexdem.theory.scaling import fit_decay
 

@@ -6,7 +6,7 @@ They compute what the NumPy code of :class:`~hexdem.analysis.tracker_kernel.Puls
 :class:`~hexdem.analysis.energy.EnergyAudit` computes, in the same order: the tests hold the
 tracker's results equal to the bit and the energies to round-off (:math:`δ^{5/2}` is taken as
 :math:`δ^2 \sqrt{δ}`; sums run body by body where NumPy's go in pairs). The NumPy code defines
-their results; every run uses the kernels (:mod:`hexdem.common.compiled`), since one pass over a
+their results; every run uses the kernels (:mod:`hexdem.common.kernel_switch`), since one pass over a
 bead's few numbers costs less than NumPy's indexing of whole arrays at every size.
 
 Compiled without fast-math or contracted multiply-adds, so that each operation rounds as

@@ -8,7 +8,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from hexdem.analysis.figures import SINGLE_PLOT_MARGINS, UNIT_LABELS, plain_log_ticks, save, set_title, subplots
+from hexdem.analysis.plotting import SINGLE_PLOT_MARGINS, UNIT_LABELS, plain_log_ticks, save, set_title, subplots
 
 #: An observation line named by its angle with a sign ("+30", "-45"): its mirror line has the other sign.
 SIGNED_ANGLE = re.compile(r"[+-]\d+(\.\d*)?")

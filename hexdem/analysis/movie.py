@@ -37,7 +37,7 @@ def speed_movie(results, model, times, speeds, v0: float, path, title: str = "",
     run's units, walls and the struck beads drawn."""
     from matplotlib.colors import LogNorm  # (drawing only: a run picks its frames without matplotlib)
 
-    from hexdem.analysis.figures import UNIT_LABELS, draw_lattice, subplots
+    from hexdem.analysis.plotting import UNIT_LABELS, draw_lattice, subplots
 
     units = UNIT_LABELS[results.units]
     fig, ax = subplots(figsize=(6.4, 5.4))

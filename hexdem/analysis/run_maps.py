@@ -13,7 +13,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import LogNorm, Normalize
 from matplotlib.figure import Figure
 
-from hexdem.analysis.figures import (UNIT_LABELS, lattice_beads, other_materials, bead_map, colour_bar, draw_lattice,
+from hexdem.analysis.plotting import (UNIT_LABELS, lattice_beads, other_materials, bead_map, colour_bar, draw_lattice,
                                      draw_walls, plain_log_ticks, save, set_title)
 from hexdem.analysis.map_layout import chain_direction, fit_chain, fit_map
 from hexdem.model.walls import CurvedWall

@@ -46,7 +46,7 @@ from hexdem.analysis.compiled import BodiesReordered, bind_pulses, sample_pulses
 from hexdem.analysis.energy import EnergyAudit, energy_error, energy_scale_j, rotational_share
 from hexdem.analysis.peaks import noise_floor, refine_peak, refine_peaks
 from hexdem.analysis.tracker_kernel import PulseState
-from hexdem.common.compiled import runs_compiled
+from hexdem.common.kernel_switch import runs_compiled
 from hexdem.common.preload import load_in_background
 from hexdem.engines.sampling import Sample
 from hexdem.errors import HexdemError

@@ -37,7 +37,7 @@ Most beads, at most samples, only enter the ring (and, for three samples after a
 the peak window): the ladder's bookkeeping runs only on beads whose running maximum rises (never
 on beads at rest, whose samples stay below the noise floor), the refinement only on those whose
 rival window completes. This NumPy code defines the results of the compiled update that runs take
-(:func:`~hexdem.analysis.compiled.sample_pulses`, :mod:`hexdem.common.compiled`).
+(:func:`~hexdem.analysis.compiled.sample_pulses`, :mod:`hexdem.common.kernel_switch`).
 """
 
 from __future__ import annotations

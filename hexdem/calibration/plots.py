@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from hexdem.analysis.figures import save, subplots
+from hexdem.analysis.plotting import save, subplots
 from hexdem.calibration.observables import ARRIVAL_UNIT_S
 
 

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from hexdem.common.io import ensure_writable_dir, locked_directory, write_json
 from hexdem.disorder.ensemble import MANIFEST_NAME, PHASE_LABELS, Ensemble, EnsembleConfig
-from hexdem.disorder.figures import fitted_laws
+from hexdem.disorder.ensemble_figures import fitted_laws
 from hexdem.disorder.impacts import impact_done, impact_task, publish_result
 from hexdem.disorder.preparation import STAGES, write_stage_deck
 from hexdem.disorder.sharing import adopt_preparation, adopt_ideal_impacts

@@ -4,7 +4,7 @@ Loads every realization's ``result.npz`` and the ideal lattice's (:mod:`hexdem.d
 runs them) and writes, into the ensemble directory, the tables ``peaks_stats.csv``,
 ``ideal_peaks.csv``, ``arrival_map.csv``, ``disorder_effect.csv`` (peak speeds over the run)
 and ``leading_pulse_effect.csv`` (the leading pulses' amplitudes) and the figures of
-:mod:`hexdem.disorder.figures`; the summary goes to ``ensemble.json``.
+:mod:`hexdem.disorder.ensemble_figures`; the summary goes to ``ensemble.json``.
 """
 
 from __future__ import annotations
@@ -193,7 +193,7 @@ def write_statistics(ensemble: Ensemble, laws: dict | None = None) -> dict:
     reference bead), ``disorder_effect.csv``, ``leading_pulse_effect.csv``. Figures: ``fig9_all_directions.png`` (with the
     fitted ``laws`` {line: ScalingLaw} if any) and ``fig8_expnumsim_v<V>.png`` per velocity.
     """
-    from hexdem.disorder import figures as ensemble_plots
+    from hexdem.disorder import ensemble_figures as ensemble_plots
 
     config, lattice, out = ensemble.config, ensemble.ideal, ensemble.out
     results = load_results(ensemble)

@@ -24,7 +24,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from hexdem.analysis.figures import UNIT_LABELS, save, subplots
+from hexdem.analysis.plotting import UNIT_LABELS, save, subplots
 from hexdem.analysis.impact import ImpactAnalysis
 from hexdem.common.checks import is_number
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json

@@ -31,7 +31,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from hexdem.analysis import figures
+from hexdem.analysis import plotting
 from hexdem.analysis.front_shape import FRONT_SHAPE_COLUMNS
 from hexdem.analysis.roundness_fit import fit_roundness
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json
@@ -120,7 +120,7 @@ def run_front_study(study: FrontStudy, out, log=None) -> dict:
         fits[name] = fit_roundness(shape.mean_radius, shape.sixfold_cos, low, high)
     labels = {"uncompressed": f"uncompressed half-disc, {study.v0_m_s:g} m/s",
               "precompressed": f"{study.control_force_n:g} N per contact, {study.control_v0_m_s:g} m/s (control)"}
-    figures.front_shape_figure({labels[name]: shape for name, shape in shapes.items()}, out / "front_shape.png",
+    plotting.front_shape_figure({labels[name]: shape for name, shape in shapes.items()}, out / "front_shape.png",
                                title="Roundness of the front as it grows",
                                fits={labels[name]: fit for name, fit in fits.items()}, signed=True)
     summary = {"study": asdict(study),

@@ -17,7 +17,7 @@ import numpy as np
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from hexdem.analysis.figures import bead_circles, draw_walls, save, set_title, subplots
+from hexdem.analysis.plotting import bead_circles, draw_walls, save, set_title, subplots
 from hexdem.common.io import staged_directory
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig

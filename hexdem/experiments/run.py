@@ -195,7 +195,7 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
     (:func:`~hexdem.experiments.provenance.run_provenance`, taken when the run started) goes into
     ``summary.json`` as its ``provenance``."""
     from hexdem.analysis.movie import SPIN_LABEL, speed_movie
-    from hexdem.analysis import figures as plots  # matplotlib: only where figures are drawn
+    from hexdem.analysis import plotting as plots  # matplotlib: only where figures are drawn
     from hexdem.analysis.decay_figure import peak_decay
     from hexdem.analysis.run_maps import arrival_map, peak_map
 
@@ -238,7 +238,7 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
 def write_front_shape(analysis: ImpactAnalysis, name: str, out: Path) -> None:
     """``front_shape.csv`` and ``front_shape.png`` (:func:`measure_front_shape`) in ``out``; ``name``:
     the packing's, for the figure's legend."""
-    from hexdem.analysis import figures as plots
+    from hexdem.analysis import plotting as plots
 
     shape = measure_front_shape(analysis)
     write_csv(out / "front_shape.csv", FRONT_SHAPE_COLUMNS, shape.rows())

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.analysis.figures import save, subplots
+from hexdem.analysis.plotting import save, subplots
 from hexdem.analysis.peaks import refine_peak, rising_crossing
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.errors import HexdemError

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.analysis import figures as plots
+from hexdem.analysis import plotting as plots
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.errors import HexdemError
 from hexdem.experiments.tracked_run import ImpactJob, track_impact

@@ -137,7 +137,7 @@ def sweep_figure(out: Path, runs: list[SweepRun], variations, rows: list[tuple])
     the audit's round-off floor and the threshold that fails a run) and the decay exponent of
     the first observation line; one curve per combination of the other keys (categories, such
     as materials, are spread evenly along the axis). Runs that warned are ringed in red."""
-    from hexdem.analysis import figures as plots
+    from hexdem.analysis import plotting as plots
 
     header, body = rows[0], rows[1:]
     shown = ["energy_drift", *[name for name in header if name.startswith("decay_exponent_")][:1]]

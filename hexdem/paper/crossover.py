@@ -223,7 +223,7 @@ def crossover_figure(rows: list[tuple], fits: list[dict], path, against: str = "
     ± 2 SEM, the fitted steps and their σ_c (dotted). Sized to be read in the report's column,
     about 1100 px wide: its smallest text is 10 px there."""
 
-    from hexdem.analysis import figures as plots
+    from hexdem.analysis import plotting as plots
 
     fig, axes = plots.subplots(len(MEASURES), len(LINES), figsize=(10, 7.6), sharex=True, sharey=True,
                                layout="constrained")

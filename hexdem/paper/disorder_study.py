@@ -190,7 +190,7 @@ def study_figure(rows: list[tuple], path) -> None:
     """Transmission (disordered / ideal) against σ/tol: lines 0° and ±30° (columns), peak over
     the run and leading pulse (rows), the paper's preparation and the relaxed one."""
 
-    from hexdem.analysis import figures as plots
+    from hexdem.analysis import plotting as plots
 
     fig, axes = plots.subplots(2, 2, figsize=(10, 7), sharex=True, sharey=True)
     styles = {"prestressed": ("o-", "C0", "walls kept prestress (paper's scheme)"),

@@ -71,7 +71,7 @@ def protocol_figure(searches: dict, path) -> None:
     """(m, b) of every protocol per combination (anchored and free starts), the paper's stated
     protocol, the closest one and the published point."""
 
-    from hexdem.analysis import figures as plots
+    from hexdem.analysis import plotting as plots
 
     fig, axes = plots.subplots(2, 2, figsize=(11, 8.5), layout="constrained")
     for ax, (name, search) in zip(axes.ravel(), searches.items()):

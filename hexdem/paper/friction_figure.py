@@ -32,7 +32,7 @@ def friction_figure(rows: list[tuple], decay: list[tuple], conditions: list[dict
     the same packing (solid: ideal lattice, dashed: σ = 6 tol, mean ± 2 SEM); (c) Sec. V's decay
     rate c over its frictionless value; (d) the disorder study with friction: disordered /
     ideal transmission at σ = 6 tol (mean ± 2 SEM), above 1 where disorder helps."""
-    from hexdem.analysis import figures as plots
+    from hexdem.analysis import plotting as plots
 
     fig, axes = plots.subplots(2, 2, figsize=(11, 8.5), layout="constrained")
     (amplitude, arrival), (rates, disorder) = axes

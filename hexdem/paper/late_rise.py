@@ -122,7 +122,7 @@ def rows(measured: dict) -> list[tuple]:
 def late_rise_figure(measured: dict, path) -> None:
     """a6/a0 against the front's radius beyond the fit range's start, the four measurements
     with their fitted laws (dotted: A∞), zoomed on the late rise."""
-    from hexdem.analysis import figures as plots
+    from hexdem.analysis import plotting as plots
 
     fig, ax = plots.subplots(figsize=(7, 4.8), layout="constrained")
     for k, (name, entry) in enumerate(measured.items()):

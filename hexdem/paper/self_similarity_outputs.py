@@ -78,7 +78,7 @@ def figures(measured: dict[str, dict[str, Ray]], out: Path) -> None:
     by distance)."""
     from matplotlib import colormaps
 
-    from hexdem.analysis import figures as plots
+    from hexdem.analysis import plotting as plots
     from hexdem.analysis.pulse_shape import PROFILE_GRID
 
     fig, axes = plots.subplots(2, 2, figsize=(11, 8.5), layout="constrained")
@@ -116,7 +116,7 @@ def figures(measured: dict[str, dict[str, Ray]], out: Path) -> None:
 def chain_figure(chain_rows: dict, hexagon_rows: dict, path) -> None:
     """Peak speed over V0 against distance: the chain's unchanged pulse beside the hexagon's
     decay along its 0° and ±30° lines ({label: (distance_d, peak / V0)})."""
-    from hexdem.analysis import figures as plots
+    from hexdem.analysis import plotting as plots
 
     fig, ax = plots.subplots(figsize=(6.4, 4.6), layout="constrained")
     for label, (distance, ratio) in {**chain_rows, **hexagon_rows}.items():

@@ -2,7 +2,7 @@
 
 :func:`write_outputs` fits every combination of :mod:`hexdem.theory.scaling` to a
 :class:`~hexdem.theory.sweep.Sweep` and publishes ``scaling.json``, the CSV tables and the PNGs of
-Figs. 6 and 7 (:mod:`hexdem.theory.figures`).
+Figs. 6 and 7 (:mod:`hexdem.theory.theory_figures`).
 """
 
 from __future__ import annotations
@@ -60,7 +60,7 @@ def write_outputs(sweep: Sweep, out, last: int | None = None, kind: str = "logli
     contents of ``scaling.json``."""
     from hexdem.common.io import ensure_writable_dir, write_csv, write_json
     from hexdem.model.config import RunConfig
-    from hexdem.theory import figures as theory_plots
+    from hexdem.theory import theory_figures as theory_plots
 
     out = ensure_writable_dir(out)
     last = sweep.settings.last if last is None else last

@@ -14,7 +14,7 @@ import numpy as np
 from hexdem.common.io import write_csv
 from hexdem.experiments.run import simulate
 from hexdem.model.config import RunConfig
-from hexdem.theory import figures as theory_plots
+from hexdem.theory import theory_figures as theory_plots
 from hexdem.theory import tca
 from hexdem.theory.sweep import SweepSettings
 

@@ -29,7 +29,7 @@ from hexdem.common.html_page import render_html
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json, write_text
 from hexdem.theory.phonons import sound_speeds
 from hexdem.waves import conical, dispersion, transition
-from hexdem.waves.figures import bands_figure, conical_figure, conical_movie, snapshots_figure
+from hexdem.waves.wave_figures import bands_figure, conical_figure, conical_movie, snapshots_figure
 
 #: The issue's bounds: the dispersion's median relative deviation (each resolved point has its own
 #: bound besides, :mod:`hexdem.waves.dispersion`), the ring's growth rate against v_D.

@@ -280,14 +280,14 @@ def run_transition(settings: TransitionSettings, workdir, log=None) -> Transitio
 def transition_figure(transition: TransitionMap, path) -> None:
     """Both measures against δ_impact/δ0 (log), one marker per force, the uncompressed runs at
     the right edge: the sixfold amplitude at ``radius_d`` above, the front speed over c_L below."""
-    from hexdem.analysis import figures  # matplotlib: only where figures are drawn
+    from hexdem.analysis import plotting  # matplotlib: only where figures are drawn
 
     ratio, settings = transition.overlap_ratio, transition.settings
     finite, free = np.isfinite(ratio), transition.forces_n == 0
     low = 10 ** math.floor(math.log10(ratio[finite].min())) if finite.any() else 0.1
     top = 10 ** math.ceil(math.log10(ratio[finite].max()) + 0.5) if finite.any() else 10.0
     x = np.where(finite, ratio, top)
-    fig, (shape_ax, speed_ax) = figures.subplots(2, 1, figsize=(7.0, 7.5), sharex=True, layout="constrained")
+    fig, (shape_ax, speed_ax) = plotting.subplots(2, 1, figsize=(7.0, 7.5), sharex=True, layout="constrained")
     markers = "osD^v<>ph"
     for k, force in enumerate(np.unique(transition.forces_n)):
         run = transition.forces_n == force
@@ -307,16 +307,16 @@ def transition_figure(transition: TransitionMap, path) -> None:
         ax.grid(True, which="major", alpha=0.3)
     shape_ax.text(1.1, 0.03, "δ_impact = δ₀", transform=shape_ax.get_xaxis_transform(), fontsize=8, color="grey")
     shape_ax.set_yscale("log")
-    figures.plain_log_ticks(shape_ax.yaxis)
+    plotting.plain_log_ticks(shape_ax.yaxis)
     shape_ax.set_ylabel(f"sixfold amplitude of the front at R = {settings.radius_d:g} d")
     shape_ax.legend(fontsize=8, loc="lower right")
-    figures.set_title(shape_ax, f"An impact's front, nonlinear to linear: hexagon of {settings.edge_beads} per edge, "
+    plotting.set_title(shape_ax, f"An impact's front, nonlinear to linear: hexagon of {settings.edge_beads} per edge, "
                                 f"{settings.impact}")
     speed_ax.axhline(1.0, color="grey", linewidth=1)
     speed_ax.set_ylabel(f"front speed / c_L ({settings.speed_from_d:g} to {settings.radius_d:g} d)")
     decades = [10.0 ** e for e in range(round(math.log10(low)), round(math.log10(top)))]
     speed_ax.set_xticks([*decades, top] if free.any() else decades,
-                        [*(figures.decade_label(t) for t in decades), *(["uncompressed"] if free.any() else [])])
+                        [*(plotting.decade_label(t) for t in decades), *(["uncompressed"] if free.any() else [])])
     speed_ax.set_xlim(low / 2, top * 3)
     speed_ax.set_xlabel("δ_impact / δ₀: the impact's Hertz overlap over the static one")
-    figures.save(fig, path)
+    plotting.save(fig, path)

@@ -38,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.common.compiled import runs_compiled
+from hexdem.common.kernel_switch import runs_compiled
 from hexdem.common.job_failure import abort_job
 from hexdem.common.interrupt import deferred_signals, raise_if_stopped
 from hexdem.common.memory import keep_freed_memory

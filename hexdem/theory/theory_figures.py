@@ -1,13 +1,13 @@
 """Figures of the theory sections: the TCA against the lattice (Fig. 5, label fig:TCA) and the
 scaling-law procedure (Figs. 6 and 7, labels fig:vodecay30 and fig:vodecay0), plus the
-geometric-or-power diagnostic. Each function saves one PNG atomically (:func:`hexdem.analysis.figures.save`).
+geometric-or-power diagnostic. Each function saves one PNG atomically (:func:`hexdem.analysis.plotting.save`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from hexdem.analysis.figures import UNIT_LABELS, save, subplots
+from hexdem.analysis.plotting import UNIT_LABELS, save, subplots
 
 ND_SPEED = UNIT_LABELS["nondimensional"]["speed"]
 

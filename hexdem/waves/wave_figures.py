@@ -27,7 +27,7 @@ def bands_figure(dispersion: Dispersion, path) -> None:
     of the resolution limit)."""
     from matplotlib.colors import LogNorm
 
-    from hexdem.analysis.figures import plain_log_ticks, save, subplots
+    from hexdem.analysis.plotting import plain_log_ticks, save, subplots
 
     theory = dispersion.theory
     position, _, omega = band_path(theory, 120)
@@ -71,7 +71,7 @@ def conical_figure(conical: Conical, path) -> None:
     """(a) The K packet's ring radius against time, the cone's R(t) for v_D, and v_D t (the
     fitted slope in the title); (b) the control: its centroid's path along its group velocity
     against the bands' prediction, and its width."""
-    from hexdem.analysis.figures import save, subplots
+    from hexdem.analysis.plotting import save, subplots
 
     d = conical.diameter_m
     fig, (left, right) = subplots(1, 2, figsize=(11, 4.4), layout="constrained")
@@ -112,7 +112,7 @@ def _energy_axes(ax, run: PacketRun, frame: int, diameter_m: float, colorbar: bo
     unless ``colorbar`` is False; the mappable."""
     from matplotlib.colors import LogNorm
 
-    from hexdem.analysis.figures import bead_map
+    from hexdem.analysis.plotting import bead_map
 
     positions = (run.recorded.positions_m - run.centre_m) / diameter_m
     circles = bead_map(ax, positions, np.ones(len(positions)), _energy_share(run, frame), cmap="inferno",
@@ -126,7 +126,7 @@ def _energy_axes(ax, run: PacketRun, frame: int, diameter_m: float, colorbar: bo
 def snapshots_figure(conical: Conical, path) -> None:
     """The K packet's energy at the start, midway and at the end, and the control's at the end:
     four panels on one colour scale, with one bar."""
-    from hexdem.analysis.figures import plain_log_ticks, save, subplots
+    from hexdem.analysis.plotting import plain_log_ticks, save, subplots
 
     fig, axes = subplots(2, 2, figsize=(9.5, 8.6), layout="constrained")
     last = len(conical.dirac.times_s) - 1
@@ -142,7 +142,7 @@ def snapshots_figure(conical: Conical, path) -> None:
 
 def conical_movie(conical: Conical, path) -> None:
     """GIF of the K packet's energy, block by block, as it opens into a ring."""
-    from hexdem.analysis.figures import subplots
+    from hexdem.analysis.plotting import subplots
     from hexdem.analysis.movie import write_gif
 
     run = conical.dirac

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.analysis import figures as plots
+from hexdem.analysis import plotting as plots
 from hexdem.errors import HexdemError
 from hexdem.model.materials import STEEL_316
 from hexdem.model.units import nondimensional
