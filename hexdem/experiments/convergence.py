@@ -172,7 +172,7 @@ def sampling_error(config: RunConfig, workdir) -> SamplingError:
 
     model = build_model(config)
     settings = run_settings(config, model)
-    sampled = simulate_model(config, model, Path(workdir) / "sampled").results
+    sampled = simulate_model(config, model, settings, Path(workdir) / "sampled").results
     every_step = simulate(config.replace(dt=settings.dt_s / settings.units.time_s, dump_every=1),
                           Path(workdir) / "every-step").results
     beads = measured_beads(every_step, config.v0)

@@ -45,7 +45,7 @@ from hexdem.experiments.random_packing import packing_name, prepare_random_packi
 from hexdem.experiments.sensors import write_sensor_files
 from hexdem.experiments.tracked_run import ImpactJob, track_impact
 from hexdem.model.config import RunConfig
-from hexdem.model.granular import GranularModel
+from hexdem.model.granular import GranularModel, RunSettings
 from hexdem.model.model_builder import build_model
 from hexdem.model.run_settings import run_settings
 from hexdem.model.sensors import sensor_beads
@@ -76,15 +76,17 @@ FRONT_WALL_MARGIN_D = 2.0
 
 
 def simulate(config: RunConfig, workdir, log=None, **observed) -> ImpactAnalysis:
-    """:func:`simulate_model` of ``config`` on the model built from it; ``observed``: what to
-    record in the run (:func:`simulate_model`'s ``trace_lines`` and the others)."""
-    return simulate_model(config, build_model(config), workdir, log, **observed)
+    """:func:`simulate_model` of ``config`` on the model and settings built from it; ``observed``:
+    what to record in the run (:func:`simulate_model`'s ``trace_lines`` and the others)."""
+    model = build_model(config)
+    return simulate_model(config, model, run_settings(config, model), workdir, log, **observed)
 
 
-def simulate_model(config: RunConfig, model: GranularModel, workdir, log=None, trace_lines=(), field_samples=(),
-                   trace_beads=(), threshold_speed: float | None = None) -> ImpactAnalysis:
-    """Run ``config``, whose model ``model`` is, with its engine in ``workdir``, analysed while it
-    runs (no result files).
+def simulate_model(config: RunConfig, model: GranularModel, settings: RunSettings, workdir, log=None, trace_lines=(),
+                   field_samples=(), trace_beads=(), threshold_speed: float | None = None) -> ImpactAnalysis:
+    """Run ``config``, whose model ``model`` is and whose step, length and sampling ``settings``
+    are (:func:`~hexdem.model.run_settings.run_settings`), with its engine in ``workdir``, analysed
+    while it runs (no result files).
 
     ``trace_lines`` (observation line names) keep the speeds of those lines' beads at every
     sample, and so do ``trace_beads`` (bead indices) for theirs; ``threshold_speed`` (run units)
@@ -95,7 +97,6 @@ def simulate_model(config: RunConfig, model: GranularModel, workdir, log=None, t
     (:mod:`~hexdem.experiments.deck_config`).
     """
     log = log or (lambda message: None)
-    settings = run_settings(config, model)
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
     if config.engine == "lammps":
@@ -113,12 +114,12 @@ def simulate_model(config: RunConfig, model: GranularModel, workdir, log=None, t
     return analysis
 
 
-def check_dump_space(config: RunConfig, model: GranularModel, out: Path) -> None:
-    """Refuse a run of ``config`` (whose model ``model`` is) whose requested dump would not fit on
-    the disk of ``out``."""
+def check_dump_space(config: RunConfig, model: GranularModel, settings: RunSettings, out: Path) -> None:
+    """Refuse a run of ``config`` (whose model ``model`` and settings ``settings`` are) whose
+    requested dump would not fit on the disk of ``out``."""
     if not (config.dump and config.engine == "lammps"):
         return
-    needed = DUMP_BYTES_PER_ATOM_FRAME * run_settings(config, model).n_samples * model.n_bodies
+    needed = DUMP_BYTES_PER_ATOM_FRAME * settings.n_samples * model.n_bodies
     free = free_disk_bytes(out)
     if needed > free:
         raise HexdemError(f"the dump would take about {needed / 1e9:.3g} GB and {out} has {free / 1e9:.3g} GB free; "
@@ -304,8 +305,9 @@ def run_experiment(config: RunConfig, out, log=None, command=None, prepared: Run
             if prepared is None:
                 prepared = prepare_random_packing(config, staging / "preparation", log)
             model = build_model(prepared)
-            check_dump_space(prepared, model, Path(out))
-            analysis = simulate_model(prepared, model, staging / "deck", log)
+            settings = run_settings(prepared, model)
+            check_dump_space(prepared, model, settings, Path(out))
+            analysis = simulate_model(prepared, model, settings, staging / "deck", log)
             write_results(config, analysis, staging, time.perf_counter() - start, provenance(), log)
             raise_if_stopped()  # a stopped run is never published, even one whose stop was swallowed
         except HexdemError as exc:
