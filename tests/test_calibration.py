@@ -128,7 +128,8 @@ def test_the_spread_between_packings_follows_the_parameters():
     deviations hold s within the sampling error of 80 sets of 8 (one set's log sample sd is off by
     1/√(2 (K − 1)) = 0.27; the emulator pools the ten or so nearest sets, 0.085, and 3 of those
     are 25 %), and the pooled correlation holds L Lᵀ's ρ = 0.8 within 4 (1 − ρ²)/√(n (K − 1)),
-    four of its standard errors."""
+    four of its standard errors, before it is shrunk as for K − 1 = ν deviations of m = 2
+    observables: ν ρ / (ν + m + 1)."""
     rng = np.random.default_rng(5)
     n, k, rho = 80, 8, 0.8
     points = inference.design(1, n, seed=6)
@@ -139,8 +140,30 @@ def test_the_spread_between_packings_follows_the_parameters():
     test = np.array([[0.1], [0.5], [0.9]])
     sd = np.sqrt(np.diagonal(spread(test), axis1=1, axis2=2))
     assert sd == pytest.approx(np.repeat(0.1 + test, 2, axis=1), rel=0.25)
-    assert spread.correlation[0, 1] == pytest.approx(rho, abs=4 * (1 - rho**2) / np.sqrt(n * (k - 1)))
+    shrink = (k - 1) / (k - 1 + 3)
+    assert spread.correlation[0, 1] == pytest.approx(shrink * rho, abs=shrink * 4 * (1 - rho**2) / np.sqrt(n * (k - 1)))
     assert Spread(points, observables[:, :1])(test) == pytest.approx(0.0)
+
+
+def test_a_record_from_a_packing_the_runs_never_took_stays_possible():
+    """Every parameter set runs on the same K packings, so K = 2 packings of m = 4 observables
+    deviate in one direction only, whatever the number of sets: pooled as it is, their correlation
+    is singular, and a record from another packing, deviating elsewhere, is all but impossible
+    (the paper protocol's quick workflow: χ² of 600 to 14,000 for 7 observables at the truth).
+    Shrunk, R ⪰ λ I with λ = (m + 1)/(ν + m + 1), so that Σ_K = D R D (D the emulated standard
+    deviations) bounds every record's χ² = rᵀ Σ_K⁻¹ r by Σ_j (r_j / D_j)² / λ."""
+    rng = np.random.default_rng(11)
+    n, k, m = 40, 2, 4
+    points = inference.design(1, n, seed=12)
+    shared = rng.standard_normal((k, m))
+    observables = points[:, None, :] + (0.1 + points)[:, None, :] * shared[None]
+    spread = Spread(points, observables)
+    floor = (m + 1) / (k - 1 + m + 1)
+    assert np.linalg.eigvalsh(spread.correlation).min() >= floor - 1e-12
+    covariance = spread(np.array([[0.5]]))[0]
+    fresh = 0.6 * rng.standard_normal((2000, m))
+    chi2 = np.einsum("ri,ri->r", fresh, np.linalg.solve(covariance, fresh.T).T)
+    assert np.all(chi2 <= np.sum((fresh / np.sqrt(np.diag(covariance))) ** 2, axis=1) / floor * (1 + 1e-9))
 
 
 DISORDERED = {"edge_beads": 5, "sensors": ["0:1", "0:3"]}

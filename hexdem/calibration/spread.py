@@ -15,8 +15,9 @@ from each parameter set's sample standard deviation over its K packings, less it
 (:func:`log_sd_bias`), and R the correlation between the observables (a slow packing's
 arrivals are late at every later sensor together), pooled over the parameter sets from the
 deviations scaled by the emulated s (each set's own sample standard deviation would bias the
-correlation towards zero: with K = 8, 0.77 for 0.8). One packing per set (the ideal
-lattice) has no spread.
+correlation towards zero: with K = 8, 0.77 for 0.8), and shrunk towards the identity, as the sets
+share their K packings (:func:`shrunk_correlation`). One packing per set (the ideal lattice) has
+no spread.
 """
 
 from __future__ import annotations
@@ -41,6 +42,21 @@ def log_sd_bias(realizations: int) -> float:
     return 0.5 * (float(digamma(half)) - np.log(half))
 
 
+def shrunk_correlation(sample, dof: int) -> np.ndarray:
+    """The correlation between observables from ``sample``, the correlation of ``dof`` independent
+    deviations, shrunk towards the identity: (ν R̂ + (m + 1) I) / (ν + m + 1).
+
+    Every parameter set is simulated on the same K packings (:mod:`~hexdem.calibration.packings`),
+    so their deviations from the mean, however many sets are pooled, are K − 1 = ν independent
+    vectors: for ν < m observables R̂ is singular, and a record whose packing deviates in a
+    direction the K packings never took would count as impossible. The estimate is that of an
+    inverse-Wishart prior centred on the identity and worth m + 1 packings (the fewest for which its
+    mean exists), updated with the ν deviations: it stays positive definite, its smallest
+    eigenvalue at least (m + 1)/(ν + m + 1), and tends to R̂ as the packings grow in number."""
+    size = len(sample)
+    return (dof * np.asarray(sample, float) + (size + 1) * np.eye(size)) / (dof + size + 1)
+
+
 class Spread:
     """Σ_K(u) fitted to simulations at unit-cube ``points`` (n, p) with ``observables`` (n, K, m)."""
 
@@ -55,7 +71,7 @@ class Spread:
         scaled = centred / np.exp(self.log_sd.predict(points)[0])[:, None, :]
         pooled = np.einsum("nki,nkj->ij", scaled, scaled)
         norm = np.sqrt(np.diag(pooled))
-        self.correlation = pooled / np.outer(norm, norm)
+        self.correlation = shrunk_correlation(pooled / np.outer(norm, norm), self.realizations - 1)
 
     def __call__(self, unit) -> np.ndarray:
         """Σ_K (k, m, m) at unit-cube points ``unit`` (k, p)."""
