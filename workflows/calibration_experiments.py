@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from hexdem.analysis.plotting import save, subplots
+from hexdem.calibration.priors import Prior
 from hexdem.calibration.study import calibrate, prepare
 from hexdem.calibration.synthetic import synthetic_rows, write_measured
 from hexdem.cli.main import exit_status
@@ -124,18 +125,27 @@ def run(argv=None) -> int:
     return 0
 
 
+#: Each key as the figure draws it: (axis label, factor from the key's unit).
+AXES = {"diameter_sigma_m": ("σ of the diameters [µm]", 1e6), "restitution": ("restitution e", 1.0)}
+
+
 def intervals(rows, truth: dict, path) -> None:
-    """Each data set's 90 % interval and median of each parameter, the truth drawn across."""
-    keys = list(truth)
-    fig, axes = subplots(1, len(keys), figsize=(5 * len(keys), 3.6), layout="constrained", squeeze=False)
-    for ax, key in zip(axes[0], keys):
+    """Each data set's 90 % interval and median of each parameter across its prior's range, the truth drawn across."""
+    priors = {prior.key: prior for prior in map(Prior.parse, PRIORS)}
+    fig, axes = subplots(1, len(truth), figsize=(5 * len(truth), 1.6 + 0.5 * len(rows) / len(truth)),
+                         layout="constrained", squeeze=False)
+    for ax, key in zip(axes[0], truth):
+        label, factor = AXES[key]
         mine = [row for row in rows if row[3] == key]
         y = np.arange(len(mine))
-        ax.errorbar([r[5] for r in mine], y, xerr=[[r[5] - r[6] for r in mine], [r[7] - r[5] for r in mine]],
-                    fmt="o", color="C0", capsize=3, label="posterior median, 90 %")
-        ax.axvline(truth[key], color="C3", ls="--", label="truth")
+        medians, lows, highs = (np.array([r[i] for r in mine]) * factor for i in (5, 6, 7))
+        ax.errorbar(medians, y, xerr=[medians - lows, highs - medians], fmt="o", color="C0", capsize=3,
+                    label="posterior median, 90 %")
+        ax.axvline(truth[key] * factor, color="C3", ls="--", label="truth")
+        ax.set_xlim(*(factor * bound for bound in priors[key].support))
+        ax.set_ylim(-0.5, len(mine) - 0.5)
         ax.set_yticks(y, [r[0] for r in mine])
-        ax.set_xlabel(key)
+        ax.set_xlabel(f"{label} (the prior's range)")
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
     fig.suptitle("What each sensor configuration and striker speed tells")
