@@ -25,14 +25,25 @@ def pytest_collection_modifyitems(items):
     """Every test that needs the session's ``hexdem paper --quick`` (two minutes) is ``slow``. Under
     ``pytest -n N --dist loadgroup`` (pytest-xdist, as CI runs the suite) those tests share one
     worker, which runs the paper once (a test that asks for the paper as it runs carries the
-    ``paper_quick`` group itself), and every other file's tests share one, which builds the file's
-    fixtures (a docs build, a wheel's install) once."""
+    ``paper_quick`` group itself); the tests of a file that share a module's fixture (a docs build,
+    a wheel's install) share one worker, which builds it once; every other test goes to whichever
+    worker is free, so that no worker waits at the end behind a long file."""
     for item in items:
         if "paper_quick" in getattr(item, "fixturenames", ()):
             item.add_marker(pytest.mark.slow)
             item.add_marker(pytest.mark.xdist_group("paper_quick"))
-        elif item.get_closest_marker("xdist_group") is None:
+        elif item.get_closest_marker("xdist_group") is None and shares_a_module_fixture(item):
             item.add_marker(pytest.mark.xdist_group(item.path.stem))
+
+
+def shares_a_module_fixture(item) -> bool:
+    """Whether ``item`` uses a fixture that its file's other tests share: one built once per module
+    or class, or one of the session that the file defines itself."""
+    info = getattr(item, "_fixtureinfo", None)
+    own = item.nodeid.split("::")[0]
+    return info is not None and any(
+        definition.scope in ("module", "class") or (definition.scope == "session" and definition.baseid == own)
+        for definitions in info.name2fixturedefs.values() for definition in definitions)
 
 
 @pytest.fixture(scope="session")
