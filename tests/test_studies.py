@@ -21,7 +21,8 @@ SMALL = "edge_beads = 6\nduration = 3e-3\n"
 #: Eight runs.
 EIGHT = ["--vary", "v0=0.2,0.3,0.4,0.5", "--vary", "friction=0,0.1"]
 #: Parsl on this machine: one block of two workers, a lost worker noticed within seconds, its
-#: tasks retried on a block started afresh.
+#: tasks retried on a block started afresh; the block started half a second after Parsl is (its
+#: strategy's first look, 5 s after by default).
 PARSL_CONFIG = '''
 from parsl.config import Config
 from parsl.executors import HighThroughputExecutor
@@ -31,7 +32,7 @@ config = Config(
     executors=[HighThroughputExecutor(label="local", address="127.0.0.1", max_workers_per_node=2,
                                       heartbeat_threshold=5, heartbeat_period=1, block_error_handler=False,
                                       provider=LocalProvider(init_blocks=1, min_blocks=1, max_blocks=1))],
-    retries=2, run_dir="{run_dir}")
+    retries=2, strategy_period=0.5, run_dir="{run_dir}")
 '''
 
 
@@ -111,19 +112,20 @@ def test_a_failed_run_is_recorded_and_the_others_finish(tmp_path, capsys):
     assert "2 runs (1 done before), 1 at once" in capsys.readouterr().err
 
 
-def test_runs_of_two_ranks_each(tmp_path, launcher):
+def test_runs_of_two_ranks_each(serial, tmp_path, launcher):
     """--ranks-per-run 2: every run starts its own two ranks (here through a launcher that notes
-    them) and gives the one-rank runs' peaks."""
+    them) and gives the serial sweep's one-rank runs' peaks."""
     command, log = launcher
     before = len(log.read_text().splitlines()) if log.exists() else 0
-    two, one = tmp_path / "two", tmp_path / "one"
-    vary = ["--vary", "v0=0.2,0.4"]
-    assert sweep(tmp_path, *vary, "--out", str(two), "--workers", "2", "--ranks-per-run", "2",
+    two = tmp_path / "two"
+    assert sweep(tmp_path, "--vary", "v0=0.2,0.4", "--vary", "friction=0", "--out", str(two), "--ranks-per-run", "2",
                  "--launcher", command) == 0
-    assert sweep(tmp_path, *vary, "--out", str(one), "--workers", "2") == 0
     jobs = log.read_text().splitlines()[before:]
     assert sorted(job.split()[:2] for job in jobs) == [["-n", "2"]] * 2
-    for (run, (header, mine)), (_, (_, theirs)) in zip(peaks_of(two).items(), peaks_of(one).items()):
+    ours, one_rank = peaks_of(two), peaks_of(serial)
+    assert sorted(ours) == ["runs/v0=0.2,friction=0", "runs/v0=0.4,friction=0"]
+    for run, (_, mine) in ours.items():
+        theirs = one_rank[run][1]
         speeds = [float(row["peak_speed"] or "nan") for row in mine]
         assert speeds == pytest.approx([float(row["peak_speed"] or "nan") for row in theirs], rel=1e-9,
                                        nan_ok=True), run
