@@ -144,7 +144,7 @@ def test_run_on_two_ranks_from_any_directory(installed, cwd, tmp_path):
 def test_one_realization_ensemble_from_any_directory(installed, cwd, tmp_path):
     out = tmp_path / "ensemble"
     done = run(installed, cwd, "ensemble", "--realizations", "1", "--velocities", "0.4", "--edge-beads", "4",
-               "--workers", "2", "--out", str(out))
+               "--workers", "1", "--out", str(out))
     assert done.returncode == 0, done.stderr
     assert json.loads((out / "ensemble.json").read_text())["config"]["realizations"] == 1
     assert (out / "peaks_stats.csv").exists()
