@@ -166,19 +166,20 @@ def test_a_record_from_a_packing_the_runs_never_took_stays_possible():
     assert np.all(chi2 <= np.sum((fresh / np.sqrt(np.diag(covariance))) ** 2, axis=1) / floor * (1 + 1e-9))
 
 
-DISORDERED = {"edge_beads": 5, "sensors": ["0:1", "0:3"]}
+DISORDERED = {"edge_beads": 4, "sensors": ["0:1", "0:3"]}
+DISORDERED_TOML = 'edge_beads = 4\nsensors = ["0:1", "0:3"]\n'
 
 
 @pytest.fixture(scope="module")
 def packings(tmp_path_factory):
-    """Packing 0 of the 5-per-edge hexagon at σ = 6 tol and 3 tol (seed 0), settled."""
+    """Packing 0 of the 4-per-edge hexagon at σ = 6 tol and 3 tol (seed 0), settled."""
     root = tmp_path_factory.mktemp("packings")
     config = RunConfig.from_dict(DISORDERED)
     return {sigma: settled_packing(config, sigma, 0, 0, root)[0] for sigma in (TRUE_SIGMA_M, TRUE_SIGMA_M / 2)}
 
 
 def test_the_disorder_prior_sets_the_standard_deviation_of_the_diameters(packings):
-    """61 diameters drawn from N(d, σ): their sample sd is σ within 4 σ/√(2 (n − 1)), their mean
+    """37 diameters drawn from N(d, σ): their sample sd is σ within 4 σ/√(2 (n − 1)), their mean
     d within 4 σ/√n."""
     diameters = packings[TRUE_SIGMA_M].diameters_m
     n = len(diameters)
@@ -219,7 +220,7 @@ def test_a_calibration_of_the_disorder_runs_on_disordered_records(tmp_path):
     rows = synthetic_rows(config, "0", 2.0, 1.5e-3, np.random.default_rng(3), disorder=(TRUE_SIGMA_M, 1000, 0),
                           packings=tmp_path / "truth")
     write_measured(tmp_path / "data.csv", rows)
-    (tmp_path / "base.toml").write_text(TINY_TOML)
+    (tmp_path / "base.toml").write_text(DISORDERED_TOML)
     out = tmp_path / "out"
     code = main(["calibrate", "--config", str(tmp_path / "base.toml"), "--measured", str(tmp_path / "data.csv"),
                  "--prior", "diameter_sigma_m=uniform(0, 1.5e-4)", "--realizations", "2", "--budget", "60",
@@ -328,10 +329,13 @@ def test_workers_and_parsl_together_are_a_usage_error(measured, tmp_path, capsys
     assert stop.value.code == 2 and "not allowed with argument" in capsys.readouterr().err
 
 
+def calibrate_arguments(measured, out):
+    return ["calibrate", "--config", str(measured / "base.toml"), "--measured", str(measured / "data.csv"),
+            "--prior", "v0=uniform(0.2, 0.7)", "--budget", "30", "--seed", "3", "--out", str(out)]
+
+
 def calibrate_command(measured, out):
-    return [sys.executable, "-m", "hexdem", "calibrate", "--config", str(measured / "base.toml"),
-            "--measured", str(measured / "data.csv"), "--prior", "v0=uniform(0.2, 0.7)", "--budget", "30",
-            "--seed", "3", "--out", str(out)]
+    return [sys.executable, "-m", "hexdem", *calibrate_arguments(measured, out)]
 
 
 def finished_simulations(out):
@@ -341,7 +345,7 @@ def finished_simulations(out):
 
 def test_a_calibration_finds_the_truth_and_resumes_after_kill_9_to_the_same_posterior(measured, tmp_path):
     whole = tmp_path / "whole"
-    subprocess.run(calibrate_command(measured, whole), check=True, capture_output=True)
+    assert main(calibrate_arguments(measured, whole)) == 0
     samples = np.loadtxt(whole / "posterior.csv", delimiter=",", skiprows=1)
     # one noisy record: its 90 % interval misses the truth one time in ten; four standard deviations, 6e-5 of the time
     assert abs(np.median(samples) - TRUE_V0) <= 4 * np.std(samples)

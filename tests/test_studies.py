@@ -21,7 +21,8 @@ SMALL = "edge_beads = 6\nduration = 3e-3\n"
 #: Eight runs.
 EIGHT = ["--vary", "v0=0.2,0.3,0.4,0.5", "--vary", "friction=0,0.1"]
 #: Parsl on this machine: one block of two workers, a lost worker noticed within seconds, its
-#: tasks retried on a block started afresh.
+#: tasks retried on a block started afresh; the block started half a second after Parsl is (its
+#: strategy's first look, 5 s after by default).
 PARSL_CONFIG = '''
 from parsl.config import Config
 from parsl.executors import HighThroughputExecutor
@@ -31,7 +32,7 @@ config = Config(
     executors=[HighThroughputExecutor(label="local", address="127.0.0.1", max_workers_per_node=2,
                                       heartbeat_threshold=5, heartbeat_period=1, block_error_handler=False,
                                       provider=LocalProvider(init_blocks=1, min_blocks=1, max_blocks=1))],
-    retries=2, run_dir="{run_dir}")
+    retries=2, strategy_period=0.5, run_dir="{run_dir}")
 '''
 
 
@@ -111,19 +112,20 @@ def test_a_failed_run_is_recorded_and_the_others_finish(tmp_path, capsys):
     assert "2 runs (1 done before), 1 at once" in capsys.readouterr().err
 
 
-def test_runs_of_two_ranks_each(tmp_path, launcher):
+def test_runs_of_two_ranks_each(serial, tmp_path, launcher):
     """--ranks-per-run 2: every run starts its own two ranks (here through a launcher that notes
-    them) and gives the one-rank runs' peaks."""
+    them) and gives the serial sweep's one-rank runs' peaks."""
     command, log = launcher
     before = len(log.read_text().splitlines()) if log.exists() else 0
-    two, one = tmp_path / "two", tmp_path / "one"
-    vary = ["--vary", "v0=0.2,0.4"]
-    assert sweep(tmp_path, *vary, "--out", str(two), "--workers", "2", "--ranks-per-run", "2",
+    two = tmp_path / "two"
+    assert sweep(tmp_path, "--vary", "v0=0.2,0.4", "--vary", "friction=0", "--out", str(two), "--ranks-per-run", "2",
                  "--launcher", command) == 0
-    assert sweep(tmp_path, *vary, "--out", str(one), "--workers", "2") == 0
     jobs = log.read_text().splitlines()[before:]
     assert sorted(job.split()[:2] for job in jobs) == [["-n", "2"]] * 2
-    for (run, (header, mine)), (_, (_, theirs)) in zip(peaks_of(two).items(), peaks_of(one).items()):
+    ours, one_rank = peaks_of(two), peaks_of(serial)
+    assert sorted(ours) == ["runs/v0=0.2,friction=0", "runs/v0=0.4,friction=0"]
+    for run, (_, mine) in ours.items():
+        theirs = one_rank[run][1]
         speeds = [float(row["peak_speed"] or "nan") for row in mine]
         assert speeds == pytest.approx([float(row["peak_speed"] or "nan") for row in theirs], rel=1e-9,
                                        nan_ok=True), run
@@ -348,24 +350,22 @@ def test_the_shipped_one_machine_parsl_file_runs_a_sweep_with_its_logs_in_the_st
                                                 "v0=0.2", "--out", str(out), "--parsl", str(shipped)]
 
 
-def test_two_runs_in_two_threads_of_one_process(tmp_path, monkeypatch):
+def test_two_runs_in_two_threads_of_one_process(serial, tmp_path, monkeypatch):
     """A Parsl ThreadPoolExecutor runs a sweep's runs in threads of this process: with a relative
     --out, each run keeps to its own folder (no run changes the process's working directory,
-    which the threads share) and gives the runs of a sweep of separate processes."""
+    which the threads share) and gives the runs of the serial sweep, whose runs were processes."""
     monkeypatch.chdir(tmp_path)
     threads = tmp_path / "threads.py"
     threads.write_text("from parsl.config import Config\nfrom parsl.executors import ThreadPoolExecutor\n"
                        "config = Config(executors=[ThreadPoolExecutor(max_threads=2)], "
                        f"run_dir={str(tmp_path / 'runinfo')!r})\n")
-    vary = ["--vary", "v0=0.2,0.3"]
-    assert sweep(tmp_path, *vary, "--out", "out", "--parsl", str(threads)) == 0
+    assert sweep(tmp_path, "--vary", "v0=0.2,0.3", "--vary", "friction=0", "--out", "out", "--parsl", str(threads)) == 0
     assert Path.cwd() == tmp_path
-    assert sweep(tmp_path, *vary, "--out", "processes", "--workers", "2") == 0
     _, rows = read_csv(tmp_path / "out" / "sweep.csv")
     assert [row["status"] for row in rows] == ["done", "done"] and not list((tmp_path / "out" / "runs").glob(".*"))
-    assert peaks_of(tmp_path / "out") == peaks_of(tmp_path / "processes")
-    assert sorted(path.name for path in tmp_path.iterdir()) == ["base.toml", "out", "processes", "runinfo",
-                                                                 "threads.py"]
+    ours = peaks_of(tmp_path / "out")
+    assert len(ours) == 2 and ours == {run: rows for run, rows in peaks_of(serial).items() if run in ours}
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["base.toml", "out", "runinfo", "threads.py"]
 
 
 def test_the_local_pools_processes_end_with_a_killed_study(tmp_path):
