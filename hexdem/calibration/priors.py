@@ -17,7 +17,6 @@ import re
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats
 
 from hexdem.errors import HexdemError
 
@@ -63,6 +62,8 @@ class Prior:
             raise HexdemError(f"--prior {text!r}: {a.strip()!r} or {b.strip()!r} is not a number") from None
 
     def _frozen(self):
+        from scipy import stats  # a second of import: only where a prior is mapped, not in a simulation's worker
+
         if self.kind == "uniform":
             return stats.uniform(self.a, self.b - self.a)
         if self.kind == "loguniform":

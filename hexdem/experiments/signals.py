@@ -19,7 +19,6 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.analysis.plotting import save, subplots
 from hexdem.analysis.peaks import refine_peak, rising_crossing
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.errors import HexdemError
@@ -104,6 +103,8 @@ def compare_signals(run_dir, measured_path, out=None) -> dict:
 
 def _overlay(traces: dict, offset: float, path) -> None:
     """Speed of each sensor: simulated, and measured shifted by −offset."""
+    from hexdem.analysis.plotting import save, subplots  # matplotlib: only where the figure is drawn
+
     count = len(traces)
     columns = min(2, count)
     fig, axes = subplots(math.ceil(count / columns), columns, figsize=(6 * columns, 3.2 * math.ceil(count / columns)),
