@@ -32,7 +32,7 @@ FULL_FRICTION_REALIZATIONS = 5
 #: Coulomb μ of the friction study's frictional runs (μ = 0 is the paper's ensemble itself), and
 #: the quick run's.
 FRICTIONS = (0.1, 0.2, 0.5)
-QUICK_FRICTIONS = (0.1, 0.5)
+QUICK_FRICTIONS = (0.5,)
 #: Beads per edge of the ensembles' hexagon: the experiment's, and the quick run's smaller one.
 ENSEMBLE_EDGE_BEADS = 11
 QUICK_ENSEMBLE_EDGE_BEADS = 7
