@@ -3,7 +3,7 @@
 The quick modes take the full modes' code paths on small packings and few steps (seconds
 each), so that an API change that breaks a benchmark is caught here rather than when
 someone next measures. The paper benchmark resumes the session's ``hexdem paper --quick``
-(tests/test_paper.py) rather than running the two-minute pipeline a second time.
+(tests/test_paper.py) rather than running the pipeline a second time.
 """
 
 import subprocess

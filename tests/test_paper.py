@@ -1,4 +1,4 @@
-"""``hexdem paper --quick``: the whole pipeline once (about a minute), its report and table
+"""``hexdem paper --quick``: the whole pipeline once (the session's), its report and table
 against the paper and the theory, resuming, and refusals."""
 
 import csv
