@@ -1,7 +1,8 @@
 """What ``hexdem paper`` computes: the full paper, or ``--quick`` (thinned).
 
 Both run the same code paths; ``--quick`` only thins them (fewer V₀, realizations, σ and μ,
-smaller packings), so that it checks the whole pipeline in under a minute. Its numbers are rough.
+smaller packings), so that it checks the whole pipeline at a fraction of the cost. Its numbers
+are rough.
 """
 
 from __future__ import annotations
