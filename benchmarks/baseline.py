@@ -20,6 +20,9 @@ from pathlib import Path
 #: The last commit before the speed work (issue: the analysis costs less than the simulation).
 BEFORE = "e8fb865"
 ROOT = Path(__file__).resolve().parents[1]
+#: The environment variable naming a folder that keeps the unpacked revisions from one benchmark
+#: to the next (the test suite's quick runs share one); unset, each benchmark unpacks its own.
+KEPT_ENV = "HEXDEM_BENCH_BASELINES"
 
 
 def baseline_tree(work: Path, revision: str = BEFORE) -> Path | None:
@@ -29,7 +32,15 @@ def baseline_tree(work: Path, revision: str = BEFORE) -> Path | None:
     clone).
 
     The warm-up, a small ``hexdem run``, fills the unpacked package's numba cache as a user's
-    first run would, so that no timed run of the earlier version compiles its kernels."""
+    first run would, so that no timed run of the earlier version compiles its kernels. With
+    ``$HEXDEM_BENCH_BASELINES`` set (:data:`KEPT_ENV`) the tree is unpacked there instead of under
+    ``work``, once: a later call finds it warmed up and returns it."""
+    kept = os.environ.get(KEPT_ENV)
+    if kept:
+        work = Path(kept) / revision
+        if (work / f"hexdem-{revision}" / "warm-up").is_dir():
+            return work / f"hexdem-{revision}"
+        shutil.rmtree(work, ignore_errors=True)  # an unpacking cut short
     source = Path(work) / f"source-{revision}"
     archive = subprocess.run(["git", "-C", str(ROOT), "archive", revision, "hexdem", "lammps_inputs", "pyproject.toml",
                               "README.md"], capture_output=True, check=False)

@@ -28,7 +28,8 @@ time"); the target: at most the loop plus 0.3 s.
 For every truth and method the table gives the simulations, the wall time, each key's 90 %
 interval width over the prior's and whether it holds the truth; the last rows count, per
 method and key, the truths inside their 90 % interval (the target: at least 7 of 10).
-``--quick``: one truth, a 5-per-edge hexagon with sensors 0:1 and 0:3, ``v0`` alone, 30 simulations.
+``--quick``: one truth, a 5-per-edge hexagon with sensors 0:1 and 0:3, ``v0`` alone, 30 simulations,
+one worker.
 """
 
 from __future__ import annotations
@@ -146,13 +147,13 @@ def main() -> None:
         simulation_cost(args.cost, Path(args.out or tempfile.mkdtemp(prefix="hexdem-bench-cost-")))
         return
     base, prior_texts = TINY_CASE if args.quick else QUICK_CASE
-    truths = 1 if args.quick else args.truths
+    truths, workers = (1, 1) if args.quick else (args.truths, args.workers)
     methods = args.methods.split(",")
     priors = [Prior.parse(text) for text in prior_texts]
     root = Path(args.out or tempfile.mkdtemp(prefix="hexdem-bench-calibration-"))
     rng = np.random.default_rng(args.seed)
     print(f"machine: {describe()}; load average {os.getloadavg()[0]:.2f}", flush=True)
-    print(f"noise {args.noise:g} m/s^2 rms, {truths} truth(s), workers {args.workers}")
+    print(f"noise {args.noise:g} m/s^2 rms, {truths} truth(s), workers {workers}")
     print("| truth | method | " + " | ".join(f"{p.key} true | {p.key} 90 % interval | {p.key} width ratio" for p in priors)
           + " | simulations | wall s |")
     print("|---" * (3 + 3 * len(priors) + 1) + "|")
@@ -165,9 +166,9 @@ def main() -> None:
         for method in methods:
             start = time.perf_counter()
             if method == "emulator":
-                samples, count = run_emulator(calibration, folder / "data.csv", folder / method, args.workers)
+                samples, count = run_emulator(calibration, folder / "data.csv", folder / method, workers)
             else:
-                samples, count = run_filter(calibration, folder / method, args.workers, seed=t)
+                samples, count = run_filter(calibration, folder / method, workers, seed=t)
             seconds = time.perf_counter() - start
             cells = []
             for j, prior in enumerate(priors):

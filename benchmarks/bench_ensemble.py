@@ -18,8 +18,9 @@ Usage: python benchmarks/bench_ensemble.py [--workers 2] [--repeats 3] [--before
    the MPI job), LAMMPS's wall time inside hexdem, its "Loop time", and atom-steps/s.
    Target: two ranks >= 1.6 x one rank.
 
-``--quick``: a 2-realization ensemble of 4-per-edge hexagons struck at one speed, and the
-snapshot run on a 5-per-edge hexagon up to 0.1 ms, one repeat (the same code paths, seconds).
+``--quick``: a 2-realization ensemble of 4-per-edge hexagons struck at one speed on one worker,
+and the snapshot run on a 5-per-edge hexagon up to 0.1 ms, one repeat (the same code paths,
+seconds).
 """
 
 from __future__ import annotations
@@ -148,7 +149,7 @@ def main() -> None:
             base, times_s = QUICK_SNAPSHOT_RUN if args.quick else SNAPSHOT_RUN
             bench_ranks(work, 1 if args.quick else args.repeats, base, times_s)
         if not args.skip_ensemble:
-            bench_ensemble(work, args.workers, QUICK_ENSEMBLE if args.quick else (), args.before)
+            bench_ensemble(work, 1 if args.quick else args.workers, QUICK_ENSEMBLE if args.quick else (), args.before)
     finally:
         shutil.rmtree(work)
 

@@ -18,8 +18,8 @@ same analysis on the same machine load.
 
 It prints, per size, the run (``summary.json``'s ``wall_time_s``: model, MPI job, analysis, up to
 the result files), the median result files' time of each version, and the target: the result
-files <= max(:data:`TARGET_FLOOR_S`, :data:`TARGET_SHARE` x the run). ``--quick``: hexagons of 4
-and 6 per edge for 0.2 ms on one rank, one repeat (the same code path, seconds).
+files <= max(:data:`TARGET_FLOOR_S`, :data:`TARGET_SHARE` x the run). ``--quick``: a hexagon of 4
+per edge for 0.2 ms on one rank, one repeat (the same code path, seconds).
 """
 
 from __future__ import annotations
@@ -107,7 +107,7 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--before", default=BEFORE, metavar="REV",
                         help=f"the revision to compare with (default {BEFORE})")
-    parser.add_argument("--quick", action="store_true", help="small hexagons, one repeat (seconds)")
+    parser.add_argument("--quick", action="store_true", help="a small hexagon, one repeat (seconds)")
     parser.add_argument("--write", nargs=2, metavar=("PICKLE", "OUT"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.write:
@@ -116,8 +116,8 @@ def main() -> None:
     from hexdem.experiments.run import run_experiment
     from hexdem.model.config import RunConfig
 
-    edges = [4, 6] if args.quick else [int(edge) for edge in args.edges.split(",")]
-    durations = [2e-4, 2e-4] if args.quick else [float(value) for value in args.durations.split(",")]
+    edges = [4] if args.quick else [int(edge) for edge in args.edges.split(",")]
+    durations = [2e-4] if args.quick else [float(value) for value in args.durations.split(",")]
     if len(durations) != len(edges):
         parser.error(f"--durations needs one duration per edge ({len(edges)}), not {len(durations)}")
     ranks, repeats = (1, 1) if args.quick else (args.ranks, args.repeats)

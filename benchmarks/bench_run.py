@@ -26,7 +26,7 @@ that feeds the analysis every ``dump_every`` steps), the ratio of each wall time
 loop, the in-run analysis's share of the loop (hexdem's loop over the bare loop, minus 1), where
 the CLI's time goes, and the targets: end to end <= import floor + 1.3 x bare loop + 0.6 s; the
 in-run analysis <= 0.25 x the bare loop. ``--quick``: a 5-per-edge hexagon for 0.2 ms, one
-repeat (the same code path, seconds).
+repeat, no warm-up (the same code path, seconds).
 """
 
 from __future__ import annotations
@@ -97,7 +97,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--before", default=BEFORE, metavar="REV", help=f"the revision to compare with (default {BEFORE})")
-    parser.add_argument("--quick", action="store_true", help="a small deck, one repeat (seconds)")
+    parser.add_argument("--quick", action="store_true", help="a small deck, one repeat, no warm-up (seconds)")
     args = parser.parse_args()
     repeats = 1 if args.quick else args.repeats
     config = QUICK if args.quick else RunConfig()
@@ -109,7 +109,8 @@ def main() -> None:
         before = baseline_tree(work, args.before)
         deck = nooutput_deck(model, settings, work / "bare")
         config_path = write_config(config, work / "run.toml")
-        run_experiment(config, work / "warm-up", log=quiet)
+        if not args.quick:
+            run_experiment(config, work / "warm-up", log=quiet)
         t = {key: [] for key in ("cli", "cli loop", "cli summary", "cli engine", "before", "before loop", "inproc",
                                  "inproc loop", "stream loop", "floor", "import", "bare", "bare loop")}
         for repeat in range(repeats):
@@ -146,7 +147,7 @@ def main() -> None:
     atom_steps = model.n_bodies * settings.n_steps
     print(f"deck: {'quick: ' if args.quick else 'default experiment, '}{model.packing.shape}, {model.n_bodies} atoms x "
           f"{settings.n_steps} steps, a sample every {settings.dump_every} steps; median of {repeats} alternating "
-          "run(s), after a warm-up")
+          f"run(s){'' if args.quick else ', after a warm-up'}")
     print(f"{'runner':<34} {'wall [s]':>9} {'loop [s]':>9} {'wall / bare loop':>17} {'M atom-steps/s (loop)':>22}")
     rows = [("hexdem run (CLI, subprocess)", m["cli"], m["cli loop"]),
             ("run_experiment (in-process)", m["inproc"], m["inproc loop"]),

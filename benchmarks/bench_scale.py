@@ -49,8 +49,8 @@ to end <= :data:`END_TO_END_FACTOR` × the bare loop + :data:`END_TO_END_OFFSET_
 ranks; a million beads' result files and figures <= :data:`MILLION_RESULTS_S`.
 ``--repeat K``: each row's times are the medians of K rounds (hexdem and before, the one first
 in one round and the other in the next, then bare; one machine's load varies by 10 to 50 %
-between runs a minute apart), its shares the medians of the rounds' own shares. ``--quick``: hexagons of 5 and 7 per edge
-for 0.2 ms on 1 and 2 ranks (the same code path, seconds).
+between runs a minute apart), its shares the medians of the rounds' own shares. ``--quick``: a
+hexagon of 5 per edge for 0.2 ms on 1 and 2 ranks (the same code path, seconds).
 """
 
 from __future__ import annotations
@@ -236,9 +236,9 @@ def main() -> None:
     parser.add_argument("--duration", type=float, default=1e-4, help="simulated time [s] (default 1e-4)")
     parser.add_argument("--before", help="also time hexdem of this revision (or unpacked package tree) side by side")
     parser.add_argument("--repeat", type=int, default=1, help="rounds per row; its times are their medians (default 1)")
-    parser.add_argument("--quick", action="store_true", help="5- and 7-per-edge hexagons for 0.2 ms on 1 and 2 ranks")
+    parser.add_argument("--quick", action="store_true", help="a 5-per-edge hexagon for 0.2 ms on 1 and 2 ranks")
     args = parser.parse_args()
-    edges, ranks, duration = ([5, 7], [1, 2], 2e-4) if args.quick else (args.edges, args.ranks, args.duration)
+    edges, ranks, duration = ([5], [1, 2], 2e-4) if args.quick else (args.edges, args.ranks, args.duration)
     print(f"machine: {describe()}; load average {os.getloadavg()[0]:.2f}; times: medians of {args.repeat} round(s)",
           flush=True)
     work = Path(tempfile.mkdtemp(prefix="hexdem-bench-scale-"))

@@ -21,7 +21,8 @@ the repeats):
 
 The target: Parsl's overhead per run exceeds the pool's by at most 0.2 s, or 5 % of a run.
 The two executors' sweeps must give equal peaks.csv (checked). ``--quick``: sweeps of 1 and 2
-runs of a 5-per-edge hexagon for 0.2 ms, one repeat, no warm-up (the same code path, seconds).
+runs of a 5-per-edge hexagon for 0.2 ms on one worker, one repeat, no warm-up (the same code
+path, seconds).
 """
 
 from __future__ import annotations
@@ -84,13 +85,13 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--runs", type=int, default=8, help="N: sweeps of N and 2N runs (default 8)")
     parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--quick", action="store_true", help="sweeps of 1 and 2 small runs, one repeat")
+    parser.add_argument("--quick", action="store_true", help="sweeps of 1 and 2 small runs on one worker, one repeat")
     args = parser.parse_args()
-    repeats, n = (1, 1) if args.quick else (args.repeats, args.runs)
+    repeats, n, workers = (1, 1, 1) if args.quick else (args.repeats, args.runs, args.workers)
     base = QUICK_BASE if args.quick else {}
     work = Path(tempfile.mkdtemp(prefix="hexdem-bench-study-"))
     config = work / "parsl_local.py"
-    config.write_text(PARSL_CONFIG.format(workers=args.workers, run_dir=work / "runinfo"))
+    config.write_text(PARSL_CONFIG.format(workers=workers, run_dir=work / "runinfo"))
     executors = {"process pool": None, "Parsl (HighThroughputExecutor, local)": str(config)}
     print(f"machine: {describe()}; load average {os.getloadavg()[0]:.2f}", flush=True)
     times = {(name, size): [] for name in executors for size in (n, 2 * n)}
@@ -99,7 +100,7 @@ def main() -> None:
         if not args.quick:
             timed_run(base, speeds(n), work / "warm-up-alone")
             for parsl in executors.values():
-                timed_sweep(base, speeds(n), work / f"warm-up-{'pool' if parsl is None else 'parsl'}", args.workers,
+                timed_sweep(base, speeds(n), work / f"warm-up-{'pool' if parsl is None else 'parsl'}", workers,
                             parsl)
         for repeat in range(repeats):
             alone.append(timed_run(base, speeds(n), work / f"{repeat}-alone"))
@@ -107,7 +108,7 @@ def main() -> None:
                 outs = {}
                 for name, parsl in executors.items():
                     outs[name] = work / f"{repeat}-{size}-{'pool' if parsl is None else 'parsl'}"
-                    times[name, size].append(timed_sweep(base, speeds(size), outs[name], args.workers, parsl))
+                    times[name, size].append(timed_sweep(base, speeds(size), outs[name], workers, parsl))
                 first, *others = (peaks(out) for out in outs.values())
                 if len(first) != size or any(other != first for other in others):
                     raise SystemExit("the executors' sweeps differ: the comparison would be unfair")
@@ -116,7 +117,7 @@ def main() -> None:
     finally:
         shutil.rmtree(work)
     print(f"sweeps of {n} and {2 * n} runs of {'a 5-per-edge hexagon for 0.2 ms' if args.quick else 'the default experiment'}"
-          f" (v0 from 0.30 m/s), {args.workers} workers; medians of {repeats} alternating repeat(s)"
+          f" (v0 from 0.30 m/s), {workers} worker{'s' * (workers > 1)}; medians of {repeats} alternating repeat(s)"
           f"{'' if args.quick else ', after a warm-up'}")
     run_s = statistics.median(alone)
     print(f"a run, in-process (no executor): {run_s:.2f} s")
@@ -125,7 +126,7 @@ def main() -> None:
     overhead = {}
     for name in executors:
         small, large = (statistics.median(times[name, size]) for size in (n, 2 * n))
-        overhead[name] = (large - small) * args.workers / n - run_s
+        overhead[name] = (large - small) * workers / n - run_s
         print(f"{name:<38} {small:>11.2f} {large:>11.2f} {2 * small - large:>21.2f} {overhead[name]:>21.3f}")
     pool, parsl = overhead.values()
     extra = parsl - pool

@@ -3,9 +3,10 @@
 The quick modes take the full modes' code paths on small packings and few steps (seconds
 each), so that an API change that breaks a benchmark is caught here rather than when
 someone next measures. The paper benchmark resumes the session's ``hexdem paper --quick``
-(tests/test_paper.py) rather than running the two-minute pipeline a second time.
+(tests/test_paper.py) rather than running the pipeline a second time.
 """
 
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -15,7 +16,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 BENCHMARKS = ROOT / "benchmarks"
 sys.path.insert(0, str(BENCHMARKS))
-from baseline import BEFORE  # noqa: E402  (the revision the benchmarks compare with)
+from baseline import BEFORE, KEPT_ENV  # noqa: E402  (the revision the benchmarks compare with)
 #: Words each benchmark's printed table must contain (headers, row names, the target line).
 EXPECTED = {
     "bench_analysis.py": ("beads", "part", "before", "NumPy", "compiled", "before / compiled", "samples", "tracker", "audit",
@@ -62,12 +63,19 @@ def test_every_benchmark_is_checked():
     assert sorted(path.name for path in BENCHMARKS.glob("bench_*.py")) == sorted(EXPECTED)
 
 
+@pytest.fixture(scope="module")
+def baselines(tmp_path_factory):
+    """The environment of the quick runs: the revisions they compare with unpacked once, into one
+    folder that they share (``baseline.KEPT_ENV``)."""
+    return {**os.environ, KEPT_ENV: str(tmp_path_factory.mktemp("baselines"))}
+
+
 @pytest.mark.parametrize("script", [pytest.param(script, marks=SLOW.get(script, ())) for script in sorted(EXPECTED)])
-def test_quick_benchmark_runs(script, request):
+def test_quick_benchmark_runs(script, request, baselines):
     # the paper benchmark reports on the session's quick paper run instead of a second one
     extra = ["--out", str(request.getfixturevalue("paper_quick"))] if script == "bench_paper.py" else []
     done = subprocess.run([sys.executable, str(BENCHMARKS / script), "--quick", *extra], cwd=ROOT, check=False,
-                          capture_output=True, text=True, timeout=180)
+                          capture_output=True, text=True, timeout=180, env=baselines)
     assert done.returncode == 0, f"{script} --quick failed:\n{done.stdout}\n{done.stderr[-3000:]}"
     lines = done.stdout.splitlines()
     assert lines and lines[0].startswith("machine: ") and "cores" in lines[0], done.stdout

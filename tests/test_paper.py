@@ -1,4 +1,4 @@
-"""``hexdem paper --quick``: the whole pipeline once (about two minutes), its report and table
+"""``hexdem paper --quick``: the whole pipeline once (the session's), its report and table
 against the paper and the theory, resuming, and refusals."""
 
 import csv
@@ -12,11 +12,15 @@ import pytest
 from hexdem.cli.main import main
 from hexdem.paper.comparison import COMPARISON_COLUMNS
 from hexdem.paper.disorder_study import STUDY_COLUMNS, change, verdict
-from hexdem.paper.friction_study import EFFECT_COLUMNS, FRICTIONS, arrival_verdict
+from hexdem.paper.friction_study import EFFECT_COLUMNS, arrival_verdict
 from hexdem.paper.published import PUBLISHED
-from hexdem.paper.settings import SIGMA_PER_TOL
+from hexdem.paper.settings import PaperSettings
 from hexdem.theory.outputs import read_sweep_peaks
 from hexdem.theory.scaling import fit_decay
+
+
+#: What the quick run computes: its σ, μ, V₀ and packings.
+QUICK = PaperSettings(quick=True)
 
 
 @pytest.fixture
@@ -72,7 +76,7 @@ def test_the_closest_protocol_refits_to_its_reported_line(quick):
 def test_the_disorder_study_covers_every_strength_and_reaches_a_verdict(quick):
     rows = table(quick / "disorder" / "disorder_study.csv")
     prestressed = {(float(r["sigma_per_tol"]), r["measure"], r["line"]) for r in rows if r["preparation"] == "prestressed"}
-    assert prestressed == {(s, m, line) for s in SIGMA_PER_TOL for m in ("peak", "lead") for line in ("0", "±30")}
+    assert prestressed == {(s, m, line) for s in QUICK.sigma_per_tol for m in ("peak", "lead") for line in ("0", "±30")}
     study = json.loads((quick / "disorder" / "disorder_study.json").read_text())
     assert study["verdict"]["summary"] and study["verdict"]["paper_case"]["sigma_per_tol"] == 6
     report = (quick / "report.md").read_text()
@@ -81,10 +85,12 @@ def test_the_disorder_study_covers_every_strength_and_reaches_a_verdict(quick):
 
 def test_the_prestress_variant_is_free_of_the_compactions_load(quick):
     """Equal beads: the paper's walls keep the 5 N compaction's load, stood-back walls only
-    the weight along the 5° tilt (331 beads × 28.9 g × 0.855 m/s² ≈ 8.2 N, spread over slanted walls)."""
+    the weight along the 5° tilt (3k(k − 1) + 1 beads of k per edge × 28.9 g × 0.855 m/s²: 8.2 N
+    for the experiment's 331, 3.1 N for the quick run's 127, spread over slanted walls)."""
     load = {(float(r["sigma_per_tol"]), r["preparation"]): float(r["wall_force_n"])
             for r in table(quick / "disorder" / "prestress.csv")}
-    weight = 331 * 8000 * math.pi * 0.01905**3 / 6 * 9.80665 * math.sin(math.radians(5))
+    k = QUICK.ensemble_edge_beads
+    weight = (3 * k * (k - 1) + 1) * 8000 * math.pi * 0.01905**3 / 6 * 9.80665 * math.sin(math.radians(5))
     assert load[(0.0, "relaxed")] < 2 * weight < load[(0.0, "prestressed")]
 
 
@@ -116,7 +122,7 @@ def test_every_mpi_job_of_the_paper_went_through_the_launcher(quick):
         assert [job.split()[:2] for job in jobs if f"{quick}/{folder}/" in job] == [["-n", str(ranks)]], folder
     impacts = [job for job in jobs if f"{quick}/disorder/sigma6tol/" in job and "/v0." in job]
     assert impacts and all(job.startswith("-n 1 ") for job in impacts), "the impacts"
-    assert sum("hexdem-scaling-" in job for job in jobs) == 2 * 8, "the V0 sweep"
+    assert sum("hexdem-scaling-" in job for job in jobs) == 2 * QUICK.n_v0, "the V0 sweep"
     decks = [job for job in jobs if job.endswith("-in in.hexdem -log log.lammps -screen none -nocite")]
     assert decks and all(job.startswith("-n 1 ") for job in decks), "the ensembles' preparation"
 
@@ -126,7 +132,7 @@ def test_the_friction_study_covers_every_friction_speed_and_line(quick):
         assert tuple(next(csv.reader(fh))) == EFFECT_COLUMNS
     rows = table(quick / "friction" / "friction_effect.csv")
     keys = {(float(r["friction"]), float(r["v_striker"]), float(r["sigma_tol"]), r["line"]) for r in rows}
-    assert keys == {(mu, v, s, line) for mu in (0.0, *FRICTIONS) for v in (0.25, 0.40, 0.70) for s in (0.0, 6.0)
+    assert keys == {(mu, v, s, line) for mu in (0.0, *QUICK.frictions) for v in (0.25, 0.40, 0.70) for s in (0.0, 6.0)
                     for line in ("0", "±30")} and len(rows) == len(keys)
     study = json.loads((quick / "friction" / "friction_study.json").read_text())
     report = (quick / "report.md").read_text()
@@ -137,8 +143,8 @@ def test_the_friction_study_covers_every_friction_speed_and_line(quick):
 def test_friction_strikes_the_papers_packings_and_only_the_impacts_differ(quick):
     """The frictional ensembles adopt the σ = 6 tol ensemble's settled packings (not prepared
     again) and strike them with nve/sphere."""
-    for mu in FRICTIONS:
-        for k in range(2):
+    for mu in QUICK.frictions:
+        for k in range(QUICK.friction_realizations):
             ours = np.load(quick / "friction" / f"friction{mu:g}" / "realizations" / f"r{k:04d}" / "result.npz")
             paper = np.load(quick / "disorder" / "sigma6tol" / "realizations" / f"r{k:04d}" / "result.npz")
             np.testing.assert_array_equal(ours["positions_m"], paper["positions_m"])
@@ -153,7 +159,7 @@ def test_friction_in_the_ideal_lattice_does_not_depend_on_the_speed(quick):
     and the arrival shifts scale as V^(−1/5)."""
     rows = table(quick / "friction" / "friction_effect.csv")
     ideal = {(float(r["friction"]), float(r["v_striker"]), r["line"]): r for r in rows if float(r["sigma_tol"]) == 0}
-    for mu in FRICTIONS:
+    for mu in QUICK.frictions:
         for line in ("0", "±30"):
             ratios = [float(ideal[mu, v, line]["mean_peak_ratio"]) for v in (0.25, 0.40, 0.70)]
             assert max(ratios) - min(ratios) < 1e-3 * max(ratios)
@@ -161,7 +167,7 @@ def test_friction_in_the_ideal_lattice_does_not_depend_on_the_speed(quick):
             shifts = [float(ideal[mu, v, line]["mean_arrival_shift_us"]) * v ** 0.2 for v in (0.25, 0.40, 0.70)]
             assert max(shifts) - min(shifts) < 1e-2 * max(abs(s) for s in shifts)
     decay = table(quick / "friction" / "friction_decay.csv")
-    for mu in (0.0, *FRICTIONS):
+    for mu in (0.0, *QUICK.frictions):
         for combination in ("0/0", "0/30"):
             rates = [float(r["decay_rate"]) for r in decay if float(r["friction"]) == mu and r["combination"] == combination]
             assert len(rates) == 3 and max(rates) - min(rates) < 1e-3 * max(rates)

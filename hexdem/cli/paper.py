@@ -18,7 +18,8 @@ def add_arguments(parser) -> None:
     parser.add_argument("--workers", type=int, default=min(2, usable_cpus()), metavar="N",
                         help="processes at once: the studies' runs, the MPI ranks of Fig. 4 (default 2)")
     parser.add_argument("--quick", action="store_true",
-                        help="fewer V0 values and realizations, same code paths (about 2 minutes; rough numbers)")
+                        help="fewer V0, realizations, disorders and frictions, smaller packings, same code paths "
+                             "(rough numbers)")
     add_parsl(parser)
     add_launcher(parser, "-n N and each run's job")
     parser.add_argument("--steps-per-contact", type=int, default=STEPS_PER_CONTACT, metavar="N",

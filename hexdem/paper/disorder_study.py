@@ -4,9 +4,9 @@ The paper finds the disordered packings' mean peak speeds above the ideal lattic
 ±30° and below along 0°. hexdem's Sec. VI-A ensembles find both lower. Three things differ
 between a prepared packing and the paper's ideal lattice, and the study separates them:
 
-* **disorder strength**: σ ∈ {0, 1, 2, 3, 6} × tol (:data:`~hexdem.paper.settings.SIGMA_PER_TOL`),
-  the same preparation for each; σ = 0 is the preparation alone (equal beads, one
-  realization: all would be identical);
+* **disorder strength**: σ ∈ {0, 1, 2, 3, 6} × tol (:data:`~hexdem.paper.settings.SIGMA_PER_TOL`;
+  the quick run's fewer), the same preparation for each; σ = 0 is the preparation alone (equal
+  beads, one realization: all would be identical);
 * **prestress**: the walls, placed around the compacted packing, keep part of the 5 N
   compression (:mod:`hexdem.disorder.prestress` measures it); the *relaxed* variant stands
   the walls back by :data:`~hexdem.paper.settings.RELAXED_WALL_SLACK_M` so that only gravity
@@ -35,7 +35,6 @@ from hexdem.paper.settings import (
     CROSSOVER_VELOCITIES_M_S,
     RELAXED_SIGMA_PER_TOL,
     RELAXED_WALL_SLACK_M,
-    SIGMA_PER_TOL,
     STUDY_VELOCITY_M_S,
     PaperSettings,
 )
@@ -73,7 +72,8 @@ class StudyEnsemble:
         disorder = Disorder(PAPER_DIAMETER_M, sigma_m=self.sigma_per_tol * TOLERANCE_M)
         preparation = Preparation(wall_slack_m=RELAXED_WALL_SLACK_M if self.relaxed else 0.0)
         return EnsembleConfig(realizations=1 if self.sigma_per_tol == 0 else settings.realizations,
-                              velocities_m_s=self.velocities_m_s, disorder=disorder, preparation=preparation,
+                              velocities_m_s=self.velocities_m_s, edge_beads=settings.ensemble_edge_beads,
+                              disorder=disorder, preparation=preparation,
                               steps_per_contact=settings.steps_per_contact)
 
 
@@ -81,7 +81,7 @@ def study_ensembles(settings: PaperSettings) -> list[StudyEnsemble]:
     """Every ensemble of the study and of the crossover sweep: the paper's preparation at every σ
     of either, struck at the sweep's three speeds (those of Fig. 9, so σ = 6 tol gives Figs. 8
     and 9), and the relaxed preparation at the study's speed."""
-    sigmas = sorted(set(SIGMA_PER_TOL) | set(settings.crossover_sigma_per_tol))
+    sigmas = sorted(set(settings.sigma_per_tol) | set(settings.crossover_sigma_per_tol))
     ensembles = [StudyEnsemble(s, False, CROSSOVER_VELOCITIES_M_S) for s in sigmas]
     return ensembles + [StudyEnsemble(s, True, (STUDY_VELOCITY_M_S,)) for s in RELAXED_SIGMA_PER_TOL]
 

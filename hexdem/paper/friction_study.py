@@ -1,13 +1,14 @@
 r"""What Mindlin friction and rotation do to the paper's results: the study of ``hexdem paper``.
 
 **Set-up.** The disorder study's (:mod:`hexdem.paper.disorder_study`): the experiment's
-11-per-edge hexagon struck by the steel striker at 0.25, 0.40 and 0.70 m/s, as the ideal
-lattice (σ = 0) and as packings prepared with σ = 6 tol. For each Coulomb μ of
-:data:`FRICTIONS`, the ensemble ``friction/friction<μ>`` is the paper's σ = 6 tol ensemble with
-``friction = μ`` (:class:`~hexdem.disorder.ensemble.EnsembleConfig`), on its first
+11-per-edge hexagon (the quick run's smaller) struck by the steel striker at 0.25, 0.40 and
+0.70 m/s, as the ideal lattice (σ = 0) and as packings prepared with σ = 6 tol. For each Coulomb
+μ of :data:`~hexdem.paper.settings.FRICTIONS` (the quick run's fewer), the ensemble
+``friction/friction<μ>`` is the paper's σ = 6 tol ensemble with ``friction = μ``
+(:class:`~hexdem.disorder.ensemble.EnsembleConfig`), on its first
 :attr:`~hexdem.paper.settings.PaperSettings.friction_realizations` packings. It adopts the
-frictionless ensemble's preparation (:mod:`hexdem.disorder.sharing`), so the very same
-packings are struck with and without friction.
+frictionless ensemble's preparation (:mod:`hexdem.disorder.sharing`), so the very same packings
+are struck with and without friction.
 
 **Measured against μ = 0, on the same packing at the same speed** (``friction_effect.csv``):
 ``mean_peak_ratio`` is the leading pulse's amplitude (:mod:`hexdem.analysis.leading_pulse`)
@@ -43,8 +44,6 @@ from hexdem.paper.disorder_study import FIGURES_ENSEMBLE, MEASURES, StudyEnsembl
 from hexdem.paper.settings import FIG9_VELOCITIES_M_S, STUDY_VELOCITY_M_S, PaperSettings
 from hexdem.theory.scaling import fit_decay
 
-#: Coulomb μ of the study's frictional runs (μ = 0 is the paper's ensemble itself).
-FRICTIONS = (0.1, 0.2, 0.5)
 #: σ / tol of the study's disordered packings: the paper's.
 FRICTION_SIGMA_PER_TOL = 6.0
 #: Columns of ``friction_effect.csv`` (a contract).
@@ -213,7 +212,7 @@ def friction_tables(out: Path, settings: PaperSettings, summaries: dict) -> tupl
     μ = 0's disorder condition is measured on the same packings as theirs, the paper's first."""
     ensembles = {0.0: Ensemble(friction_config(0.0, settings), out / "disorder" / FIGURES_ENSEMBLE)}
     ensembles |= {mu: Ensemble(friction_config(mu, settings), out / "friction" / friction_name(mu))
-                  for mu in FRICTIONS}
+                  for mu in settings.frictions}
     results = {mu: load_results(ensemble) for mu, ensemble in ensembles.items()}
     lattice = ensembles[0.0].ideal
     frictionless = {key: [dict(zip(ENSEMBLE_EFFECT_COLUMNS, row)) for row in disorder_effect(results[0.0], lattice, measure)]

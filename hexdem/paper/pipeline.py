@@ -47,8 +47,8 @@ from hexdem.paper.disorder_study import (
     study_rows,
     verdict,
 )
-from hexdem.paper.friction_study import FRICTIONS, friction_name, run_friction_ensemble
-from hexdem.paper.settings import SIGMA_PER_TOL, PaperSettings
+from hexdem.paper.friction_study import friction_name, run_friction_ensemble
+from hexdem.paper.settings import PaperSettings
 
 SETTINGS_NAME = "paper.json"
 #: Snapshot times of Fig. 4 on the quick run's smaller half-hexagon [ms].
@@ -213,19 +213,19 @@ def _run_parts(settings: PaperSettings, out: Path, parsl) -> tuple[dict, float]:
     parts += [(name, f"ensemble {e.name}", ("scaling",),
                lambda e=e: run_study_ensemble(e, settings, parsl, out / "disorder", scaling_json, ensembles))
               for name, e in zip(ensemble_parts, ensembles)]
-    study_parts = [name for name, e in zip(ensemble_parts, ensembles) if e.sigma_per_tol in SIGMA_PER_TOL]
+    study_parts = [name for name, e in zip(ensemble_parts, ensembles) if e.sigma_per_tol in settings.sigma_per_tol]
     parts.append(("disorder", "disorder study and verdict", tuple(study_parts),
                   lambda: _disorder_summary([summaries[name] for name in study_parts], out)))
     parts.append(("crossover", "disorder crossover sweep", tuple(ensemble_parts),
                   lambda: _crossover([summaries[name] for name in ensemble_parts], out)))
     paper_part = f"disorder-{FIGURES_ENSEMBLE}"
-    friction_parts = [f"friction-{friction_name(mu)}" for mu in FRICTIONS]
+    friction_parts = [f"friction-{friction_name(mu)}" for mu in settings.frictions]
     parts += [(name, f"ensemble with friction μ = {mu:g}", (paper_part,),
                lambda mu=mu: run_friction_ensemble(mu, settings, parsl, out, scaling_json))
-              for name, mu in zip(friction_parts, FRICTIONS)]
+              for name, mu in zip(friction_parts, settings.frictions)]
     parts.append(("friction", "friction and rotation study", (paper_part, *friction_parts),
                   lambda: _friction_summary(settings, {mu: summaries[name] for name, mu in
-                                                       zip(friction_parts, FRICTIONS)}, out)))
+                                                       zip(friction_parts, settings.frictions)}, out)))
     summaries: dict = {}
     computed: set = set()
     bar = progress_bar(len(parts), "hexdem paper", unit="part")
