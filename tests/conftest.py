@@ -22,7 +22,7 @@ D, V0 = 0.01905, 0.4
 
 @pytest.hookimpl(tryfirst=True)  # before pytest-xdist's own, which reads the groups
 def pytest_collection_modifyitems(items):
-    """Every test that needs the session's ``hexdem paper --quick`` (two minutes) is ``slow``. Under
+    """Every test that needs the session's ``hexdem paper --quick`` (a minute or more) is ``slow``. Under
     ``pytest -n N --dist loadgroup`` (pytest-xdist, as CI runs the suite) those tests share one
     worker, which runs the paper once (a test that asks for the paper as it runs carries the
     ``paper_quick`` group itself); the tests of a file that share a module's fixture (a docs build,
@@ -77,7 +77,7 @@ def launcher(tmp_path_factory):
 
 @pytest.fixture(scope="session")
 def paper_quick(tmp_path_factory, launcher):
-    """``hexdem paper --quick --launcher`` once per session (about two minutes): its output
+    """``hexdem paper --quick --launcher`` once per session (about a minute alone): its output
     directory. Every MPI job it started is in the launcher's log, which the session's other tests
     share: the paper's own jobs are also kept beside the output, in ``launched.log``."""
     from hexdem.cli.main import main
