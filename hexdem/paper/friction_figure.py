@@ -27,8 +27,8 @@ def _against_mu(ax, rows, column: int, sigma_tol: float, style: str) -> None:
                         color=COLOURS[line], capsize=2, label=f"{line}°, {v:.2f} m/s" if sigma_tol == 0 else None)
 
 
-def friction_figure(rows: list[tuple], decay: list[tuple], conditions: list[dict], path) -> None:
-    """(a) leading-pulse amplitude and (b) arrival shift against μ, over the frictionless run of
+def friction_figure(rows: list[tuple], decay: list[tuple], conditions: list[dict], edge_beads: int, path) -> None:
+    """On the hexagon of ``edge_beads`` per edge: (a) leading-pulse amplitude and (b) arrival shift against μ, over the frictionless run of
     the same packing (solid: ideal lattice, dashed: σ = 6 tol, mean ± 2 SEM); (c) Sec. V's decay
     rate c over its frictionless value; (d) the disorder study with friction: disordered /
     ideal transmission at σ = 6 tol (mean ± 2 SEM), above 1 where disorder helps."""
@@ -68,5 +68,5 @@ def friction_figure(rows: list[tuple], decay: list[tuple], conditions: list[dict
     for ax in axes.flat:
         ax.set_xlabel(r"Coulomb friction $\mu$")
         ax.grid(True, alpha=0.3)
-    fig.suptitle("Mindlin friction and rotation in the experiment's hexagon, against the frictionless spheres")
+    fig.suptitle(f"Mindlin friction and rotation in the hexagon of {edge_beads} per edge, against the frictionless spheres")
     plots.save(fig, path)

@@ -155,7 +155,7 @@ def _friction_summary(settings: PaperSettings, summaries: dict, out: Path) -> di
     folder = out / "friction"
     write_csv(folder / "friction_effect.csv", EFFECT_COLUMNS, rows)
     write_csv(folder / "friction_decay.csv", DECAY_COLUMNS, decay)
-    friction_figure(rows, decay, conditions, folder / "friction_effect.png")
+    friction_figure(rows, decay, conditions, settings.ensemble_edge_beads, folder / "friction_effect.png")
     result = {"rows": [dict(zip(EFFECT_COLUMNS, row)) for row in rows],
               "decay": [dict(zip(DECAY_COLUMNS, row)) for row in decay], "disorder": conditions,
               "realizations": settings.friction_realizations, "paper_realizations": settings.realizations,
