@@ -28,10 +28,11 @@ def _against_mu(ax, rows, column: int, sigma_tol: float, style: str) -> None:
 
 
 def friction_figure(rows: list[tuple], decay: list[tuple], conditions: list[dict], edge_beads: int, path) -> None:
-    """On the hexagon of ``edge_beads`` per edge: (a) leading-pulse amplitude and (b) arrival shift against μ, over the frictionless run of
-    the same packing (solid: ideal lattice, dashed: σ = 6 tol, mean ± 2 SEM); (c) Sec. V's decay
-    rate c over its frictionless value; (d) the disorder study with friction: disordered /
-    ideal transmission at σ = 6 tol (mean ± 2 SEM), above 1 where disorder helps."""
+    """On the hexagon of ``edge_beads`` per edge: (a) leading-pulse amplitude and (b) arrival
+    shift against μ, over the frictionless run of the same packing (solid: ideal lattice, dashed:
+    σ = 6 tol, mean ± 2 SEM); (c) Sec. V's decay rate c over its frictionless value; (d) the
+    disorder study with friction: disordered / ideal transmission at σ = 6 tol (mean ± 2 SEM),
+    above 1 where disorder helps."""
     from hexdem.analysis import plotting as plots
 
     fig, axes = plots.subplots(2, 2, figsize=(11, 8.5), layout="constrained")
