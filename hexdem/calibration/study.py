@@ -125,7 +125,7 @@ def calibrate(calibration: Calibration, measured, out, workers: int = 1, parsl=N
     problem, seed = calibration.problem, calibration.seed
     dimension = len(problem.priors)
     started = time.perf_counter()
-    with locked_directory(out, "another hexdem calibrate"), holding(parsl):
+    with locked_directory(out, "another hexdem calibrate"), holding(parsl, workers):
         keep_plan(out / PLAN_NAME, _plan(calibration, measured), "calibration")
         points, observables, failed, index, fit = np.empty((0, dimension)), None, 0, 0, None
         step_check, model_error = None, None

@@ -87,7 +87,7 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
     laws = fitted_laws(scaling_json, config.disorder.diameter_m) if scaling_json else {}
     out = ensure_writable_dir(out)
     ensemble = Ensemble(config, out)
-    with locked_directory(out, "another hexdem ensemble (or its LAMMPS is still shutting down)"), holding(parsl):
+    with locked_directory(out, "another hexdem ensemble (or its LAMMPS is still shutting down)"), holding(parsl, workers):
         manifest = _check_manifest(out, config)
         for leftover in list(out.rglob(".*.part")):  # atomic writes and copies cut short by a killed run
             if leftover.is_dir():

@@ -4,7 +4,9 @@ Every study (``hexdem sweep``, ``hexdem ensemble``'s impacts, ``hexdem scaling``
 ``hexdem paper``'s parts) hands each of its runs, one task each, to a
 :class:`concurrent.futures.Executor` that :func:`study_executor` opens:
 
-* by default a :class:`LocalPool` of ``workers`` spawned processes on this machine;
+* by default a :class:`LocalPool` of ``workers`` spawned processes on this machine, one for
+  all the studies that run while a command holds it (:func:`holding`), so that a command of
+  many phases (``hexdem paper``: three for each of its ensembles) starts its workers once;
 * with ``parsl`` (a :class:`ParslSession` of a Parsl configuration file that defines ``config``,
   a :class:`parsl.config.Config`) Parsl's DataFlowKernel of that configuration, behind
   :class:`ParslExecutor`, whose ``submit`` returns Parsl's AppFutures (they are
@@ -27,7 +29,7 @@ import signal
 import sys
 from concurrent.futures import FIRST_COMPLETED, Executor, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
-from contextlib import contextmanager, nullcontext
+from contextlib import contextmanager
 from multiprocessing import get_context
 from pathlib import Path
 
@@ -217,10 +219,33 @@ def parsl_session(parsl, folder=None) -> ParslSession | None:
     return ParslSession(parsl, folder)
 
 
-def holding(parsl: ParslSession | None):
-    """The context a study runs in: the session ``parsl`` held (see :class:`ParslSession`), or
-    nothing without Parsl."""
-    return nullcontext() if parsl is None else parsl
+#: The :class:`LocalPool` that the studies share while a command holds it (:func:`holding`).
+_held_pool: LocalPool | None = None
+
+
+@contextmanager
+def holding(parsl: ParslSession | None, workers: int = 1):
+    """The context a study runs in: the session ``parsl`` held (see :class:`ParslSession`), or,
+    without Parsl, a :class:`LocalPool` of ``workers`` processes that every study inside takes
+    (:func:`study_executor`); held again inside, the outermost pool stays. Leaving the outermost
+    ``with`` shuts the pool down; SIGTERM or SIGINT inside stops its workers first."""
+    global _held_pool
+    if parsl is not None:
+        with parsl:
+            yield
+        return
+    if _held_pool is not None:
+        yield
+        return
+    _held_pool = LocalPool(workers)
+    try:
+        yield
+    except KeyboardInterrupt:  # the command was stopped (hexdem.common.interrupt): its runs stop too
+        _held_pool.stop()
+        raise
+    finally:
+        pool, _held_pool = _held_pool, None
+        pool.shutdown(cancel_futures=True)
 
 
 def check_study_options(workers: int = 1, launcher: str | None = None, ranks: int | None = None) -> None:
@@ -236,9 +261,13 @@ def check_study_options(workers: int = 1, launcher: str | None = None, ranks: in
 @contextmanager
 def study_executor(workers: int, parsl: ParslSession | None = None):
     """The executor of a study's runs: the Parsl executor of the session ``parsl`` (shut down with
-    the session), else a :class:`LocalPool` of ``workers`` processes, shut down on leaving."""
+    the session), else the command's held :class:`LocalPool` (:func:`holding`), else a
+    :class:`LocalPool` of ``workers`` processes, shut down on leaving."""
     if parsl is not None:
         yield parsl.executor()
+        return
+    if _held_pool is not None:
+        yield _held_pool
         return
     pool = LocalPool(workers)
     try:

@@ -135,7 +135,7 @@ def run_study(out: Path, runs: list[SweepRun], workers: int = 1, parsl=None, ran
     its :class:`~hexdem.experiments.executors.ParslSession`."""
     log = log or _log
     parsl = parsl_session(parsl, out)
-    with locked_directory(out, "another hexdem sweep"), holding(parsl):
+    with locked_directory(out, "another hexdem sweep"), holding(parsl, workers):
         for leftover in (out / RUNS_NAME).glob(".*.part"):
             shutil.rmtree(leftover, ignore_errors=True)
         todo = [run for run in runs if not run_dir(out, run).is_dir()]

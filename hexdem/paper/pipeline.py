@@ -188,7 +188,7 @@ def run_paper(settings: PaperSettings, out, log=None) -> dict:
     log = log or (lambda message: print(f"hexdem paper: {message}", file=sys.stderr, flush=True))
     parsl = parsl_session(settings.parsl, out)
     out = ensure_writable_dir(out)
-    with locked_directory(out, "another hexdem paper"), holding(parsl):
+    with locked_directory(out, "another hexdem paper"), holding(parsl, settings.workers):
         _check_settings(out, settings)
         summaries, wall_time_s = _run_parts(settings, out, parsl)
     log(f"report in {out / 'report.html'} ({wall_time_s:.0f} s)")

@@ -186,7 +186,7 @@ def run_sweep(settings: SweepSettings, log=None, parsl=None) -> Sweep:
     sweep, start = Sweep(settings), time.perf_counter()
     where = f"on Parsl ({settings.parsl})" if settings.parsl is not None else f"{settings.workers} workers"
     log(f"{len(jobs)} runs ({settings.engine}, hexagon {settings.hexagon_edge} per edge, no walls, {where})")
-    with holding(parsl):
+    with holding(parsl, settings.workers):
         for done, (key, result) in enumerate(_results(settings, jobs, parsl), 1):
             sweep.runs[key] = result
             log(f"[{done}/{len(jobs)}] strike {result.strike_deg:g} deg, V0 = {result.v0:.4g}: "
