@@ -301,6 +301,26 @@ def test_studies_inside_a_commands_parsl_session_share_its_parsl(tmp_path):
     assert session._executor is None  # a closed session cannot hand out its cleaned-up Parsl again
 
 
+def test_studies_inside_a_commands_hold_share_its_local_pools_workers():
+    """Without Parsl, a command holds one local pool around its studies (hexdem paper: three phases
+    for each ensemble): every phase's tasks go to the same worker processes, which end with the
+    outermost hold, and a phase outside any hold starts a pool of its own."""
+    import os
+
+    from hexdem.experiments.executors import holding, study_executor
+
+    with holding(None, 1):
+        pids = []
+        for phase in range(3):
+            with holding(None, 2), study_executor(1) as executor:
+                pids.append(executor.submit(os.getpid).result())
+        assert len(set(pids)) == 1 and pids[0] != os.getpid()
+        worker = psutil.Process(pids[0])
+    assert not worker.is_running() or worker.status() == psutil.STATUS_ZOMBIE
+    with study_executor(1) as alone:
+        assert alone.submit(os.getpid).result() != pids[0]
+
+
 @pytest.mark.parametrize("wait, calls", [(True, ["wait_for_current_tasks", "cleanup"]), (False, ["cleanup"])])
 def test_the_parsl_executors_shutdown_waits_for_its_tasks_only_when_asked(wait, calls):
     from hexdem.experiments.executors import ParslExecutor
