@@ -12,13 +12,14 @@ from hexdem.cli.main import main
 from hexdem.engines.lammps.engine import LammpsEngine
 from hexdem.engines.reference.engine import PARAMETERS_NAME, ReferenceEngine
 from hexdem.errors import HexdemError
-from hexdem.experiments.compare import (COMPARE_COLUMNS, MARGIN, Tolerances, compare_analyses, expected_error,
-                                         run_comparison)
+from hexdem.experiments.compare import (COMPARE_COLUMNS, ENGINE_NAMES, MARGIN, Tolerances, compare_analyses,
+                                         expected_error, run_comparison)
 from hexdem.experiments.convergence import CHAIN
 from hexdem.experiments.run import RESULT_FILES, simulate
 from hexdem.model.config import STEPS_PER_CONTACT, RunConfig
 from hexdem.model.granular import RunSettings
 from hexdem.model.model_builder import build_model
+from hexdem.model.unused_keys import on_engine
 
 SMALL = RunConfig(edge_beads=4)
 
@@ -63,14 +64,13 @@ def test_reference_agrees_with_lammps_on_the_default_experiment(default_run, tmp
                               "glass-intruders-ptfe-striker", "listed-sites", "double-strike", "flat-striker",
                               "precompressed-interior-impact"])
 def test_engines_agree_on_small_lattices(tmp_path, changes):
+    """The engines' analyses compared as ``hexdem compare`` compares them (its files are the CLI
+    test's)."""
     config = SMALL.replace(**changes) if "shape" not in changes else RunConfig(**changes)  # edge_beads: a hexagon's
-    comparison = run_comparison(config, tmp_path, log=lambda message: None)
+    lammps, reference = (simulate(on_engine(config, name), tmp_path / name) for name in ENGINE_NAMES)
+    comparison = compare_analyses(lammps, reference, lammps.v0)
     assert comparison.agree, comparison.verdict()
     assert comparison.n_checked > 10
-    header, rows = read_csv(tmp_path / "compare.csv")
-    assert header == COMPARE_COLUMNS and len(rows) == len(comparison.rows)
-    assert json.loads((tmp_path / "compare.json").read_text())["agree"] is True
-    assert (tmp_path / "compare.png").stat().st_size > 0
 
 
 def test_engines_agree_with_per_bead_diameters(tmp_path):
@@ -189,6 +189,10 @@ def test_compare_cli_reports_agreement_and_fails_on_disagreement(tmp_path, small
     assert "engines agree" in capsys.readouterr().out
     assert {p.name for p in (tmp_path / "ok").iterdir()} == {"compare.csv", "compare.json", "compare.png",
                                                            "lammps", "reference"}
+    header, rows = read_csv(tmp_path / "ok" / "compare.csv")
+    summary = json.loads((tmp_path / "ok" / "compare.json").read_text())
+    assert header == COMPARE_COLUMNS and summary["agree"] is True
+    assert len(rows) >= summary["beads_checked"] > 10 and (tmp_path / "ok" / "compare.png").stat().st_size > 0
     assert main(["compare", "--config", str(small_toml), "--out", str(tmp_path / "strict"),
                  "--peak-tol", "1e-15"]) == 3
     error = capsys.readouterr().err.strip().splitlines()[-1]

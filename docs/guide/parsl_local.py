@@ -21,4 +21,7 @@ config = Config(
         provider=LocalProvider(init_blocks=1, min_blocks=1, max_blocks=1),
     )],
     retries=1,  # each run is tried up to twice
+    # Parsl starts the block at its strategy's first look: after half a second
+    # rather than its default 5 s
+    strategy_period=0.5,
 )
