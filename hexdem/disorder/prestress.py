@@ -15,7 +15,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from hexdem.model.granular import GranularModel
 
@@ -29,6 +28,8 @@ ROUND_OFF = 1e-10
 
 def touching_pairs(positions_m, diameters_m):
     """(i, j, overlap δ [m]) of every pair of beads that overlap by more than round-off."""
+    from scipy.spatial import cKDTree  # here: an impact's process imports this module and need not load scipy
+
     positions_m, radii = np.asarray(positions_m, float), np.asarray(diameters_m, float) / 2
     pairs = cKDTree(positions_m).query_pairs(2 * radii.max(), output_type="ndarray")
     i, j = pairs.T

@@ -47,7 +47,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import curve_fit
 
 from hexdem.errors import HexdemError
 
@@ -144,6 +143,8 @@ def fit_decay(n, v, start: int, last: int, kind: str = "loglinear", anchored: bo
     covariance = residual @ residual / (len(k) - design.shape[1]) * np.linalg.inv(design.T @ design)
     c, c_err = math.exp(coefficients[0]), math.exp(coefficients[0]) * math.sqrt(covariance[0, 0])
     if kind == "nonlinear":
+        from scipy.optimize import curve_fit  # here: a sweep's run imports this module and need not load scipy
+
         if anchored:
             popt, pcov = curve_fit(lambda kk, cc: anchor * cc**kk, k.astype(float), vk, p0=[c])
         else:
