@@ -237,14 +237,24 @@ def holding(parsl: ParslSession | None, workers: int = 1):
     if _held_pool is not None:
         yield
         return
-    _held_pool = LocalPool(workers)
+    with _local_pool(workers) as _held_pool:
+        try:
+            yield
+        finally:
+            _held_pool = None
+
+
+@contextmanager
+def _local_pool(workers: int):
+    """A :class:`LocalPool` of ``workers`` processes, shut down on leaving; SIGTERM or SIGINT
+    inside (:mod:`hexdem.common.interrupt`) stops its workers first, so that its runs stop too."""
+    pool = LocalPool(workers)
     try:
-        yield
-    except KeyboardInterrupt:  # the command was stopped (hexdem.common.interrupt): its runs stop too
-        _held_pool.stop()
+        yield pool
+    except KeyboardInterrupt:
+        pool.stop()
         raise
     finally:
-        pool, _held_pool = _held_pool, None
         pool.shutdown(cancel_futures=True)
 
 
@@ -269,14 +279,8 @@ def study_executor(workers: int, parsl: ParslSession | None = None):
     if _held_pool is not None:
         yield _held_pool
         return
-    pool = LocalPool(workers)
-    try:
+    with _local_pool(workers) as pool:
         yield pool
-    except KeyboardInterrupt:  # the study was stopped (hexdem.common.interrupt): its runs stop too
-        pool.stop()
-        raise
-    finally:
-        pool.shutdown(cancel_futures=True)
 
 
 def tasks_failed(message: str, errors) -> HexdemError:
