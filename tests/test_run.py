@@ -113,7 +113,7 @@ def _assert_same_tables(one, many) -> None:
 
 @pytest.fixture
 def more_ranks_than_cores(monkeypatch):
-    """Eight ranks on a machine of fewer cores (CI's has 2): MPICH's ranks wait for each other in a
+    """More ranks than the machine has cores (4 or 8 on CI's 2): MPICH's ranks wait for each other in a
     busy loop that takes the cores from the ranks that have work, and from the suite's other
     worker (three times the CPU of the same run alone). Its heavy yield, a sleep between polls,
     gives them back; the ranks compute the same numbers."""
