@@ -2,6 +2,8 @@
 session, tiny packings for two-body collisions, and a weakly disordered model."""
 
 import csv
+import os
+import sys
 
 import numpy as np
 import pytest
@@ -18,6 +20,12 @@ from hexdem.model.run_settings import contact_time_s, run_settings
 from hexdem.model.triangular import hexagon
 
 D, V0 = 0.01905, 0.4
+
+# The suite's processes keep the bytecode they compile, as Python does by default: in an environment
+# that turns that off (PYTHONDONTWRITEBYTECODE), each of the hundreds of processes the suite starts
+# (CLI runs, MPI ranks, pool workers) would compile hexdem's modules again.
+os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
+sys.dont_write_bytecode = False
 
 
 @pytest.hookimpl(tryfirst=True)  # before pytest-xdist's own, which reads the groups
