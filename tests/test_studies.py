@@ -5,7 +5,6 @@ recorded and the others finish; runs of two ranks each; one run at a time of a p
 once a command, an ensemble's phases sharing the one Parsl it starts."""
 
 import json
-import shutil
 import threading
 import time
 from pathlib import Path
@@ -94,22 +93,6 @@ def test_parsl_survives_a_killed_worker_with_the_serial_sweeps_runs(serial, tmp_
         assert json.loads(summary.read_text())["provenance"]["command"][:2] == ["hexdem", "sweep"], summary
 
 
-def test_a_failed_run_is_recorded_and_the_others_finish(tmp_path, capsys):
-    """dt = 3.5e-6 s passes the plan (under the contact time / 20) but its energy drift does not:
-    retried as Parsl's config says, recorded, named at the end; a rerun runs only that one."""
-    out = tmp_path / "out"
-    options = ["--vary", "dt=1e-7,3.5e-6", "--out", str(out)]
-    assert sweep(tmp_path, *options, "--parsl", parsl_config(tmp_path)) == 4  # runs of the study failed
-    error = capsys.readouterr().err
-    assert "run dt=3.5e-6 failed: energy drift" in error
-    assert "1 of 2 runs did not finish: 1 failed (dt=3.5e-6)" in error.strip().splitlines()[-1]
-    header, rows = read_csv(out / "sweep.csv")
-    assert [(row["status"], row["error"][:12]) for row in rows] == [("done", ""), ("failed", "energy drift")]
-    assert (out / "runs" / "dt=1e-7" / "peaks.csv").exists()
-    assert not (out / "runs" / "dt=3.5e-6").exists() and not list((out / "runs").glob(".*"))
-    assert "energy drift" in (out / "runs" / "dt=3.5e-6.failed").read_text()
-    assert sweep(tmp_path, *options, "--workers", "2") == 4
-    assert "2 runs (1 done before), 1 at once" in capsys.readouterr().err
 
 
 def test_runs_of_two_ranks_each(serial, tmp_path, launcher):
@@ -164,7 +147,8 @@ def test_a_failed_runs_tries_keep_one_deck_which_its_error_names(tmp_path, capsy
     monkeypatch.setenv("TMPDIR", str(scratch))  # the pool's workers, spawned, read it
     monkeypatch.setattr(tempfile, "tempdir", None)
     out = tmp_path / "out"
-    assert sweep(tmp_path, "--vary", "dt=3.5e-6", "--out", str(out)) == 4
+    assert sweep(tmp_path, "--vary", "dt=3.5e-6", "--out", str(out), "--workers", "2") == 4
+    assert "1 runs (0 done before), 1 at once" in capsys.readouterr().err  # no more workers than runs
     (kept,) = scratch.glob("hexdem-failed-*")
     assert f"{kept / 'deck'}" in (out / "runs" / "dt=3.5e-6.failed").read_text()
     assert (kept / "deck" / "in.hexdem").exists()
@@ -257,17 +241,28 @@ def traced_parsl_config(tmp_path):
     return str(path), tmp_path / "loaded.log"
 
 
-def test_a_sweeps_parsl_file_runs_once_a_command(tmp_path):
-    """A --parsl file is Python with whatever effects its author gave it: a sweep, planned or
-    resumed, runs it once, its check and its runs together."""
+def test_a_failed_run_is_recorded_and_the_others_finish(tmp_path, capsys):
+    """dt = 3.5e-6 s passes the plan (under the contact time / 20) but its energy drift does not:
+    retried as Parsl's config says, recorded, named at the end; a rerun runs only that one. A
+    --parsl file is Python with whatever effects its author gave it: a sweep, planned or resumed,
+    runs it once, its check and its runs together."""
     path, trace = traced_parsl_config(tmp_path)
     out = tmp_path / "out"
-    assert sweep(tmp_path, "--vary", "v0=0.2,0.3", "--out", str(out), "--parsl", path) == 0
+    assert sweep(tmp_path, "--vary", "dt=1e-7,3.5e-6", "--out", str(out), "--parsl", path) == 4  # a run failed
     assert trace.read_text() == "loaded\n"
-    shutil.rmtree(out / "runs" / "v0=0.3")
-    assert main(["sweep", str(out), "--parsl", path]) == 0
+    error = capsys.readouterr().err
+    assert "run dt=3.5e-6 failed: energy drift" in error
+    assert "1 of 2 runs did not finish: 1 failed (dt=3.5e-6)" in error.strip().splitlines()[-1]
+    header, rows = read_csv(out / "sweep.csv")
+    assert [(row["status"], row["error"][:12]) for row in rows] == [("done", ""), ("failed", "energy drift")]
+    assert (out / "runs" / "dt=1e-7" / "peaks.csv").exists()
+    assert not (out / "runs" / "dt=3.5e-6").exists() and not list((out / "runs").glob(".*"))
+    assert "energy drift" in (out / "runs" / "dt=3.5e-6.failed").read_text()
+    assert main(["sweep", str(out), "--parsl", path]) == 4
     assert trace.read_text() == "loaded\n" * 2
-    assert (out / "runs" / "v0=0.3" / "peaks.csv").exists()
+    assert "2 runs (1 done before), on Parsl" in capsys.readouterr().err
+    _, rows = read_csv(out / "sweep.csv")
+    assert [row["status"] for row in rows] == ["done", "failed"]
 
 
 def test_an_ensembles_phases_share_one_run_of_its_parsl_file(tmp_path):
