@@ -2,7 +2,7 @@
 this machine survives a worker killed mid-run and gives the serial sweep's runs; a failed run is
 recorded and the others finish; runs of two ranks each; one run at a time of a planned study
 (a job array's task) and the table collected after; bad input in one line; a --parsl file runs
-once a command, an ensemble's phases sharing the one Parsl it starts."""
+once a command, an ensemble's phases sharing the one Parsl that the guide's file starts."""
 
 import json
 import threading
@@ -17,6 +17,8 @@ from hexdem.cli.main import main
 
 #: A 6-per-edge hexagon (91 beads) for 3 ms: about half a second of LAMMPS a run.
 SMALL = "edge_beads = 6\nduration = 3e-3\n"
+#: The one-machine Parsl file that the guide ships.
+SHIPPED_PARSL = Path(__file__).resolve().parents[1] / "docs" / "guide" / "parsl_local.py"
 #: Six runs.
 SIX = ["--vary", "v0=0.2,0.3,0.4", "--vary", "friction=0,0.1"]
 #: Parsl on this machine: one block of two workers, a lost worker noticed within seconds, its
@@ -231,13 +233,13 @@ def test_every_studys_bad_parsl_file_is_refused_before_anything_is_written(tmp_p
     assert not out.exists()
 
 
-def traced_parsl_config(tmp_path):
-    """The local Parsl configuration file, which also appends a line to ``loaded.log`` beside itself
-    each time it runs; (its path, that log)."""
+def traced_parsl_config(tmp_path, text=None):
+    """A Parsl configuration file (``text``; None: this file's local one) that also appends a line to
+    ``loaded.log`` beside itself each time it runs; (its path, that log)."""
     path = Path(parsl_config(tmp_path))
     path.write_text("from pathlib import Path\n"
                     "with open(Path(__file__).with_name('loaded.log'), 'a') as log:\n    log.write('loaded\\n')\n"
-                    + path.read_text())
+                    + (path.read_text() if text is None else text))
     return str(path), tmp_path / "loaded.log"
 
 
@@ -265,15 +267,19 @@ def test_a_failed_run_is_recorded_and_the_others_finish(tmp_path, capsys):
     assert [row["status"] for row in rows] == ["done", "failed"]
 
 
-def test_an_ensembles_phases_share_one_run_of_its_parsl_file(tmp_path):
-    """hexdem ensemble runs its --parsl file once, and its compaction, settling and impacts all
-    run on the one Parsl that the file's configuration starts."""
-    path, trace = traced_parsl_config(tmp_path)
+def test_an_ensemble_on_the_shipped_parsl_file_runs_it_once_with_its_logs_in_the_study(tmp_path, monkeypatch):
+    """docs/guide/parsl_local.py, as a user copies it (here with a line that notes each time it
+    runs): hexdem ensemble runs it once, its compaction, settling and impacts all on the one Parsl
+    that it starts, and Parsl's runinfo/ goes into the ensemble's folder rather than the current
+    directory."""
+    monkeypatch.chdir(tmp_path)
+    path, trace = traced_parsl_config(tmp_path, SHIPPED_PARSL.read_text())
     out = tmp_path / "ensemble"
     assert main(["ensemble", "--out", str(out), "--edge-beads", "4", "--velocities", "0.4", "--realizations", "1",
                  "--parsl", path]) == 0
     assert trace.read_text() == "loaded\n"
     assert (out / "peaks_stats.csv").exists()
+    assert (out / "runinfo").is_dir() and not (tmp_path / "runinfo").exists()
 
 
 def test_studies_inside_a_commands_parsl_session_share_its_parsl(tmp_path):
@@ -348,21 +354,6 @@ def test_a_failed_task_is_submitted_again_as_many_times_as_the_retries_given(ret
     with ThreadPoolExecutor(1) as executor:
         (key, result, error), = run_tasks(executor, {"a": (fails, "a")}, retries)
     assert (key, result, type(error), len(tries)) == ("a", None, ValueError, 1 + retries)
-
-
-def test_the_shipped_one_machine_parsl_file_runs_a_sweep_with_its_logs_in_the_study(tmp_path, monkeypatch):
-    """docs/guide/parsl_local.py, as a user copies it: a sweep on it finishes, and Parsl's
-    runinfo/ goes into the study's folder rather than the current directory."""
-    monkeypatch.chdir(tmp_path)
-    shipped = Path(__file__).resolve().parents[1] / "docs" / "guide" / "parsl_local.py"
-    out = tmp_path / "out"
-    assert sweep(tmp_path, "--vary", "v0=0.2", "--out", str(out), "--parsl", str(shipped)) == 0
-    _, rows = read_csv(out / "sweep.csv")
-    assert [row["status"] for row in rows] == ["done"]
-    assert (out / "runinfo").is_dir() and not (tmp_path / "runinfo").exists()
-    summary = json.loads((out / "runs" / "v0=0.2" / "summary.json").read_text())
-    assert summary["provenance"]["command"] == ["hexdem", "sweep", "--config", str(tmp_path / "base.toml"), "--vary",
-                                                "v0=0.2", "--out", str(out), "--parsl", str(shipped)]
 
 
 def test_two_runs_in_two_threads_of_one_process(serial, tmp_path, monkeypatch):
