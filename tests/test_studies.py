@@ -95,8 +95,6 @@ def test_parsl_survives_a_killed_worker_with_the_serial_sweeps_runs(serial, tmp_
         assert json.loads(summary.read_text())["provenance"]["command"][:2] == ["hexdem", "sweep"], summary
 
 
-
-
 def test_runs_of_two_ranks_each(serial, tmp_path, launcher):
     """--ranks-per-run 2: every run starts its own two ranks (here through a launcher that notes
     them) and gives the serial sweep's one-rank runs' peaks."""
@@ -247,7 +245,7 @@ def test_a_failed_run_is_recorded_and_the_others_finish(tmp_path, capsys):
     """dt = 3.5e-6 s passes the plan (under the contact time / 20) but its energy drift does not:
     retried as Parsl's config says, recorded, named at the end; a rerun runs only that one. A
     --parsl file is Python with whatever effects its author gave it: a sweep, planned or resumed,
-    runs it once, its check and its runs together."""
+    runs it once, its check and its runs together; a run's provenance is the study's command."""
     path, trace = traced_parsl_config(tmp_path)
     out = tmp_path / "out"
     assert sweep(tmp_path, "--vary", "dt=1e-7,3.5e-6", "--out", str(out), "--parsl", path) == 4  # a run failed
@@ -260,6 +258,9 @@ def test_a_failed_run_is_recorded_and_the_others_finish(tmp_path, capsys):
     assert (out / "runs" / "dt=1e-7" / "peaks.csv").exists()
     assert not (out / "runs" / "dt=3.5e-6").exists() and not list((out / "runs").glob(".*"))
     assert "energy drift" in (out / "runs" / "dt=3.5e-6.failed").read_text()
+    summary = json.loads((out / "runs" / "dt=1e-7" / "summary.json").read_text())
+    assert summary["provenance"]["command"] == ["hexdem", "sweep", "--config", str(tmp_path / "base.toml"), "--vary",
+                                                "dt=1e-7,3.5e-6", "--out", str(out), "--parsl", path]
     assert main(["sweep", str(out), "--parsl", path]) == 4
     assert trace.read_text() == "loaded\n" * 2
     assert "2 runs (1 done before), on Parsl" in capsys.readouterr().err
