@@ -33,14 +33,19 @@ def pytest_collection_modifyitems(items):
     """Every test that needs the session's ``hexdem paper --quick`` (a minute or more) is ``slow``. Under
     ``pytest -n N --dist loadgroup`` (pytest-xdist, as CI runs the suite) those tests share one
     worker, which runs the paper once (a test that asks for the paper as it runs carries the
-    ``paper_quick`` group itself); the tests of a file that share a module's fixture (a docs build,
-    a wheel's install) share one worker, which builds it once; every other test goes to whichever
-    worker is free. The longest work goes out first (the slow tests, then the groups, each a
-    worker's for as long as it lasts), so that no worker waits at the end behind a long one."""
+    ``paper_quick`` group itself); the tests that read the default experiment's session runs
+    (``default_run``, ``dumped_run``) share one worker, which runs each once; the tests of a file
+    that share a module's fixture (a docs build, a wheel's install) share one worker, which builds
+    it once; every other test goes to whichever worker is free. The longest work goes out first
+    (the slow tests, then the groups, each a worker's for as long as it lasts), so that no worker
+    waits at the end behind a long one."""
     for item in items:
-        if "paper_quick" in getattr(item, "fixturenames", ()):
+        names = getattr(item, "fixturenames", ())
+        if "paper_quick" in names:
             item.add_marker(pytest.mark.slow)
             item.add_marker(pytest.mark.xdist_group("paper_quick"))
+        elif "default_run" in names or "dumped_run" in names:
+            item.add_marker(pytest.mark.xdist_group("default_experiment"))
         elif item.get_closest_marker("xdist_group") is None and shares_a_module_fixture(item):
             item.add_marker(pytest.mark.xdist_group(item.path.stem))
     items.sort(key=lambda item: (item.get_closest_marker("slow") is None, item.get_closest_marker("xdist_group") is None))
