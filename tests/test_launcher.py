@@ -97,7 +97,7 @@ def test_a_launcher_that_does_not_exist_is_one_line(tmp_path, capfd):
 def test_a_launched_impacts_or_sweep_runs_process_does_not_load_scipy_nor_matplotlib():
     """Every launched rank imports its task's module before it runs: an ensemble's impact
     (``hexdem.disorder.impacts``) and a V0-sweep run (``hexdem.theory.sweep``) load neither SciPy
-    nor matplotlib there (0.3 and 0.5 s of a rank's start), only where a run uses them."""
+    nor matplotlib there, only where a run uses them (the benchmarks page gives what they cost a rank)."""
     import subprocess
     import sys
 

@@ -115,8 +115,8 @@ def _assert_same_tables(one, many) -> None:
 def more_ranks_than_cores(monkeypatch):
     """More ranks than the machine has cores (4 or 8 on CI's 2): MPICH's ranks wait for each other in a
     busy loop that takes the cores from the ranks that have work, and from the suite's other
-    worker (three times the CPU of the same run alone). Its heavy yield, a sleep between polls,
-    gives them back; the ranks compute the same numbers."""
+    worker (measured on the benchmarks page). Its heavy yield, a sleep between polls, gives them
+    back; the ranks compute the same numbers."""
     monkeypatch.setenv("MPIR_CVAR_ENABLE_HEAVY_YIELD", "1")
 
 

@@ -43,10 +43,10 @@ DIRAC_WORKFLOW = WORKFLOW.parent / "dirac_point.py"
 @pytest.mark.slow
 def test_the_dirac_point_workflow_writes_its_tables_within_the_bounds(tmp_path):
     """``--quick`` (20 per edge, σ = 8 d, the small sweep) on one rank from another directory: the
-    contract's files and columns (the dispersion's first six as before, each point's verdict after them), the
-    dispersion within 2 % (median) and every point beyond the resolution limit within its bound,
-    and the ring's growth within 3 % of v_D (measured 0.24 %), the ring opened past 2.5 σ, and the
-    control away from K drifting at its group velocity within 2 % and widening by less than 10 %."""
+    contract's files and columns (the dispersion's first six as before, each point's verdict after
+    them), the dispersion within 2 % (median) and every point beyond the resolution limit within its
+    bound, and the ring's growth within 3 % of v_D, the ring opened past 2.5 σ, and the control away
+    from K drifting at its group velocity within 2 % and widening by less than 10 %."""
     done = subprocess.run([sys.executable, str(DIRAC_WORKFLOW), "--out", str(tmp_path / "out"), "--quick",
                            "--ranks", "1"], cwd=tmp_path, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr
