@@ -63,14 +63,16 @@ def serial(tmp_path_factory):
 
 
 def kill_a_worker_mid_run(out, killed: list) -> None:
-    """Once two runs are done, kill -9 the Parsl worker that has a run's part folder open."""
+    """Once two runs are done, kill -9 the Parsl worker that has a part folder of this sweep's runs
+    open (only this sweep's: the other tests' pools and Parsl workers, running beside it, live on)."""
+    part_folders = f"{out / 'runs'}/."
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline and not killed:
         if len([path for path in (out / "runs").glob("*") if path.is_dir() and not path.name.startswith(".")]) >= 2:
             for process in psutil.process_iter(["cmdline"]):
                 try:
                     if any("spawn_main" in word for word in process.info["cmdline"] or ()) and \
-                            any("/runs/." in f.path for f in process.open_files()):
+                            any(f.path.startswith(part_folders) for f in process.open_files()):
                         process.kill()
                         killed.append(process.pid)
                         return
