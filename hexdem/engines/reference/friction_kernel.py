@@ -202,10 +202,13 @@ def integrate_frictional(k, x, y, u, w, spin, pair_xi, wall_xi, h, n_steps):
     tx, ty, tu, tw, ts = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
     tp, tq = np.zeros(p), np.zeros(m)
     steps, shifts = (0.5 * h, 0.5 * h, h), (0.0, 0.25 * h * h, 0.5 * h * h)
+    # run-time bools: a literal True or False would give _rates a compiled variant of its own for
+    # each, beside the one for the bool that Python's calls of frictional_forces pass
+    capped, free = np.bool_(True), np.bool_(False)
     for step in range(n_steps):
         if stale(k, x, y):
             return step
-        _rates(k, x, y, u, w, spin, pair_xi, wall_xi, True, a[0], ps[0], ws[0])
+        _rates(k, x, y, u, w, spin, pair_xi, wall_xi, capped, a[0], ps[0], ws[0])
         for s in range(3):  # stages 2-4: q + cv v + ca a, and z + cv z' for v, ω and ξ
             cv, ca = steps[s], shifts[s]
             prev = a[s]
@@ -217,7 +220,7 @@ def integrate_frictional(k, x, y, u, w, spin, pair_xi, wall_xi, h, n_steps):
             _shifted(ts, spin, cv, prev[2], 0.0, prev[2])
             _shifted(tp, pair_xi, cv, ps[s], 0.0, ps[s])
             _shifted(tq, wall_xi, cv, ws[s], 0.0, ws[s])
-            _rates(k, tx, ty, tu, tw, ts, tp, tq, False, a[s + 1], ps[s + 1], ws[s + 1])
+            _rates(k, tx, ty, tu, tw, ts, tp, tq, free, a[s + 1], ps[s + 1], ws[s + 1])
         _advance(x, u, h, a[0, 0], a[1, 0], a[2, 0], a[3, 0])
         _advance(y, w, h, a[0, 1], a[1, 1], a[2, 1], a[3, 1])
         _first_order(spin, h, a[0, 2], a[1, 2], a[2, 2], a[3, 2])
