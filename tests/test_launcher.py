@@ -94,14 +94,15 @@ def test_a_launcher_that_does_not_exist_is_one_line(tmp_path, capfd):
     assert not (tmp_path / "out" / "summary.json").exists()
 
 
-def test_a_launched_impacts_or_sweep_runs_process_does_not_load_scipy_nor_matplotlib():
+def test_a_launched_impacts_or_sweep_runs_process_loads_only_what_its_run_uses():
     """Every launched rank imports its task's module before it runs: an ensemble's impact
-    (``hexdem.disorder.impacts``) and a V0-sweep run (``hexdem.theory.sweep``) load neither SciPy
-    nor matplotlib there, only where a run uses them (the benchmarks page gives what they cost a rank)."""
+    (``hexdem.disorder.impacts``) and a V0-sweep run (``hexdem.theory.sweep``) load neither SciPy,
+    matplotlib, tqdm (a progress bar) nor tomllib (a TOML file) there, only where a run uses them
+    (the benchmarks page gives what they cost a rank)."""
     import subprocess
     import sys
 
     code = ("import sys; import hexdem.experiments.parallel, hexdem.disorder.impacts, hexdem.theory.sweep; "
-            "print(sorted({m.split('.')[0] for m in sys.modules} & {'scipy', 'matplotlib'}))")
+            "print(sorted({m.split('.')[0] for m in sys.modules} & {'scipy', 'matplotlib', 'tqdm', 'tomllib'}))")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert done.stdout.strip() == "[]"

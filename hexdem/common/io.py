@@ -9,7 +9,6 @@ import math
 import os
 import shutil
 import tempfile
-import tomllib
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -65,6 +64,8 @@ def read_text(path, what: str) -> str:
 def read_toml(path, what: str = "config") -> dict:
     """The table of the TOML file at ``path``; an unreadable or invalid file is one clear line
     naming it as ``what``."""
+    import tomllib  # here: the MPI ranks and workers, which read no TOML, do not load it
+
     path = Path(path)
     try:
         return tomllib.loads(read_text(path, what))

@@ -11,8 +11,10 @@ from __future__ import annotations
 import os
 import sys
 from contextlib import contextmanager
+from typing import TYPE_CHECKING
 
-from tqdm import tqdm
+if TYPE_CHECKING:
+    from tqdm import tqdm
 
 #: Set (to "1") while bars are silenced; child processes inherit it.
 SILENCE_VARIABLE = "HEXDEM_SILENCE_PROGRESS"
@@ -33,7 +35,10 @@ def silenced():
 
 
 def progress_bar(total: int, description: str, unit: str = "it") -> tqdm:
-    """A tqdm bar on stderr, shown only on a terminal and outside :func:`silenced`."""
+    """A tqdm bar on stderr, shown only on a terminal and outside :func:`silenced`. (tqdm is imported
+    here, on a process's first bar: an MPI rank or a worker that shows none does not load it.)"""
+    from tqdm import tqdm
+
     quiet = os.environ.get(SILENCE_VARIABLE) == "1"
     return tqdm(total=total, desc=description, unit=unit, file=sys.stderr, disable=True if quiet else None,
                 dynamic_ncols=True, leave=False)

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import csv
 import math
-import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +23,8 @@ from hexdem.model.triangular import from_sites
 def _sites_from_file(path: Path) -> list:
     text = read_text(path, "sites_file")
     if path.suffix == ".toml":
+        import tomllib  # here, as in hexdem.common.io.read_toml: the MPI ranks read no TOML
+
         try:
             sites = tomllib.loads(text).get("sites")
         except tomllib.TOMLDecodeError as exc:
