@@ -3,14 +3,17 @@ session, tiny packings for two-body collisions, and a weakly disordered model.""
 
 import csv
 import os
+import subprocess
 import sys
+import tempfile
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from hexdem.analysis.peaks import refine_peak
 from hexdem.analysis.trajectory import TrajectoryRecorder
-from hexdem.experiments.run import run_experiment
+from hexdem.experiments.run import run_experiment, simulate
 from hexdem.model.config import RunConfig
 from hexdem.model.granular import GranularModel, Impact
 from hexdem.model.materials import DELRIN, STEEL_316
@@ -26,6 +29,37 @@ D, V0 = 0.01905, 0.4
 # (CLI runs, MPI ranks, pool workers) would compile hexdem's modules again.
 os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
 sys.dont_write_bytecode = False
+
+#: The controller's compilation of the reference engine's kernels (:func:`pytest_sessionstart`).
+WARM_UP = pytest.StashKey[subprocess.Popen]()
+
+
+def compile_reference_kernels() -> None:
+    """A short run of the reference engine without friction and one with: numba compiles both
+    kernels into its cache, with the argument types that every reference run passes."""
+    with tempfile.TemporaryDirectory() as folder:
+        for friction in (0.0, 0.3):
+            simulate(RunConfig(edge_beads=2, engine="reference", friction=friction, duration=1e-4),
+                     Path(folder) / str(friction))
+
+
+def pytest_sessionstart(session):
+    """Under pytest-xdist the controller, which runs no test, compiles the reference engine's kernels
+    (:func:`compile_reference_kernels`, in a process of its own) while the workers start: in a fresh
+    clone two workers whose first reference runs meet would otherwise each compile the same kernels,
+    seconds of CPU apiece. A run that comes before the cache is written compiles for itself, as
+    without this."""
+    config = session.config
+    if not hasattr(config, "workerinput") and config.getoption("numprocesses", None):
+        config.stash[WARM_UP] = subprocess.Popen(
+            [sys.executable, "-c", "import conftest; conftest.compile_reference_kernels()"],
+            cwd=Path(__file__).parent, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
+def pytest_sessionfinish(session):
+    warm_up = session.config.stash.get(WARM_UP, None)
+    if warm_up is not None:
+        warm_up.wait()
 
 
 @pytest.hookimpl(tryfirst=True)  # before pytest-xdist's own, which reads the groups
