@@ -335,3 +335,72 @@ def test_a_sample_that_reorders_the_bodies_unannounced_is_refused(monkeypatch, c
     swapped[[0, 1]] = swapped[[1, 0]]
     with pytest.raises(HexdemError, match="sample 2 reordered the bodies of rank 0 without saying"):
         tracker(Sample(2, 14, 2e-6, swapped, positions, velocities, migrated=False))
+
+
+def _kernel_calls():
+    """Each kernel's table by name (module.c): a callable taking its arguments by name, a valid set
+    of them (a small rank: 3 rows, 2 of them its own, one pair, one wall of one member), and the
+    names of the arrays the kernel writes."""
+    from hexdem.common import _kernels
+
+    state = PulseState(5, 8, 0.0)
+    pulses = dict(state.kernel_arrays(), q=state.q, rival_ratio=RIVAL_RATIO)
+    sample = {"ids": np.arange(5), "previous_ids": np.arange(5), "velocities": np.ones((5, 2)),
+              "rows": np.arange(5), "end_velocity": np.empty((5, 2)), "speeds": np.empty(5),
+              "complete": np.empty(5, np.int64), "s": 0}
+    rows = {"listed_at": np.zeros((3, 2)), "distance": 0.1, "i": np.array([0]), "j": np.array([1]),
+            "contact_m": np.ones(1), "coefficient": np.ones(1), "region_i": np.zeros(1, np.int64),
+            "region_j": np.zeros(1, np.int64), "masses": np.ones(2), "inertia": np.ones(2),
+            "regions": np.zeros(2, np.int64), "start": np.zeros((2, 2)), "external": np.zeros((2, 2)),
+            "curved": np.zeros(1, np.int64), "bounds": np.array([0, 1]), "points": np.zeros((1, 2)),
+            "lengths": np.ones(1), "rows": np.array([0]), "radii": np.ones(1), "wall_coefficient": np.ones(1),
+            "wall_regions": np.zeros(1, np.int64), "n_regions": 1}
+    part = {"positions": np.zeros((3, 2)), "velocities": np.zeros((2, 2)), "spins": np.zeros(0),
+            "sums": np.empty(5)}
+    full_step = {"masses": np.ones(4), "positions": np.ones((4, 3)), "velocities": np.ones((4, 3)),
+                 "forces": np.ones((4, 3)), "half_dt": 0.5, "x": np.empty((4, 2)), "v": np.empty((4, 2))}
+    pairs = {"positions": np.zeros((3, 2)), "cutoff": 1.0, "i": np.empty(8, np.int64), "j": np.empty(8, np.int64)}
+    pulse_arrays = {name for name, value in pulses.items() if isinstance(value, np.ndarray)}
+    return {
+        "full_step_state": (_kernels.full_step_state, full_step, {"x", "v"}),
+        "pairs_within": (_kernels.pairs_within, pairs, {"i", "j"}),
+        "PulseArrays": (_kernels.PulseArrays, pulses, pulse_arrays),
+        "PulseArrays.sample": (_kernels.PulseArrays(**pulses).sample, sample, {"end_velocity", "speeds", "complete"}),
+        "AuditRows": (_kernels.AuditRows, rows, set()),
+        "AuditRows.part": (_kernels.AuditRows(**rows).part, part, {"sums"}),
+    }
+
+
+def _fresh(arguments: dict) -> dict:
+    return {name: value.copy() if isinstance(value, np.ndarray) else value for name, value in arguments.items()}
+
+
+@pytest.mark.parametrize("kernel", ["full_step_state", "pairs_within", "PulseArrays", "PulseArrays.sample",
+                                    "AuditRows", "AuditRows.part"])
+def test_every_kernel_refuses_a_read_only_output_a_swap_a_missing_and_an_unknown_name(kernel):
+    """Every table of module.c, by name: an array the kernel writes is refused read-only (it would
+    be written behind NumPy's back), one it only reads is taken read-only; two arrays of other
+    types or shapes swapped, a missing name and an unknown one are refused, each naming the
+    argument."""
+    call, arguments, written = _kernel_calls()[kernel]
+    call(**_fresh(arguments))
+    arrays = [name for name, value in arguments.items() if isinstance(value, np.ndarray)]
+    for name in arrays:
+        frozen = _fresh(arguments)
+        frozen[name].flags.writeable = False
+        if name in written:
+            with pytest.raises(TypeError, match=rf"^{kernel}: {name}: not a C-ordered writable array$"):
+                call(**frozen)
+        else:
+            call(**frozen)
+    first = arrays[0]
+    other = next(name for name in arrays if (arguments[name].dtype, arguments[name].shape)
+                 != (arguments[first].dtype, arguments[first].shape))
+    swapped = dict(_fresh(arguments), **{first: arguments[other].copy(), other: arguments[first].copy()})
+    with pytest.raises(TypeError, match=rf"^{kernel}: ({first}|{other}): expected"):
+        call(**swapped)
+    for name in arguments:
+        with pytest.raises(TypeError, match=rf"^{kernel}: missing argument {name}$"):
+            call(**{key: value for key, value in _fresh(arguments).items() if key != name})
+    with pytest.raises(TypeError, match=rf"^{kernel} takes no argument named 'unknown'$"):
+        call(**_fresh(arguments), unknown=np.zeros(1))

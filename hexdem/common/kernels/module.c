@@ -103,13 +103,14 @@ typedef struct {
 enum { P_N, P_CAPACITY, P_IDS, P_PREVIOUS, P_VELOCITIES, P_SPEEDS, P_SIZES };
 _Static_assert(P_SIZES <= MAX_SIZES, "P_SIZES: more than MAX_SIZES");
 static const char *const pulse_sizes[] = {"n", "capacity", "n_ids", "n_previous", "n_velocities", "n_speeds"};
-#define P_STATE(name, kind, member) ARRAY(name, kind, PulseBinding, a.member, SIZE(P_N))
-#define P_ROWS(name, kind, columns, member) ARRAY2(name, kind, PulseBinding, a.member, SIZE(P_N), columns)
+/* The tracker writes every array of its state: each is bound writable, so that a read-only one is refused. */
+#define P_STATE(name, kind, member) OUT(name, kind, PulseBinding, a.member, SIZE(P_N))
+#define P_ROWS(name, kind, columns, member) OUT2(name, kind, PulseBinding, a.member, SIZE(P_N), columns)
 static const Field pulse_fields[] = {
     P_STATE("peak", 'd', peak),
     P_ROWS("rec_value", 'd', SIZE(P_CAPACITY), rec_value),
-    ARRAY2("ring_slots", 'd', PulseBinding, a.ring, FIXED(3), SIZE(P_N)),
-    ARRAY2("velocity_slots", 'd', PulseBinding, a.ring_velocity, FIXED(3), {P_N, 2, 0, EXACT}),
+    OUT2("ring_slots", 'd', PulseBinding, a.ring, FIXED(3), SIZE(P_N)),
+    OUT2("velocity_slots", 'd', PulseBinding, a.ring_velocity, FIXED(3), {P_N, 2, 0, EXACT}),
     P_STATE("peak_index", 'q', peak_index),
     P_ROWS("window", 'd', FIXED(7), window),
     P_STATE("after", 'q', after),
