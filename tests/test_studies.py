@@ -5,6 +5,9 @@ recorded and the others finish; runs of two ranks each; one run at a time of a p
 once a command, an ensemble's phases sharing the one Parsl that the guide's file starts."""
 
 import json
+import signal
+import subprocess
+import sys
 import threading
 import time
 from pathlib import Path
@@ -359,17 +362,26 @@ def test_a_failed_task_is_submitted_again_as_many_times_as_the_retries_given(ret
     assert (key, result, type(error), len(tries)) == ("a", None, ValueError, 1 + retries)
 
 
-def test_two_runs_in_two_threads_of_one_process(serial, tmp_path, monkeypatch):
-    """A Parsl ThreadPoolExecutor runs a sweep's runs in threads of this process: with a relative
-    --out, each run keeps to its own folder (no run changes the process's working directory,
-    which the threads share) and gives the runs of the serial sweep, whose runs were processes."""
-    monkeypatch.chdir(tmp_path)
+def threads_config(tmp_path) -> Path:
+    """Parsl's own default executor, a ThreadPoolExecutor of two threads."""
     threads = tmp_path / "threads.py"
     threads.write_text("from parsl.config import Config\nfrom parsl.executors import ThreadPoolExecutor\n"
-                       "config = Config(executors=[ThreadPoolExecutor(max_threads=2)], "
+                       "config = Config(executors=[ThreadPoolExecutor(label='threads', max_threads=2)], "
                        f"run_dir={str(tmp_path / 'runinfo')!r})\n")
-    assert sweep(tmp_path, "--vary", "v0=0.2,0.3", "--vary", "friction=0", "--out", "out", "--parsl", str(threads)) == 0
-    assert Path.cwd() == tmp_path
+    return threads
+
+
+def test_two_runs_in_two_threads_of_one_process(serial, tmp_path):
+    """``hexdem sweep --parsl`` on a Parsl ThreadPoolExecutor, as a user runs it, runs the sweep's
+    runs in threads of its process: no run installs a signal handler (only the main thread may),
+    with a relative --out each run keeps to its own folder (no run changes the process's working
+    directory, which the threads share), and they give the runs of the serial sweep, whose runs
+    were processes."""
+    (tmp_path / "base.toml").write_text(SMALL)
+    done = subprocess.run([sys.executable, "-m", "hexdem", "sweep", "--config", "base.toml", "--vary", "v0=0.2,0.3",
+                           "--vary", "friction=0", "--out", "out", "--parsl", str(threads_config(tmp_path))],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
     _, rows = read_csv(tmp_path / "out" / "sweep.csv")
     assert [row["status"] for row in rows] == ["done", "done"] and not list((tmp_path / "out" / "runs").glob(".*"))
     ours = peaks_of(tmp_path / "out")
@@ -377,11 +389,30 @@ def test_two_runs_in_two_threads_of_one_process(serial, tmp_path, monkeypatch):
     assert sorted(path.name for path in tmp_path.iterdir()) == ["base.toml", "out", "runinfo", "threads.py"]
 
 
+def test_a_sweep_on_parsls_threads_stopped_mid_run_ends_in_one_line_and_keeps_no_half_run(tmp_path):
+    """SIGTERM to ``hexdem sweep --parsl`` on Parsl's threads while two runs are in flight: the
+    runs in the threads stop at their next sample (the process's stop, which their threads see),
+    their part folders go, and the command ends as a stopped run does, within seconds."""
+    (tmp_path / "base.toml").write_text("edge_beads = 25\nduration = 0.001\n")
+    study = tmp_path / "study"
+    process = subprocess.Popen([sys.executable, "-m", "hexdem", "sweep", "--config", "base.toml",
+                                "--vary", "v0=0.2,0.3,0.4", "--out", str(study), "--parsl", str(threads_config(tmp_path))],
+                               cwd=tmp_path, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    deadline = time.monotonic() + 120
+    while not list((study / "runs").glob(".*.part/.hexdem-run-*/deck/log.lammps")):
+        assert process.poll() is None and time.monotonic() < deadline, process.stderr.read()
+        time.sleep(0.05)
+    start = time.monotonic()
+    process.send_signal(signal.SIGTERM)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 143, err
+    assert err.strip().splitlines()[-1] == "hexdem: interrupted by SIGTERM: the run was stopped and nothing unfinished was kept"
+    assert time.monotonic() - start < 10
+    assert not list((study / "runs").iterdir())
+
+
 def test_the_local_pools_processes_end_with_a_killed_study(tmp_path):
     """A study killed outright leaves no worker behind to go on writing into its folder."""
-    import subprocess
-    import sys
-
     script = tmp_path / "killed.py"
     script.write_text("import os, time\nfrom hexdem.experiments.executors import LocalPool\n"
                       "if __name__ == '__main__':\n    pool = LocalPool(2)\n"

@@ -16,8 +16,8 @@ import argparse
 import importlib
 import sys
 
-from hexdem.cli.version import VersionAction
-from hexdem.common.interrupt import Interrupted, stop_on_signals
+from hexdem.common.interrupt import (Interrupted, ignore_stops, raise_if_stopped, shielded, stop_on_signals,
+                                     stop_received)
 from hexdem.common.process_end import skip_final_collections
 from hexdem.errors import HexdemError, RunFailed
 
@@ -51,6 +51,8 @@ COMMANDS = {
 
 def build_parser(argv) -> argparse.ArgumentParser:
     """The parser, with full options only for the subcommand named in ``argv``."""
+    from hexdem.cli.version import VersionAction  # here, so that the command catches its signals at once
+
     wanted = next((token for token in argv if token in COMMANDS), None)
     parser = argparse.ArgumentParser(prog="hexdem", description="Impulses in 2D hexagonal granular crystals.")
     parser.add_argument("--version", action=VersionAction)
@@ -72,37 +74,49 @@ def exit_status(error: HexdemError) -> int:
     return FAILED if isinstance(error, RunFailed) else REFUSED
 
 
+@shielded
 def main(argv=None) -> int:
-    from hexdem.experiments.provenance import running_command
-
     command = list(sys.argv) if argv is None else ["hexdem", *argv]
     argv = command[1:]
-    parser = build_parser(argv)
-    args, unknown = parser.parse_known_args(argv)
-    if unknown:  # after the command's name, an unknown option is refused with the command's usage
-        after = argv.index(unknown[0]) > argv.index(args.command)
-        (args._parser if after else parser).error(f"unrecognized arguments: {' '.join(unknown)}")
     try:
+        from hexdem.experiments.provenance import running_command
+
+        parser = build_parser(argv)
+        args, unknown = parser.parse_known_args(argv)
+        if unknown:  # after the command's name, an unknown option is refused with the command's usage
+            after = argv.index(unknown[0]) > argv.index(args.command)
+            (args._parser if after else parser).error(f"unrecognized arguments: {' '.join(unknown)}")
+        raise_if_stopped()  # a stop that arrived while the command's modules loaded
         with running_command(command):
             args._module.run(args)
     except HexdemError as exc:
-        if args.traceback:
+        if stop_received() is not None:  # what failed was ended by the stop (a Ctrl-C that reached the ranks too)
+            return interrupted(Interrupted(stop_received()))
+        if "--traceback" in argv:
             raise
         print(f"hexdem: error: {exc}", file=sys.stderr)
         return exit_status(exc)
     except KeyboardInterrupt as exc:
-        signal = exc.name if isinstance(exc, Interrupted) else "SIGINT"
-        print(f"hexdem: interrupted by {signal}: the run was stopped and nothing unfinished was kept", file=sys.stderr)
-        return exc.exit_status if isinstance(exc, Interrupted) else INTERRUPTED
+        return interrupted(exc)
     return 0
 
 
+@shielded
+def interrupted(stop: KeyboardInterrupt) -> int:
+    """Say in one line that the command was stopped by ``stop``; return its exit status."""
+    signal = stop.name if isinstance(stop, Interrupted) else "SIGINT"
+    print(f"hexdem: interrupted by {signal}: the run was stopped and nothing unfinished was kept", file=sys.stderr)
+    return stop.exit_status if isinstance(stop, Interrupted) else INTERRUPTED
+
+
+@shielded
 def command() -> int:
     """The ``hexdem`` command: :func:`main` in a process that ends with it (see
     :mod:`hexdem.common.process_end`) and that SIGTERM and SIGINT stop
-    (:mod:`hexdem.common.interrupt`)."""
+    (:mod:`hexdem.common.interrupt`) until its work has ended."""
     stop_on_signals()
     code = main()
+    ignore_stops()
     skip_final_collections()
     return code
 

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from hexdem.common.interrupt import deferred_signals
 from hexdem.errors import HexdemError
 
 
@@ -142,7 +143,8 @@ def staged_directory(out, prefix: str = ".hexdem-staging-"):
     """Yield a fresh hidden folder inside ``out`` (created if needed) to write results into. When
     the block succeeds, its entries move into ``out``, each replacing an older one of its name; when
     it fails, the folder is removed, and so is ``out`` if this created it and it is empty: a failed
-    run leaves nothing in ``out``."""
+    run leaves nothing in ``out``. A stop (SIGTERM, SIGINT) during the moves is raised after the
+    last (:mod:`hexdem.common.interrupt`): the result is published whole or not at all."""
     out = Path(out)
     created = not out.exists()
     out = ensure_writable_dir(out)
@@ -154,12 +156,13 @@ def staged_directory(out, prefix: str = ".hexdem-staging-"):
         if created and not any(out.iterdir()):
             out.rmdir()
         raise
-    for entry in sorted(staging.iterdir()):
-        target = out / entry.name
-        if target.is_dir() and not target.is_symlink():
-            shutil.rmtree(target)
-        entry.replace(target)
-    staging.rmdir()
+    with deferred_signals():  # a stop waits for the last move: no half of a result is published
+        for entry in sorted(staging.iterdir()):
+            target = out / entry.name
+            if target.is_dir() and not target.is_symlink():
+                shutil.rmtree(target)
+            entry.replace(target)
+        staging.rmdir()
 
 
 def ensure_writable_dir(directory) -> Path:

@@ -12,8 +12,12 @@ from __future__ import annotations
 import importlib
 import threading
 
+from hexdem.common.interrupt import WAIT_S, raise_if_stopped
+
 #: The loading threads started and not yet joined.
 _LOADING: list[threading.Thread] = []
+#: Guards :data:`_LOADING`, which the runs in several threads of one process share.
+_LOADING_LOCK = threading.Lock()
 
 
 def load_in_background(*modules: str) -> None:
@@ -30,12 +34,20 @@ def load_in_background(*modules: str) -> None:
                 return
 
     thread = threading.Thread(target=load, daemon=True)
-    _LOADING.append(thread)
+    with _LOADING_LOCK:
+        _LOADING.append(thread)
     thread.start()
 
 
 def finish_background_loading() -> None:
     """Wait until every module asked of :func:`load_in_background` has loaded (or failed to): a
-    process forked while another thread imports would hold that import's lock forever."""
-    while _LOADING:
-        _LOADING.pop().join()
+    process forked while another thread imports would hold that import's lock forever. A stop
+    received meanwhile is raised (:mod:`hexdem.common.interrupt`)."""
+    with _LOADING_LOCK:
+        loading = list(_LOADING)
+    for thread in loading:
+        while thread.is_alive():
+            thread.join(WAIT_S)
+            raise_if_stopped()
+    with _LOADING_LOCK:
+        _LOADING[:] = [thread for thread in _LOADING if thread.is_alive()]

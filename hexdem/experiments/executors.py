@@ -34,7 +34,7 @@ from multiprocessing import get_context
 from pathlib import Path
 
 from hexdem.common.checks import positive_int
-from hexdem.common.interrupt import STOP_SIGNALS, Interrupted, raise_if_stopped, remember, stop_on_signals
+from hexdem.common.interrupt import STOP_SIGNALS, WAIT_S, Interrupted, raise_if_stopped, remember, stop_on_signals
 from hexdem.common.progress import progress_bar
 from hexdem.engines.lammps.standalone import die_with_parent, launcher_command
 from hexdem.errors import HexdemError, RunFailed
@@ -124,8 +124,14 @@ def _worker_task(fn, *args, **kwargs):
 
 
 def _call(fn, *args, **kwargs):
-    """The one Parsl app: any picklable callable, called on a worker."""
-    return fn(*args, **kwargs)
+    """The one Parsl app: any picklable callable, called on a worker. A task stopped with its
+    process (:class:`~hexdem.common.interrupt.Interrupted`, in a thread of a Parsl
+    ThreadPoolExecutor) fails as an ordinary exception: Parsl records only those, and would leave
+    the study waiting for the task forever."""
+    try:
+        return fn(*args, **kwargs)
+    except Interrupted as stop:
+        raise RunFailed(f"stopped by {stop.name}") from None
 
 
 def load_parsl_config(path):
@@ -302,11 +308,14 @@ def study_retries(parsl: ParslSession | None) -> int:
 def run_tasks(executor, tasks: dict, retries: int):
     """Submit ``tasks`` (``{key: (fn, *args)}``) to ``executor``; yield (key, result, error) as each
     finishes (``error``: None, or the exception of its last try), a failed task being submitted
-    again up to ``retries`` times (:func:`study_retries`)."""
+    again up to ``retries`` times (:func:`study_retries`). The wait looks for a stop every
+    :data:`~hexdem.common.interrupt.WAIT_S` seconds (:mod:`hexdem.common.interrupt`)."""
     tries = dict.fromkeys(tasks, 0)
     futures = {executor.submit(*task): key for key, task in tasks.items()}
     while futures:
-        for future in wait(futures, return_when=FIRST_COMPLETED).done:
+        done = wait(futures, timeout=WAIT_S, return_when=FIRST_COMPLETED).done
+        raise_if_stopped()  # before a task that the stop ended is taken for a failure
+        for future in done:
             key = futures.pop(future)
             error = future.exception()
             if error is not None and tries[key] < retries:

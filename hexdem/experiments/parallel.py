@@ -29,6 +29,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from hexdem.common.checks import positive_int
+from hexdem.common.interrupt import WAIT_S, raise_if_stopped
 from hexdem.common.io import atomic_path
 from hexdem.common.job_failure import ERROR_FILE_VARIABLE, abort_job, reported_error
 from hexdem.common.process_end import skip_final_collections
@@ -98,7 +99,7 @@ def run_on_ranks(job, ranks: int, directory, launcher: str | None = None, progre
             raise HexdemError(f"cannot start the MPI launcher {prefix[0]!r}: {exc.strerror}") from None
         with launched:
             try:
-                output, _ = launched.communicate()
+                output = _communicate(launched)
             except BaseException:  # stopped (SIGTERM, Ctrl-C: hexdem.common.interrupt): no rank outlives the run
                 _stop(launched)
                 raise
@@ -112,6 +113,19 @@ def run_on_ranks(job, ranks: int, directory, launcher: str | None = None, progre
     for name in (JOB_NAME, RESULT_NAME):
         paths[name].unlink()
     return result
+
+
+def _communicate(launched: subprocess.Popen) -> str:
+    """The standard output of ``launched`` once it has ended; a stop received meanwhile is raised
+    within :data:`~hexdem.common.interrupt.WAIT_S` seconds (:mod:`hexdem.common.interrupt`)."""
+    while True:
+        try:
+            output = launched.communicate(timeout=WAIT_S)[0]
+        except subprocess.TimeoutExpired:
+            output = None
+        raise_if_stopped()  # also once it has ended: ranks that a Ctrl-C ended too were stopped, not failed
+        if output is not None:
+            return output
 
 
 def _stop(launched: subprocess.Popen) -> None:
