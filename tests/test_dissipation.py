@@ -185,6 +185,20 @@ def test_two_sphere_collision_has_the_requested_restitution(tmp_path, engine, e,
 
 
 @pytest.mark.parametrize("engine", ENGINES, ids=lambda e: e.name)
+@pytest.mark.parametrize("e", [0.9999, 0.1])
+def test_a_restitution_beyond_marshalls_unit_interval_runs_in_both_engines(tmp_path, engine, e):
+    """Every restitution in (0, 1] runs: 0.9999 needs LAMMPS's Tsuji coefficient just past 1, 0.1
+    one on the rising branch of Marshall's polynomial (c ≈ 1.58), beyond the [0, 1] that reaches
+    [0.263, 0.9996]; two spheres rebound with it in both engines (to 1e-3 at e = 0.1, where LAMMPS's
+    first-order damping resolves the short, strongly damped rebound less finely)."""
+    alpha = damping_coefficient(e)
+    c = lammps_tsuji_coefficient(alpha)
+    assert not 0.0 <= c <= 1.0
+    assert float(np.polynomial.polynomial.polyval(c, TSUJI_POLYNOMIAL)) == pytest.approx(alpha, rel=1e-9)
+    assert head_on_restitution(engine, e, V0, tmp_path) == pytest.approx(e, rel=RESTITUTION_RTOL if e > 0.5 else 1e-3)
+
+
+@pytest.mark.parametrize("engine", ENGINES, ids=lambda e: e.name)
 @pytest.mark.parametrize("e", [0.95, 0.8])
 def test_sphere_wall_collision_has_the_requested_restitution(tmp_path, engine, e):
     wall = Wall("wall_180", (-1.0, 0.0), -D / 2, np.array([0]))

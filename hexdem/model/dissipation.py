@@ -123,16 +123,43 @@ def damping_coefficient(restitution: float) -> float:
 
 
 def lammps_tsuji_coefficient(alpha: float) -> float:
-    """The coefficient c to give LAMMPS's ``damping tsuji`` so that it applies damping ``alpha``."""
+    """The coefficient c ≥ 0 to give LAMMPS's ``damping tsuji`` so that it applies damping ``alpha`` > 0.
+
+    Marshall's polynomial P falls from P(0) = 1.2728 through P(1) = 0.0003 to its minimum (−0.032
+    at c = 1.12), and rises beyond it; LAMMPS takes any c ≥ 0. The weak damping of e above
+    0.9996 (α < P(1)) is found on the falling branch just past c = 1, before P turns negative, and
+    the strong damping of e below 0.263 (α > P(0)) on the rising branch, so that every e in (0, 1)
+    has its c (:func:`~hexdem.engines.lammps.tsuji_check.check_tsuji_damping` measures both)."""
     from scipy.optimize import brentq
 
     def applied(c: float) -> float:
         return float(np.polynomial.polynomial.polyval(c, TSUJI_POLYNOMIAL))
 
-    if not applied(1.0) <= alpha <= applied(0.0):
-        raise HexdemError(f"LAMMPS's damping tsuji cannot express the restitution {restitution_of(alpha):.4g}: "
-                          f"use one in [{restitution_of(applied(0.0)):.3f}, {restitution_of(applied(1.0)):.4f}] or 1")
-    return float(brentq(lambda c: applied(c) - alpha, 0.0, 1.0, xtol=1e-14))
+    if not alpha > 0:
+        raise HexdemError(f"LAMMPS's damping tsuji takes a damping alpha > 0, got {alpha!r}")
+    lowest = _polynomial_minimum()
+    if alpha <= applied(0.0):
+        return float(brentq(lambda c: applied(c) - alpha, 0.0, _first_root(lowest), xtol=1e-14))
+    high = 2.0 * lowest
+    while applied(high) < alpha:
+        high *= 2.0
+    return float(brentq(lambda c: applied(c) - alpha, lowest, high, xtol=1e-14))
+
+
+@cache
+def _polynomial_minimum() -> float:
+    """c at which Marshall's polynomial is least on c > 0."""
+    turns = np.polynomial.polynomial.Polynomial(TSUJI_POLYNOMIAL).deriv().roots()
+    real = sorted(float(c.real) for c in turns if abs(c.imag) < 1e-12 and c.real > 0)
+    return min(real, key=lambda c: float(np.polynomial.polynomial.polyval(c, TSUJI_POLYNOMIAL)))
+
+
+@cache
+def _first_root(lowest: float) -> float:
+    """The c where the falling branch of Marshall's polynomial reaches 0, before its minimum ``lowest``."""
+    from scipy.optimize import brentq
+
+    return float(brentq(lambda c: np.polynomial.polynomial.polyval(c, TSUJI_POLYNOMIAL), 0.0, lowest, xtol=1e-15))
 
 
 def check_restitution(name: str, value) -> float:
