@@ -1,35 +1,38 @@
-"""Calibration on the quick case: coverage on truths the method is not told, and the methods side by side.
+"""Simulation-based calibration of ``hexdem calibrate``: coverage and rank histograms over truths drawn
+from the prior, the records made as a lab's instruments make them.
 
-Usage: python benchmarks/bench_calibration.py [--truths 10] [--methods emulator,filter] [--workers 2]
-                                              [--noise 5] [--out DIR] [--quick]
+Usage: python benchmarks/bench_calibration.py [--case tiny|quick|disordered] [--truths 50] [--workers 2]
+                                              [--noise 5] [--seed 2026] [--out DIR] [--quick] [--cost N]
 
-**The quick case.** The ideal 11-per-edge lattice of the paper's experiment, four sensors along 0°
-(beads 1, 3, 5, 7), and two parameters: ``restitution`` ~ uniform(0.7, 0.99) and ``v0`` ~
-uniform(0.2, 0.7). Each truth is drawn from that prior (seeded). Its record is made at twice the
-calibration's time step, sampled at 500 kS/s after a 100 µs lead-in, with white accelerometer
-noise of ``--noise`` m/s² rms and a clock offset drawn in [0, 5] ms
-(:mod:`hexdem.calibration.synthetic`). Nothing of the truth reaches the method but that record.
+**Simulation-based calibration** (Talts, Betancourt, Simpson, Vehtari & Gelman 2018): draw a truth θ
+from the prior, make a record of it, calibrate, and take the rank of θ among L = 99 draws of the
+posterior. A calibration whose posteriors are right gives ranks uniform on 0..L, whatever the
+truth, and central intervals that hold θ as often as they claim. The table gives, per key, the
+coverage of the 50 % and 90 % central intervals with the binomial 95 % band of the number of
+truths, and the rank histogram with the χ² test of its uniformity.
 
-**Methods**, each given the same records, priors and likelihood:
+**The records differ from the calibration's runs as a lab's do.** Each record is made at twice the
+calibration's time resolution, sampled at 500 kS/s after a 100 µs lead-in, with a clock offset
+drawn in [0, 5] ms (:mod:`hexdem.calibration.synthetic`); and with the instruments' errors drawn as
+the calibration's defaults assume them: each sensor's gain ~ N(1, 0.02), the record's striker
+speed v0 (1 + 0.01 z), each channel's noise level uniform in [0.5, 2] × ``--noise`` m/s² rms and
+a DC offset uniform in ±20 m/s². Nothing of the truth reaches the calibration but the record.
 
-* ``emulator``: hexdem's (:mod:`hexdem.calibration.inference`), a Gaussian-process emulator
-  refined on the posterior, sampled by emcee, 90 simulations;
-* ``filter``: the iterative Bayesian filter of GrainLearning (Cheng et al. 2019), written here
-  because GrainLearning 2.0.5 requires NumPy below 2.0: each iteration simulates
-  ``FILTER_SAMPLES`` parameter sets, weighs them by the likelihood of the records, and draws
-  the next iteration's from a Gaussian mixture fitted to the weighted sets (one component per
-  set, the weighted covariance as bandwidth); ``FILTER_ITERATIONS`` iterations.
+**Cases.**
 
-**A simulation's cost** (``--cost N``): N simulations of the quick case, one after another in
-this process after one to warm up (as a worker runs them), each timed whole (configuration,
-LAMMPS, the sensors' reduction, its folder written) beside its LAMMPS loop (the log's "Loop
-time"); the target: at most the loop plus 0.3 s.
+* ``tiny``: a 5-per-edge hexagon, sensors ``0:1, 0:3``, ``v0`` ~ uniform(0.2, 0.7); 30
+  simulations a truth (the budget of ``hexdem calibrate``'s test).
+* ``quick``: the paper's 11-per-edge lattice, four sensors along 0° (``0:1, 0:3, 0:5, 0:7``),
+  ``restitution`` ~ uniform(0.7, 0.99) and ``v0`` ~ uniform(0.2, 0.7); the default budget, 90.
+* ``disordered``: a 4-per-edge hexagon, sensors ``0:1, 0:3``, ``diameter_sigma_m`` ~
+  uniform(0, 1.5e-4) and ``restitution`` ~ uniform(0.8, 1.0), on the default 8 packings per
+  parameter set, each truth's record struck on a packing of its own seed (one the calibration
+  never prepares).
 
-For every truth and method the table gives the simulations, the wall time, each key's 90 %
-interval width over the prior's and whether it holds the truth; the last rows count, per
-method and key, the truths inside their 90 % interval (the target: at least 7 of 10).
-``--quick``: one truth, a 5-per-edge hexagon with sensors 0:1 and 0:3, ``v0`` alone, 30 simulations,
-one worker.
+``--quick``: one truth of the tiny case on one worker. ``--cost N``: N simulations of the quick case,
+one after another in this process after one to warm up (as a worker runs them), each timed whole
+(configuration, LAMMPS, the sensors' reduction, its folder written) beside its LAMMPS loop (the
+log's "Loop time"); the target: at most the loop plus 0.3 s.
 """
 
 from __future__ import annotations
@@ -44,72 +47,68 @@ from pathlib import Path
 import numpy as np
 from machine import describe
 
+from hexdem.calibration.packings import SIGMA_KEY
 from hexdem.calibration.priors import Prior, to_parameters
 from hexdem.calibration.simulations import Problem, simulate_point
-from hexdem.calibration.study import calibrate, prepare
+from hexdem.calibration.study import DEFAULT_GAIN_SD, DEFAULT_SPEED_SCATTER, calibrate, prepare
 from hexdem.calibration.synthetic import synthetic_rows, write_measured
 from hexdem.engines.lammps.standalone import loop_time_s
-from hexdem.experiments.executors import run_phase
 from hexdem.model.config import RunConfig
 
-QUICK_CASE = ({"sensors": ["0:1", "0:3", "0:5", "0:7"]},
-              ("restitution=uniform(0.7, 0.99)", "v0=uniform(0.2, 0.7)"))
-TINY_CASE = ({"sensors": ["0:1", "0:3"], "edge_beads": 5}, ("v0=uniform(0.2, 0.7)",))
-FILTER_SAMPLES, FILTER_ITERATIONS = 60, 5
-#: ``--quick``'s budget: the initial design and one refinement.
-QUICK_BUDGET = 30
+#: name → (base configuration, priors, budget in parameter sets (None: the default)).
+CASES = {
+    "tiny": ({"sensors": ["0:1", "0:3"], "edge_beads": 5}, ("v0=uniform(0.2, 0.7)",), 30),
+    "quick": ({"sensors": ["0:1", "0:3", "0:5", "0:7"]}, ("restitution=uniform(0.7, 0.99)", "v0=uniform(0.2, 0.7)"),
+              None),
+    "disordered": ({"sensors": ["0:1", "0:3"], "edge_beads": 4},
+                   ("diameter_sigma_m=uniform(0, 1.5e-4)", "restitution=uniform(0.8, 1.0)"), None),
+}
+#: Posterior draws among which a truth is ranked.
+RANK_DRAWS = 99
+#: A record's channels' noise levels, as multiples of ``--noise``, and their DC offsets [m/s²].
+NOISE_FACTORS, OFFSET_M_S2 = (0.5, 2.0), 20.0
+#: The seed of a disordered truth's packing: far from the calibration's own packings' (its seed, k).
+TRUTH_PACKING_SEED = 100_000
 
 
-def truth_record(base: dict, priors, rng, noise: float, path: Path) -> np.ndarray:
-    """A truth drawn from ``priors`` and its synthetic record written to ``path``."""
-    unit = rng.random(len(priors))
-    truth = to_parameters(priors, unit[None])[0]
-    config = RunConfig.from_dict(base | {prior.key: float(v) for prior, v in zip(priors, truth)})
-    write_measured(path, synthetic_rows(config, "0", noise, float(rng.uniform(0, 5e-3)), rng))
+def truth_record(base: dict, priors, rng, noise: float, path: Path, index: int) -> np.ndarray:
+    """A truth drawn from ``priors`` and its record, as a lab's instruments make it, written to ``path``."""
+    truth = to_parameters(priors, rng.random((1, len(priors))))[0]
+    values = {prior.key: float(v) for prior, v in zip(priors, truth)}
+    sigma = values.pop(SIGMA_KEY, None)
+    config = RunConfig.from_dict(base | values)
+    sensors = len(config.sensors)
+    striker = config.replace(v0=config.v0 * (1 + DEFAULT_SPEED_SCATTER * rng.standard_normal()))
+    gains = 1 + DEFAULT_GAIN_SD * rng.standard_normal(sensors)
+    levels = noise * rng.uniform(*NOISE_FACTORS, (sensors, 2))
+    offsets = rng.uniform(-OFFSET_M_S2, OFFSET_M_S2, (sensors, 2))
+    disorder = None if sigma is None else (sigma, TRUTH_PACKING_SEED + index, 0)
+    rows = synthetic_rows(striker, "0", levels, float(rng.uniform(0, 5e-3)), rng, disorder=disorder,
+                          packings=path.parent / "truth-packing", gains=gains, offsets_m_s2=offsets)
+    write_measured(path, rows)
     (path.parent / "truth.json").write_text(json.dumps({prior.key: float(v) for prior, v in zip(priors, truth)}))
     return truth
 
 
-def run_emulator(calibration, measured, out: Path, workers: int) -> tuple[np.ndarray, int]:
-    calibrate(calibration, measured, out, workers, log=lambda message: None)
-    samples = np.loadtxt(out / "posterior.csv", delimiter=",", skiprows=1, ndmin=2)
-    return samples, int(sum(calibration.stages))
+def binomial_band(level: float, count: int) -> tuple[float, float]:
+    """The central 95 % range of the share of ``count`` truths inside an interval of ``level``."""
+    from scipy.stats import binom
+
+    return binom.ppf(0.025, count, level) / count, binom.ppf(0.975, count, level) / count
 
 
-def run_filter(calibration, out: Path, workers: int, seed: int) -> tuple[np.ndarray, int]:
-    """The iterative Bayesian filter (see the module docstring) on the simulator itself."""
-    problem, data = calibration.problem, calibration.data
-    rng = np.random.default_rng(seed)
-    p = len(problem.priors)
-    unit = rng.random((FILTER_SAMPLES, p))
-    count = 0
-    for iteration in range(FILTER_ITERATIONS):
-        values = to_parameters(problem.priors, unit)
-        tasks = {i: (simulate_point, problem, values[i].tolist(), str(out / f"{iteration}-{i:03d}"))
-                 for i in range(len(values))}
-        observables = np.full((len(values), len(data.names)), np.nan)
-        for i, error in run_phase(tasks, workers, None, f"filter {iteration + 1}", "simulation"):
-            if error is None:
-                observables[i] = json.loads((out / f"{iteration}-{i:03d}" / "observables.json").read_text())["observables"]
-        count += len(values)
-        log_weight = np.zeros(len(values))
-        for record, covariance in zip(data.records, data.covariances):
-            residual = observables - record
-            log_weight -= 0.5 * np.einsum("ki,ij,kj->k", residual, np.linalg.inv(covariance), residual)
-        log_weight[~np.isfinite(log_weight)] = -np.inf
-        weight = np.exp(log_weight - log_weight.max())
-        weight /= weight.sum()
-        if iteration == FILTER_ITERATIONS - 1:
-            return values[rng.choice(len(values), size=4000, p=weight)], count
-        bandwidth = np.atleast_2d(np.cov(unit, rowvar=False, aweights=weight + 1e-12)) + 1e-6 * np.eye(p)
-        chosen = unit[rng.choice(len(unit), size=FILTER_SAMPLES, p=weight)]
-        unit = np.clip(chosen + rng.multivariate_normal(np.zeros(p), bandwidth, FILTER_SAMPLES), 1e-6, 1 - 1e-6)
+def rank_histogram(ranks, bins: int) -> tuple[list[int], float]:
+    """(counts of ``ranks`` (0..RANK_DRAWS) in ``bins`` equal bins, the χ² test's p-value of their uniformity)."""
+    from scipy.stats import chisquare
+
+    counts = np.histogram(ranks, bins=bins, range=(-0.5, RANK_DRAWS + 0.5))[0]
+    return counts.tolist(), float(chisquare(counts).pvalue)
 
 
 def simulation_cost(count: int, root: Path) -> None:
     """The table of ``--cost``: each simulation's whole time beside its LAMMPS loop."""
-    base, prior_texts = QUICK_CASE
-    problem = prepare_problem(base, prior_texts)
+    base, prior_texts, _ = CASES["quick"]
+    problem = Problem(base, tuple(Prior.parse(text) for text in prior_texts))
     rng = np.random.default_rng(0)
     print("| simulation | whole s | LAMMPS loop s | whole - loop s |")
     print("|---|---|---|---|")
@@ -127,14 +126,10 @@ def simulation_cost(count: int, root: Path) -> None:
     print(f"median beyond the loop: {np.median(extra):.3f} s (target at most 0.3 s)")
 
 
-def prepare_problem(base: dict, prior_texts) -> Problem:
-    return Problem(base, tuple(Prior.parse(text) for text in prior_texts))
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--truths", type=int, default=10)
-    parser.add_argument("--methods", default="emulator")
+    parser.add_argument("--case", choices=sorted(CASES), default="tiny")
+    parser.add_argument("--truths", type=int, default=50)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--noise", type=float, default=5.0, help="accelerometer noise [m/s² rms]")
     parser.add_argument("--seed", type=int, default=2026)
@@ -142,45 +137,55 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--cost", type=int, metavar="N", help="time N simulations against their LAMMPS loop, only")
     args = parser.parse_args()
-    if args.cost:
-        print(f"machine: {describe()}; load average {os.getloadavg()[0]:.2f}", flush=True)
-        simulation_cost(args.cost, Path(args.out or tempfile.mkdtemp(prefix="hexdem-bench-cost-")))
-        return
-    base, prior_texts = TINY_CASE if args.quick else QUICK_CASE
-    truths, workers = (1, 1) if args.quick else (args.truths, args.workers)
-    methods = args.methods.split(",")
-    priors = [Prior.parse(text) for text in prior_texts]
-    root = Path(args.out or tempfile.mkdtemp(prefix="hexdem-bench-calibration-"))
-    rng = np.random.default_rng(args.seed)
     print(f"machine: {describe()}; load average {os.getloadavg()[0]:.2f}", flush=True)
-    print(f"noise {args.noise:g} m/s^2 rms, {truths} truth(s), workers {workers}")
-    print("| truth | method | " + " | ".join(f"{p.key} true | {p.key} 90 % interval | {p.key} width ratio" for p in priors)
-          + " | simulations | wall s |")
-    print("|---" * (3 + 3 * len(priors) + 1) + "|")
-    inside = {(m, p.key): 0 for m in methods for p in priors}
+    root = Path(args.out or tempfile.mkdtemp(prefix="hexdem-bench-calibration-"))
+    if args.cost:
+        simulation_cost(args.cost, root)
+        return
+    case = "tiny" if args.quick else args.case
+    base, prior_texts, budget = CASES[case]
+    truths, workers = (1, 1) if args.quick else (args.truths, args.workers)
+    priors = [Prior.parse(text) for text in prior_texts]
+    rng = np.random.default_rng(args.seed)
+    print(f"case {case}: {', '.join(prior_texts)}; noise {args.noise:g} m/s^2 rms; {truths} truth(s); workers {workers}")
+    print("| truth | " + " | ".join(f"{p.key} true | {p.key} 90 % interval | {p.key} rank" for p in priors)
+          + " | simulations | fit p | wall s |")
+    print("|---" * (1 + 3 * len(priors) + 3) + "|")
+    ranks, inside = {p.key: [] for p in priors}, {(p.key, level): 0 for p in priors for level in (0.5, 0.9)}
     for t in range(truths):
         folder = root / f"truth-{t}"
         folder.mkdir(parents=True, exist_ok=True)
-        truth = truth_record(base, priors, rng, args.noise, folder / "data.csv")
-        calibration = prepare(base, folder / "data.csv", prior_texts, QUICK_BUDGET if args.quick else None, seed=t)
-        for method in methods:
-            start = time.perf_counter()
-            if method == "emulator":
-                samples, count = run_emulator(calibration, folder / "data.csv", folder / method, workers)
-            else:
-                samples, count = run_filter(calibration, folder / method, workers, seed=t)
-            seconds = time.perf_counter() - start
-            cells = []
-            for j, prior in enumerate(priors):
-                q05, q95 = np.quantile(samples[:, j], [0.05, 0.95])
-                p05, p95 = prior.from_unit([0.05, 0.95])
-                hit = q05 <= truth[j] <= q95
-                inside[(method, prior.key)] += hit
-                cells.append(f"{truth[j]:.4f} | [{q05:.4f}, {q95:.4f}]{'' if hit else ' MISSED'} | "
-                             f"{(q95 - q05) / (p95 - p05):.2f}")
-            print(f"| {t} | {method} | " + " | ".join(cells) + f" | {count} | {seconds:.0f} |", flush=True)
-    for (method, key), count in inside.items():
-        print(f"coverage, {method}, {key}: {count} of {truths} truths inside the 90 % interval")
+        truth = truth_record(base, priors, rng, args.noise, folder / "data.csv", t)
+        start = time.perf_counter()
+        calibration = prepare(base, folder / "data.csv", prior_texts, None if budget is None else budget,
+                              seed=args.seed + t)
+        summary = calibrate(calibration, folder / "data.csv", folder / "calibration", workers, log=lambda message: None)
+        seconds = time.perf_counter() - start
+        samples = np.loadtxt(folder / "calibration" / "posterior.csv", delimiter=",", skiprows=1, ndmin=2)
+        draws = samples[np.random.default_rng(t).choice(len(samples), RANK_DRAWS, replace=False)]
+        cells = []
+        for j, prior in enumerate(priors):
+            rank = int(np.sum(draws[:, j] < truth[j]))
+            ranks[prior.key].append(rank)
+            for level in (0.5, 0.9):
+                low, high = np.quantile(samples[:, j], [(1 - level) / 2, (1 + level) / 2])
+                inside[(prior.key, level)] += bool(low <= truth[j] <= high)
+            q05, q95 = np.quantile(samples[:, j], [0.05, 0.95])
+            held = "" if q05 <= truth[j] <= q95 else " MISSED"
+            cells.append(f"{truth[j]:.6g} | [{q05:.6g}, {q95:.6g}]{held} | {rank}")
+        print(f"| {t} | " + " | ".join(cells) + f" | {summary['simulations']['runs']} | "
+              f"{summary['fit']['p_value']:.2f} | {seconds:.0f} |", flush=True)
+    bins = max(2, min(10, truths // 5))
+    print("\n| key | coverage 50 % | binomial band (95 %) | coverage 90 % | binomial band (95 %) | "
+          f"rank histogram ({bins} bins of 0..{RANK_DRAWS}) | uniformity p |")
+    print("|---|---|---|---|---|---|---|")
+    for prior in priors:
+        cells = []
+        for level in (0.5, 0.9):
+            low, high = binomial_band(level, truths)
+            cells.append(f"{inside[(prior.key, level)] / truths:.2f} | [{low:.2f}, {high:.2f}]")
+        counts, p_value = rank_histogram(ranks[prior.key], bins)
+        print(f"| {prior.key} | " + " | ".join(cells) + f" | {' '.join(map(str, counts))} | {p_value:.2f} |")
 
 
 if __name__ == "__main__":

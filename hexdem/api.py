@@ -76,7 +76,7 @@ def simulate_impact(config: RunConfig | None = None, out=None, verbose: bool = F
     """
     config = (config or RunConfig()).override(**changes)
     check_unused_keys(config)
-    log = (lambda message: print(f"hexdem: {message}", file=sys.stderr)) if verbose else (lambda message: None)
+    log = (lambda message: sys.stderr.write(f"hexdem: {message}\n")) if verbose else (lambda message: None)
     if out is not None:
         return ImpactResult.of(run_experiment(config, out, log))
     with tempfile.TemporaryDirectory(prefix="hexdem-") as scratch:

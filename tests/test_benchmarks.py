@@ -40,8 +40,9 @@ EXPECTED = {
     "bench_study.py": ("executor", "runs [s]", "start-up and end [s]", "a run, in-process", "overhead per run [s]",
                        "process pool", "Parsl (HighThroughputExecutor, local)", "Parsl's overhead per run over the pool's",
                        "target <= 0.2 s or 5% of a run"),
-    "bench_calibration.py": ("truth", "method", "v0 true", "v0 90 % interval", "v0 width ratio", "simulations",
-                             "wall s", "emulator", "coverage, emulator, v0"),
+    "bench_calibration.py": ("case tiny", "truth", "v0 true", "v0 90 % interval", "v0 rank", "simulations", "fit p",
+                             "wall s", "coverage 50 %", "coverage 90 %", "binomial band (95 %)", "rank histogram",
+                             "uniformity p"),
     "bench_paper.py": ("hexdem paper --quick", "part", "wall [s]", "scaling", "disorder-sigma6tol",
                        "sum of parts", "this invocation", "target <= 120 s", "140 steps"),
 }

@@ -97,6 +97,13 @@ class Emulator:
         self.weights = np.column_stack([p.signal * p.alpha for p in processes])  # (n, m)
         self.whiteners = np.array([p.signal * p.whitener for p in processes])  # (m, n, n)
 
+    def leave_one_out(self) -> np.ndarray:
+        """Each simulation's observables less the emulator's prediction there fitted without it
+        (n, m), in closed form (Rasmussen & Williams, eq. 5.12: α_i / [K⁻¹]_ii, the trend held): how
+        far the emulator is off where it was not told."""
+        diagonal = np.sum(self.whiteners**2, axis=1).T  # (n, m): [K⁻¹]_ii times each process's s⁴
+        return self.scale * self.weights * self.signal / diagonal
+
     def predict(self, xs) -> tuple[np.ndarray, np.ndarray]:
         """(mean (k, m), variance (k, m)) of the observables at unit-cube points ``xs`` (k, p): every
         observable's correlations from one table of squared distances."""

@@ -4,14 +4,16 @@ The posterior of the unit-cube coordinates u of the priors (:mod:`~hexdem.calibr
 is p(u | data) ∝ p(y_1, …, y_R | u) on [0, 1]^p, the records y_r
 (:mod:`~hexdem.calibration.observables`) modelled as
 
-    y_r = μ(u) + e + δ_r + ε_r,   e ~ N(0, C(u)),  δ_r ~ N(0, Σ_K(u)),  ε_r ~ N(0, Σ_r):
+    y_r = μ(u) + e + δ_r + ε_r,   e ~ N(0, C(u)),  δ_r ~ N(0, Σ_K(u) + V(u)),  ε_r ~ N(0, Σ_r):
 
 μ(u) the emulated mean of the model's observables over the K packings simulated at u
 (:mod:`~hexdem.calibration.emulator`); ε_r record r's accelerometer noise; δ_r its packing's
 deviation from the mean, Σ_K(u) the spread between packings (:mod:`~hexdem.calibration.spread`;
-zero on the ideal lattice), independent between records, each record being one packing; and e
-the error of μ(u) itself, common to every record: the emulator's variance s²(u), and Σ_K(u)/K,
-for a mean over K packings is not the mean over all. With D_r = Σ_r + Σ_K, P = Σ_r D_r⁻¹ and
+zero on the ideal lattice), and its striker's speed off the calibrated one, V(u)
+(:class:`Instruments`), independent between records, each record being one packing and one
+strike; and e the error common to every record: the emulator's variance s²(u), Σ_K(u)/K, for a
+mean over K packings is not the mean over all, and each sensor's gain, the same in all its
+records (:class:`Instruments`). With D_r = Σ_r + Σ_K + V, P = Σ_r D_r⁻¹ and
 b = Σ_r D_r⁻¹ (y_r − μ), integrating e out gives
 
     log p = Σ_r log N(y_r; μ, D_r) − ½ log det(I + C P) + ½ bᵀ (I + C P)⁻¹ C b,
@@ -79,21 +81,81 @@ def stage_sizes(dimension: int, budget: int, realizations: int = 1) -> list[int]
 
 
 @dataclass(frozen=True)
+class Instruments:
+    """What a lab's instruments add to the model's observables of ``sensors`` sensors (the first
+    ``sensors`` observables are log peak speeds, the next ``sensors`` − 1 arrivals relative to the
+    first sensor's, :func:`~hexdem.calibration.observables.observation_names`).
+
+    ``gain_sd``: each sensor's sensitivity is an unknown gain g ~ N(1, gain_sd), the same in every
+    record of that sensor. The velocity integrated from its acceleration, and so its peak, scale with
+    g; its half-maximum arrival does not. log g, N(0, gain_sd²) to first order, adds to the sensor's
+    log peak speed in every record alike: a term of the common error e, marginalised analytically.
+
+    ``speed_scatter``: the striker's speed differs from record to record, v (1 + speed_scatter z_r)
+    around the calibrated v. A Hertzian lattice has no scale of its own: a speed λ v gives
+    :math:`x_λ(t) = λ^{4/5} x(λ^{1/5} t)`, every velocity λ times larger at times :math:`λ^{-1/5}` later (also with
+    Tsuji's damping, whose restitution does not depend on the speed; gravity breaks it only where
+    the pulse has nearly died). To first order in z_r every log peak moves by speed_scatter z_r and
+    each relative arrival t_j by −t_j speed_scatter z_r / 5: the covariance
+    V = speed_scatter² J Jᵀ, J = (1, …, 1, −t_2/5, …), independent between records, with t_j the
+    emulated arrivals at u."""
+
+    sensors: int
+    gain_sd: float = 0.0
+    speed_scatter: float = 0.0
+
+    def common(self) -> np.ndarray:
+        """The gains' covariance (m, m), common to every record."""
+        return np.diag(np.r_[np.full(self.sensors, self.gain_sd**2), np.zeros(self.sensors - 1)])
+
+    def per_record(self, mean) -> np.ndarray:
+        """The speed scatter's covariance (k, m, m) of one record at the emulated means ``mean`` (k, m)."""
+        mean = np.atleast_2d(mean)
+        slope = np.column_stack([np.ones((len(mean), self.sensors)), -mean[:, self.sensors:] / 5.0])
+        return self.speed_scatter**2 * slope[:, :, None] * slope[:, None, :]
+
+
+@dataclass(frozen=True)
 class Data:
     """The measured records' observables ``records`` (R, m), their noise covariances
-    ``covariances`` (R, m, m), and the observables' ``names``."""
+    ``covariances`` (R, m, m), the observables' ``names``, and the records' own names
+    ``record_names`` (their ``record`` column)."""
 
     records: np.ndarray
     covariances: np.ndarray
     names: tuple[str, ...]
+    record_names: tuple[str, ...] = ()
 
 
 class Likelihood:
-    """log p(data | u) through ``emulator`` and the packings' ``spread`` (see the module docstring)."""
+    """log p(data | u) through ``emulator``, the packings' ``spread`` and the records' ``instruments``
+    (see the module docstring; without instruments, none of their errors)."""
 
-    def __init__(self, data: Data, emulator: Emulator, spread: Spread, model_error=None):
+    def __init__(self, data: Data, emulator: Emulator, spread: Spread, model_error=None,
+                 instruments: Instruments | None = None):
         self.data, self.emulator, self.spread = data, emulator, spread
         self.model_error = 0.0 if model_error is None else np.asarray(model_error, float)
+        self.instruments = instruments or Instruments(1 + data.records.shape[1] // 2)
+
+    def moments(self, unit) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """At unit-cube points ``unit`` (k, p): the emulated mean μ (k, m), the common error's
+        covariance C (k, m, m) and what each record adds to its own noise, Σ_K + V (k, m, m)."""
+        mean, variance = self.emulator.predict(unit)
+        spread = self.spread(unit)
+        common = (variance[:, :, None] * np.eye(mean.shape[1]) + spread / self.spread.realizations
+                  + self.model_error + self.instruments.common())
+        return mean, common, spread + self.instruments.per_record(mean)
+
+    def _pooled(self, mean, own):
+        """(Σ_r log N(y_r; μ, D_r), P, b) at each point (see the module docstring)."""
+        total, precision, pulled = 0.0, 0.0, 0.0
+        for record, covariance in zip(self.data.records, self.data.covariances):
+            scatter = covariance + own
+            solved = np.linalg.solve(scatter, (record - mean)[:, :, None])[:, :, 0]
+            total = total - 0.5 * (np.einsum("ki,ki->k", record - mean, solved) + np.linalg.slogdet(scatter)[1])
+            precision = precision + np.linalg.inv(scatter)
+            pulled = pulled + solved
+        return total, precision, pulled
 
     def __call__(self, unit) -> np.ndarray:
         unit = np.atleast_2d(unit)
@@ -101,28 +163,82 @@ class Likelihood:
         result = np.full(len(unit), -np.inf)
         if not inside.any():
             return result
-        mean, variance = self.emulator.predict(unit[inside])
-        spread = self.spread(unit[inside])
-        identity = np.eye(mean.shape[1])
-        common = variance[:, :, None] * identity + spread / self.spread.realizations + self.model_error
-        total, precision, pulled = 0.0, 0.0, 0.0
-        for record, covariance in zip(self.data.records, self.data.covariances):
-            own = covariance + spread
-            solved = np.linalg.solve(own, (record - mean)[:, :, None])[:, :, 0]
-            total = total - 0.5 * (np.einsum("ki,ki->k", record - mean, solved) + np.linalg.slogdet(own)[1])
-            precision = precision + np.linalg.inv(own)
-            pulled = pulled + solved
-        shrink = identity + common @ precision
+        mean, common, own = self.moments(unit[inside])
+        total, precision, pulled = self._pooled(mean, own)
+        shrink = np.eye(mean.shape[1]) + common @ precision
         gain = np.linalg.solve(shrink, (common @ pulled[:, :, None]))[:, :, 0]
         result[inside] = total - 0.5 * np.linalg.slogdet(shrink)[1] + 0.5 * np.einsum("ki,ki->k", pulled, gain)
         return result
 
+    def log_gains(self, unit) -> tuple[np.ndarray, np.ndarray]:
+        """(mean (k, n), variance (k, n)) of each sensor's log gain given the records, at unit-cube
+        points ``unit`` (k, p): g is part of the common error e, so with G its covariance,
+        E[g | y] = G (I + P C)⁻¹ b and Cov[g | y] = G − G (I + P C)⁻¹ P G."""
+        mean, common, own = self.moments(np.atleast_2d(unit))
+        _, precision, pulled = self._pooled(mean, own)
+        gains = self.instruments.common()
+        shrink = np.eye(mean.shape[1]) + precision @ common
+        centre = (gains @ np.linalg.solve(shrink, pulled[:, :, None]))[:, :, 0]
+        covariance = gains - gains @ np.linalg.solve(shrink, precision @ gains)
+        n = self.instruments.sensors
+        return centre[:, :n], np.diagonal(covariance, axis1=1, axis2=2)[:, :n]
 
-def sample_posterior(likelihood: Likelihood, dimension: int, seed: int) -> np.ndarray:
-    """Unit-cube samples (WALKERS · KEPT_STEPS / THIN, p) of the posterior of ``likelihood``: the
-    walkers start at the best of START_CANDIDATES prior points, and after the burn-in every
-    straggler (:func:`stragglers`) restarts beside a walker in the posterior and the burn-in runs
-    again."""
+    def misfit(self, unit) -> tuple[float, list[float]]:
+        """(χ² of all the records together, [χ² of each record]) at the unit-cube point ``unit``
+        (p,), each with the full covariance that the likelihood gives it: the stacked records
+        N(1 ⊗ μ, blockdiag(Σ_r + Σ_K + V) + 11ᵀ ⊗ C), and record r alone N(μ, Σ_r + Σ_K + V + C)."""
+        mean, common, own = (value[0] for value in self.moments(np.atleast_2d(unit)))
+        records, m = self.data.records, len(mean)
+        joint = np.kron(np.ones((len(records), len(records))), common)
+        alone = []
+        for r, covariance in enumerate(self.data.covariances):
+            block = slice(r * m, (r + 1) * m)
+            joint[block, block] += covariance + own
+            residual = records[r] - mean
+            alone.append(float(residual @ np.linalg.solve(covariance + own + common, residual)))
+        stacked = (records - mean).ravel()
+        return float(stacked @ np.linalg.solve(joint, stacked)), alone
+
+
+@dataclass(frozen=True)
+class Chain:
+    """How emcee's kept chain mixed: the integrated ``autocorrelation_steps`` τ of each coordinate
+    (emcee's estimate, averaged over the walkers), the walkers' mean ``acceptance_fraction``, the
+    ``steps`` kept and the ``walkers``. The chain is long enough (:attr:`long_enough`) when it
+    holds :data:`AUTOCORRELATION_LENGTHS` τ per walker and :data:`EFFECTIVE_SAMPLES` independent
+    samples, walkers × steps / τ: enough to place a 90 % interval's ends to a few per cent of its width."""
+
+    autocorrelation_steps: tuple[float, ...]
+    acceptance_fraction: float
+    steps: int
+    walkers: int
+
+    @property
+    def effective_samples(self) -> float:
+        return self.walkers * self.steps / max(self.autocorrelation_steps)
+
+    @property
+    def long_enough(self) -> bool:
+        return (self.steps >= AUTOCORRELATION_LENGTHS * max(self.autocorrelation_steps)
+                and self.effective_samples >= EFFECTIVE_SAMPLES)
+
+    def as_dict(self) -> dict:
+        return {"autocorrelation_steps": list(self.autocorrelation_steps), "acceptance_fraction": self.acceptance_fraction,
+                "kept_steps": self.steps, "walkers": self.walkers, "effective_samples": self.effective_samples,
+                "long_enough": self.long_enough}
+
+
+#: Autocorrelation times that each walker's kept chain must hold.
+AUTOCORRELATION_LENGTHS = 10
+#: Independent samples that the kept chain must hold.
+EFFECTIVE_SAMPLES = 1000
+
+
+def sample_posterior(likelihood: Likelihood, dimension: int, seed: int) -> tuple[np.ndarray, Chain]:
+    """Unit-cube samples (WALKERS · KEPT_STEPS / THIN, p) of the posterior of ``likelihood``, and
+    how the chain mixed: the walkers start at the best of START_CANDIDATES prior points, and after
+    the burn-in every straggler (:func:`stragglers`) restarts beside a walker in the posterior and
+    the burn-in runs again."""
     import emcee
 
     rng = np.random.default_rng(seed)
@@ -142,7 +258,9 @@ def sample_posterior(likelihood: Likelihood, dimension: int, seed: int) -> np.nd
         state = sampler.run_mcmc(coords, BURN_IN_STEPS)
     sampler.reset()
     sampler.run_mcmc(state, KEPT_STEPS)
-    return sampler.get_chain(thin=THIN, flat=True)
+    tau = sampler.get_autocorr_time(quiet=True, tol=0)
+    chain = Chain(tuple(float(t) for t in tau), float(np.mean(sampler.acceptance_fraction)), KEPT_STEPS, WALKERS)
+    return sampler.get_chain(thin=THIN, flat=True), chain
 
 
 def stragglers(log_probability, dimension: int) -> np.ndarray:
@@ -160,7 +278,7 @@ def stragglers(log_probability, dimension: int) -> np.ndarray:
 class Fit:
     """One stage's fit: the simulated ``points`` (n, p) and their ``observables`` (n, K, m), the
     ``emulator`` of their mean over packings, the packings' ``spread``, the posterior
-    ``samples`` (unit cube) and the ``likelihood`` they sample."""
+    ``samples`` (unit cube) and the ``likelihood`` they sample, and how the ``chain`` mixed."""
 
     points: np.ndarray
     observables: np.ndarray
@@ -168,17 +286,20 @@ class Fit:
     spread: Spread
     samples: np.ndarray
     likelihood: Likelihood
+    chain: Chain
 
 
-def fit_stage(data: Data, points, observables, seed: int, model_error=None) -> Fit:
+def fit_stage(data: Data, points, observables, seed: int, model_error=None,
+              instruments: Instruments | None = None) -> Fit:
     """Fit the emulator to the simulations and sample the posterior it implies (``model_error``:
-    the covariance of the model's own integration error, :func:`step_error`)."""
+    the covariance of the model's own integration error, :func:`step_error`; ``instruments``: the
+    records' gains and speed scatter)."""
     points, observables = np.asarray(points, float), np.asarray(observables, float)
     emulator = Emulator(points, observables.mean(axis=1))
     spread = Spread(points, observables)
-    likelihood = Likelihood(data, emulator, spread, model_error)
-    samples = sample_posterior(likelihood, points.shape[1], seed)
-    return Fit(points, observables, emulator, spread, samples, likelihood)
+    likelihood = Likelihood(data, emulator, spread, model_error, instruments)
+    samples, chain = sample_posterior(likelihood, points.shape[1], seed)
+    return Fit(points, observables, emulator, spread, samples, likelihood, chain)
 
 
 def step_error(coarse, fine) -> np.ndarray:

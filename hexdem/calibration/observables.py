@@ -9,14 +9,24 @@ sensor's arrival relative to the first sensor's [µs]. The relative arrivals car
 the experiment's unknown time offset drops out, as the paper's Fig. 8 takes t = 0 at the first
 sensor.
 
+**The instruments.** A record is read as a lab writes it: in m/s², or in g
+(``--acceleration-unit g``); with both axes of a tri-axial sensor, or one (a file without an
+``ay`` column, or an axis whose channel is exactly constant: that axis is left out of the record,
+and the simulations' records are reduced with the same axes, so that like is compared with like).
+Every record must be sampled at one steady rate (the simulations then sample at it).
+
 **Noise.** A measured record's observables are uncertain through its accelerometer noise. That
-noise is measured on the record itself, on the samples before the pulse reaches its first sensor
-(the quiet lead-in that a triggered acquisition keeps: up to :data:`FOOT_SAMPLES` before its
-acceleration first reaches :data:`FOOT_LEVEL` of its peak), as the median absolute deviation
-× 1.4826 (the standard deviation of white noise, and blind to the pulse's foot if a few of its
-samples are in the window). Its effect is found by a parametric bootstrap: :data:`BOOTSTRAP_DRAWS` copies of the record, each
-with fresh white noise of that level added, reduced as the record is. The spread of their
-observables is the noise covariance of the record's observables.
+noise is measured channel by channel on the record itself, on the samples before the pulse
+reaches its first sensor (the quiet lead-in that a triggered acquisition keeps: up to
+:data:`FOOT_SAMPLES` before its acceleration first reaches :data:`FOOT_LEVEL` of its peak), as the
+median absolute deviation of the channel about its own median × 1.4826 (the standard deviation of
+white noise, blind to each channel's own offset and to the pulse's foot if a few of its samples
+are in the window). A lead-in that is not at rest, whose second half departs from its first by
+more than :data:`REST_TOLERANCE` standard errors (the pulse has begun: a record triggered late),
+is refused, for the offset removal would take the pulse's foot for the sensor's offset. The
+noise's effect is found by a parametric bootstrap: :data:`BOOTSTRAP_DRAWS` copies of the record,
+each with fresh white noise of each channel's level added, reduced as the record is. The spread
+of their observables is the noise covariance of the record's observables.
 """
 
 from __future__ import annotations
@@ -30,6 +40,16 @@ from hexdem.errors import HexdemError
 from hexdem.experiments.signals import BASELINE_SAMPLES, integrate_velocity, pulse
 
 MEASURED_COLUMNS = ("sensor", "time", "ax", "ay")
+#: The columns a measured file must have (``ay`` is absent for single-axis sensors; ``record`` optional).
+REQUIRED_COLUMNS = ("sensor", "time", "ax")
+#: Standard gravity [m/s²], by which records in g are read.
+STANDARD_GRAVITY_M_S2 = 9.80665
+#: The acceleration units a measured file may be in (``--acceleration-unit``) → their value in m/s².
+ACCELERATION_UNITS = {"m/s2": 1.0, "g": STANDARD_GRAVITY_M_S2}
+#: The largest relative difference between two sampling intervals of a steadily sampled record.
+STEADY_RATE_RTOL = 0.01
+#: Standard errors by which the second half of a lead-in may differ from its first while at rest.
+REST_TOLERANCE = 6.0
 #: Noisy copies of a record whose reduced observables give its noise covariance: enough that the
 #: estimate's own scatter does not make the likelihood overconfident (with 64, the posterior's spread
 #: along the parameters was 1.2 times the one it claimed; docs/validation/benchmarks.md).
@@ -49,11 +69,18 @@ ARRIVAL_UNIT_S = 1e-6
 @dataclass(frozen=True)
 class Record:
     """One impact as its sensors saw it: ``times`` [s] (K,) and ``accelerations`` [m/s²]
-    (n_sensors, K, 2), the sensors in the configuration's order."""
+    (n_sensors, K, 2), the sensors in the configuration's order, and the ``axes`` (n_sensors, 2) of
+    each sensor that were measured (an axis not measured holds zeros)."""
 
     name: str
     times: np.ndarray
     accelerations: np.ndarray
+    axes: np.ndarray
+
+    @property
+    def rate_hz(self) -> float:
+        """The sampling rate [Hz]."""
+        return float(1.0 / np.median(np.diff(self.times)))
 
 
 def observation_names(sensors) -> list[str]:
@@ -61,9 +88,12 @@ def observation_names(sensors) -> list[str]:
     return [f"log_peak:{s}" for s in sensors] + [f"arrival:{s}" for s in sensors[1:]]
 
 
-def reduce_record(times, accelerations) -> np.ndarray:
+def reduce_record(times, accelerations, axes=None) -> np.ndarray:
     """The observables of one record: log peak speeds [ln(m/s)], then arrivals relative to the
-    first sensor's [µs]."""
+    first sensor's [µs]; with ``axes`` (n_sensors, 2), each sensor's speed from its measured axes
+    alone."""
+    if axes is not None:
+        accelerations = np.asarray(accelerations) * np.asarray(axes, bool)[:, None, :]
     peaks, arrivals = [], []
     for channel in accelerations:
         vx, vy = integrate_velocity(times, channel[:, 0], channel[:, 1])
@@ -93,58 +123,98 @@ def lead_in(record: Record) -> int:
     return int(np.argmax(magnitude >= FOOT_LEVEL * magnitude.max())) - FOOT_SAMPLES
 
 
-def noise_covariance(record: Record, sensors, seed: int) -> tuple[np.ndarray, float]:
-    """(covariance of the record's observables under its own accelerometer noise, that noise's
-    standard deviation [m/s²]), by the parametric bootstrap described above; a sensor (of
-    ``sensors``, the record's) whose largest acceleration is not :data:`MIN_SIGNAL_TO_NOISE`
-    times the noise holds no pulse and is refused."""
+def noise_covariance(record: Record, sensors, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """(covariance of the record's observables under its own accelerometer noise, each channel's
+    noise standard deviation [m/s²] (n_sensors, 2), NaN where the axis was not measured), by the
+    parametric bootstrap described above. A record without a quiet lead-in, a channel whose
+    lead-in is exactly constant (its noise cannot be measured), and a sensor (of ``sensors``, the
+    record's) whose largest acceleration is not :data:`MIN_SIGNAL_TO_NOISE` times its noise (it
+    holds no pulse) are refused."""
     quiet = lead_in(record)
     if quiet < BASELINE_SAMPLES:
         raise HexdemError(f"it starts {max(quiet, 0)} samples before the pulse's foot at its first "
                           f"sensor; a calibration needs at least {BASELINE_SAMPLES} quiet samples to measure the "
-                          "accelerometer's noise")
-    quiet_samples = record.accelerations[:, :quiet, :]
-    noise = float(MAD_TO_SD * np.median(np.abs(quiet_samples - np.median(quiet_samples))))
-    for sensor, channel in zip(sensors, record.accelerations):
+                          "accelerometer's noise and offset (record with a pre-trigger lead-in)")
+    noise = np.full(record.axes.shape, np.nan)
+    for (s, j), measured in np.ndenumerate(record.axes):
+        if measured:
+            noise[s, j] = _channel_noise(record.accelerations[s, :quiet, j], f"sensor {sensors[s]}'s {'xy'[j]} axis")
+    for sensor, channel, levels in zip(sensors, record.accelerations, noise):
         peak = float(np.max(np.hypot(channel[:, 0], channel[:, 1])))
-        if peak < MIN_SIGNAL_TO_NOISE * noise:
+        level = float(np.nanmax(levels))
+        if peak < MIN_SIGNAL_TO_NOISE * level:
             raise HexdemError(f"sensor {sensor} shows no pulse above the accelerometer's noise "
-                              f"(largest {peak:.3g} m/s², noise {noise:.3g} m/s² rms): is the record long enough to "
+                              f"(largest {peak:.3g} m/s², noise {level:.3g} m/s² rms): is the record long enough to "
                               "hold its pulse?")
     rng = np.random.default_rng(seed)
-    draws = np.array([reduce_record(record.times, record.accelerations + rng.normal(0, noise, record.accelerations.shape))
-                      for _ in range(BOOTSTRAP_DRAWS)])
+    scale = np.nan_to_num(noise)[:, None, :]
+    draws = np.array([reduce_record(record.times, record.accelerations + scale * rng.standard_normal(
+        record.accelerations.shape), record.axes) for _ in range(BOOTSTRAP_DRAWS)])
     return np.cov(draws, rowvar=False), noise
 
 
-def read_measured(path, sensors) -> list[Record]:
-    """The records of the measured file ``path`` (columns ``sensor,time,ax,ay`` and an optional
-    ``record``), each holding exactly ``sensors`` sampled at the same increasing times."""
+def _channel_noise(lead, name: str) -> float:
+    """The noise standard deviation [m/s²] of one channel's ``lead``-in, which must be at rest."""
+    centre = np.median(lead)
+    noise = float(MAD_TO_SD * np.median(np.abs(lead - centre)))
+    if noise == 0.0:
+        noise = float(np.std(lead))
+    if noise == 0.0:
+        raise HexdemError(f"{name} is exactly constant over the lead-in: its noise cannot be measured "
+                          "(a channel constant over the whole record is left out)")
+    half = len(lead) // 2
+    drift = abs(float(np.median(lead[half:]) - np.median(lead[:half])))
+    standard_error = noise * np.sqrt(np.pi / 2) * np.sqrt(1 / half + 1 / (len(lead) - half))  # of two medians
+    if drift > REST_TOLERANCE * standard_error:
+        raise HexdemError(f"{name} is not at rest before the pulse (its lead-in drifts by {drift:.3g} m/s², "
+                          f"{drift / noise:.1f} times its noise): the record starts after the pulse has begun; a "
+                          f"calibration needs at least {BASELINE_SAMPLES} quiet samples before it (record with a "
+                          "pre-trigger lead-in)")
+    return noise
+
+
+def read_measured(path, sensors, unit: str = "m/s2") -> list[Record]:
+    """The records of the measured file ``path`` (columns ``sensor,time,ax``, optionally ``ay`` and
+    ``record``; accelerations in ``unit``, one of :data:`ACCELERATION_UNITS`), each holding exactly
+    ``sensors`` sampled at the same increasing times, at one steady rate shared by every record.
+    An axis whose column is absent, or exactly constant in a record, is left out for its sensor."""
+    if unit not in ACCELERATION_UNITS:
+        raise HexdemError(f"--acceleration-unit {unit!r}: use one of {', '.join(ACCELERATION_UNITS)}")
     try:
         with open(path, newline="") as fh:
             reader = csv.DictReader(fh)
             columns = reader.fieldnames or ()
-            missing = [c for c in MEASURED_COLUMNS if c not in columns]
+            missing = [c for c in REQUIRED_COLUMNS if c not in columns]
             if missing:
                 raise HexdemError(f"{path} lacks the column(s) {', '.join(missing)}; expected "
-                                  f"{','.join(MEASURED_COLUMNS)} and optionally record")
+                                  f"{','.join(MEASURED_COLUMNS)} (ay may be absent for single-axis sensors) and "
+                                  "optionally record")
+            present = [c for c in MEASURED_COLUMNS[1:] if c in columns]
             grouped: dict[str, dict[str, list]] = {}
             for line, row in enumerate(reader, start=2):
                 try:
-                    values = [float(row[c]) for c in MEASURED_COLUMNS[1:]]
+                    values = [float(row[c]) for c in present]
                 except (TypeError, ValueError):
                     raise HexdemError(f"{path}, line {line}: a value that is not a number") from None
                 if not np.all(np.isfinite(values)):
                     raise HexdemError(f"{path}, line {line}: a value that is NaN or infinite")
-                grouped.setdefault(row.get("record") or "0", {}).setdefault(row["sensor"], []).append(values)
+                grouped.setdefault(row.get("record") or "0", {}).setdefault(row["sensor"], []).append(
+                    values + [0.0] * (3 - len(values)))
     except OSError as exc:
         raise HexdemError(f"cannot read {path}: {exc.strerror}") from None
     if not grouped:
         raise HexdemError(f"{path} holds no measured samples")
-    return [_record(path, name, channels, [str(s) for s in sensors]) for name, channels in grouped.items()]
+    scale = ACCELERATION_UNITS[unit]
+    records = [_record(path, name, channels, [str(s) for s in sensors], scale, "ay" in present)
+               for name, channels in grouped.items()]
+    rates = [record.rate_hz for record in records]
+    if max(rates) > (1 + STEADY_RATE_RTOL) * min(rates):
+        raise HexdemError(f"{path}: the records are sampled at different rates ({min(rates):.6g} to "
+                          f"{max(rates):.6g} Hz); calibrate records of one rate together")
+    return _common_axes(path, records, [str(s) for s in sensors])
 
 
-def _record(path, name: str, channels: dict, sensors: list[str]) -> Record:
+def _record(path, name: str, channels: dict, sensors: list[str], scale: float, has_y: bool) -> Record:
     """One record's channels checked against the configuration's ``sensors``."""
     extra = [s for s in channels if s not in sensors]
     if extra:
@@ -164,4 +234,22 @@ def _record(path, name: str, channels: dict, sensors: list[str]) -> Record:
     if len(times) < 4 * BASELINE_SAMPLES:
         raise HexdemError(f"{path}, record {name}: {len(times)} samples are too few to hold a pulse "
                           f"(at least {4 * BASELINE_SAMPLES})")
-    return Record(name, times, np.stack([a[:, 1:] for a in arrays]))
+    intervals = np.diff(times)
+    if np.max(np.abs(intervals / np.median(intervals) - 1)) > STEADY_RATE_RTOL:
+        raise HexdemError(f"{path}, record {name}: not sampled at a steady rate (intervals from "
+                          f"{intervals.min() * 1e6:.4g} to {intervals.max() * 1e6:.4g} µs)")
+    accelerations = np.stack([a[:, 1:] for a in arrays]) * scale
+    axes = np.ptp(accelerations, axis=1) > 0
+    axes[:, 1] &= has_y
+    return Record(name, times, accelerations * axes[:, None, :], axes)
+
+
+def _common_axes(path, records: list[Record], sensors: list[str]) -> list[Record]:
+    """``records`` with each sensor's axes those measured (not constant) in every record; a
+    sensor left with no axis is refused."""
+    axes = np.logical_and.reduce([record.axes for record in records])
+    for sensor, measured in zip(sensors, axes):
+        if not measured.any():
+            raise HexdemError(f"{path}: sensor {sensor} has no axis that varies in every record (exactly constant "
+                              "channels hold no signal)")
+    return [Record(r.name, r.times, r.accelerations * axes[:, None, :], axes) for r in records]

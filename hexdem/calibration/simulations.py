@@ -46,13 +46,15 @@ CHECKED_QUANTILES = (0.0, 0.5, 1.0)
 @dataclass(frozen=True)
 class Problem:
     """What a calibration simulates: the base configuration table ``base``, the ``priors`` of
-    the parameters it draws, the ``realizations`` (packings) per parameter set and the
-    ``seed`` of the packings' diameters."""
+    the parameters it draws, the ``realizations`` (packings) per parameter set, the
+    ``seed`` of the packings' diameters, and the ``axes`` each sensor measured (x, y), with which
+    a simulation's record is reduced as the measured ones are (None: both)."""
 
     base: dict
     priors: tuple[Prior, ...]
     realizations: int = 1
     seed: int = 0
+    axes: tuple[tuple[bool, bool], ...] | None = None
 
     @property
     def keys(self) -> list[str]:
@@ -184,7 +186,7 @@ def simulate_point(problem: Problem, values, folder, realization: int = 0) -> li
         units, tracked = analysis.settings.units, analysis.tracked
         times = tracked.sensor_times * units.time_s
         accelerations = np.moveaxis(tracked.sensor_states[:, :, 2:4], 1, 0) * (units.length_m / units.time_s**2)
-        observables = reduce_record(*at_rest_before(times, accelerations))
+        observables = reduce_record(*at_rest_before(times, accelerations), problem.axes)
         write_json(partial / "observables.json", {"names": problem.names, "observables": observables.tolist(),
                                                   "engine_wall_time_s": analysis.engine.get("wall_time_s", math.nan)})
         os.replace(partial, folder)

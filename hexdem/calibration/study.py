@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.calibration import inference, plots
+from hexdem.calibration import diagnostics, inference, plots
 from hexdem.calibration.observables import noise_covariance, read_measured, reduce_record
 from hexdem.calibration.packings import DISORDER_REALIZATIONS, SIGMA_KEY, on_sigma_levels
 from hexdem.calibration.priors import parse_priors, to_parameters
@@ -37,15 +37,43 @@ STEP_CHECK = "step-check"
 PREDICTIVE_DRAWS = 2000
 
 
+#: ``--sensor-gain-sd``'s default: a calibrated accelerometer's sensitivity is known to about 2 %
+#: (its calibration certificate's uncertainty, before it is glued into a particle).
+DEFAULT_GAIN_SD = 0.02
+#: ``--speed-scatter``'s default: a striker released the same way each time, to about 1 % in speed.
+DEFAULT_SPEED_SCATTER = 0.01
+#: The largest relative standard deviation ``--sensor-gain-sd`` and ``--speed-scatter`` take: the
+#: instruments' errors enter the likelihood to first order.
+LARGEST_INSTRUMENT_SD = 0.2
+#: A record whose sampling rate differs from the configuration's ``sensor_rate_hz`` by more than
+#: this share has its simulations sampled at its own rate.
+RATE_RTOL = 0.01
+#: p-value below which a record, or the records together, do not fit the model.
+MISFIT_P = 0.01
+#: A share of the posterior's samples within :data:`BOUND_ZONE` of a bound of its prior (in the
+#: prior's unit cube, where the prior puts BOUND_ZONE there) from which the posterior piles against it.
+PILED_SHARE = 0.2
+BOUND_ZONE = 0.02
+#: Posterior samples at which each sensor's gain is estimated.
+GAIN_DRAWS = 256
+
+
 @dataclass(frozen=True)
 class Calibration:
-    """A checked calibration: the ``problem``, the measured ``data``, the stage sizes, ``seed``."""
+    """A checked calibration: the ``problem``, the measured ``data``, each record's noise per channel
+    ``channel_noise_m_s2`` (R, n_sensors, 2; NaN for an axis not measured), the stage sizes, ``seed``,
+    the records' ``instruments``, the ``acceleration_unit`` they were read in, their
+    ``rate_hz``, and ``notes`` on how they were read."""
 
     problem: Problem
     data: inference.Data
-    noise_m_s2: tuple[float, ...]
+    channel_noise_m_s2: np.ndarray
     stages: tuple[int, ...]
     seed: int
+    instruments: inference.Instruments
+    acceleration_unit: str = "m/s2"
+    rate_hz: float = 0.0
+    notes: tuple[str, ...] = ()
 
 
 def _realizations(priors, realizations: int | None) -> int:
@@ -62,37 +90,69 @@ def _realizations(priors, realizations: int | None) -> int:
     return realizations
 
 
-def prepare(base: dict, measured, prior_texts, budget: int | None, seed: int,
-            realizations: int | None = None) -> Calibration:
+def instrument_sd(option: str, value) -> float:
+    """``value`` of ``option`` (``--sensor-gain-sd``, ``--speed-scatter``): a relative standard
+    deviation in [0, :data:`LARGEST_INSTRUMENT_SD`], or a one-line HexdemError."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value <= LARGEST_INSTRUMENT_SD:
+        raise HexdemError(f"{option} {value!r}: a relative standard deviation in [0, {LARGEST_INSTRUMENT_SD}] (0.02 "
+                          "is 2 %)")
+    return float(value)
+
+
+def prepare(base: dict, measured, prior_texts, budget: int | None, seed: int, realizations: int | None = None,
+            gain_sd: float = DEFAULT_GAIN_SD, speed_scatter: float = DEFAULT_SPEED_SCATTER,
+            acceleration_unit: str = "m/s2") -> Calibration:
     """Every check of the input, in one line each and before any simulation. ``budget`` counts
-    simulations: parameter sets times ``realizations``."""
+    simulations: parameter sets times ``realizations``. The records' sampling rate, where it is not
+    the configuration's ``sensor_rate_hz``, becomes the simulations'; their measured axes, those
+    with which the simulations' records are reduced."""
     priors = parse_priors(prior_texts)
     realizations = _realizations(priors, realizations)
+    gain_sd, speed_scatter = instrument_sd("--sensor-gain-sd", gain_sd), instrument_sd("--speed-scatter", speed_scatter)
     problem = Problem(base, tuple(priors), realizations, seed)
     check_problem(problem)
+    records = read_measured(measured, problem.sensors, acceleration_unit)
+    notes, rate = [], records[0].rate_hz
+    configured = problem.config([prior.from_unit(0.5) for prior in priors]).sensor_rate_hz
+    if abs(rate / configured - 1) > RATE_RTOL:
+        notes.append(f"the records are sampled at {rate / 1e3:.6g} kS/s, not the configuration's "
+                     f"{configured / 1e3:.6g} kS/s: the simulations sample at the records' rate")
+        problem = replace(problem, base=problem.base | {"sensor_rate_hz": rate})
+        check_problem(problem)
+    axes = records[0].axes
+    if not axes.all():
+        left_out = [f"{sensor} {'xy'[j]}" for (s, j), measured_axis in np.ndenumerate(axes)
+                    for sensor in [problem.sensors[s]] if not measured_axis]
+        notes.append(f"axes not measured, left out of the records and the simulations alike: {', '.join(left_out)}")
+    problem = replace(problem, axes=tuple(tuple(bool(a) for a in row) for row in axes))
     dimension = len(priors)
     budget = (inference.default_budget(dimension) * realizations if budget is None
               else positive_int("--budget", budget))
     stages = inference.stage_sizes(dimension, budget // realizations, realizations)
-    records = read_measured(measured, problem.sensors)
     observed, covariances, noise = [], [], []
     for k, record in enumerate(records):
         try:
-            covariance, level = noise_covariance(record, problem.sensors, seed + k)
-            observed.append(reduce_record(record.times, record.accelerations))
+            covariance, levels = noise_covariance(record, problem.sensors, seed + k)
+            observed.append(reduce_record(record.times, record.accelerations, record.axes))
         except HexdemError as exc:
             raise HexdemError(f"{measured}, record {record.name}: {exc}") from None
         covariances.append(covariance)
-        noise.append(level)
-    data = inference.Data(np.array(observed), np.array(covariances), tuple(problem.names))
-    return Calibration(problem, data, tuple(noise), tuple(stages), seed)
+        noise.append(levels)
+    data = inference.Data(np.array(observed), np.array(covariances), tuple(problem.names),
+                          tuple(record.name for record in records))
+    instruments = inference.Instruments(len(problem.sensors), gain_sd, speed_scatter)
+    return Calibration(problem, data, np.array(noise), tuple(stages), seed, instruments, acceleration_unit, rate,
+                       tuple(notes))
 
 
 def _plan(calibration: Calibration, measured) -> dict:
     return {"base": calibration.problem.base, "priors": [p.as_dict() | {"key": p.key} for p in calibration.problem.priors],
             "realizations": calibration.problem.realizations, "stages": list(calibration.stages),
             "seed": calibration.seed, "measured": str(measured),
-            "records": calibration.data.records.tolist()}
+            "records": calibration.data.records.tolist(), "axes": calibration.problem.axes,
+            "instruments": {"sensor_gain_sd": calibration.instruments.gain_sd,
+                            "speed_scatter": calibration.instruments.speed_scatter,
+                            "acceleration_unit": calibration.acceleration_unit}}
 
 
 def _simulate_stage(calibration: Calibration, unit_points, first_index: int, out: Path, workers: int, parsl,
@@ -125,6 +185,8 @@ def calibrate(calibration: Calibration, measured, out, workers: int = 1, parsl=N
     problem, seed = calibration.problem, calibration.seed
     dimension = len(problem.priors)
     started = time.perf_counter()
+    for note in calibration.notes:
+        log(f"note: {note}")
     with locked_directory(out, "another hexdem calibrate"), holding(parsl, workers):
         keep_plan(out / PLAN_NAME, _plan(calibration, measured), "calibration")
         points, observables, failed, index, fit = np.empty((0, dimension)), None, 0, 0, None
@@ -144,14 +206,18 @@ def calibrate(calibration: Calibration, measured, out, workers: int = 1, parsl=N
             if len(points) < inference.initial_points(dimension) // 2:
                 raise HexdemError(f"{failed} of {index} simulations failed (see {out / SIMULATIONS}); too few are "
                                   "left to calibrate")
-            fit = inference.fit_stage(calibration.data, points, observables, seed + 1000 + stage, model_error)
+            fit = inference.fit_stage(calibration.data, points, observables, seed + 1000 + stage, model_error,
+                                      calibration.instruments)
             if step_check is None:
                 step_check = _check_time_step(calibration, fit, out, workers, parsl)
                 model_error = inference.step_error(step_check["coarse"], step_check["half"])
-                fit = inference.fit_stage(calibration.data, points, observables, seed + 1000 + stage, model_error)
+                fit = inference.fit_stage(calibration.data, points, observables, seed + 1000 + stage, model_error,
+                                          calibration.instruments)
         summary = _write_results(calibration, fit, out, failed, time.perf_counter() - started, step_check)
     for note in summary["identifiability"]:
         log(f"note: {note}")
+    for warning in summary["warnings"]:
+        log(f"warning: {warning}")
     return summary
 
 
@@ -192,14 +258,68 @@ def _write_results(calibration: Calibration, fit: inference.Fit, out: Path, fail
     summary["time_step_check"] = step_check | {
         "bias": (2.0 * (np.array(step_check["coarse"]) - np.array(step_check["half"]))).tolist()}
     summary["data"] = {"records": len(data.records), "sensors": problem.sensors, "observables": list(data.names),
-                       "accelerometer_noise_m_s2": list(calibration.noise_m_s2)}
+                       "accelerometer_noise_m_s2": [float(np.sqrt(np.nanmean(levels**2)))
+                                                    for levels in calibration.channel_noise_m_s2],
+                       "channel_noise_m_s2": [{sensor: [None if np.isnan(v) else float(v) for v in levels]
+                                               for sensor, levels in zip(problem.sensors, record)}
+                                              for record in calibration.channel_noise_m_s2],
+                       "axes": {sensor: [axis for axis, measured in zip("xy", row) if measured]
+                                for sensor, row in zip(problem.sensors, problem.axes)},
+                       "sampling_rate_hz": calibration.rate_hz, "acceleration_unit": calibration.acceleration_unit}
+    _diagnose(calibration, fit, summary)
     write_json(out / "calibration.json", summary)
     plots.corner(problem.priors, samples, out / "posterior.png")
     rng = np.random.default_rng(calibration.seed)
     draws = fit.samples[rng.choice(len(fit.samples), PREDICTIVE_DRAWS)]
-    mean, variance = fit.emulator.predict(draws)
+    mean, common, own = fit.likelihood.moments(draws)
     noise = np.mean(data.covariances, axis=0)
-    spread = fit.spread(draws) * (1 + 1 / problem.realizations)
-    predicted = np.array([rng.multivariate_normal(m, noise + s + np.diag(v)) for m, s, v in zip(mean, spread, variance)])
-    plots.predictive(problem.sensors, data.records, data.covariances, predicted, out / "predictive.png")
+    predicted = np.array([rng.multivariate_normal(m, noise + c + o) for m, c, o in zip(mean, common, own)])
+    misfit = diagnostics.misfit_records(summary["fit"], MISFIT_P)
+    plots.predictive(problem.sensors, _sensor_distances(problem, samples), data.records, data.covariances, predicted,
+                     out / "predictive.png", [name in misfit for name in data.record_names])
     return summary
+
+
+def _sensor_distances(problem: Problem, samples) -> np.ndarray:
+    """Each sensor's distance from the struck bead [nominal diameters], in the configuration at the
+    posterior median."""
+    from hexdem.model.model_builder import build_model
+    from hexdem.model.sensors import sensor_beads
+
+    config = problem.config(np.median(samples, axis=0).tolist())
+    packing = build_model(config).packing
+    beads = list(sensor_beads(config.sensors, packing).values())
+    offsets = packing.positions_m[beads] - packing.positions_m[packing.struck]
+    return np.hypot(*offsets.T) / np.median(packing.diameters_m)
+
+
+def _diagnose(calibration: Calibration, fit: inference.Fit, summary: dict) -> None:
+    """Into ``summary``: ``fit``, ``convergence``, ``emulator``, the gains (``instruments``), and
+    ``warnings`` (:mod:`~hexdem.calibration.diagnostics`)."""
+    problem, data, instruments = calibration.problem, calibration.data, calibration.instruments
+    median = np.median(fit.samples, axis=0)
+    summary["fit"] = diagnostics.goodness_of_fit(fit.likelihood, median, len(problem.priors))
+    summary["convergence"] = fit.chain.as_dict()
+    noise_sd = np.sqrt(np.mean(np.diagonal(data.covariances, axis1=1, axis2=2), axis=0))
+    summary["emulator"] = diagnostics.emulator_error(fit.emulator, data.names, noise_sd)
+    rng = np.random.default_rng(calibration.seed + 1)
+    summary["instruments"] = {"sensor_gain_sd": instruments.gain_sd, "speed_scatter": instruments.speed_scatter}
+    if instruments.gain_sd > 0:
+        chosen = fit.samples[rng.choice(len(fit.samples), min(GAIN_DRAWS, len(fit.samples)), replace=False)]
+        summary["instruments"]["gains"] = diagnostics.gain_estimates(fit.likelihood, chosen, problem.sensors, rng)
+    warnings = []
+    if summary["fit"]["p_value"] < MISFIT_P or diagnostics.misfit_records(summary["fit"], MISFIT_P):
+        bad = diagnostics.misfit_records(summary["fit"], MISFIT_P)
+        named = f"; record(s) {', '.join(bad)} (p < {MISFIT_P:g} each)" if bad else ""
+        warnings.append(f"the model does not fit the records: chi2 = {summary['fit']['chi2']:.4g} for "
+                        f"{summary['fit']['dof']} degrees of freedom (p = {summary['fit']['p_value']:.2g}){named}; the "
+                        "intervals say too little: check the records' units, gains and sensors, the configuration "
+                        "and the priors (predictive.png)."
+                        + diagnostics.in_g_hint(data.records, fit.observables, len(problem.sensors)))
+    warnings += diagnostics.piled_against_bounds(problem.priors, fit.samples, PILED_SHARE, BOUND_ZONE)
+    if not fit.chain.long_enough:
+        warnings.append(f"emcee's chain mixed slowly: {fit.chain.steps} steps of {fit.chain.walkers} walkers hold "
+                        f"{fit.chain.effective_samples:.0f} independent samples (autocorrelation "
+                        f"{max(fit.chain.autocorrelation_steps):.3g} steps; wanted {inference.EFFECTIVE_SAMPLES} and "
+                        f"{inference.AUTOCORRELATION_LENGTHS} autocorrelation times): its intervals are uncertain")
+    summary["warnings"] = warnings

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.calibration.observables import MEASURED_COLUMNS
+from hexdem.calibration.observables import ACCELERATION_UNITS, MEASURED_COLUMNS
 from hexdem.calibration.simulations import disordered_impact
 from hexdem.common.io import write_csv
 from hexdem.common.progress import silenced
@@ -26,11 +26,15 @@ from hexdem.model.config import RunConfig
 LEAD_IN_S = 100e-6
 
 
-def synthetic_rows(config: RunConfig, record: str, noise_m_s2: float, offset_s: float, rng, finer: int = 2,
-                   disorder: tuple[float, int, int] | None = None, packings=None) -> list:
+def synthetic_rows(config: RunConfig, record: str, noise_m_s2, offset_s: float, rng, finer: int = 2,
+                   disorder: tuple[float, int, int] | None = None, packings=None, gains=None, offsets_m_s2=None,
+                   lead_in_s: float = LEAD_IN_S) -> list:
     """Rows ``sensor,time,ax,ay,record`` of one synthetic record of ``config``: on the ideal
     lattice, or with ``disorder`` = (σ [m], seed, k) on that packing, settled in (or read from)
-    the folder ``packings``."""
+    the folder ``packings``. As a lab's instruments record it: ``noise_m_s2``, white noise of one
+    level or of one per channel (n_sensors, 2); ``gains`` (n_sensors,), each sensor's sensitivity
+    over its nominal one; ``offsets_m_s2`` (n_sensors, 2), each channel's DC offset; a pre-trigger
+    lead-in of ``lead_in_s``."""
     from hexdem.experiments.run import simulate
 
     fine = config.replace(steps_per_contact=config.steps_per_contact * finer)
@@ -41,14 +45,26 @@ def synthetic_rows(config: RunConfig, record: str, noise_m_s2: float, offset_s: 
     times = tracked.sensor_times * units.time_s
     accelerations = tracked.sensor_states[:, :, 2:4] * (units.length_m / units.time_s**2)
     interval = 1.0 / config.sensor_rate_hz
-    lead = np.arange(-round(LEAD_IN_S / interval), 0) * interval
+    lead = np.arange(-round(lead_in_s / interval), 0) * interval
     times = np.concatenate([lead, times]) + offset_s
     accelerations = np.concatenate([np.zeros((len(lead), *accelerations.shape[1:])), accelerations])
-    accelerations = accelerations + rng.normal(0.0, noise_m_s2, accelerations.shape)
+    if gains is not None:
+        accelerations = accelerations * np.asarray(gains, float)[None, :, None]
+    level = np.broadcast_to(np.asarray(noise_m_s2, float), accelerations.shape[1:])
+    accelerations = accelerations + level * rng.standard_normal(accelerations.shape)
+    if offsets_m_s2 is not None:
+        accelerations = accelerations + np.asarray(offsets_m_s2, float)
     return [(str(sensor), float(t), float(a[s, 0]), float(a[s, 1]), record)
             for s, sensor in enumerate(config.sensors) for t, a in zip(times, accelerations)]
 
 
-def write_measured(path, rows) -> None:
-    """A measured file of ``rows`` (:func:`synthetic_rows`), as ``hexdem calibrate`` reads it."""
-    write_csv(path, (*MEASURED_COLUMNS, "record"), rows)
+def write_measured(path, rows, unit: str = "m/s2", single_axis: bool = False) -> None:
+    """A measured file of ``rows`` (:func:`synthetic_rows`), as ``hexdem calibrate`` reads it: its
+    accelerations in ``unit`` (:data:`~hexdem.calibration.observables.ACCELERATION_UNITS`), and
+    without the ``ay`` column if ``single_axis``."""
+    scale = ACCELERATION_UNITS[unit]
+    rows = [(sensor, t, ax / scale, ay / scale, record) for sensor, t, ax, ay, record in rows]
+    if single_axis:
+        write_csv(path, ("sensor", "time", "ax", "record"), [(s, t, ax, r) for s, t, ax, _, r in rows])
+    else:
+        write_csv(path, (*MEASURED_COLUMNS, "record"), rows)

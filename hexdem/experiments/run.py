@@ -297,7 +297,7 @@ def run_experiment(config: RunConfig, out, log=None, command=None, prepared: Run
     packing, which their titles and ``summary.json`` still name as ``config``'s; ``failed_deck``:
     where a failed run keeps its deck, replacing what an earlier try kept there (default: a fresh
     ``hexdem-failed-*`` folder of the temporary directory)."""
-    log = log or (lambda message: print(f"hexdem: {message}", file=sys.stderr))
+    log = log or (lambda message: sys.stderr.write(f"hexdem: {message}\n"))  # one write: a stop never splits the line
     load_in_background("hexdem.analysis.run_maps", "hexdem.analysis.decay_figure", "scipy.spatial")  # the figures, while it runs
     with staged_directory(out, STAGING_PREFIX) as staging:
         try:

@@ -1,0 +1,89 @@
+"""What a calibration says about itself: whether the model fits the records, whether its chain
+mixed, how far its emulator is off, where its priors hold the posterior, and each sensor's gain.
+
+**The fit.** The records' χ² at the posterior median u* (each coordinate's median in the priors'
+unit cube), with the full covariance that the likelihood gives them
+(:meth:`~hexdem.calibration.inference.Likelihood.misfit`): the noise of each record, the
+packings' spread, the striker's speed scatter, and the errors common to every record (the
+emulator's, the time step's, the sensors' gains). Together the records give R m observables, less
+the p parameters fitted to them: χ² with R m − p degrees of freedom; each record alone, χ² with
+m. Their p-values are those of the χ² distribution, a check at one point of the posterior rather
+than a posterior predictive check: it is exact for a model linear in the parameters near u*, and
+cheap. A p-value below :data:`~hexdem.calibration.study.MISFIT_P` is a warning naming the records
+that do not fit: the model, the instruments or the configuration differ from what the records
+measured, and the intervals then say too little.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hexdem.calibration.observables import STANDARD_GRAVITY_M_S2
+
+
+def goodness_of_fit(likelihood, unit_median, parameters: int) -> dict:
+    """``fit`` of ``calibration.json``: ``chi2``, ``dof``, ``p_value`` of the records together and
+    ``records``, each record's ``record``, ``chi2`` and ``p_value`` (see the module docstring)."""
+    from scipy.stats import chi2 as chi_squared
+
+    data = likelihood.data
+    together, alone = likelihood.misfit(unit_median)
+    count, size = data.records.shape
+    dof = max(count * size - parameters, 1)
+    names = data.record_names or tuple(str(r) for r in range(count))
+    return {"method": "chi-square at the posterior median with the likelihood's full covariance",
+            "chi2": together, "dof": dof, "p_value": float(chi_squared.sf(together, dof)),
+            "records": [{"record": name, "chi2": value, "p_value": float(chi_squared.sf(value, size))}
+                        for name, value in zip(names, alone)]}
+
+
+def misfit_records(fit: dict, threshold: float) -> list[str]:
+    """The records of ``fit`` (:func:`goodness_of_fit`) whose p-value lies below ``threshold``."""
+    return [entry["record"] for entry in fit["records"] if entry["p_value"] < threshold]
+
+
+def in_g_hint(records, simulated, sensors: int) -> str:
+    """A sentence for records whose peak speeds lie below every simulation's by about standard
+    gravity's factor (records in g read as m/s²), else an empty one: ``records`` (R, m) and the
+    simulations' ``simulated`` (n, K, m) observables, the first ``sensors`` of them log peaks."""
+    measured = float(np.mean(records[:, :sensors]))
+    lowest, highest = float(np.min(simulated[..., :sensors])), float(np.max(simulated[..., :sensors]))
+    scaled = measured + np.log(STANDARD_GRAVITY_M_S2)
+    if measured < lowest - np.log(2.0) and lowest - 1.0 <= scaled <= highest + 1.0:
+        return (f" The measured peak speeds lie {np.exp(lowest - measured):.3g} times or more below every "
+                "simulation's: are the records in g? (--acceleration-unit g)")
+    return ""
+
+
+def piled_against_bounds(priors, unit_samples, share: float, zone: float) -> list[str]:
+    """Sentences for each bounded prior (uniform, loguniform) whose posterior puts more than ``share``
+    of its samples within ``zone`` of a bound in the unit cube (where the prior puts ``zone``)."""
+    notes = []
+    for j, prior in enumerate(priors):
+        if prior.kind == "normal":
+            continue
+        for side, mass, bound in (("lower", np.mean(unit_samples[:, j] < zone), prior.a),
+                                  ("upper", np.mean(unit_samples[:, j] > 1 - zone), prior.b)):
+            if mass > share:
+                notes.append(f"the posterior of {prior.key} piles against its prior's {side} bound {bound:g} "
+                             f"({mass:.0%} of it within {zone:.0%} of the prior's range from it): the records may "
+                             "want a value beyond it; widen the prior")
+    return notes
+
+
+def gain_estimates(likelihood, unit_samples, sensors, rng) -> dict:
+    """Each sensor's gain given the records: per sensor its ``median``, ``q05`` and ``q95``, from
+    the conditional normal of its log gain (:meth:`~hexdem.calibration.inference.Likelihood.log_gains`)
+    at each of ``unit_samples``, mixed."""
+    centre, variance = likelihood.log_gains(unit_samples)
+    draws = np.exp(centre + np.sqrt(np.maximum(variance, 0.0)) * rng.standard_normal(centre.shape))
+    return {str(sensor): dict(zip(("q05", "median", "q95"), map(float, np.quantile(draws[:, s], [0.05, 0.5, 0.95]))))
+            for s, sensor in enumerate(sensors)}
+
+
+def emulator_error(emulator, names, noise_sd) -> dict:
+    """The emulator's leave-one-out error per observable (``names``): its root mean square, and that
+    over the records' mean noise standard deviation ``noise_sd`` (m,)."""
+    rms = np.sqrt(np.mean(emulator.leave_one_out() ** 2, axis=0))
+    return {"leave_one_out_rms": dict(zip(names, map(float, rms))),
+            "leave_one_out_over_noise": dict(zip(names, map(float, rms / noise_sd)))}
