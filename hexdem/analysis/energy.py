@@ -137,17 +137,14 @@ def inertia_kg_m2(model: GranularModel) -> np.ndarray:
     return 0.4 * model.masses_kg * (model.diameters_m / 2) ** 2
 
 
-def total_energy_j(positions_m, velocities_m_s, model: GranularModel) -> float:
-    return kinetic_energy_j(velocities_m_s, model) + contact_energy_j(positions_m, model)
-
-
 class EnergyAudit:
     """Total energy [J] of successive states of one run, for the drift of a conservative model.
 
-    Equal to :func:`total_energy_j` minus the work of the constant forces (``gravity_m_s2``, if
-    given, and the model's held force on a precompressed packing's struck bead), but what does
-    not change during a run (masses, radii, regions, each wall's members and stiffness, the
-    candidate pairs' stiffness) is worked out once, and the candidate contact pairs are kept
+    Equal to :func:`kinetic_energy_j` plus :func:`contact_energy_j` minus the work of the constant
+    forces (``gravity_m_s2``, if given, and the model's held force on a precompressed packing's
+    struck bead), but what does not change during a run (masses, radii, regions, each wall's
+    members and stiffness, the candidate pairs' stiffness) is worked out once, and the candidate
+    contact pairs are kept
     between calls and searched again only after some body has moved half of
     :data:`PAIR_SKIN_D` bead diameters (or the bodies seen changed), so a large packing costs a
     few vector operations per state instead of a tree search.
