@@ -111,9 +111,11 @@ def test_the_far_wall_follows_what_moves(tmp_path):
     assert (loose.results.peak_speed == 0.0).sum() >= 1 and loose.results.far_wall_reached
 
 
-def test_the_peak_maps_scale_ends_at_the_largest_peak():
-    """A square's row (0.68 to 1 V0) fills the scale's top decade; a decaying front keeps its own
-    range; beads that never moved or are still rising do not stretch it."""
-    assert peak_scale([1.0, 0.75, 0.68, 0.0, np.nan]) == (pytest.approx(0.1), 1.0)
+def test_the_peak_maps_scale_follows_the_peaks():
+    """A square's row (0.68 to 1 V0) spans the whole scale; a decaying front keeps its own range;
+    equal peaks span a tenth below their value; beads that never moved or are still rising do not
+    stretch it."""
+    assert peak_scale([1.0, 0.75, 0.68, 0.0, np.nan]) == (0.68, 1.0)
+    assert peak_scale([0.5, 0.5]) == (pytest.approx(0.45), 0.5)
     assert peak_scale([1.0, 0.2, 0.004]) == (0.004, 1.0)
     assert peak_scale([1.0, 1e-5]) == (1e-3, 1.0)

@@ -12,6 +12,8 @@ from hexdem.analysis.plotting import SINGLE_PLOT_MARGINS, UNIT_LABELS, plain_log
 
 #: An observation line named by its angle with a sign ("+30", "-45"): its mirror line has the other sign.
 SIGNED_ANGLE = re.compile(r"[+-]\d+(\.\d*)?")
+#: A line named by an angle, signed, unsigned or mirrored (±).
+ANGLE = re.compile(r"[+±-]?\d+(\.\d*)?")
 
 
 def peak_decay(rows_by_line: dict, path, units_name: str, v0: float,
@@ -36,11 +38,11 @@ def peak_decay(rows_by_line: dict, path, units_name: str, v0: float,
             style["marker"] = "^" if line[0] == "+" else "v"
             if line[0] == "-" and _mirror(line) in peaks and _mirror(line) not in still:
                 style.update(markerfacecolor="none", linestyle="--", markersize=9)
-        ax.semilogy(n, np.where(peaks[line] > 0, peaks[line], np.nan), label=f"{line}°", **style)
+        ax.semilogy(n, np.where(peaks[line] > 0, peaks[line], np.nan), label=line_label(line), **style)
     handles, labels = ax.get_legend_handles_labels()
     for name in _mirrored_names(still):
         handles.append(Line2D([], [], linestyle="none"))
-        labels.append(f"{name}°: never moved")
+        labels.append(f"{line_label(name)}: never moved")
     ax.set_xlabel("bead n along the line")
     ax.set_ylabel(f"Vₙ / V₀   (V₀ = {v0:.4g} {units['speed']})")
     plain_log_ticks(ax.yaxis)
@@ -49,6 +51,12 @@ def peak_decay(rows_by_line: dict, path, units_name: str, v0: float,
     ax.legend(handles, labels, title="observation line")
     save(fig, path)
     return fig
+
+
+def line_label(name: str) -> str:
+    """An observation line's name in a legend: an angle with its degree sign (0°, +30°, ±45°), a
+    line of the configuration's own name as it is (up, diagonal)."""
+    return f"{name}°" if ANGLE.fullmatch(name) else name
 
 
 def _mirror(line: str) -> str:

@@ -47,12 +47,27 @@ def decade_label(value: float, position=None) -> str:
     return f"{value:g}"
 
 
+class _PlainLogFormatter(LogFormatter):
+    """matplotlib's choice of the minor ticks of a logarithmic axis to label, each labelled as a
+    plain number (0.9, 0.75) rather than 9e-01."""
+
+    def _num_to_string(self, x, vmin, vmax):
+        return f"{x:.3g}"
+
+
 def plain_log_ticks(axis) -> None:
-    """Label a logarithmic axis in plain text (10⁻², and 2e−02 where minor ticks are labelled),
-    at the ticks matplotlib itself picks: its default labels are mathtext, whose parser a run's
-    first figure would load (the run's figures carry no other mathtext)."""
-    axis.set_major_formatter(FuncFormatter(decade_label))
-    axis.set_minor_formatter(LogFormatter(labelOnlyBase=False))
+    """Label a logarithmic axis in plain text at the ticks matplotlib itself picks: 10⁻² at a
+    decade, and its labelled minor ticks as numbers (0.2, 0.9); on an axis of less than a decade,
+    whose labels are mostly minor ticks, every label a number (1 beside 0.9, not 10⁰). Its
+    default labels are mathtext, whose parser a run's first figure would load (the run's figures
+    carry no other mathtext)."""
+
+    def major(value, position=None) -> str:
+        low, high = sorted(axis.get_view_interval())
+        return f"{value:.3g}" if 0 < low and high < 10 * low else decade_label(value)
+
+    axis.set_major_formatter(FuncFormatter(major))
+    axis.set_minor_formatter(_PlainLogFormatter(labelOnlyBase=False))
 
 
 def set_title(ax, title: str) -> None:

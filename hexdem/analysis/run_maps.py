@@ -65,9 +65,16 @@ def chain_map(results, model, values, along, label: str, cmap="viridis", norm=No
     coloured = np.isfinite(values) & ~np.any(list(unmeasured.values()), axis=0)
     order = np.argsort(frame[:, 0])
     shown = np.where(coloured, values, np.nan)[order]
-    profile.plot(frame[order, 0], shown, color="0.55", linewidth=1, zorder=1)
+    sizes = np.round(diameters[order], 9)
+    kinds = sorted(set(sizes.tolist()), reverse=True)
+    for kind, style in zip(kinds, ("-", "--", ":", "-.") * len(kinds)):  # a dimer's heavy and light beads apart
+        mine = sizes == kind
+        profile.plot(frame[order, 0][mine], shown[mine], color="0.55", linewidth=1, linestyle=style, zorder=1,
+                     label=f"beads of d = {kind:.4g} {units['length']}" if len(kinds) > 1 else None)
     profile.scatter(frame[order, 0], shown, c=shown, cmap=colormaps[cmap], norm=norm, edgecolors="k", linewidths=0.4,
                     zorder=2)
+    if len(kinds) > 1:
+        profile.legend(fontsize="small")
     if isinstance(norm, LogNorm) and np.any(coloured):  # (a log axis of no value cannot be drawn)
         profile.set_yscale("log")
         plain_log_ticks(profile.yaxis)
@@ -107,17 +114,21 @@ def arrival_map(results, model, path, title="Wavefront arrival time") -> Figure:
                        f"arrival time [{units['time']}]", title, cmap="viridis_r")
 
 
+#: The share of its top that a peak map's scale spans at least (for peaks that are all equal).
+FLAT_SCALE = 0.9
+
+
 def peak_scale(ratio) -> tuple[float, float]:
     """(bottom, top) of a peak map's logarithmic colour scale for peaks ``ratio`` (over V0; 0 never
-    moved, NaN still rising): it ends at the largest peak and spans at least a decade, widened
-    downward (to 1e-3 at the lowest), so that peaks that barely decay (a square crystal's row) are
-    drawn in the scale's upper colours, not at its dark end."""
+    moved, NaN still rising): it follows the peaks, from the smallest (down to 1e-3 at the lowest)
+    to the largest, so that peaks that barely decay (a square crystal's row, 0.68 to 1) spread over
+    the whole scale; equal peaks span :data:`FLAT_SCALE` of their value to it."""
     ratio = np.asarray(ratio, float)
     moved = ratio[ratio > 0]
     if not len(moved):
         return 1e-1, 1.0
     top = float(np.max(moved))
-    return min(max(float(np.min(moved)), 1e-3), top / 10), top
+    return min(max(float(np.min(moved)), 1e-3), FLAT_SCALE * top), top
 
 
 def peak_map(results, model, v0: float, path, title="Peak speed") -> Figure:

@@ -16,9 +16,8 @@ bands shaded; records that do not fit the model (:mod:`~hexdem.calibration.diagn
 from __future__ import annotations
 
 import numpy as np
-from matplotlib.ticker import FuncFormatter
 
-from hexdem.analysis.plotting import save, subplots
+from hexdem.analysis.plotting import plain_log_ticks, save, subplots
 from hexdem.calibration.observables import ARRIVAL_UNIT_S
 
 #: Axis labels of the keys a calibration usually has: (label, factor from the key's unit to the label's).
@@ -112,11 +111,7 @@ def predictive(sensors, distances, records, covariances, predicted, path, misfit
             ax.plot(np.tile(x, misfit.sum()), measured[misfit].ravel(), "x", color="C1", ms=8, mew=2,
                     label="records that do not fit (p < 0.01)")
     ax_peak.set_yscale("log")
-    low, high = ax_peak.get_ylim()
-    if high < 10 * low:  # a log axis of less than a decade: its minor ticks carry the numbers, in full
-        plain = FuncFormatter(lambda value, _: f"{value:.3g}")
-        ax_peak.yaxis.set_major_formatter(plain)
-        ax_peak.yaxis.set_minor_formatter(plain)
+    plain_log_ticks(ax_peak.yaxis)
     ax_peak.set_ylabel("peak speed [m/s]")
     ax_peak.set_title("Peak speed at each sensor")
     ax_arrival.set_ylabel(f"arrival after sensor {sensors[0]} [ms]")
