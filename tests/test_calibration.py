@@ -7,6 +7,7 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -527,3 +528,16 @@ def test_a_record_the_model_cannot_fit_is_a_warning(lab_record, tmp_path, capsys
     assert len(warnings) == 1 and "the model does not fit the records" in warnings[0] and said in warnings[0]
     summary = json.loads((tmp_path / "out" / "calibration.json").read_text())
     assert summary["fit"]["records"][0]["p_value"] < 0.01 and summary["warnings"]
+
+
+def test_the_guides_measured_example_passes_every_input_check():
+    """The example the calibration guide's first command calibrates: two records of the tiny case,
+    each holding both sensors on both axes at 500 kS/s with a quiet lead-in."""
+    from hexdem.calibration.study import prepare
+    from hexdem.experiments.sweep_plan import read_base
+
+    examples = Path(__file__).resolve().parents[1] / "docs" / "guide" / "examples"
+    calibration = prepare(read_base(str(examples / "calibration-base.toml")), examples / "measured.csv",
+                          ["v0=uniform(0.2, 0.7)", "restitution=uniform(0.8, 1.0)"], None, 0)
+    assert calibration.data.record_names == ("1", "2") and calibration.rate_hz == pytest.approx(500e3)
+    assert calibration.notes == ()
