@@ -13,8 +13,9 @@ zero on the ideal lattice), and its striker's speed off the calibrated one, V(u)
 (:class:`Instruments`), independent between records, each record being one packing and one
 strike; and e the error common to every record: the emulator's variance s²(u), Σ_K(u)/K, for a
 mean over K packings is not the mean over all, and each sensor's gain, the same in all its
-records (:class:`Instruments`). With D_r = Σ_r + Σ_K + V, P = Σ_r D_r⁻¹ and
-b = Σ_r D_r⁻¹ (y_r − μ), integrating e out gives
+records (:class:`Instruments`), and what the model cannot represent, a discrepancy of relative
+size τ (:class:`Discrepancy`, Kennedy & O'Hagan's δ, whose τ is sampled with u). With
+D_r = Σ_r + Σ_K + V, P = Σ_r D_r⁻¹ and b = Σ_r D_r⁻¹ (y_r − μ), integrating e out gives
 
     log p = Σ_r log N(y_r; μ, D_r) − ½ log det(I + C P) + ½ bᵀ (I + C P)⁻¹ C b,
 
@@ -116,6 +117,35 @@ class Instruments:
 
 
 @dataclass(frozen=True)
+class Discrepancy:
+    """What the model cannot represent (Kennedy & O'Hagan 2001): a discrepancy δ between the model's
+    observables and the records', the same in every record of one experiment, δ ~ N(0, τ² W) with
+    W = diag(1, …, 1, t_2², …): a relative error τ of every peak speed (its log moves by τ) and of
+    every relative arrival t_j (emulated at u), whatever its cause (another preparation, friction,
+    a wall of other stiffness). τ is unknown: its prior is log-uniform on [``low``, ``high``], and
+    it is sampled with the parameters, the last coordinate of the sampler's unit cube. Records that
+    the model fits leave τ below their noise, where it changes nothing; records it does not fit
+    raise it, and the parameters' intervals widen to what the misfit allows."""
+
+    sensors: int
+    low: float = 1e-4
+    high: float = 0.2
+
+    def size(self, unit) -> np.ndarray:
+        """τ (k,) of the unit-cube coordinates ``unit`` (k,)."""
+        return self.low * (self.high / self.low) ** np.asarray(unit, float)
+
+    def covariance(self, mean, unit) -> np.ndarray:
+        """τ² W (k, m, m) at the emulated means ``mean`` (k, m) and τ's coordinates ``unit`` (k,)."""
+        mean = np.atleast_2d(mean)
+        weights = np.column_stack([np.ones((len(mean), self.sensors)), mean[:, self.sensors:] ** 2])
+        return (self.size(unit) ** 2)[:, None, None] * weights[:, :, None] * np.eye(mean.shape[1])
+
+    def as_dict(self) -> dict:
+        return {"prior": f"loguniform({self.low:g}, {self.high:g})", "meaning": "relative size of the model's error"}
+
+
+@dataclass(frozen=True)
 class Data:
     """The measured records' observables ``records`` (R, m), their noise covariances
     ``covariances`` (R, m, m), the observables' ``names``, and the records' own names
@@ -132,18 +162,29 @@ class Likelihood:
     (see the module docstring; without instruments, none of their errors)."""
 
     def __init__(self, data: Data, emulator: Emulator, spread: Spread, model_error=None,
-                 instruments: Instruments | None = None):
+                 instruments: Instruments | None = None, discrepancy: Discrepancy | None = None):
         self.data, self.emulator, self.spread = data, emulator, spread
         self.model_error = 0.0 if model_error is None else np.asarray(model_error, float)
         self.instruments = instruments or Instruments(1 + data.records.shape[1] // 2)
+        self.discrepancy = discrepancy
+
+    @property
+    def dimension(self) -> int:
+        """The sampler's coordinates: the parameters', and τ's with a :class:`Discrepancy`."""
+        return self.emulator.x.shape[1] + (self.discrepancy is not None)
 
     def moments(self, unit) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """At unit-cube points ``unit`` (k, p): the emulated mean μ (k, m), the common error's
-        covariance C (k, m, m) and what each record adds to its own noise, Σ_K + V (k, m, m)."""
-        mean, variance = self.emulator.predict(unit)
-        spread = self.spread(unit)
+        """At the sampler's unit-cube points ``unit`` (k, :attr:`dimension`): the emulated mean μ
+        (k, m), the common error's covariance C (k, m, m) and what each record adds to its own
+        noise, Σ_K + V (k, m, m)."""
+        unit = np.atleast_2d(unit)
+        parameters = unit[:, :self.emulator.x.shape[1]]
+        mean, variance = self.emulator.predict(parameters)
+        spread = self.spread(parameters)
         common = (variance[:, :, None] * np.eye(mean.shape[1]) + spread / self.spread.realizations
                   + self.model_error + self.instruments.common())
+        if self.discrepancy is not None:
+            common = common + self.discrepancy.covariance(mean, unit[:, -1])
         return mean, common, spread + self.instruments.per_record(mean)
 
     def _pooled(self, mean, own):
@@ -171,8 +212,8 @@ class Likelihood:
         return result
 
     def log_gains(self, unit) -> tuple[np.ndarray, np.ndarray]:
-        """(mean (k, n), variance (k, n)) of each sensor's log gain given the records, at unit-cube
-        points ``unit`` (k, p): g is part of the common error e, so with G its covariance,
+        """(mean (k, n), variance (k, n)) of each sensor's log gain given the records, at the
+        sampler's points ``unit`` (:meth:`moments`): g is part of the common error e, so with G its covariance,
         E[g | y] = G (I + P C)⁻¹ b and Cov[g | y] = G − G (I + P C)⁻¹ P G."""
         mean, common, own = self.moments(np.atleast_2d(unit))
         _, precision, pulled = self._pooled(mean, own)
@@ -184,8 +225,8 @@ class Likelihood:
         return centre[:, :n], np.diagonal(covariance, axis1=1, axis2=2)[:, :n]
 
     def misfit(self, unit) -> tuple[float, list[float]]:
-        """(χ² of all the records together, [χ² of each record]) at the unit-cube point ``unit``
-        (p,), each with the full covariance that the likelihood gives it: the stacked records
+        """(χ² of all the records together, [χ² of each record]) at the sampler's point ``unit``
+        (:meth:`moments`), each with the full covariance that the likelihood gives it: the stacked records
         N(1 ⊗ μ, blockdiag(Σ_r + Σ_K + V) + 11ᵀ ⊗ C), and record r alone N(μ, Σ_r + Σ_K + V + C)."""
         mean, common, own = (value[0] for value in self.moments(np.atleast_2d(unit)))
         records, m = self.data.records, len(mean)
@@ -278,28 +319,40 @@ def stragglers(log_probability, dimension: int) -> np.ndarray:
 class Fit:
     """One stage's fit: the simulated ``points`` (n, p) and their ``observables`` (n, K, m), the
     ``emulator`` of their mean over packings, the packings' ``spread``, the posterior
-    ``samples`` (unit cube) and the ``likelihood`` they sample, and how the ``chain`` mixed."""
+    ``states`` the sampler visited (unit cube: the parameters', then τ's with a discrepancy), the
+    ``likelihood`` they sample, and how the ``chain`` mixed."""
 
     points: np.ndarray
     observables: np.ndarray
     emulator: Emulator
     spread: Spread
-    samples: np.ndarray
+    states: np.ndarray
     likelihood: Likelihood
     chain: Chain
 
+    @property
+    def samples(self) -> np.ndarray:
+        """The posterior's samples of the parameters (unit cube, (n, p))."""
+        return self.states[:, :self.points.shape[1]]
+
+    @property
+    def discrepancy_sizes(self) -> np.ndarray | None:
+        """The posterior's samples of the discrepancy's relative size τ, or None without one."""
+        discrepancy = self.likelihood.discrepancy
+        return None if discrepancy is None else discrepancy.size(self.states[:, -1])
+
 
 def fit_stage(data: Data, points, observables, seed: int, model_error=None,
-              instruments: Instruments | None = None) -> Fit:
+              instruments: Instruments | None = None, discrepancy: Discrepancy | None = None) -> Fit:
     """Fit the emulator to the simulations and sample the posterior it implies (``model_error``:
     the covariance of the model's own integration error, :func:`step_error`; ``instruments``: the
-    records' gains and speed scatter)."""
+    records' gains and speed scatter; ``discrepancy``: what the model cannot represent)."""
     points, observables = np.asarray(points, float), np.asarray(observables, float)
     emulator = Emulator(points, observables.mean(axis=1))
     spread = Spread(points, observables)
-    likelihood = Likelihood(data, emulator, spread, model_error, instruments)
-    samples, chain = sample_posterior(likelihood, points.shape[1], seed)
-    return Fit(points, observables, emulator, spread, samples, likelihood, chain)
+    likelihood = Likelihood(data, emulator, spread, model_error, instruments, discrepancy)
+    states, chain = sample_posterior(likelihood, likelihood.dimension, seed)
+    return Fit(points, observables, emulator, spread, states, likelihood, chain)
 
 
 def step_error(coarse, fine) -> np.ndarray:

@@ -54,6 +54,9 @@ MISFIT_P = 0.01
 #: prior's unit cube, where the prior puts BOUND_ZONE there) from which the posterior piles against it.
 PILED_SHARE = 0.2
 BOUND_ZONE = 0.02
+#: The model discrepancy's relative size (its 5 % quantile) from which the records are said to differ
+#: from the model: half a per cent, above what the time step and the emulator leave.
+DISCREPANCY_WARNING = 0.005
 #: Posterior samples at which each sensor's gain is estimated.
 GAIN_DRAWS = 256
 
@@ -63,7 +66,8 @@ class Calibration:
     """A checked calibration: the ``problem``, the measured ``data``, each record's noise per channel
     ``channel_noise_m_s2`` (R, n_sensors, 2; NaN for an axis not measured), the stage sizes, ``seed``,
     the records' ``instruments``, the ``acceleration_unit`` they were read in, their
-    ``rate_hz``, and ``notes`` on how they were read."""
+    ``rate_hz``, ``notes`` on how they were read, and the model's ``discrepancy`` (None: the model
+    taken as exact)."""
 
     problem: Problem
     data: inference.Data
@@ -74,6 +78,7 @@ class Calibration:
     acceleration_unit: str = "m/s2"
     rate_hz: float = 0.0
     notes: tuple[str, ...] = ()
+    discrepancy: inference.Discrepancy | None = None
 
 
 def _realizations(priors, realizations: int | None) -> int:
@@ -101,7 +106,7 @@ def instrument_sd(option: str, value) -> float:
 
 def prepare(base: dict, measured, prior_texts, budget: int | None, seed: int, realizations: int | None = None,
             gain_sd: float = DEFAULT_GAIN_SD, speed_scatter: float = DEFAULT_SPEED_SCATTER,
-            acceleration_unit: str = "m/s2") -> Calibration:
+            acceleration_unit: str = "m/s2", model_discrepancy: bool = True) -> Calibration:
     """Every check of the input, in one line each and before any simulation. ``budget`` counts
     simulations: parameter sets times ``realizations``. The records' sampling rate, where it is not
     the configuration's ``sensor_rate_hz``, becomes the simulations'; their measured axes, those
@@ -141,8 +146,9 @@ def prepare(base: dict, measured, prior_texts, budget: int | None, seed: int, re
     data = inference.Data(np.array(observed), np.array(covariances), tuple(problem.names),
                           tuple(record.name for record in records))
     instruments = inference.Instruments(len(problem.sensors), gain_sd, speed_scatter)
+    discrepancy = inference.Discrepancy(len(problem.sensors)) if model_discrepancy else None
     return Calibration(problem, data, np.array(noise), tuple(stages), seed, instruments, acceleration_unit, rate,
-                       tuple(notes))
+                       tuple(notes), discrepancy)
 
 
 def _plan(calibration: Calibration, measured) -> dict:
@@ -152,7 +158,8 @@ def _plan(calibration: Calibration, measured) -> dict:
             "records": calibration.data.records.tolist(), "axes": calibration.problem.axes,
             "instruments": {"sensor_gain_sd": calibration.instruments.gain_sd,
                             "speed_scatter": calibration.instruments.speed_scatter,
-                            "acceleration_unit": calibration.acceleration_unit}}
+                            "acceleration_unit": calibration.acceleration_unit},
+            "model_discrepancy": calibration.discrepancy is not None}
 
 
 def _simulate_stage(calibration: Calibration, unit_points, first_index: int, out: Path, workers: int, parsl,
@@ -207,12 +214,12 @@ def calibrate(calibration: Calibration, measured, out, workers: int = 1, parsl=N
                 raise HexdemError(f"{failed} of {index} simulations failed (see {out / SIMULATIONS}); too few are "
                                   "left to calibrate")
             fit = inference.fit_stage(calibration.data, points, observables, seed + 1000 + stage, model_error,
-                                      calibration.instruments)
+                                      calibration.instruments, calibration.discrepancy)
             if step_check is None:
                 step_check = _check_time_step(calibration, fit, out, workers, parsl)
                 model_error = inference.step_error(step_check["coarse"], step_check["half"])
                 fit = inference.fit_stage(calibration.data, points, observables, seed + 1000 + stage, model_error,
-                                          calibration.instruments)
+                                          calibration.instruments, calibration.discrepancy)
         summary = _write_results(calibration, fit, out, failed, time.perf_counter() - started, step_check)
     for note in summary["identifiability"]:
         log(f"note: {note}")
@@ -225,7 +232,7 @@ def _check_time_step(calibration: Calibration, fit: inference.Fit, out: Path, wo
     """The stage-0 posterior's most likely sample run at the calibration's time step and at half
     of it, on packing 0, two tasks of the study executor (:func:`~hexdem.calibration.inference.step_error`)."""
     problem = calibration.problem
-    unit = fit.samples[int(np.argmax(fit.likelihood(fit.samples)))][None]
+    unit = fit.samples[int(np.argmax(fit.likelihood(fit.states)))][None]
     if SIGMA_KEY in problem.keys:  # on a level, so that it runs on a packing of the calibration's
         unit = on_sigma_levels(unit, problem.keys.index(SIGMA_KEY))
     values = to_parameters(problem.priors, unit)[0].tolist()
@@ -270,7 +277,7 @@ def _write_results(calibration: Calibration, fit: inference.Fit, out: Path, fail
     write_json(out / "calibration.json", summary)
     plots.corner(problem.priors, samples, out / "posterior.png")
     rng = np.random.default_rng(calibration.seed)
-    draws = fit.samples[rng.choice(len(fit.samples), PREDICTIVE_DRAWS)]
+    draws = fit.states[rng.choice(len(fit.states), PREDICTIVE_DRAWS)]
     mean, common, own = fit.likelihood.moments(draws)
     noise = np.mean(data.covariances, axis=0)
     predicted = np.array([rng.multivariate_normal(m, noise + c + o) for m, c, o in zip(mean, common, own)])
@@ -297,15 +304,19 @@ def _diagnose(calibration: Calibration, fit: inference.Fit, summary: dict) -> No
     """Into ``summary``: ``fit``, ``convergence``, ``emulator``, the gains (``instruments``), and
     ``warnings`` (:mod:`~hexdem.calibration.diagnostics`)."""
     problem, data, instruments = calibration.problem, calibration.data, calibration.instruments
-    median = np.median(fit.samples, axis=0)
+    median = np.median(fit.states, axis=0)
     summary["fit"] = diagnostics.goodness_of_fit(fit.likelihood, median, len(problem.priors))
     summary["convergence"] = fit.chain.as_dict()
     noise_sd = np.sqrt(np.mean(np.diagonal(data.covariances, axis1=1, axis2=2), axis=0))
     summary["emulator"] = diagnostics.emulator_error(fit.emulator, data.names, noise_sd)
     rng = np.random.default_rng(calibration.seed + 1)
     summary["instruments"] = {"sensor_gain_sd": instruments.gain_sd, "speed_scatter": instruments.speed_scatter}
+    if fit.discrepancy_sizes is not None:
+        q05, median_size, q95 = np.quantile(fit.discrepancy_sizes, [0.05, 0.5, 0.95])
+        summary["model_discrepancy"] = calibration.discrepancy.as_dict() | {
+            "median": float(median_size), "q05": float(q05), "q95": float(q95)}
     if instruments.gain_sd > 0:
-        chosen = fit.samples[rng.choice(len(fit.samples), min(GAIN_DRAWS, len(fit.samples)), replace=False)]
+        chosen = fit.states[rng.choice(len(fit.states), min(GAIN_DRAWS, len(fit.states)), replace=False)]
         summary["instruments"]["gains"] = diagnostics.gain_estimates(fit.likelihood, chosen, problem.sensors, rng)
     warnings = []
     if summary["fit"]["p_value"] < MISFIT_P or diagnostics.misfit_records(summary["fit"], MISFIT_P):
@@ -316,6 +327,12 @@ def _diagnose(calibration: Calibration, fit: inference.Fit, summary: dict) -> No
                         "intervals say too little: check the records' units, gains and sensors, the configuration "
                         "and the priors (predictive.png)."
                         + diagnostics.in_g_hint(data.records, fit.observables, len(problem.sensors)))
+    if "model_discrepancy" in summary and summary["model_discrepancy"]["q05"] > DISCREPANCY_WARNING:
+        size = summary["model_discrepancy"]
+        warnings.append(f"the records differ from the model by a relative {size['median']:.2g} (90 % interval "
+                        f"[{size['q05']:.2g}, {size['q95']:.2g}]) that neither their noise nor the instruments explain: "
+                        "the model misses something the records hold (dissipation, friction, the walls, the "
+                        "packing?); the intervals allow for it, and are wider for it")
     warnings += diagnostics.piled_against_bounds(problem.priors, fit.samples, PILED_SHARE, BOUND_ZONE)
     if not fit.chain.long_enough:
         warnings.append(f"emcee's chain mixed slowly: {fit.chain.steps} steps of {fit.chain.walkers} walkers hold "

@@ -43,6 +43,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--acceleration-unit", choices=sorted(ACCELERATION_UNITS), default="m/s2",
                         help="the unit of the measured file's ax and ay (default m/s2; g: multiples of standard "
                              "gravity, 9.80665 m/s2)")
+    parser.add_argument("--no-model-discrepancy", dest="model_discrepancy", action="store_false",
+                        help="take the model as exact: no discrepancy term (by default a relative model error tau, "
+                             "log-uniform on [1e-4, 0.2], common to all records, is sampled with the parameters)")
     parser.add_argument("--seed", type=int, default=0, metavar="S",
                         help="seed of every random choice: the same seed gives the same posterior (default 0)")
     add_workers_or_parsl(parser, 1, "simulations at once, locally (default 1)")
@@ -53,7 +56,7 @@ def run(args) -> None:
     from hexdem.experiments.sweep_plan import read_base
 
     calibration = prepare(read_base(args.config), args.measured, args.prior, args.budget, args.seed, args.realizations,
-                          args.sensor_gain_sd, args.speed_scatter, args.acceleration_unit)
+                          args.sensor_gain_sd, args.speed_scatter, args.acceleration_unit, args.model_discrepancy)
     summary = calibrate(calibration, args.measured, args.out, args.workers, args.parsl,
                         log=lambda message: print(f"hexdem: {message}", flush=True))
     for key, entry in summary["parameters"].items():
