@@ -117,19 +117,7 @@ def prepare(base: dict, measured, prior_texts, budget: int | None, seed: int, re
     problem = Problem(base, tuple(priors), realizations, seed)
     check_problem(problem)
     records = read_measured(measured, problem.sensors, acceleration_unit)
-    notes, rate = [], records[0].rate_hz
-    configured = problem.config([prior.from_unit(0.5) for prior in priors]).sensor_rate_hz
-    if abs(rate / configured - 1) > RATE_RTOL:
-        notes.append(f"the records are sampled at {rate / 1e3:.6g} kS/s, not the configuration's "
-                     f"{configured / 1e3:.6g} kS/s: the simulations sample at the records' rate")
-        problem = replace(problem, base=problem.base | {"sensor_rate_hz": rate})
-        check_problem(problem)
-    axes = records[0].axes
-    if not axes.all():
-        left_out = [f"{sensor} {'xy'[j]}" for (s, j), measured_axis in np.ndenumerate(axes)
-                    for sensor in [problem.sensors[s]] if not measured_axis]
-        notes.append(f"axes not measured, left out of the records and the simulations alike: {', '.join(left_out)}")
-    problem = replace(problem, axes=tuple(tuple(bool(a) for a in row) for row in axes))
+    problem, notes = _as_measured(problem, records)
     dimension = len(priors)
     budget = (inference.default_budget(dimension) * realizations if budget is None
               else positive_int("--budget", budget))
@@ -147,8 +135,25 @@ def prepare(base: dict, measured, prior_texts, budget: int | None, seed: int, re
                           tuple(record.name for record in records))
     instruments = inference.Instruments(len(problem.sensors), gain_sd, speed_scatter)
     discrepancy = inference.Discrepancy(len(problem.sensors)) if model_discrepancy else None
-    return Calibration(problem, data, np.array(noise), tuple(stages), seed, instruments, acceleration_unit, rate,
-                       tuple(notes), discrepancy)
+    return Calibration(problem, data, np.array(noise), tuple(stages), seed, instruments, acceleration_unit,
+                       records[0].rate_hz, tuple(notes), discrepancy)
+
+
+def _as_measured(problem: Problem, records) -> tuple[Problem, list[str]]:
+    """``problem`` simulated as ``records`` were measured, and notes saying how: sampled at their
+    rate where it is not the configuration's ``sensor_rate_hz``, reduced with their axes."""
+    notes, rate = [], records[0].rate_hz
+    configured = problem.config([prior.from_unit(0.5) for prior in problem.priors]).sensor_rate_hz
+    if abs(rate / configured - 1) > RATE_RTOL:
+        notes.append(f"the records are sampled at {rate / 1e3:.6g} kS/s, not the configuration's "
+                     f"{configured / 1e3:.6g} kS/s: the simulations sample at the records' rate")
+        problem = replace(problem, base=problem.base | {"sensor_rate_hz": rate})
+        check_problem(problem)
+    axes = records[0].axes
+    if not axes.all():
+        left_out = [f"{problem.sensors[s]} {'xy'[j]}" for s, j in zip(*np.nonzero(~axes))]
+        notes.append(f"axes not measured, left out of the records and the simulations alike: {', '.join(left_out)}")
+    return replace(problem, axes=tuple(tuple(bool(a) for a in row) for row in axes)), notes
 
 
 def _plan(calibration: Calibration, measured) -> dict:
