@@ -150,10 +150,9 @@ def test_the_kernels_refuse_arrays_they_cannot_read_and_indices_outside_them():
 
 def test_the_kernels_take_every_argument_by_name_and_check_it_by_name():
     """The tracker's state is bound by name: an array of the wrong shape under a name, a missing
-    name, an unknown one or an argument given by position is refused, naming the argument. The
-    arrays the positional binding let through when swapped (``rec_prev``/``rec_prev2``,
-    ``start``/``length``, of one type and shape) cannot be swapped by their order, and each is
-    checked against its own name's type and shape."""
+    name, an unknown one or an argument given by position is refused, naming the argument. Arrays
+    of one type and shape (``rec_prev``/``rec_prev2``, ``start``/``length``) are told apart by
+    their names alone, and each is checked against its own name's type and shape."""
     from hexdem.common import _kernels
 
     state = PulseState(5, 8, 0.0)

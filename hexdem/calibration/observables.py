@@ -51,8 +51,8 @@ STEADY_RATE_RTOL = 0.01
 #: Standard errors by which the second half of a lead-in may differ from its first while at rest.
 REST_TOLERANCE = 6.0
 #: Noisy copies of a record whose reduced observables give its noise covariance: enough that the
-#: estimate's own scatter does not make the likelihood overconfident (with 64, the posterior's spread
-#: along the parameters was 1.2 times the one it claimed; docs/validation/benchmarks.md).
+#: estimate's own scatter does not make the likelihood overconfident (docs/validation/benchmarks.md,
+#: *Calibration from measurements*).
 BOOTSTRAP_DRAWS = 400
 #: The pulse's foot: where the first sensor's acceleration first reaches this share of its peak.
 FOOT_LEVEL = 0.1

