@@ -29,6 +29,12 @@ a DC offset uniform in ±20 m/s². Nothing of the truth reaches the calibration 
   parameter set, each truth's record struck on a packing of its own seed (one the calibration
   never prepares).
 
+``--toy K,R``: the disorder toy, no LAMMPS: m = 7 observables correlated 0.9 whose mean shifts as
+σ² and whose spread between packings grows as σ (σ in [0, 1]), 40 parameter sets on σ's levels,
+each on the same K packings (shared deviates, as the calibration's own), and R records of
+independent packings with a little noise; the coverage of σ's 90 % interval over ``--truths``
+truths, through the calibration's own likelihood and sampler.
+
 ``--quick``: one truth of the tiny case on one worker. ``--cost N``: N simulations of the quick case,
 one after another in this process after one to warm up (as a worker runs them), each timed whole
 (configuration, LAMMPS, the sensors' reduction, its folder written) beside its LAMMPS loop (the
@@ -105,6 +111,36 @@ def rank_histogram(ranks, bins: int) -> tuple[list[int], float]:
     return counts.tolist(), float(chisquare(counts).pvalue)
 
 
+def disorder_toy(packings: int, records: int, truths: int, seed: int) -> None:
+    """The table of ``--toy``: σ's 90 % coverage on the disorder toy (see the module docstring)."""
+    from hexdem.calibration import inference
+    from hexdem.calibration.packings import on_sigma_levels
+
+    m, rng = 7, np.random.default_rng(seed)
+    shift, curvature, scale = rng.normal(size=m), rng.normal(0, 0.5, m), rng.uniform(0.5, 1.5, m)
+    factor = np.linalg.cholesky(0.9 * np.ones((m, m)) + 0.1 * np.eye(m))
+    noise = 0.02**2 * np.eye(m)
+    held, widths = 0, []
+    for t in range(truths):
+        truth = rng.uniform(0.2, 0.9)
+        shared = rng.standard_normal((packings, m)) @ factor.T
+        points = on_sigma_levels(inference.design(1, 40, seed + t), 0)
+        sigma = points[:, 0]
+        simulated = (shift + curvature * sigma[:, None] ** 2)[:, None, :] + sigma[:, None, None] * scale * shared
+        own = rng.standard_normal((records, m)) @ factor.T
+        measured = shift + curvature * truth**2 + truth * scale * own + rng.multivariate_normal(np.zeros(m), noise, records)
+        data = inference.Data(measured, np.array([noise] * records), tuple(f"y{j}" for j in range(m)))
+        fit = inference.fit_stage(data, points, simulated, seed + t)
+        low, high = np.quantile(fit.samples[:, 0], [0.05, 0.95])
+        held += bool(low <= truth <= high)
+        widths.append(high - low)
+    band = binomial_band(0.9, truths)
+    print("| K | R | truths | coverage 90 % | binomial band (95 %) | median width |")
+    print("|---|---|---|---|---|---|")
+    print(f"| {packings} | {records} | {truths} | {held / truths:.2f} | [{band[0]:.2f}, {band[1]:.2f}] | "
+          f"{np.median(widths):.3f} |")
+
+
 def simulation_cost(count: int, root: Path) -> None:
     """The table of ``--cost``: each simulation's whole time beside its LAMMPS loop."""
     base, prior_texts, _ = CASES["quick"]
@@ -136,8 +172,13 @@ def main() -> None:
     parser.add_argument("--out", help="keep the calibrations here (default: a temporary folder)")
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--cost", type=int, metavar="N", help="time N simulations against their LAMMPS loop, only")
+    parser.add_argument("--toy", metavar="K,R", help="the disorder toy on K packings a set and R records, only")
     args = parser.parse_args()
     print(f"machine: {describe()}; load average {os.getloadavg()[0]:.2f}", flush=True)
+    if args.toy:
+        packings, records = (int(value) for value in args.toy.split(","))
+        disorder_toy(packings, records, args.truths, args.seed)
+        return
     root = Path(args.out or tempfile.mkdtemp(prefix="hexdem-bench-calibration-"))
     if args.cost:
         simulation_cost(args.cost, root)

@@ -121,6 +121,10 @@ class _Fixed:
     def __call__(self, unit):
         return np.tile(self.value, (len(unit), 1, 1))
 
+    def scale(self, unit):
+        """The spread's scale, 1 at every coordinate (the spread as given)."""
+        return np.ones(len(unit))
+
 
 def test_the_likelihood_is_the_joint_gaussian_of_records_that_share_the_emulators_error():
     """Records y_r = μ + e + δ_r + ε_r with e ~ N(0, diag s² + Σ_K/K) common to all: the stacked
@@ -141,8 +145,9 @@ def test_the_likelihood_is_the_joint_gaussian_of_records_that_share_the_emulator
         joint[i * m:(i + 1) * m, i * m:(i + 1) * m] += covariances[i] + spread
     residual = (records - mean).ravel()
     expected = -0.5 * (residual @ np.linalg.solve(joint, residual) + np.linalg.slogdet(joint)[1])
-    assert likelihood(np.array([[0.5]]))[0] == pytest.approx(expected, rel=1e-10)
-    together, alone = likelihood.misfit(np.array([0.5]))
+    assert likelihood.dimension == 2  # the spread's scale after the parameter
+    assert likelihood(np.array([[0.5, 0.5]]))[0] == pytest.approx(expected, rel=1e-10)
+    together, alone = likelihood.misfit(np.array([0.5, 0.5]))
     assert together == pytest.approx(residual @ np.linalg.solve(joint, residual), rel=1e-10)
     assert alone[1] == pytest.approx((records[1] - mean) @ np.linalg.solve(covariances[1] + spread + common,
                                                                         records[1] - mean), rel=1e-10)
@@ -208,7 +213,7 @@ def test_the_spread_between_packings_follows_the_parameters():
     1/√(2 (K − 1)) = 0.27; the emulator pools the ten or so nearest sets, 0.085, and 3 of those
     are 25 %), and the pooled correlation holds L Lᵀ's ρ = 0.8 within 4 (1 − ρ²)/√(n (K − 1)),
     four of its standard errors, before it is shrunk as for K − 1 = ν deviations of m = 2
-    observables: ν ρ / (ν + m + 1)."""
+    observables: ν ρ / (ν + w), w = max(m + 1 − ν, 1) = 1."""
     rng = np.random.default_rng(5)
     n, k, rho = 80, 8, 0.8
     points = inference.design(1, n, seed=6)
@@ -219,7 +224,7 @@ def test_the_spread_between_packings_follows_the_parameters():
     test = np.array([[0.1], [0.5], [0.9]])
     sd = np.sqrt(np.diagonal(spread(test), axis1=1, axis2=2))
     assert sd == pytest.approx(np.repeat(0.1 + test, 2, axis=1), rel=0.25)
-    shrink = (k - 1) / (k - 1 + 3)
+    shrink = (k - 1) / (k - 1 + max(3 - (k - 1), 1))
     assert spread.correlation[0, 1] == pytest.approx(shrink * rho, abs=shrink * 4 * (1 - rho**2) / np.sqrt(n * (k - 1)))
     assert Spread(points, observables[:, :1])(test) == pytest.approx(0.0)
 
@@ -229,15 +234,16 @@ def test_a_record_from_a_packing_the_runs_never_took_stays_possible():
     deviate in one direction only, whatever the number of sets: pooled as it is, their correlation
     is singular, and a record from another packing, deviating elsewhere, is all but impossible
     (the paper protocol's quick workflow: χ² of 600 to 14,000 for 7 observables at the truth).
-    Shrunk, R ⪰ λ I with λ = (m + 1)/(ν + m + 1), so that Σ_K = D R D (D the emulated standard
-    deviations) bounds every record's χ² = rᵀ Σ_K⁻¹ r by Σ_j (r_j / D_j)² / λ."""
+    Shrunk, R ⪰ λ I with λ = w/(ν + w), w = max(m + 1 − ν, 1), so that Σ_K = D R D (D the emulated
+    standard deviations) bounds every record's χ² = rᵀ Σ_K⁻¹ r by Σ_j (r_j / D_j)² / λ."""
     rng = np.random.default_rng(11)
     n, k, m = 40, 2, 4
     points = inference.design(1, n, seed=12)
     shared = rng.standard_normal((k, m))
     observables = points[:, None, :] + (0.1 + points)[:, None, :] * shared[None]
     spread = Spread(points, observables)
-    floor = (m + 1) / (k - 1 + m + 1)
+    weight = max(m + 1 - (k - 1), 1)
+    floor = weight / (k - 1 + weight)
     assert np.linalg.eigvalsh(spread.correlation).min() >= floor - 1e-12
     covariance = spread(np.array([[0.5]]))[0]
     fresh = 0.6 * rng.standard_normal((2000, m))
@@ -569,3 +575,21 @@ def test_the_guides_measured_example_passes_every_input_check():
                           ["v0=uniform(0.2, 0.7)", "restitution=uniform(0.8, 1.0)"], None, 0)
     assert calibration.data.record_names == ("1", "2") and calibration.rate_hz == pytest.approx(500e3)
     assert calibration.notes == ()
+
+
+def test_the_spread_between_packings_is_known_to_a_scale_that_k_packings_leave_open():
+    """K packings give the spread's sample variances K − 1 degrees of freedom: the true over the
+    estimated is (K − 1)/χ²_{K−1}, whose quantile u is (K − 1)/χ²_{K−1} at 1 − u; the sampler
+    takes that scale as a coordinate after the parameters (and before the discrepancy's)."""
+    from scipy.stats import chi2
+
+    points = inference.design(1, 20, seed=1)
+    observables = points[:, None, :] + np.random.default_rng(2).normal(size=(20, 8, 3))
+    spread = Spread(points, observables)
+    for u in (0.05, 0.5, 0.95):
+        assert spread.scale(np.array([u]))[0] == pytest.approx(7 / chi2.ppf(1 - u, 7), rel=1e-9)
+    data = inference.Data(observables[:2, 0], np.array([np.eye(3) * 1e-4] * 2), ("a", "b", "c"))
+    emulator = Emulator(points, observables.mean(axis=1))
+    assert inference.Likelihood(data, emulator, spread).dimension == 2
+    assert inference.Likelihood(data, emulator, spread, discrepancy=inference.Discrepancy(2)).dimension == 3
+    assert inference.Likelihood(data, emulator, Spread(points, observables[:, :1])).dimension == 1

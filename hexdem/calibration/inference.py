@@ -14,7 +14,10 @@ zero on the ideal lattice), and its striker's speed off the calibrated one, V(u)
 strike; and e the error common to every record: the emulator's variance s²(u), Σ_K(u)/K, for a
 mean over K packings is not the mean over all, and each sensor's gain, the same in all its
 records (:class:`Instruments`), and what the model cannot represent, a discrepancy of relative
-size τ (:class:`Discrepancy`, Kennedy & O'Hagan's δ, whose τ is sampled with u). With
+size τ (:class:`Discrepancy`, Kennedy & O'Hagan's δ, whose τ is sampled with u). Σ_K is known
+only to a scale λ, as K packings tell it (:meth:`~hexdem.calibration.spread.Spread.scale`): λ is
+sampled with u too, so that the records, independent packings, tell it further, and integrated out
+it gives them a joint Student-t rather than a Gaussian of a spread taken as known. With
 D_r = Σ_r + Σ_K + V, P = Σ_r D_r⁻¹ and b = Σ_r D_r⁻¹ (y_r − μ), integrating e out gives
 
     log p = Σ_r log N(y_r; μ, D_r) − ½ log det(I + C P) + ½ bᵀ (I + C P)⁻¹ C b,
@@ -169,18 +172,28 @@ class Likelihood:
         self.discrepancy = discrepancy
 
     @property
+    def scaled_spread(self) -> bool:
+        """Whether the spread between packings carries an unknown scale λ (:meth:`Spread.scale`), the
+        sampler's coordinate after the parameters': on K ≥ 2 packings a parameter set."""
+        return self.spread.realizations >= 2
+
+    @property
     def dimension(self) -> int:
-        """The sampler's coordinates: the parameters', and τ's with a :class:`Discrepancy`."""
-        return self.emulator.x.shape[1] + (self.discrepancy is not None)
+        """The sampler's coordinates: the parameters', the spread's scale λ's on disordered packings,
+        and τ's with a :class:`Discrepancy`."""
+        return self.emulator.x.shape[1] + self.scaled_spread + (self.discrepancy is not None)
 
     def moments(self, unit) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """At the sampler's unit-cube points ``unit`` (k, :attr:`dimension`): the emulated mean μ
         (k, m), the common error's covariance C (k, m, m) and what each record adds to its own
         noise, Σ_K + V (k, m, m)."""
         unit = np.atleast_2d(unit)
-        parameters = unit[:, :self.emulator.x.shape[1]]
+        count = self.emulator.x.shape[1]
+        parameters = unit[:, :count]
         mean, variance = self.emulator.predict(parameters)
         spread = self.spread(parameters)
+        if self.scaled_spread:
+            spread = spread * self.spread.scale(unit[:, count])[:, None, None]
         common = (variance[:, :, None] * np.eye(mean.shape[1]) + spread / self.spread.realizations
                   + self.model_error + self.instruments.common())
         if self.discrepancy is not None:
@@ -319,7 +332,8 @@ def stragglers(log_probability, dimension: int) -> np.ndarray:
 class Fit:
     """One stage's fit: the simulated ``points`` (n, p) and their ``observables`` (n, K, m), the
     ``emulator`` of their mean over packings, the packings' ``spread``, the posterior
-    ``states`` the sampler visited (unit cube: the parameters', then τ's with a discrepancy), the
+    ``states`` the sampler visited (unit cube: the parameters', then the spread's scale λ's on
+    disordered packings, then τ's with a discrepancy), the
     ``likelihood`` they sample, and how the ``chain`` mixed."""
 
     points: np.ndarray
@@ -336,6 +350,12 @@ class Fit:
         return self.states[:, :self.points.shape[1]]
 
     @property
+    def spread_scales(self) -> np.ndarray | None:
+        """The posterior's samples of the spread's scale λ (:meth:`Spread.scale`), or None on one packing."""
+        count = self.points.shape[1]
+        return self.spread.scale(self.states[:, count]) if self.likelihood.scaled_spread else None
+
+    @property
     def discrepancy_sizes(self) -> np.ndarray | None:
         """The posterior's samples of the discrepancy's relative size τ, or None without one."""
         discrepancy = self.likelihood.discrepancy
@@ -349,10 +369,23 @@ def fit_stage(data: Data, points, observables, seed: int, model_error=None,
     records' gains and speed scatter; ``discrepancy``: what the model cannot represent)."""
     points, observables = np.asarray(points, float), np.asarray(observables, float)
     emulator = Emulator(points, observables.mean(axis=1))
-    spread = Spread(points, observables)
+    spread = Spread(points, observables, *records_scatter(data, instruments))
     likelihood = Likelihood(data, emulator, spread, model_error, instruments, discrepancy)
     states, chain = sample_posterior(likelihood, likelihood.dimension, seed)
     return Fit(points, observables, emulator, spread, states, likelihood, chain)
+
+
+def records_scatter(data: Data, instruments: Instruments | None = None) -> tuple[np.ndarray | None, int]:
+    """(the covariance between the records that their packings make, its degrees of freedom): the
+    records' sample covariance less their mean noise covariance and the striker's speed scatter
+    (at the records' mean), from R − 1 deviations; (None, 0) for fewer than two records."""
+    records = data.records
+    if len(records) < 2:
+        return None, 0
+    scatter = np.cov(records, rowvar=False) - np.mean(data.covariances, axis=0)
+    if instruments is not None:
+        scatter = scatter - instruments.per_record(records.mean(axis=0))[0]
+    return scatter, len(records) - 1
 
 
 def step_error(coarse, fine) -> np.ndarray:

@@ -9,74 +9,114 @@ dissipation. It is modelled as
 
     Σ_K(u) = diag s(u) · R · diag s(u),
 
-with s_j(u) the standard deviation of observable j between packings, emulated as log s_j
-(:class:`~hexdem.calibration.emulator.Emulator`, its nugget free to take the sampling noise)
-from each parameter set's sample standard deviation over its K packings, less its bias
-(:func:`log_sd_bias`), and R the correlation between the observables (a slow packing's
-arrivals are late at every later sensor together), pooled over the parameter sets from the
-deviations scaled by the emulated s (each set's own sample standard deviation would bias the
-correlation towards zero: with K = 8, 0.77 for 0.8), and shrunk towards the identity, as the sets
-share their K packings (:func:`shrunk_correlation`). One packing per set (the ideal lattice) has
-no spread.
+with s_j(u) the standard deviation of observable j between packings, emulated
+(:class:`~hexdem.calibration.emulator.Emulator`, a linear trend: on shared deviates s grows in
+proportion to σ while the disorder is weak) from each parameter set's sample standard deviation
+over its K packings, less its bias (:func:`sd_bias`), and R the correlation between the
+observables (a slow packing's arrivals are late at every later sensor together), pooled over the
+parameter sets from the deviations scaled by the emulated s (each set's own sample standard
+deviation would bias the correlation towards zero: with K = 8, 0.77 for 0.8), with the records'
+own scatter where there are several records (each an independent packing: R − 1 more directions
+than the K packings' K − 1), and shrunk towards the identity only as far as those directions
+fall short of the observables (:func:`shrunk_correlation`).
+
+**What K packings cannot tell.** Every parameter set is simulated on the same K packings, so the
+sample standard deviations share one error: their scale is known from K − 1 degrees of freedom
+only, to some 25 % at K = 8, the same for every σ. The likelihood therefore takes
+Σ_K,true = λ Σ_K with λ unknown, inverse-gamma as (K − 1)/χ²_{K−1} (:meth:`Spread.scale`), sampled
+with the parameters (:mod:`~hexdem.calibration.inference`): the records, independent packings,
+tell λ further. One packing per set (the ideal lattice) has no spread.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from scipy.special import digamma
+from scipy.special import gammaln
 
 from hexdem.calibration.emulator import Emulator
 
-#: The emulator's nugget bound for log s, whose sampling noise, 1/(2 (K − 1)) for K packings, is a
-#: large share of its variance between parameter sets.
+#: The emulator's nugget bound for s: on shared deviates its sampling error is common to every
+#: parameter set (the scale λ takes it), and what is left between sets is small.
 NOISY_NUGGET = 10.0
 #: Standard deviations between packings are floored here (observables are of order one): a
-#: parameter set whose packings agree exactly (σ = 0) keeps a finite logarithm.
+#: parameter set whose packings agree exactly (σ = 0) keeps a spread of full rank.
 SD_FLOOR = 1e-9
 
 
-def log_sd_bias(realizations: int) -> float:
-    """E[log s] − log σ of the sample standard deviation s of K normal values:
-    ½ (ψ((K − 1)/2) − log((K − 1)/2)), as (K − 1) s²/σ² is χ² with K − 1 degrees of freedom."""
-    half = (realizations - 1) / 2
-    return 0.5 * (float(digamma(half)) - np.log(half))
+def sd_bias(realizations: int) -> float:
+    """E[s] / σ of the sample standard deviation s of K normal values, c₄(K) =
+    √(2/(K − 1)) Γ(K/2) / Γ((K − 1)/2)."""
+    return float(np.sqrt(2.0 / (realizations - 1)) * np.exp(gammaln(realizations / 2) - gammaln((realizations - 1) / 2)))
 
 
 def shrunk_correlation(sample, dof: int) -> np.ndarray:
-    """The correlation between observables from ``sample``, the correlation of ``dof`` independent
-    deviations, shrunk towards the identity: (ν R̂ + (m + 1) I) / (ν + m + 1).
+    """The correlation between observables from ``sample``, the correlation of ``dof`` = ν
+    independent deviations, shrunk towards the identity: (ν R̂ + w I) / (ν + w), w = max(m + 1 − ν, 1).
 
     Every parameter set is simulated on the same K packings (:mod:`~hexdem.calibration.packings`),
-    so their deviations from the mean, however many sets are pooled, are K − 1 = ν independent
-    vectors: for ν < m observables R̂ is singular, and a record whose packing deviates in a
-    direction the K packings never took would count as impossible. The estimate is that of an
-    inverse-Wishart prior centred on the identity and worth m + 1 packings (the fewest for which its
-    mean exists), updated with the ν deviations: it stays positive definite, its smallest
-    eigenvalue at least (m + 1)/(ν + m + 1), and tends to R̂ as the packings grow in number."""
+    so their deviations from the mean, however many sets are pooled, are K − 1 independent vectors
+    (and the records R − 1 more): for ν < m observables R̂ is singular, and a record whose packing
+    deviates in a direction the packings never took would count as impossible. The estimate is
+    that of an inverse-Wishart prior centred on the identity, updated with the ν deviations, and
+    worth as many packings as ν falls short of m + 1 (at least one): it stays positive definite.
+    A prior worth m + 1 packings whatever ν is would flatten correlations the data hold (0.9 read
+    as 0.42 at ν = 7, m = 7), and widen the spread across the common direction where the
+    packings deviate least: a record's σ then came out low (docs/validation/benchmarks.md)."""
     size = len(sample)
-    return (dof * np.asarray(sample, float) + (size + 1) * np.eye(size)) / (dof + size + 1)
+    weight = max(size + 1 - dof, 1)
+    return (dof * np.asarray(sample, float) + weight * np.eye(size)) / (dof + weight)
+
+
+def records_correlation(scatter) -> np.ndarray:
+    """The correlation of the packings' deviations that the records' own ``scatter`` shows (their
+    covariance less what their noise and the striker's speed add, (m, m)), its eigenvalues floored
+    at a thousandth of the largest so that it is one."""
+    values, vectors = np.linalg.eigh(np.asarray(scatter, float))
+    values = np.maximum(values, 1e-3 * max(values.max(), SD_FLOOR**2))
+    covariance = (vectors * values) @ vectors.T
+    norm = np.sqrt(np.diag(covariance))
+    return covariance / np.outer(norm, norm)
 
 
 class Spread:
-    """Σ_K(u) fitted to simulations at unit-cube ``points`` (n, p) with ``observables`` (n, K, m)."""
+    """Σ_K(u) fitted to simulations at unit-cube ``points`` (n, p) with ``observables`` (n, K, m);
+    with ``scatter``, the records' own covariance between packings (:func:`records_correlation`)
+    from ``scatter_dof`` independent records' deviations, pooled into the correlation: records of
+    independent packings are more independent directions than the K packings' K − 1."""
 
-    def __init__(self, points, observables):
+    def __init__(self, points, observables, scatter=None, scatter_dof: int = 0):
         observables = np.asarray(observables, float)
         n, self.realizations, self.size = observables.shape
         if self.realizations < 2:
             return
         centred = observables - observables.mean(axis=1, keepdims=True)
-        sd = np.maximum(np.sqrt(np.sum(centred**2, axis=1) / (self.realizations - 1)), SD_FLOOR)
-        self.log_sd = Emulator(points, np.log(sd) - log_sd_bias(self.realizations), nugget_max=NOISY_NUGGET)
-        scaled = centred / np.exp(self.log_sd.predict(points)[0])[:, None, :]
+        sd = np.sqrt(np.sum(centred**2, axis=1) / (self.realizations - 1))
+        self.sd = Emulator(points, sd / sd_bias(self.realizations), nugget_max=NOISY_NUGGET)
+        scaled = centred / self._sd(points)[:, None, :]
         pooled = np.einsum("nki,nkj->ij", scaled, scaled)
         norm = np.sqrt(np.diag(pooled))
-        self.correlation = shrunk_correlation(pooled / np.outer(norm, norm), self.realizations - 1)
+        simulated, dof = pooled / np.outer(norm, norm), self.realizations - 1
+        if scatter is not None and scatter_dof > 0:
+            simulated = (dof * simulated + scatter_dof * records_correlation(scatter)) / (dof + scatter_dof)
+            dof += scatter_dof
+        self.correlation = shrunk_correlation(simulated, dof)
 
     def __call__(self, unit) -> np.ndarray:
         """Σ_K (k, m, m) at unit-cube points ``unit`` (k, p)."""
         unit = np.atleast_2d(unit)
         if self.realizations < 2:
             return np.zeros((len(unit), self.size, self.size))
-        sd = np.exp(self.log_sd.predict(unit)[0])
+        sd = self._sd(unit)
         return sd[:, :, None] * self.correlation * sd[:, None, :]
+
+    def scale(self, unit) -> np.ndarray:
+        """The spread's scale λ (Σ_K,true = λ Σ_K) at unit coordinates ``unit`` (k,): the K packings'
+        sample variances, shared by every parameter set, carry K − 1 degrees of freedom, so the true
+        variance over theirs is (K − 1)/χ²_{K−1}, inverse-gamma with shape and scale (K − 1)/2."""
+        from scipy.stats import invgamma
+
+        half = (self.realizations - 1) / 2
+        return invgamma.ppf(np.clip(np.asarray(unit, float), 1e-12, 1 - 1e-12), half, scale=half)
+
+    def _sd(self, unit) -> np.ndarray:
+        return np.maximum(self.sd.predict(unit)[0], SD_FLOOR)
