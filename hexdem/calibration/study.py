@@ -316,6 +316,9 @@ def _diagnose(calibration: Calibration, fit: inference.Fit, summary: dict) -> No
     summary["emulator"] = diagnostics.emulator_error(fit.emulator, data.names, noise_sd)
     rng = np.random.default_rng(calibration.seed + 1)
     summary["instruments"] = {"sensor_gain_sd": instruments.gain_sd, "speed_scatter": instruments.speed_scatter}
+    if fit.spread_scales is not None:
+        q05, median_scale, q95 = np.quantile(fit.spread_scales, [0.05, 0.5, 0.95])
+        summary["spread_scale"] = {"median": float(median_scale), "q05": float(q05), "q95": float(q95)}
     if fit.discrepancy_sizes is not None:
         q05, median_size, q95 = np.quantile(fit.discrepancy_sizes, [0.05, 0.5, 0.95])
         summary["model_discrepancy"] = calibration.discrepancy.as_dict() | {
