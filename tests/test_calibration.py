@@ -14,7 +14,7 @@ import pytest
 from scipy import stats
 from scipy.stats import qmc
 
-from hexdem.calibration import inference
+from hexdem.calibration import inference, nuisance
 from hexdem.calibration.emulator import Emulator
 from hexdem.calibration.observables import Record, noise_covariance, reduce_record
 from hexdem.calibration.packings import SIGMA_LEVELS, settled_packing
@@ -161,7 +161,7 @@ def test_the_model_discrepancy_is_a_relative_error_common_to_all_records_whose_s
     covariances = np.array([np.diag([4e-6, 9e-6, 0.04])] * 2)
     records = mean + np.array([[0.01, -0.02, 1.5], [0.012, -0.018, 1.2]])
     zero = _Fixed(mean, variance, np.zeros((m, m)), 1)
-    discrepancy = inference.Discrepancy(2)
+    discrepancy = nuisance.Discrepancy(2)
     likelihood = inference.Likelihood(inference.Data(records, covariances, ("a", "b", "c")), zero, zero,
                                       discrepancy=discrepancy)
     assert likelihood.dimension == 2
@@ -186,7 +186,7 @@ def test_the_instruments_enter_as_gains_common_to_all_records_and_a_speed_per_re
     mean, variance = np.array([-1.2, -1.9, 85.0]), np.array([1e-4, 2e-4, 0.05])
     covariances = np.array([np.diag([4e-6, 9e-6, 0.04]) for _ in range(r)])
     records = mean + np.array([0.0, 0.05, 0.0]) + rng.normal(0, 0.002, (r, m)) * [1, 1, 50]
-    instruments = inference.Instruments(2, gain_sd, scatter)
+    instruments = nuisance.Instruments(2, gain_sd, scatter)
     zero = _Fixed(mean, variance, np.zeros((m, m)), 1)
     likelihood = inference.Likelihood(inference.Data(records, covariances, ("a", "b", "c")), zero, zero,
                                       instruments=instruments)
@@ -591,5 +591,5 @@ def test_the_spread_between_packings_is_known_to_a_scale_that_k_packings_leave_o
     data = inference.Data(observables[:2, 0], np.array([np.eye(3) * 1e-4] * 2), ("a", "b", "c"))
     emulator = Emulator(points, observables.mean(axis=1))
     assert inference.Likelihood(data, emulator, spread).dimension == 2
-    assert inference.Likelihood(data, emulator, spread, discrepancy=inference.Discrepancy(2)).dimension == 3
+    assert inference.Likelihood(data, emulator, spread, discrepancy=nuisance.Discrepancy(2)).dimension == 3
     assert inference.Likelihood(data, emulator, Spread(points, observables[:, :1])).dimension == 1

@@ -10,14 +10,16 @@ is p(u | data) ∝ p(y_1, …, y_R | u) on [0, 1]^p, the records y_r
 (:mod:`~hexdem.calibration.emulator`); ε_r record r's accelerometer noise; δ_r its packing's
 deviation from the mean, Σ_K(u) the spread between packings (:mod:`~hexdem.calibration.spread`;
 zero on the ideal lattice), and its striker's speed off the calibrated one, V(u)
-(:class:`Instruments`), independent between records, each record being one packing and one
-strike; and e the error common to every record: the emulator's variance s²(u), Σ_K(u)/K, for a
-mean over K packings is not the mean over all, and each sensor's gain, the same in all its
-records (:class:`Instruments`), and what the model cannot represent, a discrepancy of relative
-size τ (:class:`Discrepancy`, Kennedy & O'Hagan's δ, whose τ is sampled with u). Σ_K is known
-only to a scale λ, as K packings tell it (:meth:`~hexdem.calibration.spread.Spread.scale`): λ is
-sampled with u too, so that the records, independent packings, tell it further, and integrated out
-it gives them a joint Student-t rather than a Gaussian of a spread taken as known. With
+(:class:`~hexdem.calibration.nuisance.Instruments`), independent between records, each record
+being one packing and one strike; and e the error common to every record: the emulator's
+variance s²(u), Σ_K(u)/K, for a mean over K packings is not the mean over all, each sensor's
+gain, the same in all its records (:class:`~hexdem.calibration.nuisance.Instruments`), and what
+the model cannot represent, a discrepancy of relative size τ
+(:class:`~hexdem.calibration.nuisance.Discrepancy`, Kennedy & O'Hagan's δ, whose τ is sampled
+with u). Σ_K is known only to a scale λ, as K packings tell it
+(:meth:`~hexdem.calibration.spread.Spread.scale`): λ is sampled with u too, so that the records,
+independent packings, tell it further, and integrated out it gives them a joint Student-t rather
+than a Gaussian of a spread taken as known. With
 D_r = Σ_r + Σ_K + V, P = Σ_r D_r⁻¹ and b = Σ_r D_r⁻¹ (y_r − μ), integrating e out gives
 
     log p = Σ_r log N(y_r; μ, D_r) − ½ log det(I + C P) + ½ bᵀ (I + C P)⁻¹ C b,
@@ -43,6 +45,7 @@ import numpy as np
 from scipy.stats import qmc
 
 from hexdem.calibration.emulator import Emulator
+from hexdem.calibration.nuisance import Discrepancy, Instruments
 from hexdem.calibration.spread import Spread
 from hexdem.errors import HexdemError
 
@@ -85,70 +88,6 @@ def stage_sizes(dimension: int, budget: int, realizations: int = 1) -> list[int]
 
 
 @dataclass(frozen=True)
-class Instruments:
-    """What a lab's instruments add to the model's observables of ``sensors`` sensors (the first
-    ``sensors`` observables are log peak speeds, the next ``sensors`` − 1 arrivals relative to the
-    first sensor's, :func:`~hexdem.calibration.observables.observation_names`).
-
-    ``gain_sd``: each sensor's sensitivity is an unknown gain g ~ N(1, gain_sd), the same in every
-    record of that sensor. The velocity integrated from its acceleration, and so its peak, scale with
-    g; its half-maximum arrival does not. log g, N(0, gain_sd²) to first order, adds to the sensor's
-    log peak speed in every record alike: a term of the common error e, marginalised analytically.
-
-    ``speed_scatter``: the striker's speed differs from record to record, v (1 + speed_scatter z_r)
-    around the calibrated v. A Hertzian lattice has no scale of its own: a speed λ v gives
-    :math:`x_λ(t) = λ^{4/5} x(λ^{1/5} t)`, every velocity λ times larger at times :math:`λ^{-1/5}` later (also with
-    Tsuji's damping, whose restitution does not depend on the speed; gravity breaks it only where
-    the pulse has nearly died). To first order in z_r every log peak moves by speed_scatter z_r and
-    each relative arrival t_j by −t_j speed_scatter z_r / 5: the covariance
-    V = speed_scatter² J Jᵀ, J = (1, …, 1, −t_2/5, …), independent between records, with t_j the
-    emulated arrivals at u."""
-
-    sensors: int
-    gain_sd: float = 0.0
-    speed_scatter: float = 0.0
-
-    def common(self) -> np.ndarray:
-        """The gains' covariance (m, m), common to every record."""
-        return np.diag(np.r_[np.full(self.sensors, self.gain_sd**2), np.zeros(self.sensors - 1)])
-
-    def per_record(self, mean) -> np.ndarray:
-        """The speed scatter's covariance (k, m, m) of one record at the emulated means ``mean`` (k, m)."""
-        mean = np.atleast_2d(mean)
-        slope = np.column_stack([np.ones((len(mean), self.sensors)), -mean[:, self.sensors:] / 5.0])
-        return self.speed_scatter**2 * slope[:, :, None] * slope[:, None, :]
-
-
-@dataclass(frozen=True)
-class Discrepancy:
-    """What the model cannot represent (Kennedy & O'Hagan 2001): a discrepancy δ between the model's
-    observables and the records', the same in every record of one experiment, δ ~ N(0, τ² W) with
-    W = diag(1, …, 1, t_2², …): a relative error τ of every peak speed (its log moves by τ) and of
-    every relative arrival t_j (emulated at u), whatever its cause (another preparation, friction,
-    a wall of other stiffness). τ is unknown: its prior is log-uniform on [``low``, ``high``], and
-    it is sampled with the parameters, the last coordinate of the sampler's unit cube. Records that
-    the model fits leave τ below their noise, where it changes nothing; records it does not fit
-    raise it, and the parameters' intervals widen to what the misfit allows."""
-
-    sensors: int
-    low: float = 1e-4
-    high: float = 0.2
-
-    def size(self, unit) -> np.ndarray:
-        """τ (k,) of the unit-cube coordinates ``unit`` (k,)."""
-        return self.low * (self.high / self.low) ** np.asarray(unit, float)
-
-    def covariance(self, mean, unit) -> np.ndarray:
-        """τ² W (k, m, m) at the emulated means ``mean`` (k, m) and τ's coordinates ``unit`` (k,)."""
-        mean = np.atleast_2d(mean)
-        weights = np.column_stack([np.ones((len(mean), self.sensors)), mean[:, self.sensors:] ** 2])
-        return (self.size(unit) ** 2)[:, None, None] * weights[:, :, None] * np.eye(mean.shape[1])
-
-    def as_dict(self) -> dict:
-        return {"prior": f"loguniform({self.low:g}, {self.high:g})", "meaning": "relative size of the model's error"}
-
-
-@dataclass(frozen=True)
 class Data:
     """The measured records' observables ``records`` (R, m), their noise covariances
     ``covariances`` (R, m, m), the observables' ``names``, and the records' own names
@@ -180,7 +119,7 @@ class Likelihood:
     @property
     def dimension(self) -> int:
         """The sampler's coordinates: the parameters', the spread's scale λ's on disordered packings,
-        and τ's with a :class:`Discrepancy`."""
+        and τ's with a :class:`~hexdem.calibration.nuisance.Discrepancy`."""
         return self.emulator.x.shape[1] + self.scaled_spread + (self.discrepancy is not None)
 
     def moments(self, unit) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

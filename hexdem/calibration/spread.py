@@ -23,9 +23,9 @@ fall short of the observables (:func:`shrunk_correlation`).
 **What K packings cannot tell.** Every parameter set is simulated on the same K packings, so the
 sample standard deviations share one error: their scale is known from K − 1 degrees of freedom
 only, to some 25 % at K = 8, the same for every σ. The likelihood therefore takes
-Σ_K,true = λ Σ_K with λ unknown, inverse-gamma as (K − 1)/χ²_{K−1} (:meth:`Spread.scale`), sampled
-with the parameters (:mod:`~hexdem.calibration.inference`): the records, independent packings,
-tell λ further. One packing per set (the ideal lattice) has no spread.
+Σ_K,true = λ Σ_K with λ unknown, inverse-gamma as (K − 1)/X with X of the χ² law of K − 1
+degrees of freedom (:meth:`Spread.scale`), sampled with the parameters
+(:mod:`~hexdem.calibration.inference`): the records, independent packings, tell λ further. One packing per set (the ideal lattice) has no spread.
 """
 
 from __future__ import annotations
@@ -112,7 +112,8 @@ class Spread:
     def scale(self, unit) -> np.ndarray:
         """The spread's scale λ (Σ_K,true = λ Σ_K) at unit coordinates ``unit`` (k,): the K packings'
         sample variances, shared by every parameter set, carry K − 1 degrees of freedom, so the true
-        variance over theirs is (K − 1)/χ²_{K−1}, inverse-gamma with shape and scale (K − 1)/2."""
+        variance over theirs is (K − 1)/X, X of the χ² law of K − 1 degrees of freedom: inverse-gamma
+        with shape and scale (K − 1)/2."""
         from scipy.stats import invgamma
 
         half = (self.realizations - 1) / 2

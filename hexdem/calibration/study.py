@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.calibration import diagnostics, inference, plots
+from hexdem.calibration import diagnostics, inference, nuisance, plots
 from hexdem.calibration.observables import noise_covariance, read_measured, reduce_record
 from hexdem.calibration.packings import DISORDER_REALIZATIONS, SIGMA_KEY, on_sigma_levels
 from hexdem.calibration.priors import parse_priors, to_parameters
@@ -74,11 +74,11 @@ class Calibration:
     channel_noise_m_s2: np.ndarray
     stages: tuple[int, ...]
     seed: int
-    instruments: inference.Instruments
+    instruments: nuisance.Instruments
     acceleration_unit: str = "m/s2"
     rate_hz: float = 0.0
     notes: tuple[str, ...] = ()
-    discrepancy: inference.Discrepancy | None = None
+    discrepancy: nuisance.Discrepancy | None = None
 
 
 def _realizations(priors, realizations: int | None) -> int:
@@ -133,8 +133,8 @@ def prepare(base: dict, measured, prior_texts, budget: int | None, seed: int, re
         noise.append(levels)
     data = inference.Data(np.array(observed), np.array(covariances), tuple(problem.names),
                           tuple(record.name for record in records))
-    instruments = inference.Instruments(len(problem.sensors), gain_sd, speed_scatter)
-    discrepancy = inference.Discrepancy(len(problem.sensors)) if model_discrepancy else None
+    instruments = nuisance.Instruments(len(problem.sensors), gain_sd, speed_scatter)
+    discrepancy = nuisance.Discrepancy(len(problem.sensors)) if model_discrepancy else None
     return Calibration(problem, data, np.array(noise), tuple(stages), seed, instruments, acceleration_unit,
                        records[0].rate_hz, tuple(notes), discrepancy)
 
