@@ -309,13 +309,14 @@ def run_tasks(executor, tasks: dict, retries: int):
     """Submit ``tasks`` (``{key: (fn, *args)}``) to ``executor``; yield (key, result, error) as each
     finishes (``error``: None, or the exception of its last try), a failed task being submitted
     again up to ``retries`` times (:func:`study_retries`). The wait looks for a stop every
-    :data:`~hexdem.common.interrupt.WAIT_S` seconds (:mod:`hexdem.common.interrupt`)."""
+    :data:`~hexdem.common.interrupt.WAIT_S` seconds (:mod:`hexdem.common.interrupt`); tasks that
+    finish within one look are yielded in the order they were submitted."""
     tries = dict.fromkeys(tasks, 0)
     futures = {executor.submit(*task): key for key, task in tasks.items()}
     while futures:
         done = wait(futures, timeout=WAIT_S, return_when=FIRST_COMPLETED).done
         raise_if_stopped()  # before a task that the stop ended is taken for a failure
-        for future in done:
+        for future in [future for future in futures if future in done]:
             key = futures.pop(future)
             error = future.exception()
             if error is not None and tries[key] < retries:
