@@ -144,9 +144,8 @@ class EnergyAudit:
     forces (``gravity_m_s2``, if given, and the model's held force on a precompressed packing's
     struck bead), but what does not change during a run (masses, radii, regions, each wall's
     members and stiffness, the candidate pairs' stiffness) is worked out once, and the candidate
-    contact pairs are kept
-    between calls and searched again only after some body has moved half of
-    :data:`PAIR_SKIN_D` bead diameters (or the bodies seen changed), so a large packing costs a
+    contact pairs are kept between calls and searched again only after some body has moved half
+    of :data:`PAIR_SKIN_D` bead diameters (or the bodies seen changed), so a large packing costs a
     few vector operations per state instead of a tree search.
 
     **A share of the bodies.** :meth:`part` audits the bodies one MPI rank owns, given also the

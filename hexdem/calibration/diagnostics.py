@@ -71,14 +71,19 @@ def piled_against_bounds(priors, unit_samples, share: float, zone: float) -> lis
     return notes
 
 
+def quantile_summary(values) -> dict:
+    """``q05``, ``median`` and ``q95`` of ``values``, as ``calibration.json`` gives a quantity's posterior."""
+    q05, median, q95 = map(float, np.quantile(values, [0.05, 0.5, 0.95]))
+    return {"q05": q05, "median": median, "q95": q95}
+
+
 def gain_estimates(likelihood, unit_samples, sensors, rng) -> dict:
     """Each sensor's gain given the records: per sensor its ``median``, ``q05`` and ``q95``, from
     the conditional normal of its log gain (:meth:`~hexdem.calibration.inference.Likelihood.log_gains`)
     at each of ``unit_samples``, mixed."""
     centre, variance = likelihood.log_gains(unit_samples)
     draws = np.exp(centre + np.sqrt(np.maximum(variance, 0.0)) * rng.standard_normal(centre.shape))
-    return {str(sensor): dict(zip(("q05", "median", "q95"), map(float, np.quantile(draws[:, s], [0.05, 0.5, 0.95]))))
-            for s, sensor in enumerate(sensors)}
+    return {str(sensor): quantile_summary(draws[:, s]) for s, sensor in enumerate(sensors)}
 
 
 def emulator_error(emulator, names, noise_sd) -> dict:

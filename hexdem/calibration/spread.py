@@ -25,7 +25,8 @@ sample standard deviations share one error: their scale is known from K − 1 de
 only, to some 25 % at K = 8, the same for every σ. The likelihood therefore takes
 Σ_K,true = λ Σ_K with λ unknown, inverse-gamma as (K − 1)/X with X of the χ² law of K − 1
 degrees of freedom (:meth:`Spread.scale`), sampled with the parameters
-(:mod:`~hexdem.calibration.inference`): the records, independent packings, tell λ further. One packing per set (the ideal lattice) has no spread.
+(:mod:`~hexdem.calibration.inference`): the records, independent packings, tell λ further.
+One packing per set (the ideal lattice) has no spread.
 """
 
 from __future__ import annotations

@@ -302,7 +302,7 @@ def _sensor_distances(problem: Problem, samples) -> np.ndarray:
     packing = build_model(config).packing
     beads = list(sensor_beads(config.sensors, packing).values())
     offsets = packing.positions_m[beads] - packing.positions_m[packing.struck]
-    return np.hypot(*offsets.T) / np.median(packing.diameters_m)
+    return np.hypot(*offsets.T) / packing.diameter_m
 
 
 def _diagnose(calibration: Calibration, fit: inference.Fit, summary: dict) -> None:
@@ -317,18 +317,16 @@ def _diagnose(calibration: Calibration, fit: inference.Fit, summary: dict) -> No
     rng = np.random.default_rng(calibration.seed + 1)
     summary["instruments"] = {"sensor_gain_sd": instruments.gain_sd, "speed_scatter": instruments.speed_scatter}
     if fit.spread_scales is not None:
-        q05, median_scale, q95 = np.quantile(fit.spread_scales, [0.05, 0.5, 0.95])
-        summary["spread_scale"] = {"median": float(median_scale), "q05": float(q05), "q95": float(q95)}
+        summary["spread_scale"] = diagnostics.quantile_summary(fit.spread_scales)
     if fit.discrepancy_sizes is not None:
-        q05, median_size, q95 = np.quantile(fit.discrepancy_sizes, [0.05, 0.5, 0.95])
-        summary["model_discrepancy"] = calibration.discrepancy.as_dict() | {
-            "median": float(median_size), "q05": float(q05), "q95": float(q95)}
+        summary["model_discrepancy"] = (calibration.discrepancy.as_dict()
+                                        | diagnostics.quantile_summary(fit.discrepancy_sizes))
     if instruments.gain_sd > 0:
         chosen = fit.states[rng.choice(len(fit.states), min(GAIN_DRAWS, len(fit.states)), replace=False)]
         summary["instruments"]["gains"] = diagnostics.gain_estimates(fit.likelihood, chosen, problem.sensors, rng)
     warnings = []
-    if summary["fit"]["p_value"] < MISFIT_P or diagnostics.misfit_records(summary["fit"], MISFIT_P):
-        bad = diagnostics.misfit_records(summary["fit"], MISFIT_P)
+    bad = diagnostics.misfit_records(summary["fit"], MISFIT_P)
+    if summary["fit"]["p_value"] < MISFIT_P or bad:
         named = f"; record(s) {', '.join(bad)} (p < {MISFIT_P:g} each)" if bad else ""
         warnings.append(f"the model does not fit the records: chi2 = {summary['fit']['chi2']:.4g} for "
                         f"{summary['fit']['dof']} degrees of freedom (p = {summary['fit']['p_value']:.2g}){named}; the "

@@ -90,8 +90,8 @@ def main(argv=None) -> int:
         with running_command(command):
             args._module.run(args)
     except HexdemError as exc:
-        if stop_received() is not None:  # what failed was ended by the stop (a Ctrl-C that reached the ranks too)
-            return interrupted(Interrupted(stop_received()))
+        if (stop := stop_received()) is not None:  # the stop ended what failed (a Ctrl-C that reached the ranks too)
+            return interrupted(Interrupted(stop))
         if "--traceback" in argv:
             raise
         print(f"hexdem: error: {exc}", file=sys.stderr)

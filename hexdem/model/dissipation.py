@@ -132,18 +132,20 @@ def lammps_tsuji_coefficient(alpha: float) -> float:
     has its c (:func:`~hexdem.engines.lammps.tsuji_check.check_tsuji_damping` measures both)."""
     from scipy.optimize import brentq
 
-    def applied(c: float) -> float:
-        return float(np.polynomial.polynomial.polyval(c, TSUJI_POLYNOMIAL))
-
     if not alpha > 0:
         raise HexdemError(f"LAMMPS's damping tsuji takes a damping alpha > 0, got {alpha!r}")
     lowest = _polynomial_minimum()
-    if alpha <= applied(0.0):
-        return float(brentq(lambda c: applied(c) - alpha, 0.0, _first_root(lowest), xtol=1e-14))
+    if alpha <= marshall_alpha(0.0):
+        return float(brentq(lambda c: marshall_alpha(c) - alpha, 0.0, _first_root(lowest), xtol=1e-14))
     high = 2.0 * lowest
-    while applied(high) < alpha:
+    while marshall_alpha(high) < alpha:
         high *= 2.0
-    return float(brentq(lambda c: applied(c) - alpha, lowest, high, xtol=1e-14))
+    return float(brentq(lambda c: marshall_alpha(c) - alpha, lowest, high, xtol=1e-14))
+
+
+def marshall_alpha(c: float) -> float:
+    """The damping α = P(c) that LAMMPS's ``damping tsuji c`` applies (:data:`TSUJI_POLYNOMIAL`)."""
+    return float(np.polynomial.polynomial.polyval(c, TSUJI_POLYNOMIAL))
 
 
 @cache
@@ -151,7 +153,7 @@ def _polynomial_minimum() -> float:
     """c at which Marshall's polynomial is least on c > 0."""
     turns = np.polynomial.polynomial.Polynomial(TSUJI_POLYNOMIAL).deriv().roots()
     real = sorted(float(c.real) for c in turns if abs(c.imag) < 1e-12 and c.real > 0)
-    return min(real, key=lambda c: float(np.polynomial.polynomial.polyval(c, TSUJI_POLYNOMIAL)))
+    return min(real, key=marshall_alpha)
 
 
 @cache
@@ -159,7 +161,7 @@ def _first_root(lowest: float) -> float:
     """The c where the falling branch of Marshall's polynomial reaches 0, before its minimum ``lowest``."""
     from scipy.optimize import brentq
 
-    return float(brentq(lambda c: np.polynomial.polynomial.polyval(c, TSUJI_POLYNOMIAL), 0.0, lowest, xtol=1e-15))
+    return float(brentq(marshall_alpha, 0.0, lowest, xtol=1e-15))
 
 
 def check_restitution(name: str, value) -> float:
