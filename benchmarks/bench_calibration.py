@@ -1,8 +1,9 @@
 """Simulation-based calibration of ``hexdem calibrate``: coverage and rank histograms over truths drawn
 from the prior, the records made as a lab's instruments make them.
 
-Usage: python benchmarks/bench_calibration.py [--case tiny|quick|disordered] [--truths 50] [--workers 2]
-                                              [--noise 5] [--seed 2026] [--out DIR] [--quick] [--cost N]
+Usage: python benchmarks/bench_calibration.py [--case tiny|quick|disordered] [--truths 50] [--records 1]
+                                              [--workers 2] [--noise 5] [--seed 2026] [--out DIR] [--quick]
+                                              [--no-model-discrepancy] [--cost N]
 
 **Simulation-based calibration** (Talts, Betancourt, Simpson, Vehtari & Gelman 2018): draw a truth θ
 from the prior, make a record of it, calibrate, and take the rank of θ among L = 99 draws of the
@@ -26,8 +27,11 @@ a DC offset uniform in ±20 m/s². Nothing of the truth reaches the calibration 
   ``restitution`` ~ uniform(0.7, 0.99) and ``v0`` ~ uniform(0.2, 0.7); the default budget, 90.
 * ``disordered``: a 4-per-edge hexagon, sensors ``0:1, 0:3``, ``diameter_sigma_m`` ~
   uniform(0, 1.5e-4) and ``restitution`` ~ uniform(0.8, 1.0), on the default 8 packings per
-  parameter set, each truth's record struck on a packing of its own seed (one the calibration
+  parameter set, each truth's records struck on packings of their own seeds (ones the calibration
   never prepares).
+
+``--records R``: R records a truth (the paper's protocol strikes 20 packings a configuration), each
+sensor's gain shared by all of them, everything else drawn anew a record.
 
 ``--toy K,R``: the disorder toy, no LAMMPS: m = 7 observables correlated 0.9 whose mean shifts as
 σ² and whose spread between packings grows as σ (σ in [0, 1]), 40 parameter sets on σ's levels,
@@ -77,20 +81,25 @@ NOISE_FACTORS, OFFSET_M_S2 = (0.5, 2.0), 20.0
 TRUTH_PACKING_SEED = 100_000
 
 
-def truth_record(base: dict, priors, rng, noise: float, path: Path, index: int) -> np.ndarray:
-    """A truth drawn from ``priors`` and its record, as a lab's instruments make it, written to ``path``."""
+def truth_record(base: dict, priors, rng, noise: float, path: Path, index: int, records: int = 1) -> np.ndarray:
+    """A truth drawn from ``priors`` and ``records`` records of it, as a lab's instruments make them,
+    written to ``path``: each sensor's gain the same in every record, the striker's speed, the
+    channels' noise and offsets and the clock drawn anew for each, and on disordered packings each
+    record struck on a packing of its own."""
     truth = to_parameters(priors, rng.random((1, len(priors))))[0]
     values = {prior.key: float(v) for prior, v in zip(priors, truth)}
     sigma = values.pop(SIGMA_KEY, None)
     config = RunConfig.from_dict(base | values)
     sensors = len(config.sensors)
-    striker = config.replace(v0=config.v0 * (1 + DEFAULT_SPEED_SCATTER * rng.standard_normal()))
     gains = 1 + DEFAULT_GAIN_SD * rng.standard_normal(sensors)
-    levels = noise * rng.uniform(*NOISE_FACTORS, (sensors, 2))
-    offsets = rng.uniform(-OFFSET_M_S2, OFFSET_M_S2, (sensors, 2))
-    disorder = None if sigma is None else (sigma, TRUTH_PACKING_SEED + index, 0)
-    rows = synthetic_rows(striker, "0", levels, float(rng.uniform(0, 5e-3)), rng, disorder=disorder,
-                          packings=path.parent / "truth-packing", gains=gains, offsets_m_s2=offsets)
+    rows = []
+    for r in range(records):
+        striker = config.replace(v0=config.v0 * (1 + DEFAULT_SPEED_SCATTER * rng.standard_normal()))
+        levels = noise * rng.uniform(*NOISE_FACTORS, (sensors, 2))
+        offsets = rng.uniform(-OFFSET_M_S2, OFFSET_M_S2, (sensors, 2))
+        disorder = None if sigma is None else (sigma, TRUTH_PACKING_SEED + records * index + r, 0)
+        rows += synthetic_rows(striker, str(r), levels, float(rng.uniform(0, 5e-3)), rng, disorder=disorder,
+                               packings=path.parent / "truth-packing", gains=gains, offsets_m_s2=offsets)
     write_measured(path, rows)
     (path.parent / "truth.json").write_text(json.dumps({prior.key: float(v) for prior, v in zip(priors, truth)}))
     return truth
@@ -168,6 +177,8 @@ def main() -> None:
     parser.add_argument("--truths", type=int, default=50)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--noise", type=float, default=5.0, help="accelerometer noise [m/s² rms]")
+    parser.add_argument("--records", type=int, default=1, help="records a truth, each on a packing of its own")
+    parser.add_argument("--no-model-discrepancy", action="store_true", help="calibrate with the model taken as exact")
     parser.add_argument("--seed", type=int, default=2026)
     parser.add_argument("--out", help="keep the calibrations here (default: a temporary folder)")
     parser.add_argument("--quick", action="store_true")
@@ -188,7 +199,9 @@ def main() -> None:
     truths, workers = (1, 1) if args.quick else (args.truths, args.workers)
     priors = [Prior.parse(text) for text in prior_texts]
     rng = np.random.default_rng(args.seed)
-    print(f"case {case}: {', '.join(prior_texts)}; noise {args.noise:g} m/s^2 rms; {truths} truth(s); workers {workers}")
+    print(f"case {case}: {', '.join(prior_texts)}; noise {args.noise:g} m/s^2 rms; {truths} truth(s) of "
+          f"{args.records} record(s); workers {workers}"
+          + ("; the model taken as exact" if args.no_model_discrepancy else ""))
     print("| truth | " + " | ".join(f"{p.key} true | {p.key} 90 % interval | {p.key} rank" for p in priors)
           + " | simulations | fit p | wall s |")
     print("|---" * (1 + 3 * len(priors) + 3) + "|")
@@ -196,10 +209,10 @@ def main() -> None:
     for t in range(truths):
         folder = root / f"truth-{t}"
         folder.mkdir(parents=True, exist_ok=True)
-        truth = truth_record(base, priors, rng, args.noise, folder / "data.csv", t)
+        truth = truth_record(base, priors, rng, args.noise, folder / "data.csv", t, args.records)
         start = time.perf_counter()
         calibration = prepare(base, folder / "data.csv", prior_texts, None if budget is None else budget,
-                              seed=args.seed + t)
+                              seed=args.seed + t, model_discrepancy=not args.no_model_discrepancy)
         summary = calibrate(calibration, folder / "data.csv", folder / "calibration", workers, log=lambda message: None)
         seconds = time.perf_counter() - start
         samples = np.loadtxt(folder / "calibration" / "posterior.csv", delimiter=",", skiprows=1, ndmin=2)
