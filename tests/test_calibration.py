@@ -17,7 +17,7 @@ from scipy.stats import qmc
 from hexdem.calibration import inference, nuisance
 from hexdem.calibration.emulator import Emulator
 from hexdem.calibration.observables import Record, noise_covariance, reduce_record
-from hexdem.calibration.packings import SIGMA_LEVELS, settled_packing
+from hexdem.calibration.packings import SIGMA_LEVELS, preparation_of, settled_packing
 from hexdem.calibration.priors import NORMAL_TAIL, Prior
 from hexdem.calibration.report import summarize
 from hexdem.calibration.simulations import Problem, simulate_point
@@ -27,6 +27,7 @@ from hexdem.cli.main import main
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
 from hexdem.model.materials import PAPER_DIAMETER_M
+from hexdem.model.model_builder import build_model
 
 TINY = {"edge_beads": 5, "sensors": ["0:1", "0:3"]}
 TINY_TOML = 'edge_beads = 5\nsensors = ["0:1", "0:3"]\n'
@@ -260,7 +261,8 @@ def packings(tmp_path_factory):
     """Packing 0 of the 4-per-edge hexagon at σ = 6 tol and 3 tol (seed 0), settled."""
     root = tmp_path_factory.mktemp("packings")
     config = RunConfig.from_dict(DISORDERED)
-    return {sigma: settled_packing(config, sigma, 0, 0, root)[0] for sigma in (TRUE_SIGMA_M, TRUE_SIGMA_M / 2)}
+    model, preparation = build_model(config), preparation_of(config)
+    return {sigma: settled_packing(model, preparation, sigma, 0, 0, root)[0] for sigma in (TRUE_SIGMA_M, TRUE_SIGMA_M / 2)}
 
 
 def test_the_disorder_prior_sets_the_standard_deviation_of_the_diameters(packings):

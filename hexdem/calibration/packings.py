@@ -36,7 +36,6 @@ same key reads it instead of settling again.
 
 from __future__ import annotations
 
-import fcntl
 import hashlib
 import os
 import shutil
@@ -45,14 +44,16 @@ from pathlib import Path
 
 import numpy as np
 
+from hexdem.common.io import file_lock
+from hexdem.disorder import stages
 from hexdem.disorder.ensemble import ENSEMBLE_SHAPES
 from hexdem.disorder.preparation import (CRYSTAL_PUSH_FORCE_N, SIGMA_PER_TOLERANCE, TOLERANCE_M, Disorder,
-                                         Preparation, spaced_packing, walls_for_settling, write_stage_deck)
+                                         Preparation, write_stage_deck)
+from hexdem.disorder.stages import compaction_model, prepare
 from hexdem.engines.lammps.deck import DATA_NAME, DECK_NAME, walls_block
-from hexdem.engines.lammps.settling import SETTLED_NAME, read_data_file, read_stage
-from hexdem.engines.lammps.standalone import run_deck
-from hexdem.errors import HexdemError, RunFailed
+from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
+from hexdem.model.contact_law import NO_FRICTION
 from hexdem.model.granular import GranularModel
 from hexdem.model.model_builder import build_model
 from hexdem.model.packing import Packing
@@ -67,9 +68,6 @@ DISORDER_REALIZATIONS = 8
 #: The values σ takes in the simulated parameter sets (see the module docstring).
 SIGMA_LEVELS = 10
 PACKINGS = "packings"
-#: The keys that a preparation runs without: it is elastic and frictionless.
-PREPARATION_CONTACTS = {"restitution": 1.0, "wall_restitution": None, "friction": 0.0, "wall_friction": None,
-                        "rolling_friction": 0.0}
 
 
 def deviates(seed: int, realization: int, n_beads: int) -> np.ndarray:
@@ -106,14 +104,15 @@ def check_disorderable(config: RunConfig, sigma_max_m: float, realizations: int,
                               f"of diameter {smallest:.3g} m; lower the prior's upper end")
 
 
-def _preparation_model(config: RunConfig) -> GranularModel:
-    return build_model(config.replace(**PREPARATION_CONTACTS))
+def preparation_model(model: GranularModel) -> GranularModel:
+    """``model`` as its packing is prepared: elastic and frictionless (see the module docstring)."""
+    return replace(model, restitution=1.0, wall_restitution=1.0, friction=NO_FRICTION)
 
 
-def _compact_model(model: GranularModel, sigma_m: float, seed: int, realization: int) -> GranularModel:
+def _compaction(model: GranularModel, sigma_m: float, seed: int, realization: int) -> GranularModel:
     ideal = model.packing
     diameters = ideal.diameters_m + sigma_m * deviates(seed, realization, len(ideal))
-    return replace(model, packing=spaced_packing(ideal, diameters, Disorder(ideal.diameter_m, sigma_m=sigma_m)))
+    return compaction_model(model, ideal, diameters, Disorder(ideal.diameter_m, sigma_m=sigma_m))
 
 
 def preparation_key(compact_deck: Path, model: GranularModel, preparation: Preparation) -> str:
@@ -128,54 +127,24 @@ def preparation_key(compact_deck: Path, model: GranularModel, preparation: Prepa
     return digest.hexdigest()
 
 
-def _settled_state(directory: Path, stage: str):
-    result = read_stage(directory)
-    if not result.settled:
-        raise RunFailed(f"{directory}: stage {stage!r} did not settle in {result.steps} steps (kinetic energy "
-                        f"{result.kinetic_energy_j:.3g} J, largest force {result.max_force_n:.3g} N)")
-    return read_data_file(directory / SETTLED_NAME)
-
-
-def _walled(model: GranularModel, folder: Path, preparation: Preparation) -> Packing:
-    """The compacted packing in ``folder`` with the walls of the settling."""
-    compacted = _settled_state(folder / "compact", "compact")
-    return walls_for_settling(model.packing.with_geometry(compacted.positions_m, compacted.diameters_m), preparation)
-
-
-def _prepare(model: GranularModel, compact: GranularModel, preparation: Preparation, folder: Path) -> None:
-    """Compact and settle into ``folder`` (through ``.NAME.part``)."""
-    partial = folder.with_name(f".{folder.name}.part")
-    shutil.rmtree(partial, ignore_errors=True)
-    try:
-        run_deck(write_stage_deck(compact, "compact", preparation, partial / "compact"))
-        walled = replace(model, packing=_walled(model, partial, preparation))
-        run_deck(write_stage_deck(walled, "settle", preparation, partial / "settle"))
-        _settled_state(partial / "settle", "settle")
-        os.replace(partial, folder)
-    except BaseException:
-        shutil.rmtree(partial, ignore_errors=True)
-        raise
-
-
-def settled_packing(config: RunConfig, sigma_m: float, seed: int, realization: int, root) -> tuple[Packing, np.ndarray]:
-    """(packing ``realization`` of ``config``'s lattice at σ = ``sigma_m`` settled, with its walls;
-    the gravity it settled under [m/s²]), prepared in ``root``/KEY or read from there."""
+def settled_packing(nominal: GranularModel, preparation: Preparation, sigma_m: float, seed: int, realization: int,
+                    root) -> tuple[Packing, np.ndarray]:
+    """(packing ``realization`` of the lattice of the model ``nominal`` at σ = ``sigma_m`` settled by
+    ``preparation`` (:func:`preparation_of`), with its walls; the gravity it settled under [m/s²]),
+    prepared in ``root``/KEY or read from there."""
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
-    model, preparation = _preparation_model(config), preparation_of(config)
-    compact = _compact_model(model, sigma_m, seed, realization)
+    model = preparation_model(nominal)
+    compaction = _compaction(model, sigma_m, seed, realization)
     scratch = root / f".render-{os.getpid()}"
     shutil.rmtree(scratch, ignore_errors=True)
     try:
-        key = preparation_key(write_stage_deck(compact, "compact", preparation, scratch), model, preparation)
+        key = preparation_key(write_stage_deck(compaction, "compact", preparation, scratch), model, preparation)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
     folder = root / key[:24]
-    with open(root / f".{folder.name}.lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
+    with file_lock(root / f".{folder.name}.lock"):
         if not folder.is_dir():
-            _prepare(model, compact, preparation, folder)
-    walled = _walled(model, folder, preparation)
-    settled = _settled_state(folder / "settle", "settle")
-    packing = replace(walled, positions_m=settled.positions_m, diameters_m=settled.diameters_m)
+            prepare(model, compaction, preparation, folder)
+    packing = stages.settled_packing(model, model.packing, folder, preparation, str(folder))
     return packing, preparation.gravity_vector_m_s2(model.impact.direction)

@@ -19,17 +19,16 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import shutil
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from hexdem.calibration.observables import at_rest_before, observation_names, reduce_record
-from hexdem.calibration.packings import PACKINGS, PAPER_SIGMA_M, SIGMA_KEY, check_disorderable, settled_packing
+from hexdem.calibration.packings import (PACKINGS, PAPER_SIGMA_M, SIGMA_KEY, check_disorderable, preparation_of,
+                                         settled_packing)
 from hexdem.calibration.priors import Prior
-from hexdem.common.io import write_json
+from hexdem.common.io import atomic_directory, write_json
 from hexdem.common.progress import silenced
 from hexdem.common.typecheck import type_at
 from hexdem.errors import HexdemError
@@ -148,8 +147,8 @@ def disordered_impact(config: RunConfig, sigma_m: float, seed: int, realization:
     from hexdem.experiments.run import check_energy
     from hexdem.experiments.tracked_run import ImpactJob, track_impact
 
-    packing, gravity = settled_packing(config, sigma_m, seed, realization, packings)
     nominal = build_model(config)
+    packing, gravity = settled_packing(nominal, preparation_of(config), sigma_m, seed, realization, packings)
     model = replace(nominal, packing=packing)
     job = ImpactJob(model, run_settings(config, nominal), "lammps", Path(workdir), gravity_m_s2=tuple(float(g) for g in gravity),
                     show_progress=False)
@@ -176,10 +175,8 @@ def simulate_point(problem: Problem, values, folder, realization: int = 0) -> li
     folder = Path(folder)
     if (done := finished(folder, values)) is not None:
         return done.tolist()
-    partial = folder.with_name(f".{folder.name}.part")
-    shutil.rmtree(partial, ignore_errors=True)
-    partial.mkdir(parents=True)
-    try:
+    with atomic_directory(folder) as partial:
+        partial.mkdir(parents=True)
         write_json(partial / "parameters.json", {"keys": problem.keys, "values": [float(v) for v in values]})
         with silenced():
             analysis = _impact(problem, values, realization, partial / "deck", folder.parent.parent / PACKINGS)
@@ -189,8 +186,4 @@ def simulate_point(problem: Problem, values, folder, realization: int = 0) -> li
         observables = reduce_record(*at_rest_before(times, accelerations), problem.axes)
         write_json(partial / "observables.json", {"names": problem.names, "observables": observables.tolist(),
                                                   "engine_wall_time_s": analysis.engine.get("wall_time_s", math.nan)})
-        os.replace(partial, folder)
-    except BaseException:
-        shutil.rmtree(partial, ignore_errors=True)
-        raise
     return observables.tolist()

@@ -36,19 +36,43 @@ def atomic_path(path):
 
 
 @contextmanager
-def locked_directory(out: Path, holder: str):
-    """Hold ``out/.lock`` so that two runs never share ``out``; yields the lock's file
+def file_lock(path, holder: str | None = None):
+    """Hold an exclusive lock on the file ``path`` (made if needed) for the block; yields its
     descriptor (MPI launchers started inside inherit it, so the lock lasts as long as they do).
-    ``holder`` names who else may hold it, for the refusal."""
-    fd = os.open(Path(out) / ".lock", os.O_RDWR | os.O_CREAT, 0o644)
+    A lock held elsewhere is waited for, or, given the ``holder`` that may hold it, refused in one
+    line naming the folder."""
+    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
     try:
         try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            fcntl.flock(fd, fcntl.LOCK_EX | (fcntl.LOCK_NB if holder else 0))
         except BlockingIOError:
-            raise HexdemError(f"{out} is in use by {holder}; wait for it or choose another --out") from None
+            raise HexdemError(f"{Path(path).parent} is in use by {holder}; wait for it or choose another --out") from None
         yield fd
     finally:
         os.close(fd)
+
+
+def locked_directory(out: Path, holder: str):
+    """Hold ``out/.lock`` so that two runs never share ``out`` (:func:`file_lock`); ``holder``
+    names who else may hold it, for the refusal."""
+    return file_lock(Path(out) / ".lock", holder)
+
+
+@contextmanager
+def atomic_directory(folder):
+    """Yield the path ``.NAME.part`` beside ``folder`` (removed first, not made) to build the folder
+    in; rename it onto ``folder`` when the block succeeds, remove it when it fails: a folder that
+    exists is complete, and a stop during the rename is raised after it."""
+    folder = Path(folder)
+    partial = folder.with_name(f".{folder.name}.part")
+    shutil.rmtree(partial, ignore_errors=True)
+    try:
+        yield partial
+        with deferred_signals():
+            os.replace(partial, folder)
+    except BaseException:
+        shutil.rmtree(partial, ignore_errors=True)
+        raise
 
 
 def read_text(path, what: str) -> str:

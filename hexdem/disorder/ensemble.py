@@ -36,10 +36,11 @@ from pathlib import Path
 import numpy as np
 
 from hexdem.common.checks import is_number, positive_int
-from hexdem.disorder.preparation import Disorder, Preparation, spaced_packing, walls_for_settling
-from hexdem.engines.lammps.settling import SETTLED_NAME, read_data_file, read_stage
-from hexdem.errors import HexdemError, RunFailed
+from hexdem.disorder.preparation import Disorder, Preparation
+from hexdem.disorder.stages import compaction_model, settled_packing, settling_model
+from hexdem.errors import HexdemError
 from hexdem.model.config import MIN_STEPS_PER_CONTACT, STEPS_PER_CONTACT, RunConfig
+from hexdem.model.contact_law import NO_FRICTION
 from hexdem.model.granular import GranularModel, RunSettings
 from hexdem.model.model_builder import build_model, build_packing
 from hexdem.model.packing import Packing
@@ -129,16 +130,22 @@ class EnsembleConfig:
             raise HexdemError(f"reference bead {{{self.reference_bead[0]}, {self.reference_bead[1]}}} "
                               f"is not in the {ideal.shape}")
 
-    def run_config(self, v_striker: float) -> RunConfig:
-        """The ideal-lattice striker run at ``v_striker`` (also sets every run's dt and length)."""
+    def striker_run(self, v_striker: float) -> tuple[RunConfig, GranularModel]:
+        """The ideal-lattice striker run at ``v_striker`` (also sets every run's dt and length) and its
+        model, built once (the model does not depend on the run's duration)."""
         size = ({"edge_beads": self.edge_beads} if self.shape == "hexagon"
                 else {"rows": self.rows, "columns": self.columns})
         base = RunConfig(shape=self.shape, **size, diameter_m=self.disorder.diameter_m,
                          impact="striker", v0=float(v_striker), steps_per_contact=self.steps_per_contact,
                          dump_every=self.steps_per_contact // IMPACT_SAMPLES_PER_CONTACT, friction=self.friction)
-        if self.duration_s is not None:
-            return base.replace(duration=self.duration_s)
-        return base.replace(duration=self.duration_factor * run_settings(base, build_model(base)).duration_s)
+        model = build_model(base)
+        duration = (self.duration_s if self.duration_s is not None
+                    else self.duration_factor * run_settings(base, model).duration_s)
+        return base.replace(duration=duration), model
+
+    def run_config(self, v_striker: float) -> RunConfig:
+        """The ideal-lattice striker run at ``v_striker`` (:meth:`striker_run`)."""
+        return self.striker_run(v_striker)[0]
 
     def ideal_lattice(self) -> Packing:
         return build_packing(self.run_config(self.velocities_m_s[0]))
@@ -172,8 +179,10 @@ class Ensemble:
 
     def __init__(self, config: EnsembleConfig, out):
         self.config, self.out = config, Path(out)
-        self.ideal = config.ideal_lattice()
-        self._base_model = build_model(config.run_config(config.velocities_m_s[0]).replace(friction=0.0))
+        self._runs: dict[float, tuple[RunConfig, GranularModel]] = {}
+        run, model = self.striker_run(config.velocities_m_s[0])
+        self.ideal = build_packing(run)
+        self._base_model = replace(model, friction=NO_FRICTION)
 
     # ---- layout
     def realization_dir(self, k: int) -> Path:
@@ -195,9 +204,18 @@ class Ensemble:
         return [self.impact_dir(k, v) for v in self.config.velocities_m_s]
 
     # ---- models
-    def settings(self, v: float) -> RunSettings:
-        config = self.config.run_config(v)
-        return run_settings(config, build_model(config))
+    def striker_run(self, v: float) -> tuple[RunConfig, GranularModel]:
+        """:meth:`EnsembleConfig.striker_run`, built once per striker speed ``v``."""
+        if v not in self._runs:
+            self._runs[v] = self.config.striker_run(v)
+        return self._runs[v]
+
+    def impact(self, k: int | None, v: float) -> tuple[GranularModel, RunSettings]:
+        """The model of realization k (None: the ideal lattice) struck at ``v`` and the run's settings
+        (time step and length, from the ideal lattice's model)."""
+        config, model = self.striker_run(v)
+        settings = run_settings(config, model)
+        return (model if k is None else replace(model, packing=self.settled_packing(k))), settings
 
     def diameters_m(self, k: int) -> np.ndarray:
         """Realization k's diameters: each bead's nominal one (d, or a centered square's
@@ -209,32 +227,22 @@ class Ensemble:
         """The packing a preparation stage starts from: spaced (compact) or compacted with walls
         (settle; the walls touch it, or stand back by the preparation's slack)."""
         if stage == "compact":
-            spaced = spaced_packing(self.ideal, self.diameters_m(k), self.config.disorder)
-            return replace(self._base_model, packing=spaced)
-        compacted = self._stage_state(k, "compact")
-        walled = self.ideal.with_geometry(compacted.positions_m, compacted.diameters_m)
-        return replace(self._base_model, packing=walls_for_settling(walled, self.config.preparation))
-
-    def _stage_state(self, k: int, stage: str):
-        directory = self.stage_dir(k, stage)
-        result = read_stage(directory)
-        if not result.settled:
-            raise RunFailed(f"realization {k}: stage {stage!r} did not settle in {result.steps} steps "
-                            f"(kinetic energy {result.kinetic_energy_j:.3g} J, tolerance {result.tolerance_j:.3g} J; "
-                            f"largest force {result.max_force_n:.3g} N, tolerance {result.force_tolerance_n:.3g} N); "
-                            "rerun with a larger --max-settle-steps")
-        return read_data_file(directory / SETTLED_NAME)
+            return compaction_model(self._base_model, self.ideal, self.diameters_m(k), self.config.disorder)
+        return settling_model(self._base_model, self.ideal, self.realization_dir(k), self.config.preparation,
+                              *self._settling_names(k))
 
     def settled_packing(self, k: int) -> Packing:
         """The settled packing of realization k, with the walls placed after compaction."""
-        walled = self.stage_model(k, "settle").packing
-        settled = self._stage_state(k, "settle")
-        return replace(walled, positions_m=settled.positions_m, diameters_m=settled.diameters_m)
+        return settled_packing(self._base_model, self.ideal, self.realization_dir(k), self.config.preparation,
+                               *self._settling_names(k))
+
+    @staticmethod
+    def _settling_names(k: int) -> tuple[str, str]:
+        return f"realization {k}", "; rerun with a larger --max-settle-steps"
 
     def impact_model(self, k: int | None, v: float) -> GranularModel:
         """Realization k (None: the ideal lattice) struck at ``v``."""
-        model = build_model(self.config.run_config(v))
-        return model if k is None else replace(model, packing=self.settled_packing(k))
+        return self.impact(k, v)[0]
 
     @property
     def gravity_m_s2(self) -> np.ndarray:

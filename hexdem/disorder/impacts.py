@@ -47,7 +47,7 @@ def run_impact(ensemble: Ensemble, k: int | None, v: float, dump: bool, launcher
     directory = ensemble.impact_dir(k, v)
     gravity = None if k is None else tuple(float(g) for g in ensemble.gravity_m_s2)
     line_beads = tuple(sorted({int(b) for beads in ensemble.ideal.lines().values() for b in beads}))
-    job = ImpactJob(ensemble.impact_model(k, v), ensemble.settings(v), "lammps", directory, dump=dump,
+    job = ImpactJob(*ensemble.impact(k, v), "lammps", directory, dump=dump,
                     gravity_m_s2=gravity, trace_beads=line_beads, show_progress=False)
     analysis: ImpactAnalysis = track_impact(job, launcher=launcher)
     check_energy(analysis, analysis.engine["deck"])

@@ -23,12 +23,11 @@ interrupted copy never looks finished.
 
 from __future__ import annotations
 
-import os
 import shutil
 import tempfile
 from pathlib import Path
 
-from hexdem.common.io import atomic_path
+from hexdem.common.io import atomic_directory, atomic_path
 from hexdem.disorder.ensemble import Ensemble
 from hexdem.disorder.impacts import IMPACT_NAME
 from hexdem.disorder.preparation import write_stage_deck
@@ -65,10 +64,8 @@ def _adopt_stage(ensemble: Ensemble, source: Ensemble, k: int, stage: str, scrat
     if not _same_deck(rendered, theirs):
         return False
     shutil.rmtree(ours, ignore_errors=True)
-    partial = ours.with_name(f".{ours.name}.part")
-    shutil.rmtree(partial, ignore_errors=True)
-    shutil.copytree(theirs, partial)
-    os.replace(partial, ours)
+    with atomic_directory(ours) as partial:
+        shutil.copytree(theirs, partial)
     return True
 
 

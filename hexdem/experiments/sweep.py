@@ -32,13 +32,12 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 import shutil
 import sys
 import tempfile
 from pathlib import Path
 
-from hexdem.common.io import ensure_writable_dir, keep_plan, locked_directory
+from hexdem.common.io import atomic_directory, ensure_writable_dir, keep_plan, locked_directory
 from hexdem.errors import HexdemError, RunFailed, one_line
 from hexdem.experiments.executors import check_study_options, holding, parsl_session, run_phase
 from hexdem.experiments.provenance import user_command
@@ -86,16 +85,9 @@ def run_one(run: SweepRun, out: Path, ranks: int | None = None, launcher: str | 
     chosen = run.config.replace(**{key: value for key, value in (("ranks", ranks), ("launcher", launcher))
                                    if value is not None})
     config = on_engine(chosen, chosen.engine)
-    final = run_dir(out, run)
-    partial = final.with_name(f".{final.name}.part")
-    shutil.rmtree(partial, ignore_errors=True)
-    try:
+    with atomic_directory(run_dir(out, run)) as partial:
         run_experiment(config, partial, log=lambda message: None, command=command,
                        failed_deck=failed_deck_path(out, run))
-    except BaseException:
-        shutil.rmtree(partial, ignore_errors=True)
-        raise
-    os.replace(partial, final)
 
 
 def plan_study(base: dict, variations: list[Variation], out, source: str = "the base configuration") -> list[SweepRun]:
