@@ -63,6 +63,7 @@ from hexdem.calibration.simulations import Problem, simulate_point
 from hexdem.calibration.study import DEFAULT_GAIN_SD, DEFAULT_SPEED_SCATTER, calibrate, prepare
 from hexdem.calibration.synthetic import synthetic_rows, write_measured
 from hexdem.engines.lammps.standalone import loop_time_s
+from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
 
 #: name → (base configuration, priors, budget in parameter sets (None: the default)).
@@ -206,13 +207,19 @@ def main() -> None:
           + " | simulations | fit p | wall s |")
     print("|---" * (1 + 3 * len(priors) + 3) + "|")
     ranks, inside = {p.key: [] for p in priors}, {(p.key, level): 0 for p in priors for level in (0.5, 0.9)}
+    refused = []
     for t in range(truths):
         folder = root / f"truth-{t}"
         folder.mkdir(parents=True, exist_ok=True)
         truth = truth_record(base, priors, rng, args.noise, folder / "data.csv", t, args.records)
         start = time.perf_counter()
-        calibration = prepare(base, folder / "data.csv", prior_texts, None if budget is None else budget,
-                              seed=args.seed + t, model_discrepancy=not args.no_model_discrepancy)
+        try:
+            calibration = prepare(base, folder / "data.csv", prior_texts, None if budget is None else budget,
+                                  seed=args.seed + t, model_discrepancy=not args.no_model_discrepancy)
+        except HexdemError as exc:
+            refused.append(t)
+            print(f"| {t} | refused: {exc} |", flush=True)
+            continue
         summary = calibrate(calibration, folder / "data.csv", folder / "calibration", workers, log=lambda message: None)
         seconds = time.perf_counter() - start
         samples = np.loadtxt(folder / "calibration" / "posterior.csv", delimiter=",", skiprows=1, ndmin=2)
@@ -229,6 +236,11 @@ def main() -> None:
             cells.append(f"{truth[j]:.6g} | [{q05:.6g}, {q95:.6g}]{held} | {rank}")
         print(f"| {t} | " + " | ".join(cells) + f" | {summary['simulations']['runs']} | "
               f"{summary['fit']['p_value']:.2f} | {seconds:.0f} |", flush=True)
+    if refused:
+        print(f"\n{len(refused)} of {truths} truths refused by the calibration (truths {refused}): left out below")
+    truths -= len(refused)
+    if not truths:
+        return
     bins = max(2, min(10, truths // 5))
     print("\n| key | coverage 50 % | binomial band (95 %) | coverage 90 % | binomial band (95 %) | "
           f"rank histogram ({bins} bins of 0..{RANK_DRAWS}) | uniformity p |")
