@@ -42,16 +42,22 @@ def baseline_tree(work: Path, revision: str = BEFORE) -> Path | None:
             return work / f"hexdem-{revision}"
         shutil.rmtree(work, ignore_errors=True)  # an unpacking cut short
     source = Path(work) / f"source-{revision}"
-    archive = subprocess.run(["git", "-C", str(ROOT), "archive", revision, "hexdem", "lammps_inputs", "pyproject.toml",
-                              "README.md"], capture_output=True, check=False)
+    archive = subprocess.run(
+        ["git", "-C", str(ROOT), "archive", revision, "hexdem", "lammps_inputs", "pyproject.toml", "README.md"],
+        capture_output=True,
+        check=False,
+    )
     if archive.returncode != 0:
         return None
     source.mkdir(parents=True)
     subprocess.run(["tar", "-x", "-C", str(source)], input=archive.stdout, check=True)
     target = Path(work) / f"hexdem-{revision}"
     if (source / "hexdem" / "common" / "kernels").is_dir():
-        subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", str(target), str(source)],
-                       capture_output=True, check=True)
+        subprocess.run(
+            [sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", str(target), str(source)],
+            capture_output=True,
+            check=True,
+        )
     else:
         target.mkdir()
         shutil.move(source / "hexdem", target / "hexdem")
@@ -61,8 +67,13 @@ def baseline_tree(work: Path, revision: str = BEFORE) -> Path | None:
             shutil.copytree(source / "lammps_inputs", inputs)
     config = target / "warm-up.toml"
     config.write_text("edge_beads = 4\nduration = 1e-4\n")
-    subprocess.run(hexdem_command("run", "--config", str(config), "--out", str(target / "warm-up")), cwd=target,
-                   env=hexdem_env(target), capture_output=True, check=True)
+    subprocess.run(
+        hexdem_command("run", "--config", str(config), "--out", str(target / "warm-up")),
+        cwd=target,
+        env=hexdem_env(target),
+        capture_output=True,
+        check=True,
+    )
     return target
 
 

@@ -10,7 +10,8 @@ creeping by round-off (1e-17 m/s a sample, as LAMMPS leaves them), positions on 
 
 * **before**: the NumPy tracker without the noise floor (every creeping bead takes the path of a
   new maximum, as before round-off stopped counting as motion) and the NumPy audit;
-* **NumPy**: today's NumPy code, which defines the kernels' results (:data:`~hexdem.common.kernel_switch.COMPILED` False);
+* **NumPy**: today's NumPy code, which defines the kernels' results (:data:`~hexdem.common.kernel_switch.COMPILED`
+False);
 * **compiled**: today's compiled kernels (:mod:`hexdem.analysis.compiled`), after a warm-up.
 
 Per part, in ns per bead per sample: the **samples** (the driver's full-step positions and
@@ -102,11 +103,19 @@ def measure(model, settings, way: str, samples, out: Path) -> dict:
     for s in range(settings.n_samples):
         atoms["v"][:, :2] = velocities(s)[order]
         start = time.perf_counter()
-        positions_now, velocities_now = full_step(atoms["x"], atoms["v"], atoms["f"], masses, settings.dt_s,
-                                                  way == "compiled")
+        positions_now, velocities_now = full_step(
+            atoms["x"], atoms["v"], atoms["f"], masses, settings.dt_s, way == "compiled"
+        )
         taken += time.perf_counter() - start
-        sample = Sample(s, s * settings.dump_every, s * settings.dt_s * settings.dump_every, ids[order],
-                        positions_now, velocities_now, migrated=s == 0)
+        sample = Sample(
+            s,
+            s * settings.dump_every,
+            s * settings.dt_s * settings.dump_every,
+            ids[order],
+            positions_now,
+            velocities_now,
+            migrated=s == 0,
+        )
         start = time.perf_counter()
         tracker(sample)
         observed += time.perf_counter() - start
@@ -118,10 +127,15 @@ def measure(model, settings, way: str, samples, out: Path) -> dict:
     write_results(RunConfig(), analysis, out, 0.0, {}, lambda message: None)
     written = time.perf_counter() - start
     n, samples_count = len(model.packing), settings.n_samples
-    return {"samples": taken / (n * samples_count) * 1e9,
-            "tracker": (observed - audit.seconds) / (n * samples_count) * 1e9,
-            "audit": audit.seconds / (n * audit.calls) * 1e9, "gathering": gathered / n * 1e9,
-            "result files": written, "peaks": tracked.peak_speed, "energies": tracked.region_energies}
+    return {
+        "samples": taken / (n * samples_count) * 1e9,
+        "tracker": (observed - audit.seconds) / (n * samples_count) * 1e9,
+        "audit": audit.seconds / (n * audit.calls) * 1e9,
+        "gathering": gathered / n * 1e9,
+        "result files": written,
+        "peaks": tracked.peak_speed,
+        "energies": tracked.region_energies,
+    }
 
 
 def main() -> None:
@@ -136,8 +150,9 @@ def main() -> None:
     for edge in edges:
         model = build_model(RunConfig(edge_beads=edge))
         interval_s = 3.5868e-6
-        settings = RunSettings(dt_s=interval_s / 7, n_steps=7 * (n_samples - 1), dump_every=7,
-                               contact_time_s=20 * interval_s)
+        settings = RunSettings(
+            dt_s=interval_s / 7, n_steps=7 * (n_samples - 1), dump_every=7, contact_time_s=20 * interval_s
+        )
         samples = synthetic_samples(model, n_samples, interval_s)
         measure(model, settings, "compiled", samples, Path(tempfile.mkdtemp()))  # warm-up: numba, imports, caches
         results = {}
@@ -152,14 +167,19 @@ def main() -> None:
         np.testing.assert_allclose(compiled["energies"], now["energies"], rtol=0, atol=1e-9 * now["energies"][0].sum())
         rows.append((len(model.packing), results))
         print(f"  measured {len(model.packing):,} beads", flush=True)
-    print(f"in-run analysis of one rank, {n_samples} synthetic samples: ns per bead per sample "
-          "(audit: per audited sample; gathering: per bead, once), result files [s]")
+    print(
+        f"in-run analysis of one rank, {n_samples} synthetic samples: ns per bead per sample "
+        "(audit: per audited sample; gathering: per bead, once), result files [s]"
+    )
     print(f"{'beads':>9} {'part':>12} " + " ".join(f"{way:>10}" for way in WAYS) + f" {'before / compiled':>17}")
     for beads, results in rows:
         for part in ("samples", "tracker", "audit", "gathering", "result files"):
             values = [results[way][part] for way in WAYS]
-            print(f"{beads:>9,} {part:>12} " + " ".join(f"{v:>10.3g}" for v in values)
-                  + f" {values[0] / values[2]:>17.1f}")
+            print(
+                f"{beads:>9,} {part:>12} "
+                + " ".join(f"{v:>10.3g}" for v in values)
+                + f" {values[0] / values[2]:>17.1f}"
+            )
     print("(the three ways' peaks are equal to the bit where round-off was not motion, energies to round-off)")
 
 

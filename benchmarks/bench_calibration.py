@@ -69,10 +69,16 @@ from hexdem.model.config import RunConfig
 #: name → (base configuration, priors, budget in parameter sets (None: the default)).
 CASES = {
     "tiny": ({"sensors": ["0:1", "0:3"], "edge_beads": 5}, ("v0=uniform(0.2, 0.7)",), 30),
-    "quick": ({"sensors": ["0:1", "0:3", "0:5", "0:7"]}, ("restitution=uniform(0.7, 0.99)", "v0=uniform(0.2, 0.7)"),
-              None),
-    "disordered": ({"sensors": ["0:1", "0:3"], "edge_beads": 4},
-                   ("diameter_sigma_m=uniform(0, 1.5e-4)", "restitution=uniform(0.8, 1.0)"), None),
+    "quick": (
+        {"sensors": ["0:1", "0:3", "0:5", "0:7"]},
+        ("restitution=uniform(0.7, 0.99)", "v0=uniform(0.2, 0.7)"),
+        None,
+    ),
+    "disordered": (
+        {"sensors": ["0:1", "0:3"], "edge_beads": 4},
+        ("diameter_sigma_m=uniform(0, 1.5e-4)", "restitution=uniform(0.8, 1.0)"),
+        None,
+    ),
 }
 #: Posterior draws among which a truth is ranked.
 RANK_DRAWS = 99
@@ -99,8 +105,17 @@ def truth_record(base: dict, priors, rng, noise: float, path: Path, index: int, 
         levels = noise * rng.uniform(*NOISE_FACTORS, (sensors, 2))
         offsets = rng.uniform(-OFFSET_M_S2, OFFSET_M_S2, (sensors, 2))
         disorder = None if sigma is None else (sigma, TRUTH_PACKING_SEED + records * index + r, 0)
-        rows += synthetic_rows(striker, str(r), levels, float(rng.uniform(0, 5e-3)), rng, disorder=disorder,
-                               packings=path.parent / "truth-packing", gains=gains, offsets_m_s2=offsets)
+        rows += synthetic_rows(
+            striker,
+            str(r),
+            levels,
+            float(rng.uniform(0, 5e-3)),
+            rng,
+            disorder=disorder,
+            packings=path.parent / "truth-packing",
+            gains=gains,
+            offsets_m_s2=offsets,
+        )
     write_measured(path, rows)
     (path.parent / "truth.json").write_text(json.dumps({prior.key: float(v) for prior, v in zip(priors, truth)}))
     return truth
@@ -138,7 +153,9 @@ def disorder_toy(packings: int, records: int, truths: int, seed: int) -> None:
         sigma = points[:, 0]
         simulated = (shift + curvature * sigma[:, None] ** 2)[:, None, :] + sigma[:, None, None] * scale * shared
         own = rng.standard_normal((records, m)) @ factor.T
-        measured = shift + curvature * truth**2 + truth * scale * own + rng.multivariate_normal(np.zeros(m), noise, records)
+        measured = (
+            shift + curvature * truth**2 + truth * scale * own + rng.multivariate_normal(np.zeros(m), noise, records)
+        )
         data = inference.Data(measured, np.array([noise] * records), tuple(f"y{j}" for j in range(m)))
         fit = inference.fit_stage(data, points, simulated, seed + t)
         low, high = np.quantile(fit.samples[:, 0], [0.05, 0.95])
@@ -147,8 +164,10 @@ def disorder_toy(packings: int, records: int, truths: int, seed: int) -> None:
     band = binomial_band(0.9, truths)
     print("| K | R | truths | coverage 90 % | binomial band (95 %) | median width |")
     print("|---|---|---|---|---|---|")
-    print(f"| {packings} | {records} | {truths} | {held / truths:.2f} | [{band[0]:.2f}, {band[1]:.2f}] | "
-          f"{np.median(widths):.3f} |")
+    print(
+        f"| {packings} | {records} | {truths} | {held / truths:.2f} | [{band[0]:.2f}, {band[1]:.2f}] | "
+        f"{np.median(widths):.3f} |"
+    )
 
 
 def simulation_cost(count: int, root: Path) -> None:
@@ -200,11 +219,16 @@ def main() -> None:
     truths, workers = (1, 1) if args.quick else (args.truths, args.workers)
     priors = [Prior.parse(text) for text in prior_texts]
     rng = np.random.default_rng(args.seed)
-    print(f"case {case}: {', '.join(prior_texts)}; noise {args.noise:g} m/s^2 rms; {truths} truth(s) of "
-          f"{args.records} record(s); workers {workers}"
-          + ("; the model taken as exact" if args.no_model_discrepancy else ""))
-    print("| truth | " + " | ".join(f"{p.key} true | {p.key} 90 % interval | {p.key} rank" for p in priors)
-          + " | simulations | fit p | wall s |")
+    print(
+        f"case {case}: {', '.join(prior_texts)}; noise {args.noise:g} m/s^2 rms; {truths} truth(s) of "
+        f"{args.records} record(s); workers {workers}"
+        + ("; the model taken as exact" if args.no_model_discrepancy else "")
+    )
+    print(
+        "| truth | "
+        + " | ".join(f"{p.key} true | {p.key} 90 % interval | {p.key} rank" for p in priors)
+        + " | simulations | fit p | wall s |"
+    )
     print("|---" * (1 + 3 * len(priors) + 3) + "|")
     ranks, inside = {p.key: [] for p in priors}, {(p.key, level): 0 for p in priors for level in (0.5, 0.9)}
     refused = []
@@ -214,8 +238,14 @@ def main() -> None:
         truth = truth_record(base, priors, rng, args.noise, folder / "data.csv", t, args.records)
         start = time.perf_counter()
         try:
-            calibration = prepare(base, folder / "data.csv", prior_texts, None if budget is None else budget,
-                                  seed=args.seed + t, model_discrepancy=not args.no_model_discrepancy)
+            calibration = prepare(
+                base,
+                folder / "data.csv",
+                prior_texts,
+                None if budget is None else budget,
+                seed=args.seed + t,
+                model_discrepancy=not args.no_model_discrepancy,
+            )
         except HexdemError as exc:
             refused.append(t)
             print(f"| {t} | refused: {exc} |", flush=True)
@@ -234,16 +264,21 @@ def main() -> None:
             q05, q95 = np.quantile(samples[:, j], [0.05, 0.95])
             held = "" if q05 <= truth[j] <= q95 else " MISSED"
             cells.append(f"{truth[j]:.6g} | [{q05:.6g}, {q95:.6g}]{held} | {rank}")
-        print(f"| {t} | " + " | ".join(cells) + f" | {summary['simulations']['runs']} | "
-              f"{summary['fit']['p_value']:.2f} | {seconds:.0f} |", flush=True)
+        print(
+            f"| {t} | " + " | ".join(cells) + f" | {summary['simulations']['runs']} | "
+            f"{summary['fit']['p_value']:.2f} | {seconds:.0f} |",
+            flush=True,
+        )
     if refused:
         print(f"\n{len(refused)} of {truths} truths refused by the calibration (truths {refused}): left out below")
     truths -= len(refused)
     if not truths:
         return
     bins = max(2, min(10, truths // 5))
-    print("\n| key | coverage 50 % | binomial band (95 %) | coverage 90 % | binomial band (95 %) | "
-          f"rank histogram ({bins} bins of 0..{RANK_DRAWS}) | uniformity p |")
+    print(
+        "\n| key | coverage 50 % | binomial band (95 %) | coverage 90 % | binomial band (95 %) | "
+        f"rank histogram ({bins} bins of 0..{RANK_DRAWS}) | uniformity p |"
+    )
     print("|---|---|---|---|---|---|---|")
     for prior in priors:
         cells = []

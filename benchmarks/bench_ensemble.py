@@ -40,8 +40,8 @@ from harness import NOOUTPUT_NAME, nooutput_deck
 from machine import describe
 
 from hexdem.disorder.runner import MANIFEST_NAME
-from hexdem.engines.lammps.standalone import loop_time_s
 from hexdem.engines.lammps.runner import run_bare
+from hexdem.engines.lammps.standalone import loop_time_s
 from hexdem.experiments.snapshots import DEFAULT_TIMES_MS, snapshot_config, take_snapshots
 from hexdem.model.config import RunConfig
 from hexdem.model.model_builder import build_model
@@ -51,8 +51,10 @@ ENSEMBLE_TARGET_S = 60.0
 ENSEMBLE_SPEED_UP_TARGET = 1.5
 SPEED_UP_TARGET = 1.6
 QUICK_ENSEMBLE = ("--realizations", "2", "--velocities", "0.4", "--edge-beads", "4")
-SNAPSHOT_RUN = (RunConfig(shape="half-hexagon", impact="striker", v0=0.4),
-                tuple(t * 1e-3 for t in DEFAULT_TIMES_MS["half-hexagon"]))
+SNAPSHOT_RUN = (
+    RunConfig(shape="half-hexagon", impact="striker", v0=0.4),
+    tuple(t * 1e-3 for t in DEFAULT_TIMES_MS["half-hexagon"]),
+)
 QUICK_SNAPSHOT_RUN = (RunConfig(shape="hexagon", edge_beads=5, impact="striker", v0=0.4), (0.05e-3, 0.1e-3))
 
 
@@ -65,8 +67,14 @@ def ensemble(work: Path, workers: int, options, name: str, tree: Path | None) ->
     unpacked at ``tree`` (None: today's), in a fresh directory."""
     out = work / f"ensemble-{name}"
     start = time.perf_counter()
-    done = subprocess.run(hexdem_command("ensemble", "--out", str(out), "--workers", str(workers), *options), cwd=work,
-                          env=hexdem_env(tree), capture_output=True, text=True, check=False)
+    done = subprocess.run(
+        hexdem_command("ensemble", "--out", str(out), "--workers", str(workers), *options),
+        cwd=work,
+        env=hexdem_env(tree),
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     if done.returncode:
         raise SystemExit(f"hexdem ensemble ({name}) failed:\n{done.stderr[-3000:]}")
     return time.perf_counter() - start, json.loads((out / MANIFEST_NAME).read_text())
@@ -78,21 +86,33 @@ def bench_ensemble(work: Path, workers: int, options, before: str) -> None:
         print(f"(this clone lacks {before}: today's hexdem only)")
         del versions[f"{before} (before)"]
     runs = {name: ensemble(work, workers, options, name.split()[0], tree) for name, tree in versions.items()}
-    print(f"ensemble: hexdem ensemble {' '.join(options) or '(defaults: 20 realizations x 3 striker speeds, 11 per edge)'}"
-          f" --workers {workers}")
-    print(f"  {'version':<18} {'wall [s]':>9} " + " ".join(f"{phase:>9}" for phase in runs["now"][1]["this_run"]["wall_time_s"])
-          + f" {'LAMMPS settle / impact per run [s]':>36}")
+    print(
+        f"ensemble: hexdem ensemble "
+        f"{' '.join(options) or '(defaults: 20 realizations x 3 striker speeds, 11 per edge)'}"
+        f" --workers {workers}"
+    )
+    print(
+        f"  {'version':<18} {'wall [s]':>9} "
+        + " ".join(f"{phase:>9}" for phase in runs["now"][1]["this_run"]["wall_time_s"])
+        + f" {'LAMMPS settle / impact per run [s]':>36}"
+    )
     for name, (total, manifest) in runs.items():
         lammps = manifest["lammps_time_s"]
-        print(f"  {name:<18} {total:>9.2f} " + " ".join(f"{seconds:>9.2f}" for seconds in manifest["this_run"]["wall_time_s"].values())
-              + f" {lammps['settle_per_realization']:>17.2f} / {lammps['impact_per_run']:<16.2f}")
+        print(
+            f"  {name:<18} {total:>9.2f} "
+            + " ".join(f"{seconds:>9.2f}" for seconds in manifest["this_run"]["wall_time_s"].values())
+            + f" {lammps['settle_per_realization']:>17.2f} / {lammps['impact_per_run']:<16.2f}"
+        )
     total = runs["now"][0]
     print(f"  target <= {ENSEMBLE_TARGET_S:g} s: {'met' if total <= ENSEMBLE_TARGET_S else 'NOT met'} ({total:.1f} s)")
     for name, (seconds, _) in runs.items():
         if name != "now":
             speed_up = seconds / total
-            print(f"  before / now: {speed_up:.2f} x; target >= {ENSEMBLE_SPEED_UP_TARGET:g}: "
-                  f"{'met' if speed_up >= ENSEMBLE_SPEED_UP_TARGET else 'NOT met'}", flush=True)
+            print(
+                f"  before / now: {speed_up:.2f} x; target >= {ENSEMBLE_SPEED_UP_TARGET:g}: "
+                f"{'met' if speed_up >= ENSEMBLE_SPEED_UP_TARGET else 'NOT met'}",
+                flush=True,
+            )
 
 
 def bench_ranks(work: Path, repeats: int, base: RunConfig, times_s) -> None:
@@ -119,18 +139,24 @@ def bench_ranks(work: Path, repeats: int, base: RunConfig, times_s) -> None:
                 times[name]["wall"].append(info.wall_time_s)
                 times[name]["lammps"].append(info.wall_time_s)
                 times[name]["loop"].append(loop_time_s(decks[ranks].log_path))
-    print(f"snapshot run, {model.packing.shape}: {model.n_bodies} atoms x {settings.n_steps} steps, "
-          f"{len(times_s)} fields; median of {repeats} alternating run(s)")
+    print(
+        f"snapshot run, {model.packing.shape}: {model.n_bodies} atoms x {settings.n_steps} steps, "
+        f"{len(times_s)} fields; median of {repeats} alternating run(s)"
+    )
     print(f"  {'runner':<18} {'wall [s]':>9} {'LAMMPS [s]':>11} {'loop [s]':>9} {'M atom-steps/s (loop)':>22}")
     median = {name: {key: statistics.median(values) for key, values in t.items()} for name, t in times.items()}
     for name, m in median.items():
-        print(f"  {name:<18} {m['wall']:>9.2f} {m['lammps']:>11.2f} {m['loop']:>9.2f} "
-              f"{atom_steps / m['loop'] / 1e6:>22.2f}")
+        print(
+            f"  {name:<18} {m['wall']:>9.2f} {m['lammps']:>11.2f} {m['loop']:>9.2f} "
+            f"{atom_steps / m['loop'] / 1e6:>22.2f}"
+        )
     for kind in ("hexdem", "bare lmp"):
         one, two = median[f"{kind}, 1 rank"], median[f"{kind}, 2 ranks"]
         speed_up = one["loop"] / two["loop"]
-        print(f"  {kind}: 2 ranks / 1 rank: {speed_up:.2f} x (loop), {one['wall'] / two['wall']:.2f} x (wall); "
-              f"target >= {SPEED_UP_TARGET:g} (loop): {'met' if speed_up >= SPEED_UP_TARGET else 'NOT met'}")
+        print(
+            f"  {kind}: 2 ranks / 1 rank: {speed_up:.2f} x (loop), {one['wall'] / two['wall']:.2f} x (wall); "
+            f"target >= {SPEED_UP_TARGET:g} (loop): {'met' if speed_up >= SPEED_UP_TARGET else 'NOT met'}"
+        )
 
 
 def main() -> None:
@@ -139,7 +165,9 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--skip-ensemble", action="store_true")
     parser.add_argument("--skip-ranks", action="store_true")
-    parser.add_argument("--before", default=BEFORE, metavar="REV", help=f"the revision to compare with (default {BEFORE})")
+    parser.add_argument(
+        "--before", default=BEFORE, metavar="REV", help=f"the revision to compare with (default {BEFORE})"
+    )
     parser.add_argument("--quick", action="store_true", help="a tiny ensemble and a small hexagon (seconds)")
     args = parser.parse_args()
     print(f"machine: {describe()}; load average {os.getloadavg()[0]:.2f}", flush=True)

@@ -47,7 +47,9 @@ def run(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--quick", action="store_true", help="time hexdem paper --quick")
-    parser.add_argument("--before", default=BEFORE, metavar="REV", help=f"the revision to compare with (default {BEFORE})")
+    parser.add_argument(
+        "--before", default=BEFORE, metavar="REV", help=f"the revision to compare with (default {BEFORE})"
+    )
     parser.add_argument("--out", metavar="DIR", help="resume (or report) the paper run in DIR, today's hexdem only")
     args = parser.parse_args(argv)
     print(f"machine: {describe()}", flush=True)
@@ -67,20 +69,27 @@ def run(argv=None) -> int:
                 return result
             runs[name] = result
     names = list(runs["now"][0])
-    print(f"hexdem paper{' --quick' if args.quick else ''} --workers {args.workers}, wall [s] per part, "
-          "now and before, 140 steps per contact")
+    print(
+        f"hexdem paper{' --quick' if args.quick else ''} --workers {args.workers}, wall [s] per part, "
+        "now and before, 140 steps per contact"
+    )
     print(f"  {'part':<28}" + "".join(f" {name:>11}" for name in runs))
     for part in names:
         print(f"  {part:<28}" + "".join(f" {run[0].get(part, float('nan')):>11.1f}" for run in runs.values()))
     print(f"  {'sum of parts':<28}" + "".join(f" {sum(run[0].values()):>11.1f}" for run in runs.values()))
-    print(f"  {'this invocation':<28}" + "".join(f" {run[1]:>11.1f}" for run in runs.values())
-          + "  (a resumed run only writes the report)")
+    print(
+        f"  {'this invocation':<28}"
+        + "".join(f" {run[1]:>11.1f}" for run in runs.values())
+        + "  (a resumed run only writes the report)"
+    )
     total = sum(runs["now"][0].values())
     for name, (parts, _) in runs.items():
         if name != "now":
             speed_up = sum(parts.values()) / total
-            print(f"  before / now (sums of parts): {speed_up:.2f} x; target >= {SPEED_UP_TARGET:g}: "
-                  f"{'met' if speed_up >= SPEED_UP_TARGET else 'NOT met'}")
+            print(
+                f"  before / now (sums of parts): {speed_up:.2f} x; target >= {SPEED_UP_TARGET:g}: "
+                f"{'met' if speed_up >= SPEED_UP_TARGET else 'NOT met'}"
+            )
     target = TARGETS_S[args.quick]
     print(f"target <= {target:g} s for the parts: {'met' if total <= target else 'NOT met'}")
     return 0

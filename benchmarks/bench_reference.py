@@ -42,8 +42,8 @@ from harness import NOOUTPUT_NAME, nooutput_deck, write_config
 from machine import describe
 
 from hexdem.engines.lammps.engine import LammpsEngine
-from hexdem.engines.lammps.standalone import loop_time_s
 from hexdem.engines.lammps.runner import run_bare
+from hexdem.engines.lammps.standalone import loop_time_s
 from hexdem.engines.reference.engine import ReferenceEngine
 from hexdem.model.config import RunConfig
 from hexdem.model.granular import RunSettings
@@ -71,12 +71,21 @@ def reference_subprocess(tree: Path | None, config: RunConfig):
     """A timer of the reference engine unpacked at ``tree`` (None: today's) on ``config``'s model: this
     script's ``--time-reference`` in a subprocess that imports that version first (``config`` in a TOML
     file, read by that version)."""
+
     def timer(model, settings, directory: Path) -> float:
         path = write_config(config, directory / "config.toml")
-        command = [sys.executable, __file__, "--time-reference", str(path), str(settings.n_steps),
-                   str(settings.dump_every)]
-        return float(subprocess.run(command, env=hexdem_env(tree), capture_output=True, text=True,
-                                    check=True).stdout.split()[-1])
+        command = [
+            sys.executable,
+            __file__,
+            "--time-reference",
+            str(path),
+            str(settings.n_steps),
+            str(settings.dump_every),
+        ]
+        return float(
+            subprocess.run(command, env=hexdem_env(tree), capture_output=True, text=True, check=True).stdout.split()[-1]
+        )
+
     return timer
 
 
@@ -103,13 +112,16 @@ def bare_seconds(ranks: int):
         deck = nooutput_deck(model, settings, directory)
         run_bare(deck, ranks, NOOUTPUT_NAME)
         return loop_time_s(deck.log_path)
+
     return timer
 
 
-ENGINES = {"reference (RK4, 1 thread)": reference_seconds,
-           "LAMMPS in hexdem, 1 rank": lammps_seconds,
-           "LAMMPS bare, 1 rank": bare_seconds(1),
-           "LAMMPS bare, 2 ranks": bare_seconds(2)}
+ENGINES = {
+    "reference (RK4, 1 thread)": reference_seconds,
+    "LAMMPS in hexdem, 1 rank": lammps_seconds,
+    "LAMMPS bare, 1 rank": bare_seconds(1),
+    "LAMMPS bare, 2 ranks": bare_seconds(2),
+}
 
 
 def main() -> None:
@@ -135,8 +147,10 @@ def main() -> None:
         raise SystemExit(f"this clone lacks {args.before}")
     (reference, timer), *others = ENGINES.items()
     print(f"machine: {describe()}; load average {os.getloadavg()[0]:.2f}", flush=True)
-    print(f"median of {repeats} alternating run(s), a sample every {args.dump_every} steps "
-          "(other processes slow every engine down)")
+    print(
+        f"median of {repeats} alternating run(s), a sample every {args.dump_every} steps "
+        "(other processes slow every engine down)"
+    )
     print(f"{'lattice':<36} {'beads':>6} {'engine':<26} {'steps':>6} {'time [s]':>9} {'M (bead|atom)-steps/s':>22}")
     rates = {}
     try:
@@ -144,9 +158,14 @@ def main() -> None:
             model = build_model(config)
             settings = RunSettings(run_settings(config, model).dt_s, steps, args.dump_every)
             reference_seconds(model, RunSettings(settings.dt_s, 2, 1), work / "warm-up")
-            references = ([(reference, reference_subprocess(None, config)),
-                           (f"reference at {args.before}", reference_subprocess(tree, config))]
-                          if tree else [(reference, timer)])
+            references = (
+                [
+                    (reference, reference_subprocess(None, config)),
+                    (f"reference at {args.before}", reference_subprocess(tree, config)),
+                ]
+                if tree
+                else [(reference, timer)]
+            )
             engines = dict([*references, *others])
             seconds = {name: [] for name in engines}
             for repeat in range(repeats):
@@ -158,20 +177,27 @@ def main() -> None:
             for name, times in seconds.items():
                 rate = model.n_bodies * steps / statistics.median(times) / 1e6
                 rates[name, len(model.packing)] = rate
-                print(f"{model.packing.shape:<36} {model.n_bodies:>6} {name:<26} {steps:>6} "
-                      f"{statistics.median(times):>9.3f} {rate:>22.2f}", flush=True)
+                print(
+                    f"{model.packing.shape:<36} {model.n_bodies:>6} {name:<26} {steps:>6} "
+                    f"{statistics.median(times):>9.3f} {rate:>22.2f}",
+                    flush=True,
+                )
     finally:
         shutil.rmtree(work)
     beads = TARGET_BEADS if (reference, TARGET_BEADS) in rates else max(n for _, n in rates)
     rate = rates[reference, beads]
     note = "" if beads == TARGET_BEADS else f" (quick: the target is for {TARGET_BEADS} beads)"
-    print(f"reference on {beads} beads: {rate:.1f} M bead-steps/s; target >= {TARGET_M_BEAD_STEPS:g}: "
-          f"{'met' if rate >= TARGET_M_BEAD_STEPS else 'NOT met'}{note}")
+    print(
+        f"reference on {beads} beads: {rate:.1f} M bead-steps/s; target >= {TARGET_M_BEAD_STEPS:g}: "
+        f"{'met' if rate >= TARGET_M_BEAD_STEPS else 'NOT met'}{note}"
+    )
     one, two = rates["LAMMPS bare, 1 rank", beads], rates["LAMMPS bare, 2 ranks", beads]
     print(f"LAMMPS bare on {beads} beads: 2 ranks / 1 rank = {two / one:.2f} x")
     for n in sorted({n for _, n in rates}) if tree else ():
-        print(f"reference on {n} beads: today's bead-steps/s / at {args.before}: "
-              f"{rates[reference, n] / rates[f'reference at {args.before}', n]:.2f} x")
+        print(
+            f"reference on {n} beads: today's bead-steps/s / at {args.before}: "
+            f"{rates[reference, n] / rates[f'reference at {args.before}', n]:.2f} x"
+        )
 
 
 if __name__ == "__main__":

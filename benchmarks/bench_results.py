@@ -46,8 +46,13 @@ BEFORE = "1802d2f"
 TARGET_FLOOR_S, TARGET_SHARE = 1.5, 0.5
 #: What a run imports before its result files (``run_experiment`` loads them while LAMMPS runs; a
 #: version imports those of them it has).
-PRELOADED = ("hexdem.experiments.run", "hexdem.analysis.plotting", "hexdem.analysis.run_maps",
-             "hexdem.analysis.decay_figure", "scipy.spatial")
+PRELOADED = (
+    "hexdem.experiments.run",
+    "hexdem.analysis.plotting",
+    "hexdem.analysis.run_maps",
+    "hexdem.analysis.decay_figure",
+    "scipy.spatial",
+)
 
 
 def quiet(message: str) -> None:
@@ -89,8 +94,13 @@ def as_plain_tuples(value) -> bytes:
 
 def timed_results(pickled: Path, out: Path, tree: Path | None) -> float:
     """Seconds the version at ``tree`` (None: today's) takes to write the result files of ``pickled``."""
-    done = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--write", str(pickled), str(out)],
-                          env=hexdem_env(tree), capture_output=True, text=True, check=False)
+    done = subprocess.run(
+        [sys.executable, str(Path(__file__).resolve()), "--write", str(pickled), str(out)],
+        env=hexdem_env(tree),
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     if done.returncode != 0:
         raise SystemExit(f"writing the result files failed ({'before' if tree else 'now'}):\n{done.stderr[-3000:]}")
     shutil.rmtree(out)
@@ -99,14 +109,19 @@ def timed_results(pickled: Path, out: Path, tree: Path | None) -> float:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--edges", default="11,35,100,200",
-                        help="beads per edge of each hexagon (default 11,35,100,200)")
-    parser.add_argument("--durations", default="3e-4,1e-3,1e-3,3e-4", help="each run's duration [s], one per edge "
-                        "(default 3e-4,1e-3,1e-3,3e-4)")
+    parser.add_argument(
+        "--edges", default="11,35,100,200", help="beads per edge of each hexagon (default 11,35,100,200)"
+    )
+    parser.add_argument(
+        "--durations",
+        default="3e-4,1e-3,1e-3,3e-4",
+        help="each run's duration [s], one per edge (default 3e-4,1e-3,1e-3,3e-4)",
+    )
     parser.add_argument("--ranks", type=int, default=2, help="MPI ranks of each run (default 2)")
     parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--before", default=BEFORE, metavar="REV",
-                        help=f"the revision to compare with (default {BEFORE})")
+    parser.add_argument(
+        "--before", default=BEFORE, metavar="REV", help=f"the revision to compare with (default {BEFORE})"
+    )
     parser.add_argument("--quick", action="store_true", help="a small hexagon, one repeat (seconds)")
     parser.add_argument("--write", nargs=2, metavar=("PICKLE", "OUT"), help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -143,24 +158,40 @@ def main() -> None:
                         continue
                     tree = before if version == "before" else None
                     times[version].append(timed_results(pickled[version], work / f"out-{edge}-{version}", tree))
-            rows.append({"edge": edge, "duration": duration, "beads": len(peaks), "still": float((peaks == 0).mean()),
-                         "run": wall, **{k: statistics.median(v) if v else None for k, v in times.items()}})
+            rows.append(
+                {
+                    "edge": edge,
+                    "duration": duration,
+                    "beads": len(peaks),
+                    "still": float((peaks == 0).mean()),
+                    "run": wall,
+                    **{k: statistics.median(v) if v else None for k, v in times.items()},
+                }
+            )
             print(f"... {edge} per edge done", file=sys.stderr, flush=True)
     finally:
         shutil.rmtree(work)
-    print(f"hexagons run on {ranks} rank(s); the result files written {repeats} time(s) by each version from the same "
-          "analysis, alternating; medians")
-    print(f"{'beads':>8} {'duration [ms]':>14} {'never moved':>12} {'run [s]':>8} {'results, before [s]':>20} "
-          f"{'results, now [s]':>17} {'before / now':>13} {'target [s]':>11}  met")
+    print(
+        f"hexagons run on {ranks} rank(s); the result files written {repeats} time(s) by each version from the same "
+        "analysis, alternating; medians"
+    )
+    print(
+        f"{'beads':>8} {'duration [ms]':>14} {'never moved':>12} {'run [s]':>8} {'results, before [s]':>20} "
+        f"{'results, now [s]':>17} {'before / now':>13} {'target [s]':>11}  met"
+    )
     for row in rows:
         target = max(TARGET_FLOOR_S, TARGET_SHARE * row["run"])
         before_s = f"{row['before']:.2f}" if row["before"] is not None else "–"
         ratio = f"{row['before'] / row['now']:.1f}" if row["before"] is not None else "–"
-        print(f"{row['beads']:>8,} {row['duration'] * 1e3:>14.3g} {row['still']:>11.1%} {row['run']:>8.2f} {before_s:>20} "
-              f"{row['now']:>17.2f} {ratio:>13} {target:>11.2f}  {'met' if row['now'] <= target else 'NOT met'}")
-    print(f"target: the result files <= max({TARGET_FLOOR_S:g} s, {TARGET_SHARE:g} x the run) at every size"
-          + (f"; before: hexdem at {args.before}" if before is not None
-             else f"; before: {args.before} not in this clone"))
+        print(
+            f"{row['beads']:>8,} {row['duration'] * 1e3:>14.3g} {row['still']:>11.1%} {row['run']:>8.2f} "
+            f"{before_s:>20} "
+            f"{row['now']:>17.2f} {ratio:>13} {target:>11.2f}  {'met' if row['now'] <= target else 'NOT met'}"
+        )
+    print(
+        f"target: the result files <= max({TARGET_FLOOR_S:g} s, {TARGET_SHARE:g} x the run) at every size"
+        + (f"; before: hexdem at {args.before}" if before is not None else f"; before: {args.before} not in this clone")
+    )
 
 
 if __name__ == "__main__":

@@ -49,8 +49,8 @@ from machine import describe
 
 from hexdem.engines.lammps.deck import DECK_NAME
 from hexdem.engines.lammps.driver import run_streaming
-from hexdem.engines.lammps.standalone import loop_time_s
 from hexdem.engines.lammps.runner import run_bare
+from hexdem.engines.lammps.standalone import loop_time_s
 from hexdem.experiments.run import run_experiment
 from hexdem.model.config import RunConfig
 from hexdem.model.model_builder import build_model
@@ -71,8 +71,14 @@ def timed_cli(config_path: Path, out: Path, tree: Path | None = None) -> tuple[f
     """Wall time of ``hexdem run --config FILE --out DIR`` (of the version unpacked at ``tree``,
     None: today's) and its summary.json."""
     start = time.perf_counter()
-    done = subprocess.run(hexdem_command("run", "--config", str(config_path), "--out", str(out)), cwd=out.parent,
-                          env=hexdem_env(tree), check=False, capture_output=True, text=True)
+    done = subprocess.run(
+        hexdem_command("run", "--config", str(config_path), "--out", str(out)),
+        cwd=out.parent,
+        env=hexdem_env(tree),
+        check=False,
+        capture_output=True,
+        text=True,
+    )
     wall = time.perf_counter() - start
     if done.returncode != 0:
         raise SystemExit(f"hexdem run failed:\n{done.stderr}")
@@ -96,7 +102,9 @@ def timed_python(code: str) -> float:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=5)
-    parser.add_argument("--before", default=BEFORE, metavar="REV", help=f"the revision to compare with (default {BEFORE})")
+    parser.add_argument(
+        "--before", default=BEFORE, metavar="REV", help=f"the revision to compare with (default {BEFORE})"
+    )
     parser.add_argument("--quick", action="store_true", help="a small deck, one repeat, no warm-up (seconds)")
     args = parser.parse_args()
     repeats = 1 if args.quick else args.repeats
@@ -111,8 +119,24 @@ def main() -> None:
         config_path = write_config(config, work / "run.toml")
         if not args.quick:
             run_experiment(config, work / "warm-up", log=quiet)
-        t = {key: [] for key in ("cli", "cli loop", "cli summary", "cli engine", "before", "before loop", "inproc",
-                                 "inproc loop", "stream loop", "floor", "import", "bare", "bare loop")}
+        t = {
+            key: []
+            for key in (
+                "cli",
+                "cli loop",
+                "cli summary",
+                "cli engine",
+                "before",
+                "before loop",
+                "inproc",
+                "inproc loop",
+                "stream loop",
+                "floor",
+                "import",
+                "bare",
+                "bare loop",
+            )
+        }
         for repeat in range(repeats):
             before_first = before is not None and repeat % 2 == 1  # neither version always runs first
             if before_first:
@@ -120,7 +144,9 @@ def main() -> None:
             out = work / f"cli-{repeat}"
             wall, summary = timed_cli(config_path, out)
             if (out / "deck" / DECK_NAME).read_text() != deck.input_path.read_text():
-                raise SystemExit(f"hexdem run wrote another deck than {deck.input_path}: the comparison would be unfair")
+                raise SystemExit(
+                    f"hexdem run wrote another deck than {deck.input_path}: the comparison would be unfair"
+                )
             t["cli"].append(wall)
             t["cli loop"].append(loop_time_s(out / "deck" / "log.lammps"))
             t["cli summary"].append(summary.get("wall_time_s", math.nan))
@@ -145,39 +171,53 @@ def main() -> None:
     m = {key: statistics.median(values) if values else math.nan for key, values in t.items()}
     bare_loop = m["bare loop"]
     atom_steps = model.n_bodies * settings.n_steps
-    print(f"deck: {'quick: ' if args.quick else 'default experiment, '}{model.packing.shape}, {model.n_bodies} atoms x "
-          f"{settings.n_steps} steps, a sample every {settings.dump_every} steps; median of {repeats} alternating "
-          f"run(s){'' if args.quick else ', after a warm-up'}")
+    print(
+        f"deck: {'quick: ' if args.quick else 'default experiment, '}{model.packing.shape}, {model.n_bodies} atoms x "
+        f"{settings.n_steps} steps, a sample every {settings.dump_every} steps; median of {repeats} alternating "
+        f"run(s){'' if args.quick else ', after a warm-up'}"
+    )
     print(f"{'runner':<34} {'wall [s]':>9} {'loop [s]':>9} {'wall / bare loop':>17} {'M atom-steps/s (loop)':>22}")
-    rows = [("hexdem run (CLI, subprocess)", m["cli"], m["cli loop"]),
-            ("run_experiment (in-process)", m["inproc"], m["inproc loop"]),
-            (f"bare lmp -in {NOOUTPUT_NAME}", m["bare"], bare_loop)]
+    rows = [
+        ("hexdem run (CLI, subprocess)", m["cli"], m["cli loop"]),
+        ("run_experiment (in-process)", m["inproc"], m["inproc loop"]),
+        (f"bare lmp -in {NOOUTPUT_NAME}", m["bare"], bare_loop),
+    ]
     if before is not None:
         rows.insert(1, (f"hexdem run at {args.before} (before)", m["before"], m["before loop"]))
     for name, wall, loop in rows:
         print(f"{name:<34} {wall:>9.3f} {loop:>9.3f} {wall / bare_loop:>17.2f} {atom_steps / loop / 1e6:>22.2f}")
-    print(f"import floor ({FLOOR_IMPORTS.removeprefix('import ')}): {m['floor']:.3f} s; "
-          f"import hexdem.experiments.run: {m['import']:.3f} s")
+    print(
+        f"import floor ({FLOOR_IMPORTS.removeprefix('import ')}): {m['floor']:.3f} s; "
+        f"import hexdem.experiments.run: {m['import']:.3f} s"
+    )
     if before is not None:
         print(f"end to end, before / now: {m['before']:.2f} / {m['cli']:.2f} s = {m['before'] / m['cli']:.2f} x")
     target = m["floor"] + TARGET_FACTOR * bare_loop + TARGET_OFFSET_S
     for name, wall in (("CLI", m["cli"]), ("in-process", m["inproc"])):
         margin = target - wall
-        print(f"target end to end ({name}) <= import floor + {TARGET_FACTOR:g} x bare loop + {TARGET_OFFSET_S:g} s = "
-              f"{target:.2f} s: {wall:.2f} s, {'met' if margin >= 0 else 'NOT met'} ({'+' if margin >= 0 else '-'}"
-              f"{abs(margin):.2f} s)")
-    print(f"streaming alone (an observer that does nothing): loop {m['stream loop']:.3f} s, "
-          f"{m['stream loop'] / bare_loop - 1:.2f} x the bare loop")
+        print(
+            f"target end to end ({name}) <= import floor + {TARGET_FACTOR:g} x bare loop + {TARGET_OFFSET_S:g} s = "
+            f"{target:.2f} s: {wall:.2f} s, {'met' if margin >= 0 else 'NOT met'} ({'+' if margin >= 0 else '-'}"
+            f"{abs(margin):.2f} s)"
+        )
+    print(
+        f"streaming alone (an observer that does nothing): loop {m['stream loop']:.3f} s, "
+        f"{m['stream loop'] / bare_loop - 1:.2f} x the bare loop"
+    )
     for name, loop in (("now", m["cli loop"]), *((("before", m["before loop"]),) if before is not None else ())):
         share = loop / bare_loop - 1
-        print(f"in-run analysis ({name}): hexdem's loop / bare loop - 1 = {share:.2f} (target <= "
-              f"{ANALYSIS_SHARE_TARGET:g}: {'met' if share <= ANALYSIS_SHARE_TARGET else 'NOT met'})")
-    parts = (("python start-up + imports (alone)", m["import"]),
-             ("result files, exit (rest)", m["cli"] - m["cli summary"] - m["import"]),
-             ("model, deck, tracker, analysis", m["cli summary"] - m["cli engine"]),
-             ("LAMMPS start-up + set-up", m["cli engine"] - m["cli loop"]),
-             ("sampling callbacks in the loop", m["cli loop"] - bare_loop),
-             ("bare loop", bare_loop))
+        print(
+            f"in-run analysis ({name}): hexdem's loop / bare loop - 1 = {share:.2f} (target <= "
+            f"{ANALYSIS_SHARE_TARGET:g}: {'met' if share <= ANALYSIS_SHARE_TARGET else 'NOT met'})"
+        )
+    parts = (
+        ("python start-up + imports (alone)", m["import"]),
+        ("result files, exit (rest)", m["cli"] - m["cli summary"] - m["import"]),
+        ("model, deck, tracker, analysis", m["cli summary"] - m["cli engine"]),
+        ("LAMMPS start-up + set-up", m["cli engine"] - m["cli loop"]),
+        ("sampling callbacks in the loop", m["cli loop"] - bare_loop),
+        ("bare loop", bare_loop),
+    )
     print("where the CLI's time goes [s]: " + ", ".join(f"{name} {value:.2f}" for name, value in parts))
 
 

@@ -42,7 +42,7 @@ from hexdem.experiments.sweep_plan import Variation, plan_sweep
 
 QUICK_BASE = {"edge_beads": 5, "duration": 2e-4}
 TARGET_S, TARGET_SHARE = 0.2, 0.05
-PARSL_CONFIG = '''
+PARSL_CONFIG = """
 from parsl.config import Config
 from parsl.executors import HighThroughputExecutor
 from parsl.providers import LocalProvider
@@ -50,7 +50,7 @@ from parsl.providers import LocalProvider
 config = Config(executors=[HighThroughputExecutor(
     label="local", address="127.0.0.1", max_workers_per_node={workers},
     provider=LocalProvider(init_blocks=1, min_blocks=1, max_blocks=1))], run_dir="{run_dir}"{quick})
-'''
+"""
 #: ``--quick``'s Parsl starts its block at its strategy's first look after 0.5 s, not 5 s: the quick
 #: mode checks the benchmark's path, and its table's Parsl start-up is not the one a user meets.
 QUICK_PARSL = ", strategy_period=0.5"
@@ -94,7 +94,9 @@ def main() -> None:
     base = QUICK_BASE if args.quick else {}
     work = Path(tempfile.mkdtemp(prefix="hexdem-bench-study-"))
     config = work / "parsl_local.py"
-    config.write_text(PARSL_CONFIG.format(workers=workers, run_dir=work / "runinfo", quick=QUICK_PARSL if args.quick else ""))
+    config.write_text(
+        PARSL_CONFIG.format(workers=workers, run_dir=work / "runinfo", quick=QUICK_PARSL if args.quick else "")
+    )
     executors = {"process pool": None, "Parsl (HighThroughputExecutor, local)": str(config)}
     print(f"machine: {describe()}; load average {os.getloadavg()[0]:.2f}", flush=True)
     times = {(name, size): [] for name in executors for size in (n, 2 * n)}
@@ -103,8 +105,7 @@ def main() -> None:
         if not args.quick:
             timed_run(base, speeds(n), work / "warm-up-alone")
             for parsl in executors.values():
-                timed_sweep(base, speeds(n), work / f"warm-up-{'pool' if parsl is None else 'parsl'}", workers,
-                            parsl)
+                timed_sweep(base, speeds(n), work / f"warm-up-{'pool' if parsl is None else 'parsl'}", workers, parsl)
         for repeat in range(repeats):
             alone.append(timed_run(base, speeds(n), work / f"{repeat}-alone"))
             for size in (n, 2 * n):
@@ -119,13 +120,18 @@ def main() -> None:
                     shutil.rmtree(out)
     finally:
         shutil.rmtree(work)
-    print(f"sweeps of {n} and {2 * n} runs of {'a 5-per-edge hexagon for 0.2 ms' if args.quick else 'the default experiment'}"
-          f" (v0 from 0.30 m/s), {workers} worker{'s' * (workers > 1)}; medians of {repeats} alternating repeat(s)"
-          f"{'' if args.quick else ', after a warm-up'}")
+    print(
+        f"sweeps of {n} and {2 * n} runs of "
+        f"{'a 5-per-edge hexagon for 0.2 ms' if args.quick else 'the default experiment'}"
+        f" (v0 from 0.30 m/s), {workers} worker{'s' * (workers > 1)}; medians of {repeats} alternating repeat(s)"
+        f"{'' if args.quick else ', after a warm-up'}"
+    )
     run_s = statistics.median(alone)
     print(f"a run, in-process (no executor): {run_s:.2f} s")
-    print(f"{'executor':<38} {f'{n} runs [s]':>11} {f'{2 * n} runs [s]':>11} {'start-up and end [s]':>21} "
-          f"{'overhead per run [s]':>21}")
+    print(
+        f"{'executor':<38} {f'{n} runs [s]':>11} {f'{2 * n} runs [s]':>11} {'start-up and end [s]':>21} "
+        f"{'overhead per run [s]':>21}"
+    )
     overhead = {}
     for name in executors:
         small, large = (statistics.median(times[name, size]) for size in (n, 2 * n))
@@ -135,8 +141,10 @@ def main() -> None:
     extra = parsl - pool
     limit = max(TARGET_S, TARGET_SHARE * run_s)
     print(f"Parsl's overhead per run over the pool's: {extra:+.3f} s = {extra / run_s:+.1%} of a run ({run_s:.2f} s)")
-    print(f"target <= {TARGET_S:g} s or {TARGET_SHARE:.0%} of a run ({limit:.3f} s): "
-          f"{'met' if extra <= limit else 'NOT met'}")
+    print(
+        f"target <= {TARGET_S:g} s or {TARGET_SHARE:.0%} of a run ({limit:.3f} s): "
+        f"{'met' if extra <= limit else 'NOT met'}"
+    )
 
 
 if __name__ == "__main__":

@@ -60,8 +60,11 @@ def write_config(config: RunConfig, path) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     defaults = RunConfig().as_dict()
-    lines = [f"{key} = {_toml_value(value)}" for key, value in config.as_dict().items()
-             if value is not None and value != defaults[key]]
+    lines = [
+        f"{key} = {_toml_value(value)}"
+        for key, value in config.as_dict().items()
+        if value is not None and value != defaults[key]
+    ]
     path.write_text("\n".join(lines) + "\n")
     assert RunConfig.from_toml(path) == config
     return path
@@ -153,4 +156,6 @@ def run_watched(command, cwd=None, env=None) -> Watched:
         process.returncode = os.waitstatus_to_exitcode(ended["status"])
         err.seek(0)
         stderr = err.read().decode(errors="replace")
-    return Watched(ended["time"] - start, process.returncode, stderr, peaks, ended["usage"].ru_maxrss * 1024, process.pid)
+    return Watched(
+        ended["time"] - start, process.returncode, stderr, peaks, ended["usage"].ru_maxrss * 1024, process.pid
+    )

@@ -11,4 +11,6 @@ def describe() -> str:
             cpu = next(line.split(":", 1)[1].strip() for line in fh if line.startswith("model name"))
     except (OSError, StopIteration):
         pass
-    return f"{cpu}; {os.cpu_count()} cores; {platform.system()} {platform.machine()}; Python {platform.python_version()}"
+    return (
+        f"{cpu}; {os.cpu_count()} cores; {platform.system()} {platform.machine()}; Python {platform.python_version()}"
+    )

@@ -16,8 +16,7 @@ project = "hexdem"
 author = "the hexdem developers"
 copyright = "2026, the hexdem developers"
 release = installed_version("hexdem")
-extensions = ["myst_parser", "sphinx.ext.autodoc", "sphinx.ext.napoleon", "hexdem_reference",
-              "hexdem_mathml"]
+extensions = ["myst_parser", "sphinx.ext.autodoc", "sphinx.ext.napoleon", "hexdem_reference", "hexdem_mathml"]
 myst_enable_extensions = ["dollarmath"]
 #: Math as MathML written at build time (``_ext/hexdem_mathml.py``): no script, no network.
 html_math_renderer = "mathml"
@@ -32,9 +31,15 @@ html_title = "hexdem"
 #: The page's own headings below the section's navigation, in the one sidebar: without a second
 #: sidebar the article is wide enough for the 82 columns of the code blocks and CLI help at 1280 px
 #: (an API page lists its modules there).
-html_theme_options = {"logo": {"text": "hexdem"}, "navbar_align": "left", "show_toc_level": 2,
-                      "navigation_with_keys": False, "secondary_sidebar_items": [],
-                      "footer_start": ["copyright"], "footer_end": ["sphinx-version"]}
+html_theme_options = {
+    "logo": {"text": "hexdem"},
+    "navbar_align": "left",
+    "show_toc_level": 2,
+    "navigation_with_keys": False,
+    "secondary_sidebar_items": [],
+    "footer_start": ["copyright"],
+    "footer_end": ["sphinx-version"],
+}
 html_sidebars = {"**": ["sidebar-nav-bs", "page-toc"]}
 html_static_path = ["_static"]
 html_css_files = ["hexdem.css"]

@@ -57,12 +57,15 @@ class ImpactResult:
     far_wall_reached: bool
 
     @classmethod
-    def of(cls, analysis: ImpactAnalysis) -> "ImpactResult":
+    def of(cls, analysis: ImpactAnalysis) -> ImpactResult:
         r = analysis.results
-        lines = {name: LineResult(beads + 1, r.peak_speed[beads], r.t_peak[beads], r.arrival_time[beads])
-                 for name, beads in r.lines.items()}
-        return cls(r.units, lines, r.positions, r.peak_speed, r.t_peak, r.arrival_time, r.energy_drift,
-                   r.far_wall_reached)
+        lines = {
+            name: LineResult(beads + 1, r.peak_speed[beads], r.t_peak[beads], r.arrival_time[beads])
+            for name, beads in r.lines.items()
+        }
+        return cls(
+            r.units, lines, r.positions, r.peak_speed, r.t_peak, r.arrival_time, r.energy_drift, r.far_wall_reached
+        )
 
 
 def simulate_impact(config: RunConfig | None = None, out=None, verbose: bool = False, **changes) -> ImpactResult:
@@ -88,8 +91,9 @@ def tca() -> dict:
     return _tca.summary()
 
 
-def scaling_laws(settings: SweepSettings | None = None, last: int | None = None,
-                 kind: str = "loglinear") -> dict[str, CombinationFit]:
+def scaling_laws(
+    settings: SweepSettings | None = None, last: int | None = None, kind: str = "loglinear"
+) -> dict[str, CombinationFit]:
     """Run the V₀ sweep of ``settings`` (default: Sec. V's, on the reference integrator) and fit
     the laws of the four combinations "30/30", "30/0", "0/0", "0/30" (window up to ``last``).
 

@@ -39,8 +39,10 @@ def compile_reference_kernels() -> None:
     kernels into its cache, with the argument types that every reference run passes."""
     with tempfile.TemporaryDirectory() as folder:
         for friction in (0.0, 0.3):
-            simulate(RunConfig(edge_beads=2, engine="reference", friction=friction, duration=1e-4),
-                     Path(folder) / str(friction))
+            simulate(
+                RunConfig(edge_beads=2, engine="reference", friction=friction, duration=1e-4),
+                Path(folder) / str(friction),
+            )
 
 
 def pytest_sessionstart(session):
@@ -53,7 +55,10 @@ def pytest_sessionstart(session):
     if not hasattr(config, "workerinput") and config.getoption("numprocesses", None):
         config.stash[WARM_UP] = subprocess.Popen(
             [sys.executable, "-c", "import conftest; conftest.compile_reference_kernels()"],
-            cwd=Path(__file__).parent, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            cwd=Path(__file__).parent,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
 
 
 def pytest_sessionfinish(session):
@@ -82,7 +87,9 @@ def pytest_collection_modifyitems(items):
             item.add_marker(pytest.mark.xdist_group("default_experiment"))
         elif item.get_closest_marker("xdist_group") is None and shares_a_module_fixture(item):
             item.add_marker(pytest.mark.xdist_group(item.path.stem))
-    items.sort(key=lambda item: (item.get_closest_marker("slow") is None, item.get_closest_marker("xdist_group") is None))
+    items.sort(
+        key=lambda item: (item.get_closest_marker("slow") is None, item.get_closest_marker("xdist_group") is None)
+    )
 
 
 def shares_a_module_fixture(item) -> bool:
@@ -92,7 +99,9 @@ def shares_a_module_fixture(item) -> bool:
     own = item.nodeid.split("::")[0]
     return info is not None and any(
         definition.scope in ("module", "class") or (definition.scope == "session" and definition.baseid == own)
-        for definitions in info.name2fixturedefs.values() for definition in definitions)
+        for definitions in info.name2fixturedefs.values()
+        for definition in definitions
+    )
 
 
 @pytest.fixture(scope="session")
@@ -147,9 +156,15 @@ def record(engine, model, settings, directory, **options):
 
 def single_bead(diameter_m=0.01905) -> Packing:
     """A one-bead 'packing' at the origin, for two-body collisions with a striker or a wall."""
-    return Packing(labels=np.array([[0, 0]]), positions_m=np.zeros((1, 2)),
-                   diameters_m=np.array([diameter_m]), diameter_m=diameter_m,
-                   struck=0, walls=(), shape="single bead")
+    return Packing(
+        labels=np.array([[0, 0]]),
+        positions_m=np.zeros((1, 2)),
+        diameters_m=np.array([diameter_m]),
+        diameter_m=diameter_m,
+        struck=0,
+        walls=(),
+        shape="single bead",
+    )
 
 
 def disordered_model(seed=1, edge_beads=3) -> GranularModel:

@@ -22,7 +22,7 @@ from dataclasses import dataclass, replace
 from functools import cache
 
 import numpy as np
-from conftest import D, V0, single_bead
+from conftest import V0, D, single_bead
 
 from hexdem.engines.lammps.deck import write_deck
 from hexdem.engines.lammps.driver import in_folder, split_deck
@@ -44,8 +44,13 @@ def sphere_on_wall(incidence_deg: float, friction: float, speed: float = V0) -> 
     """A steel sphere touching a delrin-lined flat wall (inward normal +y) at t = 0, moving into it
     at ``speed`` at ``incidence_deg`` from the normal: v = V (sin θ, −cos θ)."""
     wall = Wall("wall_090", (0.0, 1.0), -D / 2, np.array([0]))
-    return GranularModel(replace(single_bead(D), walls=(wall,)), Impact(speed, incidence_deg - 90.0, bead=0),
-                         STEEL_316, DELRIN, friction=Friction(friction, friction))
+    return GranularModel(
+        replace(single_bead(D), walls=(wall,)),
+        Impact(speed, incidence_deg - 90.0, bead=0),
+        STEEL_316,
+        DELRIN,
+        friction=Friction(friction, friction),
+    )
 
 
 def sphere_in_ring(incidence_deg: float, friction: float, ring_radius_d: float = 3.0) -> GranularModel:
@@ -59,8 +64,9 @@ def sphere_pair(incidence_deg: float, friction: float, speed: float = V0) -> Gra
     """Two touching steel spheres on the x axis; the first moves at ``speed`` at ``incidence_deg`` from
     the line of centres towards the second, at rest."""
     lattice = Packing(np.array([[0, 0], [2, 0]]), np.array([[0.0, 0.0], [D, 0.0]]), np.full(2, D), D, 0, (), "pair")
-    return GranularModel(lattice, Impact(speed, incidence_deg, bead=0), STEEL_316, None,
-                         friction=Friction(friction, friction))
+    return GranularModel(
+        lattice, Impact(speed, incidence_deg, bead=0), STEEL_316, None, friction=Friction(friction, friction)
+    )
 
 
 @dataclass(frozen=True)
@@ -80,15 +86,33 @@ class Contact:
     damping: float = 0.0
 
     @classmethod
-    def of(cls, model: GranularModel) -> "Contact":
+    def of(cls, model: GranularModel) -> Contact:
         masses, radii = tuple(model.masses_kg), tuple(model.diameters_m / 2)
         if model.walls:
             law = model.laws.walls[0]
-            return cls(law.normal_stiffness_pa, law.tangential_stiffness_pa, radii[0], law.friction, masses[0],
-                       radii, masses, True, law.damping)
+            return cls(
+                law.normal_stiffness_pa,
+                law.tangential_stiffness_pa,
+                radii[0],
+                law.friction,
+                masses[0],
+                radii,
+                masses,
+                True,
+                law.damping,
+            )
         law = model.laws.pairs[0][0]
-        return cls(law.normal_stiffness_pa, law.tangential_stiffness_pa, radii[0] * radii[1] / (radii[0] + radii[1]),
-                   law.friction, masses[0] * masses[1] / (masses[0] + masses[1]), radii, masses, False, law.damping)
+        return cls(
+            law.normal_stiffness_pa,
+            law.tangential_stiffness_pa,
+            radii[0] * radii[1] / (radii[0] + radii[1]),
+            law.friction,
+            masses[0] * masses[1] / (masses[0] + masses[1]),
+            radii,
+            masses,
+            False,
+            law.damping,
+        )
 
     def compliance(self, overlap: float) -> float:
         """dv_c/dF_t: 1/m + r²/I against a wall (LAMMPS's lever r), Σ 1/m_i + r_i (r_i − δ/2)/I_i for two
@@ -103,8 +127,7 @@ class Contact:
 
 
 @cache
-def solve_contact(contact: Contact, normal_speed: float, slip_speed: float, capped: bool = True,
-                  steps: int = 1000):
+def solve_contact(contact: Contact, normal_speed: float, slip_speed: float, capped: bool = True, steps: int = 1000):
     """(J_t, rebound normal rate −w_out, slip velocity v_c,out, max |F_t|/F_n) of one contact struck at
     ``normal_speed`` with the contact points slipping at ``slip_speed``; ``capped`` False: no Coulomb
     cap (Mindlin's no-slip contact throughout); steps of at most τ/``steps``."""
@@ -127,8 +150,9 @@ def solve_contact(contact: Contact, normal_speed: float, slip_speed: float, capp
         force = normal(overlap, rate)
         if force == 0.0:
             return 0.0
-        force_rate = (1.5 * stiffness * math.sqrt(overlap) * rate
-                      + eta * (0.25 * overlap**-0.75 * rate**2 - overlap**0.25 * force / c.m_n))
+        force_rate = 1.5 * stiffness * math.sqrt(overlap) * rate + eta * (
+            0.25 * overlap**-0.75 * rate**2 - overlap**0.25 * force / c.m_n
+        )
         return per_force * (force_rate / math.sqrt(overlap) - 0.5 * force * rate / overlap**1.5)
 
     def rhs(t, y):
@@ -148,12 +172,24 @@ def solve_contact(contact: Contact, normal_speed: float, slip_speed: float, capp
 
     separated.terminal, separated.direction = True, -1
     tau = c.contact_time(normal_speed)
-    solution = solve_ivp(rhs, (0.0, 2 * tau), [0.0, normal_speed, 0.0, slip_speed, 0.0], method="DOP853",
-                         events=separated, rtol=1e-11, atol=1e-16, max_step=tau / steps, dense_output=True)
+    solution = solve_ivp(
+        rhs,
+        (0.0, 2 * tau),
+        [0.0, normal_speed, 0.0, slip_speed, 0.0],
+        method="DOP853",
+        events=separated,
+        rtol=1e-11,
+        atol=1e-16,
+        max_step=tau / steps,
+        dense_output=True,
+    )
     end = solution.y_events[0][0]
     samples = solution.sol(np.linspace(0, solution.t_events[0][0], 2001)[1:-1]).T
-    ratios = [c.k_t * math.sqrt(c.r_eff * overlap) * min(limit(overlap, rate), abs(xi)) / normal(overlap, rate)
-              for overlap, rate, xi, _, _ in samples if normal(overlap, rate) > 0]
+    ratios = [
+        c.k_t * math.sqrt(c.r_eff * overlap) * min(limit(overlap, rate), abs(xi)) / normal(overlap, rate)
+        for overlap, rate, xi, _, _ in samples
+        if normal(overlap, rate) > 0
+    ]
     return end[4], -end[1], end[3], float(max(ratios))
 
 
@@ -209,8 +245,15 @@ def reference_states(model: GranularModel, settings: RunSettings, every: int = 1
     start, records = model.initial_positions_m(), []
 
     def emit(index, step, x, y, u, w):
-        records.append((step * settings.dt_s, start + np.column_stack([x, y]), np.column_stack([u, w]),
-                        system.state["spins"].copy(), system.state["wall_xi"] * SI.length_m))
+        records.append(
+            (
+                step * settings.dt_s,
+                start + np.column_stack([x, y]),
+                np.column_stack([u, w]),
+                system.state["spins"].copy(),
+                system.state["wall_xi"] * SI.length_m,
+            )
+        )
 
     system.integrate(model.initial_velocities_m_s(), settings.dt_s, replace(settings, dump_every=every), emit)
     times, positions, velocities, spins, histories = (np.array(values) for values in zip(*records))

@@ -11,9 +11,24 @@ import hexdem
 
 PACKAGE = Path(hexdem.__file__).parent
 #: Layers in the direction data flows; a module may import only from its own layer or lower ones.
-LAYERS = ("errors", "common", "model", "engines", "analysis", "experiments", "theory", "waves", "disorder", "calibration", "paper", "api", "cli",
-          "__main__")
-MAX_LINES = 400
+LAYERS = (
+    "errors",
+    "common",
+    "model",
+    "engines",
+    "analysis",
+    "experiments",
+    "theory",
+    "waves",
+    "disorder",
+    "calibration",
+    "paper",
+    "api",
+    "cli",
+    "__main__",
+)
+#: Lines as ruff's formatter writes them (one argument a line where a call does not fit in 120 characters).
+MAX_LINES = 500
 
 
 def module_name(path: Path) -> str:
@@ -56,7 +71,7 @@ def find_cycle(graph) -> list[str] | None:
         stack.append(node)
         for target in sorted(graph[node]):
             if state.get(target) == "open":
-                return stack[stack.index(target):] + [target]
+                return stack[stack.index(target) :] + [target]
             if target not in state and (cycle := visit(target)):
                 return cycle
         stack.pop()
@@ -84,8 +99,12 @@ def test_every_package_is_a_known_layer():
 
 
 def test_imports_point_down_the_data_flow():
-    upward = [f"{name} -> {target}" for name, targets in import_graph().items() for target in targets
-              if name != "hexdem" and layer(target) > layer(name)]
+    upward = [
+        f"{name} -> {target}"
+        for name, targets in import_graph().items()
+        for target in targets
+        if name != "hexdem" and layer(target) > layer(name)
+    ]
     assert upward == []
 
 

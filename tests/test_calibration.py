@@ -78,8 +78,7 @@ def test_a_linear_gaussian_model_gives_the_analytic_posterior():
     sd = np.sqrt(np.diag(covariance))
     assert np.abs(fit.samples.mean(axis=0) - mean) == pytest.approx(0, abs=0.15 * sd.min())
     assert fit.samples.std(axis=0) == pytest.approx(sd, rel=0.12)
-    assert np.corrcoef(fit.samples, rowvar=False)[0, 1] == pytest.approx(
-        covariance[0, 1] / sd.prod(), abs=0.08)
+    assert np.corrcoef(fit.samples, rowvar=False)[0, 1] == pytest.approx(covariance[0, 1] / sd.prod(), abs=0.08)
 
 
 def test_correlated_parameters_are_reported_as_trading_off():
@@ -98,8 +97,11 @@ def test_the_directions_the_data_measure_are_named_and_a_key_left_at_its_prior_i
     rng = np.random.default_rng(0)
     along = rng.uniform(0.2, 0.8, 20000)
     unit = np.column_stack([along, 1.0 - along + rng.normal(0, 0.005, along.size), rng.uniform(0, 1, along.size)])
-    priors = [Prior("v0", "uniform", 0.2, 0.7), Prior("restitution", "uniform", 0.3, 0.99),
-              Prior("friction", "uniform", 0.0, 1.0)]
+    priors = [
+        Prior("v0", "uniform", 0.2, 0.7),
+        Prior("restitution", "uniform", 0.3, 0.99),
+        Prior("friction", "uniform", 0.0, 1.0),
+    ]
     samples = np.column_stack([prior.from_unit(unit[:, j]) for j, prior in enumerate(priors)])
     summary = summarize(priors, samples)
     best = summary["directions"][0]
@@ -138,20 +140,24 @@ def test_the_likelihood_is_the_joint_gaussian_of_records_that_share_the_emulator
     spread = 0.02 * a @ a.T
     covariances = np.array([np.diag(rng.uniform(0.01, 0.03, m)) for _ in range(r)])
     records = mean + rng.normal(0, 0.3, (r, m))
-    likelihood = inference.Likelihood(inference.Data(records, covariances, ("a", "b", "c")),
-                                      _Fixed(mean, variance, spread, k), _Fixed(mean, variance, spread, k))
+    likelihood = inference.Likelihood(
+        inference.Data(records, covariances, ("a", "b", "c")),
+        _Fixed(mean, variance, spread, k),
+        _Fixed(mean, variance, spread, k),
+    )
     common = np.diag(variance) + spread / k
     joint = np.kron(np.ones((r, r)), common)
     for i in range(r):
-        joint[i * m:(i + 1) * m, i * m:(i + 1) * m] += covariances[i] + spread
+        joint[i * m : (i + 1) * m, i * m : (i + 1) * m] += covariances[i] + spread
     residual = (records - mean).ravel()
     expected = -0.5 * (residual @ np.linalg.solve(joint, residual) + np.linalg.slogdet(joint)[1])
     assert likelihood.dimension == 2  # the spread's scale after the parameter
     assert likelihood(np.array([[0.5, 0.5]]))[0] == pytest.approx(expected, rel=1e-10)
     together, alone = likelihood.misfit(np.array([0.5, 0.5]))
     assert together == pytest.approx(residual @ np.linalg.solve(joint, residual), rel=1e-10)
-    assert alone[1] == pytest.approx((records[1] - mean) @ np.linalg.solve(covariances[1] + spread + common,
-                                                                        records[1] - mean), rel=1e-10)
+    assert alone[1] == pytest.approx(
+        (records[1] - mean) @ np.linalg.solve(covariances[1] + spread + common, records[1] - mean), rel=1e-10
+    )
 
 
 def test_the_model_discrepancy_is_a_relative_error_common_to_all_records_whose_size_is_sampled():
@@ -163,8 +169,9 @@ def test_the_model_discrepancy_is_a_relative_error_common_to_all_records_whose_s
     records = mean + np.array([[0.01, -0.02, 1.5], [0.012, -0.018, 1.2]])
     zero = _Fixed(mean, variance, np.zeros((m, m)), 1)
     discrepancy = nuisance.Discrepancy(2)
-    likelihood = inference.Likelihood(inference.Data(records, covariances, ("a", "b", "c")), zero, zero,
-                                      discrepancy=discrepancy)
+    likelihood = inference.Likelihood(
+        inference.Data(records, covariances, ("a", "b", "c")), zero, zero, discrepancy=discrepancy
+    )
     assert likelihood.dimension == 2
     for u in (0.0, 0.6, 1.0):
         tau = 1e-4 * 2000**u
@@ -189,8 +196,9 @@ def test_the_instruments_enter_as_gains_common_to_all_records_and_a_speed_per_re
     records = mean + np.array([0.0, 0.05, 0.0]) + rng.normal(0, 0.002, (r, m)) * [1, 1, 50]
     instruments = nuisance.Instruments(2, gain_sd, scatter)
     zero = _Fixed(mean, variance, np.zeros((m, m)), 1)
-    likelihood = inference.Likelihood(inference.Data(records, covariances, ("a", "b", "c")), zero, zero,
-                                      instruments=instruments)
+    likelihood = inference.Likelihood(
+        inference.Data(records, covariances, ("a", "b", "c")), zero, zero, instruments=instruments
+    )
     slope = np.array([1.0, 1.0, -mean[2] / 5])
     gains = np.diag([gain_sd**2, gain_sd**2, 0.0])
     common = np.diag(variance) + gains
@@ -262,7 +270,9 @@ def packings(tmp_path_factory):
     root = tmp_path_factory.mktemp("packings")
     config = RunConfig.from_dict(DISORDERED)
     model, preparation = build_model(config), preparation_of(config)
-    return {sigma: settled_packing(model, preparation, sigma, 0, 0, root)[0] for sigma in (TRUE_SIGMA_M, TRUE_SIGMA_M / 2)}
+    return {
+        sigma: settled_packing(model, preparation, sigma, 0, 0, root)[0] for sigma in (TRUE_SIGMA_M, TRUE_SIGMA_M / 2)
+    }
 
 
 def test_the_disorder_prior_sets_the_standard_deviation_of_the_diameters(packings):
@@ -285,8 +295,11 @@ def test_neighbouring_sigma_scale_the_same_deviates(packings):
 def test_a_settled_packing_is_prepared_once_for_every_impact_on_it(tmp_path):
     """Parameter sets that differ in restitution and v0 alone strike one settled packing; another
     σ or another packing k is prepared anew."""
-    priors = (Prior("diameter_sigma_m", "uniform", 0.0, 1.5e-4), Prior("restitution", "uniform", 0.8, 0.99),
-              Prior("v0", "uniform", 0.2, 0.7))
+    priors = (
+        Prior("diameter_sigma_m", "uniform", 0.0, 1.5e-4),
+        Prior("restitution", "uniform", 0.8, 0.99),
+        Prior("v0", "uniform", 0.2, 0.7),
+    )
     problem = Problem(DISORDERED, priors, realizations=2, seed=0)
     folders = lambda: sorted(p.name for p in (tmp_path / "packings").iterdir() if not p.name.startswith("."))
     first = simulate_point(problem, [TRUE_SIGMA_M, 0.9, 0.4], tmp_path / "simulations" / "0000-k0", 0)
@@ -304,14 +317,35 @@ def test_a_calibration_of_the_disorder_runs_on_disordered_records(tmp_path):
     """One record of a packing of its own (seed 1000) at σ = 6 tol; σ calibrated on K = 2
     packings per parameter set: 30 sets, 60 simulations, at most 2 packings per σ level."""
     config = RunConfig.from_dict(DISORDERED)
-    rows = synthetic_rows(config, "0", 2.0, 1.5e-3, np.random.default_rng(3), disorder=(TRUE_SIGMA_M, 1000, 0),
-                          packings=tmp_path / "truth")
+    rows = synthetic_rows(
+        config,
+        "0",
+        2.0,
+        1.5e-3,
+        np.random.default_rng(3),
+        disorder=(TRUE_SIGMA_M, 1000, 0),
+        packings=tmp_path / "truth",
+    )
     write_measured(tmp_path / "data.csv", rows)
     (tmp_path / "base.toml").write_text(DISORDERED_TOML)
     out = tmp_path / "out"
-    code = main(["calibrate", "--config", str(tmp_path / "base.toml"), "--measured", str(tmp_path / "data.csv"),
-                 "--prior", "diameter_sigma_m=uniform(0, 1.5e-4)", "--realizations", "2", "--budget", "60",
-                 "--out", str(out)])
+    code = main(
+        [
+            "calibrate",
+            "--config",
+            str(tmp_path / "base.toml"),
+            "--measured",
+            str(tmp_path / "data.csv"),
+            "--prior",
+            "diameter_sigma_m=uniform(0, 1.5e-4)",
+            "--realizations",
+            "2",
+            "--budget",
+            "60",
+            "--out",
+            str(out),
+        ]
+    )
     assert code == 0
     summary = json.loads((out / "calibration.json").read_text())
     assert summary["simulations"]["runs"] == 60 and summary["simulations"]["realizations"] == 2
@@ -331,7 +365,11 @@ def pulse_record(noise: float, rng) -> tuple[Record, float, float]:
         phase = np.clip((times - start) / width, 0, 1)
         a = peak * np.pi / width * np.sin(2 * np.pi * phase) * ((phase > 0) & (phase < 1))
         channels.append(np.column_stack([a, np.zeros_like(a)]) + rng.normal(0, noise, (len(times), 2)))
-    return Record("0", times, np.array(channels), np.ones((2, 2), bool)), np.log(peaks[1]), (starts[1] - starts[0]) / 1e-6
+    return (
+        Record("0", times, np.array(channels), np.ones((2, 2), bool)),
+        np.log(peaks[1]),
+        (starts[1] - starts[0]) / 1e-6,
+    )
 
 
 def test_a_record_reduces_to_its_pulses_peaks_and_relative_arrival():
@@ -349,9 +387,14 @@ def test_the_accelerometer_noise_is_measured_channel_by_channel_on_the_quiet_lea
     about 10 %)."""
     record, _, _ = pulse_record(1.0, np.random.default_rng(1))
     levels, offsets = np.array([[20.0, 5.0], [40.0, 10.0]]), np.array([[300.0, -50.0], [0.0, 2000.0]])
-    noisy = Record("0", record.times, (record.accelerations - np.random.default_rng(1).normal(0, 1, record.accelerations.shape))
-                   + levels[:, None, :] * np.random.default_rng(2).standard_normal(record.accelerations.shape)
-                   + offsets[:, None, :], record.axes)
+    noisy = Record(
+        "0",
+        record.times,
+        (record.accelerations - np.random.default_rng(1).normal(0, 1, record.accelerations.shape))
+        + levels[:, None, :] * np.random.default_rng(2).standard_normal(record.accelerations.shape)
+        + offsets[:, None, :],
+        record.axes,
+    )
     covariance, measured = noise_covariance(noisy, ["a", "b"], seed=0)
     assert measured == pytest.approx(levels, rel=0.3)
     assert np.all(np.linalg.eigvalsh(covariance) > 0)
@@ -396,31 +439,65 @@ BAD_INPUT = [
     (["--prior", "restitution=uniform(0.9, 1.2)"], None, "restitution"),
     (["--prior", "diameter_m=uniform(-0.01, 0.02)"], None, "diameter_m"),
     (["--prior", "v0=uniform(0.2, 0.7)", "--budget", "20"], None, "too small"),
-    (["--prior", "v0=uniform(0.2, 0.7)"], lambda lines: [lines[0]] + [l.replace("0:3,", "0:4,", 1) for l in lines[1:]],
-     "not among the configuration's sensors"),
-    (["--prior", "v0=uniform(0.2, 0.7)"], lambda lines: [l for l in lines if not l.startswith("0:3,")],
-     "were not measured"),
-    (["--prior", "v0=uniform(0.2, 0.7)"], lambda lines: lines[:5] + [lines[5].replace(lines[5].split(",")[2], "nan")]
-     + lines[6:], "NaN"),
+    (
+        ["--prior", "v0=uniform(0.2, 0.7)"],
+        lambda lines: [lines[0]] + [l.replace("0:3,", "0:4,", 1) for l in lines[1:]],
+        "not among the configuration's sensors",
+    ),
+    (
+        ["--prior", "v0=uniform(0.2, 0.7)"],
+        lambda lines: [l for l in lines if not l.startswith("0:3,")],
+        "were not measured",
+    ),
+    (
+        ["--prior", "v0=uniform(0.2, 0.7)"],
+        lambda lines: lines[:5] + [lines[5].replace(lines[5].split(",")[2], "nan")] + lines[6:],
+        "NaN",
+    ),
     (["--prior", "v0=uniform(0.2, 0.7)"], lambda lines: [lines[0], lines[2], lines[1]] + lines[3:], "do not increase"),
-    (["--prior", "v0=uniform(0.2, 0.7)"], lambda lines: [lines[0]] + [
-        l for l in lines[1:] if float(l.split(",")[1]) < float(lines[1].split(",")[1]) + 2e-4], "pulse"),
+    (
+        ["--prior", "v0=uniform(0.2, 0.7)"],
+        lambda lines: (
+            [lines[0]] + [l for l in lines[1:] if float(l.split(",")[1]) < float(lines[1].split(",")[1]) + 2e-4]
+        ),
+        "pulse",
+    ),
     (["--prior", "diameter_sigma_m=uniform(-1e-5, 1e-4)"], None, "diameter_sigma_m: the standard deviation"),
     (["--prior", "diameter_sigma_m=normal(5e-5, 2e-5)"], None, "reaches -3e-05 m"),
     (["--prior", "diameter_sigma_m=uniform(0, 0.01)"], None, "would hold a bead of diameter"),
     (["--prior", "diameter_sigma_m=uniform(0, 1e-4)", "--realizations", "1"], None, "at least 2 packings"),
     (["--prior", "diameter_sigma_m=uniform(0, 1e-4)", "--realizations", "2", "--budget", "50"], None, "too small"),
-    (["--prior", "v0=uniform(0.2, 0.7)", "--realizations", "2", "--config", "chain.toml"], None,
-     "disordered packings are prepared on the shapes"),
-    (["--prior", "v0=uniform(0.2, 0.7)", "--sensor-gain-sd", "-0.01"], None,
-     "--sensor-gain-sd -0.01: a relative standard deviation in [0, 0.2]"),
-    (["--prior", "v0=uniform(0.2, 0.7)", "--speed-scatter", "0.5"], None,
-     "--speed-scatter 0.5: a relative standard deviation in [0, 0.2]"),
-    (["--prior", "v0=uniform(0.2, 0.7)"], lambda lines: [l for l in lines if f",{lines[100].split(',')[1]}," not in l],
-     "not sampled at a steady rate"),
-    (["--prior", "v0=uniform(0.2, 0.7)"], lambda lines: [lines[0]] + [
-        ",".join(l.split(",")[:2] + ["0.0", "0.0"] + l.split(",")[4:]) if l.startswith("0:3,") else l
-        for l in lines[1:]], "sensor 0:3 has no axis that varies"),
+    (
+        ["--prior", "v0=uniform(0.2, 0.7)", "--realizations", "2", "--config", "chain.toml"],
+        None,
+        "disordered packings are prepared on the shapes",
+    ),
+    (
+        ["--prior", "v0=uniform(0.2, 0.7)", "--sensor-gain-sd", "-0.01"],
+        None,
+        "--sensor-gain-sd -0.01: a relative standard deviation in [0, 0.2]",
+    ),
+    (
+        ["--prior", "v0=uniform(0.2, 0.7)", "--speed-scatter", "0.5"],
+        None,
+        "--speed-scatter 0.5: a relative standard deviation in [0, 0.2]",
+    ),
+    (
+        ["--prior", "v0=uniform(0.2, 0.7)"],
+        lambda lines: [l for l in lines if f",{lines[100].split(',')[1]}," not in l],
+        "not sampled at a steady rate",
+    ),
+    (
+        ["--prior", "v0=uniform(0.2, 0.7)"],
+        lambda lines: (
+            [lines[0]]
+            + [
+                ",".join(l.split(",")[:2] + ["0.0", "0.0"] + l.split(",")[4:]) if l.startswith("0:3,") else l
+                for l in lines[1:]
+            ]
+        ),
+        "sensor 0:3 has no axis that varies",
+    ),
 ]
 
 
@@ -438,14 +515,40 @@ def test_bad_input_is_one_line_before_any_simulation(measured, tmp_path, capsys,
 
 def test_workers_and_parsl_together_are_a_usage_error(measured, tmp_path, capsys):
     with pytest.raises(SystemExit) as stop:
-        main(["calibrate", "--measured", str(measured / "data.csv"), "--prior", "v0=uniform(0.2, 0.7)",
-              "--out", str(tmp_path / "out"), "--workers", "2", "--parsl", "config.py"])
+        main(
+            [
+                "calibrate",
+                "--measured",
+                str(measured / "data.csv"),
+                "--prior",
+                "v0=uniform(0.2, 0.7)",
+                "--out",
+                str(tmp_path / "out"),
+                "--workers",
+                "2",
+                "--parsl",
+                "config.py",
+            ]
+        )
     assert stop.value.code == 2 and "not allowed with argument" in capsys.readouterr().err
 
 
 def calibrate_arguments(measured, out):
-    return ["calibrate", "--config", str(measured / "base.toml"), "--measured", str(measured / "data.csv"),
-            "--prior", "v0=uniform(0.2, 0.7)", "--budget", "30", "--seed", "3", "--out", str(out)]
+    return [
+        "calibrate",
+        "--config",
+        str(measured / "base.toml"),
+        "--measured",
+        str(measured / "data.csv"),
+        "--prior",
+        "v0=uniform(0.2, 0.7)",
+        "--budget",
+        "30",
+        "--seed",
+        "3",
+        "--out",
+        str(out),
+    ]
 
 
 def calibrate_command(measured, out):
@@ -467,8 +570,12 @@ def test_a_calibration_finds_the_truth_and_resumes_after_kill_9_to_the_same_post
         assert (whole / name).stat().st_size > 0
 
     killed = tmp_path / "killed"
-    process = subprocess.Popen(calibrate_command(measured, killed), start_new_session=True,
-                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    process = subprocess.Popen(
+        calibrate_command(measured, killed),
+        start_new_session=True,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     deadline = time.monotonic() + 120
     while len(finished_simulations(killed)) < 8 and process.poll() is None and time.monotonic() < deadline:
         time.sleep(0.05)
@@ -499,8 +606,13 @@ def test_the_prior_a_physicist_writes_first_is_accepted(measured):
     from hexdem.calibration.study import prepare
     from hexdem.experiments.sweep_plan import read_base
 
-    calibration = prepare(read_base(str(measured / "base.toml")), measured / "data.csv",
-                          ["restitution=uniform(0.8, 1.0)", "v0=uniform(0.2, 0.7)"], None, 0)
+    calibration = prepare(
+        read_base(str(measured / "base.toml")),
+        measured / "data.csv",
+        ["restitution=uniform(0.8, 1.0)", "v0=uniform(0.2, 0.7)"],
+        None,
+        0,
+    )
     assert calibration.problem.keys == ["restitution", "v0"]
 
 
@@ -516,16 +628,39 @@ def lab_record(tmp_path_factory):
     calibration's time resolution."""
     folder = tmp_path_factory.mktemp("lab")
     config = RunConfig.from_dict(TINY | {"v0": TRUE_V0, "sensor_rate_hz": 250e3})
-    rows = synthetic_rows(config, "0", [[2.0, 6.0], [1.0, 4.0]], 2.345e-3, np.random.default_rng(11), gains=LAB_GAINS,
-                          offsets_m_s2=[[40.0, -3.0], [-25.0, 7.0]])
+    rows = synthetic_rows(
+        config,
+        "0",
+        [[2.0, 6.0], [1.0, 4.0]],
+        2.345e-3,
+        np.random.default_rng(11),
+        gains=LAB_GAINS,
+        offsets_m_s2=[[40.0, -3.0], [-25.0, 7.0]],
+    )
     write_measured(folder / "data.csv", rows, unit="g", single_axis=True)
     (folder / "base.toml").write_text(TINY_TOML)
     return folder
 
 
 def calibrate_lab(lab_record, out, *options):
-    return main(["calibrate", "--config", str(lab_record / "base.toml"), "--measured", str(lab_record / "data.csv"),
-                 "--prior", "v0=uniform(0.2, 0.7)", "--budget", "30", "--seed", "3", "--out", str(out), *options])
+    return main(
+        [
+            "calibrate",
+            "--config",
+            str(lab_record / "base.toml"),
+            "--measured",
+            str(lab_record / "data.csv"),
+            "--prior",
+            "v0=uniform(0.2, 0.7)",
+            "--budget",
+            "30",
+            "--seed",
+            "3",
+            "--out",
+            str(out),
+            *options,
+        ]
+    )
 
 
 def test_a_record_as_a_lab_takes_it_gives_the_truth_and_the_gain_it_was_read_with(lab_record, tmp_path, capsys):
@@ -546,11 +681,18 @@ def test_a_record_as_a_lab_takes_it_gives_the_truth_and_the_gain_it_was_read_wit
     assert gains["0:3"]["median"] / gains["0:1"]["median"] == pytest.approx(LAB_GAINS[1], abs=0.01)
 
 
-@pytest.mark.parametrize("options, said", [
-    ([], "the model does not fit the records: chi2 = "),
-    (["--acceleration-unit", "g", "--sensor-gain-sd", "0"], "the records differ from the model by a relative "),
-    (["--acceleration-unit", "g", "--sensor-gain-sd", "0", "--no-model-discrepancy"], "record(s) 0 (p < 0.01 each)")],
-    ids=["in g read as m/s2", "a gain left out", "a gain left out, the model taken as exact"])
+@pytest.mark.parametrize(
+    "options, said",
+    [
+        ([], "the model does not fit the records: chi2 = "),
+        (["--acceleration-unit", "g", "--sensor-gain-sd", "0"], "the records differ from the model by a relative "),
+        (
+            ["--acceleration-unit", "g", "--sensor-gain-sd", "0", "--no-model-discrepancy"],
+            "record(s) 0 (p < 0.01 each)",
+        ),
+    ],
+    ids=["in g read as m/s2", "a gain left out", "a gain left out, the model taken as exact"],
+)
 def test_a_record_the_model_cannot_fit_is_a_warning(lab_record, tmp_path, capsys, options, said):
     """The same record read in m/s² (9.8 times too small), or with the gains taken as exact (sensor
     0:3's 3 % against 0:1 has no explanation): the command still ends 0, and says in a line that
@@ -573,8 +715,13 @@ def test_the_guides_measured_example_passes_every_input_check():
     from hexdem.experiments.sweep_plan import read_base
 
     examples = Path(__file__).resolve().parents[1] / "docs" / "guide" / "examples"
-    calibration = prepare(read_base(str(examples / "calibration-base.toml")), examples / "measured.csv",
-                          ["v0=uniform(0.2, 0.7)", "restitution=uniform(0.8, 1.0)"], None, 0)
+    calibration = prepare(
+        read_base(str(examples / "calibration-base.toml")),
+        examples / "measured.csv",
+        ["v0=uniform(0.2, 0.7)", "restitution=uniform(0.8, 1.0)"],
+        None,
+        0,
+    )
     assert calibration.data.record_names == ("1", "2") and calibration.rate_hz == pytest.approx(500e3)
     assert calibration.notes == ()
 

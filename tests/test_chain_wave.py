@@ -8,7 +8,6 @@ import pytest
 
 from hexdem.experiments.run import simulate
 from hexdem.model.materials import BRASS, STEEL_316, hertz_coefficient, sphere_mass
-from hexdem.theory.chain_wave import CHAIN_LINE, chain_config, measure_chain
 from hexdem.model.solitary_wave import (
     HALF_MAXIMUM_WIDTH_D,
     SUPPORT_WIDTH_D,
@@ -16,6 +15,7 @@ from hexdem.model.solitary_wave import (
     solitary_speed_m_s,
     strain_amplitude,
 )
+from hexdem.theory.chain_wave import CHAIN_LINE, chain_config, measure_chain
 
 
 @pytest.mark.parametrize("material", [STEEL_316, BRASS])
@@ -51,8 +51,12 @@ def test_the_speed_law_makes_the_travelling_wave_solve_the_long_wave_equation():
 def chains(tmp_path_factory):
     """The chain struck at 0.2 and 0.4 m/s (LAMMPS): {V0: ChainWave}."""
     root = tmp_path_factory.mktemp("chain")
-    return {v0: measure_chain(simulate(chain_config(v0), root / str(v0), log=lambda message: None,
-                                       trace_lines=[CHAIN_LINE])) for v0 in (0.2, 0.4)}
+    return {
+        v0: measure_chain(
+            simulate(chain_config(v0), root / str(v0), log=lambda message: None, trace_lines=[CHAIN_LINE])
+        )
+        for v0 in (0.2, 0.4)
+    }
 
 
 def test_the_chains_pulse_travels_unchanged_at_nesterenkos_speed(chains):

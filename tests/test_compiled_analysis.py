@@ -22,11 +22,19 @@ from hexdem.model.run_settings import run_settings
 
 RUNS = {
     "hexagon": {"edge_beads": 8},
-    "striker, friction, brass region": {"edge_beads": 7, "impact": "striker", "friction": 0.3,
-                                        "regions": ({"material": "brass", "x_min_d": 3.0},)},
+    "striker, friction, brass region": {
+        "edge_beads": 7,
+        "impact": "striker",
+        "friction": 0.3,
+        "regions": ({"material": "brass", "x_min_d": 3.0},),
+    },
     "square": {"shape": "square", "rows": 9, "columns": 9},
-    "chain with an intruder": {"shape": "chain", "beads": 20, "duration": 1e-3,
-                               "intruders": ({"bead": 10, "diameter_m": 0.009525},)},
+    "chain with an intruder": {
+        "shape": "chain",
+        "beads": 20,
+        "duration": 1e-3,
+        "intruders": ({"bead": 10, "diameter_m": 0.009525},),
+    },
     "disc": {"shape": "disc", "radius_beads": 6},
 }
 
@@ -35,7 +43,9 @@ RUNS = {
 def test_the_compiled_kernels_give_the_numpy_results(tmp_path, monkeypatch, changes):
     config = RunConfig(**changes)
     passes = []  # the compiled tracker's passes, so that each run is known to have taken its way
-    monkeypatch.setattr(tracker_module, "sample_pulses", lambda *args, **named: passes.append(1) or sample_pulses(*args, **named))
+    monkeypatch.setattr(
+        tracker_module, "sample_pulses", lambda *args, **named: passes.append(1) or sample_pulses(*args, **named)
+    )
     monkeypatch.setattr(compiled, "COMPILED", False)
     numpy_run = simulate(config, tmp_path / "numpy").tracked
     assert not passes
@@ -48,16 +58,23 @@ def test_the_compiled_kernels_give_the_numpy_results(tmp_path, monkeypatch, chan
     # compiled walls take n·x term by term, NumPy's BLAS as it likes): a contact's energy ∝ δ^{5/2} moves by
     # 2.5e-15 D / δ of itself, under 1e-9 for δ ≥ 1e-5 D, and smaller overlaps hold little of the run's
     # energy, which the audit's figures are read against
-    np.testing.assert_allclose(compiled_run.region_energies, numpy_run.region_energies, rtol=0,
-                               atol=1e-9 * numpy_run.region_energies[0].sum())
+    np.testing.assert_allclose(
+        compiled_run.region_energies, numpy_run.region_energies, rtol=0, atol=1e-9 * numpy_run.region_energies[0].sum()
+    )
     assert compiled_run.energy_drift == pytest.approx(numpy_run.energy_drift, rel=1e-6, abs=1e-12)
     assert compiled_run.rotational_energy_fraction == pytest.approx(numpy_run.rotational_energy_fraction, rel=1e-9)
 
 
-@pytest.mark.parametrize("changes, gravity_m_s2", [({"edge_beads": 6}, None), ({"shape": "disc", "radius_beads": 5}, None),
-                                                   ({"edge_beads": 5, "regions": ({"material": "brass", "x_min_d": 2.0},)},
-                                                    None), ({"edge_beads": 6}, (3.0, -9.81))],
-                         ids=["flat walls", "curved wall", "two materials", "gravity"])
+@pytest.mark.parametrize(
+    "changes, gravity_m_s2",
+    [
+        ({"edge_beads": 6}, None),
+        ({"shape": "disc", "radius_beads": 5}, None),
+        ({"edge_beads": 5, "regions": ({"material": "brass", "x_min_d": 2.0},)}, None),
+        ({"edge_beads": 6}, (3.0, -9.81)),
+    ],
+    ids=["flat walls", "curved wall", "two materials", "gravity"],
+)
 def test_the_compiled_audit_is_the_numpy_audit_of_a_squeezed_packing(changes, gravity_m_s2):
     """Every body pushed outwards by a ten-thousandth of its distance from the centre, then moved at
     random by up to 1e-5 of a diameter: the beads along the walls overlap them and some pairs
@@ -70,17 +87,19 @@ def test_the_compiled_audit_is_the_numpy_audit_of_a_squeezed_packing(changes, gr
     model = build_model(RunConfig(**changes))
     rng = np.random.default_rng(0)
     start = model.initial_positions_m()
-    squeezed = start + 1e-4 * (start - start.mean(axis=0)) + 1e-5 * model.packing.diameter_m * rng.uniform(
-        -1, 1, start.shape)
+    squeezed = (
+        start + 1e-4 * (start - start.mean(axis=0)) + 1e-5 * model.packing.diameter_m * rng.uniform(-1, 1, start.shape)
+    )
     velocities, bodies, n_own = rng.standard_normal(start.shape), rng.permutation(model.n_bodies), model.n_bodies // 2
     radii = model.diameters_m / 2
     pairs = _pair_contacts(squeezed, radii, _pair_constants(model, *_pairs(squeezed, 2 * radii.max()), radii))[2:]
     walls = [wall[1:] for wall in _wall_contacts(squeezed, _wall_constants(model))]
     assert sum(len(wall[0]) for wall in walls) > 0
     forces_n = sum(np.sum(k * np.sqrt(r_eff) * overlap**1.5) for k, r_eff, overlap in [pairs, *walls])
-    numpy_part, compiled_part = (EnergyAudit(model, gravity_m_s2, compiled=way).part(bodies, n_own, squeezed[bodies],
-                                                                                     velocities[bodies[:n_own]])
-                                 for way in (False, True))
+    numpy_part, compiled_part = (
+        EnergyAudit(model, gravity_m_s2, compiled=way).part(bodies, n_own, squeezed[bodies], velocities[bodies[:n_own]])
+        for way in (False, True)
+    )
     assert np.all(numpy_part[4::2] > 0)  # each region's contact energy
     overlap_round_off_m = 8 * np.finfo(float).eps * np.abs(squeezed).max()
     np.testing.assert_allclose(compiled_part, numpy_part, rtol=1e-13, atol=forces_n * overlap_round_off_m)
@@ -99,9 +118,11 @@ def test_the_compiled_sample_is_the_numpy_full_step_to_the_bit():
     np.testing.assert_array_equal(velocities, v[:, :2] + (half_dt / mass)[:, None] * f[:, :2])
 
 
-@pytest.mark.parametrize("count, spread, cutoff", [(0, 1.0, 1.0), (1, 1.0, 1.0), (2, 0.0, 0.5), (3000, 50.0, 1.1),
-                                                  (2000, 1.0, 0.1)], ids=["none", "one", "two at one place",
-                                                                         "sparse", "dense"])
+@pytest.mark.parametrize(
+    "count, spread, cutoff",
+    [(0, 1.0, 1.0), (1, 1.0, 1.0), (2, 0.0, 0.5), (3000, 50.0, 1.1), (2000, 1.0, 0.1)],
+    ids=["none", "one", "two at one place", "sparse", "dense"],
+)
 def test_the_compiled_pair_search_finds_the_pairs_of_scipys_tree(count, spread, cutoff):
     """Every pair within the cutoff, each once with i < j, as ``cKDTree.query_pairs`` finds them; a
     body knocked a billion cutoffs away (LAMMPS's shrink-wrapped box keeps it) neither hides a pair
@@ -132,8 +153,16 @@ def test_the_kernels_refuse_arrays_they_cannot_read_and_indices_outside_them():
 
     def take(velocities=velocities, rows=ids, speeds=speeds, previous=ids, n=4):
         state = PulseState(n, 8, 0.0)
-        return sample_pulses(bind_pulses(state), ids=ids, previous_ids=previous, velocities=velocities, rows=rows,
-                             end_velocity=end_velocity[:n], speeds=speeds, s=0)
+        return sample_pulses(
+            bind_pulses(state),
+            ids=ids,
+            previous_ids=previous,
+            velocities=velocities,
+            rows=rows,
+            end_velocity=end_velocity[:n],
+            speeds=speeds,
+            s=0,
+        )
 
     assert len(take()) == 0
     np.testing.assert_array_equal(speeds, np.full(4, np.sqrt(2)))
@@ -161,7 +190,9 @@ def test_the_kernels_take_every_argument_by_name_and_check_it_by_name():
     with pytest.raises(TypeError, match="by name"):
         _kernels.PulseArrays(*arrays.values(), *constants.values())
     narrow = dict(arrays, rec_prev2=np.zeros((5, 7)))
-    with pytest.raises(TypeError, match=r"rec_prev2: expected float64 \(n, capacity\) = \(5, 8\), got float64 \(5, 7\)"):
+    with pytest.raises(
+        TypeError, match=r"rec_prev2: expected float64 \(n, capacity\) = \(5, 8\), got float64 \(5, 7\)"
+    ):
         _kernels.PulseArrays(**narrow, **constants)
     swapped = dict(arrays, start=state.rec_prev, length=state.start)
     with pytest.raises(TypeError, match=r"start: expected int64 \(n,\) = \(5,\), got float64 \(5, 8\)"):
@@ -172,8 +203,16 @@ def test_the_kernels_take_every_argument_by_name_and_check_it_by_name():
     with pytest.raises(TypeError, match="no argument named 'rec_prev3'"):
         _kernels.PulseArrays(**arrays, **constants, rec_prev3=state.rec_prev2)
     pulses = _kernels.PulseArrays(**arrays, **constants)
-    sample = {"ids": np.arange(5), "previous_ids": np.arange(5), "velocities": np.ones((5, 2)), "rows": np.arange(5),
-              "end_velocity": np.empty((5, 2)), "speeds": np.empty(0), "complete": np.empty(5, np.int64), "s": 0}
+    sample = {
+        "ids": np.arange(5),
+        "previous_ids": np.arange(5),
+        "velocities": np.ones((5, 2)),
+        "rows": np.arange(5),
+        "end_velocity": np.empty((5, 2)),
+        "speeds": np.empty(0),
+        "complete": np.empty(5, np.int64),
+        "s": 0,
+    }
     assert pulses.sample(**sample) == 0
     with pytest.raises(TypeError, match=r"end_velocity: expected float64 \(n, 2\) = \(5, 2\)"):
         pulses.sample(**dict(sample, end_velocity=np.empty((4, 2))))
@@ -204,7 +243,9 @@ def test_the_compiled_sample_is_the_numpy_update_of_np_hypots_speeds(speeds_want
         bead = 1 + k
         largest = np.hypot(*velocities[:s, bead].T).max()
         level = largest / RIVAL_RATIO if k % 2 else largest
-        velocities[s, bead] = np.array([np.cos(directions[bead]), np.sin(directions[bead])]) * level * (1 + (k % 5 - 2) * 1e-16)
+        velocities[s, bead] = (
+            np.array([np.cos(directions[bead]), np.sin(directions[bead])]) * level * (1 + (k % 5 - 2) * 1e-16)
+        )
     floor = 1e-12
     numpy_state, compiled_state = PulseState(n, 8, floor), PulseState(n, 8, floor)
     pulses = bind_pulses(compiled_state)
@@ -214,8 +255,18 @@ def test_the_compiled_sample_is_the_numpy_update_of_np_hypots_speeds(speeds_want
         speeds = np.hypot(velocities[s, :, 0], velocities[s, :, 1])
         numpy_state.update(rows, speeds, s)
         taken = np.empty(n if speeds_wanted else 0)
-        compiled_state.challenge(sample_pulses(pulses, ids=ids, previous_ids=ids, velocities=np.ascontiguousarray(velocities[s]),
-                                               rows=rows, end_velocity=end_velocity, speeds=taken, s=s))
+        compiled_state.challenge(
+            sample_pulses(
+                pulses,
+                ids=ids,
+                previous_ids=ids,
+                velocities=np.ascontiguousarray(velocities[s]),
+                rows=rows,
+                end_velocity=end_velocity,
+                speeds=taken,
+                s=s,
+            )
+        )
         np.testing.assert_array_equal(end_velocity, velocities[s])
         if speeds_wanted:
             np.testing.assert_array_equal(taken, speeds)
@@ -226,8 +277,9 @@ def test_the_compiled_sample_is_the_numpy_update_of_np_hypots_speeds(speeds_want
         ring[left] = np.hypot(kept[:, 0], kept[:, 1])
         np.testing.assert_array_equal(ring, numpy_state.ring, err_msg=f"sample {s}")
         for name in (*SAMPLED[1:], "best_peak", "best_index", "best_offset"):
-            np.testing.assert_array_equal(getattr(compiled_state, name), getattr(numpy_state, name),
-                                          err_msg=f"{name}, sample {s}")
+            np.testing.assert_array_equal(
+                getattr(compiled_state, name), getattr(numpy_state, name), err_msg=f"{name}, sample {s}"
+            )
     assert (numpy_state.peak_index[1:] >= 0).all() and numpy_state.peak_index[0] == -1  # every moving bead peaked
     assert left_slots == 0 if speeds_wanted else left_slots > 3 * n * samples // 2  # most speeds left untaken
     assert np.isfinite(numpy_state.best_peak).sum() >= 10  # and rivals were refined on both sides
@@ -261,8 +313,17 @@ def test_beads_whose_rows_move_keep_the_speeds_their_ring_left_untaken(monkeypat
             moved = s == 0 or (reorder and s % 7 == 0)
             if moved and s:
                 order = rng.permutation(n)
-            tracker(Sample(s, s * settings.dump_every, 0.0, ids[order], positions[order],
-                           np.ascontiguousarray(velocities[s, order]), migrated=moved))
+            tracker(
+                Sample(
+                    s,
+                    s * settings.dump_every,
+                    0.0,
+                    ids[order],
+                    positions[order],
+                    np.ascontiguousarray(velocities[s, order]),
+                    migrated=moved,
+                )
+            )
         return tracker.finish()
 
     numpy_run, in_order, reordered = tracked(False, False), tracked(True, False), tracked(True, True)
@@ -287,10 +348,12 @@ def test_background_loading_loads_what_it_can_and_prints_nothing():
     import subprocess
     import sys
 
-    code = ("import sys, threading; from hexdem.common.preload import load_in_background; "
-            "load_in_background('colorsys', 'hexdem_no_such_module'); "
-            "[t.join() for t in threading.enumerate() if t is not threading.main_thread()]; "
-            "print('colorsys' in sys.modules)")
+    code = (
+        "import sys, threading; from hexdem.common.preload import load_in_background; "
+        "load_in_background('colorsys', 'hexdem_no_such_module'); "
+        "[t.join() for t in threading.enumerate() if t is not threading.main_thread()]; "
+        "print('colorsys' in sys.modules)"
+    )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert done.stdout.strip() == "True" and done.stderr == ""
 
@@ -344,20 +407,50 @@ def _kernel_calls():
 
     state = PulseState(5, 8, 0.0)
     pulses = dict(state.kernel_arrays(), q=state.q, rival_ratio=RIVAL_RATIO)
-    sample = {"ids": np.arange(5), "previous_ids": np.arange(5), "velocities": np.ones((5, 2)),
-              "rows": np.arange(5), "end_velocity": np.empty((5, 2)), "speeds": np.empty(5),
-              "complete": np.empty(5, np.int64), "s": 0}
-    rows = {"listed_at": np.zeros((3, 2)), "distance": 0.1, "i": np.array([0]), "j": np.array([1]),
-            "contact_m": np.ones(1), "coefficient": np.ones(1), "region_i": np.zeros(1, np.int64),
-            "region_j": np.zeros(1, np.int64), "masses": np.ones(2), "inertia": np.ones(2),
-            "regions": np.zeros(2, np.int64), "start": np.zeros((2, 2)), "external": np.zeros((2, 2)),
-            "curved": np.zeros(1, np.int64), "bounds": np.array([0, 1]), "points": np.zeros((1, 2)),
-            "lengths": np.ones(1), "rows": np.array([0]), "radii": np.ones(1), "wall_coefficient": np.ones(1),
-            "wall_regions": np.zeros(1, np.int64), "n_regions": 1}
-    part = {"positions": np.zeros((3, 2)), "velocities": np.zeros((2, 2)), "spins": np.zeros(0),
-            "sums": np.empty(5)}
-    full_step = {"masses": np.ones(4), "positions": np.ones((4, 3)), "velocities": np.ones((4, 3)),
-                 "forces": np.ones((4, 3)), "half_dt": 0.5, "x": np.empty((4, 2)), "v": np.empty((4, 2))}
+    sample = {
+        "ids": np.arange(5),
+        "previous_ids": np.arange(5),
+        "velocities": np.ones((5, 2)),
+        "rows": np.arange(5),
+        "end_velocity": np.empty((5, 2)),
+        "speeds": np.empty(5),
+        "complete": np.empty(5, np.int64),
+        "s": 0,
+    }
+    rows = {
+        "listed_at": np.zeros((3, 2)),
+        "distance": 0.1,
+        "i": np.array([0]),
+        "j": np.array([1]),
+        "contact_m": np.ones(1),
+        "coefficient": np.ones(1),
+        "region_i": np.zeros(1, np.int64),
+        "region_j": np.zeros(1, np.int64),
+        "masses": np.ones(2),
+        "inertia": np.ones(2),
+        "regions": np.zeros(2, np.int64),
+        "start": np.zeros((2, 2)),
+        "external": np.zeros((2, 2)),
+        "curved": np.zeros(1, np.int64),
+        "bounds": np.array([0, 1]),
+        "points": np.zeros((1, 2)),
+        "lengths": np.ones(1),
+        "rows": np.array([0]),
+        "radii": np.ones(1),
+        "wall_coefficient": np.ones(1),
+        "wall_regions": np.zeros(1, np.int64),
+        "n_regions": 1,
+    }
+    part = {"positions": np.zeros((3, 2)), "velocities": np.zeros((2, 2)), "spins": np.zeros(0), "sums": np.empty(5)}
+    full_step = {
+        "masses": np.ones(4),
+        "positions": np.ones((4, 3)),
+        "velocities": np.ones((4, 3)),
+        "forces": np.ones((4, 3)),
+        "half_dt": 0.5,
+        "x": np.empty((4, 2)),
+        "v": np.empty((4, 2)),
+    }
     pairs = {"positions": np.zeros((3, 2)), "cutoff": 1.0, "i": np.empty(8, np.int64), "j": np.empty(8, np.int64)}
     pulse_arrays = {name for name, value in pulses.items() if isinstance(value, np.ndarray)}
     return {
@@ -374,8 +467,9 @@ def _fresh(arguments: dict) -> dict:
     return {name: value.copy() if isinstance(value, np.ndarray) else value for name, value in arguments.items()}
 
 
-@pytest.mark.parametrize("kernel", ["full_step_state", "pairs_within", "PulseArrays", "PulseArrays.sample",
-                                    "AuditRows", "AuditRows.part"])
+@pytest.mark.parametrize(
+    "kernel", ["full_step_state", "pairs_within", "PulseArrays", "PulseArrays.sample", "AuditRows", "AuditRows.part"]
+)
 def test_every_kernel_refuses_a_read_only_output_a_swap_a_missing_and_an_unknown_name(kernel):
     """Every table of module.c, by name: an array the kernel writes is refused read-only (it would
     be written behind NumPy's back), one it only reads is taken read-only; two arrays of other
@@ -393,8 +487,11 @@ def test_every_kernel_refuses_a_read_only_output_a_swap_a_missing_and_an_unknown
         else:
             call(**frozen)
     first = arrays[0]
-    other = next(name for name in arrays if (arguments[name].dtype, arguments[name].shape)
-                 != (arguments[first].dtype, arguments[first].shape))
+    other = next(
+        name
+        for name in arrays
+        if (arguments[name].dtype, arguments[name].shape) != (arguments[first].dtype, arguments[first].shape)
+    )
     swapped = dict(_fresh(arguments), **{first: arguments[other].copy(), other: arguments[first].copy()})
     with pytest.raises(TypeError, match=rf"^{kernel}: ({first}|{other}): expected"):
         call(**swapped)

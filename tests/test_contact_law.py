@@ -11,9 +11,9 @@ from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
 from hexdem.model.contact_law import ContactLaws, Friction
 from hexdem.model.materials import BRASS, DELRIN, STEEL_316, hertz_stiffness, mindlin_stiffness
-from hexdem.model.units import SI
 from hexdem.model.model_builder import build_model
 from hexdem.model.run_settings import run_settings
+from hexdem.model.units import SI
 
 
 def test_mindlin_over_hertz_stiffness_of_like_spheres_is_2_1_minus_nu_over_2_minus_nu():
@@ -51,15 +51,18 @@ def test_config_friction_keys_default_to_the_frictionless_model_and_wall_frictio
     assert build_model(RunConfig(edge_beads=3, friction=0.2, wall_friction=0.0)).friction == Friction(0.2, 0.0)
 
 
-@pytest.mark.parametrize("keys, message", [
-    ({"friction": -0.1}, "friction must be a coefficient >= 0"),
-    ({"friction": "rough"}, "friction must be a number, got 'rough'"),
-    ({"friction": float("nan")}, "friction must be a number, got nan"),
-    ({"friction": True}, "friction must be a number, got True"),
-    ({"friction": 0.3, "wall_friction": -1}, "wall_friction must be a coefficient >= 0"),
-    ({"rolling_friction": 0.01}, "rolling_friction needs friction > 0"),
-    ({"rolling_friction": -0.01}, "rolling_friction must be a coefficient >= 0"),
-])
+@pytest.mark.parametrize(
+    "keys, message",
+    [
+        ({"friction": -0.1}, "friction must be a coefficient >= 0"),
+        ({"friction": "rough"}, "friction must be a number, got 'rough'"),
+        ({"friction": float("nan")}, "friction must be a number, got nan"),
+        ({"friction": True}, "friction must be a number, got True"),
+        ({"friction": 0.3, "wall_friction": -1}, "wall_friction must be a coefficient >= 0"),
+        ({"rolling_friction": 0.01}, "rolling_friction needs friction > 0"),
+        ({"rolling_friction": -0.01}, "rolling_friction must be a coefficient >= 0"),
+    ],
+)
 def test_bad_friction_is_refused_in_one_line(keys, message):
     with pytest.raises(HexdemError, match=message) as error:
         RunConfig(edge_beads=3, **keys)
@@ -88,8 +91,11 @@ def test_frictional_deck_gives_every_contact_its_own_mindlin_law_and_turns_the_s
     walls = [line.split() for line in deck.splitlines() if "wall/gran/region" in line]
     assert len(walls) == len(model.walls)
     for words in walls:
-        assert words[words.index("mindlin") + 1:words.index("mindlin") + 4] == [
-            repr(mindlin_stiffness(STEEL_316, DELRIN)), "0.0", "0.5"]
+        assert words[words.index("mindlin") + 1 : words.index("mindlin") + 4] == [
+            repr(mindlin_stiffness(STEEL_316, DELRIN)),
+            "0.0",
+            "0.5",
+        ]
 
 
 def test_one_material_with_friction_takes_one_pair_coeff():

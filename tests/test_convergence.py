@@ -8,12 +8,19 @@ import math
 
 import numpy as np
 import pytest
-from conftest import settings_of, contact_of
+from conftest import contact_of, settings_of
 
 from hexdem.errors import HexdemError
 from hexdem.experiments.compare import ARRIVAL_ERROR_N2, ARRIVAL_GROWTH_N2, expected_error
-from hexdem.experiments.convergence import (CHAIN, Convergence, arrival_growth, richardson, sampling_error,
-                                            steps_config, study_time_step)
+from hexdem.experiments.convergence import (
+    CHAIN,
+    Convergence,
+    arrival_growth,
+    richardson,
+    sampling_error,
+    steps_config,
+    study_time_step,
+)
 from hexdem.model.config import STEPS_PER_CONTACT, RunConfig
 from hexdem.model.run_settings import SAMPLES_PER_CONTACT
 
@@ -44,8 +51,11 @@ def test_too_few_steps_per_contact_is_refused():
         steps_config(RunConfig(), 110)
 
 
-@pytest.mark.parametrize("config", [RunConfig(), RunConfig(edge_beads=8, wall_material="none", units="nondimensional",
-                                                                     v0=0.3)], ids=["experiment", "V0=0.30"])
+@pytest.mark.parametrize(
+    "config",
+    [RunConfig(), RunConfig(edge_beads=8, wall_material="none", units="nondimensional", v0=0.3)],
+    ids=["experiment", "V0=0.30"],
+)
 def test_lammps_converges_at_second_order_and_its_default_meets_the_target(config, tmp_path):
     study = study_time_step(config, (80, STEPS_PER_CONTACT, 280, 560), tmp_path)
     assert study.n_beads >= 20
@@ -73,10 +83,12 @@ def test_lammps_arrival_errors_grow_with_the_time_the_pulse_has_travelled(tmp_pa
     coarse, default = study.runs[0], study.at(STEPS_PER_CONTACT)
     reached = study.arrivals > 0
     assert np.all(default.arrival_errors[reached] < 0)
-    np.testing.assert_allclose(coarse.arrival_errors[reached] * 80**2,
-                               default.arrival_errors[reached] * STEPS_PER_CONTACT**2, rtol=0.02)
-    near, far = (np.abs(default.arrival_errors[study.arrivals == t]).item()
-                 for t in np.sort(study.arrivals[reached])[[0, -1]])
+    np.testing.assert_allclose(
+        coarse.arrival_errors[reached] * 80**2, default.arrival_errors[reached] * STEPS_PER_CONTACT**2, rtol=0.02
+    )
+    near, far = (
+        np.abs(default.arrival_errors[study.arrivals == t]).item() for t in np.sort(study.arrivals[reached])[[0, -1]]
+    )
     assert far > 30 * near
 
 

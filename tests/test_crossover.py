@@ -6,6 +6,7 @@ import json
 
 import numpy as np
 import pytest
+from readable import saved_figure, smallest_text_px
 
 from hexdem.disorder.preparation import TOLERANCE_M
 from hexdem.paper.crossover import (
@@ -20,7 +21,6 @@ from hexdem.paper.crossover import (
     overlap_test,
 )
 from hexdem.paper.settings import PaperSettings
-from readable import saved_figure, smallest_text_px
 
 SIGMA_TOL = np.geomspace(1e-3, 6.0, 9)
 
@@ -49,12 +49,26 @@ def summaries_with(crossover_tol_at):
     """Ensemble summaries whose transmission steps from 0.9 to 0.6 at σ_c(V) = ``crossover_tol_at(V)``."""
     out = []
     for sigma in SIGMA_TOL:
-        effects = [{"v_striker": v, "line": line, "mean_ratio": float(_step(np.log10(sigma), 0.9, 0.6,
-                                                                              np.log10(crossover_tol_at(v)), 2.0)),
-                    "sem_ratio": 0.01, "std_ratio": 0.045, "realizations": 20}
-                   for v in (0.25, 0.4, 0.7) for line in ("0", "+30", "±30")]
-        out.append({"sigma_per_tol": float(sigma), "preparation": "prestressed", "disorder_effect": effects,
-                    "leading_pulse_effect": effects})
+        effects = [
+            {
+                "v_striker": v,
+                "line": line,
+                "mean_ratio": float(_step(np.log10(sigma), 0.9, 0.6, np.log10(crossover_tol_at(v)), 2.0)),
+                "sem_ratio": 0.01,
+                "std_ratio": 0.045,
+                "realizations": 20,
+            }
+            for v in (0.25, 0.4, 0.7)
+            for line in ("0", "+30", "±30")
+        ]
+        out.append(
+            {
+                "sigma_per_tol": float(sigma),
+                "preparation": "prestressed",
+                "disorder_effect": effects,
+                "leading_pulse_effect": effects,
+            }
+        )
     return out + [{"sigma_per_tol": 6.0, "preparation": "relaxed", "disorder_effect": [], "leading_pulse_effect": []}]
 
 

@@ -18,8 +18,13 @@ from hexdem.model.materials import PAPER_DIAMETER_M
 from hexdem.model.square_crystals import centered_square, square
 
 D = PAPER_DIAMETER_M
-CRYSTAL = {"rows": 5, "columns": 6, "velocities_m_s": (0.4,), "realizations": 1,
-           "preparation": Preparation(push_force_n=CRYSTAL_PUSH_FORCE_N)}
+CRYSTAL = {
+    "rows": 5,
+    "columns": 6,
+    "velocities_m_s": (0.4,),
+    "realizations": 1,
+    "preparation": Preparation(push_force_n=CRYSTAL_PUSH_FORCE_N),
+}
 
 
 def quiet(message):
@@ -33,7 +38,9 @@ def test_a_squares_edge_beads_are_pushed_perpendicular_to_their_own_edges():
     assert len(pushed) == 2 * (5 + 6) - 4
     rows, columns = lattice.labels.T
     for i in pushed:
-        expected = np.array([int(columns[i] == 0) - int(columns[i] == 5), int(rows[i] == -2) - int(rows[i] == 2)], float)
+        expected = np.array(
+            [int(columns[i] == 0) - int(columns[i] == 5), int(rows[i] == -2) - int(rows[i] == 2)], float
+        )
         np.testing.assert_allclose(directions[i], expected / np.linalg.norm(expected), atol=1e-12)
 
 
@@ -49,8 +56,11 @@ def test_a_spaced_centered_square_has_no_overlap_and_keeps_its_struck_bead(seed)
     lattice, interstitials = centered_square(5, 6, D)
     ensemble = Ensemble(EnsembleConfig(shape="centered-square", seed=seed, **CRYSTAL), "unused")
     diameters = ensemble.diameters_m(0)
-    np.testing.assert_allclose(np.mean(diameters[interstitials]), lattice.diameters_m[interstitials][0],
-                               atol=3 * Disorder(D).sigma / np.sqrt(len(interstitials)))
+    np.testing.assert_allclose(
+        np.mean(diameters[interstitials]),
+        lattice.diameters_m[interstitials][0],
+        atol=3 * Disorder(D).sigma / np.sqrt(len(interstitials)),
+    )
     spaced = spaced_packing(lattice, diameters, Disorder(D))
     assert len(touching_pairs(spaced.positions_m, spaced.diameters_m)[2]) == 0
     np.testing.assert_array_equal(spaced.positions_m[spaced.struck], lattice.positions_m[lattice.struck])

@@ -11,14 +11,14 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from conftest import D, V0, contact_history, record, single_bead
+from conftest import V0, D, contact_history, record, single_bead
 
 from hexdem.engines.lammps.engine import LammpsEngine
 from hexdem.engines.reference.engine import ReferenceEngine
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time, max_overlap
-from hexdem.model.walls import CurvedWall
 from hexdem.model.materials import DELRIN, STEEL_316, hertz_stiffness, sphere_mass
+from hexdem.model.walls import CurvedWall
 
 RADIUS = 1.5 * D  # three bead radii
 ENGINES = [LammpsEngine(), ReferenceEngine()]
@@ -64,8 +64,9 @@ def test_oblique_rebound_agrees_between_engines(tmp_path):
     mass, a = expected_contact()
     dt = contact_time(mass, a, V0) / 2000
     settings = RunSettings(dt, int(1.5 * contact_time(mass, a, V0) / dt), 1)
-    final = {engine.name: record(engine, model, settings, tmp_path / engine.name).velocities_m_s[-1, 0]
-             for engine in ENGINES}
+    final = {
+        engine.name: record(engine, model, settings, tmp_path / engine.name).velocities_m_s[-1, 0] for engine in ENGINES
+    }
     assert np.linalg.norm(final["lammps"]) == pytest.approx(V0, rel=1e-6)  # elastic: the speed comes back
     incoming = np.degrees(np.arctan2(*model.initial_velocities_m_s()[0][::-1]))
     outgoing = np.degrees(np.arctan2(*final["lammps"][::-1]))

@@ -39,7 +39,9 @@ def test_a_softer_region_is_crossed_at_its_own_pace():
     steel, brass = material("steel316"), material("brass")
     config = RunConfig(regions=[{"material": "brass", "x_min_d": BRASS_BEYOND_D}])
     brass_layers = sum(1 for k in range(1, 21) if k * math.sqrt(3) / 2 >= BRASS_BEYOND_D)
-    expected = (20 - brass_layers) * two_sphere_contact_s(steel, steel) + brass_layers * two_sphere_contact_s(brass, brass)
+    expected = (20 - brass_layers) * two_sphere_contact_s(steel, steel) + brass_layers * two_sphere_contact_s(
+        brass, brass
+    )
     assert brass_layers == 9
     settings = settings_of(config)
     assert settings.duration_s == pytest.approx(expected, abs=settings.dt_s / 2), "a whole number of steps"
@@ -48,9 +50,12 @@ def test_a_softer_region_is_crossed_at_its_own_pace():
 def test_a_soft_striker_adds_its_longer_contact():
     """A ptfe striker touches the steel bead longer than two steel beads touch: that much more."""
     steel, ptfe = material("steel316"), material("ptfe")
-    soft, plain = (settings_of(RunConfig(impact="striker", **changes)) for changes in ({"striker_material": "ptfe"}, {}))
+    soft, plain = (
+        settings_of(RunConfig(impact="striker", **changes)) for changes in ({"striker_material": "ptfe"}, {})
+    )
     assert soft.duration_s - plain.duration_s == pytest.approx(
-        two_sphere_contact_s(ptfe, steel) - two_sphere_contact_s(steel, steel), abs=(soft.dt_s + plain.dt_s) / 2)
+        two_sphere_contact_s(ptfe, steel) - two_sphere_contact_s(steel, steel), abs=(soft.dt_s + plain.dt_s) / 2
+    )
 
 
 def test_the_interface_gallery_run_reaches_its_brass(tmp_path):

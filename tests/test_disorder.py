@@ -24,8 +24,8 @@ from hexdem.disorder.preparation import (
 )
 from hexdem.disorder.prestress import touching_pairs
 from hexdem.engines.lammps.engine import LammpsEngine
-from hexdem.engines.lammps.standalone import run_deck
 from hexdem.engines.lammps.settling import SETTLED_NAME, read_data_file, read_stage
+from hexdem.engines.lammps.standalone import run_deck
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
 from hexdem.model.materials import PAPER_DIAMETER_M, sphere_mass
@@ -89,16 +89,19 @@ def test_edge_beads_are_pushed_inward_perpendicular_to_their_edge():
             np.testing.assert_allclose(directions[i], walls[0].normal, atol=1e-12)
 
 
-@pytest.mark.parametrize("make, message", [
-    (lambda: Disorder(D, sigma_m=-1e-6), "standard deviation sigma must be >= 0"),
-    (lambda: Disorder(D, tol_m=-1e-6), "tolerance tol must be >= 0"),
-    (lambda: Disorder(0.0), "diameter must be > 0"),
-    (lambda: Preparation(tilt_deg=90), "tilt must be below 90"),
-    (lambda: Preparation(push_force_n=0.0), "push_force_n must be a positive number"),
-    (lambda: Preparation(settled_rms_speed_m_s=float("nan")), "settled_rms_speed_m_s must be a positive number"),
-    (lambda: Preparation(max_steps=10.5), "max_steps must be an integer"),
-    (lambda: Preparation(wall_slack_m=-1e-6), "wall_slack_m must be a non-negative number"),
-])
+@pytest.mark.parametrize(
+    "make, message",
+    [
+        (lambda: Disorder(D, sigma_m=-1e-6), "standard deviation sigma must be >= 0"),
+        (lambda: Disorder(D, tol_m=-1e-6), "tolerance tol must be >= 0"),
+        (lambda: Disorder(0.0), "diameter must be > 0"),
+        (lambda: Preparation(tilt_deg=90), "tilt must be below 90"),
+        (lambda: Preparation(push_force_n=0.0), "push_force_n must be a positive number"),
+        (lambda: Preparation(settled_rms_speed_m_s=float("nan")), "settled_rms_speed_m_s must be a positive number"),
+        (lambda: Preparation(max_steps=10.5), "max_steps must be an integer"),
+        (lambda: Preparation(wall_slack_m=-1e-6), "wall_slack_m must be a non-negative number"),
+    ],
+)
 def test_bad_preparation_parameters_are_refused(make, message):
     with pytest.raises(HexdemError, match=message):
         make()
@@ -110,8 +113,9 @@ def test_the_settling_walls_stand_back_from_every_member_by_the_slack(slack):
     walled = walls_for_settling(lattice, Preparation(wall_slack_m=slack))
     for wall in walled.walls:
         members = np.asarray(wall.members)
-        np.testing.assert_allclose(wall.gaps_m(lattice.positions_m[members], lattice.radii_m[members]), slack,
-                                   atol=1e-15)
+        np.testing.assert_allclose(
+            wall.gaps_m(lattice.positions_m[members], lattice.radii_m[members]), slack, atol=1e-15
+        )
 
 
 # --------------------------------------------------------------------------- settling on LAMMPS
@@ -131,9 +135,15 @@ def prepare(directory, sigma_m=None, seed=0) -> SimpleNamespace:
     run_deck(write_stage_deck(settle, "settle", preparation, directory / "settle"))
     settled = read_data_file(directory / "settle" / SETTLED_NAME)
     model = dataclasses.replace(base, packing=dataclasses.replace(walled, positions_m=settled.positions_m))
-    return SimpleNamespace(directory=directory, preparation=preparation, compact=compact, compacted=compacted,
-                           settled=settled, model=model,
-                           gravity=preparation.gravity_vector_m_s2(base.impact.direction))
+    return SimpleNamespace(
+        directory=directory,
+        preparation=preparation,
+        compact=compact,
+        compacted=compacted,
+        settled=settled,
+        model=model,
+        gravity=preparation.gravity_vector_m_s2(base.impact.direction),
+    )
 
 
 @pytest.fixture(scope="module")
@@ -152,12 +162,14 @@ def net_forces(model, gravity):
     """Net force on every bead [N] recomputed from the positions: Hertz pairs, walls, gravity."""
     lattice = model.packing
     pos, r = lattice.positions_m, lattice.radii_m
-    force = np.outer(model.masses_kg[:len(lattice)], gravity)
+    force = np.outer(model.masses_kg[: len(lattice)], gravity)
     for i, j in cKDTree(pos).query_pairs(2 * r.max()):
         gap = pos[i] - pos[j]
         distance = np.linalg.norm(gap)
         if r[i] + r[j] > distance:
-            push = model.stiffness_table_pa[0, 0] * np.sqrt(r[i] * r[j] / (r[i] + r[j])) * (r[i] + r[j] - distance) ** 1.5
+            push = (
+                model.stiffness_table_pa[0, 0] * np.sqrt(r[i] * r[j] / (r[i] + r[j])) * (r[i] + r[j] - distance) ** 1.5
+            )
             force[i] += push * gap / distance
             force[j] -= push * gap / distance
     for wall in model.walls:

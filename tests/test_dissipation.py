@@ -18,9 +18,9 @@ from hexdem.model.contact_law import Friction
 from hexdem.model.dissipation import TSUJI_POLYNOMIAL, damping_coefficient, lammps_tsuji_coefficient, restitution_of
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time
+from hexdem.model.materials import DELRIN, STEEL_316, hertz_stiffness, sphere_mass
 from hexdem.model.packing import Packing
 from hexdem.model.walls import Wall
-from hexdem.model.materials import DELRIN, STEEL_316, hertz_stiffness, sphere_mass
 
 ENGINES = [LammpsEngine(), ReferenceEngine()]
 #: Rebounds of a contact resolved in about 1500 steps: both engines measured within 2e-5 of the
@@ -48,7 +48,9 @@ def test_the_damping_gives_back_the_requested_restitution_from_weak_to_strong_da
     from hexdem.model import dissipation
 
     integrations = []
-    monkeypatch.setattr(dissipation, "restitution_of", lambda alpha: integrations.append(alpha) or restitution_of(alpha))
+    monkeypatch.setattr(
+        dissipation, "restitution_of", lambda alpha: integrations.append(alpha) or restitution_of(alpha)
+    )
     alpha = dissipation.damping_coefficient.__wrapped__(restitution)
     assert abs(np.log(restitution_of(alpha) / restitution)) <= dissipation.LOG_RESTITUTION_TOLERANCE
     if restitution >= 0.5:
@@ -64,8 +66,15 @@ def unclipped_restitution(alpha):
         return state[0]
 
     parted.terminal, parted.direction = True, -1
-    solution = solve_ivp(lambda t, s: [s[1], -max(s[0], 0.0) ** 1.5 - alpha * max(s[0], 0.0) ** 0.25 * s[1]],
-                         (0.0, 100.0), [0.0, 1.0], events=parted, rtol=1e-12, atol=1e-14, first_step=1e-6)
+    solution = solve_ivp(
+        lambda t, s: [s[1], -(max(s[0], 0.0) ** 1.5) - alpha * max(s[0], 0.0) ** 0.25 * s[1]],
+        (0.0, 100.0),
+        [0.0, 1.0],
+        events=parted,
+        rtol=1e-12,
+        atol=1e-14,
+        first_step=1e-6,
+    )
     return -solution.y_events[0][0][1]
 
 
@@ -92,8 +101,9 @@ def steel_contacts(kind: str, mu: float) -> tuple[GranularModel, float, float]:
         lattice = Packing(np.array([[0, 0], [2, 0]]), np.array([[0.0, 0.0], [D, 0.0]]), np.full(2, D), D, 0, (), "pair")
         model = GranularModel(lattice, Impact(V0, bead=0), STEEL_316, None, restitution=0.8, friction=friction)
     else:
-        model = GranularModel(single_bead(D), Impact(V0, striker=True), STEEL_316, None, restitution=0.8,
-                              friction=friction)
+        model = GranularModel(
+            single_bead(D), Impact(V0, striker=True), STEEL_316, None, restitution=0.8, friction=friction
+        )
     return model, mass / 2, hertz_stiffness(STEEL_316, STEEL_316) * np.sqrt(D / 4)
 
 
@@ -202,8 +212,9 @@ def test_a_restitution_beyond_marshalls_unit_interval_runs_in_both_engines(tmp_p
 @pytest.mark.parametrize("e", [0.95, 0.8])
 def test_sphere_wall_collision_has_the_requested_restitution(tmp_path, engine, e):
     wall = Wall("wall_180", (-1.0, 0.0), -D / 2, np.array([0]))
-    model = GranularModel(replace(single_bead(D), walls=(wall,)), Impact(V0), STEEL_316, wall=DELRIN,
-                          restitution=1.0, wall_restitution=e)
+    model = GranularModel(
+        replace(single_bead(D), walls=(wall,)), Impact(V0), STEEL_316, wall=DELRIN, restitution=1.0, wall_restitution=e
+    )
     mass = float(sphere_mass(D, STEEL_316))
     duration = 1.3 * contact_time(mass, hertz_stiffness(STEEL_316, DELRIN) * np.sqrt(D / 2), V0)
     trajectory = record(engine, model, RunSettings(duration / 4000, 4000, 100), tmp_path)
@@ -225,8 +236,9 @@ def test_engines_agree_on_a_dissipative_lattice(tmp_path):
     comparisons = []
     for steps in (140, 280):
         run = config.replace(steps_per_contact=steps)
-        lammps, reference = (simulate(run.replace(engine=name), tmp_path / f"{name}{steps}")
-                             for name in ("lammps", "reference"))
+        lammps, reference = (
+            simulate(run.replace(engine=name), tmp_path / f"{name}{steps}") for name in ("lammps", "reference")
+        )
         comparisons.append(compare_analyses(lammps, reference, config.v0))
         assert comparisons[-1].n_checked > 20 and comparisons[-1].agree, comparisons[-1].verdict()
     assert comparisons[0].max_peak_rel_diff / comparisons[1].max_peak_rel_diff == pytest.approx(2.0, rel=0.1)

@@ -42,8 +42,11 @@ def test_every_packing_config_of_the_guide_builds_the_packing_its_comment_names(
     (random,) = [k for k, block in enumerate(blocks) if 'shape = "random"' in block]  # packed by LAMMPS
     disc = RunConfig(**tomllib.loads(blocks[random]))
     assert len(random_diameters(disc.radius_m, disc.diameter_m, disc.diameter_spread, disc.seed)) == 196
-    lattices = [build_packing(RunConfig(**tomllib.loads(block))) for k, block in enumerate(blocks)
-                if k not in packing and k != random]
+    lattices = [
+        build_packing(RunConfig(**tomllib.loads(block)))
+        for k, block in enumerate(blocks)
+        if k not in packing and k != random
+    ]
     # 9 x 12 corners and 8 x 11 interstitials; the intruder's and the dimer's chains of 40 beads
     assert [len(lattice) for lattice in lattices] == [28, 30, 514, 329, 10, 225, 9 * 12 + 8 * 11, 40, 40, 1]
     assert [len(lattice.walls) for lattice in lattices] == [3, 4, 1, 6, 1, 4, 4, 0, 0, 1]

@@ -25,8 +25,12 @@ DOCS = ROOT / "docs"
 def built(tmp_path_factory):
     """The HTML site, built from scratch (-E) with every warning an error (-W)."""
     out = tmp_path_factory.mktemp("docs") / "html"
-    done = subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-E", "-q", "-b", "html",
-                           str(DOCS), str(out)], capture_output=True, text=True, timeout=300)
+    done = subprocess.run(
+        [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-E", "-q", "-b", "html", str(DOCS), str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert done.returncode == 0, done.stderr
     return out
 
@@ -52,7 +56,11 @@ def test_the_config_reference_lists_every_key(built):
     page = (built / "reference" / "_generated" / "config.html").read_text()
     import dataclasses
 
-    missing = [f.name for f in dataclasses.fields(RunConfig) if f"<code class=\"docutils literal notranslate\"><span class=\"pre\">{f.name}</span>" not in page]
+    missing = [
+        f.name
+        for f in dataclasses.fields(RunConfig)
+        if f'<code class="docutils literal notranslate"><span class="pre">{f.name}</span>' not in page
+    ]
     assert not missing
     assert set(KEY_DESCRIPTIONS) == {f.name for f in dataclasses.fields(RunConfig)}, "every key says what it means"
     rows = re.findall(r"<tr class=\"row-(?:odd|even)\">(.*?)</tr>", page.split("</thead>")[1], flags=re.DOTALL)
@@ -74,11 +82,13 @@ def test_the_gallery_shows_every_shape_and_impact_kind():
     configs = {path.stem: RunConfig.from_toml(path) for path in sorted((DOCS / "gallery" / "configs").glob("*.toml"))}
     assert {config.shape for config in configs.values()} == set(SHAPES)
     models = {name: build_model(config) for name, config in configs.items() if config.shape not in PREPARED_SHAPES}
-    kinds = {"velocity": any(not m.strikers for m in models.values()),
-             "striker": any(len(m.strikers) == 1 for m in models.values()),
-             "several impacts": any(len(m.impacts) > 1 and not m.strikers for m in models.values()),
-             "a flat striker": any(len(m.strikers) > 1 for m in models.values()),
-             "an interior impact": any(config.precompression_n > 0 for config in configs.values())}
+    kinds = {
+        "velocity": any(not m.strikers for m in models.values()),
+        "striker": any(len(m.strikers) == 1 for m in models.values()),
+        "several impacts": any(len(m.impacts) > 1 and not m.strikers for m in models.values()),
+        "a flat striker": any(len(m.strikers) > 1 for m in models.values()),
+        "an interior impact": any(config.precompression_n > 0 for config in configs.values()),
+    }
     assert all(kinds.values()), kinds
     page = (DOCS / "gallery" / "index.md").read_text()
     for name in configs:
@@ -116,9 +126,13 @@ def test_no_code_line_is_wider_than_the_page(built):
     shows a docstring's |v| as written (no escape)."""
     import html
 
-    lines = [(path.name, line) for path in built.rglob("*.html") if "_static" not in path.parts
-             for block in re.findall(r"<pre>(.*?)</pre>", path.read_text(), flags=re.DOTALL)
-             for line in html.unescape(re.sub(r"<[^>]+>", "", block)).splitlines()]
+    lines = [
+        (path.name, line)
+        for path in built.rglob("*.html")
+        if "_static" not in path.parts
+        for block in re.findall(r"<pre>(.*?)</pre>", path.read_text(), flags=re.DOTALL)
+        for line in html.unescape(re.sub(r"<[^>]+>", "", block)).splitlines()
+    ]
     wide = [(name, line) for name, line in lines if len(line) > CODE_COLUMNS]
     assert not wide, wide[:5]
     assert not [line for _, line in lines if "\\|" in line]
@@ -128,13 +142,33 @@ def slow_tests(request) -> int:
     """How many tests pytest collects with ``-m slow``: counted in this session where it collected
     the whole suite, unselected (as CI runs it), else by a collection of its own."""
     option, items = request.config.option, request.session.items
-    whole = (not option.keyword and not option.markexpr and not option.deselect
-             and not getattr(option, "lf", False)
-             and {item.path.name for item in items} >= {path.name for path in (ROOT / "tests").glob("test_*.py")})
+    whole = (
+        not option.keyword
+        and not option.markexpr
+        and not option.deselect
+        and not getattr(option, "lf", False)
+        and {item.path.name for item in items} >= {path.name for path in (ROOT / "tests").glob("test_*.py")}
+    )
     if whole:
         return sum(item.get_closest_marker("slow") is not None for item in items)
-    done = subprocess.run([sys.executable, "-m", "pytest", "--collect-only", "-q", "-m", "slow", "-p", "no:cacheprovider",
-                           str(ROOT / "tests")], cwd=ROOT, capture_output=True, text=True, timeout=300)
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pytest",
+            "--collect-only",
+            "-q",
+            "-m",
+            "slow",
+            "-p",
+            "no:cacheprovider",
+            str(ROOT / "tests"),
+        ],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     collected = re.search(r"(\d+)/\d+ tests collected", done.stdout)
     assert collected, done.stdout[-2000:]
     return int(collected.group(1))
@@ -142,8 +176,11 @@ def slow_tests(request) -> int:
 
 def test_the_pages_count_the_slow_tests(request):
     """The number of `slow` tests the pages quote is the number pytest collects with ``-m slow``."""
-    quoted = [int(count) for page in ("development.md", "getting-started.md")
-              for count in re.findall(r"(\d+) tests (?:are )?marked\s+`?slow", (DOCS / page).read_text())]
+    quoted = [
+        int(count)
+        for page in ("development.md", "getting-started.md")
+        for count in re.findall(r"(\d+) tests (?:are )?marked\s+`?slow", (DOCS / page).read_text())
+    ]
     assert len(quoted) == 2 and set(quoted) == {slow_tests(request)}
 
 
@@ -159,8 +196,9 @@ def test_formulas_are_typeset_not_raw_latex(built):
     for path in built.rglob("*.html"):
         if "_static" in path.parts:
             continue
-        page = re.sub(r"<(pre|code|math)\b.*?</\1>|<span class=\"pre\">[^<]*</span>", "", path.read_text(),
-                      flags=re.DOTALL)
+        page = re.sub(
+            r"<(pre|code|math)\b.*?</\1>|<span class=\"pre\">[^<]*</span>", "", path.read_text(), flags=re.DOTALL
+        )
         for part in re.split(r'(?=<section id="module-)', page):
             module = re.match(r'<section id="module-([\w.]+)"', part)
             text = html.unescape(re.sub(r"<[^>]+>", "", part))
@@ -206,7 +244,6 @@ def _quoted_numbers() -> list[tuple[str, str, tuple]]:
     from hexdem.experiments import compare
     from hexdem.model import chain, config, placed, run_settings, square_crystals
     from hexdem.model.dissipation import damping_coefficient
-
     from hexdem.theory.phonons import Lattice2D, cone_slope, frequencies, sound_speeds
     from hexdem.waves.conical import ConicalSettings
 
@@ -219,64 +256,133 @@ def _quoted_numbers() -> list[tuple[str, str, tuple]]:
     damped = [compare.MARGIN * e for e in compare.expected_error(n, damping_coefficient(0.95))]
     return [
         ("docs/validation/convergence.md", r"`steps_per_contact` = (\d+)", (f"{n}",)),
-        ("docs/validation/convergence.md", r"samples every τ/(\d+) whatever the step \(`dump_every` default: "
-         r"steps_per_contact / (\d+); a step count that is not a multiple of (\d+)",
-         (f"{run_settings.SAMPLES_PER_CONTACT}",) * 3),
-        ("docs/validation/convergence.md",
-         r"peak speeds within ([\d.e-]+) relative and arrival times within ([\d.]+) µs",
-         (_sci(bench_accuracy.PEAK_TARGET, 1), f"{bench_accuracy.ARRIVAL_TARGET_S * 1e6:g}")),
+        (
+            "docs/validation/convergence.md",
+            r"samples every τ/(\d+) whatever the step \(`dump_every` default: "
+            r"steps_per_contact / (\d+); a step count that is not a multiple of (\d+)",
+            (f"{run_settings.SAMPLES_PER_CONTACT}",) * 3,
+        ),
+        (
+            "docs/validation/convergence.md",
+            r"peak speeds within ([\d.e-]+) relative and arrival times within ([\d.]+) µs",
+            (_sci(bench_accuracy.PEAK_TARGET, 1), f"{bench_accuracy.ARRIVAL_TARGET_S * 1e6:g}"),
+        ),
         ("docs/guide/configuration.md", r"\bsteps_per_contact = (\d+)", (f"{n}",)),
         ("docs/guide/paper.md", r"\[--steps-per-contact (\d+)\]", (f"{n}",)),
-        ("docs/guide/impacts.md", r"fewer than (\d+) samples or fewer than (\d+) per contact time",
-         (f"{run_settings.MIN_SAMPLES}", f"{run_settings.MIN_SAMPLES_PER_CONTACT}")),
-        ("docs/validation/engines.md", r"rounded up to ([\d.]+)/N²\), and in arrival time",
-         (f"{compare.PEAK_ERROR_N2:g}",)),
-        ("docs/validation/engines.md", r"at most \(([\d.]+) τ \+ ([\d.]+) t\)/N²",
-         (f"{compare.ARRIVAL_ERROR_N2:g}", f"{compare.ARRIVAL_GROWTH_N2:g}")),
-        ("docs/validation/engines.md", r"rounded up to ([\d.]+) and ([\d.]+)\), halving",
-         (f"{compare.PEAK_ERROR_ALPHA_N:g}", f"{compare.ARRIVAL_ERROR_ALPHA_N:g}")),
+        (
+            "docs/guide/impacts.md",
+            r"fewer than (\d+) samples or fewer than (\d+) per contact time",
+            (f"{run_settings.MIN_SAMPLES}", f"{run_settings.MIN_SAMPLES_PER_CONTACT}"),
+        ),
+        (
+            "docs/validation/engines.md",
+            r"rounded up to ([\d.]+)/N²\), and in arrival time",
+            (f"{compare.PEAK_ERROR_N2:g}",),
+        ),
+        (
+            "docs/validation/engines.md",
+            r"at most \(([\d.]+) τ \+ ([\d.]+) t\)/N²",
+            (f"{compare.ARRIVAL_ERROR_N2:g}", f"{compare.ARRIVAL_GROWTH_N2:g}"),
+        ),
+        (
+            "docs/validation/engines.md",
+            r"rounded up to ([\d.]+) and ([\d.]+)\), halving",
+            (f"{compare.PEAK_ERROR_ALPHA_N:g}", f"{compare.ARRIVAL_ERROR_ALPHA_N:g}"),
+        ),
         ("docs/validation/engines.md", r"tolerances are (\d+) times that expected error", (f"{compare.MARGIN:g}",)),
-        *[("docs/validation/engines.md", rf"\| elastic, N = {steps}[^|]*\| ([\d.e-]+) \| ([\d.e-]+) τ \+ ([\d.e-]+) t",
-            tuple(map(_sci, tolerance))) for steps, tolerance in elastic],
-        ("docs/validation/engines.md", rf"\| e = 0.95, N = {n} \| ([\d.e-]+) \| ([\d.e-]+) τ \+ ([\d.e-]+) t",
-         tuple(map(_sci, damped))),
-        ("docs/validation/engines.md",
-         rf"the peak tolerance takes ([\d.]+)/N² \(`PLACED_PEAK_ERROR_N2`\): ([\d.e-]+) at N = {n}",
-         (f"{compare.PLACED_PEAK_ERROR_N2:.1f}", _sci(compare.MARGIN * compare.PLACED_PEAK_ERROR_N2 / n**2))),
-        ("README.md", r"at (\d+) N per contact, \S+ = ([\d.]+) Hz and the cone's slope .*? = ([\d.]+) m/s",
-         (f"{force:g}", f"{lattice.dirac_frequency() / (2 * np.pi):.1f}", f"{cone_slope(lattice):.2f}")),
-        ("docs/guide/dirac-point.md", r"\| at (\d+) N, steel, d = ([\d.]+) mm \|",
-         (f"{force:g}", f"{lattice_config.diameter_m * 1e3:.2f}")),
-        ("docs/guide/dirac-point.md", r"\| \S+ = ([\d.]+) m/s, \S+ = ([\d.]+) m/s \|",
-         tuple(f"{c:.1f}" for c in sound_speeds(lattice))),
+        *[
+            (
+                "docs/validation/engines.md",
+                rf"\| elastic, N = {steps}[^|]*\| ([\d.e-]+) \| ([\d.e-]+) τ \+ ([\d.e-]+) t",
+                tuple(map(_sci, tolerance)),
+            )
+            for steps, tolerance in elastic
+        ],
+        (
+            "docs/validation/engines.md",
+            rf"\| e = 0.95, N = {n} \| ([\d.e-]+) \| ([\d.e-]+) τ \+ ([\d.e-]+) t",
+            tuple(map(_sci, damped)),
+        ),
+        (
+            "docs/validation/engines.md",
+            rf"the peak tolerance takes ([\d.]+)/N² \(`PLACED_PEAK_ERROR_N2`\): ([\d.e-]+) at N = {n}",
+            (f"{compare.PLACED_PEAK_ERROR_N2:.1f}", _sci(compare.MARGIN * compare.PLACED_PEAK_ERROR_N2 / n**2)),
+        ),
+        (
+            "README.md",
+            r"at (\d+) N per contact, \S+ = ([\d.]+) Hz and the cone's slope .*? = ([\d.]+) m/s",
+            (f"{force:g}", f"{lattice.dirac_frequency() / (2 * np.pi):.1f}", f"{cone_slope(lattice):.2f}"),
+        ),
+        (
+            "docs/guide/dirac-point.md",
+            r"\| at (\d+) N, steel, d = ([\d.]+) mm \|",
+            (f"{force:g}", f"{lattice_config.diameter_m * 1e3:.2f}"),
+        ),
+        (
+            "docs/guide/dirac-point.md",
+            r"\| \S+ = ([\d.]+) m/s, \S+ = ([\d.]+) m/s \|",
+            tuple(f"{c:.1f}" for c in sound_speeds(lattice)),
+        ),
         ("docs/guide/dirac-point.md", r"\| \S+ = ([\d.]+) Hz \|", (f"{lattice.dirac_frequency() / (2 * np.pi):.1f}",)),
         ("docs/guide/dirac-point.md", r"\| \S+ = ([\d.]+) m/s \|", (f"{cone_slope(lattice):.2f}",)),
         ("docs/guide/dirac-point.md", r"\| ([\d.]+) and ([\d.]+) kHz \|", tuple(f"{f:.2f}" for f in sorted(omega_m))),
-        ("docs/validation/benchmarks.md",
-         r"end to end ≤ floor \+ ([\d.]+) × the LAMMPS loop \+ ([\d.]+) s; the in-run "
-         r"analysis ≤ ([\d.]+) × the loop", (f"{bench_run.TARGET_FACTOR:g}", f"{bench_run.TARGET_OFFSET_S:g}",
-                                           f"{bench_run.ANALYSIS_SHARE_TARGET:g}")),
-        ("docs/validation/benchmarks.md",
-         r"at ([\d,]+) beads on (\d+) ranks the largest process ≤ (\d+) MB;.*?the\s+tables equal to "
-         r"round-off, ([\de-]+) relative",
-         (f"{bench_scale.MEMORY_TARGET_RUN[0]:,}", f"{bench_scale.MEMORY_TARGET_RUN[1]}",
-          f"{bench_scale.MEMORY_TARGET / 1e6:g}", _sci(bench_scale.RESULTS_RTOL, 1))),
-        ("docs/validation/benchmarks.md", r"target ≥ (\d+) M for (\d+) beads",
-         (f"{bench_reference.TARGET_M_BEAD_STEPS:g}", f"{bench_reference.TARGET_BEADS}")),
-        ("docs/validation/benchmarks.md", r"\(targets: ≤ (\d+) s, ≥ ([\d.]+) × faster than before\)",
-         (f"{bench_ensemble.ENSEMBLE_TARGET_S:g}", f"{bench_ensemble.ENSEMBLE_SPEED_UP_TARGET:g}")),
-        ("docs/validation/benchmarks.md",
-         r"targets: ≤ (\d+) min for the parts .*? `--quick` ≤ (\d+) min; ≥ ([\d.]+) × faster",
-         (f"{bench_paper.TARGETS_S[False] / 60:g}", f"{bench_paper.TARGETS_S[True] / 60:g}",
-          f"{bench_paper.SPEED_UP_TARGET:g}")),
-        ("docs/guide/packings.md", r"by more than ([\d.e-]+) of the smaller diameter are refused.*?that "
-         r"tolerance \((\d+) nm for the paper's beads\)",
-         (_sci(placed.MAX_REST_OVERLAP, 1).replace(".0e", "e"),
-          f"{placed.MAX_REST_OVERLAP * config.RunConfig().diameter_m * 1e9:.0f}")),
-        ("docs/guide/packings.md", r"a chain at least (\d+) beads, a square or centered-square crystal at least "
-         r"(\d+) rows and (\d+) columns", (f"{chain.MIN_CHAIN_BEADS}", *(f"{square_crystals.MIN_GRID}",) * 2)),
-        ("docs/guide/packings.md", r"spread over more than (\d+) times all of them laid end to end.*? not within "
-         r"a factor (\d+) of `diameter_m`", (f"{placed.MAX_SPAN_FACTOR:g}", f"{placed.MAX_DIAMETER_RATIO:g}")),
+        (
+            "docs/validation/benchmarks.md",
+            r"end to end ≤ floor \+ ([\d.]+) × the LAMMPS loop \+ ([\d.]+) s; the in-run "
+            r"analysis ≤ ([\d.]+) × the loop",
+            (f"{bench_run.TARGET_FACTOR:g}", f"{bench_run.TARGET_OFFSET_S:g}", f"{bench_run.ANALYSIS_SHARE_TARGET:g}"),
+        ),
+        (
+            "docs/validation/benchmarks.md",
+            r"at ([\d,]+) beads on (\d+) ranks the largest process ≤ (\d+) MB;.*?the\s+tables equal to "
+            r"round-off, ([\de-]+) relative",
+            (
+                f"{bench_scale.MEMORY_TARGET_RUN[0]:,}",
+                f"{bench_scale.MEMORY_TARGET_RUN[1]}",
+                f"{bench_scale.MEMORY_TARGET / 1e6:g}",
+                _sci(bench_scale.RESULTS_RTOL, 1),
+            ),
+        ),
+        (
+            "docs/validation/benchmarks.md",
+            r"target ≥ (\d+) M for (\d+) beads",
+            (f"{bench_reference.TARGET_M_BEAD_STEPS:g}", f"{bench_reference.TARGET_BEADS}"),
+        ),
+        (
+            "docs/validation/benchmarks.md",
+            r"\(targets: ≤ (\d+) s, ≥ ([\d.]+) × faster than before\)",
+            (f"{bench_ensemble.ENSEMBLE_TARGET_S:g}", f"{bench_ensemble.ENSEMBLE_SPEED_UP_TARGET:g}"),
+        ),
+        (
+            "docs/validation/benchmarks.md",
+            r"targets: ≤ (\d+) min for the parts .*? `--quick` ≤ (\d+) min; ≥ ([\d.]+) × faster",
+            (
+                f"{bench_paper.TARGETS_S[False] / 60:g}",
+                f"{bench_paper.TARGETS_S[True] / 60:g}",
+                f"{bench_paper.SPEED_UP_TARGET:g}",
+            ),
+        ),
+        (
+            "docs/guide/packings.md",
+            r"by more than ([\d.e-]+) of the smaller diameter are refused.*?that "
+            r"tolerance \((\d+) nm for the paper's beads\)",
+            (
+                _sci(placed.MAX_REST_OVERLAP, 1).replace(".0e", "e"),
+                f"{placed.MAX_REST_OVERLAP * config.RunConfig().diameter_m * 1e9:.0f}",
+            ),
+        ),
+        (
+            "docs/guide/packings.md",
+            r"a chain at least (\d+) beads, a square or centered-square crystal at least "
+            r"(\d+) rows and (\d+) columns",
+            (f"{chain.MIN_CHAIN_BEADS}", *(f"{square_crystals.MIN_GRID}",) * 2),
+        ),
+        (
+            "docs/guide/packings.md",
+            r"spread over more than (\d+) times all of them laid end to end.*? not within "
+            r"a factor (\d+) of `diameter_m`",
+            (f"{placed.MAX_SPAN_FACTOR:g}", f"{placed.MAX_DIAMETER_RATIO:g}"),
+        ),
     ]
 
 
@@ -312,10 +418,13 @@ def test_the_crossover_page_shows_its_runs_numbers():
     assert run["sigma_per_tol"] == sorted({*settings.SIGMA_PER_TOL, *settings.CROSSOVER_SIGMA_PER_TOL} - {0.0})
     text = " ".join(page.split())
     sweep = re.search(r"σ/tol ∈ \{([^}]*)\} \(quick: \{([^}]*)\}\)", text)
-    assert sweep and [tuple(float(s) for s in group.split(", ")) for group in sweep.groups()] == \
-        [tuple(s for s in chosen if s not in settings.SIGMA_PER_TOL)
-         for chosen in (settings.CROSSOVER_SIGMA_PER_TOL, settings.QUICK_CROSSOVER_SIGMA_PER_TOL)]
+    assert sweep and [tuple(float(s) for s in group.split(", ")) for group in sweep.groups()] == [
+        tuple(s for s in chosen if s not in settings.SIGMA_PER_TOL)
+        for chosen in (settings.CROSSOVER_SIGMA_PER_TOL, settings.QUICK_CROSSOVER_SIGMA_PER_TOL)
+    ]
     overlaps = re.search(r"is ([\d.]+), ([\d.]+) and ([\d.]+) tol at ([\d.]+), ([\d.]+) and ([\d.]+) m/s", text)
     speeds = settings.CROSSOVER_VELOCITIES_M_S
-    assert overlaps and overlaps.groups() == (*(f"{impact_overlap_m(v) / TOLERANCE_M:.2f}" for v in speeds),
-                                              *(f"{v:.2f}" for v in speeds))
+    assert overlaps and overlaps.groups() == (
+        *(f"{impact_overlap_m(v) / TOLERANCE_M:.2f}" for v in speeds),
+        *(f"{v:.2f}" for v in speeds),
+    )

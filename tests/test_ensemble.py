@@ -21,7 +21,7 @@ from hexdem.cli.main import main
 from hexdem.disorder.ensemble import Ensemble, EnsembleConfig
 from hexdem.disorder.preparation import Preparation
 from hexdem.disorder.runner import run_ensemble
-from hexdem.disorder.sharing import adopt_preparation, adopt_ideal_impacts
+from hexdem.disorder.sharing import adopt_ideal_impacts, adopt_preparation
 from hexdem.disorder.stats import STATS_COLUMNS
 from hexdem.engines.lammps.standalone import DONE_MARKER, run_deck
 from hexdem.errors import HexdemError
@@ -56,8 +56,15 @@ def test_the_ensemble_writes_its_tables_and_figures(reference):
     assert header == STATS_COLUMNS
     assert len(rows) == len(VELOCITIES) * sum(len(beads) for beads in ensemble.ideal.lines().values())
     assert {int(row["count"]) for row in rows} <= {0, 1, 2, 3}
-    for name in ("ideal_peaks.csv", "arrival_map.csv", "disorder_effect.csv", "fig9_all_directions.png",
-                 "fig8_expnumsim_v0.400.png", "fig8_expnumsim_v0.700.png", "ensemble.json"):
+    for name in (
+        "ideal_peaks.csv",
+        "arrival_map.csv",
+        "disorder_effect.csv",
+        "fig9_all_directions.png",
+        "fig8_expnumsim_v0.400.png",
+        "fig8_expnumsim_v0.700.png",
+        "ensemble.json",
+    ):
         assert (ensemble.out / name).stat().st_size > 0
     assert {row["line"] for row in summary["disorder_effect"]} == {"0", "+30", "-30", "±30"}
     assert summary["lammps_time_s"]["settle_per_realization"] > 0 < summary["lammps_time_s"]["impact_per_run"]
@@ -117,8 +124,9 @@ def test_adopting_another_ensembles_identical_runs_gives_what_running_them_gives
         for name in ("peak_speed", "t_peak", "arrival_time") + (() if k is None else ("positions_m",)):
             np.testing.assert_array_equal(results(adopted, k)[name], results(own, k)[name])
     for k in range(3):  # copied, not rerun: even LAMMPS's timings in the log are the reference's
-        assert (adopted.stage_dir(k, "compact") / "log.lammps").read_bytes() == \
-            (ensemble.stage_dir(k, "compact") / "log.lammps").read_bytes()
+        assert (adopted.stage_dir(k, "compact") / "log.lammps").read_bytes() == (
+            ensemble.stage_dir(k, "compact") / "log.lammps"
+        ).read_bytes()
         assert not np.array_equal(results(adopted, k)["wall_offsets_m"], results(ensemble, k)["wall_offsets_m"])
     seeded = Ensemble(EnsembleConfig(**SMALL, seed=1), tmp_path / "seed")
     assert adopt_preparation(seeded, ensemble) == 0 and adopt_ideal_impacts(seeded, ensemble) == 2
@@ -136,8 +144,9 @@ def test_a_frictional_ensemble_strikes_the_frictionless_preparation(reference, t
     adopted = Ensemble(rough, tmp_path)
     for k in range(3):
         for stage in ("compact", "settle"):
-            assert (adopted.stage_dir(k, stage) / "log.lammps").read_bytes() == \
-                (ensemble.stage_dir(k, stage) / "log.lammps").read_bytes()
+            assert (adopted.stage_dir(k, stage) / "log.lammps").read_bytes() == (
+                ensemble.stage_dir(k, stage) / "log.lammps"
+            ).read_bytes()
         np.testing.assert_array_equal(results(adopted, k)["positions_m"], results(ensemble, k)["positions_m"])
         assert not np.array_equal(results(adopted, k)["peak_speed"], results(ensemble, k)["peak_speed"])
     assert "nve/sphere" in (adopted.impact_dir(0, 0.4) / "in.hexdem").read_text()
@@ -187,8 +196,9 @@ def test_an_ensemble_killed_midway_resumes_with_every_realization_intact(referen
     ensemble, _ = reference
     out = tmp_path / "killed"
     args = ["ensemble", "--out", str(out), *CLI_SMALL, "--realizations", "5", "--workers", "2"]
-    process = subprocess.run([sys.executable, "-c", KILLED_AFTER_REALIZATION_1, *args], stderr=subprocess.DEVNULL,
-                             timeout=120, check=False)
+    process = subprocess.run(
+        [sys.executable, "-c", KILLED_AFTER_REALIZATION_1, *args], stderr=subprocess.DEVNULL, timeout=120, check=False
+    )
     assert process.returncode == -signal.SIGKILL
     finished = {path: path.stat().st_mtime_ns for path in out.glob("realizations/*/result.npz")}
     assert sorted(path.parent.name for path in finished) == ["r0000", "r0001"]
@@ -226,16 +236,19 @@ def test_a_directory_in_use_is_refused(reference):
         os.close(fd)
 
 
-@pytest.mark.parametrize("options, message", [
-    (["--sigma-mm", "-0.01"], "standard deviation sigma must be >= 0"),
-    (["--realizations", "0"], "number of realizations must be a positive integer"),
-    (["--velocities", "0.25;0.40"], "--velocities must be comma-separated numbers in m/s"),
-    (["--velocities", "fast"], "--velocities must be comma-separated numbers in m/s"),
-    (["--velocities", "0.4,-0.7"], "distinct positive speeds"),
-    (["--workers", "0"], "--workers must be a positive integer"),
-    (["--reference-bead", "0,1"], "reference bead {0, 1} is not in the hexagon"),
-    (["--scaling", "missing.json"], "cannot read scaling laws missing.json"),
-])
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        (["--sigma-mm", "-0.01"], "standard deviation sigma must be >= 0"),
+        (["--realizations", "0"], "number of realizations must be a positive integer"),
+        (["--velocities", "0.25;0.40"], "--velocities must be comma-separated numbers in m/s"),
+        (["--velocities", "fast"], "--velocities must be comma-separated numbers in m/s"),
+        (["--velocities", "0.4,-0.7"], "distinct positive speeds"),
+        (["--workers", "0"], "--workers must be a positive integer"),
+        (["--reference-bead", "0,1"], "reference bead {0, 1} is not in the hexagon"),
+        (["--scaling", "missing.json"], "cannot read scaling laws missing.json"),
+    ],
+)
 def test_bad_input_is_one_clear_line(tmp_path, capsys, options, message):
     out = tmp_path / "out"
     assert main(["ensemble", "--out", str(out), *CLI_SMALL, *options]) == 3
@@ -250,11 +263,12 @@ def test_the_impacts_that_warned_are_named_per_striker_speed():
     from hexdem.disorder.stats import EnsembleResults, impact_warnings
 
     reached = np.array([[True, False], [True, True], [False, False]])  # 3 realizations x 2 speeds
-    results = EnsembleResults(np.array([0.2, 0.4]), *[None] * 6,
-                              per_realization={"far_wall_reached": reached,
-                                               "ideal_far_wall_reached": np.array([True, False])})
-    assert impact_warnings(results) == ["far_wall_not_reached (r0002)",
-                                        "far_wall_not_reached (ideal, r0000, r0002)"]
+    results = EnsembleResults(
+        np.array([0.2, 0.4]),
+        *[None] * 6,
+        per_realization={"far_wall_reached": reached, "ideal_far_wall_reached": np.array([True, False])},
+    )
+    assert impact_warnings(results) == ["far_wall_not_reached (r0002)", "far_wall_not_reached (ideal, r0000, r0002)"]
 
 
 def test_a_failing_deck_is_named_with_lammps_error(tmp_path):
@@ -279,8 +293,11 @@ def test_a_failing_deck_in_an_ensemble_is_named_after_the_others_ran(tmp_path, c
     for directory, text in zip(decks, ('print "fine"\n', "units si\nbogus_command 1\n", 'print "fine"\n')):
         directory.mkdir()
         (directory / "in.hexdem").write_text(text)
-    with pytest.raises(RunFailed, match=r"1 of 3 compact decks failed .*; realization 1: LAMMPS failed on "
-                                          r".*b/in.hexdem: ERROR: Unknown command: bogus_command"):
+    with pytest.raises(
+        RunFailed,
+        match=r"1 of 3 compact decks failed .*; realization 1: LAMMPS failed on "
+        r".*b/in.hexdem: ERROR: Unknown command: bogus_command",
+    ):
         _run_phase("compact", {f"realization {k}": (run_deck, deck) for k, deck in enumerate(decks)}, 2, None)
     assert [(deck / DONE_MARKER).exists() for deck in decks] == [True, False, True]
 

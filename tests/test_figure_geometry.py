@@ -14,11 +14,13 @@ from hexdem.model.config import RunConfig
 from hexdem.model.model_builder import build_model
 
 #: Packings of every aspect the gallery draws: a hexagon, a square, a strip far wider than high, a chain of two sizes.
-PACKINGS = {"hexagon": RunConfig(edge_beads=6),
-            "square": RunConfig(shape="square", rows=7, columns=7),
-            "strip": RunConfig(shape="square", rows=2, columns=20),
-            "tall": RunConfig(shape="parallelogram", edge_beads=16, depth_beads=2),
-            "dimer": RunConfig(shape="chain", beads=40, diameters_m=[0.01905, 0.009525])}
+PACKINGS = {
+    "hexagon": RunConfig(edge_beads=6),
+    "square": RunConfig(shape="square", rows=7, columns=7),
+    "strip": RunConfig(shape="square", rows=2, columns=20),
+    "tall": RunConfig(shape="parallelogram", edge_beads=16, depth_beads=2),
+    "dimer": RunConfig(shape="chain", beads=40, diameters_m=[0.01905, 0.009525]),
+}
 
 
 def pulse(model, reach_d: float = 6.0) -> SimpleNamespace:
@@ -30,8 +32,9 @@ def pulse(model, reach_d: float = 6.0) -> SimpleNamespace:
     r = np.hypot(*(positions - positions[model.struck_beads[0]]).T)
     peaks = np.where(r <= reach_d - 1, 1.0 / (1.0 + r), np.where(r <= reach_d, np.nan, 0.0))
     arrival = np.where(peaks > 0, r / 2.0, np.nan)
-    return SimpleNamespace(positions=positions, length_unit_m=d, units="nondimensional", arrival_time=arrival,
-                           peak_speed=peaks)
+    return SimpleNamespace(
+        positions=positions, length_unit_m=d, units="nondimensional", arrival_time=arrival, peak_speed=peaks
+    )
 
 
 def extent(artist, renderer):
@@ -42,9 +45,12 @@ def extent(artist, renderer):
 def overlapping(axis, renderer) -> list[str]:
     """The tick labels of ``axis`` drawn (their tick within its view) whose boxes overlap another's."""
     low, high = sorted(axis.get_view_interval())
-    boxes = [(tick.label1.get_text(), tick.label1.get_window_extent(renderer)) for tick in axis.get_major_ticks()
-             if low <= tick.get_loc() <= high and tick.label1.get_visible() and tick.label1.get_text()]
-    return [a for k, (a, box) in enumerate(boxes) for b, other in boxes[k + 1:] if box.overlaps(other)]
+    boxes = [
+        (tick.label1.get_text(), tick.label1.get_window_extent(renderer))
+        for tick in axis.get_major_ticks()
+        if low <= tick.get_loc() <= high and tick.label1.get_visible() and tick.label1.get_text()
+    ]
+    return [a for k, (a, box) in enumerate(boxes) for b, other in boxes[k + 1 :] if box.overlaps(other)]
 
 
 def crowded(ax, renderer) -> list[str]:
@@ -148,9 +154,14 @@ def test_lines_that_never_moved_are_named_not_drawn_as_drops(tmp_path):
     n = np.arange(15)
     decay = 0.7 + 0.3 * np.exp(-n)
     still = np.r_[1.0, np.zeros(14)]
-    rows = {"0": (n, 0.4 * decay), "+45": (n, 0.4 * still), "-45": (n, 0.4 * still),
-            "+90": (n[:8], 0.4 * still[:8]), "-90": (n[:8], 0.4 * still[:8]),
-            "up": (n, 0.4 * np.r_[decay[:5], np.zeros(10)])}
+    rows = {
+        "0": (n, 0.4 * decay),
+        "+45": (n, 0.4 * still),
+        "-45": (n, 0.4 * still),
+        "+90": (n[:8], 0.4 * still[:8]),
+        "-90": (n[:8], 0.4 * still[:8]),
+        "up": (n, 0.4 * np.r_[decay[:5], np.zeros(10)]),
+    }
     fig = peak_decay(rows, tmp_path / "peak_decay.png", "si", 0.4)
     ax = fig.axes[0]
     labels = [text.get_text() for text in ax.get_legend().get_texts()]
@@ -165,7 +176,7 @@ def test_a_line_drawn_over_its_mirror_stays_visible(tmp_path):
     """A symmetric strike's −45° line coincides with its +45°: drawn open and dashed over the
     filled markers of +45°, so that a reader sees both."""
     n = np.arange(6)
-    peaks = 0.4 * 0.8 ** n
+    peaks = 0.4 * 0.8**n
     fig = peak_decay({"0": (n, peaks), "+45": (n, peaks), "-45": (n, peaks)}, tmp_path / "decay.png", "si", 0.4)
     lines = {line.get_label(): line for line in fig.axes[0].get_lines()}
     assert lines["-45°"].get_linestyle() == "--" and lines["-45°"].get_markerfacecolor() == "none"

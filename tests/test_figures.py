@@ -7,10 +7,8 @@ import re
 from pathlib import Path
 
 import numpy as np
-from matplotlib.colors import LogNorm
-
 from matplotlib import colormaps
-from matplotlib.colors import to_rgb
+from matplotlib.colors import LogNorm, to_rgb
 
 from hexdem.analysis.plotting import PIXEL_MAP_BEADS, PIXEL_REACH_D, UNMEASURED_GREYS, bead_map, subplots
 from hexdem.model.triangular import hexagon
@@ -26,8 +24,15 @@ def test_beads_without_a_peak_are_drawn_outside_the_scale_and_named_in_the_legen
     positions = np.column_stack([np.arange(5.0), np.zeros(5)])
     values = np.array([1.0, np.nan, 0.1, 0.0, np.nan])
     never = values == 0
-    coloured = bead_map(ax, positions, np.ones(5), values, cmap="magma", norm=LogNorm(0.01, 1.0),
-                        unmeasured={"never moved": never, "still rising at the run's end": np.arange(5) == 4})
+    coloured = bead_map(
+        ax,
+        positions,
+        np.ones(5),
+        values,
+        cmap="magma",
+        norm=LogNorm(0.01, 1.0),
+        unmeasured={"never moved": never, "still rising at the run's end": np.arange(5) == 4},
+    )
     assert list(coloured.get_array()) == [1.0, 0.1], "only measured beads take a colour"
     others = [c for c in ax.collections if c is not coloured]
     assert sorted(len(c.get_offsets()) for c in others) == [1, 1, 1]
@@ -47,13 +52,21 @@ def test_a_large_packing_is_drawn_as_an_image_of_its_beads_values():
     x = lattice.positions_m[:, 0]
     values = np.where(x < 0.8 * x.max(), x, np.nan)
     fig, ax = subplots()
-    image = bead_map(ax, lattice.positions_m, lattice.diameters_m, values, cmap="magma",
-                     unmeasured={"still rising at the run's end": np.isnan(values)}, outlined={"far": x > 0.5 * x.max()})
+    image = bead_map(
+        ax,
+        lattice.positions_m,
+        lattice.diameters_m,
+        values,
+        cmap="magma",
+        unmeasured={"still rising at the run's end": np.isnan(values)},
+        outlined={"far": x > 0.5 * x.max()},
+    )
     left, right, bottom, top = image.get_extent()
     pixels = np.ma.filled(image.get_array(), np.nan)
     step = (right - left) / pixels.shape[1]
-    cx, cy = np.meshgrid(left + (np.arange(pixels.shape[1]) + 0.5) * step,
-                         bottom + (np.arange(pixels.shape[0]) + 0.5) * step)
+    cx, cy = np.meshgrid(
+        left + (np.arange(pixels.shape[1]) + 0.5) * step, bottom + (np.arange(pixels.shape[0]) + 0.5) * step
+    )
     middle = lattice.positions_m.mean(axis=0)
     inside = (np.hypot(cx - middle[0], cy - middle[1]) < 0.8 * 60) & (cx < 0.8 * x.max() - 1)
     assert np.all(np.isfinite(pixels[inside])), "no gap inside the packing"
@@ -80,10 +93,16 @@ def test_beads_of_other_materials_are_ringed_and_named():
 
 
 #: Modules that draw the report's and the runs' figures.
-FIGURE_MODULES = sorted({*(ROOT / "hexdem" / "paper").glob("*.py"), *(ROOT / "hexdem").glob("*/*figures.py"),
-                         ROOT / "hexdem" / "analysis" / "plotting.py",
-                         ROOT / "hexdem" / "analysis" / "movie.py", ROOT / "hexdem" / "analysis" / "decay_figure.py",
-                         ROOT / "hexdem" / "experiments" / "snapshots.py"})
+FIGURE_MODULES = sorted(
+    {
+        *(ROOT / "hexdem" / "paper").glob("*.py"),
+        *(ROOT / "hexdem").glob("*/*figures.py"),
+        ROOT / "hexdem" / "analysis" / "plotting.py",
+        ROOT / "hexdem" / "analysis" / "movie.py",
+        ROOT / "hexdem" / "analysis" / "decay_figure.py",
+        ROOT / "hexdem" / "experiments" / "snapshots.py",
+    }
+)
 #: Calls and keywords whose string is text on a figure.
 TEXT_CALLS = {"set_xlabel", "set_ylabel", "set_title", "suptitle", "set_label", "text", "annotate", "legend"}
 TEXT_KEYWORDS = {"label", "title", "xlabel", "ylabel"}
@@ -112,8 +131,10 @@ def test_no_figure_text_is_raw_notation():
             if not isinstance(node, ast.Call):
                 continue
             name = node.func.attr if isinstance(node.func, ast.Attribute) else getattr(node.func, "id", "")
-            texts = [*(node.args[:1] if name in TEXT_CALLS else []),
-                     *(k.value for k in node.keywords if k.arg in TEXT_KEYWORDS)]
+            texts = [
+                *(node.args[:1] if name in TEXT_CALLS else []),
+                *(k.value for k in node.keywords if k.arg in TEXT_KEYWORDS),
+            ]
             for text in (text for item in texts for text in _shown(item)):
                 if RAW_NOTATION.search(re.sub(r"\$[^$]*\$", "", text)):
                     raw.append(f"{path.name}:{node.lineno}: {text}")
@@ -133,8 +154,13 @@ def test_the_maps_of_a_large_run_share_the_tiling_found_before_they_are_drawn(tm
     assert model.n_bodies > PIXEL_MAP_BEADS
     d = model.packing.diameter_m
     x = model.packing.positions_m[:, 0] / d
-    results = SimpleNamespace(positions=model.packing.positions_m / d, length_unit_m=d, units="nondimensional",
-                              arrival_time=x - x.min(), peak_speed=np.exp(-np.abs(x) / 30))
+    results = SimpleNamespace(
+        positions=model.packing.positions_m / d,
+        length_unit_m=d,
+        units="nondimensional",
+        arrival_time=x - x.min(),
+        peak_speed=np.exp(-np.abs(x) / 30),
+    )
     plotting._pixel_tiling.cache_clear()
     plotting.tile_lattice(results, model)
     run_maps.arrival_map(results, model, tmp_path / "arrival_map.png")

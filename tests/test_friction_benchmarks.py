@@ -17,9 +17,19 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from conftest import D, V0
-from oblique import (INERTIA, Contact, convergence_bound, impact_settings, lammps_deck, lammps_states, reference_states,
-                     solve_contact, sphere_on_wall, sphere_pair)
+from conftest import V0, D
+from oblique import (
+    INERTIA,
+    Contact,
+    convergence_bound,
+    impact_settings,
+    lammps_deck,
+    lammps_states,
+    reference_states,
+    solve_contact,
+    sphere_on_wall,
+    sphere_pair,
+)
 
 from hexdem.analysis.peaks import refine_peak
 from hexdem.model.config import RunConfig
@@ -37,7 +47,8 @@ STEPS = 400
 def components(model, incidence_deg):
     """(normal, tangential) speed of the impact at ``incidence_deg``."""
     return model.impact.speed_m_s * np.cos(np.radians(incidence_deg)), model.impact.speed_m_s * np.sin(
-        np.radians(incidence_deg))
+        np.radians(incidence_deg)
+    )
 
 
 def wall_rebound(model, directory, steps=STEPS):
@@ -83,7 +94,10 @@ def test_normal_impact_with_friction_is_hertz_and_does_not_spin(tmp_path):
     assert duration == pytest.approx(contact.contact_time(V0), rel=1e-4)
     assert refine_peak(states.times, depth)[1] > 0
     assert states.velocities[-1, 0, 1] == pytest.approx(V0, rel=1e-6)  # e = 1: elastic
-    assert np.abs(states.spins).max() * D / 2 < ROUND_OFF * V0 and np.abs(states.velocities[:, 0, 0]).max() < ROUND_OFF * V0
+    assert (
+        np.abs(states.spins).max() * D / 2 < ROUND_OFF * V0
+        and np.abs(states.velocities[:, 0, 0]).max() < ROUND_OFF * V0
+    )
 
 
 @pytest.mark.parametrize("incidence_deg", [75.0, 85.0])
@@ -112,8 +126,11 @@ def start_of_sliding_deficit(contact, v_n, v_t, restitution):
     def normal(t):
         return stiffness * (v_n * t) ** 1.5 + eta * (v_n * t) ** 0.25 * v_n
 
-    start = brentq(lambda t: contact.k_t * np.sqrt(contact.r_eff * v_n * t) * v_t * t - contact.mu * normal(t),
-                   1e-15 * contact.contact_time(v_n), contact.contact_time(v_n))
+    start = brentq(
+        lambda t: contact.k_t * np.sqrt(contact.r_eff * v_n * t) * v_t * t - contact.mu * normal(t),
+        1e-15 * contact.contact_time(v_n),
+        contact.contact_time(v_n),
+    )
     impulse = stiffness * v_n**1.5 * 0.4 * start**2.5 + eta * v_n**1.25 * 0.8 * start**1.25  # ∫₀^{t_s} F_n dt
     return impulse / (contact.m_n * (1 + restitution) * v_n)
 
@@ -135,8 +152,11 @@ def test_a_sphere_sliding_on_a_damped_wall_spins_as_the_rigid_body_law(tmp_path)
         spins, slides = [], []
         for steps in (800, 1600):
             settings = impact_settings(model, steps)
-            states = (lammps_states(model, settings, tmp_path / f"{name}{steps}", every=settings.n_steps)
-                      if name == "lammps" else reference_states(model, settings, every=settings.n_steps))
+            states = (
+                lammps_states(model, settings, tmp_path / f"{name}{steps}", every=settings.n_steps)
+                if name == "lammps"
+                else reference_states(model, settings, every=settings.n_steps)
+            )
             spins.append(-states.spins[-1, 0] * D / 2)
             slides.append(v_t - states.velocities[-1, 0, 0])
         for measured, law in ((spins, rigid), (slides, rigid / 2.5)):  # ω r and −Δv_t = μ (1 + e) v_n
@@ -227,13 +247,21 @@ def test_free_packing_with_friction_keeps_its_angular_momentum(tmp_path):
     """No walls: Σ m x × v + I ω about the origin is kept (LAMMPS's lever arms r_i − δ/2 add up to
     the distance of the centres, so contact torques balance the forces' moments exactly, and velocity
     Verlet keeps it to round-off)."""
-    config = RunConfig(shape="sites", sites=[[0, 0], [2, 0], [1, 1], [3, 1], [1, -1], [4, 0], [2, 2]],
-                       impact="striker", strike_angle_deg=35.0, friction=0.5, wall_material="none", duration=4e-4)
+    config = RunConfig(
+        shape="sites",
+        sites=[[0, 0], [2, 0], [1, 1], [3, 1], [1, -1], [4, 0], [2, 2]],
+        impact="striker",
+        strike_angle_deg=35.0,
+        friction=0.5,
+        wall_material="none",
+        duration=4e-4,
+    )
     model = build_model(config)
     states = lammps_states(model, run_settings(config, model), tmp_path, every=20)
     masses, radii = model.masses_kg, model.diameters_m / 2
-    orbital = masses * (states.positions[..., 0] * states.velocities[..., 1]
-                        - states.positions[..., 1] * states.velocities[..., 0])
+    orbital = masses * (
+        states.positions[..., 0] * states.velocities[..., 1] - states.positions[..., 1] * states.velocities[..., 0]
+    )
     momentum = orbital.sum(axis=1) + (INERTIA * masses * radii**2 * states.spins).sum(axis=1)
     spin = (INERTIA * masses * radii**2 * np.abs(states.spins)).sum(axis=1).max()
     scale = masses.max() * V0 * D

@@ -11,7 +11,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from conftest import D, V0
+from conftest import V0, D
 from oblique import convergence_bound, impact_settings, lammps_states, reference_states, sphere_on_wall
 
 MU = 0.3
@@ -24,11 +24,15 @@ def test_engines_agree_on_a_damped_frictional_impact(tmp_path, incidence_deg):
     results = {}
     for steps in (800, 1600):
         settings = impact_settings(model, steps)
-        for name, states in (("lammps", lammps_states(model, settings, tmp_path / str(steps), every=settings.n_steps)),
-                             ("reference", reference_states(model, settings, every=settings.n_steps))):
+        for name, states in (
+            ("lammps", lammps_states(model, settings, tmp_path / str(steps), every=settings.n_steps)),
+            ("reference", reference_states(model, settings, every=settings.n_steps)),
+        ):
             results[name, steps] = np.array([*states.velocities[-1, 0], states.spins[-1, 0] * D / 2])
     assert results["lammps", 1600][1] == pytest.approx(0.8 * V0 * np.cos(np.radians(incidence_deg)), rel=1e-3)
     for q in (0, 2):  # tangential velocity, spin
-        bound = sum(convergence_bound(results[name, 800][q], results[name, 1600][q], scale, 800)
-                    for name in ("lammps", "reference"))
+        bound = sum(
+            convergence_bound(results[name, 800][q], results[name, 1600][q], scale, 800)
+            for name in ("lammps", "reference")
+        )
         assert abs(results["lammps", 1600][q] - results["reference", 1600][q]) <= bound, q

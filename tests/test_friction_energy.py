@@ -13,7 +13,7 @@ conservative by itself, and the budget closes only with W. U_n = (2/5) A δ^{5/2
 
 import numpy as np
 import pytest
-from conftest import D, V0
+from conftest import V0, D
 from oblique import INERTIA, Contact, impact_settings, lammps_states, reference_states, sphere_on_wall
 
 MU = 0.3
@@ -31,10 +31,14 @@ def budget(model, states):
     force = stiffness * xi
     slip = -states.velocities[:, 0, 0] - radius * states.spins[:, 0]  # t = ẑ × n = −x for the normal +y
     dt = np.diff(states.times)
-    dissipated = np.cumsum((force[1:] * slip[1:] + force[:-1] * slip[:-1]) / 2 * dt
-                           - (force[1:] + force[:-1]) / 2 * np.diff(xi))
+    dissipated = np.cumsum(
+        (force[1:] * slip[1:] + force[:-1] * slip[:-1]) / 2 * dt - (force[1:] + force[:-1]) / 2 * np.diff(xi)
+    )
     stiffening = np.cumsum((xi[1:] ** 2 + xi[:-1] ** 2) / 4 * np.diff(stiffness))
-    kinetic = 0.5 * mass * (states.velocities[:, 0] ** 2).sum(axis=1) + 0.5 * INERTIA * mass * radius**2 * states.spins[:, 0] ** 2
+    kinetic = (
+        0.5 * mass * (states.velocities[:, 0] ** 2).sum(axis=1)
+        + 0.5 * INERTIA * mass * radius**2 * states.spins[:, 0] ** 2
+    )
     stored = 0.4 * contact.k_n * np.sqrt(contact.r_eff) * depth**2.5 + 0.5 * stiffness * xi**2
     return kinetic[0], kinetic + stored, np.concatenate([[0.0], dissipated]), np.concatenate([[0.0], stiffening])
 
@@ -66,8 +70,10 @@ def test_lammps_loses_the_energy_the_reference_budget_says_friction_takes(tmp_pa
         settings = impact_settings(model, steps)
         states = lammps_states(model, settings, tmp_path / str(steps), every=settings.n_steps)
         mass = model.masses_kg[0]
-        finals.append(0.5 * mass * (states.velocities[-1, 0] ** 2).sum()
-                      + 0.5 * INERTIA * mass * (D / 2) ** 2 * states.spins[-1, 0] ** 2)
+        finals.append(
+            0.5 * mass * (states.velocities[-1, 0] ** 2).sum()
+            + 0.5 * INERTIA * mass * (D / 2) ** 2 * states.spins[-1, 0] ** 2
+        )
     expected = e0 - dissipated[-1] + stiffening[-1]
     assert finals[1] == pytest.approx(expected, rel=2 * abs(finals[0] - finals[1]) / e0 + residual)
     assert e0 - finals[1] > 0.01 * e0  # friction took a visible share

@@ -8,18 +8,28 @@ tolerance comes from its own convergence in the time step (``oblique.convergence
 
 import numpy as np
 import pytest
-from conftest import D, V0, record
-from oblique import (INERTIA, Contact, convergence_bound, impact_settings, lammps_states, reference_states,
-                     solve_contact, sphere_in_ring, sphere_on_wall, sphere_pair)
+from conftest import V0, D, record
+from oblique import (
+    INERTIA,
+    Contact,
+    convergence_bound,
+    impact_settings,
+    lammps_states,
+    reference_states,
+    solve_contact,
+    sphere_in_ring,
+    sphere_on_wall,
+    sphere_pair,
+)
 
 from hexdem.engines.lammps.engine import LammpsEngine
 from hexdem.engines.reference.engine import ReferenceEngine, ReferenceSystem
 from hexdem.engines.reference.friction import FrictionalSystem
 from hexdem.model.config import RunConfig
 from hexdem.model.materials import STEEL_316
-from hexdem.model.units import SI, nondimensional
 from hexdem.model.model_builder import build_model
 from hexdem.model.run_settings import run_settings
+from hexdem.model.units import SI, nondimensional
 
 MU = 0.3
 STEPS = 200
@@ -61,8 +71,10 @@ def test_reference_engine_follows_hertz_mindlin_on_a_wall_over_the_whole_inciden
         contact, mass = Contact.of(model), model.masses_kg[0]
         v_n, v_t = V0 * np.cos(np.radians(incidence_of(normalized))), V0 * np.sin(np.radians(incidence_of(normalized)))
         impulse, _, _, _ = solve_contact(contact, v_n, v_t)
-        moved = [mass * (rebound(reference_states(model, impact_settings(model, steps), every=steps), model)[0] - v_t)
-                 for steps in (STEPS, 2 * STEPS)]
+        moved = [
+            mass * (rebound(reference_states(model, impact_settings(model, steps), every=steps), model)[0] - v_t)
+            for steps in (STEPS, 2 * STEPS)
+        ]
         gross = MU * 2 * mass * v_n
         assert abs(moved[1] - impulse) <= convergence_bound(moved[0], moved[1], gross, STEPS), normalized
 
@@ -80,12 +92,15 @@ def test_engines_agree_on_rebound_and_spin_over_the_whole_incidence_range(tmp_pa
         results = {}
         for steps in (STEPS, 2 * STEPS):
             settings = impact_settings(model, steps)
-            results["lammps", steps] = rebound(lammps_states(model, settings, tmp_path / f"{k}-{steps}",
-                                                             every=settings.n_steps), model)
+            results["lammps", steps] = rebound(
+                lammps_states(model, settings, tmp_path / f"{k}-{steps}", every=settings.n_steps), model
+            )
             results["reference", steps] = rebound(reference_states(model, settings, every=settings.n_steps), model)
         for q in range(2):  # tangential velocity, spin
-            bound = sum(convergence_bound(results[engine, STEPS][q], results[engine, 2 * STEPS][q], scale, STEPS)
-                        for engine in ("lammps", "reference"))
+            bound = sum(
+                convergence_bound(results[engine, STEPS][q], results[engine, 2 * STEPS][q], scale, STEPS)
+                for engine in ("lammps", "reference")
+            )
             gap = abs(results["lammps", 2 * STEPS][q] - results["reference", 2 * STEPS][q])
             assert gap <= bound, (normalized, q)
             worst = max(worst, gap / scale)
@@ -95,8 +110,15 @@ def test_engines_agree_on_rebound_and_spin_over_the_whole_incidence_range(tmp_pa
 def test_free_packing_keeps_its_angular_momentum_in_the_reference_engine():
     """No walls: Σ m x × v + I ω about the origin; each force evaluation balances the torques exactly
     (levers R_i − δ/2), so RK4 keeps it to its truncation error, which halving the step shrinks."""
-    config = RunConfig(shape="sites", sites=[[0, 0], [2, 0], [1, 1], [3, 1], [1, -1], [4, 0], [2, 2]],
-                       impact="striker", strike_angle_deg=35.0, friction=0.5, wall_material="none", duration=4e-4)
+    config = RunConfig(
+        shape="sites",
+        sites=[[0, 0], [2, 0], [1, 1], [3, 1], [1, -1], [4, 0], [2, 2]],
+        impact="striker",
+        strike_angle_deg=35.0,
+        friction=0.5,
+        wall_material="none",
+        duration=4e-4,
+    )
     model = build_model(config)
     masses, radii = model.masses_kg, model.diameters_m / 2
     drifts = []
@@ -104,8 +126,9 @@ def test_free_packing_keeps_its_angular_momentum_in_the_reference_engine():
         settings = run_settings(config, model)
         settings = type(settings)(settings.dt_s / halving, settings.n_steps * halving, 10 * halving)
         states = reference_states(model, settings, every=10 * halving)
-        orbital = masses * (states.positions[..., 0] * states.velocities[..., 1]
-                            - states.positions[..., 1] * states.velocities[..., 0])
+        orbital = masses * (
+            states.positions[..., 0] * states.velocities[..., 1] - states.positions[..., 1] * states.velocities[..., 0]
+        )
         momentum = orbital.sum(axis=1) + (INERTIA * masses * radii**2 * states.spins).sum(axis=1)
         drifts.append(np.abs(momentum - momentum[0]).max() / (masses.max() * V0 * D))
         assert (INERTIA * masses * radii**2 * np.abs(states.spins)).sum(axis=1).max() > 1e-3 * masses.max() * V0 * D
@@ -120,8 +143,9 @@ def test_frictionless_models_keep_the_frictionless_kernel_and_frictional_ones_sp
     for friction, system in ((0.0, ReferenceSystem), (0.4, FrictionalSystem)):
         model = build_model(config.replace(friction=friction))
         samples = []
-        engine = ReferenceEngine().run(model, run_settings(config, model), tmp_path / str(friction), samples.append,
-                                       show_progress=False)
+        engine = ReferenceEngine().run(
+            model, run_settings(config, model), tmp_path / str(friction), samples.append, show_progress=False
+        )
         assert engine["n_pairs"] == system.from_model(model, SI).pairs.n_pairs
         assert np.isfinite(samples[-1].velocities).all()
         spins = samples[-1].angular_velocities
@@ -146,10 +170,14 @@ def test_friction_in_the_papers_units_is_the_si_run_rescaled(tmp_path, engine):
     np.testing.assert_allclose(finals[1], finals[0], rtol=0, atol=1e-8 * V0)
 
 
-@pytest.mark.parametrize("keys", [
-    {"edge_beads": 5, "striker_material": "brass", "strike_angle_deg": 15.0},
-    {"edge_beads": 4, "strike_angle_deg": 25.0, "sensors": ["0:1", "+30:2"], "sensor_mass_factor": 2.0},
-], ids=["brass-striker", "heavy-sensors"])
+@pytest.mark.parametrize(
+    "keys",
+    [
+        {"edge_beads": 5, "striker_material": "brass", "strike_angle_deg": 15.0},
+        {"edge_beads": 4, "strike_angle_deg": 25.0, "sensors": ["0:1", "+30:2"], "sensor_mass_factor": 2.0},
+    ],
+    ids=["brass-striker", "heavy-sensors"],
+)
 def test_engines_agree_on_a_frictional_packings_peak_speeds(tmp_path, keys):
     """A hexagon with μ = 0.3 between spheres and against the walls, struck obliquely by a striker
     (of brass; or of steel, with sensor beads twice as heavy, whose I = (2/5) m r² follows their mass):
@@ -163,7 +191,9 @@ def test_engines_agree_on_a_frictional_packings_peak_speeds(tmp_path, keys):
         model = build_model(config)
         for name, engine in (("lammps", LammpsEngine()), ("reference", ReferenceEngine())):
             samples = []
-            engine.run(model, run_settings(config, model), tmp_path / f"{name}-{steps}", samples.append, show_progress=False)
+            engine.run(
+                model, run_settings(config, model), tmp_path / f"{name}-{steps}", samples.append, show_progress=False
+            )
             speeds = np.array([np.linalg.norm(s.velocities[np.argsort(s.ids)], axis=1) for s in samples])
             peaks[name, steps] = speeds.max(axis=0)  # by body id
         spins = np.abs([s.angular_velocities for s in samples]).max(axis=0)  # the reference engine's
@@ -193,12 +223,17 @@ def test_a_contact_that_opens_and_closes_again_starts_afresh(tmp_path):
             finals[name, steps] = np.array([*states.velocities[-1, 0], states.spins[-1, 0] * D / 2])
     apart = model.walls[0].gaps_m(reference.positions[:, 0], D / 2) > 0
     history = np.abs(reference.wall_histories[:, 0])
-    one_step = (np.linalg.norm(reference.velocities[:, 0], axis=1) + D / 2 * np.abs(reference.spins[:, 0])) * settings.dt_s
+    one_step = (
+        np.linalg.norm(reference.velocities[:, 0], axis=1) + D / 2 * np.abs(reference.spins[:, 0])
+    ) * settings.dt_s
     changes = np.flatnonzero(np.abs(np.diff(reference.spins[:, 0])) > 1e-6 * np.abs(reference.spins).max())
     assert len(np.unique(changes // 10)) >= 3  # the spin changes at three impacts
-    assert apart.sum() > 100 and np.all(history[apart] <= one_step[apart]) and history[~apart].max() > 2 * one_step.max()
+    assert (
+        apart.sum() > 100 and np.all(history[apart] <= one_step[apart]) and history[~apart].max() > 2 * one_step.max()
+    )
     scale = MU * 2 * V0 * np.cos(np.radians(40.0))  # μ(1 + e) v_n of the first impact
-    bound = sum(convergence_bound(finals[engine, 100], finals[engine, 200], scale, 100)
-                for engine in ("lammps", "reference"))
+    bound = sum(
+        convergence_bound(finals[engine, 100], finals[engine, 200], scale, 100) for engine in ("lammps", "reference")
+    )
     gap = np.abs(finals["lammps", 200] - finals["reference", 200])
     assert np.all(gap <= bound), gap / bound

@@ -7,7 +7,7 @@ import json
 
 import numpy as np
 import pytest
-from conftest import D, V0, read_csv
+from conftest import V0, D, read_csv
 from oblique import INERTIA, sphere_on_wall
 
 from hexdem.cli.main import main

@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from hexdem.analysis.plotting import front_shape_figure
 from hexdem.analysis.front_shape import (
     FRONT_SHAPE_COLUMNS,
     HEXAGON_SIXFOLD,
@@ -19,6 +18,7 @@ from hexdem.analysis.front_shape import (
     front_times,
     sixfold_roundness,
 )
+from hexdem.analysis.plotting import front_shape_figure
 from hexdem.errors import HexdemError
 from hexdem.model.triangular import hexagon
 
@@ -45,6 +45,7 @@ def hexagon_gauge(points, theta0):
 
 def hexagon_fourier():
     """(a0, |a6|) of a unit-apothem regular hexagon's polar radius, by quadrature over its six corners."""
+
     def radius(theta):
         return 1.0 / np.cos(np.mod(theta, np.pi / 3) - np.pi / 6)
 
@@ -167,15 +168,20 @@ def test_a_ray_is_read_only_until_the_front_nears_the_packings_edge():
         assert shape.bins_used.tolist() == [72, 0]
 
 
-@pytest.mark.parametrize("call, message", [
-    (lambda: front_radius(np.zeros((5, 2)), np.zeros(4), ORIGIN, 1.0), "arrival times"),
-    (lambda: front_radius(triangular_disc(5), np.zeros(len(triangular_disc(5))), ORIGIN, 1.0, n_bins=6), "n_bins"),
-    (lambda: front_radius(np.zeros((3, 3)), np.zeros(3), ORIGIN, 1.0), "positions"),
-    (lambda: front_radius(np.eye(2), np.zeros(2), ORIGIN, 1.0), "3 beads or more"),
-    (lambda: front_radius(np.outer(np.arange(5.0), [np.cos(0.5), np.sin(0.5)]), np.arange(5.0), ORIGIN, 1.0),
-     "one line"),
-    (lambda: sixfold_roundness(np.zeros(5), np.zeros(4)), "matching"),
-])
+@pytest.mark.parametrize(
+    "call, message",
+    [
+        (lambda: front_radius(np.zeros((5, 2)), np.zeros(4), ORIGIN, 1.0), "arrival times"),
+        (lambda: front_radius(triangular_disc(5), np.zeros(len(triangular_disc(5))), ORIGIN, 1.0, n_bins=6), "n_bins"),
+        (lambda: front_radius(np.zeros((3, 3)), np.zeros(3), ORIGIN, 1.0), "positions"),
+        (lambda: front_radius(np.eye(2), np.zeros(2), ORIGIN, 1.0), "3 beads or more"),
+        (
+            lambda: front_radius(np.outer(np.arange(5.0), [np.cos(0.5), np.sin(0.5)]), np.arange(5.0), ORIGIN, 1.0),
+            "one line",
+        ),
+        (lambda: sixfold_roundness(np.zeros(5), np.zeros(4)), "matching"),
+    ],
+)
 def test_bad_input_is_a_one_line_hexdem_error(call, message):
     with pytest.raises(HexdemError, match=message) as error:
         call()
@@ -185,8 +191,10 @@ def test_bad_input_is_a_one_line_hexdem_error(call, message):
 def test_front_shape_figure_is_written(tmp_path):
     points = triangular_disc(30, half_plane=True)
     times = [4.0, 8.0, 12.0]
-    curves = {"circle": front_shape(points, np.hypot(*points.T) / C, ORIGIN, times),
-              "hexagon": front_shape(points, hexagon_gauge(points, 0.0) / C, ORIGIN, times)}
+    curves = {
+        "circle": front_shape(points, np.hypot(*points.T) / C, ORIGIN, times),
+        "hexagon": front_shape(points, hexagon_gauge(points, 0.0) / C, ORIGIN, times),
+    }
     assert all(isinstance(shape, FrontShape) for shape in curves.values())
     front_shape_figure(curves, tmp_path / "front_shape.png")
     assert (tmp_path / "front_shape.png").read_bytes().startswith(b"\x89PNG")
@@ -199,8 +207,9 @@ def test_the_front_study_follows_a_hexagonal_front_that_rounds_as_it_grows(tmp_p
     every file is written."""
     from hexdem.experiments.front_study import STUDY_COLUMNS, FrontStudy, run_front_study
 
-    study = FrontStudy(edge_beads=24, radius_beads=34, ranks=1, fronts=16, fit_range_d=(5.0, 25.0),
-                       control_fit_range_d=(5.0, 25.0))
+    study = FrontStudy(
+        edge_beads=24, radius_beads=34, ranks=1, fronts=16, fit_range_d=(5.0, 25.0), control_fit_range_d=(5.0, 25.0)
+    )
     summary = run_front_study(study, tmp_path, log=lambda message: None)
     with open(tmp_path / "front_shape.csv") as fh:
         header, *rows = [line.strip().split(",") for line in fh]

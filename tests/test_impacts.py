@@ -1,6 +1,7 @@
 """Several impacts, flat strikers and extra observation lines: budgets, symmetry, and bad input."""
 
 import json
+
 import numpy as np
 import pytest
 from conftest import read_csv, record
@@ -18,10 +19,17 @@ ENGINES = [LammpsEngine(), ReferenceEngine()]
 #: A free hexagon of 5 per edge (sites n = 0..8; {0, 8} is the middle of the right edge, {8, 4}
 #: the top of the middle column) struck by three strikers: steel from the left at 0.4 m/s, brass
 #: from the right at 0.3 m/s, steel from above at 0.4 m/s.
-THREE_STRIKERS = RunConfig(edge_beads=5, wall_material="none", impact="striker", duration=4e-4,
-                           impacts=[{"site": [0, 0]},
-                                    {"site": [0, 8], "angle_deg": 180.0, "striker_material": "brass", "v0": 0.3},
-                                    {"site": [8, 4], "angle_deg": -90.0}])
+THREE_STRIKERS = RunConfig(
+    edge_beads=5,
+    wall_material="none",
+    impact="striker",
+    duration=4e-4,
+    impacts=[
+        {"site": [0, 0]},
+        {"site": [0, 8], "angle_deg": 180.0, "striker_material": "brass", "v0": 0.3},
+        {"site": [8, 4], "angle_deg": -90.0},
+    ],
+)
 
 
 def sphere_mass(material, d=0.01905):
@@ -59,9 +67,11 @@ def test_a_symmetric_strike_gives_mirror_symmetric_pulses(engine, case, tmp_path
     flat striker on the left edge (y → −y: {m, n} → {−m, n}): mirror beads have equal peaks
     and arrival times."""
     double = [{"site": [0, 0]}, {"site": [0, 8], "angle_deg": 180.0}]
-    changes = {"double-velocity": {"impacts": double},
-               "double-striker": {"impacts": double, "impact": "striker"},
-               "flat-striker": {"impacts": [{"edge_deg": 0.0}], "impact": "striker"}}[case]
+    changes = {
+        "double-velocity": {"impacts": double},
+        "double-striker": {"impacts": double, "impact": "striker"},
+        "flat-striker": {"impacts": [{"edge_deg": 0.0}], "impact": "striker"},
+    }[case]
     config = RunConfig(edge_beads=5, engine=engine, **changes)
     analysis = simulate(config, tmp_path)
     r, lattice = analysis.results, analysis.model.packing
@@ -77,15 +87,19 @@ def test_a_flat_striker_is_one_sphere_per_edge_bead_and_replaces_the_wall():
     left = np.flatnonzero(model.packing.labels[:, 1] == 0)
     assert sorted(model.struck_beads) == sorted(left) and len(left) == 11
     assert len(model.strikers) == 11 and "wall_000" not in [w.name for w in model.walls]
-    velocities = model.initial_velocities_m_s()[len(model.packing):]
+    velocities = model.initial_velocities_m_s()[len(model.packing) :]
     np.testing.assert_array_equal(velocities, np.tile([0.4, 0.0], (11, 1)))
-    gaps = np.diff(model.initial_positions_m()[len(model.packing):, 1])
+    gaps = np.diff(model.initial_positions_m()[len(model.packing) :, 1])
     np.testing.assert_allclose(np.sort(np.abs(gaps)), 0.01905, rtol=1e-12)  # the spheres touch: a plate
 
 
 def test_every_struck_bead_sits_in_a_hole_of_the_wall_it_is_pushed_through():
-    model = build_model(RunConfig(edge_beads=5, impacts=[{"site": [0, 0]}, {"site": [0, 8], "angle_deg": 180.0},
-                                             {"site": [-4, 0], "angle_deg": 0.0}]))
+    model = build_model(
+        RunConfig(
+            edge_beads=5,
+            impacts=[{"site": [0, 0]}, {"site": [0, 8], "angle_deg": 180.0}, {"site": [-4, 0], "angle_deg": 0.0}],
+        )
+    )
     members = {w.name: {tuple(model.packing.labels[b]) for b in w.members} for w in model.walls}
     assert (0, 0) not in members["wall_000"] and (0, 8) not in members["wall_180"]
     assert (-4, 0) not in members["wall_000"] and (-4, 0) in members["wall_060"]  # the corner's other wall stays
@@ -117,39 +131,48 @@ def test_a_deck_beyond_lammpss_32_groups_is_refused_before_it_runs(tmp_path):
 
 
 def test_extra_observation_lines_follow_the_lattice_from_any_bead(tmp_path):
-    config = RunConfig(edge_beads=5, engine="reference",
-                       lines=[{"name": "up", "site": [-8, 4], "angle_deg": 90},
-                              {"name": "sixty", "site": [0, 0], "angle_deg": 60}])
+    config = RunConfig(
+        edge_beads=5,
+        engine="reference",
+        lines=[{"name": "up", "site": [-8, 4], "angle_deg": 90}, {"name": "sixty", "site": [0, 0], "angle_deg": 60}],
+    )
     lattice = build_packing(config)
     assert [tuple(lattice.labels[b]) for b in lattice.line("up")] == [(m, 4) for m in range(-8, 9, 2)]
     assert [tuple(lattice.labels[b]) for b in lattice.line("sixty")] == [(0, 0), (3, 1), (6, 2)]
     run_experiment(config, tmp_path, log=lambda message: None)
     assert json.loads((tmp_path / "summary.json").read_text())["impacts"] == [
-        {"bead_id": lattice.struck + 1, "site": [0, 0], "v0": 0.4, "angle_deg": 0.0, "kind": "velocity"}]
+        {"bead_id": lattice.struck + 1, "site": [0, 0], "v0": 0.4, "angle_deg": 0.0, "kind": "velocity"}
+    ]
     header, rows = read_csv(tmp_path / "peaks.csv")
-    assert [row["line"] for row in rows if row["line"] in ("0", "+30", "-30")] == \
-           [row["line"] for row in rows[:sum(len(lattice.line(n)) for n in ("0", "+30", "-30"))]]
+    assert [row["line"] for row in rows if row["line"] in ("0", "+30", "-30")] == [
+        row["line"] for row in rows[: sum(len(lattice.line(n)) for n in ("0", "+30", "-30"))]
+    ]
     assert [int(row["n"]) for row in rows if row["line"] == "up"] == list(range(9))
 
 
-@pytest.mark.parametrize("changes, message", [
-    ({"impacts": [{"site": [0, 30]}]}, "not in the packing"),
-    ({"impacts": [{"site": [0, 0]}, {"site": [0, 0], "angle_deg": 10.0}]}, "two impacts strike the same bead"),
-    ({"impacts": [{"site": [0, 0]}, {"site": [0, 10], "kind": "striker"}]}, "would start inside bead"),
-    ({"impacts": [{"site": [0, 0], "edge_deg": 0.0}]}, "exactly one of site"),
-    ({"impacts": [{"site": [0, 0], "speed": 1.0}]}, "unknown key(s) speed"),
-    ({"impacts": [{"site": [0, 0], "kind": "hammer"}]}, "unknown kind 'hammer'"),
-    ({"impacts": [{"site": [0, 0], "v0": -1.0}]}, "v0 must be > 0"),
-    ({"impacts": [{"site": [0, 0], "striker_material": "unobtainium", "kind": "striker"}]}, "unobtainium"),
-    ({"precompression_n": 5.0, "impacts": [{"site": [0, 0]}, {"site": [0, 20], "angle_deg": 180.0}]},
-     "precompressed packing holds only"),
-    ({"lines": [{"name": "0", "site": [0, 0], "angle_deg": 90}]}, "must be a new"),
-    ({"lines": [{"name": "up", "site": [0, 0], "angle_deg": 45}]}, "not a lattice direction"),
-    ({"lines": [{"name": "up", "site": [1, 0], "angle_deg": 90}]}, "is not a bead"),
-    ({"lines": [{"name": "up", "site": [[0], 0], "angle_deg": 90}]}, "lines.0.site must be a list of 2 integers"),
-    ({"impacts": [{"edge_deg": 30.0}]}, "no flat edge"),
-    ({"impacts": [{"site": [0, 0], "angle_deg": 150.0}]}, "points out of the packing through wall_000"),
-])
+@pytest.mark.parametrize(
+    "changes, message",
+    [
+        ({"impacts": [{"site": [0, 30]}]}, "not in the packing"),
+        ({"impacts": [{"site": [0, 0]}, {"site": [0, 0], "angle_deg": 10.0}]}, "two impacts strike the same bead"),
+        ({"impacts": [{"site": [0, 0]}, {"site": [0, 10], "kind": "striker"}]}, "would start inside bead"),
+        ({"impacts": [{"site": [0, 0], "edge_deg": 0.0}]}, "exactly one of site"),
+        ({"impacts": [{"site": [0, 0], "speed": 1.0}]}, "unknown key(s) speed"),
+        ({"impacts": [{"site": [0, 0], "kind": "hammer"}]}, "unknown kind 'hammer'"),
+        ({"impacts": [{"site": [0, 0], "v0": -1.0}]}, "v0 must be > 0"),
+        ({"impacts": [{"site": [0, 0], "striker_material": "unobtainium", "kind": "striker"}]}, "unobtainium"),
+        (
+            {"precompression_n": 5.0, "impacts": [{"site": [0, 0]}, {"site": [0, 20], "angle_deg": 180.0}]},
+            "precompressed packing holds only",
+        ),
+        ({"lines": [{"name": "0", "site": [0, 0], "angle_deg": 90}]}, "must be a new"),
+        ({"lines": [{"name": "up", "site": [0, 0], "angle_deg": 45}]}, "not a lattice direction"),
+        ({"lines": [{"name": "up", "site": [1, 0], "angle_deg": 90}]}, "is not a bead"),
+        ({"lines": [{"name": "up", "site": [[0], 0], "angle_deg": 90}]}, "lines.0.site must be a list of 2 integers"),
+        ({"impacts": [{"edge_deg": 30.0}]}, "no flat edge"),
+        ({"impacts": [{"site": [0, 0], "angle_deg": 150.0}]}, "points out of the packing through wall_000"),
+    ],
+)
 def test_bad_impacts_and_lines_get_one_line_errors(changes, message):
     with pytest.raises(HexdemError, match=None) as error:
         build_model(RunConfig(**changes))
@@ -161,8 +184,8 @@ def test_the_far_wall_of_every_impact_must_be_reached():
     other's struck wall, so a run in which the left wall's beads are reached only at the very
     end (the second impact's wave still crossing) has not reached its far walls, whatever the
     first impact's far wall says."""
-    from hexdem.analysis.impact import ImpactAnalysis
     from hexdem.analysis.energy import energy_regions
+    from hexdem.analysis.impact import ImpactAnalysis
 
     config = RunConfig(impacts=[{"site": [0, 0]}, {"site": [0, 20], "angle_deg": 180.0}])
     model = build_model(config)
@@ -172,8 +195,18 @@ def test_the_far_wall_of_every_impact_must_be_reached():
 
     def far_wall_reached(reach_time):
         regions = len(energy_regions(model)[0])
-        return ImpactAnalysis(model, settings, {}, np.ones(n), np.zeros(n), np.zeros(n), reach_time, 0.0,
-                              (np.zeros(1), np.zeros((1, regions, 2))), np.zeros((n, 2))).results.far_wall_reached
+        return ImpactAnalysis(
+            model,
+            settings,
+            {},
+            np.ones(n),
+            np.zeros(n),
+            np.zeros(n),
+            reach_time,
+            0.0,
+            (np.zeros(1), np.zeros((1, regions, 2))),
+            np.zeros((n, 2)),
+        ).results.far_wall_reached
 
     reach = np.zeros(n)
     assert far_wall_reached(reach)

@@ -48,28 +48,37 @@ def test_an_overlap_set_up_by_the_displacements_pushes_the_spheres_apart(engine,
     state = tmp_path / "state.csv"
     dx, dy = (float(v) for v in -delta * ALONG)
     state.write_text(f"m,n,vx,vy,dx,dy\n1,1,0,0,{dx!r},{dy!r}\n")
-    config = RunConfig(**PAIR, v0=v0, dt=2e-7, duration=4e-4, dump_every=20, engine=engine,
-                       initial_state_file=str(state))
-    mass, energy = float(sphere_mass(d)), 0.4 * float(hertz_coefficient(d)) * delta**2.5 + 0.5 * float(sphere_mass(d)) * v0**2
+    config = RunConfig(
+        **PAIR, v0=v0, dt=2e-7, duration=4e-4, dump_every=20, engine=engine, initial_state_file=str(state)
+    )
+    mass, energy = (
+        float(sphere_mass(d)),
+        0.4 * float(hertz_coefficient(d)) * delta**2.5 + 0.5 * float(sphere_mass(d)) * v0**2,
+    )
     expected = math.sqrt(4 * energy / mass - v0**2)
     first, second = final_speeds(config, tmp_path / "run")
     assert first + second == pytest.approx(expected, rel=1e-4)  # u0 < 0: they fly apart
     assert second - first == pytest.approx(v0, abs=1e-4 * expected)  # the momentum, m V0
 
 
-@pytest.mark.parametrize("text, message", [
-    ("m,n,vx\n", "the header must be m,n,vx,vy or m,n,vx,vy,dx,dy"),
-    ("m,n,vx,vy\n1,1,fast,0\n", "line 2: m and n must be integers and the rest numbers"),
-    ("m,n,vx,vy\n1,1,nan,0\n", "line 2: the values must be finite numbers"),
-    ("m,n,vx,vy\n5,5,0.1,0\n", "line 2: site {5, 5} is not a bead of the packing"),
-    ("m,n,vx,vy\n1,1,0.1,0\n1,1,0.2,0\n", "line 3: site {1, 1} is listed twice"),
-    ("m,n,vx,vy,dx,dy\n1,1,0,0,0.01,0\n", "a displacement of half a diameter or more"),
-    ("m,n,vx,vy\n1,1,0.1\n", "line 2: 3 values, the header has 4"),
-])
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("m,n,vx\n", "the header must be m,n,vx,vy or m,n,vx,vy,dx,dy"),
+        ("m,n,vx,vy\n1,1,fast,0\n", "line 2: m and n must be integers and the rest numbers"),
+        ("m,n,vx,vy\n1,1,nan,0\n", "line 2: the values must be finite numbers"),
+        ("m,n,vx,vy\n5,5,0.1,0\n", "line 2: site {5, 5} is not a bead of the packing"),
+        ("m,n,vx,vy\n1,1,0.1,0\n1,1,0.2,0\n", "line 3: site {1, 1} is listed twice"),
+        ("m,n,vx,vy,dx,dy\n1,1,0,0,0.01,0\n", "a displacement of half a diameter or more"),
+        ("m,n,vx,vy\n1,1,0.1\n", "line 2: 3 values, the header has 4"),
+    ],
+)
 def test_bad_initial_state_files_are_one_line_and_write_nothing(tmp_path, capsys, text, message):
     (tmp_path / "state.csv").write_text(text)
-    (tmp_path / "run.toml").write_text('shape = "sites"\nsites = [[0, 0], [1, 1]]\nsite_walls_deg = []\n'
-                                      f'initial_state_file = "{tmp_path / "state.csv"}"\n')
+    (tmp_path / "run.toml").write_text(
+        'shape = "sites"\nsites = [[0, 0], [1, 1]]\nsite_walls_deg = []\n'
+        f'initial_state_file = "{tmp_path / "state.csv"}"\n'
+    )
     assert main(["run", "--config", str(tmp_path / "run.toml"), "--out", str(tmp_path / "out")]) == 3
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], lines
@@ -86,7 +95,7 @@ def test_the_time_step_follows_the_fastest_bead_of_the_state(tmp_path):
     (tmp_path / "state.csv").write_text("m,n,vx,vy\n4,0,100.0,0\n")
     base = RunConfig(edge_beads=5)
     fast = base.replace(initial_state_file=str(tmp_path / "state.csv"))
-    assert settings_of(base).dt_s / settings_of(fast).dt_s == pytest.approx(250 ** 0.2, rel=1e-12)
+    assert settings_of(base).dt_s / settings_of(fast).dt_s == pytest.approx(250**0.2, rel=1e-12)
     assert settings_of(fast).duration_s == pytest.approx(settings_of(base).duration_s, abs=settings_of(base).dt_s)
     assert simulate(fast, tmp_path / "run").results.energy_drift < 1e-4
 
@@ -99,8 +108,7 @@ def test_the_fastest_approach_is_that_of_two_beads_meeting(tmp_path):
     vx, vy = (float(v) for v in -0.2 * ALONG)
     state.write_text(f"m,n,vx,vy\n1,1,{vx!r},{vy!r}\n")
     alone = contact_of(RunConfig(**PAIR))
-    assert contact_of(RunConfig(**PAIR, initial_state_file=str(state))) == pytest.approx(alone * 1.5 ** -0.2,
-                                                                                              rel=1e-12)
+    assert contact_of(RunConfig(**PAIR, initial_state_file=str(state))) == pytest.approx(alone * 1.5**-0.2, rel=1e-12)
 
 
 def test_a_state_too_fast_for_hertz_contacts_is_refused_in_one_line(tmp_path, capsys):
@@ -110,8 +118,10 @@ def test_a_state_too_fast_for_hertz_contacts_is_refused_in_one_line(tmp_path, ca
     (tmp_path / "run.toml").write_text(f'edge_beads = 5\ninitial_state_file = "{tmp_path / "state.csv"}"\n')
     assert main(["run", "--config", str(tmp_path / "run.toml"), "--out", str(tmp_path / "out")]) == 3
     lines = capsys.readouterr().err.strip().splitlines()
-    assert len(lines) == 1 and "at 1e+06 m/s, two steel316 beads meeting head on would overlap by 67.2 diameters" \
-        in lines[0], lines
+    assert (
+        len(lines) == 1
+        and "at 1e+06 m/s, two steel316 beads meeting head on would overlap by 67.2 diameters" in lines[0]
+    ), lines
     assert not (tmp_path / "out").exists()
 
 
@@ -128,8 +138,9 @@ def test_a_deck_with_a_relative_initial_state_is_analysed_from_inside(tmp_path, 
     assert main(["analyse", ".", "--out", str(tmp_path / "analysed")]) == 0
     _, ran = read_csv(tmp_path / "out" / "peaks.csv")
     _, analysed = read_csv(tmp_path / "analysed" / "peaks.csv")
-    np.testing.assert_allclose([float(row["peak_speed"]) for row in analysed],
-                               [float(row["peak_speed"]) for row in ran], rtol=1e-4)
+    np.testing.assert_allclose(
+        [float(row["peak_speed"]) for row in analysed], [float(row["peak_speed"]) for row in ran], rtol=1e-4
+    )
 
 
 def test_a_missing_initial_state_file_is_one_line(tmp_path):
@@ -146,8 +157,10 @@ def test_both_engines_agree_on_a_random_initial_state_in_a_precompressed_packing
     rng = np.random.default_rng(7)
     config = RunConfig(edge_beads=5, precompression_n=20.0, v0=1e-4)
     velocities, displacements = 1e-4 * rng.standard_normal((61, 2)), 1e-8 * rng.standard_normal((61, 2))
-    lines = ["m,n,vx,vy,dx,dy"] + [f"{m},{n}," + ",".join(repr(float(v)) for v in (*u, *d))
-                                   for (m, n), u, d in zip(build_packing(config).labels.tolist(), velocities, displacements)]
+    lines = ["m,n,vx,vy,dx,dy"] + [
+        f"{m},{n}," + ",".join(repr(float(v)) for v in (*u, *d))
+        for (m, n), u, d in zip(build_packing(config).labels.tolist(), velocities, displacements)
+    ]
     (tmp_path / "state.csv").write_text("\n".join(lines) + "\n")
     config = config.replace(initial_state_file=str(tmp_path / "state.csv"), duration=5e-4)
     reference = simulate(config.replace(engine="reference", steps_per_contact=280), tmp_path / "reference").results
@@ -166,8 +179,10 @@ def test_beads_csv_places_the_beads_where_the_state_starts_them(tmp_path):
     state = tmp_path / "state.csv"
     state.write_text("m,n,vx,vy,dx,dy\n1,1,0,0,0.001,-0.002\n")
     config = tmp_path / "run.toml"
-    config.write_text('shape = "sites"\nsites = [[0, 0], [1, 1], [0, 4]]\nsite_walls_deg = []\nduration = 2e-4\n'
-                      f'initial_state_file = "{state}"\n')
+    config.write_text(
+        'shape = "sites"\nsites = [[0, 0], [1, 1], [0, 4]]\nsite_walls_deg = []\nduration = 2e-4\n'
+        f'initial_state_file = "{state}"\n'
+    )
     assert main(["run", "--config", str(config), "--out", str(tmp_path / "out")]) == 0
     packed = build_packing(RunConfig(shape="sites", sites=[[0, 0], [1, 1], [0, 4]])).positions_m
     rows = read_csv(tmp_path / "out" / "beads.csv")[1]

@@ -33,8 +33,11 @@ def wheel_names(wheel: Path) -> set[str]:
 def wheel(tmp_path_factory) -> Path:
     """The wheel that ``pip install .`` builds from this checkout."""
     out = tmp_path_factory.mktemp("wheel")
-    subprocess.run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(out), str(ROOT)],
-                   check=True, capture_output=True)
+    subprocess.run(
+        [sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(out), str(ROOT)],
+        check=True,
+        capture_output=True,
+    )
     (built,) = out.glob("hexdem-*.whl")
     return built
 
@@ -89,8 +92,21 @@ def installed(wheel, tmp_path_factory) -> Path:
     (:func:`link_dependencies`): its bin/."""
     venv = tmp_path_factory.mktemp("venv") / "env"
     subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(venv)], check=True)
-    subprocess.run([sys.executable, "-m", "pip", "--python", str(venv / "bin" / "python"), "install", "-q",
-                    "--no-deps", str(wheel)], check=True, capture_output=True)
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pip",
+            "--python",
+            str(venv / "bin" / "python"),
+            "install",
+            "-q",
+            "--no-deps",
+            str(wheel),
+        ],
+        check=True,
+        capture_output=True,
+    )
     link_dependencies(wheel, venv)
     return venv / "bin"
 
@@ -99,8 +115,13 @@ def test_the_fresh_environment_imports_the_wheels_hexdem_and_no_undeclared_packa
     """The commands below run the wheel's hexdem, not this checkout's; a package that hexdem does
     not declare (pytest, here) is not importable there."""
     python = str(installed / "python")
-    where = subprocess.run([python, "-c", "import hexdem; print(hexdem.__file__)"], cwd=installed,
-                           capture_output=True, text=True, check=True).stdout.strip()
+    where = subprocess.run(
+        [python, "-c", "import hexdem; print(hexdem.__file__)"],
+        cwd=installed,
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.strip()
     assert Path(where).is_relative_to(installed.parent) and not Path(where).is_relative_to(ROOT), where
     assert subprocess.run([python, "-c", "import pytest"], cwd=installed, capture_output=True).returncode != 0
 
@@ -123,10 +144,16 @@ def run(bin_dir: Path, cwd: Path, *args: str) -> subprocess.CompletedProcess:
 
 def test_wheel_holds_every_module_and_template(wheel):
     names = wheel_names(wheel)
-    modules = {path.relative_to(ROOT).as_posix() for path in (ROOT / "hexdem").rglob("*.py")
-               if "lammps_inputs" not in path.parts}
-    templates = {f"hexdem/lammps_inputs/{path.name}" for path in (ROOT / "lammps_inputs").iterdir()
-                 if path.suffix in (".in", ".py")}
+    modules = {
+        path.relative_to(ROOT).as_posix()
+        for path in (ROOT / "hexdem").rglob("*.py")
+        if "lammps_inputs" not in path.parts
+    }
+    templates = {
+        f"hexdem/lammps_inputs/{path.name}"
+        for path in (ROOT / "lammps_inputs").iterdir()
+        if path.suffix in (".in", ".py")
+    }
     assert "hexdem/paper/pipeline.py" in modules and "hexdem/lammps_inputs/impact.in" in templates
     assert sorted(modules - names) == [] and sorted(templates - names) == []
     # the in-run analysis's C kernels, built by pip for this Python
@@ -143,8 +170,21 @@ def test_run_on_two_ranks_from_any_directory(installed, cwd, tmp_path):
 
 def test_one_realization_ensemble_from_any_directory(installed, cwd, tmp_path):
     out = tmp_path / "ensemble"
-    done = run(installed, cwd, "ensemble", "--realizations", "1", "--velocities", "0.4", "--edge-beads", "4",
-               "--workers", "1", "--out", str(out))
+    done = run(
+        installed,
+        cwd,
+        "ensemble",
+        "--realizations",
+        "1",
+        "--velocities",
+        "0.4",
+        "--edge-beads",
+        "4",
+        "--workers",
+        "1",
+        "--out",
+        str(out),
+    )
     assert done.returncode == 0, done.stderr
     assert json.loads((out / "ensemble.json").read_text())["config"]["realizations"] == 1
     assert (out / "peaks_stats.csv").exists()

@@ -1,7 +1,6 @@
 """A run stopped by SIGTERM or SIGINT, or starved of disk, ends in one line of hexdem's and leaves
 nothing in its --out (hexdem.common.interrupt)."""
 
-import errno
 import os
 import signal
 import subprocess
@@ -10,8 +9,6 @@ import time
 from pathlib import Path
 
 import pytest
-
-from hexdem.cli.main import main
 
 #: 3,571 beads for 1 ms: still running several seconds after LAMMPS has started.
 LONG_RUN = "edge_beads = 35\nduration = 0.001\n"
@@ -28,9 +25,24 @@ def start_and_stop(tmp_path, ranks: int, signum: int, group: bool):
     Ctrl-C does) once LAMMPS has started, and return (exit status, stderr lines, seconds to end)."""
     (tmp_path / "long.toml").write_text(LONG_RUN)
     out = tmp_path / "out"
-    process = subprocess.Popen([sys.executable, "-m", "hexdem", "run", "--config", str(tmp_path / "long.toml"),
-                                "--ranks", str(ranks), "--out", str(out)], stderr=subprocess.PIPE, text=True,
-                               start_new_session=True, preexec_fn=ignore_sigint)
+    process = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "hexdem",
+            "run",
+            "--config",
+            str(tmp_path / "long.toml"),
+            "--ranks",
+            str(ranks),
+            "--out",
+            str(out),
+        ],
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+        preexec_fn=ignore_sigint,
+    )
     deadline = time.monotonic() + 120
     while not list(out.glob(".hexdem-run-*/deck/log.lammps")):
         assert process.poll() is None and time.monotonic() < deadline, process.stderr.read()
@@ -46,8 +58,11 @@ def start_and_stop(tmp_path, ranks: int, signum: int, group: bool):
     return process.returncode, err.strip().splitlines(), time.monotonic() - start
 
 
-@pytest.mark.parametrize("ranks, signum, group", [(2, signal.SIGINT, True), (1, signal.SIGTERM, False)],
-                         ids=["Ctrl-C (the process group)", "SIGTERM, in-process"])
+@pytest.mark.parametrize(
+    "ranks, signum, group",
+    [(2, signal.SIGINT, True), (1, signal.SIGTERM, False)],
+    ids=["Ctrl-C (the process group)", "SIGTERM, in-process"],
+)
 def test_a_stopped_run_ends_at_once_in_one_line_and_leaves_nothing(tmp_path, ranks, signum, group):
     status, err, seconds = start_and_stop(tmp_path, ranks, signum, group)
     assert status == 128 + signum
@@ -60,7 +75,9 @@ def test_a_stopped_run_ends_at_once_in_one_line_and_leaves_nothing(tmp_path, ran
 def catches_sigterm(pid: int) -> bool:
     """Whether the process ``pid`` has a handler of its own for SIGTERM (hexdem's, once installed)."""
     try:
-        caught = next(line for line in Path(f"/proc/{pid}/status").read_text().splitlines() if line.startswith("SigCgt:"))
+        caught = next(
+            line for line in Path(f"/proc/{pid}/status").read_text().splitlines() if line.startswith("SigCgt:")
+        )
     except FileNotFoundError:
         return False
     return bool(int(caught.split()[1], 16) >> (signal.SIGTERM - 1) & 1)
@@ -71,8 +88,18 @@ def catches_sigterm(pid: int) -> bool:
 #: deck, LAMMPS's start and run, the analysis, its figures and their publication.
 INSTANTS = (0.0, 0.01, 0.03, 0.06, 0.1, 0.15, 0.25, 0.35, 0.5, 0.65, 0.8, 0.9, 0.97)
 #: What a finished run leaves in its --out.
-RESULT_FILES = ["arrival_map.png", "beads.csv", "deck", "energy_regions.csv", "front_shape.csv", "front_shape.png",
-                "peak_decay.png", "peak_map.png", "peaks.csv", "summary.json"]
+RESULT_FILES = [
+    "arrival_map.png",
+    "beads.csv",
+    "deck",
+    "energy_regions.csv",
+    "front_shape.csv",
+    "front_shape.png",
+    "peak_decay.png",
+    "peak_map.png",
+    "peaks.csv",
+    "summary.json",
+]
 
 
 def signal_at(tmp_path, instant, signum) -> tuple:
@@ -82,8 +109,12 @@ def signal_at(tmp_path, instant, signum) -> tuple:
     tmp_path.mkdir()
     (tmp_path / "run.toml").write_text("ranks = 2\n")
     out = tmp_path / "out"
-    process = subprocess.Popen([sys.executable, "-m", "hexdem", "run", "--config", str(tmp_path / "run.toml"),
-                                "--out", str(out)], stderr=subprocess.PIPE, text=True, start_new_session=True)
+    process = subprocess.Popen(
+        [sys.executable, "-m", "hexdem", "run", "--config", str(tmp_path / "run.toml"), "--out", str(out)],
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
     deadline = time.monotonic() + 60
     while not catches_sigterm(process.pid):
         assert process.poll() is None and time.monotonic() < deadline, process.stderr.read()

@@ -9,8 +9,8 @@ from conftest import V0, D, contact_history, record, single_bead
 from hexdem.engines.lammps.engine import LammpsEngine
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time, max_overlap
-from hexdem.model.walls import Wall
 from hexdem.model.materials import DELRIN, STEEL_316, hertz_stiffness, sphere_mass
+from hexdem.model.walls import Wall
 
 
 def test_two_sphere_collision_matches_hertz(tmp_path):
@@ -21,8 +21,9 @@ def test_two_sphere_collision_matches_hertz(tmp_path):
     dt = 5e-8
     trajectory = record(LammpsEngine(), model, RunSettings(dt, int(1.1 * expected_time / dt), 1), tmp_path)
     start = model.initial_positions_m()
-    gap = np.linalg.norm((start[1] + trajectory.displacements_m[:, 1]) - (start[0] + trajectory.displacements_m[:, 0]),
-                         axis=1)
+    gap = np.linalg.norm(
+        (start[1] + trajectory.displacements_m[:, 1]) - (start[0] + trajectory.displacements_m[:, 0]), axis=1
+    )
     duration, peak = contact_history(trajectory.times_s, D - gap)
     assert duration == pytest.approx(expected_time, rel=1e-3)
     assert peak == pytest.approx(max_overlap(mass / 2, a, V0), rel=1e-3)

@@ -7,8 +7,16 @@ from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
 from hexdem.model.model_builder import build_model, build_packing
 from hexdem.model.packing import strike_direction
-from hexdem.model.triangular import (disc, from_sites, half_disc, half_hexagon, hexagon, parallelogram, triangle,
-                                     without_sites)
+from hexdem.model.triangular import (
+    disc,
+    from_sites,
+    half_disc,
+    half_hexagon,
+    hexagon,
+    parallelogram,
+    triangle,
+    without_sites,
+)
 
 D = 0.01905
 
@@ -48,8 +56,10 @@ def test_observation_lines_have_the_papers_spacings():
         steps = np.diff(lattice.positions_m[beads], axis=0)
         np.testing.assert_allclose(np.linalg.norm(steps, axis=1), spacing, rtol=1e-12)
         assert beads[0] == lattice.struck
-    angles = {name: np.degrees(np.arctan2(*np.diff(lattice.positions_m[lattice.line(name)][:2], axis=0)[0][::-1]))
-              for name in ("0", "+30", "-30")}
+    angles = {
+        name: np.degrees(np.arctan2(*np.diff(lattice.positions_m[lattice.line(name)][:2], axis=0)[0][::-1]))
+        for name in ("0", "+30", "-30")
+    }
     assert angles == pytest.approx({"0": 0.0, "+30": 30.0, "-30": -30.0})
     assert len(lattice.line("0")) == 11
 
@@ -97,8 +107,12 @@ def test_half_disc_holds_every_site_within_its_radius_on_the_struck_side():
     """Radius 12: every lattice site {m, n} (m + n even, n >= 0) within 12 d of the struck bead,
     and no other; one wall, the struck edge's, touching the n = 0 beads but the struck one."""
     lattice = half_disc(12, 1.0)
-    expected = {(m, n) for n in range(0, 15) for m in range(-24, 25)
-                if (m + n) % 2 == 0 and 0.75 * n**2 + 0.25 * m**2 <= 144 + 1e-9}
+    expected = {
+        (m, n)
+        for n in range(0, 15)
+        for m in range(-24, 25)
+        if (m + n) % 2 == 0 and 0.75 * n**2 + 0.25 * m**2 <= 144 + 1e-9
+    }
     assert {tuple(mn) for mn in lattice.labels.tolist()} == expected
     assert np.hypot(*lattice.positions_m.T).max() <= 12.0 + 1e-12
     (wall,) = lattice.walls
@@ -144,10 +158,15 @@ def test_listed_sites_are_the_packing_and_their_walls_touch_it():
     assert set(wall.members.tolist()) == {1, 2}, "the n = 0 beads but the struck one"
 
 
-@pytest.mark.parametrize("sites, message", [([(0, 0), (2, 0), (0, 0)], "listed twice"),
-                                            ([(0, 0), (1, 0)], "m [+] n odd"),
-                                            ([(2, 0), (4, 0)], "struck site"),
-                                            ([], "at least 1 bead")])
+@pytest.mark.parametrize(
+    "sites, message",
+    [
+        ([(0, 0), (2, 0), (0, 0)], "listed twice"),
+        ([(0, 0), (1, 0)], "m [+] n odd"),
+        ([(2, 0), (4, 0)], "struck site"),
+        ([], "at least 1 bead"),
+    ],
+)
 def test_bad_site_lists_are_refused(sites, message):
     with pytest.raises(HexdemError, match=message):
         from_sites(sites, D)
@@ -191,8 +210,12 @@ def test_disc_holds_every_site_within_its_radius_inside_a_touching_circle():
     """Radius 12: every site within 12 d of (12 d, 0) and no other; the circle touches the
     outermost beads (the struck bead, at the edge's centre, sits in its hole)."""
     lattice = disc(12, 1.0)
-    expected = {(m, n) for n in range(0, 28) for m in range(-24, 25)
-                if (m + n) % 2 == 0 and (np.sqrt(3) / 2 * n - 12) ** 2 + (m / 2) ** 2 <= 144 + 1e-9}
+    expected = {
+        (m, n)
+        for n in range(0, 28)
+        for m in range(-24, 25)
+        if (m + n) % 2 == 0 and (np.sqrt(3) / 2 * n - 12) ** 2 + (m / 2) ** 2 <= 144 + 1e-9
+    }
     assert {tuple(mn) for mn in lattice.labels.tolist()} == expected
     (wall,) = lattice.walls
     gaps = wall.gaps_m(lattice.positions_m, lattice.radii_m)

@@ -36,8 +36,22 @@ def jobs_so_far(log) -> int:
 def test_run_goes_through_the_launcher_with_the_same_peaks(launcher, tmp_path):
     command, log = launcher
     before = jobs_so_far(log)
-    assert main(["run", "--config", small_config(tmp_path), "--ranks", "2", "--launcher", command,
-                 "--out", str(tmp_path / "out")]) == 0
+    assert (
+        main(
+            [
+                "run",
+                "--config",
+                small_config(tmp_path),
+                "--ranks",
+                "2",
+                "--launcher",
+                command,
+                "--out",
+                str(tmp_path / "out"),
+            ]
+        )
+        == 0
+    )
     (job,) = launched_since(log, before)
     assert job.startswith("-n 2 ") and "-P -m hexdem.experiments.parallel" in job
     local = simulate(RunConfig(edge_beads=5), tmp_path / "local").results
@@ -57,10 +71,40 @@ def test_one_rank_through_a_launcher_is_not_run_in_process(launcher, tmp_path):
 def test_compare_and_snapshots_go_through_the_launcher(launcher, tmp_path):
     command, log = launcher
     before = jobs_so_far(log)
-    assert main(["compare", "--config", small_config(tmp_path), "--ranks", "2", "--launcher", command,
-                 "--out", str(tmp_path / "compare")]) == 0
-    assert main(["snapshots", "--edge-beads", "5", "--times", "0.1,0.2", "--ranks", "2", "--launcher", command,
-                 "--out", str(tmp_path / "snapshots")]) == 0
+    assert (
+        main(
+            [
+                "compare",
+                "--config",
+                small_config(tmp_path),
+                "--ranks",
+                "2",
+                "--launcher",
+                command,
+                "--out",
+                str(tmp_path / "compare"),
+            ]
+        )
+        == 0
+    )
+    assert (
+        main(
+            [
+                "snapshots",
+                "--edge-beads",
+                "5",
+                "--times",
+                "0.1,0.2",
+                "--ranks",
+                "2",
+                "--launcher",
+                command,
+                "--out",
+                str(tmp_path / "snapshots"),
+            ]
+        )
+        == 0
+    )
     jobs = launched_since(log, before)
     assert [job.split()[:2] for job in jobs].count(["-n", "2"]) == 2
     assert json.loads((tmp_path / "snapshots" / "snapshots.json").read_text())["ranks"] == 2
@@ -87,8 +131,22 @@ def test_an_empty_launcher_is_refused():
 
 def test_a_launcher_that_does_not_exist_is_one_line(tmp_path, capfd):
     missing = str(tmp_path / "no-such-mpiexec")
-    assert main(["run", "--config", small_config(tmp_path), "--ranks", "2", "--launcher", missing,
-                 "--out", str(tmp_path / "out")]) == 3
+    assert (
+        main(
+            [
+                "run",
+                "--config",
+                small_config(tmp_path),
+                "--ranks",
+                "2",
+                "--launcher",
+                missing,
+                "--out",
+                str(tmp_path / "out"),
+            ]
+        )
+        == 3
+    )
     error = capfd.readouterr().err
     assert f"cannot start the MPI launcher '{missing}'" in error and "Traceback" not in error
     assert not (tmp_path / "out" / "summary.json").exists()
@@ -102,7 +160,9 @@ def test_a_launched_impacts_or_sweep_runs_process_loads_only_what_its_run_uses()
     import subprocess
     import sys
 
-    code = ("import sys; import hexdem.experiments.parallel, hexdem.disorder.impacts, hexdem.theory.sweep; "
-            "print(sorted({m.split('.')[0] for m in sys.modules} & {'scipy', 'matplotlib', 'tqdm', 'tomllib'}))")
+    code = (
+        "import sys; import hexdem.experiments.parallel, hexdem.disorder.impacts, hexdem.theory.sweep; "
+        "print(sorted({m.split('.')[0] for m in sys.modules} & {'scipy', 'matplotlib', 'tqdm', 'tomllib'}))"
+    )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert done.stdout.strip() == "[]"

@@ -18,10 +18,12 @@ def test_the_local_spline_is_scipys_not_a_knot_spline(points):
         ours, theirs = LocalSpline(t, y), CubicSpline(t, y)
         grid = np.linspace(t[0], t[-1], 41)
         np.testing.assert_allclose(ours(grid), theirs(grid), rtol=0, atol=1e-13)
-        np.testing.assert_allclose(ours.stationary_points(), np.sort(theirs.derivative().roots(extrapolate=False)),
-                                   rtol=0, atol=1e-18)
-        np.testing.assert_allclose(ours.crossings(0.5), np.sort(theirs.solve(0.5, extrapolate=False)),
-                                   rtol=0, atol=1e-18)
+        np.testing.assert_allclose(
+            ours.stationary_points(), np.sort(theirs.derivative().roots(extrapolate=False)), rtol=0, atol=1e-18
+        )
+        np.testing.assert_allclose(
+            ours.crossings(0.5), np.sort(theirs.solve(0.5, extrapolate=False)), rtol=0, atol=1e-18
+        )
 
 
 def test_a_spline_through_a_cubic_is_that_cubic():
@@ -31,7 +33,9 @@ def test_a_spline_through_a_cubic_is_that_cubic():
     grid = np.linspace(0, 3, 31)
     np.testing.assert_allclose(spline(grid), cubic(grid), atol=1e-12)
     stationary = np.sort(cubic.deriv().roots().real)
-    np.testing.assert_allclose(spline.stationary_points(), stationary[(stationary >= 0) & (stationary <= 3)], atol=1e-12)
+    np.testing.assert_allclose(
+        spline.stationary_points(), stationary[(stationary >= 0) & (stationary <= 3)], atol=1e-12
+    )
 
 
 def test_the_linear_field_is_scipys_linear_interpolator():

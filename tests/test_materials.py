@@ -8,7 +8,7 @@ v₁' = (m₁ − m₂)/(m₁ + m₂) V₀, v₂' = 2m₁/(m₁ + m₂) V₀ (mo
 
 import numpy as np
 import pytest
-from conftest import D, V0, contact_history, read_csv, record, single_bead
+from conftest import V0, D, contact_history, read_csv, record, single_bead
 
 from hexdem.engines.lammps.engine import LammpsEngine
 from hexdem.engines.reference.engine import ReferenceEngine
@@ -33,8 +33,12 @@ def by_hand(a, b, da, db):
 @pytest.mark.parametrize("engine", [LammpsEngine(), ReferenceEngine()], ids=lambda e: e.name)
 @pytest.mark.parametrize("striker", [BRASS, PTFE], ids=lambda m: m.name)
 def test_a_striker_of_another_material_and_size_leaves_as_momentum_and_energy_say(engine, striker, tmp_path):
-    model = GranularModel(single_bead(D), Impact(V0, striker=True, striker_material=striker,
-                                                 striker_diameter_m=STRIKER_D), STEEL_316, wall=None)
+    model = GranularModel(
+        single_bead(D),
+        Impact(V0, striker=True, striker_material=striker, striker_diameter_m=STRIKER_D),
+        STEEL_316,
+        wall=None,
+    )
     m1, m2, a = by_hand(striker, STEEL_316, STRIKER_D, D)
     mu = m1 * m2 / (m1 + m2)
     delta_max = (5 * mu * V0**2 / (4 * a)) ** 0.4
@@ -42,8 +46,9 @@ def test_a_striker_of_another_material_and_size_leaves_as_momentum_and_energy_sa
     dt = expected / 2000
     trajectory = record(engine, model, RunSettings(dt, int(1.2 * expected / dt), 1), tmp_path)
     start = model.initial_positions_m()
-    gap = np.linalg.norm((start[1] + trajectory.displacements_m[:, 1]) - (start[0] + trajectory.displacements_m[:, 0]),
-                         axis=1)
+    gap = np.linalg.norm(
+        (start[1] + trajectory.displacements_m[:, 1]) - (start[0] + trajectory.displacements_m[:, 0]), axis=1
+    )
     duration, peak = contact_history(trajectory.times_s, (STRIKER_D + D) / 2 - gap)
     assert duration == pytest.approx(expected, rel=3e-4)
     assert peak == pytest.approx(delta_max, rel=3e-4)
@@ -53,9 +58,14 @@ def test_a_striker_of_another_material_and_size_leaves_as_momentum_and_energy_sa
 
 
 def test_regions_give_materials_half_plane_strip_and_intruders():
-    config = RunConfig(edge_beads=7, regions=[{"material": "brass", "x_min_d": 5.0},
-                                              {"material": "glass", "x_min_d": 2.0, "x_max_d": 3.0},
-                                              {"material": "ptfe", "sites": [[0, 6], [1, 7]]}])
+    config = RunConfig(
+        edge_beads=7,
+        regions=[
+            {"material": "brass", "x_min_d": 5.0},
+            {"material": "glass", "x_min_d": 2.0, "x_max_d": 3.0},
+            {"material": "ptfe", "sites": [[0, 6], [1, 7]]},
+        ],
+    )
     model = build_model(config)
     assert [m.name for m in model.materials] == ["steel316", "brass", "glass", "ptfe"]
     x_d = (model.packing.positions_m[:, 0] - model.packing.positions_m[model.packing.struck, 0]) / D
@@ -63,19 +73,25 @@ def test_regions_give_materials_half_plane_strip_and_intruders():
     intruders = [model.packing.index_of(0, 6), model.packing.index_of(1, 7)]
     assert set(names[intruders]) == {"ptfe"}
     rest = np.setdiff1d(np.arange(len(names)), intruders)
-    expected = np.where(x_d[rest] >= 5.0 - 1e-9, "brass", np.where((x_d[rest] >= 2.0 - 1e-9) & (x_d[rest] <= 3.0 + 1e-9),
-                                                                      "glass", "steel316"))
+    expected = np.where(
+        x_d[rest] >= 5.0 - 1e-9,
+        "brass",
+        np.where((x_d[rest] >= 2.0 - 1e-9) & (x_d[rest] <= 3.0 + 1e-9), "glass", "steel316"),
+    )
     np.testing.assert_array_equal(names[rest], expected)
     assert model.masses_kg[intruders[0]] == pytest.approx(PTFE.density_kg_m3 * np.pi * D**3 / 6)
 
 
-@pytest.mark.parametrize("regions, message", [
-    ([{"material": "unobtainium", "x_min_d": 1.0}], "unknown material 'unobtainium'"),
-    ([{"material": "brass", "sites": [[40, 2]]}], "site {40, 2} is not in the packing"),
-    ([{"material": "brass", "x_min_d": 99.0}], "selects no bead"),
-    ([{"material": "brass"}], "selects nothing"),
-    ([{"material": "brass", "z_min_d": 1.0}], "unknown key(s) z_min_d"),
-])
+@pytest.mark.parametrize(
+    "regions, message",
+    [
+        ([{"material": "unobtainium", "x_min_d": 1.0}], "unknown material 'unobtainium'"),
+        ([{"material": "brass", "sites": [[40, 2]]}], "site {40, 2} is not in the packing"),
+        ([{"material": "brass", "x_min_d": 99.0}], "selects no bead"),
+        ([{"material": "brass"}], "selects nothing"),
+        ([{"material": "brass", "z_min_d": 1.0}], "unknown key(s) z_min_d"),
+    ],
+)
 def test_bad_regions_are_refused(regions, message):
     with pytest.raises(HexdemError, match=message.replace("(", r"\(").replace(")", r"\)").replace("{", r"\{")):
         build_model(RunConfig(edge_beads=4, regions=regions))
@@ -85,8 +101,13 @@ def test_bad_regions_are_refused(regions, message):
 def test_energy_is_conserved_across_an_interface_struck_by_a_striker_of_its_own(engine, tmp_path):
     """Steel | brass at 3 d, a ptfe intruder, a glass striker: the total energy with each pair's
     own Hertz energy stays put (Verlet at 140 steps: 0.9/140² ≈ 5e-5; RK4 far below)."""
-    config = RunConfig(edge_beads=6, engine=engine, impact="striker", striker_material="glass",
-                       regions=[{"material": "brass", "x_min_d": 3.0}, {"material": "ptfe", "sites": [[0, 4]]}])
+    config = RunConfig(
+        edge_beads=6,
+        engine=engine,
+        impact="striker",
+        striker_material="glass",
+        regions=[{"material": "brass", "x_min_d": 3.0}, {"material": "ptfe", "sites": [[0, 4]]}],
+    )
     results = simulate(config, tmp_path).results
     assert results.far_wall_reached
     assert results.energy_drift < (1e-4 if engine == "lammps" else 1e-6)
@@ -102,7 +123,9 @@ def test_energy_by_region_adds_up_to_the_impact_and_starts_in_the_struck_region(
     r = analysis.results
     totals = r.region_energies.sum(axis=(1, 2))
     np.testing.assert_allclose(totals, totals[0], rtol=2 * r.energy_drift + 1e-12)
-    assert totals[0] == pytest.approx(0.5 * analysis.model.masses_kg[-1 if impact == "striker" else 0] * V0**2, rel=1e-12)
+    assert totals[0] == pytest.approx(
+        0.5 * analysis.model.masses_kg[-1 if impact == "striker" else 0] * V0**2, rel=1e-12
+    )
     first = "striker" if impact == "striker" else "steel316"
     assert r.region_names == ["steel316", "ptfe", *(["striker"] if impact == "striker" else [])]
     shares = r.region_energies.sum(axis=2) / totals[:, None]

@@ -27,9 +27,15 @@ TAU = contact_time(sphere_mass(D, STEEL_316) / 2, hertz_stiffness(STEEL_316, STE
 def packing(positions_m, struck: int, shape: str) -> Packing:
     """Beads of diameter D at ``positions_m``, labelled 0, 1, … (the engines use positions only)."""
     n = len(positions_m)
-    return Packing(labels=np.column_stack([np.arange(n), np.zeros(n, int)]),
-                   positions_m=np.asarray(positions_m, float), diameters_m=np.full(n, D), diameter_m=D, struck=struck,
-                   walls=(), shape=shape)
+    return Packing(
+        labels=np.column_stack([np.arange(n), np.zeros(n, int)]),
+        positions_m=np.asarray(positions_m, float),
+        diameters_m=np.full(n, D),
+        diameter_m=D,
+        struck=struck,
+        walls=(),
+        shape=shape,
+    )
 
 
 def square(rows: int, cols: int) -> tuple[GranularModel, np.ndarray]:
@@ -70,8 +76,7 @@ def test_two_beads_that_start_apart_collide_and_part(tmp_path):
     """Bead 1 starts 0.2 d from bead 2 (beyond the skin: not listed at t = 0); the list is rebuilt as
     it closes in, the contact closes, lasts the two-bead Hertz contact time and opens; the equal beads
     exchange their velocities."""
-    model = GranularModel(packing([[0.0, 0.0], [1.2 * D, 0.0]], 0, "two beads apart"), Impact(V0), STEEL_316,
-                          wall=None)
+    model = GranularModel(packing([[0.0, 0.0], [1.2 * D, 0.0]], 0, "two beads apart"), Impact(V0), STEEL_316, wall=None)
     approach = 0.2 * D / V0
     settings = RunSettings(TAU / 280, int((approach + 1.3 * TAU) / (TAU / 280)), 1)
     trajectory = record(ReferenceEngine(), model, settings, tmp_path)
@@ -97,8 +102,9 @@ def test_rebuilding_the_list_often_changes_nothing(tmp_path, monkeypatch, fricti
 
     def run(name):
         samples = []
-        engine = ReferenceEngine().run(model, run_settings(config, model), tmp_path / name, samples.append,
-                                       show_progress=False)
+        engine = ReferenceEngine().run(
+            model, run_settings(config, model), tmp_path / name, samples.append, show_progress=False
+        )
         spins = [np.zeros(0) if s.angular_velocities is None else s.angular_velocities for s in samples]
         return engine, np.array([s.velocities for s in samples]), np.array(spins)
 
@@ -119,9 +125,10 @@ def test_engines_agree_on_a_square_packing(tmp_path):
     model = GranularModel(model.packing, Impact(V0, angle_deg=20.0), STEEL_316, wall=None)
     settings = RunSettings(dt_s=TAU / 140, n_steps=8 * 140, dump_every=7, contact_time_s=TAU)
     tolerances = Tolerances().for_run(model, settings)
-    lammps, reference = (ImpactAnalysis.from_trajectory(model, settings, record(engine, model, settings,
-                                                                              tmp_path / engine.name)).results
-                         for engine in (LammpsEngine(), ReferenceEngine()))
+    lammps, reference = (
+        ImpactAnalysis.from_trajectory(model, settings, record(engine, model, settings, tmp_path / engine.name)).results
+        for engine in (LammpsEngine(), ReferenceEngine())
+    )
     moving = np.nan_to_num(lammps.peak_speed) > tolerances.min_peak_fraction * V0
     column = np.arange(row[0], model.n_bodies, 8)
     np.testing.assert_array_equal(np.flatnonzero(moving), np.union1d(row, column))

@@ -12,11 +12,14 @@ import numpy as np
 from hexdem.engines.lammps.deck import DECK_NAME, pair_block, write_deck
 from hexdem.engines.lammps.library import load_lammps
 from hexdem.model.config import RunConfig
-from hexdem.model.units import SI
 from hexdem.model.model_builder import build_model
 from hexdem.model.run_settings import run_settings
+from hexdem.model.units import SI
 
-GRANULAR_PAIR = "pair_style      granular\npair_coeff      * * hertz {k} 0.0 damping viscoelastic tangential linear_nohistory 0.0 0.0"
+GRANULAR_PAIR = (
+    "pair_style      granular\n"
+    "pair_coeff      * * hertz {k} 0.0 damping viscoelastic tangential linear_nohistory 0.0 0.0"
+)
 
 
 def compressed_model():
@@ -32,7 +35,7 @@ def forces_every_step(directory, pair_lines: str | None, steps: int):
     """(steps + 1, N, 2) forces and (steps + 1, N) z torques of the deck in ``directory``, its
     pair lines replaced by ``pair_lines`` if given."""
     text = (directory / DECK_NAME).read_text()
-    setup = text[:text.index("# --- output")]
+    setup = text[: text.index("# --- output")]
     if pair_lines is not None:
         start = setup.index("pair_style")
         end = setup.index("\n", setup.index("pair_coeff"))

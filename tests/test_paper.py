@@ -18,7 +18,6 @@ from hexdem.paper.settings import PaperSettings
 from hexdem.theory.outputs import read_sweep_peaks
 from hexdem.theory.scaling import fit_decay
 
-
 #: What the quick run computes: its σ, μ, V₀ and packings.
 QUICK = PaperSettings(quick=True)
 
@@ -67,15 +66,21 @@ def test_the_closest_protocol_refits_to_its_reported_line(quick):
         line = peaks[row["combination"]]
         chosen = (v0 >= float(row["v0_min"])) & (v0 <= float(row["v0_max"]))
         assert np.count_nonzero(chosen) == int(row["n_v0"])
-        c = [fit_decay(np.arange(line.shape[1]), p, int(row["start"]), int(row["last"]), row["fit"],
-                       row["anchored"] == "True")[0] for p in line[chosen]]
+        c = [
+            fit_decay(
+                np.arange(line.shape[1]), p, int(row["start"]), int(row["last"]), row["fit"], row["anchored"] == "True"
+            )[0]
+            for p in line[chosen]
+        ]
         m, b = np.polyfit(v0[chosen], c, 1)
         assert m == pytest.approx(float(row["m"]), rel=1e-8) and b == pytest.approx(float(row["b"]), rel=1e-10)
 
 
 def test_the_disorder_study_covers_every_strength_and_reaches_a_verdict(quick):
     rows = table(quick / "disorder" / "disorder_study.csv")
-    prestressed = {(float(r["sigma_per_tol"]), r["measure"], r["line"]) for r in rows if r["preparation"] == "prestressed"}
+    prestressed = {
+        (float(r["sigma_per_tol"]), r["measure"], r["line"]) for r in rows if r["preparation"] == "prestressed"
+    }
     assert prestressed == {(s, m, line) for s in QUICK.sigma_per_tol for m in ("peak", "lead") for line in ("0", "±30")}
     study = json.loads((quick / "disorder" / "disorder_study.json").read_text())
     assert study["verdict"]["summary"] and study["verdict"]["paper_case"]["sigma_per_tol"] == 6
@@ -87,8 +92,10 @@ def test_the_prestress_variant_is_free_of_the_compactions_load(quick):
     """Equal beads: the paper's walls keep the 5 N compaction's load, stood-back walls only
     the weight along the 5° tilt (3k(k − 1) + 1 beads of k per edge × 28.9 g × 0.855 m/s²: 8.2 N
     for the experiment's 331, 3.1 N for the quick run's 127, spread over slanted walls)."""
-    load = {(float(r["sigma_per_tol"]), r["preparation"]): float(r["wall_force_n"])
-            for r in table(quick / "disorder" / "prestress.csv")}
+    load = {
+        (float(r["sigma_per_tol"]), r["preparation"]): float(r["wall_force_n"])
+        for r in table(quick / "disorder" / "prestress.csv")
+    }
     k = QUICK.ensemble_edge_beads
     weight = (3 * k * (k - 1) + 1) * 8000 * math.pi * 0.01905**3 / 6 * 9.80665 * math.sin(math.radians(5))
     assert load[(0.0, "relaxed")] < 2 * weight < load[(0.0, "prestressed")]
@@ -103,8 +110,9 @@ def test_the_html_report_is_self_contained_with_every_figure(quick):
 
 def test_a_rerun_resumes_without_recomputing(quick, capsys):
     markers = sorted((quick / "parts").glob("*.json"))
-    assert {"tca", "fig3", "fig4", "scaling", "fit_protocols", "disorder", "crossover", "friction"} \
-        <= {p.stem for p in markers}
+    assert {"tca", "fig3", "fig4", "scaling", "fit_protocols", "disorder", "crossover", "friction"} <= {
+        p.stem for p in markers
+    }
     before = {p.name: p.stat().st_mtime_ns for p in markers}
     assert main(["paper", "--out", str(quick), "--quick"]) == 0
     err = capsys.readouterr().err
@@ -132,8 +140,13 @@ def test_the_friction_study_covers_every_friction_speed_and_line(quick):
         assert tuple(next(csv.reader(fh))) == EFFECT_COLUMNS
     rows = table(quick / "friction" / "friction_effect.csv")
     keys = {(float(r["friction"]), float(r["v_striker"]), float(r["sigma_tol"]), r["line"]) for r in rows}
-    assert keys == {(mu, v, s, line) for mu in (0.0, *QUICK.frictions) for v in (0.25, 0.40, 0.70) for s in (0.0, 6.0)
-                    for line in ("0", "±30")} and len(rows) == len(keys)
+    assert keys == {
+        (mu, v, s, line)
+        for mu in (0.0, *QUICK.frictions)
+        for v in (0.25, 0.40, 0.70)
+        for s in (0.0, 6.0)
+        for line in ("0", "±30")
+    } and len(rows) == len(keys)
     study = json.loads((quick / "friction" / "friction_study.json").read_text())
     report = (quick / "report.md").read_text()
     assert "Friction and rotation" in report and "friction/friction_effect.png" in report
@@ -164,12 +177,14 @@ def test_friction_in_the_ideal_lattice_does_not_depend_on_the_speed(quick):
             ratios = [float(ideal[mu, v, line]["mean_peak_ratio"]) for v in (0.25, 0.40, 0.70)]
             assert max(ratios) - min(ratios) < 1e-3 * max(ratios)
             assert abs(ratios[0] - 1) > 1e-2, "friction changes the leading pulse"
-            shifts = [float(ideal[mu, v, line]["mean_arrival_shift_us"]) * v ** 0.2 for v in (0.25, 0.40, 0.70)]
+            shifts = [float(ideal[mu, v, line]["mean_arrival_shift_us"]) * v**0.2 for v in (0.25, 0.40, 0.70)]
             assert max(shifts) - min(shifts) < 1e-2 * max(abs(s) for s in shifts)
     decay = table(quick / "friction" / "friction_decay.csv")
     for mu in (0.0, *QUICK.frictions):
         for combination in ("0/0", "0/30"):
-            rates = [float(r["decay_rate"]) for r in decay if float(r["friction"]) == mu and r["combination"] == combination]
+            rates = [
+                float(r["decay_rate"]) for r in decay if float(r["friction"]) == mu and r["combination"] == combination
+            ]
             assert len(rates) == 3 and max(rates) - min(rates) < 1e-3 * max(rates)
 
 
@@ -197,9 +212,17 @@ def test_bad_workers_is_one_clear_line(tmp_path, capsys):
     assert not (tmp_path / "out").exists()
 
 
-@pytest.mark.parametrize("mean, sem, realizations, expected", [
-    (1.10, 0.02, 20, "rises"), (1.03, 0.02, 20, "unchanged"), (0.90, 0.02, 20, "falls"),
-    (1.01, float("nan"), 1, "rises"), (1.01, float("nan"), 20, "undetermined"), (float("nan"), 0.1, 20, "undetermined")])
+@pytest.mark.parametrize(
+    "mean, sem, realizations, expected",
+    [
+        (1.10, 0.02, 20, "rises"),
+        (1.03, 0.02, 20, "unchanged"),
+        (0.90, 0.02, 20, "falls"),
+        (1.01, float("nan"), 1, "rises"),
+        (1.01, float("nan"), 20, "undetermined"),
+        (float("nan"), 0.1, 20, "undetermined"),
+    ],
+)
 def test_a_change_counts_only_beyond_two_standard_errors(mean, sem, realizations, expected):
     assert change(mean, sem, realizations) == expected
 
@@ -208,13 +231,19 @@ def test_the_verdict_names_the_conditions_of_the_papers_claim():
     def row(sigma, preparation, line, ratio, sem=0.01):
         return (sigma, 0.0, preparation, "peak", line, ratio, sem, sem * 4, 20, ratio)
 
-    rows = [row(6.0, "prestressed", "±30", 0.80), row(6.0, "prestressed", "0", 0.70),
-            row(6.0, "relaxed", "±30", 1.10), row(6.0, "relaxed", "0", 0.90)]
+    rows = [
+        row(6.0, "prestressed", "±30", 0.80),
+        row(6.0, "prestressed", "0", 0.70),
+        row(6.0, "relaxed", "±30", 1.10),
+        row(6.0, "relaxed", "0", 0.90),
+    ]
     result = verdict(rows)
     assert [(c["sigma_per_tol"], c["preparation"]) for c in result["rises_at"]] == [(6.0, "relaxed")]
     assert result["paper_case"]["pm30"] == "falls" and "relaxed" in result["summary"]
     assert result["summary"].startswith("At σ = 6 tol (the study's strengths, 0.40 m/s"), "its σ range stated"
-    assert verdict([r for r in rows if r[2] == "prestressed"] + [row(1.0, "prestressed", "±30", 0.9),
-                   row(1.0, "prestressed", "0", 0.9)])["summary"].startswith("At σ = 1, 6 tol")
+    assert verdict(
+        [r for r in rows if r[2] == "prestressed"]
+        + [row(1.0, "prestressed", "±30", 0.9), row(1.0, "prestressed", "0", 0.9)]
+    )["summary"].startswith("At σ = 1, 6 tol")
     assert np.isclose(result["paper_case"]["pm30_ratio"], 0.80)
     assert len(STUDY_COLUMNS) == len(rows[0])

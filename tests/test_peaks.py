@@ -26,8 +26,9 @@ def hertz_like_pulse(t, centre, width, height):
 def test_peak_and_half_maximum_between_samples(step):
     times = np.arange(0, 4e-4, step)
     centre, width, height = 1.234567e-4, 6e-5, 0.1
-    speeds = np.column_stack([hertz_like_pulse(times, centre, width, height),
-                              hertz_like_pulse(times, 2 * centre, width, height / 3)])
+    speeds = np.column_stack(
+        [hertz_like_pulse(times, centre, width, height), hertz_like_pulse(times, 2 * centre, width, height / 3)]
+    )
     result = pulse_times(times, speeds)
     np.testing.assert_allclose(result.peak_speed, [height, height / 3], rtol=2e-4)
     np.testing.assert_allclose(result.t_peak, [centre, 2 * centre], atol=0.05 * step)
@@ -60,7 +61,7 @@ def test_many_windows_at_once_equal_one_window_at_a_time():
     windows = []
     while len(windows) < 300:
         centre, width = rng.uniform(-0.5, 0.5), rng.uniform(0.6, 3.0)
-        window = rng.uniform(0.5, 2.0) * np.exp(-((knots - centre) / width) ** 2) + rng.normal(0.0, 0.01, 7)
+        window = rng.uniform(0.5, 2.0) * np.exp(-(((knots - centre) / width) ** 2)) + rng.normal(0.0, 0.01, 7)
         if np.argmax(window) == 3:
             windows.append(window)
     interval = 2.5e-6
@@ -80,7 +81,7 @@ def two_maxima(t, narrow_first: bool):
     then a complete running maximum that the broad one's largest sample replaces), else second (a
     rival below the running maximum)."""
     narrow, broad = (30.5, 80.0) if narrow_first else (80.5, 30.0)
-    return 1.002 * np.exp(-((t - narrow) / 7) ** 2) + np.exp(-((t - broad) / 20) ** 2)
+    return 1.002 * np.exp(-(((t - narrow) / 7) ** 2)) + np.exp(-(((t - broad) / 20) ** 2))
 
 
 @pytest.mark.parametrize("narrow_first", [True, False], ids=["narrow-first", "narrow-second"])
@@ -116,7 +117,7 @@ def test_a_lower_maximum_beyond_the_overshoot_is_not_a_rival():
     """A local maximum further than PEAK_OVERSHOOT below the largest sample is not refined: its
     spline cannot reach the largest sample at the runs' sampling."""
     times = np.arange(120.0)
-    speeds = np.exp(-((times - 30) / 20) ** 2) + (1 - 2 * PEAK_OVERSHOOT) * np.exp(-((times - 80.5) / 7) ** 2)
+    speeds = np.exp(-(((times - 30) / 20) ** 2)) + (1 - 2 * PEAK_OVERSHOOT) * np.exp(-(((times - 80.5) / 7) ** 2))
     assert refine_peak(times, speeds)[0] == pytest.approx(30.0, abs=0.05)
 
 
@@ -147,7 +148,7 @@ def chain_speeds(config: RunConfig, times):
     SciPy's DOP853 at rtol 1e-12."""
     model = build_model(config)
     d = np.asarray(config.diameters_m)
-    masses = model.masses_kg[:len(d)]
+    masses = model.masses_kg[: len(d)]
     material = config.material(config.bead_material)
     reduced = d[:-1] * d[1:] / (2 * (d[:-1] + d[1:]))
     prefactor = hertz_stiffness(material, material) * np.sqrt(reduced)
@@ -160,7 +161,7 @@ def chain_speeds(config: RunConfig, times):
     start = np.zeros(2 * len(d))
     start[len(d)] = config.v0
     solution = solve_ivp(rates, (0.0, times[-1]), start, method="DOP853", rtol=1e-12, atol=1e-16, t_eval=times)
-    return np.abs(solution.y[len(d):].T)
+    return np.abs(solution.y[len(d) :].T)
 
 
 def test_a_dimer_chains_peaks_are_the_integrators(tmp_path):

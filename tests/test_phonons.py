@@ -30,8 +30,9 @@ def test_gamma_k_and_m_by_hand():
     np.testing.assert_allclose(frequencies(LATTICE, points["Γ"]), [0.0, 0.0], atol=1e-9 * SCALE)
     np.testing.assert_allclose(frequencies(LATTICE, points["K"]) / SCALE, [math.sqrt(4.5)] * 2, rtol=1e-12)
     np.testing.assert_allclose(frequencies(LATTICE, points["M"]) / SCALE, [math.sqrt(2), math.sqrt(6)], rtol=1e-12)
-    np.testing.assert_allclose(dynamical_matrix(LATTICE, points["K"]), 4.5 * SCALE**2 * np.eye(2), rtol=1e-12,
-                               atol=1e-9 * SCALE**2)
+    np.testing.assert_allclose(
+        dynamical_matrix(LATTICE, points["K"]), 4.5 * SCALE**2 * np.eye(2), rtol=1e-12, atol=1e-9 * SCALE**2
+    )
 
 
 @pytest.mark.parametrize("angle_deg", [0.0, 37.0, 90.0, 200.0, 300.0])
@@ -53,8 +54,9 @@ def test_long_waves_travel_at_the_lame_sound_speeds():
     the same in every direction (the lattice's long-wave limit is isotropic)."""
     c_l, c_t = sound_speeds(LATTICE)
     coefficient = float(hertz_coefficient(0.01905))
-    assert c_l == pytest.approx(longitudinal_sound_speed(20.0, coefficient, LATTICE.mass_kg, LATTICE.spacing_m),
-                                rel=1e-12)
+    assert c_l == pytest.approx(
+        longitudinal_sound_speed(20.0, coefficient, LATTICE.mass_kg, LATTICE.spacing_m), rel=1e-12
+    )
     q = 1e-5 / LATTICE.spacing_m
     for angle in np.radians([0.0, 17.0, 45.0, 90.0]):
         low, high = frequencies(LATTICE, q * np.array([math.cos(angle), math.sin(angle)])) / q
@@ -65,7 +67,9 @@ def test_the_band_path_runs_gamma_k_m_gamma():
     position, vectors, omega = band_path(LATTICE, 30)
     points = LATTICE.high_symmetry_points()
     assert len(position) == 91 and np.all(np.diff(position) > 0)
-    np.testing.assert_allclose(vectors[[0, 30, 60, 90]], [points["Γ"], points["K"], points["M"], points["Γ"]], atol=1e-9)
+    np.testing.assert_allclose(
+        vectors[[0, 30, 60, 90]], [points["Γ"], points["K"], points["M"], points["Γ"]], atol=1e-9
+    )
     np.testing.assert_allclose(omega[30], [math.sqrt(4.5) * SCALE] * 2, rtol=1e-12)
     assert np.all(omega[:, 1] >= omega[:, 0])
 

@@ -37,8 +37,9 @@ def net_forces(lattice, f0):
     for wall in lattice.walls:
         members = wall.members
         depth = np.maximum(-wall.gaps_m(pos[members], lattice.radii_m[members]), 0.0)
-        np.add.at(net, members, (K_WALL * np.sqrt(lattice.radii_m[members]) * depth**1.5)[:, None]
-                  * np.asarray(wall.normal))
+        np.add.at(
+            net, members, (K_WALL * np.sqrt(lattice.radii_m[members]) * depth**1.5)[:, None] * np.asarray(wall.normal)
+        )
     net[lattice.struck] += hole_force(lattice, f0)
     return force, net
 
@@ -63,8 +64,7 @@ def test_spring_stiffness_is_the_slope_of_the_hertz_law():
 @pytest.mark.parametrize("engine", ["lammps", "reference"])
 def test_without_an_impact_the_packing_stays_static(tmp_path, engine):
     """5 N per contact, V0 = 1e-9 m/s (no impact to speak of): every bead slower than 1e-6 m/s over 1 ms."""
-    analysis = simulate(RunConfig(edge_beads=6, precompression_n=5.0, v0=1e-9, duration=1e-3, engine=engine),
-                        tmp_path)
+    analysis = simulate(RunConfig(edge_beads=6, precompression_n=5.0, v0=1e-9, duration=1e-3, engine=engine), tmp_path)
     assert np.nanmax(analysis.results.peak_speed) < 1e-6
     assert analysis.results.energy_drift < 1e-3, "round-off of the static energy is not integration error"
 
@@ -82,8 +82,9 @@ def test_weak_impulses_travel_at_the_longitudinal_sound_speed(tmp_path, engine):
     front along the 0° line, fitted over beads 4 to 12 of a 16-per-edge hexagon, moves at
     c_L = sqrt(9/8) a sqrt(k/m) within 5 % (measured: +1.1 %)."""
     f0 = 20.0
-    analysis = simulate(RunConfig(edge_beads=16, precompression_n=f0, v0=1e-4, duration=1.2e-3, engine=engine),
-                        tmp_path)
+    analysis = simulate(
+        RunConfig(edge_beads=16, precompression_n=f0, v0=1e-4, duration=1.2e-3, engine=engine), tmp_path
+    )
     r = analysis.results
     line = r.lines["0"][4:13]
     speed = np.polyfit(r.arrival_time[line], r.positions[line, 0], 1)[0]
@@ -91,10 +92,13 @@ def test_weak_impulses_travel_at_the_longitudinal_sound_speed(tmp_path, engine):
     assert speed == pytest.approx(c_l, rel=0.05)
 
 
-@pytest.mark.parametrize("changes, message", [
-    ({"precompression_n": -1.0}, "precompression_n must be a force >= 0 N"),
-    ({"precompression_n": 5.0, "wall_material": "none"}, "needs walls"),
-])
+@pytest.mark.parametrize(
+    "changes, message",
+    [
+        ({"precompression_n": -1.0}, "precompression_n must be a force >= 0 N"),
+        ({"precompression_n": 5.0, "wall_material": "none"}, "needs walls"),
+    ],
+)
 def test_bad_precompression_is_refused(changes, message):
     with pytest.raises(HexdemError, match=message):
         build_model(RunConfig(**changes))

@@ -39,8 +39,9 @@ def test_a_wall_pushed_in_by_delta_loads_each_of_its_beads_by_hertz():
     lattice = model.packing
     delta = 2e-6
     wall = lattice.walls[0]
-    pushed = replace(model, packing=replace(lattice, walls=(replace(wall, offset_m=wall.offset_m + delta),
-                                                            *lattice.walls[1:])))
+    pushed = replace(
+        model, packing=replace(lattice, walls=(replace(wall, offset_m=wall.offset_m + delta), *lattice.walls[1:]))
+    )
     load = prestress(pushed)
     per_bead = model.wall_stiffness_pa([0])[0] * np.sqrt(lattice.diameter_m / 2) * delta**1.5
     assert load.contacts == 0

@@ -17,7 +17,7 @@ GALLERY = Path(__file__).resolve().parents[1] / "docs" / "gallery" / "configs"
 def colour_pixels(path, colour: str) -> int:
     """How many pixels of the PNG at ``path`` have the colour ``#rrggbb``."""
     rgb = np.asarray(Image.open(path).convert("RGB")).reshape(-1, 3)
-    return int(np.all(rgb == [int(colour[k:k + 2], 16) for k in (1, 3, 5)], axis=1).sum())
+    return int(np.all(rgb == [int(colour[k : k + 2], 16) for k in (1, 3, 5)], axis=1).sum())
 
 
 def test_the_default_hexagon_is_drawn_with_its_struck_bead_and_nothing_is_run(tmp_path):
@@ -36,10 +36,16 @@ def test_a_packing_file_of_two_materials_shows_both(tmp_path, capsys):
     assert colour_pixels(out / PREVIEW_NAME, MATERIAL_COLOURS[1]) > 1000, "the five brass beads"
 
 
-@pytest.mark.parametrize("config_text", [
-    "edge_beads = 1", 'shape = "packing"\npacking_file = "missing.csv"', "dt = 1e-3",
-    f'shape = "packing"\npacking_file = "{GALLERY / "packing.csv"}"\nstruck_bead = 500',
-    f'shape = "packing"\npacking_file = "{GALLERY / "packing.csv"}"\nwalls = "box"'])
+@pytest.mark.parametrize(
+    "config_text",
+    [
+        "edge_beads = 1",
+        'shape = "packing"\npacking_file = "missing.csv"',
+        "dt = 1e-3",
+        f'shape = "packing"\npacking_file = "{GALLERY / "packing.csv"}"\nstruck_bead = 500',
+        f'shape = "packing"\npacking_file = "{GALLERY / "packing.csv"}"\nwalls = "box"',
+    ],
+)
 def test_a_packing_run_refuses_is_refused_in_the_same_line_and_nothing_is_written(tmp_path, capsys, config_text):
     config = tmp_path / "bad.toml"
     config.write_text(config_text)

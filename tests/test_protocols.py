@@ -18,14 +18,14 @@ def test_line_fits_over_every_range_equal_ordinary_least_squares():
     first, final, m, m_err, b, b_err = protocols.line_fits_over_ranges(x, y, min_points=4)
     assert len(m) == sum(12 - size + 1 for size in range(4, 13))
     for i, j, *values in zip(first, final, m, m_err, b, b_err):
-        fit = scaling.polynomial_fit(x[i:j + 1], y[i:j + 1], 1, ("m", "b"))
+        fit = scaling.polynomial_fit(x[i : j + 1], y[i : j + 1], 1, ("m", "b"))
         np.testing.assert_allclose(values, [fit["m"], fit.error("m"), fit["b"], fit.error("b")], rtol=1e-8)
 
 
 @pytest.mark.parametrize("kind", scaling.FIT_KINDS)
 def test_free_and_anchored_starts_agree_on_an_exact_geometric_decay(kind):
     n = np.arange(14)
-    v = 0.3 * 0.83 ** n
+    v = 0.3 * 0.83**n
     for anchored in (True, False):
         c, c_err = scaling.fit_decay(n, v, 2, 12, kind, anchored)
         assert c == pytest.approx(0.83, rel=1e-10) and c_err < 1e-8
@@ -33,7 +33,7 @@ def test_free_and_anchored_starts_agree_on_an_exact_geometric_decay(kind):
 
 def test_a_free_start_ignores_an_outlying_start_bead_that_an_anchored_one_follows():
     n = np.arange(14)
-    v = 0.3 * 0.83 ** n
+    v = 0.3 * 0.83**n
     v[2] *= 1.3
     anchored, _ = scaling.fit_decay(n, v, 2, 12, anchored=True)
     free, _ = scaling.fit_decay(n, v, 2, 12, anchored=False)
@@ -45,8 +45,13 @@ def test_a_free_start_ignores_an_outlying_start_bead_that_an_anchored_one_follow
 def test_every_protocol_recovers_an_exact_law(name):
     combination = scaling.COMBINATIONS[name]
     search = protocols.search_protocols(name, V0, synthetic_peaks(combination), EXACT, max_last=13)
-    expected = len(protocols.STARTS) * 2 * 2 * sum(
-        30 - size + 1 for size in range(protocols.MIN_V0, 31)) * np.mean([13 - s - 1 for s in protocols.STARTS])
+    expected = (
+        len(protocols.STARTS)
+        * 2
+        * 2
+        * sum(30 - size + 1 for size in range(protocols.MIN_V0, 31))
+        * np.mean([13 - s - 1 for s in protocols.STARTS])
+    )
     assert len(search) == expected
     assert np.max(search.distance) < 1e-8 and search.consistent.all()
     stated = search.find(combination.start, 12, True, "loglinear", 0, 29)

@@ -19,8 +19,7 @@ from hexdem.experiments.random_packing import PACKING_NAME, prepare_random_packi
 from hexdem.model.config import RunConfig
 from hexdem.model.model_builder import build_model
 from hexdem.model.placed import MAX_REST_OVERLAP
-from hexdem.model.random_disc import (DENSE_FRACTION, LOOSE_GAP, edge_bead, loose_positions,
-                                      random_diameters)
+from hexdem.model.random_disc import DENSE_FRACTION, LOOSE_GAP, edge_bead, loose_positions, random_diameters
 
 D = RunConfig().diameter_m
 #: Neighbours closer than this are touching at rest [m]: far below the µm overlaps of a 0.4 m/s impact.
@@ -61,13 +60,16 @@ def test_the_struck_bead_is_the_middle_of_the_edge_facing_the_strike():
     assert tuple(grid[edge_bead(grid, diameters, [-1.0, 0.0])] / D) == (4, 2)
 
 
-@pytest.mark.parametrize("changes, message", [
-    ({"diameter_spread": 0.5}, "diameter_spread must be at least 0 and below 0.5"),
-    ({"radius_m": 0.01}, "radius_m must be at least 1.5 diameter_m"),
-    ({"radius_m": D}, r"radius_m must be at least 1.5 diameter_m = 0.028575 m for a random disc \(a middle bead "),
-    ({"seed": -1}, "seed must be an integer >= 0"),
-    ({"seed": 1.5}, "seed must be an integer"),
-])
+@pytest.mark.parametrize(
+    "changes, message",
+    [
+        ({"diameter_spread": 0.5}, "diameter_spread must be at least 0 and below 0.5"),
+        ({"radius_m": 0.01}, "radius_m must be at least 1.5 diameter_m"),
+        ({"radius_m": D}, r"radius_m must be at least 1.5 diameter_m = 0.028575 m for a random disc \(a middle bead "),
+        ({"seed": -1}, "seed must be an integer >= 0"),
+        ({"seed": 1.5}, "seed must be an integer"),
+    ],
+)
 def test_bad_random_discs_are_one_line_errors(changes, message):
     with pytest.raises(HexdemError, match=message) as error:
         RunConfig(shape="random", **changes)
@@ -101,7 +103,9 @@ def test_a_random_disc_that_cannot_run_is_refused_before_it_is_packed(tmp_path, 
     packs it, by every command (compare once left the packing in --out; sweep checked nothing)."""
     (tmp_path / "random.toml").write_text('shape = "random"\nradius_m = 0.06\nseed = 1\nsensors = [100000]\n')
     out = tmp_path / "out"
-    assert main([*command, "--config", str(tmp_path / "random.toml"), "--out", str(out)]) == 3  # refused before it is packed
+    assert (
+        main([*command, "--config", str(tmp_path / "random.toml"), "--out", str(out)]) == 3
+    )  # refused before it is packed
     lines = [line for line in capsys.readouterr().err.strip().splitlines() if "error" in line]
     assert len(lines) == 1 and "sensor bead id 100000 is not in the packing" in lines[0], lines
     assert not out.exists() or not any(out.iterdir())
@@ -111,7 +115,9 @@ def test_a_stage_that_does_not_settle_is_kept_where_its_message_says(tmp_path, m
     stage = random_packing.settling_stage
     monkeypatch.setattr(random_packing, "settling_stage", lambda name: replace(stage(name), max_steps=1000))
     (tmp_path / "random.toml").write_text('shape = "random"\nradius_m = 0.06\nseed = 1\n')
-    assert main(["run", "--config", str(tmp_path / "random.toml"), "--out", str(tmp_path / "out")]) == 4  # the run started and failed
+    assert (
+        main(["run", "--config", str(tmp_path / "random.toml"), "--out", str(tmp_path / "out")]) == 4
+    )  # the run started and failed
     error = [line for line in capsys.readouterr().err.splitlines() if "error" in line][0]
     assert "compact stage did not settle in" in error
     assert (Path(error.rsplit("see ", 1)[1]) / DECK_NAME).is_file()
@@ -164,11 +170,14 @@ def test_the_same_seed_packs_the_same_disc_and_says_so_stage_by_stage(compared, 
     again = prepare_random_packing(RunConfig(**SMALL), tmp_path, log=messages.append)
     assert (tmp_path / PACKING_NAME).read_bytes() == (out / "preparation" / PACKING_NAME).read_bytes()
     assert again.shape == "packing" and again.struck_bead >= 0
-    stages = [found.group(2) for message in messages if (found := re.match(r"random disc(, stage \d of 2:|,) (\w+)",
-                                                                              message))]
+    stages = [
+        found.group(2) for message in messages if (found := re.match(r"random disc(, stage \d of 2:|,) (\w+)", message))
+    ]
     assert stages == ["compact", "compact", "relax", "relax"] and messages[-1].startswith("random disc packed")
-    assert all(re.search(r"settled after \d+ steps, [\d.e+-]+ s simulated, in [\d.]+ s$", message)
-               for message in messages[2:-1:2])
+    assert all(
+        re.search(r"settled after \d+ steps, [\d.e+-]+ s simulated, in [\d.]+ s$", message)
+        for message in messages[2:-1:2]
+    )
 
 
 def test_both_engines_agree_on_a_struck_random_disc(compared):

@@ -4,7 +4,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from conftest import D, V0, contact_history, disordered_model, record, settings_of, single_bead
+from conftest import V0, D, contact_history, disordered_model, record, settings_of, single_bead
 
 from hexdem.analysis.energy import contact_energy_j
 from hexdem.engines.reference.engine import PARAMETERS_NAME, ReferenceEngine, ReferenceSystem
@@ -13,10 +13,10 @@ from hexdem.experiments.run import simulate
 from hexdem.model.config import RunConfig
 from hexdem.model.granular import GranularModel, Impact, RunSettings
 from hexdem.model.hertz import contact_time, max_overlap
-from hexdem.model.walls import Wall
 from hexdem.model.materials import DELRIN, STEEL_316, hertz_stiffness, sphere_mass
-from hexdem.model.units import SI, nondimensional
 from hexdem.model.model_builder import build_model
+from hexdem.model.units import SI, nondimensional
+from hexdem.model.walls import Wall
 
 #: A small experiment: 5 beads per edge (61 beads), everything else the paper's defaults.
 SMALL = RunConfig(edge_beads=5, engine="reference")
@@ -35,8 +35,9 @@ def test_forces_are_minus_the_gradient_of_the_hertz_energy(units):
         for axis in range(2):
             shift = np.zeros_like(q)
             shift[body, axis] = step
-            gradient[body, axis] = (contact_energy_j(start + q + shift, model)
-                                    - contact_energy_j(start + q - shift, model)) / (2 * step)
+            gradient[body, axis] = (
+                contact_energy_j(start + q + shift, model) - contact_energy_j(start + q - shift, model)
+            ) / (2 * step)
     assert np.count_nonzero(gradient) > model.n_bodies  # the perturbation makes many contacts
     force = ReferenceSystem.from_model(model, units).forces(q / units.length_m) * units.force_n
     np.testing.assert_allclose(force, -gradient, rtol=1e-6, atol=1e-6 * np.abs(gradient).max())
@@ -79,8 +80,9 @@ def test_sphere_on_a_delrin_wall_uses_the_walls_own_modulus(tmp_path):
     np.testing.assert_allclose(trajectory.velocities_m_s[-1, 0], [-V0, 0.0], atol=1e-7 * V0)
 
 
-@pytest.mark.parametrize("changes", [{}, {"impact": "striker", "strike_angle_deg": 30.0}],
-                         ids=["velocity-0deg", "striker-30deg"])
+@pytest.mark.parametrize(
+    "changes", [{}, {"impact": "striker", "strike_angle_deg": 30.0}], ids=["velocity-0deg", "striker-30deg"]
+)
 def test_energy_is_conserved(tmp_path, changes):
     """RK4 at the default 140 steps per contact: about 3e-7 (bench_accuracy.py), against Verlet's 4.5e-5."""
     analysis = simulate(SMALL.replace(**changes), tmp_path)
@@ -120,8 +122,12 @@ def test_nondimensional_run_is_the_scaled_si_run(tmp_path):
     si = SMALL.replace(strike_angle_deg=30.0)
     scale = nondimensional(D)
     settings = settings_of(si)
-    nd = si.replace(units="nondimensional", v0=si.v0 / scale.velocity_m_s, dt=settings.dt_s / scale.time_s,
-                    duration=settings.duration_s / scale.time_s)
+    nd = si.replace(
+        units="nondimensional",
+        v0=si.v0 / scale.velocity_m_s,
+        dt=settings.dt_s / scale.time_s,
+        duration=settings.duration_s / scale.time_s,
+    )
     a, b = simulate(si, tmp_path / "si"), simulate(nd, tmp_path / "nd")
     assert b.engine["units"] == "nondimensional"
     np.testing.assert_allclose(b.results.peak_speed / nd.v0, a.results.peak_speed / si.v0, rtol=1e-9)
@@ -138,9 +144,15 @@ def test_samples_start_at_zero_every_dump_interval_and_the_run_is_described(tmp_
     assert trajectory.engine["n_pairs"] == len(model.packing.bonds())  # a triangular packing's list: its touching pairs
 
 
-@pytest.mark.parametrize("settings, message", [
-    (RunSettings(0.0, 10, 1), "time step"), (RunSettings(float("nan"), 10, 1), "time step"),
-    (RunSettings(1e-7, 0, 1), "n_steps"), (RunSettings(1e-7, 10, 0), "dump_every")])
+@pytest.mark.parametrize(
+    "settings, message",
+    [
+        (RunSettings(0.0, 10, 1), "time step"),
+        (RunSettings(float("nan"), 10, 1), "time step"),
+        (RunSettings(1e-7, 0, 1), "n_steps"),
+        (RunSettings(1e-7, 10, 0), "dump_every"),
+    ],
+)
 def test_bad_settings_are_one_line_errors(tmp_path, settings, message):
     with pytest.raises(HexdemError, match=message):
         ReferenceEngine().run(build_model(SMALL), settings, tmp_path, lambda sample: None)

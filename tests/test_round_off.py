@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from hexdem.analysis.run_maps import peak_scale
 from hexdem.analysis.peaks import ROUND_OFF_SPEED, noise_floor, pulse_times
+from hexdem.analysis.run_maps import peak_scale
 from hexdem.experiments.run import simulate
 from hexdem.model.config import RunConfig
 
@@ -32,9 +32,11 @@ def _reading(analysis) -> dict:
 
 @pytest.fixture(scope="module")
 def crystal_runs(tmp_path_factory):
-    return {(name, engine): simulate(RunConfig(**changes, engine=engine), tmp_path_factory.mktemp(name),
-                                     trace_lines=["0"])
-            for name, changes in CRYSTALS.items() for engine in ("lammps", "reference")}
+    return {
+        (name, engine): simulate(RunConfig(**changes, engine=engine), tmp_path_factory.mktemp(name), trace_lines=["0"])
+        for name, changes in CRYSTALS.items()
+        for engine in ("lammps", "reference")
+    }
 
 
 def test_the_noise_floor_is_the_square_root_of_a_doubles_precision():
@@ -46,7 +48,7 @@ def test_round_off_below_the_floor_never_moved_and_above_it_a_pulse():
     """A bead that creeps at 1e-17 (LAMMPS's round-off at 0.4 m/s) or 1e-58 (the reference
     integrator's) never moved; one whose pulse rises to 1e-3 of V0 has a peak."""
     times = np.linspace(0.0, 1.0, 201)
-    pulse = np.exp(-((times - 0.5) / 0.05) ** 2)
+    pulse = np.exp(-(((times - 0.5) / 0.05) ** 2))
     speeds = np.column_stack([1e-17 * times, 1e-58 * times, 4e-4 * pulse, 1e-17 * times[::-1]])
     result = pulse_times(times, speeds, noise_floor(0.4))
     np.testing.assert_array_equal(result.peak_speed[[0, 1, 3]], 0.0)

@@ -35,7 +35,11 @@ def test_default_run_writes_the_contracted_files(default_run):
     by_id = {int(row["bead_id"]): row for row in beads}
     for row in rows:  # the lines' beads carry the same pulse in both tables
         bead = by_id[int(row["bead_id"])]
-        assert (bead["peak_speed"], bead["arrival_time"], bead["x"]) == (row["peak_speed"], row["arrival_time"], row["x"])
+        assert (bead["peak_speed"], bead["arrival_time"], bead["x"]) == (
+            row["peak_speed"],
+            row["arrival_time"],
+            row["x"],
+        )
         assert {bead["material"]} == {"steel316"}
 
 
@@ -91,8 +95,10 @@ def _numbers(path):
     """(the text columns, the numeric columns as a float array) of a result table."""
     header, rows = read_csv(path)
     text = {key for key in header if any(not _is_number(row[key]) for row in rows)}
-    return ([[row[key] for key in header if key in text] for row in rows],
-            np.array([[float(row[key]) for key in header if key not in text] for row in rows]))
+    return (
+        [[row[key] for key in header if key in text] for row in rows],
+        np.array([[float(row[key]) for key in header if key not in text] for row in rows]),
+    )
 
 
 def _is_number(text: str) -> bool:
@@ -140,8 +146,9 @@ def test_nondimensional_deck_reproduces_the_si_run(default_run, tmp_path):
     si = default_run[1]
     nondim_config = RunConfig(units="nondimensional")
     units = nondim_config.unit_system
-    config = nondim_config.replace(v0=0.4 / units.velocity_m_s, dt=si.settings.dt_s / units.time_s,
-                                   duration=si.settings.duration_s / units.time_s)
+    config = nondim_config.replace(
+        v0=0.4 / units.velocity_m_s, dt=si.settings.dt_s / units.time_s, duration=si.settings.duration_s / units.time_s
+    )
     nd = simulate(config, tmp_path)
     assert "units           lj" in (tmp_path / "in.hexdem").read_text()
     np.testing.assert_allclose(nd.results.peak_speed * units.velocity_m_s, si.results.peak_speed, rtol=1e-7)
@@ -174,7 +181,9 @@ def test_striker_impact_matches_initial_velocity_impact(default_run, tmp_path):
 
 def test_config_file_sets_parameters(tmp_path):
     path = tmp_path / "run.toml"
-    path.write_text('edge_beads = 5\nstrike_angle_deg = 30.0\nimpact = "striker"\nunits = "nondimensional"\nv0 = 0.05\n')
+    path.write_text(
+        'edge_beads = 5\nstrike_angle_deg = 30.0\nimpact = "striker"\nunits = "nondimensional"\nv0 = 0.05\n'
+    )
     config = RunConfig.from_toml(path)
     model = build_model(config)
     assert len(model.packing) == 61 and model.has_striker

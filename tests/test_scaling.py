@@ -17,8 +17,9 @@ TRUE = {"m": 0.21, "b": 0.84, "amplitude": {1: (0.2, 0.63), 2: (-0.4, 0.05, 0.2)
 
 def synthetic_peaks(combination, n_beads=14, noise=0.0, rng=None):
     """Peaks that follow the combination's law exactly, times log-normal noise."""
-    law = scaling.ScalingLaw(combination.name, combination.start, TRUE["m"], TRUE["b"],
-                             TRUE["amplitude"][combination.degree])
+    law = scaling.ScalingLaw(
+        combination.name, combination.start, TRUE["m"], TRUE["b"], TRUE["amplitude"][combination.degree]
+    )
     n = np.arange(n_beads)
     peaks = law(V0[:, None], n[None, :])
     if noise:
@@ -40,15 +41,19 @@ def test_sweep_fits_recover_known_m_b_and_amplitude(name, kind):
 def test_sensitivity_table_covers_every_window_and_fit_type():
     combination = scaling.COMBINATIONS["0/0"]
     rows = scaling.sensitivity(combination, V0, synthetic_peaks(combination))
-    assert [(r["last"], r["fit"]) for r in rows] == [(last, kind) for last in range(4, 14) for kind in scaling.FIT_KINDS]
+    assert [(r["last"], r["fit"]) for r in rows] == [
+        (last, kind) for last in range(4, 14) for kind in scaling.FIT_KINDS
+    ]
     np.testing.assert_allclose([r["m"] for r in rows], TRUE["m"], rtol=1e-8)
     np.testing.assert_allclose([r["b"] for r in rows], TRUE["b"], rtol=1e-9)
 
 
 def test_standard_errors_match_the_scatter_of_repeated_noisy_sweeps():
     combination, rng = scaling.COMBINATIONS["30/30"], np.random.default_rng(7)
-    fits = [scaling.fit_combination(combination, V0, synthetic_peaks(combination, noise=0.01, rng=rng), last=12)
-            for _ in range(300)]
+    fits = [
+        scaling.fit_combination(combination, V0, synthetic_peaks(combination, noise=0.01, rng=rng), last=12)
+        for _ in range(300)
+    ]
     m = np.array([f.rate["m"] for f in fits])
     assert abs(m.mean() - TRUE["m"]) < 3 * m.std() / np.sqrt(len(m))
     assert np.mean([f.rate.error("m") for f in fits]) == pytest.approx(m.std(), rel=0.2)
@@ -93,8 +98,9 @@ def test_laws_are_the_papers_equations():
         }[combination.equation]
         np.testing.assert_allclose(law(v0, n), paper(), rtol=1e-14)
     assert {c.equation for c in scaling.COMBINATIONS.values()} == {"v30", "v0", "veq0"}
-    assert [c.start for c in scaling.COMBINATIONS.values()] == [1 if c.line == "+30" else 2
-                                                               for c in scaling.COMBINATIONS.values()]
+    assert [c.start for c in scaling.COMBINATIONS.values()] == [
+        1 if c.line == "+30" else 2 for c in scaling.COMBINATIONS.values()
+    ]
 
 
 @pytest.mark.parametrize("amplitude", [(0.3, 0.6), (-0.4, 0.1, 0.5)])
@@ -141,8 +147,23 @@ def test_larger_hexagon_gives_identical_peaks():
 
 def test_scaling_command_writes_the_four_laws(tmp_path, capsys):
     out = tmp_path / "scaling"
-    status = main(["scaling", "--out", str(out), "--n-v0", "4", "--v0-max", "0.2", "--last", "5",
-                   "--duration", "8", "--workers", "1"])
+    status = main(
+        [
+            "scaling",
+            "--out",
+            str(out),
+            "--n-v0",
+            "4",
+            "--v0-max",
+            "0.2",
+            "--last",
+            "5",
+            "--duration",
+            "8",
+            "--workers",
+            "1",
+        ]
+    )
     assert status == 0
     summary = json.loads((out / "scaling.json").read_text())
     for name, combination in scaling.COMBINATIONS.items():
@@ -162,7 +183,8 @@ def test_a_run_whose_fit_window_peaks_within_a_contact_time_of_its_end_warns():
     """The study's table names a run whose window's last peaks came late (cut short) or never."""
     assert sweep.window_warnings({"0": np.array([1.0, 2.0]), "+30": np.array([1.5, 6.9])}, 8.0, 1.0) == ()
     assert sweep.window_warnings({"0": np.array([1.0, 7.2]), "+30": np.array([1.5])}, 8.0, 1.0) == (
-        "window_peak_near_end",)
+        "window_peak_near_end",
+    )
     assert sweep.window_warnings({"0": np.array([1.0, np.nan])}, 8.0, 1.0) == ("window_peak_near_end",)
     late = sweep.run_one(sweep.SweepSettings(last=6, duration_contacts=4.0, workers=1), 0.3, 0.0)
     assert late.warnings == ("window_peak_near_end",)

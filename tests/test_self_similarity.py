@@ -24,8 +24,13 @@ WORKFLOW = Path(__file__).resolve().parents[1] / "workflows" / "self_similarity.
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory):
     out = tmp_path_factory.mktemp("self_similarity")
-    done = subprocess.run([sys.executable, str(WORKFLOW), "--out", str(out), "--quick", "--ranks", "1"], cwd=out,
-                          capture_output=True, text=True, timeout=600)
+    done = subprocess.run(
+        [sys.executable, str(WORKFLOW), "--out", str(out), "--quick", "--ranks", "1"],
+        cwd=out,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert done.returncode == 0, done.stderr
     return out
 
@@ -40,11 +45,12 @@ def table(out):
 @pytest.mark.slow
 def test_the_workflow_writes_its_files(quick):
     rows = table(quick)
-    assert {(r["study"], r["line"]) for r in rows} == {(s, line) for s in ("uncompressed", "precompressed")
-                                                      for line in ("0", "15", "30")}
+    assert {(r["study"], r["line"]) for r in rows} == {
+        (s, line) for s in ("uncompressed", "precompressed") for line in ("0", "15", "30")
+    }
     result = json.loads((quick / "self_similarity.json").read_text())
     for study in ("uncompressed", "precompressed"):
-        for line, entry in result[study].items():
+        for _line, entry in result[study].items():
             for name in ("amplitude_exponent", "width_exponent", "speed_exponent", "energy_exponent"):
                 assert set(entry[name]) == {"value", "stderr"} and entry[name]["stderr"] >= 0
             assert len(entry["fit_range_d"]) == 2 and entry["energy_verdict"]
@@ -52,8 +58,18 @@ def test_the_workflow_writes_its_files(quick):
     assert {"front_speed_m_s", "nesterenko_speed_m_s", "relative_deviation", "peak_ratio"} <= set(chain)
     rise = json.loads((quick / "late_rise.json").read_text())
     assert set(rise["fits"]) == set(rise["rises"]) == {"baseline", "finer_sampling", "finer_step", "fixed_speed"}
-    assert rise["kind"] in ("no late rise", "artefact of the sampling", "artefact of the time step",
-                            "of the half-maximum measure", "the front's own", "undetermined") and rise["verdict"]
+    assert (
+        rise["kind"]
+        in (
+            "no late rise",
+            "artefact of the sampling",
+            "artefact of the time step",
+            "of the half-maximum measure",
+            "the front's own",
+            "undetermined",
+        )
+        and rise["verdict"]
+    )
     with open(quick / "late_rise.csv", newline="") as fh:
         assert {row["variant"] for row in csv.DictReader(fh)} == set(rise["fits"])
     page = (quick / "self_similarity.html").read_text()

@@ -35,9 +35,15 @@ def test_sensors_are_sampled_exactly_at_the_acquisition_rate():
     assert settings.dt_s <= settings_of(RunConfig(edge_beads=7)).dt_s
 
 
-@pytest.mark.parametrize("sensors, message", [
-    (["1:2"], "neither a bead id nor 'line:n'"), (["+30:99"], "has beads 0 to 9"),
-    ([10_000], "not in the packing"), (["0:1", "0:1"], "the same bead twice")])
+@pytest.mark.parametrize(
+    "sensors, message",
+    [
+        (["1:2"], "neither a bead id nor 'line:n'"),
+        (["+30:99"], "has beads 0 to 9"),
+        ([10_000], "not in the packing"),
+        (["0:1", "0:1"], "the same bead twice"),
+    ],
+)
 def test_bad_sensors_are_refused(sensors, message):
     with pytest.raises(HexdemError, match=message):
         build_model(RunConfig(edge_beads=7, sensors=sensors))
@@ -70,7 +76,8 @@ def test_sensor_files_follow_the_run(sensor_run):
     for p in peaks:
         assert float(p["peak_speed"]) == float(by_bead[p["bead_id"]]["peak_speed"])
         assert float(p["relative_arrival_time"]) == pytest.approx(
-            float(p["arrival_time"]) - float(peaks[0]["arrival_time"]), abs=1e-15)
+            float(p["arrival_time"]) - float(peaks[0]["arrival_time"]), abs=1e-15
+        )
 
 
 def test_recorded_accelerations_integrate_to_the_recorded_velocities(sensor_run):
@@ -109,8 +116,10 @@ def test_measured_signals_are_aligned_and_compared(sensor_run, tmp_path):
     with open(measured, "w") as fh:
         fh.write("sensor,time,ax,ay\n")
         for r in rows:
-            fh.write(f"{r['sensor']},{float(r['time']) + 123.4e-6!r},{float(r['ax']) + rng.normal(0, 1.0)!r},"
-                     f"{float(r['ay']) + rng.normal(0, 1.0)!r}\n")
+            fh.write(
+                f"{r['sensor']},{float(r['time']) + 123.4e-6!r},{float(r['ax']) + rng.normal(0, 1.0)!r},"
+                f"{float(r['ay']) + rng.normal(0, 1.0)!r}\n"
+            )
     assert main(["signals", "--measured", str(measured), "--run", str(out), "--out", str(tmp_path)]) == 0
     header, table = read_csv(tmp_path / "signals.csv")
     assert header == SIGNAL_COLUMNS and len(table) == len(SENSORS)
@@ -131,8 +140,9 @@ def test_measured_file_without_accelerations_is_a_one_line_error(sensor_run, tmp
 def test_both_engines_record_the_same_sensor_signals(tmp_path):
     """Velocities and accelerations of every sensor sample, t = 0 included, within 0.5 % of each
     signal's largest value."""
-    lammps, reference = (simulate(CONFIG.replace(engine=name), tmp_path / name).tracked
-                         for name in ("lammps", "reference"))
+    lammps, reference = (
+        simulate(CONFIG.replace(engine=name), tmp_path / name).tracked for name in ("lammps", "reference")
+    )
     np.testing.assert_allclose(lammps.sensor_times, reference.sensor_times, rtol=1e-12)
     scale = np.max(np.abs(reference.sensor_states), axis=0)
     assert np.all(np.abs(lammps.sensor_states - reference.sensor_states) <= 5e-3 * scale + 1e-12)

@@ -49,8 +49,9 @@ def test_two_bead_oblique_collision_exchanges_the_normal_velocity(tmp_path, engi
     centres n̂ and keep the rest: bead 2 leaves with (V0·n̂) n̂, bead 1 with V0 − (V0·n̂) n̂. The line
     of centres turns while they touch, by about the tangential slip over d, v_t τ / d (8e-4 rad
     here), which bounds the difference; momentum and kinetic energy are conserved exactly."""
-    summary, beads = run_cli(tmp_path, 'shape = "sites"\nsites = [[0, 0], [1, 1]]\nsite_walls_deg = []\n'
-                                       'duration = 3e-4\n', engine)
+    summary, beads = run_cli(
+        tmp_path, 'shape = "sites"\nsites = [[0, 0], [1, 1]]\nsite_walls_deg = []\nduration = 3e-4\n', engine
+    )
     normal = np.array([np.cos(np.radians(CONTACT_DEG)), np.sin(np.radians(CONTACT_DEG))])
     struck = np.array([V0, 0.0])
     expected = np.array([struck - (struck @ normal) * normal, (struck @ normal) * normal])
@@ -66,8 +67,11 @@ def test_two_bead_oblique_collision_exchanges_the_normal_velocity(tmp_path, engi
 def test_two_bead_frictional_collision_conserves_momentum(tmp_path):
     """The issue's case (μ = 0.05): the run completes, momentum is conserved, and friction turns
     both spheres equally (the tangential force acts on both at the same lever arm)."""
-    summary, beads = run_cli(tmp_path, 'shape = "sites"\nsites = [[0, 0], [1, 1]]\nsite_walls_deg = []\n'
-                                       'friction = 0.05\nduration = 3e-4\n', "lammps")
+    summary, beads = run_cli(
+        tmp_path,
+        'shape = "sites"\nsites = [[0, 0], [1, 1]]\nsite_walls_deg = []\nfriction = 0.05\nduration = 3e-4\n',
+        "lammps",
+    )
     np.testing.assert_allclose(end_velocities(beads).sum(axis=0), [V0, 0.0], atol=1e-9)
     spins = [float(bead["peak_angular_speed"]) for bead in beads]
     assert spins[0] > 0 and spins[0] == pytest.approx(spins[1], rel=1e-9)
@@ -84,8 +88,9 @@ def test_chain_along_a_contact_row_runs_and_skips_the_front(tmp_path):
     row = [float(p["peak_speed"]) for p in peaks if p["line"] == "+30"]
     assert len(row) == 10 and all(np.isfinite(row[:8]))
     velocity = end_velocities(beads)
-    np.testing.assert_allclose(velocity.sum(axis=0), V0 * np.array([np.cos(np.radians(30)), np.sin(np.radians(30))]),
-                               atol=1e-9)
+    np.testing.assert_allclose(
+        velocity.sum(axis=0), V0 * np.array([np.cos(np.radians(30)), np.sin(np.radians(30))]), atol=1e-9
+    )
 
 
 def test_a_bead_that_never_moved_has_peak_speed_zero(tmp_path):

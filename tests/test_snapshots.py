@@ -5,6 +5,7 @@ import json
 import numpy as np
 import pytest
 from conftest import read_csv
+from readable import saved_figure, smallest_text_px
 
 from hexdem.cli.main import main
 from hexdem.errors import HexdemError
@@ -13,7 +14,6 @@ from hexdem.model.config import RunConfig
 from hexdem.model.model_builder import build_model, build_packing
 from hexdem.model.run_settings import run_settings
 from hexdem.model.triangular import hexagon
-from readable import saved_figure, smallest_text_px
 
 TIMES_S = (1e-4, 2e-4, 3e-4)
 #: A half-hexagon small enough for seconds, large enough to split between two ranks.
@@ -43,8 +43,7 @@ def test_bad_times_are_refused(times):
 def one_and_two_ranks(tmp_path_factory):
     base = tmp_path_factory.mktemp("snapshots")
     model = build_model(SMALL_HALF)
-    return [take_snapshots(SMALL_HALF.replace(ranks=ranks), model, TIMES_S, base / f"ranks{ranks}")
-            for ranks in (1, 2)]
+    return [take_snapshots(SMALL_HALF.replace(ranks=ranks), model, TIMES_S, base / f"ranks{ranks}") for ranks in (1, 2)]
 
 
 def test_one_and_two_ranks_give_the_same_speeds(one_and_two_ranks):
@@ -79,16 +78,19 @@ def test_the_command_writes_the_figure_and_its_table(tmp_path):
     assert summary["ranks"] == 1 and summary["n_beads"] == 61
 
 
-@pytest.mark.parametrize("config", [RunConfig(edge_beads=11),
-                                    RunConfig(shape="half-hexagon", long_edge=41, short_edge=21)])
+@pytest.mark.parametrize(
+    "config", [RunConfig(edge_beads=11), RunConfig(shape="half-hexagon", long_edge=41, short_edge=21)]
+)
 def test_the_panels_share_one_colour_bar_readable_in_the_report(monkeypatch, config):
     """Six panels, one colour scale from 0 to the median of their largest speeds with one bar
     (Fig. 4 had six bars of 6-point labels), every text at least 10 px where the report shows it."""
     lattice = build_packing(config)
     speeds = np.random.default_rng(1).uniform(0.0, 0.05, (6, len(lattice))) * np.arange(1, 7)[:, None]
     snapshots = Snapshots(config, lattice, np.arange(1, 7) * 2e-4, speeds, {})
-    fig = saved_figure(monkeypatch, lambda: snapshot_figure(snapshots, build_model(config).walls, "unused.png",
-                                                            hexagon(11, config.diameter_m)))
+    fig = saved_figure(
+        monkeypatch,
+        lambda: snapshot_figure(snapshots, build_model(config).walls, "unused.png", hexagon(11, config.diameter_m)),
+    )
     panels = [ax for ax in fig.axes if ax.get_title().startswith("t = ")]
     assert len(panels) == 6 and len(fig.axes) == 7, "six panels and one colour bar"
     assert all(ax.collections[0].get_clim() == (0.0, np.median(speeds.max(axis=1))) for ax in panels)

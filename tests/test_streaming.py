@@ -42,7 +42,11 @@ def test_streaming_agrees_with_hexdem_analyse_of_the_dump(dumped_run, tmp_path):
     _, stream_rows = read_csv(out / "peaks.csv")
     _, dump_rows = read_csv(tmp_path / "peaks.csv")
     assert len(stream_rows) == len(dump_rows) == 11 + 2 * 16
-    for key, tolerance, relative in (("peak_speed", 1e-4, True), ("arrival_time", 1e-7, False), ("t_peak", 5e-7, False)):
+    for key, tolerance, relative in (
+        ("peak_speed", 1e-4, True),
+        ("arrival_time", 1e-7, False),
+        ("t_peak", 5e-7, False),
+    ):
         a = np.array([float(row[key]) for row in stream_rows])
         b = np.array([float(row[key]) for row in dump_rows])
         np.testing.assert_array_equal(np.isnan(a), np.isnan(b))
@@ -55,8 +59,8 @@ def _synthetic_speeds(times, n_beads, rng):
     """Pulses of Hertz-like shape arriving one after another, a weaker echo later, and noise."""
     arrival = np.linspace(0.1, 0.6, n_beads) + rng.uniform(0, 0.02, n_beads)
     width = rng.uniform(0.04, 0.08, n_beads)
-    speeds = np.exp(-((times[:, None] - arrival) / width) ** 2)
-    speeds += rng.uniform(0.2, 0.9, n_beads) * np.exp(-((times[:, None] - arrival - 0.3) / width) ** 2)
+    speeds = np.exp(-(((times[:, None] - arrival) / width) ** 2))
+    speeds += rng.uniform(0.2, 0.9, n_beads) * np.exp(-(((times[:, None] - arrival - 0.3) / width) ** 2))
     return speeds * rng.uniform(0.5, 2.0, n_beads) + 1e-9 * rng.random((len(times), n_beads))
 
 
@@ -105,14 +109,29 @@ class MigratingBeads:
         draws = self.n_samples // self.every + 1
         owners = np.repeat(rng.integers(0, ranks, (draws, n)), self.every, axis=0)
         orders = np.repeat([rng.permutation(n) for _ in range(draws)], self.every, axis=0)
-        tracker = PulseTracker(model, RunSettings(dt_s=times[1], n_steps=self.n_samples - 1, dump_every=1), comm,
-                               trace_beads=(0, 5, 17), field_samples=(10, 150), threshold_speed=0.05)
+        tracker = PulseTracker(
+            model,
+            RunSettings(dt_s=times[1], n_steps=self.n_samples - 1, dump_every=1),
+            comm,
+            trace_beads=(0, 5, 17),
+            field_samples=(10, 150),
+            threshold_speed=0.05,
+        )
         tracker.audit = NoAudit()
         rank = 0 if comm is None else comm.Get_rank()
         for s, row in enumerate(speeds):
             ids = orders[s][owners[s][orders[s]] == rank] + 1
-            tracker(Sample(s, s, times[s], ids, np.zeros((len(ids), 2)), np.column_stack([row[ids - 1], np.zeros(len(ids))]),
-                           migrated=s % self.every == 0))
+            tracker(
+                Sample(
+                    s,
+                    s,
+                    times[s],
+                    ids,
+                    np.zeros((len(ids), 2)),
+                    np.column_stack([row[ids - 1], np.zeros(len(ids))]),
+                    migrated=s % self.every == 0,
+                )
+            )
         return tracker.finish(), int(np.sum(owners[1:] != owners[:-1]))
 
 
@@ -122,12 +141,22 @@ def test_beads_that_change_ranks_keep_their_pulses(tmp_path, monkeypatch):
     and snapshot fields. One collective per such sample and the final gather; none at the other
     samples, audited or not."""
     # the ranks unpickle the job from here, with the hexdem this test imports
-    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(filter(None, [str(Path(__file__).parent), os.environ.get("PYTHONPATH")])))
+    monkeypatch.setenv(
+        "PYTHONPATH", os.pathsep.join(filter(None, [str(Path(__file__).parent), os.environ.get("PYTHONPATH")]))
+    )
     one, _ = MigratingBeads()(None)
     two, handed_over = run_on_ranks(MigratingBeads(), 2, tmp_path)
     assert handed_over > 500  # about half of 37 beads at each of 42 draws
     assert np.isfinite(one.arrival_time).sum() > 20 and np.isfinite(one.threshold_time).sum() > 20
-    for name in ("peak_speed", "t_peak", "arrival_time", "reach_time", "threshold_time", "trace_speeds", "field_speeds"):
+    for name in (
+        "peak_speed",
+        "t_peak",
+        "arrival_time",
+        "reach_time",
+        "threshold_time",
+        "trace_speeds",
+        "field_speeds",
+    ):
         np.testing.assert_array_equal(getattr(two, name), getattr(one, name), err_msg=name)
     assert np.isfinite(two.trace_speeds).all() and np.isfinite(two.field_speeds).all()
     assert one.collectives == 0
@@ -138,12 +167,13 @@ def test_the_tracker_records_when_each_bead_first_reaches_a_fixed_speed(tmp_path
     """The threshold's first crossing, from the whole trace of the 0° line, interpolated by hand
     between the samples around it: the same time to round-off (the struck bead: 0)."""
     threshold = 0.01
-    analysis = simulate(RunConfig(edge_beads=5, engine="reference"), tmp_path, trace_lines=["0"],
-                        threshold_speed=threshold)
+    analysis = simulate(
+        RunConfig(edge_beads=5, engine="reference"), tmp_path, trace_lines=["0"], threshold_speed=threshold
+    )
     times, speeds = analysis.line_trace("0")
     for k, bead in enumerate(analysis.results.lines["0"]):
         i = int(np.argmax(speeds[:, k] >= threshold))
-        expected = 0.0 if i == 0 else np.interp(threshold, speeds[i - 1:i + 1, k], times[i - 1:i + 1])
+        expected = 0.0 if i == 0 else np.interp(threshold, speeds[i - 1 : i + 1, k], times[i - 1 : i + 1])
         assert analysis.tracked.threshold_time[bead] == pytest.approx(expected, rel=1e-12, abs=1e-15)
     assert analysis.tracked.threshold_time[analysis.results.lines["0"][-1]] > 0
 
@@ -185,8 +215,9 @@ def test_an_earlier_small_pulse_just_above_half_the_peak_is_the_arrival():
     tracker = PulseTracker(model, RunSettings(dt_s=1.0, n_steps=59, dump_every=1))
     tracker.audit = NoAudit()
     for s, v in enumerate(series):
-        tracker(Sample(s, s, float(s), np.arange(1, n + 1), np.zeros((n, 2)),
-                       np.column_stack([np.full(n, v), np.zeros(n)])))
+        tracker(
+            Sample(s, s, float(s), np.arange(1, n + 1), np.zeros((n, 2)), np.column_stack([np.full(n, v), np.zeros(n)]))
+        )
     whole = pulse_times(np.arange(60.0), series[:, None])
     assert whole.arrival_time[0] == pytest.approx(7.96, abs=0.01)
     assert tracker.finish().arrival_time[0] == pytest.approx(whole.arrival_time[0], abs=0.2)
@@ -231,7 +262,9 @@ def test_the_energy_audit_summed_over_ranks_equals_the_gathered_one(tmp_path, mo
     (the packing and the striker). Collectives: one per sample at which atoms may have changed ranks
     (the first of the run, and after each rebuild of the neighbour lists) and the final gather, which
     brings the ranks' audit parts to be summed: none per audited sample."""
-    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(filter(None, [str(Path(__file__).parent), os.environ.get("PYTHONPATH")])))
+    monkeypatch.setenv(
+        "PYTHONPATH", os.pathsep.join(filter(None, [str(Path(__file__).parent), os.environ.get("PYTHONPATH")]))
+    )
     tracked, gathered, migrations = run_on_ranks(GatheredAudit(tmp_path / "deck"), 3, tmp_path)
     assert gathered.shape == tracked.region_energies.shape == (len(tracked.energy_times), 2, 2)
     assert np.all(gathered[1:, 0, 1] > 0) and gathered[:, 1, 1].max() > 0, "contacts in both regions"
@@ -253,4 +286,6 @@ def test_the_dump_carries_each_beads_radius_and_mass_which_mdanalysis_reads(dump
     assert analysis.settings.units.name == "si"
     universe = mda.Universe(str(dump), format="LAMMPSDUMP", additional_columns=["radius"])
     np.testing.assert_allclose(universe.atoms.masses, analysis.model.masses_kg, rtol=1e-12)
-    np.testing.assert_allclose(universe.trajectory.ts.data["radius"], analysis.model.packing.diameters_m / 2, rtol=1e-15)
+    np.testing.assert_allclose(
+        universe.trajectory.ts.data["radius"], analysis.model.packing.diameters_m / 2, rtol=1e-15
+    )

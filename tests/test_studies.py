@@ -27,7 +27,7 @@ SIX = ["--vary", "v0=0.2,0.3,0.4", "--vary", "friction=0,0.1"]
 #: Parsl on this machine: one block of two workers, a lost worker noticed within seconds, its
 #: tasks retried on a block started afresh; the block started half a second after Parsl is (its
 #: strategy's first look, 5 s after by default).
-PARSL_CONFIG = '''
+PARSL_CONFIG = """
 from parsl.config import Config
 from parsl.executors import HighThroughputExecutor
 from parsl.providers import LocalProvider
@@ -37,7 +37,7 @@ config = Config(
                                       heartbeat_threshold=5, heartbeat_period=1, block_error_handler=False,
                                       provider=LocalProvider(init_blocks=1, min_blocks=1, max_blocks=1))],
     retries=2, strategy_period=0.5, run_dir="{run_dir}")
-'''
+"""
 
 
 def sweep(tmp_path, *options):
@@ -74,8 +74,9 @@ def kill_a_worker_mid_run(out, killed: list) -> None:
         if len([path for path in (out / "runs").glob("*") if path.is_dir() and not path.name.startswith(".")]) >= 2:
             for process in psutil.process_iter(["cmdline"]):
                 try:
-                    if any("spawn_main" in word for word in process.info["cmdline"] or ()) and \
-                            any(f.path.startswith(part_folders) for f in process.open_files()):
+                    if any("spawn_main" in word for word in process.info["cmdline"] or ()) and any(
+                        f.path.startswith(part_folders) for f in process.open_files()
+                    ):
                         process.kill()
                         killed.append(process.pid)
                         return
@@ -106,8 +107,22 @@ def test_runs_of_two_ranks_each(serial, tmp_path, launcher):
     command, log = launcher
     before = len(log.read_text().splitlines()) if log.exists() else 0
     two = tmp_path / "two"
-    assert sweep(tmp_path, "--vary", "v0=0.2,0.4", "--vary", "friction=0", "--out", str(two), "--ranks-per-run", "2",
-                 "--launcher", command) == 0
+    assert (
+        sweep(
+            tmp_path,
+            "--vary",
+            "v0=0.2,0.4",
+            "--vary",
+            "friction=0",
+            "--out",
+            str(two),
+            "--ranks-per-run",
+            "2",
+            "--launcher",
+            command,
+        )
+        == 0
+    )
     jobs = log.read_text().splitlines()[before:]
     assert sorted(job.split()[:2] for job in jobs) == [["-n", "2"]] * 2
     ours, one_rank = peaks_of(two), peaks_of(serial)
@@ -115,8 +130,9 @@ def test_runs_of_two_ranks_each(serial, tmp_path, launcher):
     for run, (_, mine) in ours.items():
         theirs = one_rank[run][1]
         speeds = [float(row["peak_speed"] or "nan") for row in mine]
-        assert speeds == pytest.approx([float(row["peak_speed"] or "nan") for row in theirs], rel=1e-9,
-                                       nan_ok=True), run
+        assert speeds == pytest.approx([float(row["peak_speed"] or "nan") for row in theirs], rel=1e-9, nan_ok=True), (
+            run
+        )
 
 
 def test_a_job_arrays_runs_one_at_a_time_then_the_table(serial, tmp_path, capsys):
@@ -168,16 +184,19 @@ def test_a_job_arrays_failed_run_exits_as_a_failed_run(tmp_path, capsys):
     assert "energy drift" in (out / "runs" / "dt=3.5e-6.failed").read_text()
 
 
-@pytest.mark.parametrize("arguments, message", [
-    (["sweep", "{out}", "--run", "5"], "--run 5: {out} plans runs 0 to 1"),
-    (["sweep", "{tmp}/nothing", "--collect"], "holds no planned sweep"),
-    (["sweep", "{out}", "--vary", "v0=0.1"], "is a planned study"),
-    (["sweep", "--vary", "v0=0.1,0.2"], "a sweep needs --vary"),
-    (["sweep", "--run", "0"], "--run and --collect need the study folder"),
-    (["sweep", "{out}", "--run", "0", "--parsl", "x.py"], "--run I runs here, without --parsl"),
-    (["sweep", "{out}", "--run", "0", "--ranks-per-run", "0"], "--ranks-per-run must be a positive integer"),
-    (["sweep", "{out}", "--workers", "0"], "--workers must be a positive integer"),
-])
+@pytest.mark.parametrize(
+    "arguments, message",
+    [
+        (["sweep", "{out}", "--run", "5"], "--run 5: {out} plans runs 0 to 1"),
+        (["sweep", "{tmp}/nothing", "--collect"], "holds no planned sweep"),
+        (["sweep", "{out}", "--vary", "v0=0.1"], "is a planned study"),
+        (["sweep", "--vary", "v0=0.1,0.2"], "a sweep needs --vary"),
+        (["sweep", "--run", "0"], "--run and --collect need the study folder"),
+        (["sweep", "{out}", "--run", "0", "--parsl", "x.py"], "--run I runs here, without --parsl"),
+        (["sweep", "{out}", "--run", "0", "--ranks-per-run", "0"], "--ranks-per-run must be a positive integer"),
+        (["sweep", "{out}", "--workers", "0"], "--workers must be a positive integer"),
+    ],
+)
 def test_bad_study_commands_are_one_line(tmp_path, capsys, arguments, message):
     out = tmp_path / "out"
     assert sweep(tmp_path, "--vary", "v0=0.2,0.3", "--out", str(out), "--plan-only") == 0
@@ -188,13 +207,16 @@ def test_bad_study_commands_are_one_line(tmp_path, capsys, arguments, message):
     assert len(lines) == 1 and message.format(out=out) in lines[0], lines
 
 
-@pytest.mark.parametrize("text, message", [
-    (None, "no such file"),
-    ("config = 3\n", "must define config = parsl.config.Config(...), got int"),
-    ("import nonexistent_module\n", "the configuration file fails: ModuleNotFoundError"),
-    ("import sys\nsys.exit(0)\n", "the configuration file exits (sys.exit(0))"),
-    ("import sys\nsys.exit(1)\n", "the configuration file exits (sys.exit(1))"),
-])
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        (None, "no such file"),
+        ("config = 3\n", "must define config = parsl.config.Config(...), got int"),
+        ("import nonexistent_module\n", "the configuration file fails: ModuleNotFoundError"),
+        ("import sys\nsys.exit(0)\n", "the configuration file exits (sys.exit(0))"),
+        ("import sys\nsys.exit(1)\n", "the configuration file exits (sys.exit(1))"),
+    ],
+)
 def test_a_bad_parsl_file_is_one_line_before_anything_is_written(tmp_path, capsys, text, message):
     path = tmp_path / "parsl.py"
     if text is not None:
@@ -240,9 +262,11 @@ def traced_parsl_config(tmp_path, text=None):
     """A Parsl configuration file (``text``; None: this file's local one) that also appends a line to
     ``loaded.log`` beside itself each time it runs; (its path, that log)."""
     path = Path(parsl_config(tmp_path))
-    path.write_text("from pathlib import Path\n"
-                    "with open(Path(__file__).with_name('loaded.log'), 'a') as log:\n    log.write('loaded\\n')\n"
-                    + (path.read_text() if text is None else text))
+    path.write_text(
+        "from pathlib import Path\n"
+        "with open(Path(__file__).with_name('loaded.log'), 'a') as log:\n    log.write('loaded\\n')\n"
+        + (path.read_text() if text is None else text)
+    )
     return str(path), tmp_path / "loaded.log"
 
 
@@ -264,8 +288,18 @@ def test_a_failed_run_is_recorded_and_the_others_finish(tmp_path, capsys):
     assert not (out / "runs" / "dt=3.5e-6").exists() and not list((out / "runs").glob(".*"))
     assert "energy drift" in (out / "runs" / "dt=3.5e-6.failed").read_text()
     summary = json.loads((out / "runs" / "dt=1e-7" / "summary.json").read_text())
-    assert summary["provenance"]["command"] == ["hexdem", "sweep", "--config", str(tmp_path / "base.toml"), "--vary",
-                                                "dt=1e-7,3.5e-6", "--out", str(out), "--parsl", path]
+    assert summary["provenance"]["command"] == [
+        "hexdem",
+        "sweep",
+        "--config",
+        str(tmp_path / "base.toml"),
+        "--vary",
+        "dt=1e-7,3.5e-6",
+        "--out",
+        str(out),
+        "--parsl",
+        path,
+    ]
     assert main(["sweep", str(out), "--parsl", path]) == 4
     assert trace.read_text() == "loaded\n" * 2
     assert "2 runs (1 done before), on Parsl" in capsys.readouterr().err
@@ -281,8 +315,24 @@ def test_an_ensemble_on_the_shipped_parsl_file_runs_it_once_with_its_logs_in_the
     monkeypatch.chdir(tmp_path)
     path, trace = traced_parsl_config(tmp_path, SHIPPED_PARSL.read_text())
     out = tmp_path / "ensemble"
-    assert main(["ensemble", "--out", str(out), "--edge-beads", "4", "--velocities", "0.4", "--realizations", "1",
-                 "--parsl", path]) == 0
+    assert (
+        main(
+            [
+                "ensemble",
+                "--out",
+                str(out),
+                "--edge-beads",
+                "4",
+                "--velocities",
+                "0.4",
+                "--realizations",
+                "1",
+                "--parsl",
+                path,
+            ]
+        )
+        == 0
+    )
     assert trace.read_text() == "loaded\n"
     assert (out / "peaks_stats.csv").exists()
     assert (out / "runinfo").is_dir() and not (tmp_path / "runinfo").exists()
@@ -294,9 +344,11 @@ def test_studies_inside_a_commands_parsl_session_share_its_parsl(tmp_path):
     from hexdem.experiments.executors import holding, parsl_session, study_executor
 
     path = tmp_path / "threads.py"
-    path.write_text("from parsl.config import Config\nfrom parsl.executors import ThreadPoolExecutor\n"
-                    "config = Config(executors=[ThreadPoolExecutor(max_threads=2)], "
-                    f"run_dir={str(tmp_path / 'runinfo')!r})\n")
+    path.write_text(
+        "from parsl.config import Config\nfrom parsl.executors import ThreadPoolExecutor\n"
+        "config = Config(executors=[ThreadPoolExecutor(max_threads=2)], "
+        f"run_dir={str(tmp_path / 'runinfo')!r})\n"
+    )
     session, used = parsl_session(str(path)), []
     with holding(session):
         for study in range(2):
@@ -318,7 +370,7 @@ def test_studies_inside_a_commands_hold_share_its_local_pools_workers():
 
     with holding(None, 1):
         pids = []
-        for phase in range(3):
+        for _phase in range(3):
             with holding(None, 2), study_executor(1) as executor:
                 pids.append(executor.submit(os.getpid).result())
         assert len(set(pids)) == 1 and pids[0] != os.getpid()
@@ -358,16 +410,18 @@ def test_a_failed_task_is_submitted_again_as_many_times_as_the_retries_given(ret
         raise ValueError(key)
 
     with ThreadPoolExecutor(1) as executor:
-        (key, result, error), = run_tasks(executor, {"a": (fails, "a")}, retries)
+        ((key, result, error),) = run_tasks(executor, {"a": (fails, "a")}, retries)
     assert (key, result, type(error), len(tries)) == ("a", None, ValueError, 1 + retries)
 
 
 def threads_config(tmp_path) -> Path:
     """Parsl's own default executor, a ThreadPoolExecutor of two threads."""
     threads = tmp_path / "threads.py"
-    threads.write_text("from parsl.config import Config\nfrom parsl.executors import ThreadPoolExecutor\n"
-                       "config = Config(executors=[ThreadPoolExecutor(label='threads', max_threads=2)], "
-                       f"run_dir={str(tmp_path / 'runinfo')!r})\n")
+    threads.write_text(
+        "from parsl.config import Config\nfrom parsl.executors import ThreadPoolExecutor\n"
+        "config = Config(executors=[ThreadPoolExecutor(label='threads', max_threads=2)], "
+        f"run_dir={str(tmp_path / 'runinfo')!r})\n"
+    )
     return threads
 
 
@@ -378,9 +432,28 @@ def test_two_runs_in_two_threads_of_one_process(serial, tmp_path):
     directory, which the threads share), and they give the runs of the serial sweep, whose runs
     were processes."""
     (tmp_path / "base.toml").write_text(SMALL)
-    done = subprocess.run([sys.executable, "-m", "hexdem", "sweep", "--config", "base.toml", "--vary", "v0=0.2,0.3",
-                           "--vary", "friction=0", "--out", "out", "--parsl", str(threads_config(tmp_path))],
-                          cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "hexdem",
+            "sweep",
+            "--config",
+            "base.toml",
+            "--vary",
+            "v0=0.2,0.3",
+            "--vary",
+            "friction=0",
+            "--out",
+            "out",
+            "--parsl",
+            str(threads_config(tmp_path)),
+        ],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert done.returncode == 0, done.stderr
     _, rows = read_csv(tmp_path / "out" / "sweep.csv")
     assert [row["status"] for row in rows] == ["done", "done"] and not list((tmp_path / "out" / "runs").glob(".*"))
@@ -395,9 +468,26 @@ def test_a_sweep_on_parsls_threads_stopped_mid_run_ends_in_one_line_and_keeps_no
     their part folders go, and the command ends as a stopped run does, within seconds."""
     (tmp_path / "base.toml").write_text("edge_beads = 25\nduration = 0.001\n")
     study = tmp_path / "study"
-    process = subprocess.Popen([sys.executable, "-m", "hexdem", "sweep", "--config", "base.toml",
-                                "--vary", "v0=0.2,0.3,0.4", "--out", str(study), "--parsl", str(threads_config(tmp_path))],
-                               cwd=tmp_path, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    process = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "hexdem",
+            "sweep",
+            "--config",
+            "base.toml",
+            "--vary",
+            "v0=0.2,0.3,0.4",
+            "--out",
+            str(study),
+            "--parsl",
+            str(threads_config(tmp_path)),
+        ],
+        cwd=tmp_path,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
     deadline = time.monotonic() + 120
     while not list((study / "runs").glob(".*.part/.hexdem-run-*/deck/log.lammps")):
         assert process.poll() is None and time.monotonic() < deadline, process.stderr.read()
@@ -406,7 +496,10 @@ def test_a_sweep_on_parsls_threads_stopped_mid_run_ends_in_one_line_and_keeps_no
     process.send_signal(signal.SIGTERM)
     _, err = process.communicate(timeout=60)
     assert process.returncode == 143, err
-    assert err.strip().splitlines()[-1] == "hexdem: interrupted by SIGTERM: the run was stopped and nothing unfinished was kept"
+    assert (
+        err.strip().splitlines()[-1]
+        == "hexdem: interrupted by SIGTERM: the run was stopped and nothing unfinished was kept"
+    )
     assert time.monotonic() - start < 10
     assert not list((study / "runs").iterdir())
 
@@ -414,12 +507,18 @@ def test_a_sweep_on_parsls_threads_stopped_mid_run_ends_in_one_line_and_keeps_no
 def test_the_local_pools_processes_end_with_a_killed_study(tmp_path):
     """A study killed outright leaves no worker behind to go on writing into its folder."""
     script = tmp_path / "killed.py"
-    script.write_text("import os, time\nfrom hexdem.experiments.executors import LocalPool\n"
-                      "if __name__ == '__main__':\n    pool = LocalPool(2)\n"
-                      "    print(*{pool.submit(os.getpid).result() for _ in range(4)}, flush=True)\n"
-                      "    pool.submit(time.sleep, 60)\n    os._exit(0)\n")
-    workers = [int(pid) for pid in subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
-                                                  check=True, timeout=60).stdout.split()]
+    script.write_text(
+        "import os, time\nfrom hexdem.experiments.executors import LocalPool\n"
+        "if __name__ == '__main__':\n    pool = LocalPool(2)\n"
+        "    print(*{pool.submit(os.getpid).result() for _ in range(4)}, flush=True)\n"
+        "    pool.submit(time.sleep, 60)\n    os._exit(0)\n"
+    )
+    workers = [
+        int(pid)
+        for pid in subprocess.run(
+            [sys.executable, str(script)], capture_output=True, text=True, check=True, timeout=60
+        ).stdout.split()
+    ]
     deadline = time.monotonic() + 10
     while time.monotonic() < deadline and any(psutil.pid_exists(pid) for pid in workers):
         time.sleep(0.1)

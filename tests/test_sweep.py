@@ -37,11 +37,17 @@ def swept(tmp_path_factory):
 def test_the_table_has_a_row_per_run_in_the_plans_order(swept):
     header, rows = read_csv(swept / "sweep.csv")
     assert header[:5] == ("regions.0.material", "v0", "run", "status", "warnings") and header[-1] == "error"
-    assert header[5:5 + len(SUMMARY_COLUMNS)] == SUMMARY_COLUMNS
+    assert header[5 : 5 + len(SUMMARY_COLUMNS)] == SUMMARY_COLUMNS
     assert {(row["status"], row["warnings"], row["error"]) for row in rows} == {("done", "", "")}
     assert [(r["regions.0.material"], float(r["v0"])) for r in rows] == PLAN
-    assert {"energy_share_steel316", "energy_share_brass", "energy_share_ptfe", "decay_exponent_0",
-            "decay_exponent_+30", "decay_exponent_-30"} <= set(header)
+    assert {
+        "energy_share_steel316",
+        "energy_share_brass",
+        "energy_share_ptfe",
+        "decay_exponent_0",
+        "decay_exponent_+30",
+        "decay_exponent_-30",
+    } <= set(header)
     for row in rows:
         summary = json.loads((swept / row["run"] / "summary.json").read_text())
         assert summary["config"]["regions"][0]["material"] == row["regions.0.material"]
@@ -71,8 +77,10 @@ def test_runs_that_warned_are_named_in_the_table_the_figure_and_the_last_line(tm
     assert last.startswith("hexdem sweep: 1 of 2 runs warned") and "far_wall_not_reached in 1 (duration=1e-4)" in last
     assert "increase 'duration'" in last
     _, rows = read_csv(out / "sweep.csv")
-    assert [(row["warnings"], row["far_wall_reached"]) for row in rows] == [("far_wall_not_reached", "False"),
-                                                                            ("", "True")]
+    assert [(row["warnings"], row["far_wall_reached"]) for row in rows] == [
+        ("far_wall_not_reached", "False"),
+        ("", "True"),
+    ]
     (fig,) = drawn
     energy, decay = fig.axes[:2]
     for ax in (energy, decay):
@@ -93,8 +101,9 @@ def test_the_table_is_that_of_four_separate_runs(swept, tmp_path):
         assert main(["run", "--config", str(config), "--out", str(tmp_path / str(k))]) == 0
         alone = json.loads((tmp_path / str(k) / "summary.json").read_text())
         for key in ("energy_drift", "energy_lost", "far_wall_reached", "n_samples"):
-            assert alone[key] == pytest.approx(float(row[key]) if key != "far_wall_reached" else row[key] == "True",
-                                               rel=1e-12)
+            assert alone[key] == pytest.approx(
+                float(row[key]) if key != "far_wall_reached" else row[key] == "True", rel=1e-12
+            )
         _, ours = read_csv(swept / row["run"] / "peaks.csv")
         _, theirs = read_csv(tmp_path / str(k) / "peaks.csv")
         assert ours == theirs
@@ -107,7 +116,7 @@ def test_the_runs_show_the_physics_they_must(swept):
     more between ptfe beads ((m/E*)^(2/5): 0.28 of the mass, 1/115 of E*)."""
     _, rows = read_csv(swept / "sweep.csv")
     by = {(r["regions.0.material"], float(r["v0"])): r for r in rows}
-    for key, row in by.items():
+    for _key, row in by.items():
         assert abs(float(row["energy_lost"])) < 1e-4
     for material in ("brass", "ptfe"):
         for line in ("0", "+30", "-30"):
@@ -139,8 +148,9 @@ def test_a_rerun_resumes_an_interrupted_sweep(swept, tmp_path, capsys):
     assert not list((out / "runs").glob(".*.part"))
     _, again = read_csv(out / "sweep.csv")
     timings = ("engine_wall_time_s", "wall_time_s")
-    assert [{k: v for k, v in r.items() if k not in timings} for r in again] == \
-        [{k: v for k, v in r.items() if k not in timings} for r in rows]
+    assert [{k: v for k, v in r.items() if k not in timings} for r in again] == [
+        {k: v for k, v in r.items() if k not in timings} for r in rows
+    ]
 
 
 def test_another_plan_in_the_same_directory_is_refused(swept, tmp_path, capsys):
@@ -149,28 +159,33 @@ def test_another_plan_in_the_same_directory_is_refused(swept, tmp_path, capsys):
     assert len(lines) == 1 and "another plan" in lines[0]
 
 
-@pytest.mark.parametrize("options, message", [
-    (["--vary", "frictoin=0,0.1"], "'frictoin' is not a run-config key"),
-    (["--vary", "friction"], "expected KEY=V1,V2,..."),
-    (["--vary", "friction=0,,0.1"], "no empty value"),
-    (["--vary", "friction="], "no empty value"),
-    (["--vary", "friction=0,rough"], "--vary friction must be a number, got 'rough'"),
-    (["--vary", "edge_beads=abc,5"], "--vary edge_beads must be an integer, got 'abc'"),
-    (["--vary", "initial_state_file=3"], "--vary initial_state_file must be a string, got 3"),
-    (["--vary", "dump=yes"], "--vary dump must be true or false, got 'yes'"),
-    (["--vary", "regions.0.x_min_d=far"], "--vary regions.0.x_min_d must be a number, got 'far'"),
-    (["--vary", "materials.bronze.density_kg_m3=heavy"], "--vary materials.bronze.density_kg_m3 must be a number"),
-    (["--vary", "vacancies.0.1=x"], "--vary vacancies.0.1 must be an integer, got 'x'"),
-    (["--vary", "friction=0,0.1", "--launcher", "/nonexistent/mpiexec"],
-     "cannot start the MPI launcher '/nonexistent/mpiexec': no such executable"),
-    (["--vary", "friction=0.1,0.1"], "a value is listed twice"),
-    (["--vary", "v0=0.4,0.40"], "two values are the same once read"),
-    (["--vary", "friction=0,-0.2"], "run friction=-0.2: friction must be a coefficient >= 0"),
-    (["--vary", "v0=0.4", "--vary", "v0=0.2"], "a key is varied twice"),
-    (["--vary", "regions.1.material=brass"], "the base configuration has no item 1"),
-    (["--vary", "regions.0.material=unobtainium"], "run regions.0.material=unobtainium"),
-    (["--vary", "friction=0", "--workers", "0"], "--workers must be a positive integer"),
-])
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        (["--vary", "frictoin=0,0.1"], "'frictoin' is not a run-config key"),
+        (["--vary", "friction"], "expected KEY=V1,V2,..."),
+        (["--vary", "friction=0,,0.1"], "no empty value"),
+        (["--vary", "friction="], "no empty value"),
+        (["--vary", "friction=0,rough"], "--vary friction must be a number, got 'rough'"),
+        (["--vary", "edge_beads=abc,5"], "--vary edge_beads must be an integer, got 'abc'"),
+        (["--vary", "initial_state_file=3"], "--vary initial_state_file must be a string, got 3"),
+        (["--vary", "dump=yes"], "--vary dump must be true or false, got 'yes'"),
+        (["--vary", "regions.0.x_min_d=far"], "--vary regions.0.x_min_d must be a number, got 'far'"),
+        (["--vary", "materials.bronze.density_kg_m3=heavy"], "--vary materials.bronze.density_kg_m3 must be a number"),
+        (["--vary", "vacancies.0.1=x"], "--vary vacancies.0.1 must be an integer, got 'x'"),
+        (
+            ["--vary", "friction=0,0.1", "--launcher", "/nonexistent/mpiexec"],
+            "cannot start the MPI launcher '/nonexistent/mpiexec': no such executable",
+        ),
+        (["--vary", "friction=0.1,0.1"], "a value is listed twice"),
+        (["--vary", "v0=0.4,0.40"], "two values are the same once read"),
+        (["--vary", "friction=0,-0.2"], "run friction=-0.2: friction must be a coefficient >= 0"),
+        (["--vary", "v0=0.4", "--vary", "v0=0.2"], "a key is varied twice"),
+        (["--vary", "regions.1.material=brass"], "the base configuration has no item 1"),
+        (["--vary", "regions.0.material=unobtainium"], "run regions.0.material=unobtainium"),
+        (["--vary", "friction=0", "--workers", "0"], "--workers must be a positive integer"),
+    ],
+)
 def test_bad_plans_are_one_line_before_any_run(tmp_path, capsys, options, message):
     """Refused before anything is written: a corrected command may then use the same --out."""
     assert sweep(tmp_path, *options, "--out", str(tmp_path / "out")) == 3
@@ -182,8 +197,10 @@ def test_bad_plans_are_one_line_before_any_run(tmp_path, capsys, options, messag
 def test_nested_keys_change_one_part_of_a_table_or_list():
     base = {"edge_beads": 4, "regions": [{"material": "brass", "x_min_d": 2.0}], "impacts": [{"site": [0, 0]}]}
     runs = plan_sweep(base, [Variation.parse("regions.0.material=ptfe,glass"), Variation.parse("impacts.0.v0=0.3")])
-    assert [run.name for run in runs] == ["regions.0.material=ptfe,impacts.0.v0=0.3",
-                                          "regions.0.material=glass,impacts.0.v0=0.3"]
+    assert [run.name for run in runs] == [
+        "regions.0.material=ptfe,impacts.0.v0=0.3",
+        "regions.0.material=glass,impacts.0.v0=0.3",
+    ]
     assert [run.config.regions[0]["material"] for run in runs] == ["ptfe", "glass"]
     assert runs[0].config.impacts[0]["v0"] == 0.3 and base["regions"][0]["material"] == "brass"
 
@@ -192,10 +209,27 @@ def test_each_run_reaches_its_rank_through_the_launcher(tmp_path, launcher):
     """--launcher starts each run's ranks (as "srun" would inside an allocation), --ranks-per-run of
     them for a LAMMPS run; the reference engine's runs go the same way, one process each."""
     out = tmp_path / "out"
-    assert sweep(tmp_path, "--vary", "engine=lammps,reference", "--out", str(out), "--workers", "2",
-                 "--ranks-per-run", "2", "--launcher", launcher[0]) == 0
-    jobs = {job.split(f"{out}/runs/.")[1].split(".part/")[0]: job.split()[:2]  # (each run in .NAME.part)
-            for job in launcher[1].read_text().splitlines() if f"{out}/runs/" in job}
+    assert (
+        sweep(
+            tmp_path,
+            "--vary",
+            "engine=lammps,reference",
+            "--out",
+            str(out),
+            "--workers",
+            "2",
+            "--ranks-per-run",
+            "2",
+            "--launcher",
+            launcher[0],
+        )
+        == 0
+    )
+    jobs = {
+        job.split(f"{out}/runs/.")[1].split(".part/")[0]: job.split()[:2]  # (each run in .NAME.part)
+        for job in launcher[1].read_text().splitlines()
+        if f"{out}/runs/" in job
+    }
     assert jobs == {"engine=lammps": ["-n", "2"], "engine=reference": ["-n", "1"]}
     _, rows = read_csv(out / "sweep.csv")
     summaries = [json.loads((out / r["run"] / "summary.json").read_text()) for r in rows]
@@ -208,6 +242,7 @@ def test_a_key_idle_in_some_runs_of_a_sweep_is_kept_and_one_idle_in_all_is_refus
     base = {"impact": "striker", "striker_material": "brass"}
     runs = plan_sweep(base, [Variation.parse("impact=velocity,striker")])
     assert [run.config.striker_material for run in runs] == ["brass", "brass"]
-    with pytest.raises(HexdemError, match="^striker_material does nothing in any run of the sweep: no impact is a "
-                                          "striker"):
+    with pytest.raises(
+        HexdemError, match="^striker_material does nothing in any run of the sweep: no impact is a striker"
+    ):
         plan_sweep({"striker_material": "brass"}, [Variation.parse("v0=0.3,0.4")])

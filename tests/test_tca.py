@@ -28,10 +28,18 @@ def test_reduced_equations_are_the_strains_of_the_three_bead_system():
     """Eq. (TCA_strain) with K = [[2, 1], [1/2, 3/2]] at θ = π/3, derived from the beads."""
     np.testing.assert_allclose(tca.strain_matrix(), [[2.0, 1.0], [0.5, 1.5]], atol=1e-15)
     v0 = 0.3
-    full = solve_ivp(tca.three_bead_rhs, (0, 12.0), [0, 0, 0, v0, 0, 0], method="DOP853",
-                     rtol=1e-11, atol=1e-14, dense_output=True)
-    reduced = solve_ivp(tca.strain_rhs, (0, 12.0), [0, 0, v0, v0 * np.cos(tca.THETA)], method="DOP853",
-                        rtol=1e-11, atol=1e-14, dense_output=True)
+    full = solve_ivp(
+        tca.three_bead_rhs, (0, 12.0), [0, 0, 0, v0, 0, 0], method="DOP853", rtol=1e-11, atol=1e-14, dense_output=True
+    )
+    reduced = solve_ivp(
+        tca.strain_rhs,
+        (0, 12.0),
+        [0, 0, v0, v0 * np.cos(tca.THETA)],
+        method="DOP853",
+        rtol=1e-11,
+        atol=1e-14,
+        dense_output=True,
+    )
     t = np.linspace(0, 12.0, 200)
     x0, x1, xa = full.sol(t)[:3]
     z, y = reduced.sol(t)[:2]
@@ -53,8 +61,9 @@ def test_three_bead_energy_and_momentum_are_conserved(v0):
 
 def test_reduced_system_conserves_its_energy():
     v = 0.2
-    sol = solve_ivp(tca.strain_rhs, (0, 30.0), [0, 0, v, v / 2], method="DOP853", rtol=1e-11, atol=1e-14,
-                    dense_output=True)
+    sol = solve_ivp(
+        tca.strain_rhs, (0, 30.0), [0, 0, v, v / 2], method="DOP853", rtol=1e-11, atol=1e-14, dense_output=True
+    )
     states = sol.sol(np.linspace(0, 30.0, 500)).T
     energies = np.array([tca.strain_energy(s) for s in states])
     np.testing.assert_allclose(energies, energies[0], rtol=1e-9)
@@ -101,8 +110,9 @@ def test_hypergeometric_solution_inverts_the_ansatz_dynamics():
         return s[1]
 
     turning.terminal, turning.direction = True, -1
-    sol = solve_ivp(rhs, (0, 100.0), [0.0, v], method="DOP853", rtol=1e-12, atol=1e-15, events=turning,
-                    dense_output=True)
+    sol = solve_ivp(
+        rhs, (0, 100.0), [0.0, v], method="DOP853", rtol=1e-12, atol=1e-15, events=turning, dense_output=True
+    )
     t = np.linspace(0, sol.t_events[0][0] * 0.999, 60)
     z = sol.sol(t)[0]
     np.testing.assert_allclose(tca.hypergeometric_time(z, v, omega), t, rtol=1e-7, atol=1e-10)
@@ -122,10 +132,9 @@ def test_pulse_prediction_decays_geometrically_and_slows_down():
 def test_crossing_times_of_shifted_pulses():
     """Identical pulses delayed by τ per bead: speeds n, n+1 meet half-way, τ(n + 1/2) + t_peak."""
     tau, times = 0.7, np.linspace(0, 20, 4001)
-    speeds = np.column_stack([np.exp(-((times - 2.0 - tau * n) / 0.5) ** 2) for n in range(6)])
+    speeds = np.column_stack([np.exp(-(((times - 2.0 - tau * n) / 0.5) ** 2)) for n in range(6)])
     arrival = 2.0 + tau * np.arange(6) - 0.5 * np.sqrt(np.log(2))
-    np.testing.assert_allclose(tca.crossing_times(times, speeds, arrival), 2.0 + tau * (np.arange(5) + 0.5),
-                               atol=1e-6)
+    np.testing.assert_allclose(tca.crossing_times(times, speeds, arrival), 2.0 + tau * (np.arange(5) + 0.5), atol=1e-6)
 
 
 def test_bad_velocity_is_a_hexdem_error():
@@ -169,7 +178,9 @@ def test_the_tca_comparison_refuses_a_run_of_several_impacts(tmp_path, table):
     from hexdem.experiments.run import simulate
     from hexdem.model.config import RunConfig
 
-    config = RunConfig(edge_beads=5, engine="reference", impacts=[{"site": [0, 0]}, {"site": [0, 8], "angle_deg": 180.0}])
+    config = RunConfig(
+        edge_beads=5, engine="reference", impacts=[{"site": [0, 0]}, {"site": [0, 8], "angle_deg": 180.0}]
+    )
     analysis = simulate(config, tmp_path, log=lambda message: None, trace_lines=["+30"])
     with pytest.raises(HexdemError, match="single impact; this run has 2"):
         table(analysis)

@@ -7,10 +7,17 @@ from conftest import contact_of
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
 from hexdem.model.hertz import contact_time
-from hexdem.model.materials import (DELRIN, MATERIALS, STEEL_316, Material, effective_modulus, hertz_coefficient,
-                                     sphere_mass)
-from hexdem.model.units import nondimensional, to_nondimensional_velocity, to_physical_velocity
+from hexdem.model.materials import (
+    DELRIN,
+    MATERIALS,
+    STEEL_316,
+    Material,
+    effective_modulus,
+    hertz_coefficient,
+    sphere_mass,
+)
 from hexdem.model.model_builder import build_model
+from hexdem.model.units import nondimensional, to_nondimensional_velocity, to_physical_velocity
 
 D = 0.01905
 
@@ -40,7 +47,6 @@ def test_hertz_coefficient_matches_the_two_sphere_hertz_law():
 def test_bad_material_values():
     with pytest.raises(HexdemError, match="Poisson"):
         Material("rubberish", 1e6, 0.6, 1000.0)
-
 
 
 def test_every_preset_material_is_physical_and_sourced():

@@ -15,13 +15,13 @@ from hexdem.errors import HexdemError
 from hexdem.experiments.wave_run import record_waves
 from hexdem.model.config import RunConfig
 from hexdem.model.initial_state import read_initial_state, write_initial_state
+from hexdem.model.model_builder import build_model, build_packing
+from hexdem.model.run_settings import run_settings
 from hexdem.theory.conical import CIRCULAR, cone_ring_radius, dirac_matrix
 from hexdem.theory.phonons import Lattice2D, cone_slope, sound_speeds
 from hexdem.waves.conical import ConicalSettings, measure_conical
 from hexdem.waves.dispersion import DispersionSettings, band_spread, measure_dispersion, packing_width, taper
 from hexdem.waves.states import bloch_packet, broadband_state
-from hexdem.model.model_builder import build_model, build_packing
-from hexdem.model.run_settings import run_settings
 
 STEEL_20N = Lattice2D.precompressed(20.0, 0.01905)
 
@@ -54,7 +54,7 @@ def test_each_band_takes_the_peak_its_polarization_matches():
     omega1, omega2, tilt = 12345.0, 23456.0, math.radians(35.0)
     lower, upper = np.array([1.0, 0.0]), np.array([0.0, 1.0])
     line = np.array([math.sin(tilt), math.cos(tilt)])
-    components = (np.exp(-1j * omega1 * times)[:, None] * lower + 2 * np.exp(-1j * omega2 * times)[:, None] * line)
+    components = np.exp(-1j * omega1 * times)[:, None] * lower + 2 * np.exp(-1j * omega2 * times)[:, None] * line
     polarization = np.column_stack([lower, upper])[None]
     omega, power = power_spectrum(times, branch_signals(components[:, None, :], polarization))
     assert peak_frequency(omega, power)[0, 0] == pytest.approx(omega2, rel=1e-3)  # by projection alone
@@ -66,7 +66,7 @@ def test_the_resolution_of_a_packing_by_hand():
     falls with the distance from it and is 0 from the inscribed circle's rim on. Near Γ the
     bands are ω = c q, so over a disc of radius r about q the spread is c r for each band."""
     config = DispersionSettings(edge_beads=20).config()
-    positions = build_model(config).packing.positions_m[:config.n_beads()]
+    positions = build_model(config).packing.positions_m[: config.n_beads()]
     a = Lattice2D.of(config).spacing_m
     width = packing_width(positions)
     assert width == pytest.approx(math.sqrt(3) * 19 * a, rel=1e-9)
@@ -76,8 +76,9 @@ def test_the_resolution_of_a_packing_by_hand():
     np.testing.assert_allclose(weights[radius >= width / 2], 0.0, atol=1e-30)
     assert np.all(np.diff(weights[np.argsort(radius)]) <= 1e-12)
     spread = band_spread(STEEL_20N, [[0.01 / STEEL_20N.spacing_m, 0.0]], 0.001 / STEEL_20N.spacing_m)
-    np.testing.assert_allclose(spread[0], np.array(sound_speeds(STEEL_20N))[::-1] * 0.001 / STEEL_20N.spacing_m,
-                               rtol=1e-3)
+    np.testing.assert_allclose(
+        spread[0], np.array(sound_speeds(STEEL_20N))[::-1] * 0.001 / STEEL_20N.spacing_m, rtol=1e-3
+    )
 
 
 def test_the_recorder_keeps_the_lattice_fourier_sum_and_the_block_energies():
@@ -154,11 +155,15 @@ def test_the_measured_dispersion_lies_on_the_bands(engine, tmp_path):
     |q| a = 0.91 against 22.9 %; without the window and the polarizations, 9.3 % at |q| a = 3.49
     against 5.4 %). The points nearest Γ on Γ–K (|q| a = 0.35) and on M–Γ (0.30) are short of
     the limit."""
-    measured = measure_dispersion(DispersionSettings(edge_beads=20, duration_s=0.01, points_per_segment=12,
-                                                     engine=engine), tmp_path, show_progress=False)
+    measured = measure_dispersion(
+        DispersionSettings(edge_beads=20, duration_s=0.01, points_per_segment=12, engine=engine),
+        tmp_path,
+        show_progress=False,
+    )
     assert measured.median_deviation < 0.02
     assert measured.smallest_resolved_per_m * measured.theory.spacing_m == pytest.approx(
-        4 * math.pi / (math.sqrt(3) * 19), rel=1e-6)
+        4 * math.pi / (math.sqrt(3) * 19), rel=1e-6
+    )
     assert measured.resolved.tolist() == [False] + [True] * 33 + [False]
     assert measured.within_bound[measured.resolved].all()
     rows = measured.rows()
@@ -171,8 +176,9 @@ def test_a_packet_at_the_dirac_point_opens_into_a_ring_at_the_cone_slope(tmp_pat
     """σ = 8 d to 3σ in the reference engine: the ring's growth rate is v_D within 3 % (measured
     0.06 %), and the control away from K drifts at its group velocity within 2 % and widens by
     less than 10 %. LAMMPS's same packets are the Dirac-point workflow's (tests/test_workflows.py)."""
-    packets = measure_conical(ConicalSettings(width_d=8.0, reach=3.0, engine="reference"), tmp_path,
-                              show_progress=False)
+    packets = measure_conical(
+        ConicalSettings(width_d=8.0, reach=3.0, engine="reference"), tmp_path, show_progress=False
+    )
     assert packets.slope_deviation < 0.03
     assert packets.drift_deviation < 0.02
     assert packets.control_width_m[-1] / packets.control_width_m[0] < 1.1
@@ -206,14 +212,17 @@ def test_two_ranks_record_what_one_rank_records(tmp_path):
     np.testing.assert_allclose(two.block_kinetic_j, one.block_kinetic_j, rtol=1e-7)
 
 
-@pytest.mark.parametrize("settings, message", [
-    (lambda: DispersionSettings(precompression_n=0.0), "precompression_n must be a number > 0"),
-    (lambda: DispersionSettings(samples_per_period=2), "samples_per_period must be at least 3"),
-    (lambda: DispersionSettings(seed=-1), "seed must be an integer >= 0"),
-    (lambda: ConicalSettings(width_d=-2.0), "width_d must be a number > 0"),
-    (lambda: ConicalSettings(control_fraction=1.5), "control_fraction must lie between 0 and 1"),
-    (lambda: ConicalSettings(width_d=2.0, reach=1.0), "the ring needs at least 4"),
-])
+@pytest.mark.parametrize(
+    "settings, message",
+    [
+        (lambda: DispersionSettings(precompression_n=0.0), "precompression_n must be a number > 0"),
+        (lambda: DispersionSettings(samples_per_period=2), "samples_per_period must be at least 3"),
+        (lambda: DispersionSettings(seed=-1), "seed must be an integer >= 0"),
+        (lambda: ConicalSettings(width_d=-2.0), "width_d must be a number > 0"),
+        (lambda: ConicalSettings(control_fraction=1.5), "control_fraction must lie between 0 and 1"),
+        (lambda: ConicalSettings(width_d=2.0, reach=1.0), "the ring needs at least 4"),
+    ],
+)
 def test_bad_wave_settings_are_one_line(settings, message):
     with pytest.raises(HexdemError, match=message) as caught:
         settings()

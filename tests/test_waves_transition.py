@@ -14,8 +14,16 @@ from hexdem.common.io import write_csv
 from hexdem.errors import HexdemError
 from hexdem.model.materials import STEEL_316, hertz_coefficient, sphere_mass
 from hexdem.model.precompression import static_overlap
-from hexdem.waves.transition import (COLUMNS, QUICK, TransitionMap, TransitionSettings, leading_arrivals,
-                                     overlap_ratio, run_transition, transition_figure)
+from hexdem.waves.transition import (
+    COLUMNS,
+    QUICK,
+    TransitionMap,
+    TransitionSettings,
+    leading_arrivals,
+    overlap_ratio,
+    run_transition,
+    transition_figure,
+)
 
 D = 0.01905
 A = float(hertz_coefficient(D, STEEL_316))
@@ -74,7 +82,7 @@ def test_the_uncompressed_front_scales_as_the_hertz_lattice_does(quick):
     shape and multiplies its speed by 1000^(1/5)."""
     slow, fast = run_of(quick, 0.0, 1e-4), run_of(quick, 0.0, 0.1)
     assert quick.sixfold_amplitude[fast] == pytest.approx(quick.sixfold_amplitude[slow], rel=0.01)
-    assert quick.front_speed_m_s[fast] / quick.front_speed_m_s[slow] == pytest.approx(1000 ** 0.2, rel=0.02)
+    assert quick.front_speed_m_s[fast] / quick.front_speed_m_s[slow] == pytest.approx(1000**0.2, rel=0.02)
     assert np.isinf(quick.overlap_ratio[[slow, fast]]).all() and np.isnan(quick.speed_ratio[[slow, fast]]).all()
 
 
@@ -112,9 +120,15 @@ def test_the_csv_rows_write_nan_empty_and_read_back(quick, tmp_path):
 def test_the_finding_reads_the_transition_off_the_numbers():
     """A made-up sweep: at c_L up to δ_impact/δ0 = 1, 30 % faster at 50, whose sixfold amplitude
     passes half the uncompressed front's."""
-    sweep = TransitionMap(np.array([0.0, 20.0, 20.0, 20.0]), np.array([1.0, 1e-3, 0.1, 3.0]),
-                          np.array([math.inf, 0.01, 1.0, 50.0]), np.array([0.02, 0.001, 0.004, 0.015]),
-                          np.array([400.0, 510.0, 515.0, 660.0]), np.array([math.nan, 1.0, 1.01, 1.3]), QUICK)
+    sweep = TransitionMap(
+        np.array([0.0, 20.0, 20.0, 20.0]),
+        np.array([1.0, 1e-3, 0.1, 3.0]),
+        np.array([math.inf, 0.01, 1.0, 50.0]),
+        np.array([0.02, 0.001, 0.004, 0.015]),
+        np.array([400.0, 510.0, 515.0, 660.0]),
+        np.array([math.nan, 1.0, 1.01, 1.3]),
+        QUICK,
+    )
     finding = sweep.finding()
     assert "within 2 % up to δ_impact/δ0 = 1," in finding
     assert "5 % faster from 50 on and reach 1.30 c_L at 50" in finding
@@ -126,14 +140,17 @@ def test_the_map_is_drawn(quick, tmp_path):
     assert (tmp_path / "transition_map.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
-@pytest.mark.parametrize("changes, words", [
-    ({"forces_n": ()}, "forces_n must be a non-empty list"),
-    ({"speeds_m_s": (0.1, -0.01)}, "speeds_m_s must hold numbers > 0 m/s"),
-    ({"forces_n": (0.0, float("nan"))}, "forces_n must hold numbers ≥ 0 N"),
-    ({"radius_d": 40.0}, "needs a hexagon of at least 33 per edge"),
-    ({"speed_from_d": 20.0}, "need 0 < speed_from_d < radius_d"),
-    ({"impact": "hammer"}, "unknown impact 'hammer'"),
-])
+@pytest.mark.parametrize(
+    "changes, words",
+    [
+        ({"forces_n": ()}, "forces_n must be a non-empty list"),
+        ({"speeds_m_s": (0.1, -0.01)}, "speeds_m_s must hold numbers > 0 m/s"),
+        ({"forces_n": (0.0, float("nan"))}, "forces_n must hold numbers ≥ 0 N"),
+        ({"radius_d": 40.0}, "needs a hexagon of at least 33 per edge"),
+        ({"speed_from_d": 20.0}, "need 0 < speed_from_d < radius_d"),
+        ({"impact": "hammer"}, "unknown impact 'hammer'"),
+    ],
+)
 def test_bad_settings_are_refused_in_one_line(changes, words):
     with pytest.raises(HexdemError) as error:
         TransitionSettings(**{"edge_beads": 21, "radius_d": 18.0, "speed_from_d": 8.0, **changes})

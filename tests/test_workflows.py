@@ -15,12 +15,25 @@ WORKFLOW = Path(__file__).resolve().parents[1] / "workflows" / "basins_and_inter
 
 @pytest.mark.slow
 def test_the_basins_and_interfaces_workflow_runs_in_one_command(tmp_path):
-    done = subprocess.run([sys.executable, str(WORKFLOW), "--out", str(tmp_path), "--quick"], cwd=tmp_path,
-                          capture_output=True, text=True, timeout=600)
+    done = subprocess.run(
+        [sys.executable, str(WORKFLOW), "--out", str(tmp_path), "--quick"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert done.returncode == 0, done.stderr
     cases = json.loads((tmp_path / "workflow.json").read_text())["cases"]
-    assert list(cases) == ["hexagon", "triangle", "disc", "steel_brass", "steel_ptfe", "double_strike",
-                           "flat_striker", "ring"]
+    assert list(cases) == [
+        "hexagon",
+        "triangle",
+        "disc",
+        "steel_brass",
+        "steel_ptfe",
+        "double_strike",
+        "flat_striker",
+        "ring",
+    ]
     page = (tmp_path / "index.html").read_text()
     for case in cases:
         assert (tmp_path / case / "movie.gif").read_bytes()[:6] == b"GIF89a"
@@ -47,8 +60,13 @@ def test_the_dirac_point_workflow_writes_its_tables_within_the_bounds(tmp_path):
     them), the dispersion within 2 % (median) and every point beyond the resolution limit within its
     bound, and the ring's growth within 3 % of v_D, the ring opened past 2.5 σ, and the control away
     from K drifting at its group velocity within 2 % and widening by less than 10 %."""
-    done = subprocess.run([sys.executable, str(DIRAC_WORKFLOW), "--out", str(tmp_path / "out"), "--quick",
-                           "--ranks", "1"], cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    done = subprocess.run(
+        [sys.executable, str(DIRAC_WORKFLOW), "--out", str(tmp_path / "out"), "--quick", "--ranks", "1"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert done.returncode == 0, done.stderr
     out = tmp_path / "out"
     result = json.loads((out / "dirac_point.json").read_text())
@@ -60,8 +78,18 @@ def test_the_dirac_point_workflow_writes_its_tables_within_the_bounds(tmp_path):
     with open(out / "conical.csv", newline="") as fh:
         assert float(list(csv.DictReader(fh))[-1]["ring_radius_d"]) > 2.5 * 8.0  # σ = 8 d
     headers = {name: next(csv.reader(open(out / name))) for name in ("dispersion.csv", "conical.csv", "transition.csv")}
-    assert headers["dispersion.csv"] == ["path_position", "kx", "ky", "branch", "omega_theory", "omega_measured",
-                                         "relative_deviation", "bound", "resolved", "within_bound"]
+    assert headers["dispersion.csv"] == [
+        "path_position",
+        "kx",
+        "ky",
+        "branch",
+        "omega_theory",
+        "omega_measured",
+        "relative_deviation",
+        "bound",
+        "resolved",
+        "within_bound",
+    ]
     assert headers["conical.csv"] == ["time_s", "ring_radius_d", "theory_radius_d"]
     assert headers["transition.csv"][:2] == ["precompression_n", "v0_m_s"]
     assert (out / "conical.gif").read_bytes()[:6] == b"GIF89a"
@@ -71,6 +99,11 @@ def test_the_dirac_point_workflow_writes_its_tables_within_the_bounds(tmp_path):
 
 def test_the_dirac_point_workflow_refuses_an_unwritable_out_in_one_line(tmp_path):
     (tmp_path / "file").write_text("")
-    done = subprocess.run([sys.executable, str(DIRAC_WORKFLOW), "--out", str(tmp_path / "file" / "out"), "--quick"],
-                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    done = subprocess.run(
+        [sys.executable, str(DIRAC_WORKFLOW), "--out", str(tmp_path / "file" / "out"), "--quick"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert done.returncode == 3 and len(done.stderr.strip().splitlines()) == 1, done.stderr  # refused input

@@ -7,7 +7,8 @@
 The paper's protocol (Sec. II): 4 sensors at a time, in three configurations that share the
 sensor nearest the impact (along 0°; across the 0° line near the impact; across it further
 away), 20 packings for each, struck at 0.40 m/s, and configuration 1 also at 0.25 and 0.70 m/s;
-accelerometers sampled at 500 kS/s, records and runs of 3 ms (:data:`RECORD_DURATION_S`). The sensors' beads are the text's positions on the
+accelerometers sampled at 500 kS/s, records and runs of 3 ms (:data:`RECORD_DURATION_S`). The sensors' beads are the
+text's positions on the
 11-per-edge lattice (Fig. 1's exact beads are not in the text):
 
 * configuration 1: ``0:1, 0:3, 0:5, 0:7``;
@@ -46,8 +47,11 @@ from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
 
-CONFIGURATIONS = {1: ("0:1", "0:3", "0:5", "0:7"), 2: ("0:1", "+30:2", "-30:2", "+30:3"),
-                  3: ("0:1", "0:4", "+30:8", "-30:8")}
+CONFIGURATIONS = {
+    1: ("0:1", "0:3", "0:5", "0:7"),
+    2: ("0:1", "+30:2", "-30:2", "+30:3"),
+    3: ("0:1", "0:4", "+30:8", "-30:8"),
+}
 DATA_SETS = ((1, 0.40), (2, 0.40), (3, 0.40), (1, 0.25), (1, 0.70))
 QUICK_DATA_SETS = ((1, 0.40), (2, 0.40))
 QUICK_BUDGET = 90
@@ -69,8 +73,15 @@ def make_records(base: dict, truth: dict, packings: int, noise: float, path: Pat
     config = RunConfig.from_dict(base | {"restitution": truth["restitution"]})
     rows = []
     for k in range(packings):
-        rows += synthetic_rows(config, str(k), noise, float(rng.uniform(0, 5e-3)), rng,
-                               disorder=(truth["diameter_sigma_m"], DATA_SEED, k), packings=path.parent / "truth-packings")
+        rows += synthetic_rows(
+            config,
+            str(k),
+            noise,
+            float(rng.uniform(0, 5e-3)),
+            rng,
+            disorder=(truth["diameter_sigma_m"], DATA_SEED, k),
+            packings=path.parent / "truth-packings",
+        )
     write_measured(path, rows)
 
 
@@ -90,8 +101,9 @@ def run(argv=None) -> int:
     log = lambda message: print(f"calibration_experiments: {message}", file=sys.stderr, flush=True)  # noqa: E731
     truth = {"diameter_sigma_m": args.sigma, "restitution": args.restitution}
     data_sets = QUICK_DATA_SETS if args.quick else DATA_SETS
-    packings, realizations, budget = (3, 2, QUICK_BUDGET) if args.quick else (args.packings, args.realizations,
-                                                                             args.budget)
+    packings, realizations, budget = (
+        (3, 2, QUICK_BUDGET) if args.quick else (args.packings, args.realizations, args.budget)
+    )
     start = time.perf_counter()
     rows = []
     try:
@@ -106,22 +118,45 @@ def run(argv=None) -> int:
                 make_records(base, truth, packings, args.noise, folder / "data.csv", rng)
             log(f"{name}: calibrating")
             calibration = prepare(base, folder / "data.csv", PRIORS, budget, seed=0, realizations=realizations)
-            summary = calibrate(calibration, folder / "data.csv", folder / "calibration", args.workers, args.parsl, log=log)
+            summary = calibrate(
+                calibration, folder / "data.csv", folder / "calibration", args.workers, args.parsl, log=log
+            )
             keys = list(summary["parameters"])
             for key, entry in summary["parameters"].items():
                 other = next(k for k in keys if k != key)
-                rows.append((name, " ".join(base["sensors"]), v0, key, truth[key], entry["median"], entry["q05"],
-                             entry["q95"], entry["width_ratio"], summary["correlations"][key][other]))
+                rows.append(
+                    (
+                        name,
+                        " ".join(base["sensors"]),
+                        v0,
+                        key,
+                        truth[key],
+                        entry["median"],
+                        entry["q05"],
+                        entry["q95"],
+                        entry["width_ratio"],
+                        summary["correlations"][key][other],
+                    )
+                )
         write_csv(out / "calibration_experiments.csv", COLUMNS, rows)
         intervals(rows, truth, out / "calibration_experiments.png")
     except HexdemError as exc:
         print(f"calibration_experiments: error: {exc}", file=sys.stderr)
         return exit_status(exc)
-    write_json(out / "workflow.json", {"command": "python workflows/calibration_experiments.py " + " ".join(
-        sys.argv[1:] if argv is None else argv), "truth": truth, "wall_time_s": time.perf_counter() - start})
+    write_json(
+        out / "workflow.json",
+        {
+            "command": "python workflows/calibration_experiments.py "
+            + " ".join(sys.argv[1:] if argv is None else argv),
+            "truth": truth,
+            "wall_time_s": time.perf_counter() - start,
+        },
+    )
     for row in rows:
-        print(f"{row[0]} {row[3]}: median {row[5]:.4g}, 90 % [{row[6]:.4g}, {row[7]:.4g}] (truth {row[4]:.4g}, "
-              f"{row[8]:.0%} of the prior)")
+        print(
+            f"{row[0]} {row[3]}: median {row[5]:.4g}, 90 % [{row[6]:.4g}, {row[7]:.4g}] (truth {row[4]:.4g}, "
+            f"{row[8]:.0%} of the prior)"
+        )
     return 0
 
 
@@ -132,15 +167,23 @@ AXES = {"diameter_sigma_m": ("σ of the diameters [µm]", 1e6), "restitution": (
 def intervals(rows, truth: dict, path) -> None:
     """Each data set's 90 % interval and median of each parameter across its prior's range, the truth drawn across."""
     priors = {prior.key: prior for prior in map(Prior.parse, PRIORS)}
-    fig, axes = subplots(1, len(truth), figsize=(5 * len(truth), 1.6 + 0.5 * len(rows) / len(truth)),
-                         layout="constrained", squeeze=False)
+    fig, axes = subplots(
+        1, len(truth), figsize=(5 * len(truth), 1.6 + 0.5 * len(rows) / len(truth)), layout="constrained", squeeze=False
+    )
     for ax, key in zip(axes[0], truth):
         label, factor = AXES[key]
         mine = [row for row in rows if row[3] == key]
         y = np.arange(len(mine))
         medians, lows, highs = (np.array([r[i] for r in mine]) * factor for i in (5, 6, 7))
-        ax.errorbar(medians, y, xerr=[medians - lows, highs - medians], fmt="o", color="C0", capsize=3,
-                    label="posterior median, 90 %")
+        ax.errorbar(
+            medians,
+            y,
+            xerr=[medians - lows, highs - medians],
+            fmt="o",
+            color="C0",
+            capsize=3,
+            label="posterior median, 90 %",
+        )
         ax.axvline(truth[key] * factor, color="C3", ls="--", label="truth")
         ax.set_xlim(*(factor * bound for bound in priors[key].support))
         ax.set_ylim(-0.5, len(mine) - 0.5)

@@ -31,8 +31,12 @@ def run(argv=None) -> int:
     parser.add_argument("--out", required=True, metavar="DIR")
     parser.add_argument("--quick", action="store_true", help="the test suite's smaller case")
     parser.add_argument("--ranks", type=int, default=2, help="MPI ranks per LAMMPS run (default 2)")
-    parser.add_argument("--engine", choices=("lammps", "reference"), default="lammps",
-                        help="the engine of every run (default lammps; the reference runs on one rank)")
+    parser.add_argument(
+        "--engine",
+        choices=("lammps", "reference"),
+        default="lammps",
+        help="the engine of every run (default lammps; the reference runs on one rank)",
+    )
     args = parser.parse_args(argv)
 
     def log(message):
@@ -40,24 +44,32 @@ def run(argv=None) -> int:
 
     start = time.perf_counter()
     try:
-        study = (DiracStudy.quick() if args.quick else DiracStudy()).on(args.engine,
-                                                                         args.ranks if args.engine == "lammps" else 1)
+        study = (DiracStudy.quick() if args.quick else DiracStudy()).on(
+            args.engine, args.ranks if args.engine == "lammps" else 1
+        )
         out = ensure_writable_dir(args.out)
         result = run_dirac_study(study, out, log)
     except HexdemError as exc:
         print(f"dirac_point: error: {exc}", file=sys.stderr)
         return exit_status(exc)
     wall = time.perf_counter() - start
-    write_json(out / "workflow.json", {"command": "python workflows/dirac_point.py " + " ".join(
-        sys.argv[1:] if argv is None else argv), "wall_time_s": wall})
+    write_json(
+        out / "workflow.json",
+        {
+            "command": "python workflows/dirac_point.py " + " ".join(sys.argv[1:] if argv is None else argv),
+            "wall_time_s": wall,
+        },
+    )
     theory = result["theory"]
     spread = result["dispersion"]
-    log(f"ω_K/2π = {theory['dirac_frequency_hz']:.1f} Hz, v_D = {theory['cone_slope_m_s']:.2f} m/s; dispersion "
+    log(
+        f"ω_K/2π = {theory['dirac_frequency_hz']:.1f} Hz, v_D = {theory['cone_slope_m_s']:.2f} m/s; dispersion "
         f"{100 * spread['median_relative_deviation']:.2f} % (median), worst beyond the resolution limit "
         f"{100 * spread['largest_resolved_relative_deviation']:.1f} % (its bound "
         f"{100 * spread['largest_resolved_bound']:.1f} %), {spread['resolved_points_within_bound']} of "
         f"{spread['resolved_points']} resolved points within their bounds; ring growth "
-        f"{100 * result['conical']['slope_relative_deviation']:.2f} % from v_D; {wall:.0f} s in all")
+        f"{100 * result['conical']['slope_relative_deviation']:.2f} % from v_D; {wall:.0f} s in all"
+    )
     log(result["transition"]["finding"])
     return 0
 

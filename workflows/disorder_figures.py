@@ -42,8 +42,15 @@ def run(argv=None) -> int:
     out = Path(args.out)
     common = ["--workers", str(args.workers), "--seed", str(args.seed)]
     commands = {
-        "ensemble": ["ensemble", "--out", str(out / "ensemble"), "--realizations", str(args.realizations), *common,
-                     *(["--scaling", args.scaling] if args.scaling else [])],
+        "ensemble": [
+            "ensemble",
+            "--out",
+            str(out / "ensemble"),
+            "--realizations",
+            str(args.realizations),
+            *common,
+            *(["--scaling", args.scaling] if args.scaling else []),
+        ],
         "control": ["ensemble", "--out", str(out / "control"), "--realizations", "1", "--sigma-mm", "0", *common],
     }
     wall = {}
@@ -54,19 +61,33 @@ def run(argv=None) -> int:
             return status
         wall[name] = time.perf_counter() - start
     disordered, control = effect(out / "ensemble"), effect(out / "control")
-    rows = [(float(v), line, float(row["mean_ratio"]), float(row["sem_ratio"]),
-             float(control[(v, line)]["mean_ratio"]),
-             float(row["mean_ratio"]) / float(control[(v, line)]["mean_ratio"]))
-            for (v, line), row in disordered.items()]
+    rows = [
+        (
+            float(v),
+            line,
+            float(row["mean_ratio"]),
+            float(row["sem_ratio"]),
+            float(control[(v, line)]["mean_ratio"]),
+            float(row["mean_ratio"]) / float(control[(v, line)]["mean_ratio"]),
+        )
+        for (v, line), row in disordered.items()
+    ]
     write_csv(out / "disorder_vs_control.csv", COLUMNS, rows)
-    write_json(out / "workflow.json", {
-        "command": "python workflows/disorder_figures.py " + " ".join(sys.argv[1:] if argv is None else argv),
-        "hexdem_commands": {name: "hexdem " + " ".join(command) for name, command in commands.items()},
-        "wall_time_s": wall})
+    write_json(
+        out / "workflow.json",
+        {
+            "command": "python workflows/disorder_figures.py " + " ".join(sys.argv[1:] if argv is None else argv),
+            "hexdem_commands": {name: "hexdem " + " ".join(command) for name, command in commands.items()},
+            "wall_time_s": wall,
+        },
+    )
     for v, line, ratio, sem, _, over_control in rows:
         if line in ("0", "±30"):
-            print(f"V = {v:g} m/s, line {line}: disordered/ideal {ratio:.3f} ± {sem:.3f}, "
-                  f"disordered/control {over_control:.3f}", file=sys.stderr)
+            print(
+                f"V = {v:g} m/s, line {line}: disordered/ideal {ratio:.3f} ± {sem:.3f}, "
+                f"disordered/control {over_control:.3f}",
+                file=sys.stderr,
+            )
     print(f"disorder_figures: {sum(wall.values()):.1f} s wall time, results in {out}", file=sys.stderr)
     return 0
 

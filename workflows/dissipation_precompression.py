@@ -53,8 +53,12 @@ def measure(run_dir: Path, restitution: float, f0: float) -> list[tuple]:
 
 def figure(rows: list[tuple], path: Path) -> None:
     fig, axes = subplots(2, 2, figsize=(10, 7), layout="constrained")
-    for column, (key, values, label) in enumerate(((0, RESTITUTIONS, "coefficient of restitution e  (f0 = 0)"),
-                                                   (1, PRECOMPRESSIONS_N, "static contact force f0 [N]  (e = 1)"))):
+    for column, (key, _values, label) in enumerate(
+        (
+            (0, RESTITUTIONS, "coefficient of restitution e  (f0 = 0)"),
+            (1, PRECOMPRESSIONS_N, "static contact force f0 [N]  (e = 1)"),
+        )
+    ):
         other = 1 - key
         chosen = [r for r in rows if r[other] == (0.0 if key == 0 else 1.0)]
         for line, marker in zip(START, "o^v"):

@@ -34,27 +34,49 @@ def run(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", required=True, metavar="DIR")
     parser.add_argument("--ranks", type=int, default=defaults.ranks, help="MPI ranks per run (default 2)")
-    parser.add_argument("--radius-beads", type=int, default=defaults.radius_beads,
-                        help=f"radius of the half-disc in bead diameters (default {defaults.radius_beads})")
-    parser.add_argument("--edge-beads", type=int, default=defaults.edge_beads,
-                        help=f"beads per edge of the control's hexagon (default {defaults.edge_beads})")
+    parser.add_argument(
+        "--radius-beads",
+        type=int,
+        default=defaults.radius_beads,
+        help=f"radius of the half-disc in bead diameters (default {defaults.radius_beads})",
+    )
+    parser.add_argument(
+        "--edge-beads",
+        type=int,
+        default=defaults.edge_beads,
+        help=f"beads per edge of the control's hexagon (default {defaults.edge_beads})",
+    )
     parser.add_argument("--fronts", type=int, default=defaults.fronts, help=f"front times (default {defaults.fronts})")
     add_launcher(parser)
     args = parser.parse_args(argv)
-    study = FrontStudy(edge_beads=args.edge_beads, radius_beads=args.radius_beads, ranks=args.ranks,
-                       launcher=args.launcher, fronts=args.fronts)
+    study = FrontStudy(
+        edge_beads=args.edge_beads,
+        radius_beads=args.radius_beads,
+        ranks=args.ranks,
+        launcher=args.launcher,
+        fronts=args.fronts,
+    )
     start = time.perf_counter()
     try:
-        summary = run_front_study(study, args.out, log=lambda message: print(f"front_shape: {message}", file=sys.stderr))
+        summary = run_front_study(
+            study, args.out, log=lambda message: print(f"front_shape: {message}", file=sys.stderr)
+        )
     except HexdemError as exc:
         print(f"front_shape: error: {exc}", file=sys.stderr)
         return exit_status(exc)
     wall = time.perf_counter() - start
-    write_json(Path(args.out) / "workflow.json", {"command": "python workflows/front_shape.py " + " ".join(
-        sys.argv[1:] if argv is None else argv), "wall_time_s": wall})
+    write_json(
+        Path(args.out) / "workflow.json",
+        {
+            "command": "python workflows/front_shape.py " + " ".join(sys.argv[1:] if argv is None else argv),
+            "wall_time_s": wall,
+        },
+    )
     for name, fit in summary["fits"].items():
-        print(f"{name}: A = {fit['a_inf']:.4f} ± {fit['a_inf_se']:.4f} + {fit['b']:.3f} (R/d)^-{fit['p']:.2f} over "
-              f"R = {fit['radius_min_d']:.1f}..{fit['radius_max_d']:.1f} d ({wall:.0f} s in all)")
+        print(
+            f"{name}: A = {fit['a_inf']:.4f} ± {fit['a_inf_se']:.4f} + {fit['b']:.3f} (R/d)^-{fit['p']:.2f} over "
+            f"R = {fit['radius_min_d']:.1f}..{fit['radius_max_d']:.1f} d ({wall:.0f} s in all)"
+        )
     return 0
 
 

@@ -44,8 +44,10 @@ def compare(out: Path, other: Path) -> list[tuple]:
             a, b = ours[name][key], theirs[name][key]
             if a is not None:
                 rows.append((key, name, a, b, abs(a - b) / abs(b), agreeing_digits(a, b)))
-    fits = [{(r["combination"], r["v0"]): float(r["c"]) for r in csv.DictReader(open(d / "decay_fits.csv"))}
-            for d in (out, other)]
+    fits = [
+        {(r["combination"], r["v0"]): float(r["c"]) for r in csv.DictReader(open(d / "decay_fits.csv"))}
+        for d in (out, other)
+    ]
     for (name, v0), a in fits[0].items():
         b = fits[1][(name, v0)]
         rows.append((f"c(V0={float(v0):.3f})", name, a, b, abs(a - b) / abs(b), agreeing_digits(a, b)))
@@ -65,18 +67,28 @@ def run(argv=None) -> int:
     if status:
         return status
     wall = time.perf_counter() - start
-    record = {"command": "python workflows/scaling_laws.py " + " ".join(sys.argv[1:] if argv is None else argv),
-              "engine": args.engine, "workers": args.workers, "wall_time_s": wall}
+    record = {
+        "command": "python workflows/scaling_laws.py " + " ".join(sys.argv[1:] if argv is None else argv),
+        "engine": args.engine,
+        "workers": args.workers,
+        "wall_time_s": wall,
+    }
     if args.compare_with:
         rows = compare(out, Path(args.compare_with))
-        write_csv(out / "engine_agreement.csv",
-                  ("quantity", "combination", "this", "other", "relative_difference", "digits"), rows)
+        write_csv(
+            out / "engine_agreement.csv",
+            ("quantity", "combination", "this", "other", "relative_difference", "digits"),
+            rows,
+        )
         laws = [r for r in rows if r[0] in COEFFICIENTS]
         record["compared_with"] = str(args.compare_with)
         record["min_digits_laws"] = min(r[5] for r in laws)
         record["min_digits_c"] = min(r[5] for r in rows if r[0].startswith("c("))
-        print(f"agreement with {args.compare_with}: laws >= {record['min_digits_laws']:.2f} digits, "
-              f"per-V0 c >= {record['min_digits_c']:.2f} digits", file=sys.stderr)
+        print(
+            f"agreement with {args.compare_with}: laws >= {record['min_digits_laws']:.2f} digits, "
+            f"per-V0 c >= {record['min_digits_c']:.2f} digits",
+            file=sys.stderr,
+        )
     write_json(out / "workflow.json", record)
     print(f"scaling_laws: {wall:.1f} s wall time, results in {out}", file=sys.stderr)
     return 0

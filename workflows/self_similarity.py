@@ -50,9 +50,15 @@ def chain_comparison(out: Path, log) -> dict:
     chain = measure_chain(chain_run).as_dict()
     beads = chain_run.results.lines[CHAIN_LINE]
     spacing = {"0": np.sqrt(3.0), "+30": 1.0, "-30": 1.0}
-    chain_figure({"chain (80 beads)": (np.arange(len(beads)), chain_run.results.peak_speed[beads] / V0_M_S)},
-                 {f"hexagon, {line}°": (np.arange(len(b)) * spacing[line], hexagon.peak_speed[b] / V0_M_S)
-                  for line, b in hexagon.lines.items() if line in ("0", "+30")}, out / "chain.png")
+    chain_figure(
+        {"chain (80 beads)": (np.arange(len(beads)), chain_run.results.peak_speed[beads] / V0_M_S)},
+        {
+            f"hexagon, {line}°": (np.arange(len(b)) * spacing[line], hexagon.peak_speed[b] / V0_M_S)
+            for line, b in hexagon.lines.items()
+            if line in ("0", "+30")
+        },
+        out / "chain.png",
+    )
     return chain
 
 
@@ -65,8 +71,10 @@ def run(argv=None) -> int:
     args = parser.parse_args(argv)
     study = SelfSimilarityStudy.quick() if args.quick else SelfSimilarityStudy()
     study = replace(study, front=replace(study.front, ranks=args.ranks, launcher=args.launcher))
+
     def log(message):
         print(f"self_similarity: {message}", file=sys.stderr, flush=True)
+
     start = time.perf_counter()
     try:
         out = ensure_writable_dir(args.out)
@@ -83,8 +91,14 @@ def run(argv=None) -> int:
         print(f"self_similarity: error: {exc}", file=sys.stderr)
         return exit_status(exc)
     wall = time.perf_counter() - start
-    write_json(out / "workflow.json", {"command": "python workflows/self_similarity.py " + " ".join(
-        sys.argv[1:] if argv is None else argv), "wall_time_s": wall, "study": study.as_dict()})
+    write_json(
+        out / "workflow.json",
+        {
+            "command": "python workflows/self_similarity.py " + " ".join(sys.argv[1:] if argv is None else argv),
+            "wall_time_s": wall,
+            "study": study.as_dict(),
+        },
+    )
     for name in STUDIES:
         log(verdict(result, name))
     log(rise_verdict["verdict"])

@@ -28,9 +28,14 @@ def run(argv=None) -> int:
     if status:
         return status
     wall = time.perf_counter() - start
-    write_json(Path(args.out) / "workflow.json",
-               {"command": "python workflows/tca_figures.py " + " ".join(sys.argv[1:] if argv is None else argv),
-                "engine": args.engine, "wall_time_s": wall})
+    write_json(
+        Path(args.out) / "workflow.json",
+        {
+            "command": "python workflows/tca_figures.py " + " ".join(sys.argv[1:] if argv is None else argv),
+            "engine": args.engine,
+            "wall_time_s": wall,
+        },
+    )
     print(f"tca_figures: {wall:.1f} s wall time, results in {args.out}", file=sys.stderr)
     return 0
 

@@ -25,9 +25,10 @@ def run(argv=None) -> int:
     parser.add_argument("--ranks", type=int, default=2, help="MPI ranks for the half-hexagon (default 2)")
     args = parser.parse_args(argv)
     out = Path(args.out)
-    commands = {"fig3": ["snapshots", "--shape", "hexagon", "--out", str(out / "fig3")],
-                "fig4": ["snapshots", "--shape", "half-hexagon", "--ranks", str(args.ranks),
-                         "--out", str(out / "fig4")]}
+    commands = {
+        "fig3": ["snapshots", "--shape", "hexagon", "--out", str(out / "fig3")],
+        "fig4": ["snapshots", "--shape", "half-hexagon", "--ranks", str(args.ranks), "--out", str(out / "fig4")],
+    }
     record = WorkflowRecord(__file__, argv)
     for name, command in commands.items():
         status = record.run(name, command)

@@ -34,8 +34,11 @@ def visit_math(translator, node) -> None:
 
 
 def visit_displaymath(translator, node) -> None:
-    translator.body += [translator.starttag(node, "div", CLASS="math"), mathml(translator, node, block=True),
-                        "</div>\n"]
+    translator.body += [
+        translator.starttag(node, "div", CLASS="math"),
+        mathml(translator, node, block=True),
+        "</div>\n",
+    ]
     raise nodes.SkipNode
 
 

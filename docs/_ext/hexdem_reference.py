@@ -40,15 +40,35 @@ def _write(path: Path, text: str) -> None:
 
 def cli_page() -> str:
     os.environ["COLUMNS"] = HELP_COLUMNS
-    lines = ["# Command line", "", "`hexdem` (or `python -m hexdem`) and every subcommand's `--help`, as `hexdem` "
-             "prints it.", "", "```text", build_parser([]).format_help().rstrip(), "```", "", "## Exit status", "",
-             "| status | meaning |", "|---|---|", *(f"| {code} | {meaning} |" for code, meaning in EXIT_CODES.items()),
-             ""]
+    lines = [
+        "# Command line",
+        "",
+        "`hexdem` (or `python -m hexdem`) and every subcommand's `--help`, as `hexdem` prints it.",
+        "",
+        "```text",
+        build_parser([]).format_help().rstrip(),
+        "```",
+        "",
+        "## Exit status",
+        "",
+        "| status | meaning |",
+        "|---|---|",
+        *(f"| {code} | {meaning} |" for code, meaning in EXIT_CODES.items()),
+        "",
+    ]
     for name, (_, summary) in COMMANDS.items():
         parser = build_parser([name])
         subcommand = parser._subparsers._group_actions[0].choices[name]
-        lines += [f"## hexdem {name}", "", summary[0].upper() + summary[1:] + ".", "", "```text",
-                  subcommand.format_help().rstrip(), "```", ""]
+        lines += [
+            f"## hexdem {name}",
+            "",
+            summary[0].upper() + summary[1:] + ".",
+            "",
+            "```text",
+            subcommand.format_help().rstrip(),
+            "```",
+            "",
+        ]
     return "\n".join(lines)
 
 
@@ -63,26 +83,55 @@ def _default(field: dataclasses.Field) -> str:
 
 
 def config_page() -> str:
-    rows = [f"| `{f.name}` | {_default(f)} | {str(f.type).replace(' | ', ' or ')} | {KEY_DESCRIPTIONS[f.name]} |"
-            for f in dataclasses.fields(RunConfig)]
-    return "\n".join(["# Run configuration keys", "",
-                      "The keys of a `hexdem run --config FILE.toml` file (and of `hexdem sweep --vary`), with "
-                      "their defaults and what they mean; a file sets any of them, the rest keep these. "
-                      "Lengths are in metres; `v0`, `dt` and `duration` in the run's `units`.", "",
-                      "| key | default | type | meaning |", "|---|---|---|---|", *rows, "",
-                      "```{eval-rst}", ".. autoclass:: hexdem.model.config.RunConfig", "   :no-members:",
-                      "   :no-index:", "```", ""])
+    rows = [
+        f"| `{f.name}` | {_default(f)} | {str(f.type).replace(' | ', ' or ')} | {KEY_DESCRIPTIONS[f.name]} |"
+        for f in dataclasses.fields(RunConfig)
+    ]
+    return "\n".join(
+        [
+            "# Run configuration keys",
+            "",
+            "The keys of a `hexdem run --config FILE.toml` file (and of `hexdem sweep --vary`), with "
+            "their defaults and what they mean; a file sets any of them, the rest keep these. "
+            "Lengths are in metres; `v0`, `dt` and `duration` in the run's `units`.",
+            "",
+            "| key | default | type | meaning |",
+            "|---|---|---|---|",
+            *rows,
+            "",
+            "```{eval-rst}",
+            ".. autoclass:: hexdem.model.config.RunConfig",
+            "   :no-members:",
+            "   :no-index:",
+            "```",
+            "",
+        ]
+    )
 
 
 def api_pages() -> dict[str, str]:
     """{page name: text}: an index of the subpackages, and one page per subpackage with a heading
     per module (so that the sidebar lists them)."""
-    modules = sorted(info.name for info in pkgutil.walk_packages(hexdem.__path__, "hexdem.")
-                     if not info.name.endswith("__main__"))
+    modules = sorted(
+        info.name for info in pkgutil.walk_packages(hexdem.__path__, "hexdem.") if not info.name.endswith("__main__")
+    )
     packages = sorted({m.split(".")[1] for m in modules})
-    pages = {"api": "\n".join(["# API", "", "Every module of the package, from its docstrings, one page per "
-                               "subpackage.", "", "```{toctree}", ":maxdepth: 2", "",
-                               *(f"api_{package}" for package in packages), "```", ""])}
+    pages = {
+        "api": "\n".join(
+            [
+                "# API",
+                "",
+                "Every module of the package, from its docstrings, one page per subpackage.",
+                "",
+                "```{toctree}",
+                ":maxdepth: 2",
+                "",
+                *(f"api_{package}" for package in packages),
+                "```",
+                "",
+            ]
+        )
+    }
     for package in packages:
         lines = [f"# hexdem.{package}", ""]
         for module in (m for m in modules if m.split(".")[1] == package):
@@ -102,8 +151,9 @@ def escape_bars(app, what, name, obj, options, lines) -> None:
             continue
         literal = indent if line.rstrip().endswith("::") else None
         if not line.lstrip().startswith(("|", "+")):
-            lines[i] = "".join(part if part.startswith(":math:") else part.replace("|", "\\|")
-                               for part in MATH_ROLE.split(line))
+            lines[i] = "".join(
+                part if part.startswith(":math:") else part.replace("|", "\\|") for part in MATH_ROLE.split(line)
+            )
 
 
 def generate(app) -> None:

@@ -9,17 +9,19 @@ from parsl.executors import HighThroughputExecutor
 from parsl.providers import LocalProvider
 
 config = Config(
-    executors=[HighThroughputExecutor(
-        label="local",
-        # the workers are on this machine
-        address="127.0.0.1",
-        # runs at once: one per CPU (each run on one rank; with
-        # --ranks-per-run K, divide by K)
-        max_workers_per_node=os.cpu_count(),
-        # a worker pool that dies is replaced and its runs retried
-        block_error_handler=False,
-        provider=LocalProvider(init_blocks=1, min_blocks=1, max_blocks=1),
-    )],
+    executors=[
+        HighThroughputExecutor(
+            label="local",
+            # the workers are on this machine
+            address="127.0.0.1",
+            # runs at once: one per CPU (each run on one rank; with
+            # --ranks-per-run K, divide by K)
+            max_workers_per_node=os.cpu_count(),
+            # a worker pool that dies is replaced and its runs retried
+            block_error_handler=False,
+            provider=LocalProvider(init_blocks=1, min_blocks=1, max_blocks=1),
+        )
+    ],
     retries=1,  # each run is tried up to twice
     # Parsl starts the block at its strategy's first look: after half a second
     # rather than its default 5 s

@@ -46,8 +46,9 @@ def bind_pulses(state: PulseState) -> _kernels.PulseArrays:
     return _kernels.PulseArrays(**state.kernel_arrays(), q=state.q, rival_ratio=RIVAL_RATIO)
 
 
-def sample_pulses(pulses: _kernels.PulseArrays, *, ids, previous_ids, velocities, rows, end_velocity, speeds,
-                  s: int) -> np.ndarray:
+def sample_pulses(
+    pulses: _kernels.PulseArrays, *, ids, previous_ids, velocities, rows, end_velocity, speeds, s: int
+) -> np.ndarray:
     """Sample ``s`` into the tracker's state (``pulses``, :func:`bind_pulses`), in one pass: row ``b`` takes the
     speed ``|v|`` of its velocity ``v = velocities[rows[b]]`` (C's hypot, as ``np.hypot``) as its sample, as
     :meth:`~hexdem.analysis.tracker_kernel.PulseState.update` takes it, but for the refinement. Each row's
@@ -64,8 +65,16 @@ def sample_pulses(pulses: _kernels.PulseArrays, *, ids, previous_ids, velocities
     :class:`BodiesReordered`, with the state as it was, if the sample's body ids ``ids`` are not
     ``previous_ids`` (``np.array_equal``)."""
     complete = np.empty(len(rows), np.int64)
-    count = pulses.sample(ids=ids, previous_ids=previous_ids, velocities=velocities, rows=rows,
-                          end_velocity=end_velocity, speeds=speeds, complete=complete, s=s)
+    count = pulses.sample(
+        ids=ids,
+        previous_ids=previous_ids,
+        velocities=velocities,
+        rows=rows,
+        end_velocity=end_velocity,
+        speeds=speeds,
+        complete=complete,
+        s=s,
+    )
     return complete[:count]
 
 

@@ -16,8 +16,9 @@ SIGNED_ANGLE = re.compile(r"[+-]\d+(\.\d*)?")
 ANGLE = re.compile(r"[+±-]?\d+(\.\d*)?")
 
 
-def peak_decay(rows_by_line: dict, path, units_name: str, v0: float,
-               title="Peak speed along the observation lines") -> Figure:
+def peak_decay(
+    rows_by_line: dict, path, units_name: str, v0: float, title="Peak speed along the observation lines"
+) -> Figure:
     """Peak speed V_n / V0 vs n for each observation line, logarithmic axis; the figure, saved.
 
     A bead that never moved (peak 0) has no place on a logarithmic axis: it is left out, not drawn

@@ -37,8 +37,10 @@ def open_dump(path, dt: float):
             warnings.simplefilter("ignore")
             return mda.Universe(str(path), format="LAMMPSDUMP", dt=dt, additional_columns=list(FULL_PRECISION_COLUMNS))
     except Exception as exc:
-        raise HexdemError(f"cannot read dump {path}: it is corrupt or not a hexdem dump "
-                          f"({type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else 'no detail'})") from None
+        raise HexdemError(
+            f"cannot read dump {path}: it is corrupt or not a hexdem dump "
+            f"({type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else 'no detail'})"
+        ) from None
 
 
 def _analysis_base():
@@ -87,8 +89,9 @@ def read_dump(path, dt: float, expected_frames: int | None = None) -> BeadRecord
     """
     universe = open_dump(path, dt)
     if expected_frames is not None and len(universe.trajectory) != expected_frames:
-        raise HexdemError(f"dump {path} is corrupt or truncated: {len(universe.trajectory)} "
-                          f"of {expected_frames} frames")
+        raise HexdemError(
+            f"dump {path} is corrupt or truncated: {len(universe.trajectory)} of {expected_frames} frames"
+        )
     try:
         return BeadRecord(universe).run(verbose=sys.stderr.isatty())
     except HexdemError:
@@ -102,5 +105,9 @@ def read_trajectory(path, settings: RunSettings, engine: dict | None = None) -> 
     :class:`~hexdem.analysis.trajectory.Trajectory`; ``engine`` describes the run."""
     units = settings.units
     record = read_dump(path, settings.dt_s / units.time_s, settings.n_samples).results
-    return Trajectory(times_s=record.times * units.time_s, velocities_m_s=record.velocities * units.velocity_m_s,
-                      displacements_m=record.displacements * units.length_m, engine=engine or {})
+    return Trajectory(
+        times_s=record.times * units.time_s,
+        velocities_m_s=record.velocities * units.velocity_m_s,
+        displacements_m=record.displacements * units.length_m,
+        engine=engine or {},
+    )

@@ -39,7 +39,8 @@ def _hertz_energies_j(stiffness_pa, r_eff_m, overlap_m) -> np.ndarray:
 
 
 def hertz_energy_j(stiffness_pa, r_eff_m, overlap_m) -> float:
-    r""":math:`\sum \tfrac{2}{5} k_n \sqrt{R_\text{eff}}\, δ^{5/2}` [J] over contacts with overlap δ > 0 (k_n per contact; one
+    r""":math:`\sum \tfrac{2}{5} k_n \sqrt{R_\text{eff}}\, δ^{5/2}` [J] over contacts with overlap δ > 0 (k_n per
+    contact; one
     value factored out when all are equal, the single-material sum as it always was)."""
     stiffness_pa = np.asarray(stiffness_pa, float)
     terms = np.sqrt(r_eff_m) * overlap_m**2.5
@@ -70,8 +71,9 @@ def _wall_constants(model: GranularModel, bodies=None) -> list[tuple]:
     for wall in model.walls:
         rows = wall.members if bodies is None else np.flatnonzero(np.isin(bodies, wall.members))
         members = rows if bodies is None else bodies[rows]
-        constants.append((wall, rows, model.wall_stiffness_pa(members), radii[members],
-                          wall.contact_radii_m(radii[members])))
+        constants.append(
+            (wall, rows, model.wall_stiffness_pa(members), radii[members], wall.contact_radii_m(radii[members]))
+        )
     return constants
 
 
@@ -108,10 +110,16 @@ def _wall_rows(walls, regions) -> dict[str, np.ndarray]:
         return np.concatenate([np.zeros(0, dtype), *(np.asarray(wall[k], dtype) for wall in walls)])
 
     rows = joined(1, np.int64)
-    return {"bounds": bounds.astype(np.int64), "curved": np.array(curved, np.int64),
-            "points": np.array(points, float).reshape(-1, 2), "lengths": np.array(lengths, float), "rows": rows,
-            "radii": joined(3), "wall_coefficient": 0.4 * joined(2) * np.sqrt(joined(4)),
-            "wall_regions": regions[rows].astype(np.int64)}
+    return {
+        "bounds": bounds.astype(np.int64),
+        "curved": np.array(curved, np.int64),
+        "points": np.array(points, float).reshape(-1, 2),
+        "lengths": np.array(lengths, float),
+        "rows": rows,
+        "radii": joined(3),
+        "wall_coefficient": 0.4 * joined(2) * np.sqrt(joined(4)),
+        "wall_regions": regions[rows].astype(np.int64),
+    }
 
 
 def _wall_energy_j(walls) -> float:
@@ -207,12 +215,23 @@ class EnergyAudit:
         regions = self.regions[bodies]
         own = np.where(np.arange(len(bodies)) < n_own, regions, -1)
         audited = bodies[:n_own]
-        return bind_audit(listed_at=self._listed_at, distance=self.skin_m / 2, i=i, j=j,
-                          contact_m=self.radii_m[bodies[i]] + self.radii_m[bodies[j]],
-                          coefficient=0.4 * stiffness * np.sqrt(r_eff), region_i=own[i], region_j=own[j],
-                          masses=self.masses_kg[audited], inertia=self.inertia_kg_m2[audited], regions=regions[:n_own],
-                          start=self.start_m[audited], external=self.external_n[audited],
-                          **_wall_rows(self._walls, regions), n_regions=len(self.region_names))
+        return bind_audit(
+            listed_at=self._listed_at,
+            distance=self.skin_m / 2,
+            i=i,
+            j=j,
+            contact_m=self.radii_m[bodies[i]] + self.radii_m[bodies[j]],
+            coefficient=0.4 * stiffness * np.sqrt(r_eff),
+            region_i=own[i],
+            region_j=own[j],
+            masses=self.masses_kg[audited],
+            inertia=self.inertia_kg_m2[audited],
+            regions=regions[:n_own],
+            start=self.start_m[audited],
+            external=self.external_n[audited],
+            **_wall_rows(self._walls, regions),
+            n_regions=len(self.region_names),
+        )
 
     def part(self, bodies, n_own: int, positions_m, velocities_m_s, angular_velocities_s=None) -> np.ndarray:
         """The audit's sums over the bodies ``bodies[:n_own]`` (indices; the rest are ghosts, see the
@@ -229,12 +248,18 @@ class EnergyAudit:
             return self._compiled_part(bodies, n_own, positions_m, velocities_m_s, angular_velocities_s)
         if not self._listed_for(bodies, n_own) or self._moved_beyond(positions_m, self.skin_m / 2):
             self._list(bodies, n_own, positions_m)
-        contact = _pair_energies_j(_pair_contacts(positions_m, self.radii_m[bodies], self._candidates),
-                                   self.regions[bodies], len(self.region_names), n_own)
-        _add_wall_energies_j(contact, _wall_contacts(positions_m, self._walls), self.regions[bodies],
-                             len(self.region_names))
+        contact = _pair_energies_j(
+            _pair_contacts(positions_m, self.radii_m[bodies], self._candidates),
+            self.regions[bodies],
+            len(self.region_names),
+            n_own,
+        )
+        _add_wall_energies_j(
+            contact, _wall_contacts(positions_m, self._walls), self.regions[bodies], len(self.region_names)
+        )
         translational, rotational, kinetic, external = self._body_energies_j(
-            bodies[:n_own], positions_m[:n_own], velocities_m_s, angular_velocities_s)
+            bodies[:n_own], positions_m[:n_own], velocities_m_s, angular_velocities_s
+        )
         by_region = np.column_stack([kinetic, contact])
         return np.concatenate([[float(np.sum(by_region)) - external, translational, rotational], by_region.ravel()])
 
@@ -264,8 +289,11 @@ class EnergyAudit:
         work [J] of the constant forces) of the audited bodies ``own`` at ``positions_m`` with
         ``velocities_m_s`` and spins (None: spheres that do not turn)."""
         translational = 0.5 * self.masses_kg[own] * np.sum(velocities_m_s**2, axis=1)
-        rotational = (np.zeros(len(own)) if angular_velocities_s is None
-                      else 0.5 * self.inertia_kg_m2[own] * np.asarray(angular_velocities_s, float) ** 2)
+        rotational = (
+            np.zeros(len(own))
+            if angular_velocities_s is None
+            else 0.5 * self.inertia_kg_m2[own] * np.asarray(angular_velocities_s, float) ** 2
+        )
         kinetic = _by_region(self.regions[own], translational + rotational, len(self.region_names))
         external = float(np.sum((positions_m - self.start_m[own]) * self.external_n[own]))
         return float(np.sum(translational)), float(np.sum(rotational)), kinetic, external
@@ -284,7 +312,7 @@ class EnergyAudit:
 def energy_regions(model: GranularModel) -> tuple[list[str], np.ndarray]:
     """(names, (n_bodies,) region of each body): the beads by material, then the strikers, if
     any, as one region of their own (so that what they keep is not counted in the packing)."""
-    names = [m.name for m in model.materials[:1 + len(model.extra_materials)]]
+    names = [m.name for m in model.materials[: 1 + len(model.extra_materials)]]
     regions = model.packing.material_ids
     if model.has_striker:
         names, regions = [*names, "striker"], np.append(regions, np.full(len(model.strikers), len(names)))

@@ -71,8 +71,10 @@ class FrontShape:
 
     def rows(self) -> list[tuple]:
         """Rows following :data:`FRONT_SHAPE_COLUMNS`."""
-        return [(float(t), float(r), float(a), int(n))
-                for t, r, a, n in zip(self.time, self.mean_radius, self.sixfold_amplitude, self.bins_used)]
+        return [
+            (float(t), float(r), float(a), int(n))
+            for t, r, a, n in zip(self.time, self.mean_radius, self.sixfold_amplitude, self.bins_used)
+        ]
 
 
 @dataclass(frozen=True)
@@ -217,8 +219,9 @@ def _window(rays: _Rays, window_deg: float | None) -> np.ndarray:
     return np.abs(rays.theta) <= np.radians(window_deg) / 2
 
 
-def front_shape(positions, arrival_times, origin, times, n_bins=DEFAULT_BINS, min_bins=None,
-                wall_margin=0.0, window_deg=None) -> FrontShape:
+def front_shape(
+    positions, arrival_times, origin, times, n_bins=DEFAULT_BINS, min_bins=None, wall_margin=0.0, window_deg=None
+) -> FrontShape:
     """Mean radius and sixfold amplitude of the front at each of ``times``.
 
     Each ray is read up to ``wall_margin`` from where it leaves the packing; with
@@ -244,8 +247,17 @@ def front_shape(positions, arrival_times, origin, times, n_bins=DEFAULT_BINS, mi
     return FrontShape(times, mean, np.hypot(cos6, sin6), used, cos6, sin6)
 
 
-def front_times(positions, arrival_times, origin, count=8, start_quantile=0.05, n_bins=DEFAULT_BINS,
-                wall_margin=0.0, geometric=False, window_deg=None) -> np.ndarray:
+def front_times(
+    positions,
+    arrival_times,
+    origin,
+    count=8,
+    start_quantile=0.05,
+    n_bins=DEFAULT_BINS,
+    wall_margin=0.0,
+    geometric=False,
+    window_deg=None,
+) -> np.ndarray:
     """``count`` front times from early on to the last time the front can be read over 60°.
 
     Start: the ``start_quantile`` quantile of the known arrival times, so the front is already a

@@ -13,8 +13,8 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from hexdem.analysis.peaks import pulse_times
 from hexdem.analysis.energy import energy_regions
+from hexdem.analysis.peaks import pulse_times
 from hexdem.analysis.tracker import ENERGY_SAMPLES, TrackedPulses, run_noise_floor
 from hexdem.analysis.trajectory import Trajectory
 from hexdem.errors import HexdemError
@@ -33,7 +33,8 @@ class ImpactAnalysis:
 
     ``results``: ``units``, ``length_unit_m``, ``positions`` (N, 2), ``peak_speed``, ``t_peak``,
     ``arrival_time``, ``reach_time`` (N,), ``lines`` {name: bead indices}, ``energy_drift``,
-    ``far_wall_reached``, ``end_velocity`` (N, 2) each bead's velocity at the last sample, ``region_names``, ``region_times`` (T,) and ``region_energies`` (T, R, 2)
+    ``far_wall_reached``, ``end_velocity`` (N, 2) each bead's velocity at the last sample, ``region_names``,
+    ``region_times`` (T,) and ``region_energies`` (T, R, 2)
     [J] (:func:`~hexdem.analysis.energy.energy_regions`), ``peak_angular_speed`` (N,) each bead's
     largest |ω_z| and ``rotational_energy_fraction`` the largest share of the energy held in
     rotation (0 for spheres that do not turn; NaN for a frictional run read from a dump, which
@@ -41,14 +42,26 @@ class ImpactAnalysis:
     else None.
     """
 
-    def __init__(self, model: GranularModel, settings: RunSettings, engine: dict, peak_speed, t_peak, arrival_time,
-                 reach_time, energy_drift: float, region_energies, end_velocity, tracked: TrackedPulses | None = None):
+    def __init__(
+        self,
+        model: GranularModel,
+        settings: RunSettings,
+        engine: dict,
+        peak_speed,
+        t_peak,
+        arrival_time,
+        reach_time,
+        energy_drift: float,
+        region_energies,
+        end_velocity,
+        tracked: TrackedPulses | None = None,
+    ):
         self.model, self.settings, self.engine, self.tracked = model, settings, engine, tracked
         units = settings.units
         self.results = r = SimpleNamespace()
         r.units = units.name
         r.length_unit_m = units.length_m
-        r.positions = model.initial_positions_m()[:len(model.packing)] / units.length_m  # where the beads start
+        r.positions = model.initial_positions_m()[: len(model.packing)] / units.length_m  # where the beads start
         r.peak_speed, r.t_peak, r.arrival_time, r.reach_time = peak_speed, t_peak, arrival_time, reach_time
         r.end_velocity = np.asarray(end_velocity, float)
         r.lines = model.packing.lines()
@@ -61,22 +74,44 @@ class ImpactAnalysis:
         r.rotational_energy_fraction = unknown if tracked is None else tracked.rotational_energy_fraction
 
     @classmethod
-    def from_tracker(cls, model: GranularModel, settings: RunSettings, tracked: TrackedPulses,
-                     engine: dict) -> "ImpactAnalysis":
-        return cls(model, settings, engine, tracked.peak_speed, tracked.t_peak, tracked.arrival_time,
-                   tracked.reach_time, tracked.energy_drift, (tracked.energy_times, tracked.region_energies),
-                   tracked.end_velocity, tracked)
+    def from_tracker(
+        cls, model: GranularModel, settings: RunSettings, tracked: TrackedPulses, engine: dict
+    ) -> ImpactAnalysis:
+        return cls(
+            model,
+            settings,
+            engine,
+            tracked.peak_speed,
+            tracked.t_peak,
+            tracked.arrival_time,
+            tracked.reach_time,
+            tracked.energy_drift,
+            (tracked.energy_times, tracked.region_energies),
+            tracked.end_velocity,
+            tracked,
+        )
 
     @classmethod
-    def from_trajectory(cls, model: GranularModel, settings: RunSettings, trajectory: Trajectory) -> "ImpactAnalysis":
+    def from_trajectory(cls, model: GranularModel, settings: RunSettings, trajectory: Trajectory) -> ImpactAnalysis:
         units = settings.units
-        pulses = pulse_times(trajectory.times_s / units.time_s,
-                             trajectory.speeds_m_s[:, :len(model.packing)] / units.velocity_m_s,
-                             run_noise_floor(model, settings))
+        pulses = pulse_times(
+            trajectory.times_s / units.time_s,
+            trajectory.speeds_m_s[:, : len(model.packing)] / units.velocity_m_s,
+            run_noise_floor(model, settings),
+        )
         times_s, energies = trajectory.region_energies_j(model, ENERGY_SAMPLES)
-        return cls(model, settings, trajectory.engine, pulses.peak_speed, pulses.t_peak, pulses.arrival_time,
-                   pulses.reach_time, trajectory.energy_drift(model), (times_s / units.time_s, energies),
-                   trajectory.velocities_m_s[-1, :len(model.packing)] / units.velocity_m_s)
+        return cls(
+            model,
+            settings,
+            trajectory.engine,
+            pulses.peak_speed,
+            pulses.t_peak,
+            pulses.arrival_time,
+            pulses.reach_time,
+            trajectory.energy_drift(model),
+            (times_s / units.time_s, energies),
+            trajectory.velocities_m_s[-1, : len(model.packing)] / units.velocity_m_s,
+        )
 
     def _far_wall_reached(self) -> bool:
         """Did the leading waves cross the packing within the run? They did when every bead they
@@ -129,6 +164,15 @@ class ImpactAnalysis:
         rows = []
         for name, beads in r.lines.items():
             for n, bead in enumerate(beads):
-                rows.append((name, n, int(bead) + 1, *(float(v) for v in r.positions[bead]),
-                             float(r.peak_speed[bead]), float(r.t_peak[bead]), float(r.arrival_time[bead])))
+                rows.append(
+                    (
+                        name,
+                        n,
+                        int(bead) + 1,
+                        *(float(v) for v in r.positions[bead]),
+                        float(r.peak_speed[bead]),
+                        float(r.t_peak[bead]),
+                        float(r.arrival_time[bead]),
+                    )
+                )
         return rows

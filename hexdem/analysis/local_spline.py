@@ -71,8 +71,11 @@ class LocalSpline:
             root = np.sqrt(np.maximum(discriminant, 0.0))
             q = -0.5 * (linear + np.copysign(root, linear))
             curved = np.abs(quadratic) * self.steps > ROOT_TOLERANCE * np.abs(linear)
-            candidates = np.where(curved[:, None], np.column_stack([q / quadratic, constant / q]),
-                                  np.column_stack([-constant / linear, np.full_like(linear, np.nan)]))
+            candidates = np.where(
+                curved[:, None],
+                np.column_stack([q / quadratic, constant / q]),
+                np.column_stack([-constant / linear, np.full_like(linear, np.nan)]),
+            )
         real = ~curved | (discriminant >= -IMAGINARY_TOLERANCE * np.abs(linear) ** 2)
         for i in np.flatnonzero(real):
             found += self._on_piece(i, candidates[i])
@@ -88,12 +91,15 @@ class LocalSpline:
             nonzero = np.flatnonzero(coefficients)
             if len(nonzero) < 2:
                 continue
-            roots = np.roots(coefficients[nonzero[0]:])
+            roots = np.roots(coefficients[nonzero[0] :])
             found += self._on_piece(i, roots[np.abs(roots.imag) <= IMAGINARY_TOLERANCE * self.steps[i]].real)
         return np.array(sorted(found))
 
     def _on_piece(self, i: int, roots) -> list[float]:
         """Times of the local roots s that lie on piece i (its ends within round-off)."""
         h = self.steps[i]
-        return [float(self.knots[i] + min(max(s, 0.0), h)) for s in np.asarray(roots, float)
-                if np.isfinite(s) and -ROOT_TOLERANCE * h <= s <= h * (1 + ROOT_TOLERANCE)]
+        return [
+            float(self.knots[i] + min(max(s, 0.0), h))
+            for s in np.asarray(roots, float)
+            if np.isfinite(s) and -ROOT_TOLERANCE * h <= s <= h * (1 + ROOT_TOLERANCE)
+        ]

@@ -83,10 +83,14 @@ def map_layout(low, high, title: str, legend: bool, colour_bar: bool = True) -> 
     fig_h = bottom + axes_h + TOP_IN + TITLE_LINE_IN * (len(lines) - 1)
     left = (fig_w - used) / 2 + LEFT_IN
     bar_left = left + axes_w + BAR_PAD_IN
-    return MapLayout(title="\n".join(lines), size=(fig_w, fig_h),
-                     axes=(left / fig_w, bottom / fig_h, axes_w / fig_w, axes_h / fig_h),
-                     bar=(bar_left / fig_w, bottom / fig_h, BAR_WIDTH_IN / fig_w, axes_h / fig_h),
-                     xlim=(low[0], high[0]), ylim=(centre_y - half_y, centre_y + half_y))
+    return MapLayout(
+        title="\n".join(lines),
+        size=(fig_w, fig_h),
+        axes=(left / fig_w, bottom / fig_h, axes_w / fig_w, axes_h / fig_h),
+        bar=(bar_left / fig_w, bottom / fig_h, BAR_WIDTH_IN / fig_w, axes_h / fig_h),
+        xlim=(low[0], high[0]),
+        ylim=(centre_y - half_y, centre_y + half_y),
+    )
 
 
 def wrap_title(title: str, width: int) -> list[str]:

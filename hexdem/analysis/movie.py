@@ -42,9 +42,17 @@ def speed_movie(results, model, times, speeds, v0: float, path, title: str = "",
     units = UNIT_LABELS[results.units]
     fig, ax = subplots(figsize=(6.4, 5.4))
     fig.subplots_adjust(left=0.1, right=0.97, bottom=0.09, top=0.92)
-    floor = 10.0 ** -DECADES
-    circles = draw_lattice(ax, results, model, np.full(len(model.packing), floor), label,
-                           cmap="inferno", norm=LogNorm(floor, 1.0), marker_colour="c")
+    floor = 10.0**-DECADES
+    circles = draw_lattice(
+        ax,
+        results,
+        model,
+        np.full(len(model.packing), floor),
+        label,
+        cmap="inferno",
+        norm=LogNorm(floor, 1.0),
+        marker_colour="c",
+    )
     clock = ax.text(0.5, 1.01, "", transform=ax.transAxes, ha="center", va="bottom", fontsize=12)
 
     def show(frame: int) -> None:

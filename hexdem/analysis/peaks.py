@@ -98,10 +98,10 @@ def rival_maxima(values, floor: float = 0.0) -> np.ndarray:
     k = np.arange(HALF_WINDOW, len(values) - HALF_WINDOW)
     if not len(k):
         return k
-    shifted = [values[HALF_WINDOW + j:len(values) - HALF_WINDOW + j] for j in range(-HALF_WINDOW, HALF_WINDOW + 1)]
+    shifted = [values[HALF_WINDOW + j : len(values) - HALF_WINDOW + j] for j in range(-HALF_WINDOW, HALF_WINDOW + 1)]
     middle = shifted[HALF_WINDOW]
     before = np.max(shifted[:HALF_WINDOW], axis=0)
-    after = np.max(shifted[HALF_WINDOW + 1:], axis=0)
+    after = np.max(shifted[HALF_WINDOW + 1 :], axis=0)
     running = np.maximum.accumulate(np.concatenate([[floor], values]))[k]
     return k[(middle > before) & (middle >= after) & may_overtake(middle, running)]
 
@@ -157,8 +157,11 @@ def refine_peaks(windows, interval: float) -> tuple[np.ndarray, np.ndarray]:
         discriminant = linear**2 - 4 * quadratic * constant
         q = -0.5 * (linear + np.copysign(np.sqrt(np.maximum(discriminant, 0.0)), linear))
         curved = np.abs(quadratic) > ROOT_TOLERANCE * np.abs(linear)
-        roots = np.where(curved[..., None], np.stack([q / quadratic, constant / q], axis=-1),
-                         np.stack([-constant / linear, np.full_like(linear, np.nan)], axis=-1))
+        roots = np.where(
+            curved[..., None],
+            np.stack([q / quadratic, constant / q], axis=-1),
+            np.stack([-constant / linear, np.full_like(linear, np.nan)], axis=-1),
+        )
     real = ~curved | (discriminant >= -IMAGINARY_TOLERANCE * np.abs(linear) ** 2)
     on_piece = real[..., None] & np.isfinite(roots) & (roots >= -ROOT_TOLERANCE) & (roots <= 1 + ROOT_TOLERANCE)
     s = np.clip(np.where(on_piece, roots, 0.0), 0.0, 1.0)
@@ -182,7 +185,7 @@ def rising_crossing(times, values, level) -> float:
         return float(times[0])
     spline, lo = _spline_window(times, values, k)
     roots = [t for t in spline.crossings(level, piece=k - 1 - lo) if times[k - 1] <= t <= times[k]]
-    return float(min(roots)) if roots else float(np.interp(level, values[k - 1:k + 1], times[k - 1:k + 1]))
+    return float(min(roots)) if roots else float(np.interp(level, values[k - 1 : k + 1], times[k - 1 : k + 1]))
 
 
 def pulse_times(times, speeds, floor: float = 0.0) -> PulseTimes:
@@ -206,5 +209,5 @@ def pulse_times(times, speeds, floor: float = 0.0) -> PulseTimes:
             reach[bead] = rising_crossing(times, series, 0.5 * series[k])
             continue
         t_peak[bead], peak[bead] = refine_peak(times, series, floor)
-        arrival[bead] = reach[bead] = rising_crossing(times[:k + 1], series[:k + 1], 0.5 * peak[bead])
+        arrival[bead] = reach[bead] = rising_crossing(times[: k + 1], series[: k + 1], 0.5 * peak[bead])
     return PulseTimes(peak, t_peak, arrival, reach)

@@ -16,9 +16,9 @@ import numpy as np
 from matplotlib import colormaps
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import EllipseCollection
-from matplotlib.patches import Patch
 from matplotlib.colors import ListedColormap, LogNorm
 from matplotlib.figure import Figure
+from matplotlib.patches import Patch
 from matplotlib.ticker import FuncFormatter, LogFormatter
 
 from hexdem.analysis.front_shape import HEXAGON_SIXFOLD
@@ -27,8 +27,10 @@ from hexdem.model.walls import CurvedWall
 
 #: Axis units of the run's unit systems: SI, or the paper's (eq. 3): lengths in d, times in
 #: :math:`T = \sqrt{M / (A d^{1/2})}`, so speeds in :math:`d/T = \sqrt{A/M}\, d^{5/4}`.
-UNIT_LABELS = {"si": {"length": "m", "speed": "m/s", "time": "ms", "time_scale": 1e3},
-               "nondimensional": {"length": "d", "speed": "d/T", "time": "T", "time_scale": 1.0}}
+UNIT_LABELS = {
+    "si": {"length": "m", "speed": "m/s", "time": "ms", "time_scale": 1e3},
+    "nondimensional": {"length": "d", "speed": "d/T", "time": "T", "time_scale": 1.0},
+}
 
 #: Fixed margins of the one-panel figures every run writes: a constrained layout costs each
 #: figure a layout pass.
@@ -120,8 +122,15 @@ def bead_circles(ax, positions, diameters, **style) -> EllipseCollection:
     """Circles of the true ``diameters`` (in ``ax``'s data units) centred at ``positions``, one
     collection drawn in ``style`` (edges 0.2 pt wide unless ``linewidths`` says), for the caller to
     colour and add: the bead maps' beads and the preview's bodies."""
-    return EllipseCollection(diameters, diameters, np.zeros(len(diameters)), units="xy", offsets=positions,
-                             offset_transform=ax.transData, **{"linewidths": 0.2, **style})
+    return EllipseCollection(
+        diameters,
+        diameters,
+        np.zeros(len(diameters)),
+        units="xy",
+        offsets=positions,
+        offset_transform=ax.transData,
+        **{"linewidths": 0.2, **style},
+    )
 
 
 #: Above this many beads a map is drawn as an image (:func:`_pixel_beads`): matplotlib's cost
@@ -135,6 +144,7 @@ MAP_PIXELS = 700
 #: d/√3 = 0.577 d away; drawing each bead's own disc left its gaps as a moiré), while a void
 #: wider than 1.2 d stays white.
 PIXEL_REACH_D = 0.6
+
 
 @functools.lru_cache(maxsize=1)
 def _pixel_tiling(positions_bytes: bytes, diameters_bytes: bytes) -> tuple[np.ndarray, tuple]:
@@ -169,7 +179,9 @@ def tile_lattice(results, model) -> None:
 
 def _tiling_of(positions, diameters) -> tuple[np.ndarray, tuple]:
     """:func:`_pixel_tiling` of the beads at ``positions`` of ``diameters``, found once for the same beads."""
-    return _pixel_tiling(np.ascontiguousarray(positions, float).tobytes(), np.ascontiguousarray(diameters, float).tobytes())
+    return _pixel_tiling(
+        np.ascontiguousarray(positions, float).tobytes(), np.ascontiguousarray(diameters, float).tobytes()
+    )
 
 
 def _pixel_beads(ax, positions, diameters, values, coloured, groups: dict, outlined: dict, cmap, norm, clim):
@@ -182,22 +194,46 @@ def _pixel_beads(ax, positions, diameters, values, coloured, groups: dict, outli
     for name, beads in groups.items():
         if np.any(beads):
             grey = np.where(covered & beads[bead], 1.0, np.nan)
-            ax.imshow(grey, origin="lower", extent=extent, cmap=ListedColormap([UNMEASURED_GREYS[name]]),
-                      interpolation="nearest", vmin=0.0, vmax=1.0)
+            ax.imshow(
+                grey,
+                origin="lower",
+                extent=extent,
+                cmap=ListedColormap([UNMEASURED_GREYS[name]]),
+                interpolation="nearest",
+                vmin=0.0,
+                vmax=1.0,
+            )
             legend.append(Patch(label=name, facecolor=UNMEASURED_GREYS[name], edgecolor=UNMEASURED_EDGE))
     shown = np.where(covered & coloured[bead], values[bead], np.nan)
     image = ax.imshow(shown, origin="lower", extent=extent, cmap=colormaps[cmap], norm=norm, interpolation="nearest")
     if clim is not None:
         image.set_clim(*clim)
     for (name, beads), colour in zip(outlined.items(), OUTLINE_COLOURS):
-        ax.contour((covered & beads[bead]).astype(float), levels=[0.5], colors=[colour], linewidths=1.2,
-                   origin="lower", extent=extent)
+        ax.contour(
+            (covered & beads[bead]).astype(float),
+            levels=[0.5],
+            colors=[colour],
+            linewidths=1.2,
+            origin="lower",
+            extent=extent,
+        )
         legend.append(Patch(label=name, linewidth=1.2, facecolor="none", edgecolor=colour))
     return image, legend
 
 
-def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=None, norm=None, unmeasured=None,
-             outlined=None, colorbar=True):
+def bead_map(
+    ax,
+    positions,
+    diameters,
+    values,
+    cmap="viridis",
+    label="",
+    clim=None,
+    norm=None,
+    unmeasured=None,
+    outlined=None,
+    colorbar=True,
+):
     """Beads as true-size circles (one collection, sized in data units) coloured by ``values``
     through ``norm`` (None: linear), with a colour bar labelled ``label`` (:func:`colour_bar`) unless
     ``colorbar`` is False (panels that share a scale share one bar; a map laid out by
@@ -213,11 +249,13 @@ def bead_map(ax, positions, diameters, values, cmap="viridis", label="", clim=No
     groups["no value"] = ~np.isfinite(values) & ~flagged
     coloured = ~np.any(list(groups.values()), axis=0)
     if len(values) > PIXEL_MAP_BEADS:
-        mappable, legend = _pixel_beads(ax, positions, diameters, values, coloured, groups, outlined or {}, cmap,
-                                        norm, clim)
+        mappable, legend = _pixel_beads(
+            ax, positions, diameters, values, coloured, groups, outlined or {}, cmap, norm, clim
+        )
     else:
-        mappable, legend = _circle_beads(ax, positions, diameters, values, coloured, groups, outlined or {}, cmap,
-                                         norm, clim)
+        mappable, legend = _circle_beads(
+            ax, positions, diameters, values, coloured, groups, outlined or {}, cmap, norm, clim
+        )
     if legend:
         ax.figure.legend(handles=legend, loc="lower center", ncol=len(legend), frameon=False, fontsize="small")
     radius = np.max(diameters) / 2
@@ -269,8 +307,9 @@ def draw_walls(ax, walls, positions, radii, scale=1.0, **style):
     for wall in walls:
         if isinstance(wall, CurvedWall):
             angle = np.linspace(0.0, 2 * np.pi, 361)
-            circle = np.asarray(wall.centre_m) * scale + wall.radius_m * scale * np.column_stack([np.cos(angle),
-                                                                                              np.sin(angle)])
+            circle = np.asarray(wall.centre_m) * scale + wall.radius_m * scale * np.column_stack(
+                [np.cos(angle), np.sin(angle)]
+            )
             ax.plot(circle[:, 0], circle[:, 1], **{"color": "k", "linewidth": 2, **style})
             continue
         normal = np.asarray(wall.normal)
@@ -287,16 +326,27 @@ def lattice_beads(results, model) -> tuple[np.ndarray, np.ndarray]:
     return results.positions, model.packing.diameters_m * (1.0 / results.length_unit_m)
 
 
-def draw_lattice(ax, results, model, values, label: str, cmap="viridis", norm=None, marker_colour="w",
-                 unmeasured=None, colorbar=True):
+def draw_lattice(
+    ax, results, model, values, label: str, cmap="viridis", norm=None, marker_colour="w", unmeasured=None, colorbar=True
+):
     """The packing's beads coloured by ``values`` (one per bead, in the run's units), its walls,
     its struck beads marked with crosses of ``marker_colour``, axes labelled; returns the beads'
     mappable. ``unmeasured`` and ``colorbar`` as for :func:`bead_map`."""
     units = UNIT_LABELS[results.units]
     scale = 1.0 / results.length_unit_m
     positions, diameters = lattice_beads(results, model)
-    circles = bead_map(ax, positions, diameters, values, cmap=cmap, label=label, norm=norm, unmeasured=unmeasured,
-                       outlined=other_materials(model), colorbar=colorbar)
+    circles = bead_map(
+        ax,
+        positions,
+        diameters,
+        values,
+        cmap=cmap,
+        label=label,
+        norm=norm,
+        unmeasured=unmeasured,
+        outlined=other_materials(model),
+        colorbar=colorbar,
+    )
     draw_walls(ax, model.walls, positions, diameters / 2, scale=scale)
     struck = positions[np.unique(model.struck_beads)]
     ax.plot(struck[:, 0], struck[:, 1], linestyle="", marker="x", color=marker_colour, markersize=8, mew=2)
@@ -330,8 +380,9 @@ def energy_regions_figure(results, path, title="Where the energy is") -> None:
     save(fig, path)
 
 
-def front_shape_figure(curves: dict, path, title="Roundness of the wavefront", fits: dict | None = None,
-                       signed: bool = False) -> None:
+def front_shape_figure(
+    curves: dict, path, title="Roundness of the wavefront", fits: dict | None = None, signed: bool = False
+) -> None:
     """Relative sixfold amplitude of the front vs its mean radius, one curve per labelled packing.
 
     ``curves`` maps a label to a :class:`~hexdem.analysis.front_shape.FrontShape` (or anything
@@ -346,18 +397,30 @@ def front_shape_figure(curves: dict, path, title="Roundness of the wavefront", f
     fig.subplots_adjust(**SINGLE_PLOT_MARGINS)
     for label, shape in curves.items():
         values = shape.sixfold_cos if signed else shape.sixfold_amplitude
-        line, = ax.plot(shape.mean_radius, values, marker="o", linestyle="-" if not fits else "",
-                        markersize=4 if fits else 6, label=label)
+        (line,) = ax.plot(
+            shape.mean_radius,
+            values,
+            marker="o",
+            linestyle="-" if not fits else "",
+            markersize=4 if fits else 6,
+            label=label,
+        )
         fit = (fits or {}).get(label)
         if fit is not None:
             radius = np.geomspace(fit.radius_min_d, fit.radius_max_d, 100)
-            ax.plot(radius, fit(radius), color=line.get_color(),
-                    label=f"A∞ + B (R/d)⁻ᵖ: A∞ = {fit.a_inf:.4f} ± {fit.a_inf_se:.4f}, p = {fit.p:.2f}")
+            ax.plot(
+                radius,
+                fit(radius),
+                color=line.get_color(),
+                label=f"A∞ + B (R/d)⁻ᵖ: A∞ = {fit.a_inf:.4f} ± {fit.a_inf_se:.4f}, p = {fit.p:.2f}",
+            )
             ax.axhline(fit.a_inf, color=line.get_color(), linestyle=":", linewidth=1)
     if fits:
         ax.set_xscale("log")
         plain_log_ticks(ax.xaxis)
-    ax.axhline(HEXAGON_SIXFOLD, color="k", linestyle="--", linewidth=1, label=f"regular hexagon ({HEXAGON_SIXFOLD:.4f})")
+    ax.axhline(
+        HEXAGON_SIXFOLD, color="k", linestyle="--", linewidth=1, label=f"regular hexagon ({HEXAGON_SIXFOLD:.4f})"
+    )
     if signed:
         ax.axhline(-HEXAGON_SIXFOLD, color="k", linestyle="--", linewidth=1)
     ax.axhline(0.0, color="grey", linestyle="-", linewidth=1, label="circle (0)")

@@ -74,16 +74,19 @@ def fit_roundness(radius_d, amplitude, radius_min_d: float = 5.0, radius_max_d: 
     use = np.isfinite(radius_d) & np.isfinite(amplitude) & (radius_d >= radius_min_d) & (radius_d <= radius_max_d)
     r, a = radius_d[use], amplitude[use]
     if len(r) < MIN_FRONTS or r.max() < 2 * r.min():
-        raise HexdemError(f"a roundness fit needs at least {MIN_FRONTS} fronts over a factor 2 in radius beyond "
-                          f"{radius_min_d:g} d, got {len(r)}" + (f" from {r.min():.3g} to {r.max():.3g} d" if len(r) else ""))
+        raise HexdemError(
+            f"a roundness fit needs at least {MIN_FRONTS} fronts over a factor 2 in radius beyond "
+            f"{radius_min_d:g} d, got {len(r)}" + (f" from {r.min():.3g} to {r.max():.3g} d" if len(r) else "")
+        )
     b_zero = p_zero = rms_zero = float("nan")
     if np.all(a > 0):
         slope, intercept = np.polyfit(np.log(r), np.log(a), 1)  # the pure power law on log scales: a start
         with warnings.catch_warnings():  # only the parameters of the comparison law are used, not their errors
             warnings.simplefilter("ignore", OptimizeWarning)
             try:
-                (b_zero, p_zero), _ = curve_fit(lambda x, b, p: _power_law(x, 0.0, b, p), r, a,
-                                                p0=(float(np.exp(intercept)), -slope), maxfev=20000)
+                (b_zero, p_zero), _ = curve_fit(
+                    lambda x, b, p: _power_law(x, 0.0, b, p), r, a, p0=(float(np.exp(intercept)), -slope), maxfev=20000
+                )
                 rms_zero = float(np.sqrt(np.mean((_power_law(r, 0.0, b_zero, p_zero) - a) ** 2)))
             except RuntimeError:  # the comparison law does not fit: left as NaN
                 pass
@@ -94,6 +97,18 @@ def fit_roundness(radius_d, amplitude, radius_min_d: float = 5.0, radius_max_d: 
         raise HexdemError(f"the roundness fit over {r.min():.3g}-{r.max():.3g} d did not converge: {exc}") from None
     errors = np.sqrt(np.diag(covariance))
     rms = float(np.sqrt(np.mean((_power_law(r, *params) - a) ** 2)))
-    return RoundnessFit(float(params[0]), float(errors[0]), float(params[1]), float(errors[1]), float(params[2]),
-                        float(errors[2]), rms, float(p_zero), float(b_zero), rms_zero, int(len(r)),
-                        float(r.min()), float(r.max()))
+    return RoundnessFit(
+        float(params[0]),
+        float(errors[0]),
+        float(params[1]),
+        float(errors[1]),
+        float(params[2]),
+        float(errors[2]),
+        rms,
+        float(p_zero),
+        float(b_zero),
+        rms_zero,
+        int(len(r)),
+        float(r.min()),
+        float(r.max()),
+    )

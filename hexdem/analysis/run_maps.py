@@ -13,9 +13,19 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import LogNorm, Normalize
 from matplotlib.figure import Figure
 
-from hexdem.analysis.plotting import (UNIT_LABELS, lattice_beads, other_materials, bead_map, colour_bar, draw_lattice,
-                                     draw_walls, plain_log_ticks, save, set_title)
 from hexdem.analysis.map_layout import chain_direction, fit_chain, fit_map
+from hexdem.analysis.plotting import (
+    UNIT_LABELS,
+    bead_map,
+    colour_bar,
+    draw_lattice,
+    draw_walls,
+    lattice_beads,
+    other_materials,
+    plain_log_ticks,
+    save,
+    set_title,
+)
 from hexdem.model.walls import CurvedWall
 
 
@@ -56,10 +66,24 @@ def chain_map(results, model, values, along, label: str, cmap="viridis", norm=No
     strip = fig.add_axes((0.0, 0.0, 1.0, 0.1), sharex=profile)
     unmeasured = unmeasured_beads(results)
     norm = norm or Normalize()
-    bead_map(strip, frame, diameters, values, cmap=cmap, norm=norm, unmeasured=unmeasured,
-             outlined=other_materials(model), colorbar=False)
-    draw_walls(strip, _walls_along(model.walls, origin * results.length_unit_m, along), frame, diameters / 2,
-               scale=1.0 / results.length_unit_m)
+    bead_map(
+        strip,
+        frame,
+        diameters,
+        values,
+        cmap=cmap,
+        norm=norm,
+        unmeasured=unmeasured,
+        outlined=other_materials(model),
+        colorbar=False,
+    )
+    draw_walls(
+        strip,
+        _walls_along(model.walls, origin * results.length_unit_m, along),
+        frame,
+        diameters / 2,
+        scale=1.0 / results.length_unit_m,
+    )
     strip.plot(*frame[np.unique(model.struck_beads)].T, linestyle="", marker="x", color="k", markersize=7, mew=1.5)
     values = np.asarray(values, float)
     coloured = np.isfinite(values) & ~np.any(list(unmeasured.values()), axis=0)
@@ -69,10 +93,18 @@ def chain_map(results, model, values, along, label: str, cmap="viridis", norm=No
     kinds = sorted(set(sizes.tolist()), reverse=True)
     for kind, style in zip(kinds, ("-", "--", ":", "-.") * len(kinds)):  # a dimer's heavy and light beads apart
         mine = sizes == kind
-        profile.plot(frame[order, 0][mine], shown[mine], color="0.55", linewidth=1, linestyle=style, zorder=1,
-                     label=f"beads of d = {kind:.4g} {units['length']}" if len(kinds) > 1 else None)
-    profile.scatter(frame[order, 0], shown, c=shown, cmap=colormaps[cmap], norm=norm, edgecolors="k", linewidths=0.4,
-                    zorder=2)
+        profile.plot(
+            frame[order, 0][mine],
+            shown[mine],
+            color="0.55",
+            linewidth=1,
+            linestyle=style,
+            zorder=1,
+            label=f"beads of d = {kind:.4g} {units['length']}" if len(kinds) > 1 else None,
+        )
+    profile.scatter(
+        frame[order, 0], shown, c=shown, cmap=colormaps[cmap], norm=norm, edgecolors="k", linewidths=0.4, zorder=2
+    )
     if len(kinds) > 1:
         profile.legend(fontsize="small")
     if isinstance(norm, LogNorm) and np.any(coloured):  # (a log axis of no value cannot be drawn)
@@ -100,8 +132,9 @@ def lattice_map(results, model, values, path, label: str, title: str, cmap="viri
         fig = Figure()
         FigureCanvasAgg(fig)
         ax = fig.add_subplot()
-        beads = draw_lattice(ax, results, model, values, label, cmap, norm, unmeasured=unmeasured_beads(results),
-                             colorbar=False)
+        beads = draw_lattice(
+            ax, results, model, values, label, cmap, norm, unmeasured=unmeasured_beads(results), colorbar=False
+        )
         colour_bar(beads, label, cax=fit_map(ax, title))
     save(fig, path)
     return fig
@@ -110,8 +143,15 @@ def lattice_map(results, model, values, path, label: str, title: str, cmap="viri
 def arrival_map(results, model, path, title="Wavefront arrival time") -> Figure:
     """Every bead's arrival time on the lattice (like Fig. 8a); the figure (:func:`lattice_map`)."""
     units = UNIT_LABELS[results.units]
-    return lattice_map(results, model, results.arrival_time * units["time_scale"], path,
-                       f"arrival time [{units['time']}]", title, cmap="viridis_r")
+    return lattice_map(
+        results,
+        model,
+        results.arrival_time * units["time_scale"],
+        path,
+        f"arrival time [{units['time']}]",
+        title,
+        cmap="viridis_r",
+    )
 
 
 #: The share of its top that a peak map's scale spans at least (for peaks that are all equal).
@@ -135,5 +175,6 @@ def peak_map(results, model, v0: float, path, title="Peak speed") -> Figure:
     """Every bead's peak speed over V0 on the lattice, on a logarithmic scale (the fronts decay
     by decades as they spread; :func:`peak_scale`); the figure (:func:`lattice_map`)."""
     ratio = results.peak_speed / v0
-    return lattice_map(results, model, ratio, path, "peak speed Vₘₐₓ / V₀", title, cmap="magma",
-                       norm=LogNorm(*peak_scale(ratio)))
+    return lattice_map(
+        results, model, ratio, path, "peak speed Vₘₐₓ / V₀", title, cmap="magma", norm=LogNorm(*peak_scale(ratio))
+    )

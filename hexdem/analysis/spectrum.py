@@ -49,8 +49,8 @@ def power_spectrum(times_s, signals, pad: int = 4) -> tuple[np.ndarray, np.ndarr
     transform = np.fft.fft((signals - signals.mean(axis=0)) * window, n=n, axis=0)
     power = np.abs(transform) ** 2
     half = n // 2
-    folded = power[:half + 1].copy()
-    folded[1:half] += power[n - 1:n - half:-1]
+    folded = power[: half + 1].copy()
+    folded[1:half] += power[n - 1 : n - half : -1]
     return 2 * np.pi * np.arange(half + 1) / (n * interval), folded
 
 
@@ -73,7 +73,9 @@ def peak_frequency(omega, power, lowest: float = 0.0, allowed=None) -> np.ndarra
         candidates = np.where(allowed, candidates, -np.inf)
     peaks = inside[np.argmax(candidates, axis=0)]
     span = np.arange(columns.shape[1])
-    left, middle, right = (np.log(np.maximum(columns[peaks + shift, span], np.finfo(float).tiny)) for shift in (-1, 0, 1))
+    left, middle, right = (
+        np.log(np.maximum(columns[peaks + shift, span], np.finfo(float).tiny)) for shift in (-1, 0, 1)
+    )
     curvature = left - 2 * middle + right
     shift = np.where(curvature < 0, 0.5 * (left - right) / np.where(curvature < 0, curvature, -1.0), 0.0)
     return (omega[peaks] + shift * (omega[1] - omega[0])).reshape(shape)

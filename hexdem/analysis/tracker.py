@@ -83,7 +83,8 @@ class TrackedPulses:
     ``settings.sensor_every`` steps. ``collectives`` the MPI collective operations the tracker took
     part in (each rank takes part in the same ones; 0 on one rank). ``analysis_cpu_s`` the CPU time [s]
     of each part of the analysis, summed over the ranks: ``tracker`` (each sample's update),
-    ``audit`` (the energy audit), ``gathering`` (each bead's results at the end). ``peak_angular_speed`` (N,) each bead's largest |ω_z| (0 for
+    ``audit`` (the energy audit), ``gathering`` (each bead's results at the end). ``peak_angular_speed`` (N,) each
+    bead's largest |ω_z| (0 for
     spheres that do not turn); ``rotational_energy_fraction`` the largest share of the kinetic and
     contact energy held in rotation at the audited times; ``end_velocity`` (N, 2) each bead's
     velocity at the last sample (a rebound's outgoing velocity).
@@ -124,8 +125,16 @@ class PulseTracker:
     ``threshold_speed`` (run units) a speed whose first crossing by each bead is recorded.
     """
 
-    def __init__(self, model: GranularModel, settings: RunSettings, comm=None, trace_beads=(),
-                 field_samples=(), gravity_m_s2=None, threshold_speed: float | None = None):
+    def __init__(
+        self,
+        model: GranularModel,
+        settings: RunSettings,
+        comm=None,
+        trace_beads=(),
+        field_samples=(),
+        gravity_m_s2=None,
+        threshold_speed: float | None = None,
+    ):
         self.model, self.settings, self.comm = model, settings, comm
         self.root = comm is None or comm.Get_rank() == 0
         self.several = comm is not None and comm.Get_size() > 1
@@ -213,8 +222,10 @@ class PulseTracker:
                 for array, values in zip(new, their_rows):
                     array[arrived[found]] = values[at]
             if missing.any():
-                raise HexdemError(f"bead {ids[arrived[missing]][0]} came to rank {self.comm.Get_rank()} at sample "
-                                  f"{sample.index} from no rank: its pulse state is lost")
+                raise HexdemError(
+                    f"bead {ids[arrived[missing]][0]} came to rank {self.comm.Get_rank()} at sample "
+                    f"{sample.index} from no rank: its pulse state is lost"
+                )
         self.sample_ids, self.bead_rows, self.ids = sample.ids.copy(), beads, ids
         self.trace_here, self.trace_rows = self._rows_of(self.trace_beads + 1, ids)
         self.sensors_here, self.sensor_rows = self._rows_of(self.sensor_beads + 1, ids)
@@ -237,12 +248,14 @@ class PulseTracker:
         if spins is not None:
             np.maximum(self.peak_spin, spins, out=self.peak_spin)
         if len(self.trace_beads):
-            self.traces[s, self.trace_here] = (np.hypot(*self.end_velocity[self.trace_rows].T) if speeds is None
-                                               else speeds[self.trace_rows])
+            self.traces[s, self.trace_here] = (
+                np.hypot(*self.end_velocity[self.trace_rows].T) if speeds is None else speeds[self.trace_rows]
+            )
         if self.sensor_every and sample.step % self.sensor_every == 0 and len(self.sensor_beads):
             rows = self.bead_rows[self.sensor_rows]
             self.sensors[sample.step // self.sensor_every, self.sensors_here] = np.hstack(
-                [sample.velocities[rows], sample.accelerations[rows]])
+                [sample.velocities[rows], sample.accelerations[rows]]
+            )
         if s in self.field_set:
             radii = self.model.packing.diameters_m[self.ids - 1] / 2 / self.settings.units.length_m
             rims = spins * radii if self.model.laws.tangential else None
@@ -268,17 +281,28 @@ class PulseTracker:
         wanted = self.threshold_speed is not None or s in self.field_set
         speeds = np.empty(len(self.ids) if wanted else 0)
         try:
-            self.pulses.challenge(sample_pulses(self.pulse_arrays, ids=np.asarray(sample.ids, np.int64), s=s, speeds=speeds,
-                                                previous_ids=self.sample_ids, velocities=sample.velocities,
-                                                rows=self.bead_rows, end_velocity=self.end_velocity))
+            self.pulses.challenge(
+                sample_pulses(
+                    self.pulse_arrays,
+                    ids=np.asarray(sample.ids, np.int64),
+                    s=s,
+                    speeds=speeds,
+                    previous_ids=self.sample_ids,
+                    velocities=sample.velocities,
+                    rows=self.bead_rows,
+                    end_velocity=self.end_velocity,
+                )
+            )
         except BodiesReordered:
             raise self._reordered(sample) from None
         return speeds if wanted else None
 
     def _reordered(self, sample: Sample) -> HexdemError:
         """The error for ``sample``, whose bodies are not the previous sample's, in order."""
-        return HexdemError(f"sample {sample.index} reordered the bodies of rank "
-                           f"{0 if self.comm is None else self.comm.Get_rank()} without saying that they may have migrated")
+        return HexdemError(
+            f"sample {sample.index} reordered the bodies of rank "
+            f"{0 if self.comm is None else self.comm.Get_rank()} without saying that they may have migrated"
+        )
 
     def _cross_threshold(self, index: np.ndarray, speeds: np.ndarray, s: int) -> None:
         """Record, as a fractional sample index, where each bead's speed first reached the
@@ -300,8 +324,15 @@ class PulseTracker:
             self.audit_bodies = (np.concatenate([sample.ids, sample.ghost_ids]) if ghosts else sample.ids) - 1
         positions = np.concatenate([sample.positions, sample.ghost_positions]) if ghosts else sample.positions
         angular = None if sample.angular_velocities is None else sample.angular_velocities / units.time_s
-        self.audit_parts.append(self.audit.part(self.audit_bodies, len(sample.ids), in_si(positions, units.length_m),
-                                                in_si(sample.velocities, units.velocity_m_s), angular))
+        self.audit_parts.append(
+            self.audit.part(
+                self.audit_bodies,
+                len(sample.ids),
+                in_si(positions, units.length_m),
+                in_si(sample.velocities, units.velocity_m_s),
+                angular,
+            )
+        )
         self.energy_times.append(sample.time)
         self.cpu_s["audit"] += time.thread_time() - start
 
@@ -313,7 +344,7 @@ class PulseTracker:
             return 0.0
         moved = self.model.initial_positions_m()
         packed = moved.copy()
-        packed[:len(state.displacements_m)] -= state.displacements_m
+        packed[: len(state.displacements_m)] -= state.displacements_m
         still = np.zeros_like(moved)
         return self.audit(moved, still) - self.audit(packed, still)
 
@@ -342,8 +373,9 @@ class PulseTracker:
             reach[b] = interval * state.first_crossing(b, level)
             if complete[b]:
                 arrival[b] = reach[b]
-        return np.column_stack([peak, t_peak, arrival, reach, self.threshold_index * interval, self.peak_spin,
-                                self.end_velocity])
+        return np.column_stack(
+            [peak, t_peak, arrival, reach, self.threshold_index * interval, self.peak_spin, self.end_velocity]
+        )
 
     def finish(self) -> TrackedPulses | None:
         """The results on rank 0 (None on the other ranks); see :class:`TrackedPulses`. Each rank
@@ -378,19 +410,31 @@ class PulseTracker:
         region_energies = sums[:, 3:].reshape(len(self.energy_times), len(self.audit.region_names), 2)
         impact_energy = translational[0] + self._displacement_energy_j()
         scale = energy_scale_j(energies, impact_energy)
-        return TrackedPulses(peak_speed=beads[:, 0], t_peak=beads[:, 1], arrival_time=beads[:, 2], reach_time=beads[:, 3],
-                             energy_drift=energy_error(energies, impact_energy, self.model.dissipative),
-                             energy_lost=(energies[0] - energies[-1]) / scale,
-                             energy_times=np.array(self.energy_times), region_energies=region_energies,
-                             n_samples=self.count, trace_beads=self.trace_beads,
-                             trace_times=np.arange(self.count) * interval, trace_speeds=traces[:self.count],
-                             field_times=self.field_samples * interval, field_speeds=fields,
-                             field_rim_speeds=rim_fields, threshold_time=beads[:, 4],
-                             sensor_times=np.arange(len(sensors)) * self.sensor_every * self.settings.dt_s
-                             / self.settings.units.time_s, sensor_states=sensors,
-                             peak_angular_speed=beads[:, 5], end_velocity=beads[:, 6:8],
-                             rotational_energy_fraction=rotational_share(rotational, region_energies),
-                             collectives=self.collectives, analysis_cpu_s=cpu_s)
+        return TrackedPulses(
+            peak_speed=beads[:, 0],
+            t_peak=beads[:, 1],
+            arrival_time=beads[:, 2],
+            reach_time=beads[:, 3],
+            energy_drift=energy_error(energies, impact_energy, self.model.dissipative),
+            energy_lost=(energies[0] - energies[-1]) / scale,
+            energy_times=np.array(self.energy_times),
+            region_energies=region_energies,
+            n_samples=self.count,
+            trace_beads=self.trace_beads,
+            trace_times=np.arange(self.count) * interval,
+            trace_speeds=traces[: self.count],
+            field_times=self.field_samples * interval,
+            field_speeds=fields,
+            field_rim_speeds=rim_fields,
+            threshold_time=beads[:, 4],
+            sensor_times=np.arange(len(sensors)) * self.sensor_every * self.settings.dt_s / self.settings.units.time_s,
+            sensor_states=sensors,
+            peak_angular_speed=beads[:, 5],
+            end_velocity=beads[:, 6:8],
+            rotational_energy_fraction=rotational_share(rotational, region_energies),
+            collectives=self.collectives,
+            analysis_cpu_s=cpu_s,
+        )
 
 
 def run_noise_floor(model: GranularModel, settings: RunSettings) -> float:

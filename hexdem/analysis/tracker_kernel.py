@@ -50,8 +50,26 @@ from hexdem.analysis.peaks import PEAK_OVERSHOOT, may_overtake, refine_peaks
 #: (:func:`~hexdem.analysis.peaks.may_overtake`; the compiled update takes it as an argument).
 RIVAL_RATIO = 1 + PEAK_OVERSHOOT
 #: The state arrays a sample updates, bead first.
-SAMPLED = ("ring", "peak", "peak_index", "window", "after", "start", "length", "rec_index", "rec_value", "rec_prev",
-           "rec_prev2", "first_index", "first_value", "first_prev", "first_prev2", "rival", "rival_index", "rival_after")
+SAMPLED = (
+    "ring",
+    "peak",
+    "peak_index",
+    "window",
+    "after",
+    "start",
+    "length",
+    "rec_index",
+    "rec_value",
+    "rec_prev",
+    "rec_prev2",
+    "first_index",
+    "first_value",
+    "first_prev",
+    "first_prev2",
+    "rival",
+    "rival_index",
+    "rival_after",
+)
 
 
 def rung(capacity: int) -> float:
@@ -108,8 +126,14 @@ class PulseState:
         """Every state array, bead first (for merging the beads' states across MPI ranks): those a
         sample updates (:data:`SAMPLED`), the compiled update's own, and the best refined rival's
         peak, sample index and offset from it (in samples)."""
-        return [*(getattr(self, name) for name in SAMPLED), self.ring_velocity, self.lazy_below, self.best_peak,
-                self.best_index, self.best_offset]
+        return [
+            *(getattr(self, name) for name in SAMPLED),
+            self.ring_velocity,
+            self.lazy_below,
+            self.best_peak,
+            self.best_index,
+            self.best_offset,
+        ]
 
     def kernel_arrays(self) -> dict[str, np.ndarray]:
         """The arrays :func:`~hexdem.analysis.compiled.sample_pulses` updates, by name: the ring and
@@ -176,7 +200,9 @@ class PulseState:
         # below half of an earlier maximum: every free slot is below half of any new one. So the
         # ladder's records below half are all slots below it but the free ones.
         length = self.length[beads]
-        below = np.add.reduce(self.rec_value[beads] < 0.5 * speeds[:, None], axis=1, dtype=np.int64) - (capacity - length)
+        below = np.add.reduce(self.rec_value[beads] < 0.5 * speeds[:, None], axis=1, dtype=np.int64) - (
+            capacity - length
+        )
         drop = np.maximum(below - 1, 0)
         start = (self.start[beads] + drop) % capacity
         n = length - drop
@@ -200,9 +226,16 @@ class PulseState:
     def first_crossing(self, bead: int, level: float) -> float:
         """Fractional sample index at which ``bead``'s samples first reached ``level`` (NaN if never)."""
         order = (self.start[bead] + np.arange(self.length[bead])) % self.rec_value.shape[1]
-        records = zip(self.rec_index[bead, order], self.rec_value[bead, order], self.rec_prev[bead, order],
-                      self.rec_prev2[bead, order], self.first_index[bead, order], self.first_value[bead, order],
-                      self.first_prev[bead, order], self.first_prev2[bead, order])
+        records = zip(
+            self.rec_index[bead, order],
+            self.rec_value[bead, order],
+            self.rec_prev[bead, order],
+            self.rec_prev2[bead, order],
+            self.first_index[bead, order],
+            self.first_value[bead, order],
+            self.first_prev[bead, order],
+            self.first_prev2[bead, order],
+        )
         for s, value, before, before2, s0, v0, before0, before0_2 in records:
             if value >= level:
                 if v0 >= level:

@@ -50,8 +50,9 @@ class Trajectory:
         audit = EnergyAudit(model, self.gravity_m_s2)
         start = model.initial_positions_m()
         picked = np.unique(np.linspace(0, len(self.times_s) - 1, min(samples, len(self.times_s))).round().astype(int))
-        return self.times_s[picked], np.array([audit.measure(start + self.displacements_m[k], self.velocities_m_s[k])[1]
-                                               for k in picked])
+        return self.times_s[picked], np.array(
+            [audit.measure(start + self.displacements_m[k], self.velocities_m_s[k])[1] for k in picked]
+        )
 
     def energy_drift(self, model: GranularModel) -> float:
         """The energy audit's error (:func:`~hexdem.analysis.energy.energy_error`)."""
@@ -77,6 +78,9 @@ class TrajectoryRecorder:
         positions = np.array([s.positions[o] for s, o in zip(self.samples, order)])
         velocities = np.array([s.velocities[o] for s, o in zip(self.samples, order)])
         units = self.units
-        return Trajectory(times_s=np.array([s.time for s in self.samples]) * units.time_s,
-                          velocities_m_s=velocities * units.velocity_m_s,
-                          displacements_m=(positions - self.start) * units.length_m, engine=engine)
+        return Trajectory(
+            times_s=np.array([s.time for s in self.samples]) * units.time_s,
+            velocities_m_s=velocities * units.velocity_m_s,
+            displacements_m=(positions - self.start) * units.length_m,
+            engine=engine,
+        )

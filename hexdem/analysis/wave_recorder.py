@@ -61,11 +61,12 @@ class WaveRecorder:
     ``weights`` (N,) each bead's weight in the plane-wave components (None: all 1).
     """
 
-    def __init__(self, model: GranularModel, settings: RunSettings, wave_vectors_m=(), block: int = 0, comm=None,
-                 weights=None):
+    def __init__(
+        self, model: GranularModel, settings: RunSettings, wave_vectors_m=(), block: int = 0, comm=None, weights=None
+    ):
         self.settings, self.comm = settings, comm
         self.n_beads = len(model.packing)
-        self.positions_m = model.packing.positions_m[:self.n_beads].copy()
+        self.positions_m = model.packing.positions_m[: self.n_beads].copy()
         vectors = np.asarray(wave_vectors_m, float).reshape(-1, 2)
         self.phases = np.exp(-1j * self.positions_m @ vectors.T)  # (N, Q)
         if weights is not None:
@@ -74,7 +75,7 @@ class WaveRecorder:
         self.block = block
         n_blocks = settings.n_samples // block if block else 0
         self.kinetic = np.zeros((n_blocks, self.n_beads))
-        self.half_masses = 0.5 * model.masses_kg[:self.n_beads]
+        self.half_masses = 0.5 * model.masses_kg[: self.n_beads]
         self.count = 0
 
     def __call__(self, sample: Sample) -> None:
@@ -100,7 +101,11 @@ class WaveRecorder:
                 return None
         interval = self.settings.dump_every * self.settings.dt_s
         n_blocks = min(len(self.kinetic), self.count // self.block) if self.block else 0
-        return RecordedWaves(times_s=np.arange(self.count) * interval, components=self.components[:self.count],
-                             block_times_s=(np.arange(n_blocks) + 0.5) * self.block * interval - 0.5 * interval,
-                             block_kinetic_j=self.kinetic[:n_blocks], block_samples=self.block,
-                             positions_m=self.positions_m)
+        return RecordedWaves(
+            times_s=np.arange(self.count) * interval,
+            components=self.components[: self.count],
+            block_times_s=(np.arange(n_blocks) + 0.5) * self.block * interval - 0.5 * interval,
+            block_kinetic_j=self.kinetic[:n_blocks],
+            block_samples=self.block,
+            positions_m=self.positions_m,
+        )

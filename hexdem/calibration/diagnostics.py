@@ -31,10 +31,16 @@ def goodness_of_fit(likelihood, unit_median, parameters: int) -> dict:
     count, size = data.records.shape
     dof = max(count * size - parameters, 1)
     names = data.record_names or tuple(str(r) for r in range(count))
-    return {"method": "chi-square at the posterior median with the likelihood's full covariance",
-            "chi2": together, "dof": dof, "p_value": float(chi_squared.sf(together, dof)),
-            "records": [{"record": name, "chi2": value, "p_value": float(chi_squared.sf(value, size))}
-                        for name, value in zip(names, alone)]}
+    return {
+        "method": "chi-square at the posterior median with the likelihood's full covariance",
+        "chi2": together,
+        "dof": dof,
+        "p_value": float(chi_squared.sf(together, dof)),
+        "records": [
+            {"record": name, "chi2": value, "p_value": float(chi_squared.sf(value, size))}
+            for name, value in zip(names, alone)
+        ],
+    }
 
 
 def misfit_records(fit: dict, threshold: float) -> list[str]:
@@ -50,8 +56,10 @@ def in_g_hint(records, simulated, sensors: int) -> str:
     lowest, highest = float(np.min(simulated[..., :sensors])), float(np.max(simulated[..., :sensors]))
     scaled = measured + np.log(STANDARD_GRAVITY_M_S2)
     if measured < lowest - np.log(2.0) and lowest - 1.0 <= scaled <= highest + 1.0:
-        return (f" The measured peak speeds lie {np.exp(lowest - measured):.3g} times or more below every "
-                "simulation's: are the records in g? (--acceleration-unit g)")
+        return (
+            f" The measured peak speeds lie {np.exp(lowest - measured):.3g} times or more below every "
+            "simulation's: are the records in g? (--acceleration-unit g)"
+        )
     return ""
 
 
@@ -62,12 +70,16 @@ def piled_against_bounds(priors, unit_samples, share: float, zone: float) -> lis
     for j, prior in enumerate(priors):
         if prior.kind == "normal":
             continue
-        for side, mass, bound in (("lower", np.mean(unit_samples[:, j] < zone), prior.a),
-                                  ("upper", np.mean(unit_samples[:, j] > 1 - zone), prior.b)):
+        for side, mass, bound in (
+            ("lower", np.mean(unit_samples[:, j] < zone), prior.a),
+            ("upper", np.mean(unit_samples[:, j] > 1 - zone), prior.b),
+        ):
             if mass > share:
-                notes.append(f"the posterior of {prior.key} piles against its prior's {side} bound {bound:g} "
-                             f"({mass:.0%} of it within {zone:.0%} of the prior's range from it): the records may "
-                             "want a value beyond it; widen the prior")
+                notes.append(
+                    f"the posterior of {prior.key} piles against its prior's {side} bound {bound:g} "
+                    f"({mass:.0%} of it within {zone:.0%} of the prior's range from it): the records may "
+                    "want a value beyond it; widen the prior"
+                )
     return notes
 
 
@@ -90,5 +102,7 @@ def emulator_error(emulator, names, noise_sd) -> dict:
     """The emulator's leave-one-out error per observable (``names``): its root mean square, and that
     over the records' mean noise standard deviation ``noise_sd`` (m,)."""
     rms = np.sqrt(np.mean(emulator.leave_one_out() ** 2, axis=0))
-    return {"leave_one_out_rms": dict(zip(names, map(float, rms))),
-            "leave_one_out_over_noise": dict(zip(names, map(float, rms / noise_sd)))}
+    return {
+        "leave_one_out_rms": dict(zip(names, map(float, rms))),
+        "leave_one_out_over_noise": dict(zip(names, map(float, rms / noise_sd))),
+    }

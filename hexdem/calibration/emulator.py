@@ -21,8 +21,11 @@ from scipy.optimize import minimize
 
 #: Bounds of log ℓ (unit-cube widths), log s² and log τ² of the standardized residuals (τ²'s
 #: upper bound is the emulator's ``nugget_max``).
-LOG_BOUNDS = {"length": (np.log(0.02), np.log(20.0)), "signal": (np.log(1e-4), np.log(1e2)),
-              "nugget": (np.log(1e-10), np.log(1e-1))}
+LOG_BOUNDS = {
+    "length": (np.log(0.02), np.log(20.0)),
+    "signal": (np.log(1e-4), np.log(1e2)),
+    "nugget": (np.log(1e-10), np.log(1e-1)),
+}
 
 
 def matern52_of_distance(r) -> np.ndarray:
@@ -77,7 +80,6 @@ class _Process:
         starts = [np.r_[np.full(p, np.log(length)), 0.0, np.log(1e-4)] for length in (0.3, 1.0)]
         fits = [minimize(self._negative_log_likelihood, start, method="L-BFGS-B", bounds=bounds) for start in starts]
         return min(fits, key=lambda fit: fit.fun).x
-
 
 
 class Emulator:

@@ -81,9 +81,11 @@ def stage_sizes(dimension: int, budget: int, realizations: int = 1) -> list[int]
     first, size = initial_points(dimension), round_points(dimension)
     if budget < first + size:
         runs = "" if realizations == 1 else f" ({budget * realizations} simulations on {realizations} packings each)"
-        raise HexdemError(f"a budget of {budget} parameter sets{runs} is too small for {dimension} parameter(s): "
-                          f"the method needs {first} for its initial design and {size} for each refinement "
-                          f"(at least {first + size} parameter sets)")
+        raise HexdemError(
+            f"a budget of {budget} parameter sets{runs} is too small for {dimension} parameter(s): "
+            f"the method needs {first} for its initial design and {size} for each refinement "
+            f"(at least {first + size} parameter sets)"
+        )
     return [first] + [size] * ((budget - first) // size)
 
 
@@ -103,8 +105,15 @@ class Likelihood:
     """log p(data | u) through ``emulator``, the packings' ``spread`` and the records' ``instruments``
     (see the module docstring; without instruments, none of their errors)."""
 
-    def __init__(self, data: Data, emulator: Emulator, spread: Spread, model_error=None,
-                 instruments: Instruments | None = None, discrepancy: Discrepancy | None = None):
+    def __init__(
+        self,
+        data: Data,
+        emulator: Emulator,
+        spread: Spread,
+        model_error=None,
+        instruments: Instruments | None = None,
+        discrepancy: Discrepancy | None = None,
+    ):
         self.data, self.emulator, self.spread = data, emulator, spread
         self.model_error = 0.0 if model_error is None else np.asarray(model_error, float)
         self.instruments = instruments or Instruments(1 + data.records.shape[1] // 2)
@@ -133,8 +142,12 @@ class Likelihood:
         spread = self.spread(parameters)
         if self.scaled_spread:
             spread = spread * self.spread.scale(unit[:, count])[:, None, None]
-        common = (variance[:, :, None] * np.eye(mean.shape[1]) + spread / self.spread.realizations
-                  + self.model_error + self.instruments.common())
+        common = (
+            variance[:, :, None] * np.eye(mean.shape[1])
+            + spread / self.spread.realizations
+            + self.model_error
+            + self.instruments.common()
+        )
         if self.discrepancy is not None:
             common = common + self.discrepancy.covariance(mean, unit[:, -1])
         return mean, common, spread + self.instruments.per_record(mean)
@@ -212,13 +225,20 @@ class Chain:
 
     @property
     def long_enough(self) -> bool:
-        return (self.steps >= AUTOCORRELATION_LENGTHS * max(self.autocorrelation_steps)
-                and self.effective_samples >= EFFECTIVE_SAMPLES)
+        return (
+            self.steps >= AUTOCORRELATION_LENGTHS * max(self.autocorrelation_steps)
+            and self.effective_samples >= EFFECTIVE_SAMPLES
+        )
 
     def as_dict(self) -> dict:
-        return {"autocorrelation_steps": list(self.autocorrelation_steps), "acceptance_fraction": self.acceptance_fraction,
-                "kept_steps": self.steps, "walkers": self.walkers, "effective_samples": self.effective_samples,
-                "long_enough": self.long_enough}
+        return {
+            "autocorrelation_steps": list(self.autocorrelation_steps),
+            "acceptance_fraction": self.acceptance_fraction,
+            "kept_steps": self.steps,
+            "walkers": self.walkers,
+            "effective_samples": self.effective_samples,
+            "long_enough": self.long_enough,
+        }
 
 
 #: Autocorrelation times that each walker's kept chain must hold.
@@ -245,8 +265,9 @@ def sample_posterior(likelihood: Likelihood, dimension: int, seed: int) -> tuple
     if lost.any():
         coords = state.coords.copy()
         kept = np.flatnonzero(~lost)
-        coords[lost] = np.clip(coords[rng.choice(kept, lost.sum())] + rng.normal(0.0, 1e-6, (lost.sum(), dimension)),
-                               0.0, 1.0)
+        coords[lost] = np.clip(
+            coords[rng.choice(kept, lost.sum())] + rng.normal(0.0, 1e-6, (lost.sum(), dimension)), 0.0, 1.0
+        )
         sampler.reset()
         state = sampler.run_mcmc(coords, BURN_IN_STEPS)
     sampler.reset()
@@ -286,7 +307,7 @@ class Fit:
     @property
     def samples(self) -> np.ndarray:
         """The posterior's samples of the parameters (unit cube, (n, p))."""
-        return self.states[:, :self.points.shape[1]]
+        return self.states[:, : self.points.shape[1]]
 
     @property
     def spread_scales(self) -> np.ndarray | None:
@@ -301,8 +322,15 @@ class Fit:
         return None if discrepancy is None else discrepancy.size(self.states[:, -1])
 
 
-def fit_stage(data: Data, points, observables, seed: int, model_error=None,
-              instruments: Instruments | None = None, discrepancy: Discrepancy | None = None) -> Fit:
+def fit_stage(
+    data: Data,
+    points,
+    observables,
+    seed: int,
+    model_error=None,
+    instruments: Instruments | None = None,
+    discrepancy: Discrepancy | None = None,
+) -> Fit:
     """Fit the emulator to the simulations and sample the posterior it implies (``model_error``:
     the covariance of the model's own integration error, :func:`step_error`; ``instruments``: the
     records' gains and speed scatter; ``discrepancy``: what the model cannot represent)."""

@@ -44,7 +44,7 @@ class Instruments:
     def per_record(self, mean) -> np.ndarray:
         """The speed scatter's covariance (k, m, m) of one record at the emulated means ``mean`` (k, m)."""
         mean = np.atleast_2d(mean)
-        slope = np.column_stack([np.ones((len(mean), self.sensors)), -mean[:, self.sensors:] / 5.0])
+        slope = np.column_stack([np.ones((len(mean), self.sensors)), -mean[:, self.sensors :] / 5.0])
         return self.speed_scatter**2 * slope[:, :, None] * slope[:, None, :]
 
 
@@ -70,7 +70,7 @@ class Discrepancy:
     def covariance(self, mean, unit) -> np.ndarray:
         """τ² W (k, m, m) at the emulated means ``mean`` (k, m) and τ's coordinates ``unit`` (k,)."""
         mean = np.atleast_2d(mean)
-        weights = np.column_stack([np.ones((len(mean), self.sensors)), mean[:, self.sensors:] ** 2])
+        weights = np.column_stack([np.ones((len(mean), self.sensors)), mean[:, self.sensors :] ** 2])
         return (self.size(unit) ** 2)[:, None, None] * weights[:, :, None] * np.eye(mean.shape[1])
 
     def as_dict(self) -> dict:

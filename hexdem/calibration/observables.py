@@ -132,9 +132,11 @@ def noise_covariance(record: Record, sensors, seed: int) -> tuple[np.ndarray, np
     holds no pulse) are refused."""
     quiet = lead_in(record)
     if quiet < BASELINE_SAMPLES:
-        raise HexdemError(f"it starts {max(quiet, 0)} samples before the pulse's foot at its first "
-                          f"sensor; a calibration needs at least {BASELINE_SAMPLES} quiet samples to measure the "
-                          "accelerometer's noise and offset (record with a pre-trigger lead-in)")
+        raise HexdemError(
+            f"it starts {max(quiet, 0)} samples before the pulse's foot at its first "
+            f"sensor; a calibration needs at least {BASELINE_SAMPLES} quiet samples to measure the "
+            "accelerometer's noise and offset (record with a pre-trigger lead-in)"
+        )
     noise = np.full(record.axes.shape, np.nan)
     for (s, j), measured in np.ndenumerate(record.axes):
         if measured:
@@ -143,13 +145,23 @@ def noise_covariance(record: Record, sensors, seed: int) -> tuple[np.ndarray, np
         peak = float(np.max(np.hypot(channel[:, 0], channel[:, 1])))
         level = float(np.nanmax(levels))
         if peak < MIN_SIGNAL_TO_NOISE * level:
-            raise HexdemError(f"sensor {sensor} shows no pulse above the accelerometer's noise "
-                              f"(largest {peak:.3g} m/s², noise {level:.3g} m/s² rms): is the record long enough to "
-                              "hold its pulse?")
+            raise HexdemError(
+                f"sensor {sensor} shows no pulse above the accelerometer's noise "
+                f"(largest {peak:.3g} m/s², noise {level:.3g} m/s² rms): is the record long enough to "
+                "hold its pulse?"
+            )
     rng = np.random.default_rng(seed)
     scale = np.nan_to_num(noise)[:, None, :]
-    draws = np.array([reduce_record(record.times, record.accelerations + scale * rng.standard_normal(
-        record.accelerations.shape), record.axes) for _ in range(BOOTSTRAP_DRAWS)])
+    draws = np.array(
+        [
+            reduce_record(
+                record.times,
+                record.accelerations + scale * rng.standard_normal(record.accelerations.shape),
+                record.axes,
+            )
+            for _ in range(BOOTSTRAP_DRAWS)
+        ]
+    )
     return np.cov(draws, rowvar=False), noise
 
 
@@ -160,16 +172,20 @@ def _channel_noise(lead, name: str) -> float:
     if noise == 0.0:
         noise = float(np.std(lead))
     if noise == 0.0:
-        raise HexdemError(f"{name} is exactly constant over the lead-in: its noise cannot be measured "
-                          "(a channel constant over the whole record is left out)")
+        raise HexdemError(
+            f"{name} is exactly constant over the lead-in: its noise cannot be measured "
+            "(a channel constant over the whole record is left out)"
+        )
     half = len(lead) // 2
     drift = abs(float(np.median(lead[half:]) - np.median(lead[:half])))
     standard_error = noise * np.sqrt(np.pi / 2) * np.sqrt(1 / half + 1 / (len(lead) - half))  # of two medians
     if drift > REST_TOLERANCE * standard_error:
-        raise HexdemError(f"{name} is not at rest before the pulse (its lead-in drifts by {drift:.3g} m/s², "
-                          f"{drift / noise:.1f} times its noise): the record starts after the pulse has begun; a "
-                          f"calibration needs at least {BASELINE_SAMPLES} quiet samples before it (record with a "
-                          "pre-trigger lead-in)")
+        raise HexdemError(
+            f"{name} is not at rest before the pulse (its lead-in drifts by {drift:.3g} m/s², "
+            f"{drift / noise:.1f} times its noise): the record starts after the pulse has begun; a "
+            f"calibration needs at least {BASELINE_SAMPLES} quiet samples before it (record with a "
+            "pre-trigger lead-in)"
+        )
     return noise
 
 
@@ -186,9 +202,11 @@ def read_measured(path, sensors, unit: str = "m/s2") -> list[Record]:
             columns = reader.fieldnames or ()
             missing = [c for c in REQUIRED_COLUMNS if c not in columns]
             if missing:
-                raise HexdemError(f"{path} lacks the column(s) {', '.join(missing)}; expected "
-                                  f"{','.join(MEASURED_COLUMNS)} (ay may be absent for single-axis sensors) and "
-                                  "optionally record")
+                raise HexdemError(
+                    f"{path} lacks the column(s) {', '.join(missing)}; expected "
+                    f"{','.join(MEASURED_COLUMNS)} (ay may be absent for single-axis sensors) and "
+                    "optionally record"
+                )
             present = [c for c in MEASURED_COLUMNS[1:] if c in columns]
             grouped: dict[str, dict[str, list]] = {}
             for line, row in enumerate(reader, start=2):
@@ -199,18 +217,23 @@ def read_measured(path, sensors, unit: str = "m/s2") -> list[Record]:
                 if not np.all(np.isfinite(values)):
                     raise HexdemError(f"{path}, line {line}: a value that is NaN or infinite")
                 grouped.setdefault(row.get("record") or "0", {}).setdefault(row["sensor"], []).append(
-                    values + [0.0] * (3 - len(values)))
+                    values + [0.0] * (3 - len(values))
+                )
     except OSError as exc:
         raise HexdemError(f"cannot read {path}: {exc.strerror}") from None
     if not grouped:
         raise HexdemError(f"{path} holds no measured samples")
     scale = ACCELERATION_UNITS[unit]
-    records = [_record(path, name, channels, [str(s) for s in sensors], scale, "ay" in present)
-               for name, channels in grouped.items()]
+    records = [
+        _record(path, name, channels, [str(s) for s in sensors], scale, "ay" in present)
+        for name, channels in grouped.items()
+    ]
     rates = [record.rate_hz for record in records]
     if max(rates) > (1 + STEADY_RATE_RTOL) * min(rates):
-        raise HexdemError(f"{path}: the records are sampled at different rates ({min(rates):.6g} to "
-                          f"{max(rates):.6g} Hz); calibrate records of one rate together")
+        raise HexdemError(
+            f"{path}: the records are sampled at different rates ({min(rates):.6g} to "
+            f"{max(rates):.6g} Hz); calibrate records of one rate together"
+        )
     return _common_axes(path, records, [str(s) for s in sensors])
 
 
@@ -218,12 +241,16 @@ def _record(path, name: str, channels: dict, sensors: list[str], scale: float, h
     """One record's channels checked against the configuration's ``sensors``."""
     extra = [s for s in channels if s not in sensors]
     if extra:
-        raise HexdemError(f"{path}, record {name}: sensor(s) {', '.join(extra)} are not among the configuration's "
-                          f"sensors ({', '.join(sensors) or 'none'})")
+        raise HexdemError(
+            f"{path}, record {name}: sensor(s) {', '.join(extra)} are not among the configuration's "
+            f"sensors ({', '.join(sensors) or 'none'})"
+        )
     lacking = [s for s in sensors if s not in channels]
     if lacking:
-        raise HexdemError(f"{path}, record {name}: the configuration's sensor(s) {', '.join(lacking)} were not "
-                          "measured; list only measured sensors in the configuration's sensors")
+        raise HexdemError(
+            f"{path}, record {name}: the configuration's sensor(s) {', '.join(lacking)} were not "
+            "measured; list only measured sensors in the configuration's sensors"
+        )
     arrays = [np.array(channels[s]) for s in sensors]
     for sensor, array in zip(sensors, arrays):
         if np.any(np.diff(array[:, 0]) <= 0):
@@ -232,12 +259,15 @@ def _record(path, name: str, channels: dict, sensors: list[str], scale: float, h
     if any(len(a) != len(times) or not np.array_equal(a[:, 0], times) for a in arrays):
         raise HexdemError(f"{path}, record {name}: the sensors are not sampled at the same times")
     if len(times) < 4 * BASELINE_SAMPLES:
-        raise HexdemError(f"{path}, record {name}: {len(times)} samples are too few to hold a pulse "
-                          f"(at least {4 * BASELINE_SAMPLES})")
+        raise HexdemError(
+            f"{path}, record {name}: {len(times)} samples are too few to hold a pulse (at least {4 * BASELINE_SAMPLES})"
+        )
     intervals = np.diff(times)
     if np.max(np.abs(intervals / np.median(intervals) - 1)) > STEADY_RATE_RTOL:
-        raise HexdemError(f"{path}, record {name}: not sampled at a steady rate (intervals from "
-                          f"{intervals.min() * 1e6:.4g} to {intervals.max() * 1e6:.4g} µs)")
+        raise HexdemError(
+            f"{path}, record {name}: not sampled at a steady rate (intervals from "
+            f"{intervals.min() * 1e6:.4g} to {intervals.max() * 1e6:.4g} µs)"
+        )
     accelerations = np.stack([a[:, 1:] for a in arrays]) * scale
     axes = np.ptp(accelerations, axis=1) > 0
     axes[:, 1] &= has_y
@@ -250,6 +280,8 @@ def _common_axes(path, records: list[Record], sensors: list[str]) -> list[Record
     axes = np.logical_and.reduce([record.axes for record in records])
     for sensor, measured in zip(sensors, axes):
         if not measured.any():
-            raise HexdemError(f"{path}: sensor {sensor} has no axis that varies in every record (exactly constant "
-                              "channels hold no signal)")
+            raise HexdemError(
+                f"{path}: sensor {sensor} has no axis that varies in every record (exactly constant "
+                "channels hold no signal)"
+            )
     return [Record(r.name, r.times, r.accelerations * axes[:, None, :], axes) for r in records]

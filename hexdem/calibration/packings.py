@@ -47,8 +47,14 @@ import numpy as np
 from hexdem.common.io import file_lock
 from hexdem.disorder import stages
 from hexdem.disorder.ensemble import ENSEMBLE_SHAPES
-from hexdem.disorder.preparation import (CRYSTAL_PUSH_FORCE_N, SIGMA_PER_TOLERANCE, TOLERANCE_M, Disorder,
-                                         Preparation, write_stage_deck)
+from hexdem.disorder.preparation import (
+    CRYSTAL_PUSH_FORCE_N,
+    SIGMA_PER_TOLERANCE,
+    TOLERANCE_M,
+    Disorder,
+    Preparation,
+    write_stage_deck,
+)
 from hexdem.disorder.stages import compaction_model, prepare
 from hexdem.engines.lammps.deck import DATA_NAME, DECK_NAME, walls_block
 from hexdem.errors import HexdemError
@@ -94,14 +100,18 @@ def check_disorderable(config: RunConfig, sigma_max_m: float, realizations: int,
     """Refuse, in one line, a lattice that the preparation does not build and a σ at which a
     packing would hold a bead of no positive diameter."""
     if config.shape not in ENSEMBLE_SHAPES:
-        raise HexdemError(f"--config: disordered packings are prepared on the shapes {', '.join(ENSEMBLE_SHAPES)}, "
-                          f"not {config.shape!r}")
+        raise HexdemError(
+            f"--config: disordered packings are prepared on the shapes {', '.join(ENSEMBLE_SHAPES)}, "
+            f"not {config.shape!r}"
+        )
     nominal = build_model(config).packing.diameters_m
     for k in range(realizations):
         smallest = float(np.min(nominal + sigma_max_m * deviates(seed, k, len(nominal))))
         if smallest <= 0:
-            raise HexdemError(f"--prior {SIGMA_KEY}: at sigma = {sigma_max_m:.6g} m packing {k} would hold a bead "
-                              f"of diameter {smallest:.3g} m; lower the prior's upper end")
+            raise HexdemError(
+                f"--prior {SIGMA_KEY}: at sigma = {sigma_max_m:.6g} m packing {k} would hold a bead "
+                f"of diameter {smallest:.3g} m; lower the prior's upper end"
+            )
 
 
 def preparation_model(model: GranularModel) -> GranularModel:
@@ -127,8 +137,9 @@ def preparation_key(compact_deck: Path, model: GranularModel, preparation: Prepa
     return digest.hexdigest()
 
 
-def settled_packing(nominal: GranularModel, preparation: Preparation, sigma_m: float, seed: int, realization: int,
-                    root) -> tuple[Packing, np.ndarray]:
+def settled_packing(
+    nominal: GranularModel, preparation: Preparation, sigma_m: float, seed: int, realization: int, root
+) -> tuple[Packing, np.ndarray]:
     """(packing ``realization`` of the lattice of the model ``nominal`` at σ = ``sigma_m`` settled by
     ``preparation`` (:func:`preparation_of`), with its walls; the gravity it settled under [m/s²]),
     prepared in ``root``/KEY or read from there."""

@@ -21,8 +21,14 @@ from hexdem.analysis.plotting import plain_log_ticks, save, subplots
 from hexdem.calibration.observables import ARRIVAL_UNIT_S
 
 #: Axis labels of the keys a calibration usually has: (label, factor from the key's unit to the label's).
-LABELS = {"v0": ("V₀ [m/s]", 1.0), "restitution": ("e", 1.0), "wall_restitution": ("e (walls)", 1.0),
-          "diameter_sigma_m": ("σ [µm]", 1e6), "friction": ("μ", 1.0), "wall_friction": ("μ (walls)", 1.0)}
+LABELS = {
+    "v0": ("V₀ [m/s]", 1.0),
+    "restitution": ("e", 1.0),
+    "wall_restitution": ("e (walls)", 1.0),
+    "diameter_sigma_m": ("σ [µm]", 1e6),
+    "friction": ("μ", 1.0),
+    "wall_friction": ("μ (walls)", 1.0),
+}
 #: A key's unit from its name's suffix, for the keys :data:`LABELS` does not name.
 SUFFIX_UNITS = {"_m": "m", "_pa": "Pa", "_hz": "Hz", "_s": "s", "_kg_m3": "kg/m³", "_m_s": "m/s", "_deg": "°"}
 
@@ -31,8 +37,10 @@ def axis_label(key: str) -> tuple[str, float]:
     """(the axis label of the calibrated ``key`` with its unit, the factor from its values to the axis's)."""
     if key in LABELS:
         return LABELS[key]
-    unit = next((unit for suffix, unit in sorted(SUFFIX_UNITS.items(), key=lambda item: -len(item[0]))
-                 if key.endswith(suffix)), None)
+    unit = next(
+        (unit for suffix, unit in sorted(SUFFIX_UNITS.items(), key=lambda item: -len(item[0])) if key.endswith(suffix)),
+        None,
+    )
     return (f"{key} [{unit}]" if unit else key), 1.0
 
 
@@ -51,8 +59,9 @@ def corner(priors, samples, path) -> None:
     fig, axes = subplots(p, p, figsize=(size, size), layout="constrained", squeeze=False)
     labels = [axis_label(prior.key) for prior in priors]
     scaled = samples * np.array([factor for _, factor in labels])
-    ranges = [tuple(np.array(zoomed_range(samples[:, j], prior.support)) * labels[j][1])
-              for j, prior in enumerate(priors)]
+    ranges = [
+        tuple(np.array(zoomed_range(samples[:, j], prior.support)) * labels[j][1]) for j, prior in enumerate(priors)
+    ]
     for i in range(p):
         for j in range(p):
             ax = axes[i, j]
@@ -93,13 +102,16 @@ def predictive(sensors, distances, records, covariances, predicted, path, misfit
     peaks = np.exp(records[:, :n])
     arrivals = np.column_stack([np.zeros(len(records)), records[:, n:]]) * to_ms
     noise = np.sqrt(np.mean(np.diagonal(covariances, axis1=1, axis2=2), axis=0))
-    fig, axes = subplots(2, 2, figsize=(11, 7.5), layout="constrained", sharex=True,
-                         gridspec_kw={"height_ratios": [3, 2]})
+    fig, axes = subplots(
+        2, 2, figsize=(11, 7.5), layout="constrained", sharex=True, gridspec_kw={"height_ratios": [3, 2]}
+    )
     (ax_peak, ax_arrival), (z_peak, z_arrival) = axes
     predicted_peaks = np.exp(predicted[:, :n])
     predicted_arrivals = np.column_stack([np.zeros(len(predicted)), predicted[:, n:]]) * to_ms
-    for ax, measured, draws, error in ((ax_peak, peaks, predicted_peaks, peaks.mean(axis=0) * noise[:n]),
-                                       (ax_arrival, arrivals, predicted_arrivals, np.r_[0.0, noise[n:]] * to_ms)):
+    for ax, measured, draws, error in (
+        (ax_peak, peaks, predicted_peaks, peaks.mean(axis=0) * noise[:n]),
+        (ax_arrival, arrivals, predicted_arrivals, np.r_[0.0, noise[n:]] * to_ms),
+    ):
         low, median, high = np.quantile(draws, [0.05, 0.5, 0.95], axis=0)
         order = np.argsort(x)
         ax.fill_between(x[order], low[order], high[order], color="0.8", label="posterior predictive 90 %")
@@ -108,8 +120,15 @@ def predictive(sensors, distances, records, covariances, predicted, path, misfit
         if len(records) > 1:
             ax.plot(np.tile(x, len(records)), measured.ravel(), ".", color="C3", alpha=0.5, label="measured records")
         if misfit.any():
-            ax.plot(np.tile(x, misfit.sum()), measured[misfit].ravel(), "x", color="C1", ms=8, mew=2,
-                    label="records that do not fit (p < 0.01)")
+            ax.plot(
+                np.tile(x, misfit.sum()),
+                measured[misfit].ravel(),
+                "x",
+                color="C1",
+                ms=8,
+                mew=2,
+                label="records that do not fit (p < 0.01)",
+            )
     ax_peak.set_yscale("log")
     plain_log_ticks(ax_peak.yaxis)
     ax_peak.set_ylabel("peak speed [m/s]")
@@ -123,8 +142,14 @@ def predictive(sensors, distances, records, covariances, predicted, path, misfit
         ax.axhspan(-1, 1, color="0.82")
         ax.axhline(0, color="0.4", lw=0.8)
         for r, row in enumerate(z[:, columns]):
-            ax.plot(shown, row, "x" if misfit[r] else "o", color="C1" if misfit[r] else "C3", ms=7 if misfit[r] else 4,
-                    mew=2 if misfit[r] else 1)
+            ax.plot(
+                shown,
+                row,
+                "x" if misfit[r] else "o",
+                color="C1" if misfit[r] else "C3",
+                ms=7 if misfit[r] else 4,
+                mew=2 if misfit[r] else 1,
+            )
         ax.set_ylabel("residual [predictive s.d.]")
         ax.set_xlabel("distance from the struck bead [d]")
     z_peak.set_title("Log peak speed: measured − predicted", fontsize=10)
@@ -133,6 +158,14 @@ def predictive(sensors, distances, records, covariances, predicted, path, misfit
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
         for sensor, distance in zip(sensors, x):
-            ax.annotate(str(sensor), (distance, 1.0), xycoords=("data", "axes fraction"), ha="center", va="bottom",
-                        fontsize=7, xytext=(0, 2), textcoords="offset points")
+            ax.annotate(
+                str(sensor),
+                (distance, 1.0),
+                xycoords=("data", "axes fraction"),
+                ha="center",
+                va="bottom",
+                fontsize=7,
+                xytext=(0, 2),
+                textcoords="offset points",
+            )
     save(fig, path)

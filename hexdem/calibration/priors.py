@@ -49,12 +49,13 @@ class Prior:
             raise HexdemError(f"--prior {self.key}: loguniform(a, b) needs a > 0, got {self.a!r}")
 
     @classmethod
-    def parse(cls, text: str) -> "Prior":
+    def parse(cls, text: str) -> Prior:
         """``KEY=DIST`` → a prior; a malformed one is one clear line."""
         match = _PATTERN.match(text)
         if not match:
-            raise HexdemError(f"--prior {text!r}: expected KEY=uniform(a, b), KEY=loguniform(a, b) or "
-                              "KEY=normal(mu, sigma)")
+            raise HexdemError(
+                f"--prior {text!r}: expected KEY=uniform(a, b), KEY=loguniform(a, b) or KEY=normal(mu, sigma)"
+            )
         key, kind, a, b = match.groups()
         try:
             return cls(key, kind, float(a), float(b))

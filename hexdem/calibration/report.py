@@ -5,7 +5,8 @@ emcee's chain, thinned). ``calibration.json`` holds, per key, its prior, the pos
 median, 5 % and 95 % quantiles and ``width_ratio``, the posterior's 90 % interval over the
 prior's; the posterior's correlations; ``directions``, the combinations of the keys that the data
 measure (:func:`directions`); and ``identifiability``, sentences that say where the data
-cannot tell two parameters apart (an absolute correlation of :data:`TRADE_OFF_CORRELATION` or more: they trade off, and only a
+cannot tell two parameters apart (an absolute correlation of :data:`TRADE_OFF_CORRELATION` or more: they trade off, and
+only a
 combination of them is measured) or barely constrain one (``width_ratio`` ≥
 :data:`UNCONSTRAINED_RATIO`), so that no precision is quoted that the data do not hold.
 """
@@ -32,16 +33,24 @@ def summarize(priors, samples) -> dict:
     for j, prior in enumerate(priors):
         q05, median, q95 = np.quantile(samples[:, j], QUANTILES)
         p05, p95 = prior.from_unit([QUANTILES[0], QUANTILES[2]])
-        parameters[prior.key] = {"prior": prior.as_dict(), "mean": float(np.mean(samples[:, j])),
-                                 "median": float(median), "q05": float(q05), "q95": float(q95),
-                                 "width_ratio": float((q95 - q05) / (p95 - p05))}
+        parameters[prior.key] = {
+            "prior": prior.as_dict(),
+            "mean": float(np.mean(samples[:, j])),
+            "median": float(median),
+            "q05": float(q05),
+            "q95": float(q95),
+            "width_ratio": float((q95 - q05) / (p95 - p05)),
+        }
     correlations = np.corrcoef(samples, rowvar=False) if len(keys) > 1 else np.ones((1, 1))
     unit = np.column_stack([prior.to_unit(samples[:, j]) for j, prior in enumerate(priors)])
     found = directions(keys, unit)
-    return {"parameters": parameters,
-            "correlations": {a: {b: float(correlations[i, j]) for j, b in enumerate(keys)} for i, a in enumerate(keys)},
-            "directions": found,
-            "identifiability": identifiability(keys, parameters, np.atleast_2d(correlations)) + direction_notes(keys, found)}
+    return {
+        "parameters": parameters,
+        "correlations": {a: {b: float(correlations[i, j]) for j, b in enumerate(keys)} for i, a in enumerate(keys)},
+        "directions": found,
+        "identifiability": identifiability(keys, parameters, np.atleast_2d(correlations))
+        + direction_notes(keys, found),
+    }
 
 
 def directions(keys, unit_samples) -> list[dict]:
@@ -56,8 +65,12 @@ def directions(keys, unit_samples) -> list[dict]:
     found = []
     for value, vector in zip(values, vectors.T):
         vector = vector * np.sign(vector[np.argmax(np.abs(vector))])
-        found.append({"combination": {key: float(c) for key, c in zip(keys, vector)},
-                      "sd_over_prior": float(np.sqrt(max(value, 0.0)))})
+        found.append(
+            {
+                "combination": {key: float(c) for key, c in zip(keys, vector)},
+                "sd_over_prior": float(np.sqrt(max(value, 0.0))),
+            }
+        )
     return found
 
 
@@ -69,8 +82,10 @@ def direction_notes(keys, found: list[dict]) -> list[str]:
         parts = [(key, c) for key, c in direction["combination"].items() if abs(c) >= COMBINATION_SHARE]
         if len(parts) > 1:
             text = " ".join(f"{'-' if c < 0 else '+'} {abs(c):.2f} {key}" for key, c in parts).lstrip("+ ")
-            notes.append(f"the data measure the combination {text} (in the priors' unit scale) to "
-                         f"{direction['sd_over_prior']:.0%} of its prior's spread, rather than each key alone")
+            notes.append(
+                f"the data measure the combination {text} (in the priors' unit scale) to "
+                f"{direction['sd_over_prior']:.0%} of its prior's spread, rather than each key alone"
+            )
     for key in keys:
         if all(abs(d["combination"][key]) < COMBINATION_SHARE for d in measured):
             notes.append(f"the data leave {key} at its prior: no direction they measure involves it")
@@ -84,8 +99,10 @@ def identifiability(keys, parameters: dict, correlations) -> list[str]:
         for j in range(i + 1, len(keys)):
             rho = correlations[i, j]
             if abs(rho) >= TRADE_OFF_CORRELATION:
-                notes.append(f"{a} and {keys[j]} trade off (posterior correlation {rho:+.2f}): the data measure a "
-                             "combination of them, not each alone; their intervals are not independent")
+                notes.append(
+                    f"{a} and {keys[j]} trade off (posterior correlation {rho:+.2f}): the data measure a "
+                    "combination of them, not each alone; their intervals are not independent"
+                )
     for key in keys:
         ratio = parameters[key]["width_ratio"]
         if ratio >= UNCONSTRAINED_RATIO:

@@ -25,8 +25,14 @@ from pathlib import Path
 import numpy as np
 
 from hexdem.calibration.observables import at_rest_before, observation_names, reduce_record
-from hexdem.calibration.packings import (PACKINGS, PAPER_SIGMA_M, SIGMA_KEY, check_disorderable, preparation_of,
-                                         settled_packing)
+from hexdem.calibration.packings import (
+    PACKINGS,
+    PAPER_SIGMA_M,
+    SIGMA_KEY,
+    check_disorderable,
+    preparation_of,
+    settled_packing,
+)
 from hexdem.calibration.priors import Prior
 from hexdem.common.io import atomic_directory, write_json
 from hexdem.common.progress import silenced
@@ -94,16 +100,21 @@ def check_problem(problem: Problem) -> None:
     the key's valid range (each configuration is built at the support's ends and middle)."""
     base = RunConfig.from_dict(problem.base, source="--config")
     if not base.sensors:
-        raise HexdemError("--config: a calibration compares sensor records; list the measured sensors in the "
-                          "configuration's sensors")
+        raise HexdemError(
+            "--config: a calibration compares sensor records; list the measured sensors in the configuration's sensors"
+        )
     if base.engine != "lammps" or base.ranks != 1:
-        raise HexdemError("--config: a calibration runs each simulation on one LAMMPS rank of its own (--workers "
-                          "runs several at once); leave engine and ranks at their defaults")
+        raise HexdemError(
+            "--config: a calibration runs each simulation on one LAMMPS rank of its own (--workers "
+            "runs several at once); leave engine and ranks at their defaults"
+        )
     for prior in problem.priors:
         if prior.key == SIGMA_KEY:
             if prior.support[0] < 0:
-                raise HexdemError(f"--prior {SIGMA_KEY}: the standard deviation of the diameters must be >= 0 m, "
-                                  f"but {prior.describe()} reaches {prior.support[0]:.6g} m")
+                raise HexdemError(
+                    f"--prior {SIGMA_KEY}: the standard deviation of the diameters must be >= 0 m, "
+                    f"but {prior.describe()} reaches {prior.support[0]:.6g} m"
+                )
             continue
         kind = type_at(RunConfig, prior.key)
         if kind is None or kind is bool or not any(t in (int, float) for t in (kind, *getattr(kind, "__args__", ()))):
@@ -117,7 +128,9 @@ def check_problem(problem: Problem) -> None:
             run_settings(config, build_model(config))
         except HexdemError as exc:
             named = ", ".join(f"{prior.key} = {value:.6g}" for prior, value in zip(problem.priors, values))
-            raise HexdemError(f"--prior: the configuration with {named} (inside the priors) is refused: {exc}") from None
+            raise HexdemError(
+                f"--prior: the configuration with {named} (inside the priors) is refused: {exc}"
+            ) from None
     if problem.disordered:
         largest = max((prior.support[1] for prior in problem.priors if prior.key == SIGMA_KEY), default=PAPER_SIGMA_M)
         check_disorderable(base, largest, problem.realizations, problem.seed)
@@ -135,8 +148,10 @@ def finished(folder: Path, values) -> np.ndarray | None:
         return None
     stored = json.loads((folder / "parameters.json").read_text())["values"]
     if not np.allclose(stored, values, rtol=1e-12, atol=0.0):
-        raise HexdemError(f"{folder} holds a simulation of other parameters: {folder.parent.parent} holds another "
-                          "calibration; rerun the same command to resume it, or choose another --out")
+        raise HexdemError(
+            f"{folder} holds a simulation of other parameters: {folder.parent.parent} holds another "
+            "calibration; rerun the same command to resume it, or choose another --out"
+        )
     return np.array(json.loads(path.read_text())["observables"])
 
 
@@ -150,8 +165,14 @@ def disordered_impact(config: RunConfig, sigma_m: float, seed: int, realization:
     nominal = build_model(config)
     packing, gravity = settled_packing(nominal, preparation_of(config), sigma_m, seed, realization, packings)
     model = replace(nominal, packing=packing)
-    job = ImpactJob(model, run_settings(config, nominal), "lammps", Path(workdir), gravity_m_s2=tuple(float(g) for g in gravity),
-                    show_progress=False)
+    job = ImpactJob(
+        model,
+        run_settings(config, nominal),
+        "lammps",
+        Path(workdir),
+        gravity_m_s2=tuple(float(g) for g in gravity),
+        show_progress=False,
+    )
     analysis = track_impact(job)
     check_energy(analysis, workdir)
     return analysis
@@ -184,6 +205,12 @@ def simulate_point(problem: Problem, values, folder, realization: int = 0) -> li
         times = tracked.sensor_times * units.time_s
         accelerations = np.moveaxis(tracked.sensor_states[:, :, 2:4], 1, 0) * (units.length_m / units.time_s**2)
         observables = reduce_record(*at_rest_before(times, accelerations), problem.axes)
-        write_json(partial / "observables.json", {"names": problem.names, "observables": observables.tolist(),
-                                                  "engine_wall_time_s": analysis.engine.get("wall_time_s", math.nan)})
+        write_json(
+            partial / "observables.json",
+            {
+                "names": problem.names,
+                "observables": observables.tolist(),
+                "engine_wall_time_s": analysis.engine.get("wall_time_s", math.nan),
+            },
+        )
     return observables.tolist()

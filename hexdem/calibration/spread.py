@@ -47,7 +47,9 @@ SD_FLOOR = 1e-9
 def sd_bias(realizations: int) -> float:
     """E[s] / σ of the sample standard deviation s of K normal values, c₄(K) =
     √(2/(K − 1)) Γ(K/2) / Γ((K − 1)/2)."""
-    return float(np.sqrt(2.0 / (realizations - 1)) * np.exp(gammaln(realizations / 2) - gammaln((realizations - 1) / 2)))
+    return float(
+        np.sqrt(2.0 / (realizations - 1)) * np.exp(gammaln(realizations / 2) - gammaln((realizations - 1) / 2))
+    )
 
 
 def shrunk_correlation(sample, dof: int) -> np.ndarray:

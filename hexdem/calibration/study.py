@@ -24,7 +24,14 @@ from hexdem.calibration.observables import noise_covariance, read_measured, redu
 from hexdem.calibration.packings import DISORDER_REALIZATIONS, SIGMA_KEY, on_sigma_levels
 from hexdem.calibration.priors import parse_priors, to_parameters
 from hexdem.calibration.report import summarize, write_posterior
-from hexdem.calibration.simulations import SIMULATIONS, Problem, check_problem, finished, simulate_point, simulation_name
+from hexdem.calibration.simulations import (
+    SIMULATIONS,
+    Problem,
+    check_problem,
+    finished,
+    simulate_point,
+    simulation_name,
+)
 from hexdem.common.checks import positive_int
 from hexdem.common.io import ensure_writable_dir, keep_plan, locked_directory, write_json
 from hexdem.errors import HexdemError, RunFailed, one_line
@@ -90,8 +97,10 @@ def _realizations(priors, realizations: int | None) -> int:
         return DISORDER_REALIZATIONS if calibrates_sigma else 1
     realizations = positive_int("--realizations", realizations)
     if calibrates_sigma and realizations < 2:
-        raise HexdemError(f"--realizations {realizations}: a prior on {SIGMA_KEY} needs at least 2 packings per "
-                          "parameter set, whose spread the comparison accounts for")
+        raise HexdemError(
+            f"--realizations {realizations}: a prior on {SIGMA_KEY} needs at least 2 packings per "
+            "parameter set, whose spread the comparison accounts for"
+        )
     return realizations
 
 
@@ -99,14 +108,24 @@ def instrument_sd(option: str, value) -> float:
     """``value`` of ``option`` (``--sensor-gain-sd``, ``--speed-scatter``): a relative standard
     deviation in [0, :data:`LARGEST_INSTRUMENT_SD`], or a one-line HexdemError."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value <= LARGEST_INSTRUMENT_SD:
-        raise HexdemError(f"{option} {value!r}: a relative standard deviation in [0, {LARGEST_INSTRUMENT_SD}] (0.02 "
-                          "is 2 %)")
+        raise HexdemError(
+            f"{option} {value!r}: a relative standard deviation in [0, {LARGEST_INSTRUMENT_SD}] (0.02 is 2 %)"
+        )
     return float(value)
 
 
-def prepare(base: dict, measured, prior_texts, budget: int | None, seed: int, realizations: int | None = None,
-            gain_sd: float = DEFAULT_GAIN_SD, speed_scatter: float = DEFAULT_SPEED_SCATTER,
-            acceleration_unit: str = "m/s2", model_discrepancy: bool = True) -> Calibration:
+def prepare(
+    base: dict,
+    measured,
+    prior_texts,
+    budget: int | None,
+    seed: int,
+    realizations: int | None = None,
+    gain_sd: float = DEFAULT_GAIN_SD,
+    speed_scatter: float = DEFAULT_SPEED_SCATTER,
+    acceleration_unit: str = "m/s2",
+    model_discrepancy: bool = True,
+) -> Calibration:
     """Every check of the input, in one line each and before any simulation. ``budget`` counts
     simulations: parameter sets times ``realizations``. The records' sampling rate, where it is not
     the configuration's ``sensor_rate_hz``, becomes the simulations'; their measured axes, those
@@ -119,8 +138,7 @@ def prepare(base: dict, measured, prior_texts, budget: int | None, seed: int, re
     records = read_measured(measured, problem.sensors, acceleration_unit)
     problem, notes = _as_measured(problem, records)
     dimension = len(priors)
-    budget = (inference.default_budget(dimension) * realizations if budget is None
-              else positive_int("--budget", budget))
+    budget = inference.default_budget(dimension) * realizations if budget is None else positive_int("--budget", budget)
     stages = inference.stage_sizes(dimension, budget // realizations, realizations)
     observed, covariances, noise = [], [], []
     for k, record in enumerate(records):
@@ -131,12 +149,23 @@ def prepare(base: dict, measured, prior_texts, budget: int | None, seed: int, re
             raise HexdemError(f"{measured}, record {record.name}: {exc}") from None
         covariances.append(covariance)
         noise.append(levels)
-    data = inference.Data(np.array(observed), np.array(covariances), tuple(problem.names),
-                          tuple(record.name for record in records))
+    data = inference.Data(
+        np.array(observed), np.array(covariances), tuple(problem.names), tuple(record.name for record in records)
+    )
     instruments = nuisance.Instruments(len(problem.sensors), gain_sd, speed_scatter)
     discrepancy = nuisance.Discrepancy(len(problem.sensors)) if model_discrepancy else None
-    return Calibration(problem, data, np.array(noise), tuple(stages), seed, instruments, acceleration_unit,
-                       records[0].rate_hz, tuple(notes), discrepancy)
+    return Calibration(
+        problem,
+        data,
+        np.array(noise),
+        tuple(stages),
+        seed,
+        instruments,
+        acceleration_unit,
+        records[0].rate_hz,
+        tuple(notes),
+        discrepancy,
+    )
 
 
 def _as_measured(problem: Problem, records) -> tuple[Problem, list[str]]:
@@ -145,8 +174,10 @@ def _as_measured(problem: Problem, records) -> tuple[Problem, list[str]]:
     notes, rate = [], records[0].rate_hz
     configured = problem.config([prior.from_unit(0.5) for prior in problem.priors]).sensor_rate_hz
     if abs(rate / configured - 1) > RATE_RTOL:
-        notes.append(f"the records are sampled at {rate / 1e3:.6g} kS/s, not the configuration's "
-                     f"{configured / 1e3:.6g} kS/s: the simulations sample at the records' rate")
+        notes.append(
+            f"the records are sampled at {rate / 1e3:.6g} kS/s, not the configuration's "
+            f"{configured / 1e3:.6g} kS/s: the simulations sample at the records' rate"
+        )
         problem = replace(problem, base=problem.base | {"sensor_rate_hz": rate})
         check_problem(problem)
     axes = records[0].axes
@@ -157,27 +188,42 @@ def _as_measured(problem: Problem, records) -> tuple[Problem, list[str]]:
 
 
 def _plan(calibration: Calibration, measured) -> dict:
-    return {"base": calibration.problem.base, "priors": [p.as_dict() | {"key": p.key} for p in calibration.problem.priors],
-            "realizations": calibration.problem.realizations, "stages": list(calibration.stages),
-            "seed": calibration.seed, "measured": str(measured),
-            "records": calibration.data.records.tolist(), "axes": calibration.problem.axes,
-            "instruments": {"sensor_gain_sd": calibration.instruments.gain_sd,
-                            "speed_scatter": calibration.instruments.speed_scatter,
-                            "acceleration_unit": calibration.acceleration_unit},
-            "model_discrepancy": calibration.discrepancy is not None}
+    return {
+        "base": calibration.problem.base,
+        "priors": [p.as_dict() | {"key": p.key} for p in calibration.problem.priors],
+        "realizations": calibration.problem.realizations,
+        "stages": list(calibration.stages),
+        "seed": calibration.seed,
+        "measured": str(measured),
+        "records": calibration.data.records.tolist(),
+        "axes": calibration.problem.axes,
+        "instruments": {
+            "sensor_gain_sd": calibration.instruments.gain_sd,
+            "speed_scatter": calibration.instruments.speed_scatter,
+            "acceleration_unit": calibration.acceleration_unit,
+        },
+        "model_discrepancy": calibration.discrepancy is not None,
+    }
 
 
-def _simulate_stage(calibration: Calibration, unit_points, first_index: int, out: Path, workers: int, parsl,
-                    label: str) -> tuple[np.ndarray, np.ndarray, int]:
+def _simulate_stage(
+    calibration: Calibration, unit_points, first_index: int, out: Path, workers: int, parsl, label: str
+) -> tuple[np.ndarray, np.ndarray, int]:
     """Simulate ``unit_points`` (those not finished before); (points kept, observables (n, K, m),
     failed count). A failed simulation is left out of the fit and counted."""
     problem = calibration.problem
     values = to_parameters(problem.priors, unit_points)
-    folders = {(i, k): out / SIMULATIONS / simulation_name(first_index + i, k, problem.realizations)
-               for i in range(len(values)) for k in range(problem.realizations)}
+    folders = {
+        (i, k): out / SIMULATIONS / simulation_name(first_index + i, k, problem.realizations)
+        for i in range(len(values))
+        for k in range(problem.realizations)
+    }
     results = {key: finished(folder, values[key[0]]) for key, folder in folders.items()}
-    tasks = {key: (simulate_point, problem, values[key[0]].tolist(), str(folder), key[1])
-             for key, folder in folders.items() if results[key] is None}
+    tasks = {
+        key: (simulate_point, problem, values[key[0]].tolist(), str(folder), key[1])
+        for key, folder in folders.items()
+        if results[key] is None
+    }
     failed = set()
     for key, error in run_phase(tasks, workers, parsl, label, "simulation", done_before=len(folders) - len(tasks)):
         if error is None:
@@ -204,27 +250,47 @@ def calibrate(calibration: Calibration, measured, out, workers: int = 1, parsl=N
         points, observables, failed, index, fit = np.empty((0, dimension)), None, 0, 0, None
         step_check, model_error = None, None
         for stage, size in enumerate(calibration.stages):
-            new = (inference.design(dimension, size, seed) if fit is None
-                   else inference.next_points(fit, size, seed + stage))
+            new = (
+                inference.design(dimension, size, seed)
+                if fit is None
+                else inference.next_points(fit, size, seed + stage)
+            )
             if SIGMA_KEY in problem.keys:
                 new = on_sigma_levels(new, problem.keys.index(SIGMA_KEY))
             label = f"stage {stage + 1}/{len(calibration.stages)}"
-            log(f"{label}: {size} parameter set(s) x {problem.realizations} packing(s)"
-                + (" over the prior" if fit is None else " from the posterior"))
+            log(
+                f"{label}: {size} parameter set(s) x {problem.realizations} packing(s)"
+                + (" over the prior" if fit is None else " from the posterior")
+            )
             kept, simulated, lost = _simulate_stage(calibration, new, index, out, workers, parsl, label)
             index, failed = index + size, failed + lost
             points = np.vstack([points, kept])
             observables = simulated if observables is None else np.concatenate([observables, simulated])
             if len(points) < inference.initial_points(dimension) // 2:
-                raise HexdemError(f"{failed} of {index} simulations failed (see {out / SIMULATIONS}); too few are "
-                                  "left to calibrate")
-            fit = inference.fit_stage(calibration.data, points, observables, seed + 1000 + stage, model_error,
-                                      calibration.instruments, calibration.discrepancy)
+                raise HexdemError(
+                    f"{failed} of {index} simulations failed (see {out / SIMULATIONS}); too few are left to calibrate"
+                )
+            fit = inference.fit_stage(
+                calibration.data,
+                points,
+                observables,
+                seed + 1000 + stage,
+                model_error,
+                calibration.instruments,
+                calibration.discrepancy,
+            )
             if step_check is None:
                 step_check = _check_time_step(calibration, fit, out, workers, parsl)
                 model_error = inference.step_error(step_check["coarse"], step_check["half"])
-                fit = inference.fit_stage(calibration.data, points, observables, seed + 1000 + stage, model_error,
-                                          calibration.instruments, calibration.discrepancy)
+                fit = inference.fit_stage(
+                    calibration.data,
+                    points,
+                    observables,
+                    seed + 1000 + stage,
+                    model_error,
+                    calibration.instruments,
+                    calibration.discrepancy,
+                )
         summary = _write_results(calibration, fit, out, failed, time.perf_counter() - started, step_check)
     for note in summary["identifiability"]:
         log(f"note: {note}")
@@ -244,40 +310,69 @@ def _check_time_step(calibration: Calibration, fit: inference.Fit, out: Path, wo
     steps = problem.config(values).steps_per_contact
     half = replace(problem, base=problem.base | {"steps_per_contact": 2 * steps})
     folders = {"coarse": out / SIMULATIONS / STEP_CHECK, "half": out / SIMULATIONS / f"{STEP_CHECK}-half-step"}
-    tasks = {name: (simulate_point, run, values, str(folders[name]))
-             for name, run in (("coarse", problem), ("half", half)) if finished(folders[name], values) is None}
+    tasks = {
+        name: (simulate_point, run, values, str(folders[name]))
+        for name, run in (("coarse", problem), ("half", half))
+        if finished(folders[name], values) is None
+    }
     for name, error in run_phase(tasks, workers, parsl, "time-step check", "simulation"):
         if error is not None:
             step = "at half the time step" if name == "half" else "at the calibration's time step"
             raise RunFailed(f"the time-step check's run {step} failed: {one_line(error)}")
-    return {"parameters": dict(zip(problem.keys, values)), "steps_per_contact": [steps, 2 * steps],
-            **{name: finished(folder, values).tolist() for name, folder in folders.items()}}
+    return {
+        "parameters": dict(zip(problem.keys, values)),
+        "steps_per_contact": [steps, 2 * steps],
+        **{name: finished(folder, values).tolist() for name, folder in folders.items()},
+    }
 
 
-def _write_results(calibration: Calibration, fit: inference.Fit, out: Path, failed: int, seconds: float,
-                   step_check: dict) -> dict:
+def _write_results(
+    calibration: Calibration, fit: inference.Fit, out: Path, failed: int, seconds: float, step_check: dict
+) -> dict:
     problem, data = calibration.problem, calibration.data
     samples = to_parameters(problem.priors, fit.samples)
     write_posterior(out / "posterior.csv", problem.priors, samples)
     summary = summarize(problem.priors, samples)
-    summary["method"] = {"name": "Gaussian-process emulator refined on the posterior, sampled by emcee",
-                         "stages": list(calibration.stages), "walkers": inference.WALKERS,
-                         "burn_in_steps": inference.BURN_IN_STEPS, "kept_steps": inference.KEPT_STEPS,
-                         "thin": inference.THIN, "seed": calibration.seed}
-    summary["simulations"] = {"parameter_sets": int(sum(calibration.stages)), "realizations": problem.realizations,
-                              "runs": int(sum(calibration.stages)) * problem.realizations, "failed": failed,
-                              "wall_time_s": seconds}
+    summary["method"] = {
+        "name": "Gaussian-process emulator refined on the posterior, sampled by emcee",
+        "stages": list(calibration.stages),
+        "walkers": inference.WALKERS,
+        "burn_in_steps": inference.BURN_IN_STEPS,
+        "kept_steps": inference.KEPT_STEPS,
+        "thin": inference.THIN,
+        "seed": calibration.seed,
+    }
+    summary["simulations"] = {
+        "parameter_sets": int(sum(calibration.stages)),
+        "realizations": problem.realizations,
+        "runs": int(sum(calibration.stages)) * problem.realizations,
+        "failed": failed,
+        "wall_time_s": seconds,
+    }
     summary["time_step_check"] = step_check | {
-        "bias": (2.0 * (np.array(step_check["coarse"]) - np.array(step_check["half"]))).tolist()}
-    summary["data"] = {"records": len(data.records), "sensors": problem.sensors, "observables": list(data.names),
-                       "accelerometer_noise_m_s2": [float(np.sqrt(np.nanmean(levels**2)))
-                                                    for levels in calibration.channel_noise_m_s2],
-                       "channel_noise_m_s2": [{sensor: [None if np.isnan(v) else float(v) for v in levels]
-                                               for sensor, levels in zip(problem.sensors, record)}
-                                              for record in calibration.channel_noise_m_s2],
-                       "axes": {sensor: [axis for axis, measured in zip("xy", row) if measured]
-                                for sensor, row in zip(problem.sensors, problem.axes)},
-                       "sampling_rate_hz": calibration.rate_hz, "acceleration_unit": calibration.acceleration_unit}
+        "bias": (2.0 * (np.array(step_check["coarse"]) - np.array(step_check["half"]))).tolist()
+    }
+    summary["data"] = {
+        "records": len(data.records),
+        "sensors": problem.sensors,
+        "observables": list(data.names),
+        "accelerometer_noise_m_s2": [
+            float(np.sqrt(np.nanmean(levels**2))) for levels in calibration.channel_noise_m_s2
+        ],
+        "channel_noise_m_s2": [
+            {
+                sensor: [None if np.isnan(v) else float(v) for v in levels]
+                for sensor, levels in zip(problem.sensors, record)
+            }
+            for record in calibration.channel_noise_m_s2
+        ],
+        "axes": {
+            sensor: [axis for axis, measured in zip("xy", row) if measured]
+            for sensor, row in zip(problem.sensors, problem.axes)
+        },
+        "sampling_rate_hz": calibration.rate_hz,
+        "acceleration_unit": calibration.acceleration_unit,
+    }
     _diagnose(calibration, fit, summary)
     write_json(out / "calibration.json", summary)
     plots.corner(problem.priors, samples, out / "posterior.png")
@@ -287,8 +382,15 @@ def _write_results(calibration: Calibration, fit: inference.Fit, out: Path, fail
     noise = np.mean(data.covariances, axis=0)
     predicted = np.array([rng.multivariate_normal(m, noise + c + o) for m, c, o in zip(mean, common, own)])
     misfit = diagnostics.misfit_records(summary["fit"], MISFIT_P)
-    plots.predictive(problem.sensors, _sensor_distances(problem, samples), data.records, data.covariances, predicted,
-                     out / "predictive.png", [name in misfit for name in data.record_names])
+    plots.predictive(
+        problem.sensors,
+        _sensor_distances(problem, samples),
+        data.records,
+        data.covariances,
+        predicted,
+        out / "predictive.png",
+        [name in misfit for name in data.record_names],
+    )
     return summary
 
 
@@ -319,8 +421,9 @@ def _diagnose(calibration: Calibration, fit: inference.Fit, summary: dict) -> No
     if fit.spread_scales is not None:
         summary["spread_scale"] = diagnostics.quantile_summary(fit.spread_scales)
     if fit.discrepancy_sizes is not None:
-        summary["model_discrepancy"] = (calibration.discrepancy.as_dict()
-                                        | diagnostics.quantile_summary(fit.discrepancy_sizes))
+        summary["model_discrepancy"] = calibration.discrepancy.as_dict() | diagnostics.quantile_summary(
+            fit.discrepancy_sizes
+        )
     if instruments.gain_sd > 0:
         chosen = fit.states[rng.choice(len(fit.states), min(GAIN_DRAWS, len(fit.states)), replace=False)]
         summary["instruments"]["gains"] = diagnostics.gain_estimates(fit.likelihood, chosen, problem.sensors, rng)
@@ -328,21 +431,27 @@ def _diagnose(calibration: Calibration, fit: inference.Fit, summary: dict) -> No
     bad = diagnostics.misfit_records(summary["fit"], MISFIT_P)
     if summary["fit"]["p_value"] < MISFIT_P or bad:
         named = f"; record(s) {', '.join(bad)} (p < {MISFIT_P:g} each)" if bad else ""
-        warnings.append(f"the model does not fit the records: chi2 = {summary['fit']['chi2']:.4g} for "
-                        f"{summary['fit']['dof']} degrees of freedom (p = {summary['fit']['p_value']:.2g}){named}; the "
-                        "intervals say too little: check the records' units, gains and sensors, the configuration "
-                        "and the priors (predictive.png)."
-                        + diagnostics.in_g_hint(data.records, fit.observables, len(problem.sensors)))
+        warnings.append(
+            f"the model does not fit the records: chi2 = {summary['fit']['chi2']:.4g} for "
+            f"{summary['fit']['dof']} degrees of freedom (p = {summary['fit']['p_value']:.2g}){named}; the "
+            "intervals say too little: check the records' units, gains and sensors, the configuration "
+            "and the priors (predictive.png)."
+            + diagnostics.in_g_hint(data.records, fit.observables, len(problem.sensors))
+        )
     if "model_discrepancy" in summary and summary["model_discrepancy"]["q05"] > DISCREPANCY_WARNING:
         size = summary["model_discrepancy"]
-        warnings.append(f"the records differ from the model by a relative {size['median']:.2g} (90 % interval "
-                        f"[{size['q05']:.2g}, {size['q95']:.2g}]) that neither their noise nor the instruments explain: "
-                        "the model misses something the records hold (dissipation, friction, the walls, the "
-                        "packing?); the intervals allow for it, and are wider for it")
+        warnings.append(
+            f"the records differ from the model by a relative {size['median']:.2g} (90 % interval "
+            f"[{size['q05']:.2g}, {size['q95']:.2g}]) that neither their noise nor the instruments explain: "
+            "the model misses something the records hold (dissipation, friction, the walls, the "
+            "packing?); the intervals allow for it, and are wider for it"
+        )
     warnings += diagnostics.piled_against_bounds(problem.priors, fit.samples, PILED_SHARE, BOUND_ZONE)
     if not fit.chain.long_enough:
-        warnings.append(f"emcee's chain mixed slowly: {fit.chain.steps} steps of {fit.chain.walkers} walkers hold "
-                        f"{fit.chain.effective_samples:.0f} independent samples (autocorrelation "
-                        f"{max(fit.chain.autocorrelation_steps):.3g} steps; wanted {inference.EFFECTIVE_SAMPLES} and "
-                        f"{inference.AUTOCORRELATION_LENGTHS} autocorrelation times): its intervals are uncertain")
+        warnings.append(
+            f"emcee's chain mixed slowly: {fit.chain.steps} steps of {fit.chain.walkers} walkers hold "
+            f"{fit.chain.effective_samples:.0f} independent samples (autocorrelation "
+            f"{max(fit.chain.autocorrelation_steps):.3g} steps; wanted {inference.EFFECTIVE_SAMPLES} and "
+            f"{inference.AUTOCORRELATION_LENGTHS} autocorrelation times): its intervals are uncertain"
+        )
     summary["warnings"] = warnings

@@ -26,9 +26,19 @@ from hexdem.model.config import RunConfig
 LEAD_IN_S = 100e-6
 
 
-def synthetic_rows(config: RunConfig, record: str, noise_m_s2, offset_s: float, rng, finer: int = 2,
-                   disorder: tuple[float, int, int] | None = None, packings=None, gains=None, offsets_m_s2=None,
-                   lead_in_s: float = LEAD_IN_S) -> list:
+def synthetic_rows(
+    config: RunConfig,
+    record: str,
+    noise_m_s2,
+    offset_s: float,
+    rng,
+    finer: int = 2,
+    disorder: tuple[float, int, int] | None = None,
+    packings=None,
+    gains=None,
+    offsets_m_s2=None,
+    lead_in_s: float = LEAD_IN_S,
+) -> list:
     """Rows ``sensor,time,ax,ay,record`` of one synthetic record of ``config``: on the ideal
     lattice, or with ``disorder`` = (σ [m], seed, k) on that packing, settled in (or read from)
     the folder ``packings``. As a lab's instruments record it: ``noise_m_s2``, white noise of one
@@ -39,8 +49,13 @@ def synthetic_rows(config: RunConfig, record: str, noise_m_s2, offset_s: float, 
 
     fine = config.replace(steps_per_contact=config.steps_per_contact * finer)
     with tempfile.TemporaryDirectory() as workdir, silenced():
-        analysis = simulate(fine, workdir) if disorder is None else disordered_impact(
-            fine, *disorder, Path(workdir) / "deck", Path(packings or Path(workdir) / "packings"))
+        analysis = (
+            simulate(fine, workdir)
+            if disorder is None
+            else disordered_impact(
+                fine, *disorder, Path(workdir) / "deck", Path(packings or Path(workdir) / "packings")
+            )
+        )
     units, tracked = analysis.settings.units, analysis.tracked
     times = tracked.sensor_times * units.time_s
     accelerations = tracked.sensor_states[:, :, 2:4] * (units.length_m / units.time_s**2)
@@ -54,8 +69,11 @@ def synthetic_rows(config: RunConfig, record: str, noise_m_s2, offset_s: float, 
     accelerations = accelerations + level * rng.standard_normal(accelerations.shape)
     if offsets_m_s2 is not None:
         accelerations = accelerations + np.asarray(offsets_m_s2, float)
-    return [(str(sensor), float(t), float(a[s, 0]), float(a[s, 1]), record)
-            for s, sensor in enumerate(config.sensors) for t, a in zip(times, accelerations)]
+    return [
+        (str(sensor), float(t), float(a[s, 0]), float(a[s, 1]), record)
+        for s, sensor in enumerate(config.sensors)
+        for t, a in zip(times, accelerations)
+    ]
 
 
 def write_measured(path, rows, unit: str = "m/s2", single_axis: bool = False) -> None:

@@ -16,20 +16,28 @@ import argparse
 import importlib
 import sys
 
-from hexdem.common.interrupt import (Interrupted, ignore_stops, raise_if_stopped, shielded, stop_on_signals,
-                                     stop_received)
+from hexdem.common.interrupt import (
+    Interrupted,
+    ignore_stops,
+    raise_if_stopped,
+    shielded,
+    stop_on_signals,
+    stop_received,
+)
 from hexdem.common.process_end import skip_final_collections
 from hexdem.errors import HexdemError, RunFailed
 
 #: Exit status → what it means (also in the CLI reference).
-EXIT_CODES = {0: "success", 1: "an unexpected error (a bug: Python prints its traceback)",
-              2: "a usage error: an unknown command or option, a value of the wrong form",
-              3: "refused: input or an environment hexdem cannot use, or a check that failed (the engines "
-                 "disagree), named in one line",
-              4: "a simulation that started and failed (LAMMPS stopped, the energy drifted, a packing did not "
-                 "settle)",
-              130: "interrupted (Ctrl-C, SIGINT): the run stopped, nothing unfinished kept",
-              143: "stopped (SIGTERM, as kill and batch schedulers send): the run stopped, nothing unfinished kept"}
+EXIT_CODES = {
+    0: "success",
+    1: "an unexpected error (a bug: Python prints its traceback)",
+    2: "a usage error: an unknown command or option, a value of the wrong form",
+    3: "refused: input or an environment hexdem cannot use, or a check that failed (the engines "
+    "disagree), named in one line",
+    4: "a simulation that started and failed (LAMMPS stopped, the energy drifted, a packing did not settle)",
+    130: "interrupted (Ctrl-C, SIGINT): the run stopped, nothing unfinished kept",
+    143: "stopped (SIGTERM, as kill and batch schedulers send): the run stopped, nothing unfinished kept",
+}
 REFUSED, FAILED, INTERRUPTED = 3, 4, 130
 
 #: name → (module, one-line help)

@@ -8,10 +8,14 @@ from hexdem.model.config import RunConfig
 
 
 def add_arguments(parser) -> None:
-    parser.add_argument("--config", metavar="FILE.toml", help="parameters, as for hexdem run (default: the "
-                        "paper's 11-per-edge steel experiment)")
-    parser.add_argument("--out", metavar="DIR", default="results",
-                        help="output directory of DIR/preview.png (default: results/)")
+    parser.add_argument(
+        "--config",
+        metavar="FILE.toml",
+        help="parameters, as for hexdem run (default: the paper's 11-per-edge steel experiment)",
+    )
+    parser.add_argument(
+        "--out", metavar="DIR", default="results", help="output directory of DIR/preview.png (default: results/)"
+    )
 
 
 def run(args) -> None:

@@ -15,26 +15,49 @@ from hexdem.errors import HexdemError
 
 
 def add_arguments(parser) -> None:
-    parser.add_argument("study", nargs="?", metavar="DIR",
-                        help="a study folder already planned (by --out DIR): run what it lacks, or --run I, or --collect")
-    parser.add_argument("--config", metavar="BASE.toml", help="the base configuration (keys: RunConfig fields); "
-                        "default: the paper's 11-per-edge steel experiment")
-    parser.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2,...",
-                        help="a key and its values (repeat for more keys: the runs are the product); KEY may be "
-                             "nested, e.g. regions.0.material or impacts.1.v0")
-    parser.add_argument("--out", metavar="DIR",
-                        help="the sweep's folder: sweep.json (the plan), runs/ (one result directory per run), "
-                             "sweep.csv, sweep.png; rerunning the same command resumes it")
-    parser.add_argument("--plan-only", action="store_true",
-                        help="write the plan into --out and list its runs (index and name), running none")
+    parser.add_argument(
+        "study",
+        nargs="?",
+        metavar="DIR",
+        help="a study folder already planned (by --out DIR): run what it lacks, or --run I, or --collect",
+    )
+    parser.add_argument(
+        "--config",
+        metavar="BASE.toml",
+        help="the base configuration (keys: RunConfig fields); default: the paper's 11-per-edge steel experiment",
+    )
+    parser.add_argument(
+        "--vary",
+        action="append",
+        default=[],
+        metavar="KEY=V1,V2,...",
+        help="a key and its values (repeat for more keys: the runs are the product); KEY may be "
+        "nested, e.g. regions.0.material or impacts.1.v0",
+    )
+    parser.add_argument(
+        "--out",
+        metavar="DIR",
+        help="the sweep's folder: sweep.json (the plan), runs/ (one result directory per run), "
+        "sweep.csv, sweep.png; rerunning the same command resumes it",
+    )
+    parser.add_argument(
+        "--plan-only",
+        action="store_true",
+        help="write the plan into --out and list its runs (index and name), running none",
+    )
     single = parser.add_mutually_exclusive_group()
     single.add_argument("--run", type=int, metavar="I", help="run only run I (from 0) of the study DIR, here")
-    single.add_argument("--collect", action="store_true",
-                        help="write the table and figure of the study DIR from the runs it holds")
+    single.add_argument(
+        "--collect", action="store_true", help="write the table and figure of the study DIR from the runs it holds"
+    )
     add_workers_or_parsl(parser, 1, "runs at once, locally (default 1)")
-    parser.add_argument("--ranks-per-run", type=int, metavar="K",
-                        help="MPI ranks of each LAMMPS run (default: the configuration's ranks, 1; "
-                             "the reference engine's runs take one)")
+    parser.add_argument(
+        "--ranks-per-run",
+        type=int,
+        metavar="K",
+        help="MPI ranks of each LAMMPS run (default: the configuration's ranks, 1; "
+        "the reference engine's runs take one)",
+    )
     add_launcher(parser, "-n K python -P -m hexdem.experiments.parallel JOB for each run")
 
 
@@ -76,5 +99,13 @@ def run_plan(args) -> None:
         for index, run in enumerate(plan_study(read_base(args.config), variations, args.out, source)):
             print(f"{index}\t{run.name}")
         return
-    run_sweep(read_base(args.config), variations, args.out, args.workers, args.parsl, args.ranks_per_run,
-              args.launcher, source=source)
+    run_sweep(
+        read_base(args.config),
+        variations,
+        args.out,
+        args.workers,
+        args.parsl,
+        args.ranks_per_run,
+        args.launcher,
+        source=source,
+    )

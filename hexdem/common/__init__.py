@@ -1,1 +1,2 @@
-"""Helpers every layer uses: number checks (:mod:`.checks`), atomic output (:mod:`.io`), progress bars (:mod:`.progress`)."""
+"""Helpers every layer uses: number checks (:mod:`.checks`), atomic output (:mod:`.io`), progress bars
+(:mod:`.progress`)."""

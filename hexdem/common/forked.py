@@ -24,8 +24,12 @@ def spare_cores() -> bool:
     """Whether this process may run on more than one core, the platform forks, and this is the
     main thread: a run in one thread of several (a Parsl ThreadPoolExecutor's) must not fork, as
     its child would inherit the locks the other threads hold at that moment, and wait on them forever."""
-    return (hasattr(os, "fork") and hasattr(os, "sched_getaffinity") and len(os.sched_getaffinity(0)) > 1
-            and threading.current_thread() is threading.main_thread())
+    return (
+        hasattr(os, "fork")
+        and hasattr(os, "sched_getaffinity")
+        and len(os.sched_getaffinity(0)) > 1
+        and threading.current_thread() is threading.main_thread()
+    )
 
 
 def run_shared(jobs: Sequence[Callable[[], None]]) -> None:

@@ -46,7 +46,9 @@ def file_lock(path, holder: str | None = None):
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | (fcntl.LOCK_NB if holder else 0))
         except BlockingIOError:
-            raise HexdemError(f"{Path(path).parent} is in use by {holder}; wait for it or choose another --out") from None
+            raise HexdemError(
+                f"{Path(path).parent} is in use by {holder}; wait for it or choose another --out"
+            ) from None
         yield fd
     finally:
         os.close(fd)
@@ -83,7 +85,9 @@ def read_text(path, what: str) -> str:
     except OSError as exc:
         raise HexdemError(f"cannot read {what} {path}: {exc.strerror}") from None
     except UnicodeDecodeError as exc:
-        raise HexdemError(f"{what} {path} is not UTF-8 text (byte {exc.start}: {exc.object[exc.start:exc.start + 1]!r})") from None
+        raise HexdemError(
+            f"{what} {path} is not UTF-8 text (byte {exc.start}: {exc.object[exc.start : exc.start + 1]!r})"
+        ) from None
 
 
 def read_toml(path, what: str = "config") -> dict:
@@ -211,8 +215,11 @@ def keep_plan(path, plan: dict, study: str) -> None:
         try:
             previous = json.loads(path.read_text())
         except (OSError, ValueError):
-            raise HexdemError(f"{path} is unreadable: {out} does not hold a hexdem {study}; choose another --out") from None
+            raise HexdemError(
+                f"{path} is unreadable: {out} does not hold a hexdem {study}; choose another --out"
+            ) from None
         if previous != json.loads(json.dumps(plan)):
-            raise HexdemError(f"{out} holds a {study} with another plan; rerun the same command to resume it, "
-                              "or choose another --out")
+            raise HexdemError(
+                f"{out} holds a {study} with another plan; rerun the same command to resume it, or choose another --out"
+            )
     write_json(path, plan)

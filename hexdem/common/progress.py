@@ -40,5 +40,12 @@ def progress_bar(total: int, description: str, unit: str = "it") -> tqdm:
     from tqdm import tqdm
 
     quiet = os.environ.get(SILENCE_VARIABLE) == "1"
-    return tqdm(total=total, desc=description, unit=unit, file=sys.stderr, disable=True if quiet else None,
-                dynamic_ncols=True, leave=False)
+    return tqdm(
+        total=total,
+        desc=description,
+        unit=unit,
+        file=sys.stderr,
+        disable=True if quiet else None,
+        dynamic_ncols=True,
+        leave=False,
+    )

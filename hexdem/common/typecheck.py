@@ -4,7 +4,8 @@ A parameter object declares each key's type in its annotations: ``int``, ``float
 ``bool``, unions such as ``float | None`` or ``str | int``, ``tuple[X, ...]`` (a list of X, as
 TOML writes it), ``tuple[X, Y]`` (a list of exactly those), ``dict[str, X]`` (a table of X) and
 ``TypedDict`` tables (each known key of its type; unknown keys are left to the code that reads
-the table, which words them), and any other class (an instance of it). :func:`check_type` refuses a value of another type in one line
+the table, which words them), and any other class (an instance of it). :func:`check_type` refuses a value of another
+type in one line
 naming the key, the type and the value; :func:`type_at` finds the declared type of a dotted
 path into the tables and lists, so that a value can be checked before it is put there.
 
@@ -37,8 +38,12 @@ def _is_list(args) -> bool:
 
 
 #: Scalar types in words: (one, several).
-NOUNS = {bool: ("true or false", "trues or falses"), int: ("an integer", "integers"),
-         float: ("a number", "numbers"), str: ("a string", "strings")}
+NOUNS = {
+    bool: ("true or false", "trues or falses"),
+    int: ("an integer", "integers"),
+    float: ("a number", "numbers"),
+    str: ("a string", "strings"),
+}
 
 
 def describe(kind, plural: bool = False) -> str:
@@ -53,8 +58,11 @@ def describe(kind, plural: bool = False) -> str:
     elif origin is tuple and _is_list(args):
         words = f"list{'s' if plural else ''} of {describe(args[0], True)}"
     elif origin is tuple:
-        parts = (f"{len(args)} {describe(args[0], True)}" if len(set(args)) == 1
-                 else ", ".join(describe(arg) for arg in args))
+        parts = (
+            f"{len(args)} {describe(args[0], True)}"
+            if len(set(args)) == 1
+            else ", ".join(describe(arg) for arg in args)
+        )
         words = f"list{'s' if plural else ''} of {parts}"
     elif origin is dict:
         words = f"table{'s' if plural else ''} of {describe(args[1], True)}"
@@ -91,8 +99,11 @@ def _matches(value, kind, name: str) -> bool:
                 check_type(f"{name}.{k}", item, args[0])
         return isinstance(value, (list, tuple))
     if origin is tuple:
-        return isinstance(value, (list, tuple)) and len(value) == len(args) and all(
-            _matches(item, arg, f"{name}.{k}") for k, (item, arg) in enumerate(zip(value, args)))
+        return (
+            isinstance(value, (list, tuple))
+            and len(value) == len(args)
+            and all(_matches(item, arg, f"{name}.{k}") for k, (item, arg) in enumerate(zip(value, args)))
+        )
     if origin is dict:
         if isinstance(value, dict):
             for key, item in value.items():

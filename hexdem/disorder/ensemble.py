@@ -23,7 +23,8 @@ on one rank, bit-identical results, however many workers share the work.
 
 **Layout of OUT**: ``ensemble.json`` (parameters, timings, disorder effect),
 ``realizations/r0007/{compact,settle,v0.400,...}/`` decks and ``result.npz``,
-``ideal/v0.400/`` decks and ``ideal/result.npz``, and the tables and figures of :func:`hexdem.disorder.stats.write_statistics`.
+``ideal/v0.400/`` decks and ``ideal/result.npz``, and the tables and figures of
+:func:`hexdem.disorder.stats.write_statistics`.
 """
 
 from __future__ import annotations
@@ -64,9 +65,11 @@ def check_impact_steps(name: str, steps_per_contact) -> int:
     option or key the value came from."""
     positive_int(name, steps_per_contact)
     if steps_per_contact < MIN_STEPS_PER_CONTACT or steps_per_contact % IMPACT_SAMPLES_PER_CONTACT:
-        raise HexdemError(f"{name} of the ensembles' impacts must be a multiple of {IMPACT_SAMPLES_PER_CONTACT} "
-                          f"of at least {MIN_STEPS_PER_CONTACT} (they are sampled every 1/{IMPACT_SAMPLES_PER_CONTACT} "
-                          f"of the contact time), got {steps_per_contact}")
+        raise HexdemError(
+            f"{name} of the ensembles' impacts must be a multiple of {IMPACT_SAMPLES_PER_CONTACT} "
+            f"of at least {MIN_STEPS_PER_CONTACT} (they are sampled every 1/{IMPACT_SAMPLES_PER_CONTACT} "
+            f"of the contact time), got {steps_per_contact}"
+        )
     return steps_per_contact
 
 
@@ -117,8 +120,7 @@ class EnsembleConfig:
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
             raise HexdemError(f"the seed must be a non-negative integer, got {self.seed!r}")
         speeds = tuple(self.velocities_m_s)
-        if not speeds or len(set(speeds)) != len(speeds) or not all(
-                is_number(v) and v > 0 for v in speeds):
+        if not speeds or len(set(speeds)) != len(speeds) or not all(is_number(v) and v > 0 for v in speeds):
             raise HexdemError(f"striker velocities must be distinct positive speeds in m/s, got {speeds!r}")
         object.__setattr__(self, "velocities_m_s", tuple(float(v) for v in speeds))
         if self.duration_s is not None and not (is_number(self.duration_s) and self.duration_s > 0):
@@ -127,20 +129,32 @@ class EnsembleConfig:
             raise HexdemError(f"duration_factor must be >= 1, got {self.duration_factor!r}")
         ideal = self.ideal_lattice()
         if ideal.index_of(*self.reference_bead) is None:
-            raise HexdemError(f"reference bead {{{self.reference_bead[0]}, {self.reference_bead[1]}}} "
-                              f"is not in the {ideal.shape}")
+            raise HexdemError(
+                f"reference bead {{{self.reference_bead[0]}, {self.reference_bead[1]}}} is not in the {ideal.shape}"
+            )
 
     def striker_run(self, v_striker: float) -> tuple[RunConfig, GranularModel]:
         """The ideal-lattice striker run at ``v_striker`` (also sets every run's dt and length) and its
         model, built once (the model does not depend on the run's duration)."""
-        size = ({"edge_beads": self.edge_beads} if self.shape == "hexagon"
-                else {"rows": self.rows, "columns": self.columns})
-        base = RunConfig(shape=self.shape, **size, diameter_m=self.disorder.diameter_m,
-                         impact="striker", v0=float(v_striker), steps_per_contact=self.steps_per_contact,
-                         dump_every=self.steps_per_contact // IMPACT_SAMPLES_PER_CONTACT, friction=self.friction)
+        size = (
+            {"edge_beads": self.edge_beads} if self.shape == "hexagon" else {"rows": self.rows, "columns": self.columns}
+        )
+        base = RunConfig(
+            shape=self.shape,
+            **size,
+            diameter_m=self.disorder.diameter_m,
+            impact="striker",
+            v0=float(v_striker),
+            steps_per_contact=self.steps_per_contact,
+            dump_every=self.steps_per_contact // IMPACT_SAMPLES_PER_CONTACT,
+            friction=self.friction,
+        )
         model = build_model(base)
-        duration = (self.duration_s if self.duration_s is not None
-                    else self.duration_factor * run_settings(base, model).duration_s)
+        duration = (
+            self.duration_s
+            if self.duration_s is not None
+            else self.duration_factor * run_settings(base, model).duration_s
+        )
         return base.replace(duration=duration), model
 
     def run_config(self, v_striker: float) -> RunConfig:
@@ -228,13 +242,15 @@ class Ensemble:
         (settle; the walls touch it, or stand back by the preparation's slack)."""
         if stage == "compact":
             return compaction_model(self._base_model, self.ideal, self.diameters_m(k), self.config.disorder)
-        return settling_model(self._base_model, self.ideal, self.realization_dir(k), self.config.preparation,
-                              *self._settling_names(k))
+        return settling_model(
+            self._base_model, self.ideal, self.realization_dir(k), self.config.preparation, *self._settling_names(k)
+        )
 
     def settled_packing(self, k: int) -> Packing:
         """The settled packing of realization k, with the walls placed after compaction."""
-        return settled_packing(self._base_model, self.ideal, self.realization_dir(k), self.config.preparation,
-                               *self._settling_names(k))
+        return settled_packing(
+            self._base_model, self.ideal, self.realization_dir(k), self.config.preparation, *self._settling_names(k)
+        )
 
     @staticmethod
     def _settling_names(k: int) -> tuple[str, str]:

@@ -40,8 +40,10 @@ def fitted_laws(path, diameter_m: float) -> dict:
     except OSError as exc:
         raise HexdemError(f"cannot read scaling laws {path}: {exc.strerror}") from None
     except (ValueError, KeyError, TypeError):
-        raise HexdemError(f"{path} is not a scaling.json of hexdem scaling (needs keys \"0/0\" and \"0/30\" "
-                          "with m, b, alpha, beta, gamma, start_bead)") from None
+        raise HexdemError(
+            f'{path} is not a scaling.json of hexdem scaling (needs keys "0/0" and "0/30" '
+            "with m, b, alpha, beta, gamma, start_bead)"
+        ) from None
     return laws
 
 
@@ -71,8 +73,7 @@ def all_directions(stats_rows, ideal_rows, laws: dict, path, lines=FIG9_LINES) -
     stats = _by_velocity_line(stats_rows, slice(3, 5))
     ideal = _by_velocity_line(ideal_rows, slice(3, 4))
     velocities = sorted({v for v, _ in stats})
-    fig, axes = plots.subplots(len(velocities), 2, figsize=(10, 3.2 * len(velocities)), squeeze=False,
-                               sharex="col")
+    fig, axes = plots.subplots(len(velocities), 2, figsize=(10, 3.2 * len(velocities)), squeeze=False, sharex="col")
     for row, v in enumerate(velocities):
         for col, line in enumerate(lines):
             ax = axes[row, col]
@@ -98,8 +99,9 @@ def all_directions(stats_rows, ideal_rows, laws: dict, path, lines=FIG9_LINES) -
     plots.save(fig, path)
 
 
-def expnumsim(lattice, walls, ideal_relative, mean_relative, reference: int, v_striker: float,
-              realizations: int, path) -> None:
+def expnumsim(
+    lattice, walls, ideal_relative, mean_relative, reference: int, v_striker: float, realizations: int, path
+) -> None:
     """Fig. 8 (a), (c): arrival time relative to the reference bead (white x), ideal lattice
     beside the mean over the disordered realizations, one colour scale and its one bar [ms]."""
 
@@ -107,8 +109,10 @@ def expnumsim(lattice, walls, ideal_relative, mean_relative, reference: int, v_s
     clim = (float(finite.min()) * 1e3, float(finite.max()) * 1e3)
     positions, diameters = lattice.positions_m, lattice.diameters_m
     fig, axes = plots.subplots(1, 2, figsize=(13, 5.5))
-    panels = (("(a) ideal lattice", ideal_relative),
-              (f"(c) weak disorder, mean of {realizations} realizations", mean_relative))
+    panels = (
+        ("(a) ideal lattice", ideal_relative),
+        (f"(c) weak disorder, mean of {realizations} realizations", mean_relative),
+    )
     for ax, (title, values) in zip(axes, panels):
         circles = plots.bead_map(ax, positions, diameters, values * 1e3, cmap="viridis_r", clim=clim, colorbar=False)
         plots.draw_walls(ax, walls, positions, diameters / 2)
@@ -117,6 +121,8 @@ def expnumsim(lattice, walls, ideal_relative, mean_relative, reference: int, v_s
         ax.set_xlabel("x [m]")
         ax.set_ylabel("y [m]")
     fig.colorbar(circles, ax=list(axes), label="relative arrival time [ms]", shrink=0.8)
-    fig.suptitle(f"Wavefront arrival relative to the marked bead, $V_{{\\rm striker}}$ = {v_striker:g} m/s (Fig. 8; "
-                 "its panel (b), the experiments' mean, is measured, not simulated)")
+    fig.suptitle(
+        f"Wavefront arrival relative to the marked bead, $V_{{\\rm striker}}$ = {v_striker:g} m/s (Fig. 8; "
+        "its panel (b), the experiments' mean, is measured, not simulated)"
+    )
     plots.save(fig, path)

@@ -21,14 +21,22 @@ from hexdem.common.io import atomic_path
 from hexdem.disorder.ensemble import Ensemble, EnsembleConfig
 from hexdem.disorder.preparation import STAGES
 from hexdem.disorder.prestress import prestress
-from hexdem.engines.lammps.standalone import loop_time_s
 from hexdem.engines.lammps.settling import read_stage
+from hexdem.engines.lammps.standalone import loop_time_s
 from hexdem.experiments.run import check_energy
 from hexdem.experiments.tracked_run import ImpactJob, track_impact
 
 IMPACT_NAME = "impact.npz"
 #: Arrays of ``impact.npz``, stacked over the striker speeds in ``result.npz``.
-IMPACT_ARRAYS = ("peak_speed", "lead_speed", "t_peak", "arrival_time", "energy_drift", "far_wall_reached", "impact_lammps_s")
+IMPACT_ARRAYS = (
+    "peak_speed",
+    "lead_speed",
+    "t_peak",
+    "arrival_time",
+    "energy_drift",
+    "far_wall_reached",
+    "impact_lammps_s",
+)
 
 
 def _save(path: Path, arrays: dict) -> None:
@@ -47,21 +55,37 @@ def run_impact(ensemble: Ensemble, k: int | None, v: float, dump: bool, launcher
     directory = ensemble.impact_dir(k, v)
     gravity = None if k is None else tuple(float(g) for g in ensemble.gravity_m_s2)
     line_beads = tuple(sorted({int(b) for beads in ensemble.ideal.lines().values() for b in beads}))
-    job = ImpactJob(*ensemble.impact(k, v), "lammps", directory, dump=dump,
-                    gravity_m_s2=gravity, trace_beads=line_beads, show_progress=False)
+    job = ImpactJob(
+        *ensemble.impact(k, v),
+        "lammps",
+        directory,
+        dump=dump,
+        gravity_m_s2=gravity,
+        trace_beads=line_beads,
+        show_progress=False,
+    )
     analysis: ImpactAnalysis = track_impact(job, launcher=launcher)
     check_energy(analysis, analysis.engine["deck"])
     r = analysis.results
     lead = np.full(len(r.peak_speed), np.nan)
     lead[list(line_beads)] = leading_pulse_amplitude(analysis.tracked.trace_speeds)
-    _save(directory / IMPACT_NAME, {"peak_speed": r.peak_speed, "lead_speed": lead, "t_peak": r.t_peak,
-                                    "arrival_time": r.arrival_time, "energy_drift": r.energy_drift,
-                                    "far_wall_reached": r.far_wall_reached,
-                                    "impact_lammps_s": analysis.engine["wall_time_s"]})
+    _save(
+        directory / IMPACT_NAME,
+        {
+            "peak_speed": r.peak_speed,
+            "lead_speed": lead,
+            "t_peak": r.t_peak,
+            "arrival_time": r.arrival_time,
+            "energy_drift": r.energy_drift,
+            "far_wall_reached": r.far_wall_reached,
+            "impact_lammps_s": analysis.engine["wall_time_s"],
+        },
+    )
 
 
-def impact_task(config: EnsembleConfig, out: Path, k: int | None, v: float, dump: bool,
-                launcher: str | None = None) -> None:
+def impact_task(
+    config: EnsembleConfig, out: Path, k: int | None, v: float, dump: bool, launcher: str | None = None
+) -> None:
     """One impact of the ensemble ``config`` in ``out`` (see :func:`run_impact`): a task."""
     run_impact(Ensemble(config, out), k, v, dump, launcher)
 
@@ -80,9 +104,13 @@ def publish_result(ensemble: Ensemble, k: int | None) -> None:
     if k is not None:
         model = ensemble.impact_model(k, ensemble.config.velocities_m_s[0])
         lattice, load = model.packing, prestress(model)
-        arrays.update(diameters_m=lattice.diameters_m, positions_m=lattice.positions_m,
-                      wall_offsets_m=np.array([w.offset_m for w in lattice.walls]),
-                      max_overlap_m=load.max_overlap_m, **load.as_arrays())
+        arrays.update(
+            diameters_m=lattice.diameters_m,
+            positions_m=lattice.positions_m,
+            wall_offsets_m=np.array([w.offset_m for w in lattice.walls]),
+            max_overlap_m=load.max_overlap_m,
+            **load.as_arrays(),
+        )
         for stage in STAGES:
             result = read_stage(ensemble.stage_dir(k, stage))
             arrays[f"{stage}_steps"] = result.steps

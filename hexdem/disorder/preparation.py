@@ -160,8 +160,10 @@ class Preparation:
             value = getattr(self, f.name)
             may_be_zero = f.name in ("tilt_deg", "wall_slack_m")
             if not is_number(value) or value < 0 or (value == 0 and not may_be_zero):
-                raise HexdemError(f"preparation parameter {f.name} must be a {'non-negative' if may_be_zero else 'positive'} "
-                                  f"number, got {value!r}")
+                raise HexdemError(
+                    f"preparation parameter {f.name} must be a {'non-negative' if may_be_zero else 'positive'} "
+                    f"number, got {value!r}"
+                )
             if f.type == "int" and int(value) != value:
                 raise HexdemError(f"preparation parameter {f.name} must be an integer, got {value!r}")
         if self.tilt_deg >= 90:
@@ -233,8 +235,7 @@ def spaced_packing(lattice: Packing, diameters_m, disorder: Disorder) -> Packing
     nothing overlaps: by :meth:`Disorder.spacing_m` over d, or more where a bead grew by a larger
     share of its own nominal diameter (a centered-square's small interstitials)."""
     diameters_m = np.asarray(diameters_m, float)
-    scale = max(disorder.spacing_m(diameters_m) / lattice.diameter_m,
-                float(np.max(diameters_m / lattice.diameters_m)))
+    scale = max(disorder.spacing_m(diameters_m) / lattice.diameter_m, float(np.max(diameters_m / lattice.diameters_m)))
     origin = lattice.positions_m[lattice.struck]
     return lattice.with_geometry(origin + (lattice.positions_m - origin) * scale, diameters_m)
 
@@ -250,8 +251,10 @@ def _push_block(model: GranularModel, preparation: Preparation, framed: bool) ->
     for k, members in enumerate(groups[key] for key in sorted(groups)):
         force = preparation.push_force_n * directions[members[0]]
         ids = [i + 1 for i in members]
-        lines += [f"group           push_{k} id {' '.join(map(str, ids))}",
-                  f"fix             push_{k} push_{k} addforce {float(force[0])!r} {float(force[1])!r} 0.0"]
+        lines += [
+            f"group           push_{k} id {' '.join(map(str, ids))}",
+            f"fix             push_{k} push_{k} addforce {float(force[0])!r} {float(force[1])!r} 0.0",
+        ]
     if not framed:
         lines.append("fix             rigid_modes all momentum 10 linear 1 1 0 angular")
     return "\n".join(lines) + "\n"
@@ -261,17 +264,23 @@ def _stage_blocks(model: GranularModel, stage: str, preparation: Preparation) ->
     """What differs between the stages: walls, loads, damping time, force criterion (None: none)."""
     if stage == "compact":
         framed = not model.packing.bond_steps
-        return {"walls": walls_block(model, SI) if framed else
-                "# (none yet: they are placed touching the compacted packing)\n",
-                "loads": _push_block(model, preparation, framed), "damping_s": preparation.compact_damping_s,
-                "loads_note": f"{preparation.push_force_n:g} N inward on every edge bead; " +
-                ("the frame of walls touching the spaced crystal holds it" if framed else "rigid drift and spin removed"),
-                "force_tolerance": None}
-    return {"walls": walls_block(model, SI),
-            "loads": gravity_block(preparation.gravity_vector_m_s2(model.impact.direction), SI),
-            "damping_s": preparation.settle_damping_s,
-            "loads_note": f"gravity of the {preparation.tilt_deg:g} deg tilt along the strike, no push",
-            "force_tolerance": preparation.settled_max_force_n}
+        return {
+            "walls": walls_block(model, SI)
+            if framed
+            else "# (none yet: they are placed touching the compacted packing)\n",
+            "loads": _push_block(model, preparation, framed),
+            "damping_s": preparation.compact_damping_s,
+            "loads_note": f"{preparation.push_force_n:g} N inward on every edge bead; "
+            + ("the frame of walls touching the spaced crystal holds it" if framed else "rigid drift and spin removed"),
+            "force_tolerance": None,
+        }
+    return {
+        "walls": walls_block(model, SI),
+        "loads": gravity_block(preparation.gravity_vector_m_s2(model.impact.direction), SI),
+        "damping_s": preparation.settle_damping_s,
+        "loads_note": f"gravity of the {preparation.tilt_deg:g} deg tilt along the strike, no push",
+        "force_tolerance": preparation.settled_max_force_n,
+    }
 
 
 def write_stage_deck(model: GranularModel, stage: str, preparation: Preparation, directory) -> Path:
@@ -284,9 +293,22 @@ def write_stage_deck(model: GranularModel, stage: str, preparation: Preparation,
     if stage not in STAGES:
         raise HexdemError(f"unknown preparation stage {stage!r}; known: {', '.join(STAGES)}")
     blocks = _stage_blocks(model, stage, preparation)
-    return write_settling_deck(model, SettlingStage(
-        name=stage, purpose="Preparation of a weakly disordered packing (Sec. VI-A).", walls=blocks["walls"],
-        loads=blocks["loads"], loads_note=blocks["loads_note"], damping_s=blocks["damping_s"],
-        force_tolerance_n=blocks["force_tolerance"], settled_rms_speed_m_s=preparation.settled_rms_speed_m_s,
-        max_step_m=preparation.max_step_m, max_dt_s=preparation.max_dt_s, check_every=preparation.check_every,
-        min_steps=preparation.min_steps, max_steps=preparation.max_steps), directory)
+    return write_settling_deck(
+        model,
+        SettlingStage(
+            name=stage,
+            purpose="Preparation of a weakly disordered packing (Sec. VI-A).",
+            walls=blocks["walls"],
+            loads=blocks["loads"],
+            loads_note=blocks["loads_note"],
+            damping_s=blocks["damping_s"],
+            force_tolerance_n=blocks["force_tolerance"],
+            settled_rms_speed_m_s=preparation.settled_rms_speed_m_s,
+            max_step_m=preparation.max_step_m,
+            max_dt_s=preparation.max_dt_s,
+            check_every=preparation.check_every,
+            min_steps=preparation.min_steps,
+            max_steps=preparation.max_steps,
+        ),
+        directory,
+    )

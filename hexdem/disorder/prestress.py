@@ -65,6 +65,13 @@ def prestress(model: GranularModel) -> Prestress:
     for wall in model.walls:
         members = np.asarray(wall.members, dtype=int)
         depth = np.maximum(-wall.gaps_m(lattice.positions_m[members], radii[members]), 0.0)
-        wall_force += float(np.sum(model.wall_stiffness_pa(members) * np.sqrt(wall.contact_radii_m(radii[members])) * depth**1.5))
-    return Prestress(len(forces), float(overlap.max(initial=0.0)), float(forces.mean()) if len(forces) else 0.0,
-                     float(forces.max(initial=0.0)), wall_force)
+        wall_force += float(
+            np.sum(model.wall_stiffness_pa(members) * np.sqrt(wall.contact_radii_m(radii[members])) * depth**1.5)
+        )
+    return Prestress(
+        len(forces),
+        float(overlap.max(initial=0.0)),
+        float(forces.mean()) if len(forces) else 0.0,
+        float(forces.max(initial=0.0)),
+        wall_force,
+    )

@@ -22,7 +22,7 @@ from hexdem.disorder.ensemble import MANIFEST_NAME, PHASE_LABELS, Ensemble, Ense
 from hexdem.disorder.ensemble_figures import fitted_laws
 from hexdem.disorder.impacts import impact_done, impact_task, publish_result
 from hexdem.disorder.preparation import STAGES, write_stage_deck
-from hexdem.disorder.sharing import adopt_preparation, adopt_ideal_impacts
+from hexdem.disorder.sharing import adopt_ideal_impacts, adopt_preparation
 from hexdem.disorder.stats import write_statistics
 from hexdem.engines.lammps.standalone import is_done, run_deck
 from hexdem.errors import HexdemError, one_line
@@ -39,13 +39,17 @@ def _check_manifest(out: Path, config: EnsembleConfig) -> dict:
         manifest = json.loads(path.read_text())
         previous = EnsembleConfig.identity_of(manifest["config"])
     except (OSError, ValueError, KeyError, AttributeError, TypeError):
-        raise HexdemError(f"{path} is unreadable: {out} does not hold a hexdem ensemble; "
-                          "choose another --out") from None
+        raise HexdemError(
+            f"{path} is unreadable: {out} does not hold a hexdem ensemble; choose another --out"
+        ) from None
     if previous != config.identity():
-        changed = sorted(key for key in set(previous) | set(config.identity())
-                         if previous.get(key) != config.identity().get(key))
-        raise HexdemError(f"{out} holds an ensemble with other parameters ({', '.join(changed)}); "
-                          "rerun with the same parameters to resume it, or choose another --out")
+        changed = sorted(
+            key for key in set(previous) | set(config.identity()) if previous.get(key) != config.identity().get(key)
+        )
+        raise HexdemError(
+            f"{out} holds an ensemble with other parameters ({', '.join(changed)}); "
+            "rerun with the same parameters to resume it, or choose another --out"
+        )
     return manifest
 
 
@@ -66,12 +70,22 @@ def _run_phase(name: str, tasks: dict, workers: int, parsl, on_done=None) -> Non
         if on_done is not None:
             on_done()
     if failed:
-        raise tasks_failed(f"{len(failed)} of {len(tasks)} {name} decks failed (rerun to run them again); "
-                           f"{'; '.join(failed)}", errors)
+        raise tasks_failed(
+            f"{len(failed)} of {len(tasks)} {name} decks failed (rerun to run them again); {'; '.join(failed)}", errors
+        )
 
 
-def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | None = None, parsl=None,
-                 keep_dumps: bool = False, scaling_json=None, log=None, share_from=()) -> dict:
+def run_ensemble(
+    config: EnsembleConfig,
+    out,
+    workers: int = 1,
+    launcher: str | None = None,
+    parsl=None,
+    keep_dumps: bool = False,
+    scaling_json=None,
+    log=None,
+    share_from=(),
+) -> dict:
     """Run (or resume) the ensemble in ``out`` and write its statistics; returns the summary.
 
     ``workers`` decks run at once in local processes, or on Parsl with the configuration file
@@ -87,7 +101,10 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
     laws = fitted_laws(scaling_json, config.disorder.diameter_m) if scaling_json else {}
     out = ensure_writable_dir(out)
     ensemble = Ensemble(config, out)
-    with locked_directory(out, "another hexdem ensemble (or its LAMMPS is still shutting down)"), holding(parsl, workers):
+    with (
+        locked_directory(out, "another hexdem ensemble (or its LAMMPS is still shutting down)"),
+        holding(parsl, workers),
+    ):
         manifest = _check_manifest(out, config)
         for leftover in list(out.rglob(".*.part")):  # atomic writes and copies cut short by a killed run
             if leftover.is_dir():
@@ -99,20 +116,27 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
             adopt_preparation(ensemble, source)
         todo = [k for k in range(config.realizations) if not ensemble.result_path(k).exists()]
         ideal_todo = not ensemble.result_path(None).exists()
-        log(f"{config.realizations} realizations x {len(config.velocities_m_s)} striker velocities, "
-            f"{ensemble.ideal.shape}, seed {config.seed}: {len(todo)} to run, {workers} workers")
+        log(
+            f"{config.realizations} realizations x {len(config.velocities_m_s)} striker velocities, "
+            f"{ensemble.ideal.shape}, seed {config.seed}: {len(todo)} to run, {workers} workers"
+        )
         wall: dict[str, float] = {}
 
         for stage in STAGES:
             pending = [k for k in todo if not is_done(ensemble.stage_dir(k, stage))]
             for k in pending:
                 shutil.rmtree(ensemble.stage_dir(k, stage), ignore_errors=True)
-                write_stage_deck(ensemble.stage_model(k, stage), stage, config.preparation,
-                                 ensemble.stage_dir(k, stage))
+                write_stage_deck(
+                    ensemble.stage_model(k, stage), stage, config.preparation, ensemble.stage_dir(k, stage)
+                )
             log(f"{stage}: {len(pending)} decks")
             start = time.perf_counter()
-            _run_phase(stage, {f"realization {k}": (run_deck, ensemble.stage_dir(k, stage), launcher) for k in pending},
-                       workers, parsl)
+            _run_phase(
+                stage,
+                {f"realization {k}": (run_deck, ensemble.stage_dir(k, stage), launcher) for k in pending},
+                workers,
+                parsl,
+            )
             wall[stage] = time.perf_counter() - start
 
         groups = [*todo, *([None] if ideal_todo else [])]
@@ -129,13 +153,31 @@ def run_ensemble(config: EnsembleConfig, out, workers: int = 1, launcher: str | 
                     published.add(k)
 
         publish_finished()
-        _run_phase("impacts", {f"{'ideal' if k is None else f'realization {k}'} at {v:g} m/s":
-                               (impact_task, config, out, k, v, keep_dumps, launcher) for k, v in tasks},
-                   workers, parsl, publish_finished)
+        _run_phase(
+            "impacts",
+            {
+                f"{'ideal' if k is None else f'realization {k}'} at {v:g} m/s": (
+                    impact_task,
+                    config,
+                    out,
+                    k,
+                    v,
+                    keep_dumps,
+                    launcher,
+                )
+                for k, v in tasks
+            },
+            workers,
+            parsl,
+            publish_finished,
+        )
         wall["impacts"] = time.perf_counter() - start
         summary = write_statistics(ensemble, laws)
-        summary["this_run"] = {"realizations_run": len(todo), "workers": workers,
-                               "wall_time_s": {name: round(t, 3) for name, t in wall.items()}}
+        summary["this_run"] = {
+            "realizations_run": len(todo),
+            "workers": workers,
+            "wall_time_s": {name: round(t, 3) for name, t in wall.items()},
+        }
         write_json(out / MANIFEST_NAME, {**manifest, "config": config.as_dict(), **summary})
         log(f"done ({', '.join(f'{name} {t:.1f} s' for name, t in wall.items())}); results in {out}")
         for v, warnings in zip(config.velocities_m_s, summary["impact_warnings"]):

@@ -59,8 +59,9 @@ def _adopt_stage(ensemble: Ensemble, source: Ensemble, k: int, stage: str, scrat
     theirs, ours = source.stage_dir(k, stage), ensemble.stage_dir(k, stage)
     if not is_done(theirs) or is_done(ours):
         return False
-    rendered = write_stage_deck(ensemble.stage_model(k, stage), stage, ensemble.config.preparation,
-                                scratch / f"r{k}-{stage}")
+    rendered = write_stage_deck(
+        ensemble.stage_model(k, stage), stage, ensemble.config.preparation, scratch / f"r{k}-{stage}"
+    )
     if not _same_deck(rendered, theirs):
         return False
     shutil.rmtree(ours, ignore_errors=True)

@@ -29,15 +29,17 @@ def stage_state(directory: Path, what: str, hint: str = ""):
     :class:`~hexdem.errors.RunFailed` naming ``what`` was prepared, ending with ``hint``."""
     result = read_stage(directory)
     if not result.settled:
-        raise RunFailed(f"{what}: stage {directory.name!r} did not settle in {result.steps} steps "
-                        f"(kinetic energy {result.kinetic_energy_j:.3g} J, tolerance {result.tolerance_j:.3g} J; "
-                        f"largest force {result.max_force_n:.3g} N, tolerance {result.force_tolerance_n:.3g} N)"
-                        + hint)
+        raise RunFailed(
+            f"{what}: stage {directory.name!r} did not settle in {result.steps} steps "
+            f"(kinetic energy {result.kinetic_energy_j:.3g} J, tolerance {result.tolerance_j:.3g} J; "
+            f"largest force {result.max_force_n:.3g} N, tolerance {result.force_tolerance_n:.3g} N)" + hint
+        )
     return read_data_file(directory / SETTLED_NAME)
 
 
-def settling_model(model: GranularModel, lattice: Packing, folder: Path, preparation: Preparation,
-                   what: str, hint: str = "") -> GranularModel:
+def settling_model(
+    model: GranularModel, lattice: Packing, folder: Path, preparation: Preparation, what: str, hint: str = ""
+) -> GranularModel:
     """Stage 2's start: ``lattice`` as ``folder``/compact left it, with the walls of the settling
     (touching it, or stood back by the preparation's slack)."""
     compacted = stage_state(Path(folder) / "compact", what, hint)
@@ -45,8 +47,9 @@ def settling_model(model: GranularModel, lattice: Packing, folder: Path, prepara
     return replace(model, packing=walls_for_settling(walled, preparation))
 
 
-def settled_packing(model: GranularModel, lattice: Packing, folder: Path, preparation: Preparation,
-                    what: str, hint: str = "") -> Packing:
+def settled_packing(
+    model: GranularModel, lattice: Packing, folder: Path, preparation: Preparation, what: str, hint: str = ""
+) -> Packing:
     """The packing the preparation in ``folder`` left: settled, with the walls placed after compaction."""
     walled = settling_model(model, lattice, folder, preparation, what, hint).packing
     settled = stage_state(Path(folder) / "settle", what, hint)

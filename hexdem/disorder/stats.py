@@ -24,8 +24,18 @@ from hexdem.model.packing import Packing
 #: Columns of ``peaks_stats.csv`` (a contract).
 STATS_COLUMNS = ("v_striker", "line", "n", "mean_peak_speed", "std_peak_speed", "count", "warnings")
 IDEAL_COLUMNS = ("v_striker", "line", "n", "peak_speed")
-ARRIVAL_COLUMNS = ("v_striker", "bead_id", "m", "n", "x", "y", "ideal_relative_arrival",
-                   "mean_relative_arrival", "std_relative_arrival", "count")
+ARRIVAL_COLUMNS = (
+    "v_striker",
+    "bead_id",
+    "m",
+    "n",
+    "x",
+    "y",
+    "ideal_relative_arrival",
+    "mean_relative_arrival",
+    "std_relative_arrival",
+    "count",
+)
 EFFECT_COLUMNS = ("v_striker", "line", "first_n", "last_n", "mean_ratio", "std_ratio", "sem_ratio", "realizations")
 #: First bead of the lines entering the disorder-effect ratio (n = 0, 1 are the struck bead
 #: and its neighbour, set by the striker rather than by the lattice).
@@ -66,19 +76,23 @@ def load_results(ensemble: Ensemble) -> EnsembleResults:
     config = ensemble.config
     missing = [k for k in range(config.realizations) if not ensemble.result_path(k).exists()]
     if missing or not ensemble.result_path(None).exists():
-        raise HexdemError(f"{ensemble.out}: {len(missing)} realization(s) unfinished; "
-                          "rerun hexdem ensemble to complete it")
+        raise HexdemError(
+            f"{ensemble.out}: {len(missing)} realization(s) unfinished; rerun hexdem ensemble to complete it"
+        )
     runs = [_load(ensemble.result_path(k)) for k in range(config.realizations)]
     ideal = _load(ensemble.result_path(None))
     stacked = ("peak_speed", "lead_speed", "arrival_time")
-    return EnsembleResults(velocities_m_s=ideal["velocities_m_s"],
-                           **{name: np.array([r[name] for r in runs]) for name in stacked},
-                           **{f"ideal_{name}": ideal[name] for name in stacked},
-                           per_realization={key: np.array([r[key] for r in runs]) for key in runs[0]
-                                            if key not in (*stacked, "t_peak")}
-                           | {"ideal_energy_drift": ideal["energy_drift"],
-                              "ideal_lammps_s": ideal["impact_lammps_s"],
-                              "ideal_far_wall_reached": ideal["far_wall_reached"]})
+    return EnsembleResults(
+        velocities_m_s=ideal["velocities_m_s"],
+        **{name: np.array([r[name] for r in runs]) for name in stacked},
+        **{f"ideal_{name}": ideal[name] for name in stacked},
+        per_realization={key: np.array([r[key] for r in runs]) for key in runs[0] if key not in (*stacked, "t_peak")}
+        | {
+            "ideal_energy_drift": ideal["energy_drift"],
+            "ideal_lammps_s": ideal["impact_lammps_s"],
+            "ideal_far_wall_reached": ideal["far_wall_reached"],
+        },
+    )
 
 
 def _mean_std_count(values: np.ndarray, axis: int = 0):
@@ -104,8 +118,10 @@ def impact_warnings(results: EnsembleResults) -> list[str]:
     ``far_wall_not_reached (ideal, r0000, r0003)``; empty where none warned."""
     from hexdem.experiments.run import run_warnings
 
-    everyone = [("ideal", results.per_realization["ideal_far_wall_reached"]),
-                *((f"r{k:04d}", row) for k, row in enumerate(results.per_realization["far_wall_reached"]))]
+    everyone = [
+        ("ideal", results.per_realization["ideal_far_wall_reached"]),
+        *((f"r{k:04d}", row) for k, row in enumerate(results.per_realization["far_wall_reached"])),
+    ]
     cells = []
     for iv in range(len(results.velocities_m_s)):
         warned: dict[str, list[str]] = {}
@@ -123,30 +139,50 @@ def peak_statistics(results: EnsembleResults, lattice: Packing) -> list[tuple]:
     has peaks that depend on the run's duration."""
     mean, std, count = _mean_std_count(results.peak_speed)
     warnings = impact_warnings(results)
-    return [(float(v), line, n, float(mean[iv, bead]), float(std[iv, bead]), int(count[iv, bead]), warnings[iv])
-            for iv, v in enumerate(results.velocities_m_s) for line, beads in lattice.lines().items()
-            for n, bead in enumerate(beads)]
+    return [
+        (float(v), line, n, float(mean[iv, bead]), float(std[iv, bead]), int(count[iv, bead]), warnings[iv])
+        for iv, v in enumerate(results.velocities_m_s)
+        for line, beads in lattice.lines().items()
+        for n, bead in enumerate(beads)
+    ]
 
 
 def ideal_peaks(results: EnsembleResults, lattice: Packing) -> list[tuple]:
-    return [(float(v), line, n, float(results.ideal_peak_speed[iv, bead]))
-            for iv, v in enumerate(results.velocities_m_s) for line, beads in lattice.lines().items()
-            for n, bead in enumerate(beads)]
+    return [
+        (float(v), line, n, float(results.ideal_peak_speed[iv, bead]))
+        for iv, v in enumerate(results.velocities_m_s)
+        for line, beads in lattice.lines().items()
+        for n, bead in enumerate(beads)
+    ]
 
 
 def relative_arrivals(results: EnsembleResults, reference: int):
     """Arrival times relative to bead ``reference``: ideal (V, N) and per realization (R, V, N)."""
-    return (results.ideal_arrival_time - results.ideal_arrival_time[:, [reference]],
-            results.arrival_time - results.arrival_time[:, :, [reference]])
+    return (
+        results.ideal_arrival_time - results.ideal_arrival_time[:, [reference]],
+        results.arrival_time - results.arrival_time[:, :, [reference]],
+    )
 
 
 def arrival_rows(results: EnsembleResults, lattice: Packing, reference: int) -> list[tuple]:
     ideal, disordered = relative_arrivals(results, reference)
     mean, std, count = _mean_std_count(disordered)
-    return [(float(v), bead + 1, int(m), int(n), float(x), float(y), float(ideal[iv, bead]),
-             float(mean[iv, bead]), float(std[iv, bead]), int(count[iv, bead]))
-            for iv, v in enumerate(results.velocities_m_s)
-            for bead, ((m, n), (x, y)) in enumerate(zip(lattice.labels, lattice.positions_m))]
+    return [
+        (
+            float(v),
+            bead + 1,
+            int(m),
+            int(n),
+            float(x),
+            float(y),
+            float(ideal[iv, bead]),
+            float(mean[iv, bead]),
+            float(std[iv, bead]),
+            int(count[iv, bead]),
+        )
+        for iv, v in enumerate(results.velocities_m_s)
+        for bead, ((m, n), (x, y)) in enumerate(zip(lattice.labels, lattice.positions_m))
+    ]
 
 
 def mirror_lines(lines) -> list[tuple[str, str]]:
@@ -159,7 +195,8 @@ def disorder_effect(results: EnsembleResults, lattice: Packing, measure: str = "
     """Transmission along each line, disordered / ideal (the paper's claim of Sec. VI-B).
 
     For each realization, the ratio V_n / V_n(ideal) averaged over beads n ≥ 2 of the line
-    whose ideal speed was seen (a square's beads off the struck row stay at rest); then the mean, sample standard deviation and standard error
+    whose ideal speed was seen (a square's beads off the struck row stay at rest); then the mean, sample standard
+    deviation and standard error
     over realizations. "±30" pools both 30° lines of each realization (on a square, "±45" and "±90"
     pool its mirrored rays). ``measure``: V_n is the
     peak speed over the run ("peak") or the leading pulse's amplitude ("lead").
@@ -181,8 +218,18 @@ def disorder_effect(results: EnsembleResults, lattice: Packing, measure: str = "
             per_realization = np.nanmean(ratio, axis=1) if ratio.shape[1] else np.full(len(ratio), np.nan)
             mean, std, count = _mean_std_count(per_realization)
             last_n = EFFECT_FIRST_N + len(beads) - 1
-            rows.append((float(v), line, EFFECT_FIRST_N, int(last_n), float(mean), float(std),
-                         float(std / np.sqrt(count)) if count > 1 else float("nan"), int(count)))
+            rows.append(
+                (
+                    float(v),
+                    line,
+                    EFFECT_FIRST_N,
+                    int(last_n),
+                    float(mean),
+                    float(std),
+                    float(std / np.sqrt(count)) if count > 1 else float("nan"),
+                    int(count),
+                )
+            )
     return rows
 
 
@@ -190,7 +237,8 @@ def write_statistics(ensemble: Ensemble, laws: dict | None = None) -> dict:
     """Write the tables and figures of a finished ensemble; returns the summary for ensemble.json.
 
     Tables: ``peaks_stats.csv``, ``ideal_peaks.csv``, ``arrival_map.csv`` (relative to the
-    reference bead), ``disorder_effect.csv``, ``leading_pulse_effect.csv``. Figures: ``fig9_all_directions.png`` (with the
+    reference bead), ``disorder_effect.csv``, ``leading_pulse_effect.csv``. Figures: ``fig9_all_directions.png`` (with
+    the
     fitted ``laws`` {line: ScalingLaw} if any) and ``fig8_expnumsim_v<V>.png`` per velocity.
     """
     from hexdem.disorder import ensemble_figures as ensemble_plots
@@ -205,33 +253,56 @@ def write_statistics(ensemble: Ensemble, laws: dict | None = None) -> dict:
     write_csv(out / "arrival_map.csv", ARRIVAL_COLUMNS, arrival_rows(results, lattice, reference))
     write_csv(out / "disorder_effect.csv", EFFECT_COLUMNS, effect)
     write_csv(out / "leading_pulse_effect.csv", EFFECT_COLUMNS, lead_effect)
-    ensemble_plots.all_directions(stats, ideal, laws or {}, out / "fig9_all_directions.png",
-                                  ensemble_plots.fig9_lines(lattice))
+    ensemble_plots.all_directions(
+        stats, ideal, laws or {}, out / "fig9_all_directions.png", ensemble_plots.fig9_lines(lattice)
+    )
     ideal_rel, disordered_rel = relative_arrivals(results, reference)
     for iv, v in enumerate(results.velocities_m_s):
         mean, _, _ = _mean_std_count(disordered_rel[:, iv])
-        ensemble_plots.expnumsim(lattice, ensemble.impact_model(None, v).walls, ideal_rel[iv], mean, reference,
-                                 float(v), config.realizations, out / f"fig8_expnumsim_{velocity_name(v)}.png")
+        ensemble_plots.expnumsim(
+            lattice,
+            ensemble.impact_model(None, v).walls,
+            ideal_rel[iv],
+            mean,
+            reference,
+            float(v),
+            config.realizations,
+            out / f"fig8_expnumsim_{velocity_name(v)}.png",
+        )
     per = results.per_realization
     effect_beads = np.concatenate([beads[EFFECT_FIRST_N:] for beads in lattice.lines().values()])
     return {
         "disorder_effect": [dict(zip(EFFECT_COLUMNS, row)) for row in effect],
         "leading_pulse_effect": [dict(zip(EFFECT_COLUMNS, row)) for row in lead_effect],
         "leading_pulse_defined_fraction": float(np.mean(np.isfinite(results.lead_speed[:, :, effect_beads]))),
-        "prestress": {name: {"mean": float(np.mean(per[name])), "std": float(np.std(per[name], ddof=1))
-                             if len(per[name]) > 1 else float("nan")} for name in PRESTRESS_ARRAYS},
-        "preparation": {stage: {"mean_steps": float(np.mean(per[f"{stage}_steps"])),
-                                "max_steps": int(np.max(per[f"{stage}_steps"])),
-                                "mean_simulated_time_s": float(np.mean(per[f"{stage}_time_s"])),
-                                "max_kinetic_energy_j": float(np.max(per[f"{stage}_kinetic_energy_j"])),
-                                "max_force_n": float(np.max(per[f"{stage}_max_force_n"]))}
-                        for stage in STAGES} | {"max_overlap_m": float(np.max(per["max_overlap_m"]))},
-        "lammps_time_s": {"settle_per_realization": float(np.mean(per["compact_lammps_s"] + per["settle_lammps_s"])),
-                          "impact_per_run": float(np.mean(per["impact_lammps_s"])),
-                          "settle_total": float(np.sum(per["compact_lammps_s"] + per["settle_lammps_s"])),
-                          "impact_total": float(np.sum(per["impact_lammps_s"]) + np.sum(per["ideal_lammps_s"]))},
-        "energy_drift_max": {"disordered": float(np.max(per["energy_drift"])),
-                             "ideal": float(np.max(per["ideal_energy_drift"]))},
+        "prestress": {
+            name: {
+                "mean": float(np.mean(per[name])),
+                "std": float(np.std(per[name], ddof=1)) if len(per[name]) > 1 else float("nan"),
+            }
+            for name in PRESTRESS_ARRAYS
+        },
+        "preparation": {
+            stage: {
+                "mean_steps": float(np.mean(per[f"{stage}_steps"])),
+                "max_steps": int(np.max(per[f"{stage}_steps"])),
+                "mean_simulated_time_s": float(np.mean(per[f"{stage}_time_s"])),
+                "max_kinetic_energy_j": float(np.max(per[f"{stage}_kinetic_energy_j"])),
+                "max_force_n": float(np.max(per[f"{stage}_max_force_n"])),
+            }
+            for stage in STAGES
+        }
+        | {"max_overlap_m": float(np.max(per["max_overlap_m"]))},
+        "lammps_time_s": {
+            "settle_per_realization": float(np.mean(per["compact_lammps_s"] + per["settle_lammps_s"])),
+            "impact_per_run": float(np.mean(per["impact_lammps_s"])),
+            "settle_total": float(np.sum(per["compact_lammps_s"] + per["settle_lammps_s"])),
+            "impact_total": float(np.sum(per["impact_lammps_s"]) + np.sum(per["ideal_lammps_s"])),
+        },
+        "energy_drift_max": {
+            "disordered": float(np.max(per["energy_drift"])),
+            "ideal": float(np.max(per["ideal_energy_drift"])),
+        },
         "far_wall_reached_fraction": float(np.mean(per["far_wall_reached"])),
         "impact_warnings": impact_warnings(results),
     }

@@ -46,7 +46,6 @@ class Sample:
     ghost_positions: np.ndarray | None = None
 
 
-
 class Observer(Protocol):
     """What an engine hands its samples to: called with each :class:`Sample` of the bodies its
     rank owns, in the order of the run."""

@@ -39,18 +39,27 @@ def analyse_deck(deck_dir, out=None, log=None) -> ImpactAnalysis:
     config = read_deck_config(deck_dir)
     dump = deck_dir / DUMP_NAME
     if not dump.exists():
-        raise HexdemError(f"{deck_dir} has no {DUMP_NAME}: run the deck by hand first "
-                          f"(cd {deck_dir} && lmp -in in.hexdem), or use hexdem run --dump")
+        raise HexdemError(
+            f"{deck_dir} has no {DUMP_NAME}: run the deck by hand first "
+            f"(cd {deck_dir} && lmp -in in.hexdem), or use hexdem run --dump"
+        )
     model = build_model(config)
     settings = run_settings(config, model)
     log(f"reading {dump} ({settings.n_samples} frames of {model.n_bodies} atoms) through MDAnalysis")
-    engine = {"name": "lammps", "version": log_version(deck_dir / "log.lammps"), "ranks": None,
-              "wall_time_s": None, "deck": str(deck_dir / "in.hexdem")}
+    engine = {
+        "name": "lammps",
+        "version": log_version(deck_dir / "log.lammps"),
+        "ranks": None,
+        "wall_time_s": None,
+        "deck": str(deck_dir / "in.hexdem"),
+    }
     trajectory = read_trajectory(dump, settings, engine)
     atoms = trajectory.velocities_m_s.shape[1]
     if atoms != model.n_bodies:
-        raise HexdemError(f"{dump} holds {atoms} atoms, the packing of {deck_dir / CONFIG_NAME} {model.n_bodies}: "
-                          "the dump is another packing's")
+        raise HexdemError(
+            f"{dump} holds {atoms} atoms, the packing of {deck_dir / CONFIG_NAME} {model.n_bodies}: "
+            "the dump is another packing's"
+        )
     analysis = ImpactAnalysis.from_trajectory(model, settings, trajectory)
     out = Path(out if out is not None else deck_dir.parent)
     with staged_directory(out) as staging:

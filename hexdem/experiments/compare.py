@@ -24,8 +24,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from hexdem.analysis.plotting import UNIT_LABELS, save, subplots
 from hexdem.analysis.impact import ImpactAnalysis
+from hexdem.analysis.plotting import UNIT_LABELS, save, subplots
 from hexdem.common.checks import is_number
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.errors import HexdemError
@@ -41,10 +41,22 @@ ENGINE_NAMES = ("lammps", "reference")
 LINE_MARKERS = "o^v<>sD"
 #: Columns of ``compare.csv``; differences are reference − LAMMPS (relative to LAMMPS for peaks).
 #: ``arrival_tolerance`` is the bead's own: the tolerance's floor plus its rate times the bead's arrival.
-COMPARE_COLUMNS = ("line", "n", "bead_id", "peak_lammps", "peak_reference", "peak_rel_diff",
-                   "arrival_lammps", "arrival_reference", "arrival_diff", "arrival_tolerance", "checked")
+COMPARE_COLUMNS = (
+    "line",
+    "n",
+    "bead_id",
+    "peak_lammps",
+    "peak_reference",
+    "peak_rel_diff",
+    "arrival_lammps",
+    "arrival_reference",
+    "arrival_diff",
+    "arrival_tolerance",
+    "checked",
+)
 PEAK_DIFF, ARRIVAL_DIFF, ARRIVAL_TOLERANCE, CHECKED = (
-    COMPARE_COLUMNS.index(key) for key in ("peak_rel_diff", "arrival_diff", "arrival_tolerance", "checked"))
+    COMPARE_COLUMNS.index(key) for key in ("peak_rel_diff", "arrival_diff", "arrival_tolerance", "checked")
+)
 
 
 #: LAMMPS's measured error at N steps per contact time τ, against the converged answer, over the
@@ -71,16 +83,19 @@ PEAK_ERROR_ALPHA_N, ARRIVAL_ERROR_ALPHA_N = 1.5, 2.5
 MARGIN = 4.0
 
 
-def expected_error(steps_per_contact: float, alpha: float = 0.0,
-                   peak_n2: float = PEAK_ERROR_N2) -> tuple[float, float, float]:
+def expected_error(
+    steps_per_contact: float, alpha: float = 0.0, peak_n2: float = PEAK_ERROR_N2
+) -> tuple[float, float, float]:
     """LAMMPS's expected (relative peak-speed error, arrival-time error at the impact in contact
     times, growth of the arrival-time error per unit of arrival time) at ``steps_per_contact``
     with Tsuji damping ``alpha`` of the bead–bead contacts; ``peak_n2`` the packing's peak error
     coefficient (:data:`PLACED_PEAK_ERROR_N2` off the triangular lattice)."""
     n = float(steps_per_contact)
-    return (peak_n2 / n**2 + PEAK_ERROR_ALPHA_N * alpha / n,
-            ARRIVAL_ERROR_N2 / n**2 + ARRIVAL_ERROR_ALPHA_N * alpha / n,
-            ARRIVAL_GROWTH_N2 / n**2)
+    return (
+        peak_n2 / n**2 + PEAK_ERROR_ALPHA_N * alpha / n,
+        ARRIVAL_ERROR_N2 / n**2 + ARRIVAL_ERROR_ALPHA_N * alpha / n,
+        ARRIVAL_GROWTH_N2 / n**2,
+    )
 
 
 @dataclass(frozen=True)
@@ -110,14 +125,16 @@ class Tolerances:
             return replace(self, arrival_rate=rate)
         if not settings.contact_time_s > 0:
             raise HexdemError("the default tolerances need the run's contact time; give peak_rel and arrival_s")
-        peak, arrival, growth = expected_error(settings.contact_time_s / settings.dt_s,
-                                               damping_coefficient(model.restitution),
-                                               PEAK_ERROR_N2 if model.packing.bond_steps
-                                               else PLACED_PEAK_ERROR_N2)
+        peak, arrival, growth = expected_error(
+            settings.contact_time_s / settings.dt_s,
+            damping_coefficient(model.restitution),
+            PEAK_ERROR_N2 if model.packing.bond_steps else PLACED_PEAK_ERROR_N2,
+        )
         peak_rel = MARGIN * peak if self.peak_rel is None else self.peak_rel
         arrival_s = MARGIN * arrival * settings.contact_time_s if self.arrival_s is None else self.arrival_s
-        return replace(self, peak_rel=peak_rel, arrival_s=arrival_s,
-                       arrival_rate=MARGIN * growth if rate is None else rate)
+        return replace(
+            self, peak_rel=peak_rel, arrival_s=arrival_s, arrival_rate=MARGIN * growth if rate is None else rate
+        )
 
     def arrival(self, arrival_time: float) -> float:
         """The arrival tolerance of a bead reached at ``arrival_time`` [s] (filled in: :meth:`for_run`)."""
@@ -155,11 +172,13 @@ class EngineComparison:
         """One line: the largest differences against their tolerances."""
         time_label = "µs" if self.units == "si" else "T"
         scale = 1e6 if self.units == "si" else 1.0
-        return (f"max relative peak difference {self.max_peak_rel_diff:.2g} (tolerance {self.tolerances.peak_rel:g}), "
-                f"max arrival difference {self.max_arrival_diff * scale:.2g} {time_label} (tolerance "
-                f"{self.arrival_tolerance * scale:.3g} {time_label} + {self.tolerances.arrival_rate:.2g} × arrival "
-                f"time; at most {self.max_arrival_share:.2g} of a bead's) over {self.n_checked} beads: "
-                + ("engines agree" if self.agree else "engines DISAGREE"))
+        return (
+            f"max relative peak difference {self.max_peak_rel_diff:.2g} (tolerance {self.tolerances.peak_rel:g}), "
+            f"max arrival difference {self.max_arrival_diff * scale:.2g} {time_label} (tolerance "
+            f"{self.arrival_tolerance * scale:.3g} {time_label} + {self.tolerances.arrival_rate:.2g} × arrival "
+            f"time; at most {self.max_arrival_share:.2g} of a bead's) over {self.n_checked} beads: "
+            + ("engines agree" if self.agree else "engines DISAGREE")
+        )
 
 
 def _difference(lammps: float, reference: float, relative: bool) -> float:
@@ -183,8 +202,9 @@ def _share(difference: float, tolerance: float) -> float:
     return size / tolerance if tolerance > 0 else float("inf")
 
 
-def compare_analyses(lammps: ImpactAnalysis, reference: ImpactAnalysis, v0: float,
-                     tolerances: Tolerances = Tolerances()) -> EngineComparison:
+def compare_analyses(
+    lammps: ImpactAnalysis, reference: ImpactAnalysis, v0: float, tolerances: Tolerances = Tolerances()
+) -> EngineComparison:
     """Compare two analyses of the same model; ``v0`` is the impact speed in the run's units."""
     tolerances = tolerances.for_run(lammps.model, lammps.settings)
     time_s = lammps.settings.units.time_s
@@ -192,12 +212,26 @@ def compare_analyses(lammps: ImpactAnalysis, reference: ImpactAnalysis, v0: floa
     rows = []
     for name, beads in a.lines.items():
         for n, bead in enumerate(beads):
-            pa, pb, ta, tb = (float(v) for v in (a.peak_speed[bead], b.peak_speed[bead],
-                                                  a.arrival_time[bead], b.arrival_time[bead]))
+            pa, pb, ta, tb = (
+                float(v) for v in (a.peak_speed[bead], b.peak_speed[bead], a.arrival_time[bead], b.arrival_time[bead])
+            )
             checked = bool(np.nanmax([pa, pb, -np.inf]) > tolerances.min_peak_fraction * v0)
             tolerance = tolerances.arrival((tb if np.isnan(ta) else ta) * time_s) / time_s
-            rows.append((name, n, int(bead) + 1, pa, pb, _difference(pa, pb, True),
-                         ta, tb, _difference(ta, tb, False), tolerance, checked))
+            rows.append(
+                (
+                    name,
+                    n,
+                    int(bead) + 1,
+                    pa,
+                    pb,
+                    _difference(pa, pb, True),
+                    ta,
+                    tb,
+                    _difference(ta, tb, False),
+                    tolerance,
+                    checked,
+                )
+            )
     checked = [row for row in rows if row[CHECKED]]
     return EngineComparison(
         rows=rows,
@@ -205,7 +239,9 @@ def compare_analyses(lammps: ImpactAnalysis, reference: ImpactAnalysis, v0: floa
         max_arrival_diff=max((abs(row[ARRIVAL_DIFF]) for row in checked), default=0.0),
         max_arrival_share=max((_share(row[ARRIVAL_DIFF], row[ARRIVAL_TOLERANCE]) for row in checked), default=0.0),
         arrival_tolerance=tolerances.arrival_s / time_s,
-        tolerances=tolerances, units=a.units)
+        tolerances=tolerances,
+        units=a.units,
+    )
 
 
 def comparison_plot(comparison: EngineComparison, v0: float, path) -> None:
@@ -217,19 +253,27 @@ def comparison_plot(comparison: EngineComparison, v0: float, path) -> None:
     for k, (name, marker) in enumerate(zip(lines, itertools.cycle(LINE_MARKERS))):
         rows = [row for row in comparison.rows if row[0] == name]
         n = np.array([row[1] for row in rows])
-        column = {key: np.array([row[COMPARE_COLUMNS.index(key)] for row in rows], float)
-                  for key in COMPARE_COLUMNS[3:10]}
+        column = {
+            key: np.array([row[COMPARE_COLUMNS.index(key)] for row in rows], float) for key in COMPARE_COLUMNS[3:10]
+        }
         colour = f"C{k}"
-        for engine, style in zip(ENGINE_NAMES, ({"marker": marker, "linestyle": "none", "mfc": "none"},
-                                               {"linestyle": "-"})):
+        for engine, style in zip(
+            ENGINE_NAMES, ({"marker": marker, "linestyle": "none", "mfc": "none"}, {"linestyle": "-"})
+        ):
             label = f"{name}°, {engine}"
             axes[0, 0].semilogy(n, column[f"peak_{engine}"] / v0, color=colour, label=label, **style)
             axes[0, 1].plot(n, column[f"arrival_{engine}"] * scale, color=colour, label=label, **style)
         for ax, key, factor in ((axes[1, 0], "peak_rel_diff", 1.0), (axes[1, 1], "arrival_diff", scale)):
             size = np.abs(column[key]) * factor
             ax.semilogy(n, np.where(size > 0, size, np.nan), color=colour, marker=marker, label=f"{name}°")
-        axes[1, 1].semilogy(n, column["arrival_tolerance"] * scale, color=colour, linestyle="--", linewidth=1,
-                            label=f"{name}°, tolerance")
+        axes[1, 1].semilogy(
+            n,
+            column["arrival_tolerance"] * scale,
+            color=colour,
+            linestyle="--",
+            linewidth=1,
+            label=f"{name}°, tolerance",
+        )
     axes[1, 0].axhline(comparison.tolerances.peak_rel, color="grey", linestyle="--", linewidth=1, label="tolerance")
     axes[0, 0].set_ylabel("$V_n / V_0$")
     axes[0, 1].set_ylabel(f"arrival time [{units['time']}]")
@@ -252,8 +296,10 @@ def run_comparison(config: RunConfig, out, log=None, tolerances: Tolerances = To
     fresh = [path for path in (out / "preparation", *(out / name for name in ENGINE_NAMES)) if not path.exists()]
     try:
         prepared = prepare_random_packing(config, out / "preparation", log=log)  # one packing for both engines
-        analyses = {name: run_experiment(on_engine(config, name), out / name, log,
-                                         prepared=on_engine(prepared, name)) for name in ENGINE_NAMES}
+        analyses = {
+            name: run_experiment(on_engine(config, name), out / name, log, prepared=on_engine(prepared, name))
+            for name in ENGINE_NAMES
+        }
     except BaseException:
         for path in fresh:
             shutil.rmtree(path, ignore_errors=True)
@@ -262,18 +308,26 @@ def run_comparison(config: RunConfig, out, log=None, tolerances: Tolerances = To
     comparison = compare_analyses(analyses["lammps"], analyses["reference"], v0, tolerances)
     tolerances = comparison.tolerances
     write_csv(out / "compare.csv", COMPARE_COLUMNS, comparison.rows)
-    write_json(out / "compare.json", {
-        "config": {key: value for key, value in config.shape_dict().items() if key != "engine"},
-        "units": comparison.units,
-        "tolerances": {"peak_rel": tolerances.peak_rel, "arrival": comparison.arrival_tolerance,
-                       "arrival_s": tolerances.arrival_s, "arrival_rate": tolerances.arrival_rate,
-                       "min_peak_fraction": tolerances.min_peak_fraction},
-        "beads_checked": comparison.n_checked, "max_peak_rel_diff": comparison.max_peak_rel_diff,
-        "max_arrival_diff": comparison.max_arrival_diff, "max_arrival_share": comparison.max_arrival_share,
-        "agree": comparison.agree,
-        "energy_drift": {name: analysis.results.energy_drift for name, analysis in analyses.items()},
-        "engine_wall_time_s": {name: analysis.engine.get("wall_time_s")
-                               for name, analysis in analyses.items()},
-    })
+    write_json(
+        out / "compare.json",
+        {
+            "config": {key: value for key, value in config.shape_dict().items() if key != "engine"},
+            "units": comparison.units,
+            "tolerances": {
+                "peak_rel": tolerances.peak_rel,
+                "arrival": comparison.arrival_tolerance,
+                "arrival_s": tolerances.arrival_s,
+                "arrival_rate": tolerances.arrival_rate,
+                "min_peak_fraction": tolerances.min_peak_fraction,
+            },
+            "beads_checked": comparison.n_checked,
+            "max_peak_rel_diff": comparison.max_peak_rel_diff,
+            "max_arrival_diff": comparison.max_arrival_diff,
+            "max_arrival_share": comparison.max_arrival_share,
+            "agree": comparison.agree,
+            "energy_drift": {name: analysis.results.energy_drift for name, analysis in analyses.items()},
+            "engine_wall_time_s": {name: analysis.engine.get("wall_time_s") for name, analysis in analyses.items()},
+        },
+    )
     comparison_plot(comparison, v0, out / "compare.png")
     return comparison

@@ -90,8 +90,10 @@ def steps_config(config: RunConfig, steps_per_contact: int) -> RunConfig:
     contact time (the steps per contact must be a multiple of it so that every run samples at
     the same times)."""
     if steps_per_contact % SAMPLES_PER_CONTACT:
-        raise HexdemError(f"a convergence study needs multiples of {SAMPLES_PER_CONTACT} steps per contact "
-                          f"(the same sampling times in every run), got {steps_per_contact}")
+        raise HexdemError(
+            f"a convergence study needs multiples of {SAMPLES_PER_CONTACT} steps per contact "
+            f"(the same sampling times in every run), got {steps_per_contact}"
+        )
     return config.replace(dt=None, dump_every=None, steps_per_contact=steps_per_contact)
 
 
@@ -123,12 +125,22 @@ def study_time_step(config: RunConfig, steps, workdir, log=None) -> Convergence:
     runs = []
     for n, (analysis, wall), peak, arrival in zip(steps, results, peaks, arrivals):
         arrival_error = float(np.max(np.abs(arrival - exact_arrival)))
-        runs.append(StepError(n, analysis.settings.dt_s / analysis.settings.units.time_s,
-                              float(np.max(np.abs(peak / exact_peak - 1.0))), arrival_error,
-                              arrival_error / contact, float(analysis.results.energy_drift), wall,
-                              (arrival - exact_arrival) / contact))
-    observed = tuple(float(np.log(a.peak_error / b.peak_error) / np.log(b.steps_per_contact / a.steps_per_contact))
-                     for a, b in zip(runs[:-2], runs[1:-1]))
+        runs.append(
+            StepError(
+                n,
+                analysis.settings.dt_s / analysis.settings.units.time_s,
+                float(np.max(np.abs(peak / exact_peak - 1.0))),
+                arrival_error,
+                arrival_error / contact,
+                float(analysis.results.energy_drift),
+                wall,
+                (arrival - exact_arrival) / contact,
+            )
+        )
+    observed = tuple(
+        float(np.log(a.peak_error / b.peak_error) / np.log(b.steps_per_contact / a.steps_per_contact))
+        for a, b in zip(runs[:-2], runs[1:-1])
+    )
     return Convergence(config.engine, order, tuple(runs), observed, len(beads), exact_arrival / contact)
 
 
@@ -146,8 +158,9 @@ class ArrivalGrowth:
 def arrival_growth(study: Convergence) -> ArrivalGrowth:
     """The :class:`ArrivalGrowth` of ``study``'s arrival-time errors (of an engine of order 2)."""
     if study.order != 2:
-        raise HexdemError(f"the arrival errors' growth is scaled for a second-order engine, not {study.engine}'s "
-                          f"order {study.order}")
+        raise HexdemError(
+            f"the arrival errors' growth is scaled for a second-order engine, not {study.engine}'s order {study.order}"
+        )
     scaled = np.abs([run.arrival_errors * run.steps_per_contact**2 for run in study.runs])
     arrivals = np.broadcast_to(study.arrivals, scaled.shape)
     rate = float(np.polyfit(arrivals.ravel(), scaled.ravel(), 1)[0])
@@ -173,8 +186,9 @@ def sampling_error(config: RunConfig, workdir) -> SamplingError:
     model = build_model(config)
     settings = run_settings(config, model)
     sampled = simulate_model(config, model, settings, Path(workdir) / "sampled").results
-    every_step = simulate(config.replace(dt=settings.dt_s / settings.units.time_s, dump_every=1),
-                          Path(workdir) / "every-step").results
+    every_step = simulate(
+        config.replace(dt=settings.dt_s / settings.units.time_s, dump_every=1), Path(workdir) / "every-step"
+    ).results
     beads = measured_beads(every_step, config.v0)
     peak = np.max(np.abs(sampled.peak_speed[beads] / every_step.peak_speed[beads] - 1.0))
     arrival = np.max(np.abs(sampled.arrival_time[beads] - every_step.arrival_time[beads]))

@@ -48,8 +48,9 @@ def read_deck_config(deck: Path) -> RunConfig:
     except ValueError:
         raise HexdemError(f"{path} is not valid JSON") from None
     if not isinstance(data, dict):
-        raise HexdemError(f"{path} holds {json.dumps(data)[:40]} where a table of run-config keys belongs: "
-                          "it is damaged")
+        raise HexdemError(
+            f"{path} holds {json.dumps(data)[:40]} where a table of run-config keys belongs: it is damaged"
+        )
     data.setdefault("steps_per_contact", LEGACY_STEPS_PER_CONTACT)  # a deck written before the key existed
     for key in FILE_KEYS:
         if isinstance(data.get(key), str):

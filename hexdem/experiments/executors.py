@@ -56,8 +56,12 @@ class LocalPool(Executor):
         self._pool = self._new()
 
     def _new(self) -> ProcessPoolExecutor:
-        return ProcessPoolExecutor(max_workers=self.workers, mp_context=get_context("spawn"),
-                                   initializer=_start_worker, initargs=(os.getpid(),))
+        return ProcessPoolExecutor(
+            max_workers=self.workers,
+            mp_context=get_context("spawn"),
+            initializer=_start_worker,
+            initargs=(os.getpid(),),
+        )
 
     def submit(self, fn, /, *args, **kwargs):
         """A future of ``fn`` called with ``args`` and ``kwargs`` in a worker process (a fresh pool
@@ -147,14 +151,17 @@ def load_parsl_config(path):
     try:
         namespace = runpy.run_path(str(path))
     except SystemExit as exc:  # sys.exit() in the file would end hexdem in silence, with its status
-        raise HexdemError(f"--parsl {path}: the configuration file exits (sys.exit({exc.code!r})) instead of "
-                          "defining config") from None
+        raise HexdemError(
+            f"--parsl {path}: the configuration file exits (sys.exit({exc.code!r})) instead of defining config"
+        ) from None
     except Exception as exc:
         raise HexdemError(f"--parsl {path}: the configuration file fails: {type(exc).__name__}: {exc}") from None
     config = namespace.get("config")
     if not isinstance(config, Config):
-        raise HexdemError(f"--parsl {path} must define config = parsl.config.Config(...), "
-                          f"got {type(config).__name__ if 'config' in namespace else 'no config'}")
+        raise HexdemError(
+            f"--parsl {path} must define config = parsl.config.Config(...), "
+            f"got {type(config).__name__ if 'config' in namespace else 'no config'}"
+        )
     return config
 
 

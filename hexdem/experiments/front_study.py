@@ -83,13 +83,24 @@ class FrontStudy:
         base = RunConfig(edge_beads=self.edge_beads, ranks=self.ranks, launcher=self.launcher)
         bead, d = base.material(base.bead_material), base.diameter_m
         coefficient = float(hertz_coefficient(d, bead))
-        c_l = longitudinal_sound_speed(self.control_force_n, coefficient, float(sphere_mass(d, bead)),
-                                       d - static_overlap(self.control_force_n, coefficient))
+        c_l = longitudinal_sound_speed(
+            self.control_force_n,
+            coefficient,
+            float(sphere_mass(d, bead)),
+            d - static_overlap(self.control_force_n, coefficient),
+        )
         far_m = math.sqrt(3) * (self.edge_beads - 1) * d
-        return {"uncompressed": base.replace(shape="half-disc", edge_beads=RunConfig.edge_beads,
-                                             radius_beads=self.radius_beads, v0=self.v0_m_s),
-                "precompressed": base.replace(precompression_n=self.control_force_n, v0=self.control_v0_m_s, impact="striker",
-                                              duration=self.control_crossings * far_m / c_l)}
+        return {
+            "uncompressed": base.replace(
+                shape="half-disc", edge_beads=RunConfig.edge_beads, radius_beads=self.radius_beads, v0=self.v0_m_s
+            ),
+            "precompressed": base.replace(
+                precompression_n=self.control_force_n,
+                v0=self.control_v0_m_s,
+                impact="striker",
+                duration=self.control_crossings * far_m / c_l,
+            ),
+        }
 
 
 def study_front_shape(study: FrontStudy, analysis, arrival_times=None):
@@ -99,8 +110,15 @@ def study_front_shape(study: FrontStudy, analysis, arrival_times=None):
     lattice = analysis.model.packing
     distance_d = np.hypot(*(lattice.positions_m - lattice.positions_m[lattice.struck]).T) / lattice.diameter_m
     start = float(np.mean(distance_d <= START_RADIUS_FRACTION * study.radius_min_d))  # fronts from there on
-    return measure_front_shape(analysis, study.fronts, geometric=True, window_deg=study.window_deg,
-                               start_quantile=start, wall_margin_d=study.wall_margin_d, arrival_times=arrival_times)
+    return measure_front_shape(
+        analysis,
+        study.fronts,
+        geometric=True,
+        window_deg=study.window_deg,
+        start_quantile=start,
+        wall_margin_d=study.wall_margin_d,
+        arrival_times=arrival_times,
+    )
 
 
 def run_front_study(study: FrontStudy, out, log=None) -> dict:
@@ -112,19 +130,29 @@ def run_front_study(study: FrontStudy, out, log=None) -> dict:
     for name, config in study.configs().items():
         analysis = run_experiment(config, out / name, log)
         shapes[name] = shape = study_front_shape(study, analysis)
-        rows += [(name, *row, float(cos6), float(sin6))
-                 for row, cos6, sin6 in zip(shape.rows(), shape.sixfold_cos, shape.sixfold_sin)]
+        rows += [
+            (name, *row, float(cos6), float(sin6))
+            for row, cos6, sin6 in zip(shape.rows(), shape.sixfold_cos, shape.sixfold_sin)
+        ]
     write_csv(out / "front_shape.csv", STUDY_COLUMNS, rows)  # the measurement stays if a fit fails
     for name, shape in shapes.items():
         low, high = study.fit_range_d if name == "uncompressed" else study.control_fit_range_d
         fits[name] = fit_roundness(shape.mean_radius, shape.sixfold_cos, low, high)
-    labels = {"uncompressed": f"uncompressed half-disc, {study.v0_m_s:g} m/s",
-              "precompressed": f"{study.control_force_n:g} N per contact, {study.control_v0_m_s:g} m/s (control)"}
-    plotting.front_shape_figure({labels[name]: shape for name, shape in shapes.items()}, out / "front_shape.png",
-                               title="Roundness of the front as it grows",
-                               fits={labels[name]: fit for name, fit in fits.items()}, signed=True)
-    summary = {"study": asdict(study),
-               "fits": {name: fit.as_dict() for name, fit in fits.items()},
-               "largest_radius_d": {name: float(np.nanmax(shape.mean_radius)) for name, shape in shapes.items()}}
+    labels = {
+        "uncompressed": f"uncompressed half-disc, {study.v0_m_s:g} m/s",
+        "precompressed": f"{study.control_force_n:g} N per contact, {study.control_v0_m_s:g} m/s (control)",
+    }
+    plotting.front_shape_figure(
+        {labels[name]: shape for name, shape in shapes.items()},
+        out / "front_shape.png",
+        title="Roundness of the front as it grows",
+        fits={labels[name]: fit for name, fit in fits.items()},
+        signed=True,
+    )
+    summary = {
+        "study": asdict(study),
+        "fits": {name: fit.as_dict() for name, fit in fits.items()},
+        "largest_radius_d": {name: float(np.nanmax(shape.mean_radius)) for name, shape in shapes.items()},
+    }
     write_json(out / "front_shape_fit.json", summary)
     return summary

@@ -8,7 +8,8 @@ None. For N > 1 ranks (or any launcher) hexdem pickles the job into its director
 starts ``mpiexec -n N python -P -m hexdem.experiments.parallel job.pickle`` (both from this
 environment: the ``mpich`` wheel's launcher and this Python), which writes rank 0's result
 atomically beside the job. ``-P`` keeps the current directory off ``sys.path``, so that the
-ranks import the hexdem that is installed even when they start inside a source checkout. A failure on any rank is written to ``job.error`` in one line and
+ranks import the hexdem that is installed even when they start inside a source checkout. A failure on any rank is
+written to ``job.error`` in one line and
 aborts the whole MPI job, so that no rank waits forever in a collective call (a failure inside
 a LAMMPS sampling callback is written there too, through ``HEXDEM_JOB_ERROR``). A run that is
 stopped (SIGTERM, Ctrl-C: :mod:`hexdem.common.interrupt`) stops the launcher, which ends the
@@ -93,8 +94,13 @@ def run_on_ranks(job, ranks: int, directory, launcher: str | None = None, progre
     command = [*prefix, "-n", str(ranks), sys.executable, "-P", "-m", __name__, str(paths[JOB_NAME].resolve())]
     with _progress(progress):
         try:
-            launched = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=None, text=True,
-                                        preexec_fn=functools.partial(die_with_parent, os.getpid()))
+            launched = subprocess.Popen(
+                command,
+                stdout=subprocess.PIPE,
+                stderr=None,
+                text=True,
+                preexec_fn=functools.partial(die_with_parent, os.getpid()),
+            )
         except OSError as exc:
             raise HexdemError(f"cannot start the MPI launcher {prefix[0]!r}: {exc.strerror}") from None
         with launched:
@@ -107,8 +113,10 @@ def run_on_ranks(job, ranks: int, directory, launcher: str | None = None, progre
         reported = paths[ERROR_NAME].read_text().strip() if paths[ERROR_NAME].exists() else ""
         if reported:
             raise reported_error(reported)
-        raise RunFailed(f"the MPI job on {ranks} ranks failed (exit status {launched.returncode}): "
-                        f"{(output.strip().splitlines() or ['no output'])[-1]}")
+        raise RunFailed(
+            f"the MPI job on {ranks} ranks failed (exit status {launched.returncode}): "
+            f"{(output.strip().splitlines() or ['no output'])[-1]}"
+        )
     result = pickle.loads(paths[RESULT_NAME].read_bytes())
     for name in (JOB_NAME, RESULT_NAME):
         paths[name].unlink()

@@ -49,8 +49,9 @@ def preview_figure(config: RunConfig, path) -> str:
         body = np.flatnonzero(ids[:beads] == k)
         if len(body):
             colour = MATERIAL_COLOURS[k % len(MATERIAL_COLOURS)]
-            ax.add_collection(bead_circles(ax, positions[body], diameters[body], facecolor=colour, edgecolor="0.3",
-                                           linewidths=0.4))
+            ax.add_collection(
+                bead_circles(ax, positions[body], diameters[body], facecolor=colour, edgecolor="0.3", linewidths=0.4)
+            )
             legend.append(Patch(facecolor=colour, edgecolor="0.3", label=f"{material.name} ({len(body)})"))
     if model.walls:
         draw_walls(ax, model.walls, positions[:beads], diameters[:beads] / 2, color=WALL_COLOUR, linewidth=2.5)
@@ -86,8 +87,16 @@ def _draw_lines(ax, lattice, positions, legend) -> None:
         ax.plot(ends[:, 0], ends[:, 1], color=LINE_COLOUR, linewidth=1.2, linestyle="--")
         along = (ends[1] - ends[0]) / np.linalg.norm(ends[1] - ends[0])
         label = ends[1] + LABEL_BEYOND_D * lattice.diameters_m[beads[-1]] * along
-        ax.text(*label, name, ha="center", va="center", color=LINE_COLOUR, fontsize="small", fontweight="bold",
-                bbox={"boxstyle": "round,pad=0.15", "facecolor": "white", "edgecolor": "none", "alpha": 0.85})
+        ax.text(
+            *label,
+            name,
+            ha="center",
+            va="center",
+            color=LINE_COLOUR,
+            fontsize="small",
+            fontweight="bold",
+            bbox={"boxstyle": "round,pad=0.15", "facecolor": "white", "edgecolor": "none", "alpha": 0.85},
+        )
         ax.update_datalim([label])
         drawn = True
     if drawn:
@@ -98,23 +107,58 @@ def _draw_impacts(ax, model, positions, diameters, legend) -> None:
     """Each struck bead ringed, its striker (if any) dashed where it starts, and an arrow of the
     impact's direction ending just short of the body it sets moving."""
     struck = model.struck_beads
-    ax.add_collection(bead_circles(ax, positions[struck], diameters[struck], facecolor="none",
-                                   edgecolor=STRUCK_COLOUR, linewidths=2.0))
-    legend.append(Line2D([], [], linestyle="", marker="o", markerfacecolor="none", markeredgecolor=STRUCK_COLOUR,
-                         markeredgewidth=2, label="struck bead"))
+    ax.add_collection(
+        bead_circles(
+            ax, positions[struck], diameters[struck], facecolor="none", edgecolor=STRUCK_COLOUR, linewidths=2.0
+        )
+    )
+    legend.append(
+        Line2D(
+            [],
+            [],
+            linestyle="",
+            marker="o",
+            markerfacecolor="none",
+            markeredgecolor=STRUCK_COLOUR,
+            markeredgewidth=2,
+            label="struck bead",
+        )
+    )
     bodies = model.impact_bodies()
     strikers = bodies[bodies >= len(model.packing)]
     if len(strikers):
-        ax.add_collection(bead_circles(ax, positions[strikers], diameters[strikers], facecolor="white",
-                                       edgecolor=STRUCK_COLOUR, linewidths=1.5, linestyles="--"))
-        legend.append(Line2D([], [], linestyle="", marker="o", markerfacecolor="white", markeredgecolor=STRUCK_COLOUR,
-                             label="striker"))
+        ax.add_collection(
+            bead_circles(
+                ax,
+                positions[strikers],
+                diameters[strikers],
+                facecolor="white",
+                edgecolor=STRUCK_COLOUR,
+                linewidths=1.5,
+                linestyles="--",
+            )
+        )
+        legend.append(
+            Line2D(
+                [],
+                [],
+                linestyle="",
+                marker="o",
+                markerfacecolor="white",
+                markeredgecolor=STRUCK_COLOUR,
+                label="striker",
+            )
+        )
     for impact, body in zip(model.impacts, bodies):
         d = diameters[body]
         tip = positions[body] - (0.5 + ARROW_GAP_D) * d * impact.direction
         tail = tip - ARROW_LENGTH_D * d * impact.direction
-        ax.annotate("", xy=tip, xytext=tail, arrowprops={"arrowstyle": "-|>", "color": STRUCK_COLOUR, "linewidth": 2,
-                                                         "mutation_scale": 18})
+        ax.annotate(
+            "",
+            xy=tip,
+            xytext=tail,
+            arrowprops={"arrowstyle": "-|>", "color": STRUCK_COLOUR, "linewidth": 2, "mutation_scale": 18},
+        )
         ax.update_datalim([tail])
     speeds = sorted({f"{impact.speed_m_s:g} m/s at {impact.angle_deg:g}°" for impact in model.impacts})
     legend.append(Line2D([], [], color=STRUCK_COLOUR, linewidth=2, label=f"impact: {', '.join(speeds)}"))
@@ -124,8 +168,10 @@ def preview(config: RunConfig, out) -> Path:
     """``OUT/preview.png`` of ``config``'s packing (see the module docstring); a configuration a
     run would refuse is refused in the same one line, and nothing is written."""
     if config.shape == "random":
-        raise HexdemError('a random disc is packed by LAMMPS before it can be drawn: run it, then preview '
-                          'OUT/preparation/packing.csv as shape = "packing"')
+        raise HexdemError(
+            "a random disc is packed by LAMMPS before it can be drawn: run it, then preview "
+            'OUT/preparation/packing.csv as shape = "packing"'
+        )
     with staged_directory(out) as staging:
         preview_figure(config, staging / PREVIEW_NAME)
     return Path(out) / PREVIEW_NAME

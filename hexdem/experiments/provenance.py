@@ -14,7 +14,7 @@ import sys
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from functools import cache
 from importlib.metadata import version
 from pathlib import Path
@@ -48,8 +48,13 @@ def source_commit() -> str | None:
 @cache
 def versions() -> dict[str, str | None]:
     """hexdem's version and commit, LAMMPS's and the MPI library's, and Python's."""
-    return {"hexdem_version": version("hexdem"), "git_commit": source_commit(), "lammps_version": lammps_version(),
-            "mpi_version": mpi_version(), "python_version": platform.python_version()}
+    return {
+        "hexdem_version": version("hexdem"),
+        "git_commit": source_commit(),
+        "lammps_version": lammps_version(),
+        "mpi_version": mpi_version(),
+        "python_version": platform.python_version(),
+    }
 
 
 #: The command line hexdem is running in this process, as its user gave it (None: the process's own).
@@ -86,8 +91,11 @@ def started_provenance(argv=None) -> Callable[[], dict]:
     while the run goes (three git commands and LAMMPS's and MPI's libraries, which would otherwise
     delay the start of every run from a checkout). Returns the function that gives it, once they
     are found."""
-    started = {"command": user_command() if argv is None else list(argv), "host": socket.gethostname(),
-               "start_time": datetime.now(timezone.utc).isoformat(timespec="seconds")}
+    started = {
+        "command": user_command() if argv is None else list(argv),
+        "host": socket.gethostname(),
+        "start_time": datetime.now(UTC).isoformat(timespec="seconds"),
+    }
     pool = ThreadPoolExecutor(1)
     found = pool.submit(versions)
     pool.shutdown(wait=False)  # its thread ends with the lookup

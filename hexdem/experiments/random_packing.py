@@ -39,8 +39,14 @@ from pathlib import Path
 import numpy as np
 
 from hexdem.common.io import write_csv
-from hexdem.engines.lammps.settling import (SETTLED_NAME, SettlingStage, read_data_file, read_stage,
-                                            run_settling_deck, write_settling_deck)
+from hexdem.engines.lammps.settling import (
+    SETTLED_NAME,
+    SettlingStage,
+    read_data_file,
+    read_stage,
+    run_settling_deck,
+    write_settling_deck,
+)
 from hexdem.errors import HexdemError, RunFailed
 from hexdem.model.config import RunConfig
 from hexdem.model.model_builder import build_model
@@ -78,31 +84,46 @@ def pull_block(force_n: float) -> str:
     """A constant force ``force_n`` [N] on every bead towards the origin, the disc's centre,
     falling linearly to zero within :data:`PULL_CORE_M` of it."""
     core = repr(PULL_CORE_M)
-    return ("variable        pull_r atom sqrt(x*x+y*y)\n"
-            f"variable        pull_reach atom v_pull_r+({core}-v_pull_r)*(v_pull_r<{core})\n"
-            f"variable        pull_x atom -{force_n!r}*x/v_pull_reach\n"
-            f"variable        pull_y atom -{force_n!r}*y/v_pull_reach\n"
-            "fix             pull all addforce v_pull_x v_pull_y 0.0\n")
+    return (
+        "variable        pull_r atom sqrt(x*x+y*y)\n"
+        f"variable        pull_reach atom v_pull_r+({core}-v_pull_r)*(v_pull_r<{core})\n"
+        f"variable        pull_x atom -{force_n!r}*x/v_pull_reach\n"
+        f"variable        pull_y atom -{force_n!r}*y/v_pull_reach\n"
+        "fix             pull all addforce v_pull_x v_pull_y 0.0\n"
+    )
 
 
 def settling_stage(name: str) -> SettlingStage:
     """The settling deck of stage ``name`` ("compact" or "relax"; see the module docstring)."""
     compact = name == "compact"
     return SettlingStage(
-        name=name, purpose="Packing of a random polydisperse disc (shape = \"random\").",
-        walls="# (none)\n", loads=pull_block(PULL_FORCE_N) if compact else "# (none)\n",
+        name=name,
+        purpose='Packing of a random polydisperse disc (shape = "random").',
+        walls="# (none)\n",
+        loads=pull_block(PULL_FORCE_N) if compact else "# (none)\n",
         loads_note=f"{PULL_FORCE_N:g} N on every bead towards the centre" if compact else "none: the pull is removed",
         damping_s=COMPACT_DAMPING_S if compact else RELAX_DAMPING_S,
-        force_tolerance_n=None if compact else SETTLED_MAX_FORCE_N, settled_rms_speed_m_s=SETTLED_RMS_SPEED_M_S,
+        force_tolerance_n=None if compact else SETTLED_MAX_FORCE_N,
+        settled_rms_speed_m_s=SETTLED_RMS_SPEED_M_S,
         max_step_m=COMPACT_MAX_STEP_M if compact else RELAX_MAX_STEP_M,
-        max_dt_s=COMPACT_MAX_DT_S if compact else RELAX_MAX_DT_S, check_every=100,
-        min_steps=1000, max_steps=2_000_000)
+        max_dt_s=COMPACT_MAX_DT_S if compact else RELAX_MAX_DT_S,
+        check_every=100,
+        min_steps=1000,
+        max_steps=2_000_000,
+    )
 
 
 def _packing_config(config: RunConfig, path: Path, struck: int, walls: str) -> RunConfig:
     """``config`` as the ``packing`` of the file at ``path``, its random disc's keys at their defaults."""
-    return config.replace(shape="packing", packing_file=str(path), struck_bead=struck, walls=walls,
-                          radius_m=RunConfig.radius_m, diameter_spread=RunConfig.diameter_spread, seed=RunConfig.seed)
+    return config.replace(
+        shape="packing",
+        packing_file=str(path),
+        struck_bead=struck,
+        walls=walls,
+        radius_m=RunConfig.radius_m,
+        diameter_spread=RunConfig.diameter_spread,
+        seed=RunConfig.seed,
+    )
 
 
 def _write_packing(path: Path, positions_m, diameters_m) -> Path:
@@ -155,33 +176,48 @@ def prepare_random_packing(config: RunConfig, directory, log=None) -> RunConfig:
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     loose, _, diameters = _loose_start(config, directory)
-    bare = config.replace(impacts=(), lines=(), sensors=(), regions=(), vacancies=(), initial_state_file=None,
-                          strike_angle_deg=None, precompression_n=0.0)
+    bare = config.replace(
+        impacts=(),
+        lines=(),
+        sensors=(),
+        regions=(),
+        vacancies=(),
+        initial_state_file=None,
+        strike_angle_deg=None,
+        precompression_n=0.0,
+    )
     model = build_model(_packing_config(bare, loose, 0, "none"))
-    log(f"packing a random disc of {len(diameters)} beads (radius {config.radius_m:g} m, "
-        f"diameters d (1 ± {config.diameter_spread:g}), seed {config.seed}) with LAMMPS")
+    log(
+        f"packing a random disc of {len(diameters)} beads (radius {config.radius_m:g} m, "
+        f"diameters d (1 ± {config.diameter_spread:g}), seed {config.seed}) with LAMMPS"
+    )
     for number, name in enumerate(STAGES, 1):
         stage, start = settling_stage(name), time.perf_counter()
-        log(f"random disc, stage {number} of {len(STAGES)}: {name} (loads {stage.loads_note}), until the rms speed "
-            f"is below {stage.settled_rms_speed_m_s:g} m/s")
+        log(
+            f"random disc, stage {number} of {len(STAGES)}: {name} (loads {stage.loads_note}), until the rms speed "
+            f"is below {stage.settled_rms_speed_m_s:g} m/s"
+        )
         deck = write_settling_deck(model, stage, directory / name)
         try:
             run_settling_deck(deck)
         except HexdemError as exc:
             raise type(exc)(str(exc).replace(str(deck), str(_kept(deck)))) from None
         result = read_stage(deck)
-        log(f"random disc, {name}: {'settled' if result.settled else 'stopped'} after {result.steps} steps, "
-            f"{result.time_s:.3g} s simulated, in {time.perf_counter() - start:.1f} s")
+        log(
+            f"random disc, {name}: {'settled' if result.settled else 'stopped'} after {result.steps} steps, "
+            f"{result.time_s:.3g} s simulated, in {time.perf_counter() - start:.1f} s"
+        )
         if not result.settled:
-            raise RunFailed(f"the random disc's {name} stage did not settle in {result.steps} steps "
-                              f"(kinetic energy {result.kinetic_energy_j:.3g} J, largest force "
-                              f"{result.max_force_n:.3g} N); see {_kept(deck)}")
+            raise RunFailed(
+                f"the random disc's {name} stage did not settle in {result.steps} steps "
+                f"(kinetic energy {result.kinetic_energy_j:.3g} J, largest force "
+                f"{result.max_force_n:.3g} N); see {_kept(deck)}"
+            )
         state = read_data_file(deck / SETTLED_NAME)
         model = replace(model, packing=model.packing.with_geometry(state.positions_m, state.diameters_m))
     packed = _write_packing(directory / PACKING_NAME, state.positions_m, state.diameters_m)
     struck = _struck(config, state.positions_m, state.diameters_m)
-    log(f"random disc packed: {len(diameters)} beads, area fraction {area_fraction(state):.3f}, "
-        f"struck bead {struck}")
+    log(f"random disc packed: {len(diameters)} beads, area fraction {area_fraction(state):.3f}, struck bead {struck}")
     return _packing_config(config, packed, struck, config.walls)
 
 

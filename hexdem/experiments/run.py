@@ -50,13 +50,34 @@ from hexdem.model.model_builder import build_model
 from hexdem.model.run_settings import run_settings
 from hexdem.model.sensors import sensor_beads
 
-RESULT_FILES = ("peaks.csv", "summary.json", "arrival_map.png", "peak_decay.png", "front_shape.csv",
-                "front_shape.png", "energy_regions.csv", "beads.csv", "peak_map.png")
+RESULT_FILES = (
+    "peaks.csv",
+    "summary.json",
+    "arrival_map.png",
+    "peak_decay.png",
+    "front_shape.csv",
+    "front_shape.png",
+    "energy_regions.csv",
+    "beads.csv",
+    "peak_map.png",
+)
 #: Columns of ``beads.csv``: every bead's label, position, material and pulse, its largest
 #: spin |ω_z| (run's units: rad/s in SI; 0 for frictionless spheres, which never turn) and its
 #: velocity at the run's last sample (a rebound's outgoing velocity).
-BEAD_COLUMNS = ("bead_id", "m", "n", "x", "y", "material", "peak_speed", "t_peak", "arrival_time", "peak_angular_speed",
-                "vx_end", "vy_end")
+BEAD_COLUMNS = (
+    "bead_id",
+    "m",
+    "n",
+    "x",
+    "y",
+    "material",
+    "peak_speed",
+    "t_peak",
+    "arrival_time",
+    "peak_angular_speed",
+    "vx_end",
+    "vy_end",
+)
 #: Columns of ``energy_regions.csv``: time in the run's units, energies in J, share of the total.
 ENERGY_REGION_COLUMNS = ("time", "region", "kinetic_energy_j", "contact_energy_j", "energy_fraction")
 #: Bytes per atom and frame of a full-precision dump (measured: 30 MB for 331 atoms x 701 frames).
@@ -66,8 +87,10 @@ MAX_ENERGY_DRIFT = 1e-3
 #: A run writes everything into a fresh ``OUT/.hexdem-run-*`` folder and moves it into ``OUT`` at the end.
 STAGING_PREFIX = ".hexdem-run-"
 #: What a finished run warns of, by the name that study tables (``warnings`` columns) give it.
-RUN_WARNINGS = {"far_wall_not_reached": "the leading wave had not reached every bead at the far wall one contact "
-                                        "time before the run ended; increase 'duration'"}
+RUN_WARNINGS = {
+    "far_wall_not_reached": "the leading wave had not reached every bead at the far wall one contact "
+    "time before the run ended; increase 'duration'"
+}
 #: A failed run's deck is kept in a folder of the temporary directory named so.
 FAILED_PREFIX = "hexdem-failed-"
 #: The front is read along each direction until it comes this close to the packing's edge [d]:
@@ -82,8 +105,17 @@ def simulate(config: RunConfig, workdir, log=None, **observed) -> ImpactAnalysis
     return simulate_model(config, model, run_settings(config, model), workdir, log, **observed)
 
 
-def simulate_model(config: RunConfig, model: GranularModel, settings: RunSettings, workdir, log=None, trace_lines=(),
-                   field_samples=(), trace_beads=(), threshold_speed: float | None = None) -> ImpactAnalysis:
+def simulate_model(
+    config: RunConfig,
+    model: GranularModel,
+    settings: RunSettings,
+    workdir,
+    log=None,
+    trace_lines=(),
+    field_samples=(),
+    trace_beads=(),
+    threshold_speed: float | None = None,
+) -> ImpactAnalysis:
     """Run ``config``, whose model ``model`` is and whose step, length and sampling ``settings``
     are (:func:`~hexdem.model.run_settings.run_settings`), with its engine in ``workdir``, analysed
     while it runs (no result files).
@@ -101,14 +133,30 @@ def simulate_model(config: RunConfig, model: GranularModel, settings: RunSetting
     workdir.mkdir(parents=True, exist_ok=True)
     if config.engine == "lammps":
         write_deck_config(config, workdir)
-    log(f"running {config.engine}: {model.packing.shape}, {model.n_bodies} bodies, "
+    log(
+        f"running {config.engine}: {model.packing.shape}, {model.n_bodies} bodies, "
         f"{settings.n_steps} steps of {settings.dt_s:.4g} s ({settings.duration_s * 1e3:.4g} ms), "
-        f"{config.processes} rank(s), {settings.n_samples} samples analysed in the run")
-    traced = tuple(dict.fromkeys([*(int(bead) for line in trace_lines for bead in model.packing.line(line)),
-                                  *(int(bead) for bead in trace_beads)]))
+        f"{config.processes} rank(s), {settings.n_samples} samples analysed in the run"
+    )
+    traced = tuple(
+        dict.fromkeys(
+            [
+                *(int(bead) for line in trace_lines for bead in model.packing.line(line)),
+                *(int(bead) for bead in trace_beads),
+            ]
+        )
+    )
     frames = movie_samples(settings.n_samples) if config.movie else ()
-    job = ImpactJob(model, settings, config.engine, workdir, dump=config.dump, trace_beads=traced,
-                    field_samples=tuple(sorted(set(field_samples) | set(frames))), threshold_speed=threshold_speed)
+    job = ImpactJob(
+        model,
+        settings,
+        config.engine,
+        workdir,
+        dump=config.dump,
+        trace_beads=traced,
+        field_samples=tuple(sorted(set(field_samples) | set(frames))),
+        threshold_speed=threshold_speed,
+    )
     analysis = track_impact(job, config.ranks, config.launcher)
     check_energy(analysis, workdir)
     return analysis
@@ -122,8 +170,10 @@ def check_dump_space(config: RunConfig, model: GranularModel, settings: RunSetti
     needed = DUMP_BYTES_PER_ATOM_FRAME * settings.n_samples * model.n_bodies
     free = free_disk_bytes(out)
     if needed > free:
-        raise HexdemError(f"the dump would take about {needed / 1e9:.3g} GB and {out} has {free / 1e9:.3g} GB free; "
-                          "drop dump, raise dump_every or free some space")
+        raise HexdemError(
+            f"the dump would take about {needed / 1e9:.3g} GB and {out} has {free / 1e9:.3g} GB free; "
+            "drop dump, raise dump_every or free some space"
+        )
 
 
 def check_energy(analysis: ImpactAnalysis, where) -> None:
@@ -136,8 +186,10 @@ def check_energy(analysis: ImpactAnalysis, where) -> None:
     and convergence hold the frictional step (tests/test_friction_*.py)."""
     drift = analysis.results.energy_drift
     if not analysis.model.laws.tangential and not drift <= MAX_ENERGY_DRIFT:
-        raise RunFailed(f"energy drift {drift:.1e} exceeds {MAX_ENERGY_DRIFT:g} in {where}: the time step "
-                          f"{analysis.settings.dt_s:.3g} s is too large for V0; leave dt at its default or reduce it")
+        raise RunFailed(
+            f"energy drift {drift:.1e} exceeds {MAX_ENERGY_DRIFT:g} in {where}: the time step "
+            f"{analysis.settings.dt_s:.3g} s is too large for V0; leave dt at its default or reduce it"
+        )
 
 
 def summary(config: RunConfig, analysis: ImpactAnalysis, wall_time_s: float) -> dict:
@@ -147,8 +199,11 @@ def summary(config: RunConfig, analysis: ImpactAnalysis, wall_time_s: float) -> 
         "hexdem_version": version("hexdem"),
         "config": config.shape_dict(),
         "units": r.units,
-        "lattice": {"shape": packing_name(config, analysis.model.packing), "n_beads": len(analysis.model.packing),
-                    "struck_bead_id": analysis.model.packing.struck + 1},
+        "lattice": {
+            "shape": packing_name(config, analysis.model.packing),
+            "n_beads": len(analysis.model.packing),
+            "struck_bead_id": analysis.model.packing.struck + 1,
+        },
         "time_step": settings.dt_s / settings.units.time_s,
         "n_steps": settings.n_steps,
         "duration": settings.duration_s / settings.units.time_s,
@@ -167,10 +222,16 @@ def summary(config: RunConfig, analysis: ImpactAnalysis, wall_time_s: float) -> 
         "rotational_energy_fraction": r.rotational_energy_fraction,
         "far_wall_reached": r.far_wall_reached,
         "beads_per_line": {name: len(beads) for name, beads in r.lines.items()},
-        "impacts": [{"bead_id": int(bead) + 1, "site": [int(v) for v in analysis.model.packing.labels[bead]],
-                     "v0": impact.speed_m_s / settings.units.velocity_m_s, "angle_deg": float(impact.angle_deg),
-                     "kind": "striker" if impact.striker else "velocity"}
-                    for bead, impact in zip(analysis.model.struck_beads, analysis.model.impacts)],
+        "impacts": [
+            {
+                "bead_id": int(bead) + 1,
+                "site": [int(v) for v in analysis.model.packing.labels[bead]],
+                "v0": impact.speed_m_s / settings.units.velocity_m_s,
+                "angle_deg": float(impact.angle_deg),
+                "kind": "striker" if impact.striker else "velocity",
+            }
+            for bead, impact in zip(analysis.model.struck_beads, analysis.model.impacts)
+        ],
     }
 
 
@@ -188,16 +249,17 @@ def unmeasurable_outputs(analysis: ImpactAnalysis) -> dict[str, str]:
     return skipped
 
 
-def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_time_s: float, provenance: dict,
-                  log=None) -> None:
+def write_results(
+    config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_time_s: float, provenance: dict, log=None
+) -> None:
     """Every result file of the run (see the module docstring), each written atomically; those
     that cannot be measured on the packing are skipped, named with their reason in
     ``summary.json``'s ``skipped_outputs`` and in the ``log``. ``provenance``
     (:func:`~hexdem.experiments.provenance.run_provenance`, taken when the run started) goes into
     ``summary.json`` as its ``provenance``."""
-    from hexdem.analysis.movie import SPIN_LABEL, speed_movie
     from hexdem.analysis import plotting as plots  # matplotlib: only where figures are drawn
     from hexdem.analysis.decay_figure import peak_decay
+    from hexdem.analysis.movie import SPIN_LABEL, speed_movie
     from hexdem.analysis.run_maps import arrival_map, peak_map
 
     log = log or (lambda message: None)
@@ -207,31 +269,49 @@ def write_results(config: RunConfig, analysis: ImpactAnalysis, out: Path, wall_t
     rows = analysis.line_rows()
     write_csv(out / "peaks.csv", PEAK_COLUMNS, rows)
     write_csv_columns(out / "beads.csv", BEAD_COLUMNS, bead_columns(analysis))
-    write_json(out / "summary.json", {**summary(config, analysis, wall_time_s), "skipped_outputs": skipped,
-                                        "provenance": provenance})
+    write_json(
+        out / "summary.json",
+        {**summary(config, analysis, wall_time_s), "skipped_outputs": skipped, "provenance": provenance},
+    )
     r, model = analysis.results, analysis.model
     v0, name = analysis.v0, packing_name(config, model.packing)
     if config.sensors:
         write_sensor_files(analysis, list(sensor_beads(config.sensors, analysis.model.packing)), out)
     write_csv(out / "energy_regions.csv", ENERGY_REGION_COLUMNS, energy_region_rows(r))
     impact = f"V₀ = {v0:g} {plots.UNIT_LABELS[r.units]['speed']}"
-    jobs = [lambda: arrival_map(r, model, out / "arrival_map.png", title=f"Arrival time, {name}, {impact}"),
-            lambda: peak_map(r, model, v0, out / "peak_map.png", title=f"Peak speed, {name}, {impact}")]
+    jobs = [
+        lambda: arrival_map(r, model, out / "arrival_map.png", title=f"Arrival time, {name}, {impact}"),
+        lambda: peak_map(r, model, v0, out / "peak_map.png", title=f"Peak speed, {name}, {impact}"),
+    ]
     if "peak_decay.png" not in skipped:
         by_line = {name: (np.arange(len(beads)), r.peak_speed[beads]) for name, beads in r.lines.items()}
         jobs.append(lambda: peak_decay(by_line, out / "peak_decay.png", r.units, v0))
     if "front_shape.csv" not in skipped:
         jobs.append(lambda: write_front_shape(analysis, name, out))
     if analysis.model.extra_materials:
-        jobs.append(lambda: plots.energy_regions_figure(r, out / "energy_regions.png",
-                                                        title=f"Where the energy is, {', '.join(r.region_names)}"))
+        jobs.append(
+            lambda: plots.energy_regions_figure(
+                r, out / "energy_regions.png", title=f"Where the energy is, {', '.join(r.region_names)}"
+            )
+        )
     tracked = analysis.tracked
     if config.movie and tracked is not None and len(tracked.field_times):  # (a dump read back has no fields)
-        jobs.append(lambda: speed_movie(r, model, tracked.field_times, tracked.field_speeds, v0, out / "movie.gif",
-                                        title=name))
+        jobs.append(
+            lambda: speed_movie(r, model, tracked.field_times, tracked.field_speeds, v0, out / "movie.gif", title=name)
+        )
         if len(tracked.field_rim_speeds):
-            jobs.append(lambda: speed_movie(r, model, tracked.field_times, tracked.field_rim_speeds, v0,
-                                            out / "spin_movie.gif", title=name, label=SPIN_LABEL))
+            jobs.append(
+                lambda: speed_movie(
+                    r,
+                    model,
+                    tracked.field_times,
+                    tracked.field_rim_speeds,
+                    v0,
+                    out / "spin_movie.gif",
+                    title=name,
+                    label=SPIN_LABEL,
+                )
+            )
     plots.tile_lattice(r, model)  # once for both maps, before they part
     run_shared(jobs)  # the figures and what they draw on two cores, where the machine has them
 
@@ -252,23 +332,42 @@ def bead_columns(analysis: ImpactAnalysis) -> list:
     r, model = analysis.results, analysis.model
     names = np.array([material.name for material in model.materials])
     labels = np.asarray(model.packing.labels, int)
-    return [np.arange(1, len(labels) + 1), labels[:, 0], labels[:, 1], r.positions[:, 0], r.positions[:, 1],
-            names[model.packing.material_ids], r.peak_speed, r.t_peak, r.arrival_time, r.peak_angular_speed,
-            r.end_velocity[:, 0], r.end_velocity[:, 1]]
+    return [
+        np.arange(1, len(labels) + 1),
+        labels[:, 0],
+        labels[:, 1],
+        r.positions[:, 0],
+        r.positions[:, 1],
+        names[model.packing.material_ids],
+        r.peak_speed,
+        r.t_peak,
+        r.arrival_time,
+        r.peak_angular_speed,
+        r.end_velocity[:, 0],
+        r.end_velocity[:, 1],
+    ]
 
 
 def energy_region_rows(results) -> list[tuple]:
     """Rows of ``energy_regions.csv``: per audited time and region, its kinetic and contact
     energy [J] and its share of the total."""
     totals = results.region_energies.sum(axis=(1, 2))
-    return [(float(t), name, float(kinetic), float(contact), float((kinetic + contact) / total))
-            for t, energies, total in zip(results.region_times, results.region_energies, totals)
-            for name, (kinetic, contact) in zip(results.region_names, energies)]
+    return [
+        (float(t), name, float(kinetic), float(contact), float((kinetic + contact) / total))
+        for t, energies, total in zip(results.region_times, results.region_energies, totals)
+        for name, (kinetic, contact) in zip(results.region_names, energies)
+    ]
 
 
-def measure_front_shape(analysis: ImpactAnalysis, count: int = 8, geometric: bool = False,
-                        window_deg: float | None = None, start_quantile: float = 0.05,
-                        wall_margin_d: float = FRONT_WALL_MARGIN_D, arrival_times=None) -> FrontShape:
+def measure_front_shape(
+    analysis: ImpactAnalysis,
+    count: int = 8,
+    geometric: bool = False,
+    window_deg: float | None = None,
+    start_quantile: float = 0.05,
+    wall_margin_d: float = FRONT_WALL_MARGIN_D,
+    arrival_times=None,
+) -> FrontShape:
     """Roundness of the half-maximum arrival front about the struck bead against its mean radius
     in bead diameters at ``count`` times (:func:`~hexdem.analysis.front_shape.front_times`), each
     direction read until the front comes within ``wall_margin_d`` of the packing's edge there
@@ -281,15 +380,24 @@ def measure_front_shape(analysis: ImpactAnalysis, count: int = 8, geometric: boo
     positions = model.packing.positions_m / model.packing.diameter_m
     origin = positions[model.packing.struck]
     try:
-        times = front_times(positions, arrivals, origin, count, start_quantile, wall_margin=wall_margin_d,
-                            geometric=geometric, window_deg=window_deg)
+        times = front_times(
+            positions,
+            arrivals,
+            origin,
+            count,
+            start_quantile,
+            wall_margin=wall_margin_d,
+            geometric=geometric,
+            window_deg=window_deg,
+        )
     except HexdemError:
         times = []
     return front_shape(positions, arrivals, origin, times, wall_margin=wall_margin_d, window_deg=window_deg)
 
 
-def run_experiment(config: RunConfig, out, log=None, command=None, prepared: RunConfig | None = None,
-                   failed_deck=None) -> ImpactAnalysis:
+def run_experiment(
+    config: RunConfig, out, log=None, command=None, prepared: RunConfig | None = None, failed_deck=None
+) -> ImpactAnalysis:
     """Run ``config`` and publish its result files in ``out`` (see module docstring); ``command``:
     the argument vector that asked for the run, for its provenance (default: this process's; a
     study's worker is handed the study's); ``prepared``: ``config``'s random disc packed already
@@ -298,7 +406,9 @@ def run_experiment(config: RunConfig, out, log=None, command=None, prepared: Run
     where a failed run keeps its deck, replacing what an earlier try kept there (default: a fresh
     ``hexdem-failed-*`` folder of the temporary directory)."""
     log = log or (lambda message: sys.stderr.write(f"hexdem: {message}\n"))  # one write: a stop never splits the line
-    load_in_background("hexdem.analysis.run_maps", "hexdem.analysis.decay_figure", "scipy.spatial")  # the figures, while it runs
+    load_in_background(
+        "hexdem.analysis.run_maps", "hexdem.analysis.decay_figure", "scipy.spatial"
+    )  # the figures, while it runs
     with staged_directory(out, STAGING_PREFIX) as staging:
         try:
             start, provenance = time.perf_counter(), started_provenance(command)
@@ -318,8 +428,10 @@ def run_experiment(config: RunConfig, out, log=None, command=None, prepared: Run
         except OSError as exc:
             if exc.errno != errno.ENOSPC:
                 raise
-            raise HexdemError(f"no space left on the device of {out} while writing the run's files; nothing was "
-                              "kept: free some space or choose another --out") from None
+            raise HexdemError(
+                f"no space left on the device of {out} while writing the run's files; nothing was "
+                "kept: free some space or choose another --out"
+            ) from None
     log(f"energy drift {analysis.results.energy_drift:.2e}; results in {out}")
     for name in run_warnings(analysis.results.far_wall_reached):
         log(f"warning: {RUN_WARNINGS[name]}")

@@ -32,8 +32,11 @@ def sensor_rows(analysis: ImpactAnalysis, labels) -> list[tuple]:
     """Rows of ``sensors.csv`` for the sensors ``labels`` (in the order of the model's sensor beads)."""
     times, states = _si_states(analysis)
     beads = analysis.model.sensor_beads
-    return [(label, bead + 1, float(t), *(float(v) for v in states[k, s]))
-            for s, (label, bead) in enumerate(zip(labels, beads)) for k, t in enumerate(times)]
+    return [
+        (label, bead + 1, float(t), *(float(v) for v in states[k, s]))
+        for s, (label, bead) in enumerate(zip(labels, beads))
+        for k, t in enumerate(times)
+    ]
 
 
 def sensor_peak_rows(analysis: ImpactAnalysis, labels) -> list[tuple]:
@@ -44,8 +47,16 @@ def sensor_peak_rows(analysis: ImpactAnalysis, labels) -> list[tuple]:
     rows = []
     for s, (label, bead) in enumerate(zip(labels, analysis.model.sensor_beads)):
         accel = float(np.nanmax(np.hypot(states[:, s, 2], states[:, s, 3])))
-        rows.append((label, bead + 1, float(r.peak_speed[bead] * units.velocity_m_s), accel, arrivals[s],
-                     arrivals[s] - arrivals[0]))
+        rows.append(
+            (
+                label,
+                bead + 1,
+                float(r.peak_speed[bead] * units.velocity_m_s),
+                accel,
+                arrivals[s],
+                arrivals[s] - arrivals[0],
+            )
+        )
     return rows
 
 

@@ -24,8 +24,16 @@ from hexdem.common.io import ensure_writable_dir, write_csv, write_json
 from hexdem.errors import HexdemError
 
 MEASURED_COLUMNS = ("sensor", "time", "ax", "ay")
-SIGNAL_COLUMNS = ("sensor", "bead_id", "simulated_peak_speed", "measured_peak_speed", "peak_ratio",
-                  "simulated_arrival_time", "measured_arrival_time", "arrival_difference")
+SIGNAL_COLUMNS = (
+    "sensor",
+    "bead_id",
+    "simulated_peak_speed",
+    "measured_peak_speed",
+    "peak_ratio",
+    "simulated_arrival_time",
+    "measured_arrival_time",
+    "arrival_difference",
+)
 #: Samples at the start of a measured record that set the accelerometer's offset (before the pulse).
 BASELINE_SAMPLES = 10
 
@@ -70,7 +78,7 @@ def pulse(times, vx, vy) -> tuple[float, float]:
     speed = np.hypot(vx, vy)
     k = int(np.argmax(speed))
     _, peak = refine_peak(times, speed, floor=0.5 * speed[k])
-    return peak, rising_crossing(times[:k + 1], speed[:k + 1], 0.5 * peak)
+    return peak, rising_crossing(times[: k + 1], speed[: k + 1], 0.5 * peak)
 
 
 def compare_signals(run_dir, measured_path, out=None) -> dict:
@@ -81,21 +89,29 @@ def compare_signals(run_dir, measured_path, out=None) -> dict:
     measured = _read_table(Path(measured_path), MEASURED_COLUMNS)
     order = [s for s in simulated if s in measured]
     if not order:
-        raise HexdemError(f"no sensor of {measured_path} ({', '.join(measured) or 'none'}) is in the run "
-                          f"({', '.join(simulated) or 'none'})")
+        raise HexdemError(
+            f"no sensor of {measured_path} ({', '.join(measured) or 'none'}) is in the run "
+            f"({', '.join(simulated) or 'none'})"
+        )
     out = ensure_writable_dir(out if out is not None else run_dir)
     traces, rows = {}, []
     for sensor in order:
         sim, meas = simulated[sensor], measured[sensor]
         vx, vy = integrate_velocity(meas["time"], meas["ax"], meas["ay"])
         traces[sensor] = ((sim["time"], np.hypot(sim["vx"], sim["vy"])), (meas["time"], np.hypot(vx, vy)))
-        rows.append([sensor, int(sim["bead_id"][0]), *pulse(sim["time"], sim["vx"], sim["vy"]),
-                     *pulse(meas["time"], vx, vy)])
+        rows.append(
+            [sensor, int(sim["bead_id"][0]), *pulse(sim["time"], sim["vx"], sim["vy"]), *pulse(meas["time"], vx, vy)]
+        )
     offset = rows[0][5] - rows[0][3]
     table = [(s, bead, sp, mp, mp / sp, sa, ma - offset, ma - offset - sa) for s, bead, sp, sa, mp, ma in rows]
     write_csv(out / "signals.csv", SIGNAL_COLUMNS, table)
-    summary = {"run": str(run_dir), "measured": str(measured_path), "aligned_on": order[0],
-               "time_offset_s": offset, "sensors": [dict(zip(SIGNAL_COLUMNS, row)) for row in table]}
+    summary = {
+        "run": str(run_dir),
+        "measured": str(measured_path),
+        "aligned_on": order[0],
+        "time_offset_s": offset,
+        "sensors": [dict(zip(SIGNAL_COLUMNS, row)) for row in table],
+    }
     write_json(out / "signals.json", summary)
     _overlay(traces, offset, out / "signals.png")
     return summary
@@ -107,8 +123,13 @@ def _overlay(traces: dict, offset: float, path) -> None:
 
     count = len(traces)
     columns = min(2, count)
-    fig, axes = subplots(math.ceil(count / columns), columns, figsize=(6 * columns, 3.2 * math.ceil(count / columns)),
-                         squeeze=False, layout="constrained")
+    fig, axes = subplots(
+        math.ceil(count / columns),
+        columns,
+        figsize=(6 * columns, 3.2 * math.ceil(count / columns)),
+        squeeze=False,
+        layout="constrained",
+    )
     for ax, (sensor, ((ts, vs), (tm, vm))) in zip(axes.flat, traces.items()):
         ax.plot(ts * 1e3, vs, label="simulated", color="C0")
         ax.plot((tm - offset) * 1e3, vm, label="measured (aligned)", color="C3", alpha=0.8)

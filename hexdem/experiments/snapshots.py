@@ -84,15 +84,18 @@ def take_snapshots(config: RunConfig, model: GranularModel, times_s, directory) 
     job = ImpactJob(model, settings, "lammps", Path(directory), dump=config.dump, field_samples=tuple(samples))
     analysis = track_impact(job, config.ranks, launcher=config.launcher)
     tracked = analysis.tracked
-    return Snapshots(config, model.packing, tracked.field_times * settings.units.time_s, tracked.field_speeds,
-                     analysis.engine)
+    return Snapshots(
+        config, model.packing, tracked.field_times * settings.units.time_s, tracked.field_speeds, analysis.engine
+    )
 
 
 def snapshot_rows(snapshots: Snapshots) -> list[tuple]:
     lattice = snapshots.packing
-    return [(float(t), bead + 1, int(m), int(n), float(x), float(y), float(speed))
-            for t, speeds in zip(snapshots.times_s, snapshots.speeds)
-            for bead, ((m, n), (x, y), speed) in enumerate(zip(lattice.labels, lattice.positions_m, speeds))]
+    return [
+        (float(t), bead + 1, int(m), int(n), float(x), float(y), float(speed))
+        for t, speeds in zip(snapshots.times_s, snapshots.speeds)
+        for bead, ((m, n), (x, y), speed) in enumerate(zip(lattice.labels, lattice.positions_m, speeds))
+    ]
 
 
 def snapshot_figure(snapshots: Snapshots, walls, path, outline: Packing | None = None) -> None:
@@ -108,12 +111,18 @@ def snapshot_figure(snapshots: Snapshots, walls, path, outline: Packing | None =
     columns = min(3, count)
     rows = math.ceil(count / columns)
     width = 3.2 if aspect > 1.5 else 4.0
-    fig, axes = plots.subplots(rows, columns, figsize=(width * columns + 1.0, 0.85 * width * aspect * rows + 0.9),
-                               squeeze=False, layout="constrained")
+    fig, axes = plots.subplots(
+        rows,
+        columns,
+        figsize=(width * columns + 1.0, 0.85 * width * aspect * rows + 0.9),
+        squeeze=False,
+        layout="constrained",
+    )
     top = float(np.median(np.max(snapshots.speeds, axis=1)))
     for ax, t, speeds in zip(axes.flat, snapshots.times_s, snapshots.speeds):
-        circles = plots.bead_map(ax, lattice.positions_m, lattice.diameters_m, speeds, cmap="hot_r", clim=(0.0, top),
-                                 colorbar=False)
+        circles = plots.bead_map(
+            ax, lattice.positions_m, lattice.diameters_m, speeds, cmap="hot_r", clim=(0.0, top), colorbar=False
+        )
         plots.draw_walls(ax, walls, lattice.positions_m, lattice.radii_m, linewidth=1)
         if outline is not None:
             plots.draw_walls(ax, outline.walls, outline.positions_m, outline.radii_m, linestyle="--", linewidth=1.2)
@@ -122,12 +131,16 @@ def snapshot_figure(snapshots: Snapshots, walls, path, outline: Packing | None =
         ax.set_yticks([])
     for ax in list(axes.flat)[count:]:
         ax.set_visible(False)
-    bar = fig.colorbar(circles, ax=axes.ravel().tolist(), shrink=0.6, extend="max" if snapshots.speeds.max() > top
-                       else "neither")
+    bar = fig.colorbar(
+        circles, ax=axes.ravel().tolist(), shrink=0.6, extend="max" if snapshots.speeds.max() > top else "neither"
+    )
     bar.set_label("bead speed [m/s]", fontsize=12)
     bar.ax.tick_params(labelsize=11)
-    fig.suptitle(f"Wavefront, {lattice.shape}, striker at {config.v0:g} m/s"
-                 + (f";\ndashed: walls of the {outline.shape}" if outline is not None else ""), fontsize=12)
+    fig.suptitle(
+        f"Wavefront, {lattice.shape}, striker at {config.v0:g} m/s"
+        + (f";\ndashed: walls of the {outline.shape}" if outline is not None else ""),
+        fontsize=12,
+    )
     plots.save(fig, path)
 
 
@@ -142,19 +155,29 @@ def run_snapshots(config: RunConfig, times_s, out, outline_edge: int | None = No
     outline = hexagon(outline_edge, config.diameter_m) if outline_edge else None
     out = ensure_writable_dir(out)
     start = time.perf_counter()
-    log(f"{model.packing.shape}, striker at {config.v0:g} m/s, {config.ranks} rank(s), "
-        f"{len(times_s)} snapshots up to {max(times_s) * 1e3:g} ms")
+    log(
+        f"{model.packing.shape}, striker at {config.v0:g} m/s, {config.ranks} rank(s), "
+        f"{len(times_s)} snapshots up to {max(times_s) * 1e3:g} ms"
+    )
     snapshots = take_snapshots(config, model, times_s, out / "deck")
     name = FIGURE_NAMES.get(config.shape, "snapshots")
     write_csv(out / f"{name}.csv", SNAPSHOT_COLUMNS, snapshot_rows(snapshots))
     snapshot_figure(snapshots, model.walls, out / f"{name}.png", outline)
     settings = run_settings(snapshots.config, model)
     engine = snapshots.engine
-    write_json(out / "snapshots.json", {
-        "hexdem_version": version("hexdem"), "config": snapshots.config.shape_dict(),
-        "times_s": snapshots.times_s.tolist(), "n_beads": len(snapshots.packing),
-        "lammps_version": engine["version"], "ranks": engine["ranks"], "lammps_wall_time_s": engine["wall_time_s"],
-        "atom_steps_per_s": (len(snapshots.packing) + 1) * settings.n_steps / engine["wall_time_s"],
-        "wall_time_s": time.perf_counter() - start})
+    write_json(
+        out / "snapshots.json",
+        {
+            "hexdem_version": version("hexdem"),
+            "config": snapshots.config.shape_dict(),
+            "times_s": snapshots.times_s.tolist(),
+            "n_beads": len(snapshots.packing),
+            "lammps_version": engine["version"],
+            "ranks": engine["ranks"],
+            "lammps_wall_time_s": engine["wall_time_s"],
+            "atom_steps_per_s": (len(snapshots.packing) + 1) * settings.n_steps / engine["wall_time_s"],
+            "wall_time_s": time.perf_counter() - start,
+        },
+    )
     log(f"LAMMPS {engine['wall_time_s']:.1f} s on {engine['ranks']} rank(s); results in {out}")
     return snapshots

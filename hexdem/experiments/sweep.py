@@ -82,12 +82,14 @@ def run_one(run: SweepRun, out: Path, ranks: int | None = None, launcher: str | 
     runs' provenance (default: this process's)."""
     from hexdem.experiments.run import run_experiment
 
-    chosen = run.config.replace(**{key: value for key, value in (("ranks", ranks), ("launcher", launcher))
-                                   if value is not None})
+    chosen = run.config.replace(
+        **{key: value for key, value in (("ranks", ranks), ("launcher", launcher)) if value is not None}
+    )
     config = on_engine(chosen, chosen.engine)
     with atomic_directory(run_dir(out, run)) as partial:
-        run_experiment(config, partial, log=lambda message: None, command=command,
-                       failed_deck=failed_deck_path(out, run))
+        run_experiment(
+            config, partial, log=lambda message: None, command=command, failed_deck=failed_deck_path(out, run)
+        )
 
 
 def plan_study(base: dict, variations: list[Variation], out, source: str = "the base configuration") -> list[SweepRun]:
@@ -106,8 +108,10 @@ def planned_study(out) -> tuple[list[SweepRun], list[Variation]]:
         plan = json.loads(path.read_text())
         base, vary = plan["base"], plan["vary"]
     except FileNotFoundError:
-        raise HexdemError(f"{out} holds no planned sweep (no {PLAN_NAME}); plan it with "
-                          f"hexdem sweep --vary KEY=V1,V2,... --out {out} --plan-only") from None
+        raise HexdemError(
+            f"{out} holds no planned sweep (no {PLAN_NAME}); plan it with "
+            f"hexdem sweep --vary KEY=V1,V2,... --out {out} --plan-only"
+        ) from None
     except (OSError, ValueError, KeyError, TypeError):
         raise HexdemError(f"{path} is unreadable: {out} does not hold a hexdem sweep") from None
     variations = [Variation.parse(f"{key}={','.join(texts)}") for key, texts in vary.items()]
@@ -120,8 +124,15 @@ def _record_failure(out: Path, run: SweepRun, error: BaseException) -> str:
     return message
 
 
-def run_study(out: Path, runs: list[SweepRun], workers: int = 1, parsl=None, ranks: int | None = None,
-              launcher: str | None = None, log=None) -> None:
+def run_study(
+    out: Path,
+    runs: list[SweepRun],
+    workers: int = 1,
+    parsl=None,
+    ranks: int | None = None,
+    launcher: str | None = None,
+    log=None,
+) -> None:
     """Run the runs of ``runs`` that are missing or failed in the study folder ``out``, each one a
     task of the study executor, recording the failures; ``parsl``: a Parsl configuration file, or
     its :class:`~hexdem.experiments.executors.ParslSession`."""
@@ -138,8 +149,9 @@ def run_study(out: Path, runs: list[SweepRun], workers: int = 1, parsl=None, ran
         named = {run.name: run for run in todo}
         tasks = {name: (run_one, run, out, ranks, launcher, user_command()) for name, run in named.items()}
         try:
-            for name, error in run_phase(tasks, workers, parsl, "hexdem sweep", "run",
-                                         done_before=len(runs) - len(todo)):
+            for name, error in run_phase(
+                tasks, workers, parsl, "hexdem sweep", "run", done_before=len(runs) - len(todo)
+            ):
                 if error is not None:
                     log(f"run {name} failed: {_record_failure(out, named[name], error)}")
         except KeyboardInterrupt:  # stopped: the finished runs stay, a half-run its worker left goes
@@ -148,8 +160,9 @@ def run_study(out: Path, runs: list[SweepRun], workers: int = 1, parsl=None, ran
             raise
 
 
-def run_single(out, runs: list[SweepRun], index: int, ranks: int | None = None,
-               launcher: str | None = None) -> tuple[SweepRun, bool]:
+def run_single(
+    out, runs: list[SweepRun], index: int, ranks: int | None = None, launcher: str | None = None
+) -> tuple[SweepRun, bool]:
     """Run run ``index`` (from 0, in the plan's order) of ``runs``, the study planned in ``out``
     (:func:`planned_study`), in this process, unless it is done already (a job array's task that
     is requeued keeps the finished work, as ``hexdem sweep DIR`` does); (the run, whether it ran).
@@ -185,16 +198,21 @@ def collect(out: Path, runs: list[SweepRun], variations: list[Variation], log=No
     warned = warned_runs(rows)
     if warned:
         count = len({cell for cells in warned.values() for cell in cells})
-        reasons = "; ".join(f"{name} in {len(cells)} ({', '.join(Path(cell).name for cell in cells)}): "
-                            f"{RUN_WARNINGS[name]}" for name, cells in warned.items())
+        reasons = "; ".join(
+            f"{name} in {len(cells)} ({', '.join(Path(cell).name for cell in cells)}): {RUN_WARNINGS[name]}"
+            for name, cells in warned.items()
+        )
         log(f"{count} of {len(runs)} runs warned (the warnings column of sweep.csv): {reasons}")
-    unfinished = {what: [run.name for run, (status, _) in zip(runs, states) if status == what]
-                  for what in ("failed", "missing")}
+    unfinished = {
+        what: [run.name for run, (status, _) in zip(runs, states) if status == what] for what in ("failed", "missing")
+    }
     if any(unfinished.values()):
         parts = [f"{len(names)} {what} ({'; '.join(names)})" for what, names in unfinished.items() if names]
         where = f"; errors in {out / RUNS_NAME}/NAME{FAILED_SUFFIX}" if unfinished["failed"] else ""
-        raise RunFailed(f"{sum(map(len, unfinished.values()))} of {len(runs)} runs did not finish: "
-                        f"{', '.join(parts)}{where}; rerun to run them")
+        raise RunFailed(
+            f"{sum(map(len, unfinished.values()))} of {len(runs)} runs did not finish: "
+            f"{', '.join(parts)}{where}; rerun to run them"
+        )
     return rows
 
 
@@ -202,8 +220,17 @@ def _log(message: str) -> None:
     print(f"hexdem sweep: {message}", file=sys.stderr, flush=True)
 
 
-def run_sweep(base: dict, variations: list[Variation], out, workers: int = 1, parsl=None, ranks: int | None = None,
-              launcher: str | None = None, source: str = "the base configuration", log=None) -> list[tuple]:
+def run_sweep(
+    base: dict,
+    variations: list[Variation],
+    out,
+    workers: int = 1,
+    parsl=None,
+    ranks: int | None = None,
+    launcher: str | None = None,
+    source: str = "the base configuration",
+    log=None,
+) -> list[tuple]:
     """Plan (or resume) the sweep into ``out``, run it and write its table and figure; the table's
     rows. An error names the runs that failed, after the table is written."""
     check_study_options(workers, launcher, ranks)

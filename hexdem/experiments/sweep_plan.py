@@ -49,7 +49,7 @@ class Variation:
     texts: tuple[str, ...]
 
     @classmethod
-    def parse(cls, option: str) -> "Variation":
+    def parse(cls, option: str) -> Variation:
         """``KEY=V1,V2,...`` → a variation; a malformed option is one clear line."""
         key, sign, listed = option.partition("=")
         key, texts = key.strip(), tuple(text.strip() for text in listed.split(","))
@@ -65,7 +65,7 @@ class Variation:
         if (kind := type_at(RunConfig, key)) is not None:
             for value in values:
                 check_type(f"--vary {key}", value, kind)
-        if any(a == b and type(a) is type(b) for i, a in enumerate(values) for b in values[i + 1:]):
+        if any(a == b and type(a) is type(b) for i, a in enumerate(values) for b in values[i + 1 :]):
             raise HexdemError(f"--vary {key}: two values are the same once read ({listed})")
         return cls(key, values, texts)
 
@@ -81,8 +81,7 @@ def toml_value(text: str):
 def _step(container, step: str, path: str, option: str):
     if isinstance(container, list):
         if not re.fullmatch(r"[0-9]+", step) or int(step) >= len(container):
-            raise HexdemError(f"{option} {path}: the base configuration has no item {step} "
-                              f"(it has {len(container)})")
+            raise HexdemError(f"{option} {path}: the base configuration has no item {step} (it has {len(container)})")
         return int(step)
     if isinstance(container, dict):
         return step
@@ -145,15 +144,19 @@ def plan_sweep(base: dict, variations: list[Variation], source: str = "the base 
             message = str(exc)
             raise HexdemError(message if message.startswith(f"run {name}") else f"run {name}: {message}") from None
         if config.ranks != 1:
-            raise HexdemError(f"run {name}: a sweep runs each run on one rank of its own (--workers runs at "
-                              f"once); leave ranks at 1, got {config.ranks}")
-        runs.append(SweepRun(name, {variation.key: variation.values[i] for variation, i in zip(variations, chosen)},
-                             config))
+            raise HexdemError(
+                f"run {name}: a sweep runs each run on one rank of its own (--workers runs at "
+                f"once); leave ranks at 1, got {config.ranks}"
+            )
+        runs.append(
+            SweepRun(name, {variation.key: variation.values[i] for variation, i in zip(variations, chosen)}, config)
+        )
     check_unused_in_every([run.config for run in runs])
     names = [run.name for run in runs]
     if len(set(names)) != len(names):
-        raise HexdemError("--vary: two runs would share a directory name; use values that differ in letters, "
-                          "digits or . _ = , + -")
+        raise HexdemError(
+            "--vary: two runs would share a directory name; use values that differ in letters, digits or . _ = , + -"
+        )
     return runs
 
 

@@ -33,8 +33,16 @@ from hexdem.common.io import write_csv
 from hexdem.experiments.sweep_plan import SweepRun
 
 #: Scalar figures of a run's ``summary.json`` in the table, in this order.
-SUMMARY_COLUMNS = ("n_beads", "n_samples", "energy_drift", "energy_lost", "rotational_energy_fraction",
-                   "far_wall_reached", "engine_wall_time_s", "wall_time_s")
+SUMMARY_COLUMNS = (
+    "n_beads",
+    "n_samples",
+    "energy_drift",
+    "energy_lost",
+    "rotational_energy_fraction",
+    "far_wall_reached",
+    "engine_wall_time_s",
+    "wall_time_s",
+)
 #: The first bead of a line in the decay fit.
 DECAY_FIRST_N = 2
 
@@ -75,8 +83,12 @@ def _run_figures(directory: Path) -> tuple[dict, dict, dict, list[str]]:
 
     summary = json.loads((directory / "summary.json").read_text())
     scalars = {key: summary["lattice"]["n_beads"] if key == "n_beads" else summary[key] for key in SUMMARY_COLUMNS}
-    return (scalars, final_energy_shares(directory / "energy_regions.csv"),
-            decay_exponents(directory / "peaks.csv"), run_warnings(summary["far_wall_reached"]))
+    return (
+        scalars,
+        final_energy_shares(directory / "energy_regions.csv"),
+        decay_exponents(directory / "peaks.csv"),
+        run_warnings(summary["far_wall_reached"]),
+    )
 
 
 def _first_seen(keys_per_run) -> list[str]:
@@ -90,18 +102,38 @@ def write_table(out: Path, runs: list[SweepRun], variations, states) -> list[tup
     """Write ``out / sweep.csv`` (see the module docstring) from the runs' ``states``, a
     (status, error) each; its rows."""
     empty = (dict.fromkeys(SUMMARY_COLUMNS, ""), {}, {}, [])
-    figures = [_run_figures(out / "runs" / run.name) if status == "done" else empty
-               for run, (status, _) in zip(runs, states)]
+    figures = [
+        _run_figures(out / "runs" / run.name) if status == "done" else empty for run, (status, _) in zip(runs, states)
+    ]
     regions = _first_seen(shares for _, shares, _, _ in figures)
     lines = _first_seen(exponents for _, _, exponents, _ in figures)
-    header = (*(v.key for v in variations), "run", "status", "warnings", *SUMMARY_COLUMNS,
-              *(f"energy_share_{r}" for r in regions), *(f"decay_exponent_{line}" for line in lines), "error")
+    header = (
+        *(v.key for v in variations),
+        "run",
+        "status",
+        "warnings",
+        *SUMMARY_COLUMNS,
+        *(f"energy_share_{r}" for r in regions),
+        *(f"decay_exponent_{line}" for line in lines),
+        "error",
+    )
+
     def cell(value):
         return "" if value == "" or not np.isfinite(value) else value
 
-    rows = [(*run.values.values(), f"runs/{run.name}", status, ";".join(warnings), *scalars.values(),
-             *(shares.get(r, "") for r in regions), *(cell(exponents.get(line, "")) for line in lines), error)
-            for run, (status, error), (scalars, shares, exponents, warnings) in zip(runs, states, figures)]
+    rows = [
+        (
+            *run.values.values(),
+            f"runs/{run.name}",
+            status,
+            ";".join(warnings),
+            *scalars.values(),
+            *(shares.get(r, "") for r in regions),
+            *(cell(exponents.get(line, "")) for line in lines),
+            error,
+        )
+        for run, (status, error), (scalars, shares, exponents, warnings) in zip(runs, states, figures)
+    ]
     write_csv(out / "sweep.csv", header, rows)
     return [header, *rows]
 
@@ -141,14 +173,20 @@ def sweep_figure(out: Path, runs: list[SweepRun], variations, rows: list[tuple])
 
     header, body = rows[0], rows[1:]
     shown = ["energy_drift", *[name for name in header if name.startswith("decay_exponent_")][:1]]
-    fig, axes = plots.subplots(len(shown), len(variations), figsize=(4.6 * len(variations), 3.4 * len(shown)),
-                               squeeze=False, layout="constrained")
+    fig, axes = plots.subplots(
+        len(shown),
+        len(variations),
+        figsize=(4.6 * len(variations), 3.4 * len(shown)),
+        squeeze=False,
+        layout="constrained",
+    )
     table = [dict(zip(header, row)) for row in body]
     warned = warned_runs(rows)
     for j, variation in enumerate(variations):
         numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in variation.values)
-        position = {text: (value if numeric else i)
-                    for i, (value, text) in enumerate(zip(variation.values, variation.texts))}
+        position = {
+            text: (value if numeric else i) for i, (value, text) in enumerate(zip(variation.values, variation.texts))
+        }
         groups: dict[tuple, list] = {}
         for run, row in zip(runs, table):
             others = tuple((key, value) for key, value in run.values.items() if key != variation.key)
@@ -161,16 +199,19 @@ def sweep_figure(out: Path, runs: list[SweepRun], variations, rows: list[tuple])
             else:
                 ax.set_ylabel(name.replace("_", " "))
 
-            def value(row):
+            def value(row, name=name):
                 return float(row[name]) if row[name] != "" else np.nan
 
             for others, points in groups.items():
-                ax.plot([x for x, _ in points], [value(r) for _, r in points],
-                        "o-", label=", ".join(f"{key} = {value}" for key, value in others) or None)
+                ax.plot(
+                    [x for x, _ in points],
+                    [value(r) for _, r in points],
+                    "o-",
+                    label=", ".join(f"{key} = {value}" for key, value in others) or None,
+                )
             ringed = [(x, value(r)) for points in groups.values() for x, r in points if r["warnings"]]
             if ringed:
-                ax.plot(*zip(*ringed), "o", ms=13, mfc="none", mec="red", mew=1.5,
-                        label=f"warned: {', '.join(warned)}")
+                ax.plot(*zip(*ringed), "o", ms=13, mfc="none", mec="red", mew=1.5, label=f"warned: {', '.join(warned)}")
             ax.set_xlabel(variation.key)
             ax.grid(True, alpha=0.3)
             if not numeric:

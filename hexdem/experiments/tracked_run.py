@@ -12,8 +12,8 @@ from pathlib import Path
 
 from hexdem.analysis.impact import ImpactAnalysis
 from hexdem.analysis.tracker import PulseTracker
-from hexdem.engines.lammps.engine import LammpsEngine
 from hexdem.engines.lammps.deck import Deck
+from hexdem.engines.lammps.engine import LammpsEngine
 from hexdem.engines.lammps.runner import logged_step
 from hexdem.engines.sampling import InRunAnalysis, Results
 from hexdem.experiments.parallel import run_on_ranks
@@ -42,10 +42,16 @@ class ImpactJob:
     threshold_speed: float | None = None
 
     def __call__(self, comm):
-        tracker = PulseTracker(self.model, self.settings, comm, self.trace_beads, self.field_samples,
-                               self.gravity_m_s2, self.threshold_speed)
-        tracked, description = observed_run(make_engine(self.engine, self.dump, self.gravity_m_s2), self, tracker,
-                                            comm)
+        tracker = PulseTracker(
+            self.model,
+            self.settings,
+            comm,
+            self.trace_beads,
+            self.field_samples,
+            self.gravity_m_s2,
+            self.threshold_speed,
+        )
+        tracked, description = observed_run(make_engine(self.engine, self.dump, self.gravity_m_s2), self, tracker, comm)
         return None if tracked is None else (tracked, description)
 
 
@@ -73,7 +79,10 @@ def track_impact(job: ImpactJob, ranks: int = 1, launcher: str | None = None) ->
     ranks = ranks if job.engine == "lammps" else 1
     launched = ranks > 1 or launcher is not None
     log = Deck(job.directory, job.settings, job.model.n_bodies).log_path
-    progress = ((job.settings.n_steps, f"LAMMPS on {ranks} ranks", lambda: logged_step(log))
-                if launched and job.show_progress else None)
+    progress = (
+        (job.settings.n_steps, f"LAMMPS on {ranks} ranks", lambda: logged_step(log))
+        if launched and job.show_progress
+        else None
+    )
     tracked, description = run_on_ranks(job, ranks, job.directory, launcher, progress)
     return ImpactAnalysis.from_tracker(job.model, job.settings, tracked, description)

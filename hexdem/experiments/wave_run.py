@@ -38,8 +38,9 @@ class WaveJob:
     weights: tuple = ()
 
     def __call__(self, comm):
-        recorder = WaveRecorder(self.model, self.settings, np.asarray(self.wave_vectors_m, float), self.block, comm,
-                                self.weights or None)
+        recorder = WaveRecorder(
+            self.model, self.settings, np.asarray(self.wave_vectors_m, float), self.block, comm, self.weights or None
+        )
         return observed_run(make_engine(self.engine), self, recorder, comm)[0]
 
 
@@ -49,8 +50,9 @@ def steps_per_sample(dt_s: float, period_s: float, samples_per_period: int) -> i
     return max(1, int(period_s / samples_per_period / dt_s))
 
 
-def record_waves(config: RunConfig, workdir, wave_vectors_m=(), block: int = 0, log=None,
-                 show_progress: bool = True, weights=()) -> RecordedWaves:
+def record_waves(
+    config: RunConfig, workdir, wave_vectors_m=(), block: int = 0, log=None, show_progress: bool = True, weights=()
+) -> RecordedWaves:
     """Run ``config`` in ``workdir`` on its engine and ranks, recording the plane-wave components
     at ``wave_vectors_m`` [1/m], each bead weighted by ``weights`` (N,) (empty: all 1), and the
     energy blocks of ``block`` samples."""
@@ -59,8 +61,18 @@ def record_waves(config: RunConfig, workdir, wave_vectors_m=(), block: int = 0, 
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
     if log is not None:
-        log(f"running {config.engine}: {len(model.packing)} beads, {settings.n_steps} steps of "
-            f"{settings.dt_s:.4g} s, {settings.n_samples} samples recorded")
-    job = WaveJob(model, settings, config.engine, workdir, tuple(map(tuple, np.asarray(wave_vectors_m, float).reshape(-1, 2))),
-                  block, show_progress, tuple(map(float, weights)))
+        log(
+            f"running {config.engine}: {len(model.packing)} beads, {settings.n_steps} steps of "
+            f"{settings.dt_s:.4g} s, {settings.n_samples} samples recorded"
+        )
+    job = WaveJob(
+        model,
+        settings,
+        config.engine,
+        workdir,
+        tuple(map(tuple, np.asarray(wave_vectors_m, float).reshape(-1, 2))),
+        block,
+        show_progress,
+        tuple(map(float, weights)),
+    )
     return run_on_ranks(job, config.processes, workdir, config.launcher)

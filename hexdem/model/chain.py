@@ -14,7 +14,6 @@ from hexdem.errors import HexdemError
 from hexdem.model.packing import Packing, unit_vector
 from hexdem.model.placed import placed_packing
 
-
 #: The fewest beads of a chain: the struck one and one to pass the pulse to.
 MIN_CHAIN_BEADS = 2
 
@@ -22,8 +21,9 @@ MIN_CHAIN_BEADS = 2
 def chain_beads(beads) -> int:
     """``beads`` as the bead count of a chain, or a one-line HexdemError below :data:`MIN_CHAIN_BEADS`."""
     if int(beads) != beads or beads < MIN_CHAIN_BEADS:
-        raise HexdemError(f"a chain needs beads >= {MIN_CHAIN_BEADS} (the struck one and one to pass the pulse to), "
-                          f"got {beads}")
+        raise HexdemError(
+            f"a chain needs beads >= {MIN_CHAIN_BEADS} (the struck one and one to pass the pulse to), got {beads}"
+        )
     return int(beads)
 
 

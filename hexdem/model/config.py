@@ -16,8 +16,8 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import math
-from pathlib import Path
 from dataclasses import dataclass
+from pathlib import Path
 
 from hexdem.common.checks import positive_int
 from hexdem.common.io import read_toml
@@ -69,16 +69,16 @@ def read_config_table(path) -> dict:
 @dataclass(frozen=True)
 class RunConfig:
     """One simulation: every key a configuration file may set, each checked against its declared
-    type (:mod:`hexdem.common.typecheck`) and its meaning in
-    :data:`~hexdem.model.config_keys.KEY_DESCRIPTIONS`. Lengths in m; ``v0``, ``dt``, ``duration``
-    in ``units``. ``given``: the keys the user wrote (:meth:`from_dict`, :meth:`override`), each
-    set whatever its value (:meth:`set_keys`). ``dt = None`` takes the contact time
-(:func:`~hexdem.model.run_settings.contact_time_s`) over
-    ``steps_per_contact``, shortened so that the default sampling interval, 1/20 of the contact
-    time, is whole steps; ``duration = None`` follows the pulse layer by layer from the struck
-    bead to the far wall, each layer for the contact time of its quickest material, and a soft
-    striker's longer contact (:func:`~hexdem.model.timescale.crossing_time_s`; the pulse resides
-    less than that on each layer: 0.82 ms are needed, 1.43 ms are run for the default experiment).
+        type (:mod:`hexdem.common.typecheck`) and its meaning in
+        :data:`~hexdem.model.config_keys.KEY_DESCRIPTIONS`. Lengths in m; ``v0``, ``dt``, ``duration``
+        in ``units``. ``given``: the keys the user wrote (:meth:`from_dict`, :meth:`override`), each
+        set whatever its value (:meth:`set_keys`). ``dt = None`` takes the contact time
+    (:func:`~hexdem.model.run_settings.contact_time_s`) over
+        ``steps_per_contact``, shortened so that the default sampling interval, 1/20 of the contact
+        time, is whole steps; ``duration = None`` follows the pulse layer by layer from the struck
+        bead to the far wall, each layer for the contact time of its quickest material, and a soft
+        striker's longer contact (:func:`~hexdem.model.timescale.crossing_time_s`; the pulse resides
+        less than that on each layer: 0.82 ms are needed, 1.43 ms are run for the default experiment).
     """
 
     shape: str = "hexagon"
@@ -143,8 +143,10 @@ class RunConfig:
     def __post_init__(self, given):
         object.__setattr__(self, "given", frozenset(given))
         if isinstance(self.materials, (list, tuple)):
-            raise HexdemError("materials is a table of this configuration's own materials; a chain's material "
-                              "per bead goes in bead_materials = [\"steel316\", \"brass\", ...]")
+            raise HexdemError(
+                "materials is a table of this configuration's own materials; a chain's material "
+                'per bead goes in bead_materials = ["steel316", "brass", ...]'
+            )
         check_fields(self)
         for name, allowed in (("shape", SHAPES), ("impact", IMPACTS), ("units", UNITS), ("engine", ENGINES)):
             if getattr(self, name) not in allowed:
@@ -153,17 +155,29 @@ class RunConfig:
             if getattr(self, name) is not None:
                 positive_int(name, getattr(self, name))
         if positive_int("steps_per_contact", self.steps_per_contact) < MIN_STEPS_PER_CONTACT:
-            raise HexdemError(f"steps_per_contact must be at least {MIN_STEPS_PER_CONTACT} (the Hertz contact "
-                              f"needs them), got {self.steps_per_contact}")
-        for name in ("sensors", "sites", "site_walls_deg", "vacancies", "regions", "impacts", "lines", "diameters_m",
-                     "bead_materials", "intruders"):
+            raise HexdemError(
+                f"steps_per_contact must be at least {MIN_STEPS_PER_CONTACT} (the Hertz contact "
+                f"needs them), got {self.steps_per_contact}"
+            )
+        for name in (
+            "sensors",
+            "sites",
+            "site_walls_deg",
+            "vacancies",
+            "regions",
+            "impacts",
+            "lines",
+            "diameters_m",
+            "bead_materials",
+            "intruders",
+        ):
             object.__setattr__(self, name, tuple(tuple(v) if isinstance(v, list) else v for v in getattr(self, name)))
         if not self.sensor_rate_hz > 0:
             raise HexdemError(f"sensor_rate_hz must be > 0, got {self.sensor_rate_hz!r}")
         if not self.precompression_n >= 0:
             raise HexdemError(f"precompression_n must be a force >= 0 N, got {self.precompression_n!r}")
         if self.launcher is not None and not self.launcher.split():
-            raise HexdemError(f"launcher must be a command such as \"mpiexec -f hosts\", got {self.launcher!r}")
+            raise HexdemError(f'launcher must be a command such as "mpiexec -f hosts", got {self.launcher!r}')
         for name in ("dt", "duration"):
             value = getattr(self, name)
             if value is not None and not value > 0:
@@ -172,9 +186,11 @@ class RunConfig:
             raise HexdemError(f"v0 must be > 0 (the impact moves into the packing), got {self.v0!r}")
         check_shape_keys(self)
         if self.strike_angle_deg is not None and math.cos(math.radians(self.strike_angle_deg - self.inward_deg)) <= 0:
-            raise HexdemError(f"strike angle {self.strike_angle_deg}° does not point into the packing, which lies at "
-                              f"{self.inward_deg:g}° from its struck bead: use an angle within 90° of it, or leave "
-                              "strike_angle_deg out")
+            raise HexdemError(
+                f"strike angle {self.strike_angle_deg}° does not point into the packing, which lies at "
+                f"{self.inward_deg:g}° from its struck bead: use an angle within 90° of it, or leave "
+                "strike_angle_deg out"
+            )
         for alpha in {damping_coefficient(self.restitution), damping_coefficient(self.effective_wall_restitution)}:
             if alpha:
                 lammps_tsuji_coefficient(alpha)
@@ -199,11 +215,15 @@ class RunConfig:
         """Every material the keys name must be a preset or one of ``materials`` (each table
         complete); a chain's ``bead_materials`` and ``intruders`` and the ``regions`` name theirs the
         same way."""
-        names = [self.bead_material, self.striker_material, self.interstitial_material,
-                 *(spec.striker_material for spec in self.impact_specs()),
-                 *(region["material"] for region in self.regions if isinstance(region, dict) and "material" in region),
-                 *(name for name in self.bead_materials if name),
-                 *(intruder.get("material") for intruder in self.intruders)]
+        names = [
+            self.bead_material,
+            self.striker_material,
+            self.interstitial_material,
+            *(spec.striker_material for spec in self.impact_specs()),
+            *(region["material"] for region in self.regions if isinstance(region, dict) and "material" in region),
+            *(name for name in self.bead_materials if name),
+            *(intruder.get("material") for intruder in self.intruders),
+        ]
         for name in dict.fromkeys(names):
             if isinstance(name, str):
                 self.material(name)
@@ -222,25 +242,29 @@ class RunConfig:
         (2π/√3 (R + 1)² for a radius of R d, half for a half-disc); a file's lines, at least
         4 bytes each (``0,0``) for sites and 6 (``0,0,1``) for a packing; a random disc's share
         of its area, :data:`~hexdem.model.random_disc.DENSE_FRACTION`, over its smallest bead's."""
+
         def lines(path, shortest):
             return Path(path).stat().st_size // shortest if path and Path(path).is_file() else 0
+
         counted = self.n_beads()
         if counted is not None:
             return counted
         disc_sites = 2 * math.pi / math.sqrt(3) * (self.radius_beads + 1) ** 2
         smallest = self.diameter_m * (1 - self.diameter_spread)
-        return int({
-            "triangle": lambda: self.edge_beads * (self.edge_beads + 1) / 2,
-            "parallelogram": lambda: self.edge_beads * (self.depth_beads or self.edge_beads),
-            "half-disc": lambda: disc_sites / 2,
-            "disc": lambda: disc_sites,
-            "sites": lambda: len(self.sites) + lines(self.sites_file, 4),
-            "square": lambda: self.rows * self.columns,
-            "centered-square": lambda: self.rows * self.columns + (self.rows - 1) * (self.columns - 1),
-            "chain": lambda: self.beads,
-            "packing": lambda: lines(self.packing_file, 6),
-            "random": lambda: DENSE_FRACTION * (2 * self.radius_m / smallest) ** 2 + 2,
-        }[self.shape]())
+        return int(
+            {
+                "triangle": lambda: self.edge_beads * (self.edge_beads + 1) / 2,
+                "parallelogram": lambda: self.edge_beads * (self.depth_beads or self.edge_beads),
+                "half-disc": lambda: disc_sites / 2,
+                "disc": lambda: disc_sites,
+                "sites": lambda: len(self.sites) + lines(self.sites_file, 4),
+                "square": lambda: self.rows * self.columns,
+                "centered-square": lambda: self.rows * self.columns + (self.rows - 1) * (self.columns - 1),
+                "chain": lambda: self.beads,
+                "packing": lambda: lines(self.packing_file, 6),
+                "random": lambda: DENSE_FRACTION * (2 * self.radius_m / smallest) ** 2 + 2,
+            }[self.shape]()
+        )
 
     def memory_estimate_bytes(self) -> float:
         """Peak memory of the run on each of its processes [bytes] (see MEMORY_PER_BEAD_BYTES and
@@ -251,23 +275,27 @@ class RunConfig:
     def _check_size(self) -> None:
         """Refuse a packing that this machine's memory cannot hold, counted without building it
         (:meth:`max_beads`); the builders word any error in the sizes themselves."""
-        if not self.diameter_m > 0 or any(getattr(self, key) < 1 for key in (
-                "edge_beads", "long_edge", "short_edge", "radius_beads", "rows", "columns", "beads")):
+        if not self.diameter_m > 0 or any(
+            getattr(self, key) < 1
+            for key in ("edge_beads", "long_edge", "short_edge", "radius_beads", "rows", "columns", "beads")
+        ):
             return
         needed = self.memory_estimate_bytes() * self.processes
         available = available_memory_bytes()
         if needed > available:
-            raise HexdemError(f"{self.shape} of up to {self.max_beads():,} beads needs about {needed / 1e9:.3g} GB of "
-                              f"memory ({self.processes} process(es)); this machine has {available / 1e9:.3g} GB "
-                              "available")
+            raise HexdemError(
+                f"{self.shape} of up to {self.max_beads():,} beads needs about {needed / 1e9:.3g} GB of "
+                f"memory ({self.processes} process(es)); this machine has {available / 1e9:.3g} GB "
+                "available"
+            )
 
     @classmethod
-    def from_toml(cls, path) -> "RunConfig":
+    def from_toml(cls, path) -> RunConfig:
         """Read a TOML file whose keys are :class:`RunConfig` field names (:func:`read_config_table`)."""
         return cls.from_dict(read_config_table(path), source=str(path))
 
     @classmethod
-    def from_dict(cls, data: dict, source: str = "config", given: bool = True) -> "RunConfig":
+    def from_dict(cls, data: dict, source: str = "config", given: bool = True) -> RunConfig:
         """The configuration of the table ``data`` of keys, each key in it set whatever its value
         (:meth:`set_keys`); ``given=False`` for a table hexdem wrote with every key (a deck's
         ``hexdem.json``), whose keys are set where they differ from their defaults. An unknown
@@ -276,17 +304,18 @@ class RunConfig:
         for key in data:
             if key not in known:
                 nearest = difflib.get_close_matches(key, known, n=3)
-                hint = (f"did you mean {' or '.join(nearest)}?" if nearest
-                        else f"the keys are {', '.join(sorted(known))}")
+                hint = (
+                    f"did you mean {' or '.join(nearest)}?" if nearest else f"the keys are {', '.join(sorted(known))}"
+                )
                 raise HexdemError(f"{source}: unknown parameter {key}; {hint}")
         return cls(**data, given=frozenset(data) if given else frozenset())
 
-    def replace(self, **changes) -> "RunConfig":
+    def replace(self, **changes) -> RunConfig:
         """This configuration with ``changes`` that hexdem makes (a derived run's): a key changed
         is no longer the user's, and is set only where it differs from its default."""
         return dataclasses.replace(self, given=self.given - changes.keys(), **changes)
 
-    def override(self, **changes) -> "RunConfig":
+    def override(self, **changes) -> RunConfig:
         """This configuration with ``changes`` that the user makes (a command line's options, the
         Python API's keywords): each key set whatever its value, as if written in the file."""
         return dataclasses.replace(self, given=self.given | changes.keys(), **changes)
@@ -300,8 +329,13 @@ class RunConfig:
         are the keys that may be refused for describing another shape
         (:func:`~hexdem.model.packing_builders.check_shape_keys`) or for doing nothing
         (:mod:`~hexdem.model.unused_keys`)."""
-        return [field.name for field in dataclasses.fields(self) if field.name in self.given or getattr(
-            self, field.name) != (field.default_factory() if field.default is dataclasses.MISSING else field.default)]
+        return [
+            field.name
+            for field in dataclasses.fields(self)
+            if field.name in self.given
+            or getattr(self, field.name)
+            != (field.default_factory() if field.default is dataclasses.MISSING else field.default)
+        ]
 
     def shape_dict(self) -> dict:
         """:meth:`as_dict` less the keys that describe other shapes (:data:`SHAPE_KEYS`): the keys
@@ -335,5 +369,11 @@ class RunConfig:
 
     def impact_specs(self) -> list[ImpactSpec]:
         """The configured impacts, the run's values filled in (:func:`~hexdem.model.impacts.impact_specs`)."""
-        return impact_specs(self.impacts, self.v0, self.strike_direction_deg, self.impact, self.striker_material,
-                            self.striker_diameter_m)
+        return impact_specs(
+            self.impacts,
+            self.v0,
+            self.strike_direction_deg,
+            self.impact,
+            self.striker_material,
+            self.striker_diameter_m,
+        )

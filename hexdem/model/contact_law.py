@@ -48,7 +48,7 @@ class Friction:
             raise HexdemError("rolling_friction > 0 is not modelled yet: leave it at 0")
 
     @classmethod
-    def of(cls, friction, wall_friction, rolling_friction) -> "Friction":
+    def of(cls, friction, wall_friction, rolling_friction) -> Friction:
         """The configuration keys' friction, ``wall_friction`` None meaning ``friction``."""
         return cls(friction, friction if wall_friction is None else wall_friction, rolling_friction)
 
@@ -88,13 +88,26 @@ class ContactLaws:
     walls: tuple[ContactLaw, ...]
 
     @classmethod
-    def of(cls, materials, wall: Material | None, pair_damping: float, wall_damping: float,
-           friction: Friction = NO_FRICTION) -> "ContactLaws":
+    def of(
+        cls,
+        materials,
+        wall: Material | None,
+        pair_damping: float,
+        wall_damping: float,
+        friction: Friction = NO_FRICTION,
+    ) -> ContactLaws:
         """The laws of bodies of ``materials`` (by id) touching each other and the ``wall``."""
-        pairs = tuple(tuple(contact_law(a, b, pair_damping, friction.friction, friction.rolling_friction)
-                            for b in materials) for a in materials)
-        walls = () if wall is None else tuple(contact_law(a, wall, wall_damping, friction.wall_friction,
-                                                          friction.rolling_friction) for a in materials)
+        pairs = tuple(
+            tuple(contact_law(a, b, pair_damping, friction.friction, friction.rolling_friction) for b in materials)
+            for a in materials
+        )
+        walls = (
+            ()
+            if wall is None
+            else tuple(
+                contact_law(a, wall, wall_damping, friction.wall_friction, friction.rolling_friction) for a in materials
+            )
+        )
         return cls(pairs, walls)
 
     @property

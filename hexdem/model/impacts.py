@@ -30,7 +30,6 @@ from hexdem.model.packing import Packing, unit_vector
 from hexdem.model.walls import facing_edge
 
 
-
 class ImpactTable(TypedDict, total=False):
     """An impact's keys and their types (checked by :class:`~hexdem.model.config.RunConfig`)."""
 
@@ -87,9 +86,17 @@ def impact_specs(entries, v0, angle_deg, kind, striker_material, striker_diamete
         if chosen_kind not in KINDS:
             raise HexdemError(f"impact {k}: unknown kind {chosen_kind!r}; use one of: {', '.join(KINDS)}")
         default_angle = angle_deg if site is not None else None
-        specs.append(ImpactSpec(site, entry.get("edge_deg"), entry.get("v0", v0), entry.get("angle_deg", default_angle),
-                                chosen_kind, entry.get("striker_material", striker_material),
-                                entry.get("striker_diameter_m", striker_diameter_m)))
+        specs.append(
+            ImpactSpec(
+                site,
+                entry.get("edge_deg"),
+                entry.get("v0", v0),
+                entry.get("angle_deg", default_angle),
+                chosen_kind,
+                entry.get("striker_material", striker_material),
+                entry.get("striker_diameter_m", striker_diameter_m),
+            )
+        )
     return specs
 
 
@@ -112,10 +119,16 @@ def resolve_impacts(specs: list[ImpactSpec], packing: Packing, velocity_scale_m_
         else:
             beads = facing_edge(packing, unit_vector(spec.edge_deg))[1]  # the beads a wall there would touch
             if len(beads) < 2:
-                raise HexdemError(f"impact {k}: the packing has no flat edge whose inward normal points at "
-                                  f"{spec.edge_deg:g}° (one bead there); use the angle of a wall, e.g. 0")
+                raise HexdemError(
+                    f"impact {k}: the packing has no flat edge whose inward normal points at "
+                    f"{spec.edge_deg:g}° (one bead there); use the angle of a wall, e.g. 0"
+                )
             angle = spec.edge_deg if spec.angle_deg is None else spec.angle_deg
         striker = material(spec.striker_material) if spec.striker_material is not None else None
-        impacts += [Impact(spec.v0 * velocity_scale_m_s, float(angle), spec.striker, int(bead), striker,
-                           spec.striker_diameter_m) for bead in beads]
+        impacts += [
+            Impact(
+                spec.v0 * velocity_scale_m_s, float(angle), spec.striker, int(bead), striker, spec.striker_diameter_m
+            )
+            for bead in beads
+        ]
     return impacts

@@ -3,7 +3,8 @@
 ``initial_state_file`` is a CSV whose header is ``m,n,vx,vy`` or ``m,n,vx,vy,dx,dy``: one bead
 per line, by its label {m, n}, its initial velocity [m/s] and optionally its displacement [m]
 from where the packing (precompressed or not) puts it. Beads not listed start at rest where the
-packing puts them. The impacts add their speeds on top (:meth:`~hexdem.model.granular.GranularModel.initial_velocities_m_s`).
+packing puts them. The impacts add their speeds on top
+(:meth:`~hexdem.model.granular.GranularModel.initial_velocities_m_s`).
 Both engines start from :meth:`~hexdem.model.granular.GranularModel.initial_positions_m` and
 that method, so they read the state alike.
 
@@ -45,7 +46,9 @@ def read_initial_state(path, packing: Packing) -> InitialState:
     rows = list(csv.reader(lines))
     header = tuple(cell.strip() for cell in rows[0]) if rows else ()
     if header not in HEADERS:
-        raise HexdemError(f"{name}: the header must be m,n,vx,vy or m,n,vx,vy,dx,dy, got {','.join(header) or 'nothing'}")
+        raise HexdemError(
+            f"{name}: the header must be m,n,vx,vy or m,n,vx,vy,dx,dy, got {','.join(header) or 'nothing'}"
+        )
     n = len(packing)
     velocities, displacements, seen = np.zeros((n, 2)), np.zeros((n, 2)), set()
     for number, row in enumerate(rows[1:], start=2):
@@ -67,8 +70,10 @@ def read_initial_state(path, packing: Packing) -> InitialState:
         velocities[bead] = values[:2]
         if len(values) == 4:
             if math.hypot(*values[2:]) >= packing.diameters_m[bead] / 2:
-                raise HexdemError(f"{name}, line {number}: a displacement of half a diameter or more would put "
-                                  f"bead {{{m}, {k}}} inside its neighbours")
+                raise HexdemError(
+                    f"{name}, line {number}: a displacement of half a diameter or more would put "
+                    f"bead {{{m}, {k}}} inside its neighbours"
+                )
             displacements[bead] = values[2:]
     return InitialState(velocities, displacements)
 
@@ -80,9 +85,13 @@ def write_initial_state(path, packing: Packing, velocities_m_s, displacements_m=
     if displacements_m is not None:
         columns.append(np.asarray(displacements_m, float))
     if any(column.shape != (len(packing), 2) for column in columns):
-        raise HexdemError(f"an initial state needs ({len(packing)}, 2) arrays for the packing's beads, got "
-                          f"{' and '.join(str(column.shape) for column in columns)}")
+        raise HexdemError(
+            f"an initial state needs ({len(packing)}, 2) arrays for the packing's beads, got "
+            f"{' and '.join(str(column.shape) for column in columns)}"
+        )
     header = HEADERS[len(columns) - 1]
-    rows = [[m, n, *(repr(float(value)) for value in values)]
-            for (m, n), values in zip(packing.labels.tolist(), np.hstack(columns))]
+    rows = [
+        [m, n, *(repr(float(value)) for value in values)]
+        for (m, n), values in zip(packing.labels.tolist(), np.hstack(columns))
+    ]
     write_csv(path, header, rows)

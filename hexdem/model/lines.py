@@ -32,16 +32,22 @@ def with_lines(packing: Packing, entries) -> Packing:
     lines, names = [], {name for name, _, _ in packing.label_lines}
     for k, entry in enumerate(entries):
         if sorted(entry) != sorted(LINE_KEYS):
-            raise HexdemError(f"line {k} must be a table {{name = \"up\", site = [m, n], angle_deg = 90}} with "
-                              f"exactly the keys {', '.join(LINE_KEYS)}")
+            raise HexdemError(
+                f'line {k} must be a table {{name = "up", site = [m, n], angle_deg = 90}} with '
+                f"exactly the keys {', '.join(LINE_KEYS)}"
+            )
         name, site, angle = entry["name"], entry["site"], entry["angle_deg"]
         if not name or name in names:
-            raise HexdemError(f"line {k}: name {name!r} must be a new, non-empty string (taken: {', '.join(sorted(names))})")
+            raise HexdemError(
+                f"line {k}: name {name!r} must be a new, non-empty string (taken: {', '.join(sorted(names))})"
+            )
         if packing.index_of(*site) is None:
             raise HexdemError(f"line {name}: site {site!r} is not a bead [m, n] of the packing")
         if angle not in DIRECTION_STEPS:
-            raise HexdemError(f"line {name}: angle_deg {angle!r} is not a lattice direction; use one of "
-                              f"{', '.join(str(a) for a in DIRECTION_STEPS)}")
+            raise HexdemError(
+                f"line {name}: angle_deg {angle!r} is not a lattice direction; use one of "
+                f"{', '.join(str(a) for a in DIRECTION_STEPS)}"
+            )
         names.add(name)
         lines.append(LabelLine(name, (int(site[0]), int(site[1])), DIRECTION_STEPS[int(angle)]))
     return replace(packing, label_lines=packing.label_lines + tuple(lines))

@@ -19,8 +19,6 @@ import numpy as np
 from hexdem.errors import HexdemError
 
 
-
-
 class MaterialTable(TypedDict, total=False):
     """A configuration's own material: its keys and their types (checked by
     :class:`~hexdem.model.config.RunConfig`)."""
@@ -73,23 +71,45 @@ class Material:
 
 
 #: Stainless steel type 316 as used in the paper's experiment (Sec. II).
-STEEL_316 = Material("steel316", youngs_modulus_pa=193e9, poisson_ratio=0.3, density_kg_m3=8000.0,
-                     source="the paper, Sec. II")
+STEEL_316 = Material(
+    "steel316", youngs_modulus_pa=193e9, poisson_ratio=0.3, density_kg_m3=8000.0, source="the paper, Sec. II"
+)
 #: Delrin, the soft lining of the confining walls (Sec. II).
-DELRIN = Material("delrin", youngs_modulus_pa=3.1e9, poisson_ratio=0.35, density_kg_m3=1400.0,
-                  source="the paper, Sec. II")
+DELRIN = Material(
+    "delrin", youngs_modulus_pa=3.1e9, poisson_ratio=0.35, density_kg_m3=1400.0, source="the paper, Sec. II"
+)
 #: Cartridge brass (C26000), typical handbook values.
-BRASS = Material("brass", youngs_modulus_pa=110e9, poisson_ratio=0.375, density_kg_m3=8530.0,
-                 source="C26000 cartridge brass, ASM handbook typical values")
+BRASS = Material(
+    "brass",
+    youngs_modulus_pa=110e9,
+    poisson_ratio=0.375,
+    density_kg_m3=8530.0,
+    source="C26000 cartridge brass, ASM handbook typical values",
+)
 #: Aluminium alloy 6061-T6, typical handbook values.
-ALUMINIUM = Material("aluminium", youngs_modulus_pa=68.9e9, poisson_ratio=0.33, density_kg_m3=2700.0,
-                     source="6061-T6, ASM handbook typical values")
+ALUMINIUM = Material(
+    "aluminium",
+    youngs_modulus_pa=68.9e9,
+    poisson_ratio=0.33,
+    density_kg_m3=2700.0,
+    source="6061-T6, ASM handbook typical values",
+)
 #: Soda-lime glass, typical handbook values.
-GLASS = Material("glass", youngs_modulus_pa=72e9, poisson_ratio=0.22, density_kg_m3=2520.0,
-                 source="soda-lime glass, typical handbook values")
+GLASS = Material(
+    "glass",
+    youngs_modulus_pa=72e9,
+    poisson_ratio=0.22,
+    density_kg_m3=2520.0,
+    source="soda-lime glass, typical handbook values",
+)
 #: PTFE (Teflon) beads as measured for granular chains.
-PTFE = Material("ptfe", youngs_modulus_pa=1.46e9, poisson_ratio=0.46, density_kg_m3=2200.0,
-                source="Daraio et al., Phys. Rev. E 72, 016603 (2005), Teflon beads")
+PTFE = Material(
+    "ptfe",
+    youngs_modulus_pa=1.46e9,
+    poisson_ratio=0.46,
+    density_kg_m3=2200.0,
+    source="Daraio et al., Phys. Rev. E 72, 016603 (2005), Teflon beads",
+)
 
 MATERIALS = {m.name: m for m in (STEEL_316, DELRIN, BRASS, ALUMINIUM, GLASS, PTFE)}
 
@@ -117,8 +137,13 @@ def custom_materials(table) -> dict[str, Material]:
         missing = sorted(set(MATERIAL_KEYS) - set(values))
         unknown = sorted(set(values) - {*MATERIAL_KEYS, "source"})
         if missing or unknown:
-            raise HexdemError(f"material {name!r}: " + "; ".join(
-                ([f"missing {', '.join(missing)}"] if missing else []) + ([f"unknown {', '.join(unknown)}"] if unknown else [])))
+            raise HexdemError(
+                f"material {name!r}: "
+                + "; ".join(
+                    ([f"missing {', '.join(missing)}"] if missing else [])
+                    + ([f"unknown {', '.join(unknown)}"] if unknown else [])
+                )
+            )
         materials[name] = Material(name, **{"source": "this configuration", **values})
     return materials
 

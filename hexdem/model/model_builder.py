@@ -48,12 +48,14 @@ def _precompressed(config, packing: Packing, extra, bead, wall) -> tuple[Packing
     if extra:
         raise HexdemError("precompression is built for a packing of one material; drop the regions")
     if wall is None:
-        raise HexdemError("a precompressed packing needs walls to hold it (wall_material = \"none\")")
+        raise HexdemError('a precompressed packing needs walls to hold it (wall_material = "none")')
     if config.shape == "half-disc":
         raise HexdemError("a precompressed packing needs walls all round; the half-disc's arc is free")
     if config.shape in ("disc", "sites") + PLACED_SHAPES:
-        raise HexdemError(f"precompression is built for flat-walled basins (hexagon, half-hexagon, triangle, "
-                          f"parallelogram), not shape = {config.shape!r}")
+        raise HexdemError(
+            f"precompression is built for flat-walled basins (hexagon, half-hexagon, triangle, "
+            f"parallelogram), not shape = {config.shape!r}"
+        )
     coefficient = float(hertz_coefficient(config.diameter_m, bead))
     packing = precompressed_packing(packing, config.precompression_n, coefficient, hertz_stiffness(bead, wall))
     return packing, tuple(float(f) for f in hole_force(packing, config.precompression_n))
@@ -65,8 +67,10 @@ def build_model(config) -> GranularModel:
     bead, held = config.material(config.bead_material), (0.0, 0.0)
     built = configured_packing(config)
     if len(built.packing) < 2 and not built.packing.walls:
-        raise HexdemError(f"{built.packing.shape}: a packing needs at least 2 beads, or 1 bead and a wall to rebound "
-                          "from; a lone free bead carries no wave")
+        raise HexdemError(
+            f"{built.packing.shape}: a packing needs at least 2 beads, or 1 bead and a wall to rebound "
+            "from; a lone free bead carries no wave"
+        )
     packing, extra = assign_materials(built.packing, built.regions + config.regions, bead, config.material)
     if config.precompression_n > 0:
         packing, held = _precompressed(config, packing, extra, bead, wall)
@@ -75,15 +79,28 @@ def build_model(config) -> GranularModel:
         holed, opened = cut_holes(packing, impacts)
         if config.precompression_n > 0:
             if opened - {packing.struck}:
-                raise HexdemError("a precompressed packing holds only the first impact's bead in a hole of its "
-                                  "wall; strike the other beads inside the packing")
+                raise HexdemError(
+                    "a precompressed packing holds only the first impact's bead in a hole of its "
+                    "wall; strike the other beads inside the packing"
+                )
             held = held if packing.struck in opened else (0.0, 0.0)
         packing = holed
     state = None if config.initial_state_file is None else read_initial_state(config.initial_state_file, packing)
-    return GranularModel(packing, impacts[0], bead, wall, config.restitution, config.effective_wall_restitution,
-                         held, tuple(sensor_beads(config.sensors, packing).values()), config.sensor_mass_factor,
-                         extra, tuple(impacts[1:]),
-                         Friction.of(config.friction, config.wall_friction, config.rolling_friction), state)
+    return GranularModel(
+        packing,
+        impacts[0],
+        bead,
+        wall,
+        config.restitution,
+        config.effective_wall_restitution,
+        held,
+        tuple(sensor_beads(config.sensors, packing).values()),
+        config.sensor_mass_factor,
+        extra,
+        tuple(impacts[1:]),
+        Friction.of(config.friction, config.wall_friction, config.rolling_friction),
+        state,
+    )
 
 
 def model_impacts(config, packing: Packing) -> list[Impact]:
@@ -91,6 +108,14 @@ def model_impacts(config, packing: Packing) -> list[Impact]:
     if not config.impacts:
         striker = None if config.striker_material is None else config.material(config.striker_material)
         bead = packing.struck if config.shape == "chain" else None  # a chain's way in is along it, at any angle
-        return [Impact(config.v0 * config.unit_system.velocity_m_s, config.strike_direction_deg,
-                       config.impact == "striker", bead, striker, config.striker_diameter_m)]
+        return [
+            Impact(
+                config.v0 * config.unit_system.velocity_m_s,
+                config.strike_direction_deg,
+                config.impact == "striker",
+                bead,
+                striker,
+                config.striker_diameter_m,
+            )
+        ]
     return resolve_impacts(config.impact_specs(), packing, config.unit_system.velocity_m_s, config.material)

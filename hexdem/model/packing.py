@@ -27,6 +27,7 @@ from hexdem.errors import HexdemError
 from hexdem.model.rays import ray_beads, ray_name
 from hexdem.model.walls import CurvedWall, Wall, touching_walls
 
+
 class LabelLine(NamedTuple):
     """An observation line on the labels: from label ``start`` (None: the struck bead's) on,
     one label step ``step`` (dm, dn) at a time."""
@@ -46,7 +47,8 @@ class Packing:
     confining walls; ``shape`` a readable description; ``material_ids`` (N,) each bead's material,
     an index into the model's materials (None: all 0, the bead material).
 
-    Lines: ``label_lines``, each a :class:`LabelLine`, holds the beads from the start on, one label step at a time, until the packing ends;
+    Lines: ``label_lines``, each a :class:`LabelLine`, holds the beads from the start on, one label step at a time,
+    until the packing ends;
     ``rays_deg`` the angles from +x of the rays from the struck bead (:mod:`hexdem.model.rays`),
     named by :func:`~hexdem.model.rays.ray_name`. ``bond_steps``: the label steps between touching
     neighbours, each bond once, where the labels say which beads touch (the triangular lattice's
@@ -94,8 +96,12 @@ class Packing:
         each pair once; a packing without them finds its contacts from the geometry alone."""
         if not self.bond_steps:
             raise HexdemError(f"{self.shape} is not a triangular packing: its contacts come from the geometry")
-        pairs = [(i, j) for i, (m, n) in enumerate(self.labels.tolist())
-                 for dm, dn in self.bond_steps if (j := self.index_of(m + dm, n + dn)) is not None]
+        pairs = [
+            (i, j)
+            for i, (m, n) in enumerate(self.labels.tolist())
+            for dm, dn in self.bond_steps
+            if (j := self.index_of(m + dm, n + dn)) is not None
+        ]
         return np.array(pairs, dtype=int).reshape(-1, 2)
 
     def _line_names(self) -> list[str]:
@@ -123,8 +129,9 @@ class Packing:
 
     def with_geometry(self, positions_m, diameters_m) -> Packing:
         """The same labels with new positions and diameters, walls re-placed to touch them."""
-        moved = replace(self, positions_m=np.asarray(positions_m, float),
-                        diameters_m=np.asarray(diameters_m, float), walls=())
+        moved = replace(
+            self, positions_m=np.asarray(positions_m, float), diameters_m=np.asarray(diameters_m, float), walls=()
+        )
         return replace(moved, walls=touching_walls(moved, [w.normal for w in self.walls]))
 
 
@@ -138,6 +145,7 @@ def strike_direction(angle_deg: float) -> np.ndarray:
     """Unit vector of a strike at ``angle_deg`` from +x; it must point into the packing."""
     angle = float(angle_deg)
     if not np.isfinite(angle) or abs(angle) >= 90.0:
-        raise HexdemError(f"strike angle {angle_deg}° does not point into the packing; "
-                          "use an angle in (-90°, 90°), e.g. 0 or 30")
+        raise HexdemError(
+            f"strike angle {angle_deg}° does not point into the packing; use an angle in (-90°, 90°), e.g. 0 or 30"
+        )
     return unit_vector(angle)

@@ -78,8 +78,9 @@ SHAPE_KEYS = {
     "radius_m": ("random",),
     "diameter_spread": ("random",),
     "seed": ("random",),
-    **dict.fromkeys(("wall_material", "wall_restitution", "wall_friction"),
-                    tuple(shape for shape in SHAPES if shape != "chain")),
+    **dict.fromkeys(
+        ("wall_material", "wall_restitution", "wall_friction"), tuple(shape for shape in SHAPES if shape != "chain")
+    ),
 }
 
 
@@ -115,9 +116,11 @@ def material_regions(packing: Packing, names) -> tuple:
     """Regions {material, sites} giving each bead of ``packing`` its name in ``names`` (one per
     bead; an empty name keeps the beads' material)."""
     names = np.asarray(names, dtype=object)
-    return tuple({"material": str(name), "sites": tuple(tuple(int(v) for v in label)
-                                                         for label in packing.labels[names == name])}
-                 for name in dict.fromkeys(names.tolist()) if name)
+    return tuple(
+        {"material": str(name), "sites": tuple(tuple(int(v) for v in label) for label in packing.labels[names == name])}
+        for name in dict.fromkeys(names.tolist())
+        if name
+    )
 
 
 def per_bead(values, fill, beads: int, key: str, what: str) -> list:
@@ -127,8 +130,10 @@ def per_bead(values, fill, beads: int, key: str, what: str) -> list:
     if not values:
         return [fill] * beads
     if beads % len(values):
-        raise HexdemError(f"{key} lists {len(values)} {what} for a chain of {beads} beads: list one per bead, or a "
-                          "pattern that repeats, whose length divides beads")
+        raise HexdemError(
+            f"{key} lists {len(values)} {what} for a chain of {beads} beads: list one per bead, or a "
+            "pattern that repeats, whose length divides beads"
+        )
     return list(values) * (beads // len(values))
 
 
@@ -139,8 +144,10 @@ def _chain(config, struck) -> BuiltPacking:
     for k, intruder in enumerate(config.intruders):
         bead = intruder.get("bead")
         if bead is None or not 0 <= bead < beads or not {"diameter_m", "material"} & set(intruder):
-            raise HexdemError(f"intruders.{k} must be a table {{bead = k, diameter_m = ..., material = ...}} with "
-                              f"bead from 0 to {beads - 1} and a diameter_m or a material, got {intruder!r}")
+            raise HexdemError(
+                f"intruders.{k} must be a table {{bead = k, diameter_m = ..., material = ...}} with "
+                f"bead from 0 to {beads - 1} and a diameter_m or a material, got {intruder!r}"
+            )
         sizes[bead] = intruder.get("diameter_m", sizes[bead])
         names[bead] = intruder.get("material", names[bead])
     packing = chain(beads, config.diameter_m, config.angle_deg, sizes, struck)
@@ -148,8 +155,9 @@ def _chain(config, struck) -> BuiltPacking:
 
 
 def _centered_square(config, struck) -> BuiltPacking:
-    packing, interstitials = centered_square(config.rows, config.columns, config.diameter_m,
-                                             config.interstitial_diameter_m, struck)
+    packing, interstitials = centered_square(
+        config.rows, config.columns, config.diameter_m, config.interstitial_diameter_m, struck
+    )
     if config.interstitial_material is None:
         return BuiltPacking(packing)
     names = np.full(len(packing), "", dtype=object)
@@ -161,8 +169,14 @@ def _packing_file(config) -> BuiltPacking:
     if config.packing_file is None:
         raise HexdemError('shape = "packing" needs packing_file = "beads.csv" (header x,y,diameter[,material])')
     beads = read_packing_rows(config.packing_file)
-    packing = packing_from_file(config.packing_file, beads, config.diameter_m, config.struck_bead, config.walls,
-                                strike_direction(config.strike_direction_deg))
+    packing = packing_from_file(
+        config.packing_file,
+        beads,
+        config.diameter_m,
+        config.struck_bead,
+        config.walls,
+        strike_direction(config.strike_direction_deg),
+    )
     return BuiltPacking(packing, material_regions(packing, beads.materials))
 
 
@@ -171,22 +185,31 @@ def shape_packing(config, struck) -> BuiltPacking:
     at the bead labelled ``struck`` (a packing file: at its ``struck_bead``)."""
     builders = {
         "hexagon": lambda: BuiltPacking(hexagon(config.edge_beads, config.diameter_m, struck)),
-        "half-hexagon": lambda: BuiltPacking(half_hexagon(config.long_edge, config.short_edge, config.diameter_m,
-                                                          struck)),
+        "half-hexagon": lambda: BuiltPacking(
+            half_hexagon(config.long_edge, config.short_edge, config.diameter_m, struck)
+        ),
         "half-disc": lambda: BuiltPacking(half_disc(config.radius_beads, config.diameter_m, struck)),
         "triangle": lambda: BuiltPacking(triangle(config.edge_beads, config.diameter_m, struck)),
         "disc": lambda: BuiltPacking(disc(config.radius_beads, config.diameter_m, struck)),
-        "parallelogram": lambda: BuiltPacking(parallelogram(
-            config.edge_beads, config.edge_beads if config.depth_beads is None else config.depth_beads,
-            config.diameter_m, struck)),
-        "sites": lambda: BuiltPacking(read_sites(config.sites, config.sites_file, config.diameter_m,
-                                                 config.site_walls_deg, struck)),
+        "parallelogram": lambda: BuiltPacking(
+            parallelogram(
+                config.edge_beads,
+                config.edge_beads if config.depth_beads is None else config.depth_beads,
+                config.diameter_m,
+                struck,
+            )
+        ),
+        "sites": lambda: BuiltPacking(
+            read_sites(config.sites, config.sites_file, config.diameter_m, config.site_walls_deg, struck)
+        ),
         "square": lambda: BuiltPacking(square(config.rows, config.columns, config.diameter_m, struck)),
         "centered-square": lambda: _centered_square(config, struck),
         "chain": lambda: _chain(config, struck),
         "packing": lambda: _packing_file(config),
     }
     if config.shape in PREPARED_SHAPES:
-        raise HexdemError(f"shape = {config.shape!r} is packed by a LAMMPS compaction before it is built: "
-                          "hexdem run, compare and sweep prepare it (hexdem.experiments.random_packing)")
+        raise HexdemError(
+            f"shape = {config.shape!r} is packed by a LAMMPS compaction before it is built: "
+            "hexdem run, compare and sweep prepare it (hexdem.experiments.random_packing)"
+        )
     return builders[config.shape]()

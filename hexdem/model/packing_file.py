@@ -19,8 +19,8 @@ import numpy as np
 from hexdem.common.io import read_text
 from hexdem.errors import HexdemError
 from hexdem.model.packing import Packing
-from hexdem.model.walls import touching_walls, with_holes
 from hexdem.model.placed import placed_packing
+from hexdem.model.walls import touching_walls, with_holes
 
 WALLS = ("none", "hull")
 #: The rays of a packing read from a file: the paper's three directions.
@@ -54,8 +54,10 @@ def read_packing_rows(path) -> PackingRows:
     except ValueError:
         numbers = np.zeros((0, 3))
     if numbers.shape != (len(rows) - 1, 3) or not np.all(np.isfinite(numbers)):
-        raise HexdemError(f"packing_file {path}: every line after the header must hold {len(header)} values, "
-                          "x, y and diameter finite numbers [m]")
+        raise HexdemError(
+            f"packing_file {path}: every line after the header must hold {len(header)} values, "
+            "x, y and diameter finite numbers [m]"
+        )
     materials = tuple(row[3].strip() if len(header) == 4 else "" for row in rows[1:])
     return PackingRows(numbers[:, :2], numbers[:, 2], materials)
 
@@ -67,12 +69,13 @@ def hull_normals(positions_m) -> list[np.ndarray]:
     try:
         hull = ConvexHull(positions_m)
     except (QhullError, ValueError):
-        raise HexdemError("walls = \"hull\" needs at least 3 beads not all on one line") from None
+        raise HexdemError('walls = "hull" needs at least 3 beads not all on one line') from None
     return [-equation[:2] / np.linalg.norm(equation[:2]) for equation in hull.equations]
 
 
-def packing_from_file(path, beads: PackingRows, diameter_m: float, struck_bead: int, walls: str,
-                      strike_direction) -> Packing:
+def packing_from_file(
+    path, beads: PackingRows, diameter_m: float, struck_bead: int, walls: str, strike_direction
+) -> Packing:
     """The packing of the ``beads`` read from ``packing_file`` ``path`` (:func:`read_packing_rows`;
     nominal ``diameter_m``), struck at row ``struck_bead`` along the unit vector
     ``strike_direction``, with ``walls``."""
@@ -82,14 +85,26 @@ def packing_from_file(path, beads: PackingRows, diameter_m: float, struck_bead: 
         raise HexdemError(f"struck_bead {struck_bead} is not a bead of {path} (rows 0 to {len(beads.diameters_m) - 1})")
     ratio = beads.diameters_m / diameter_m
     if ratio.min() < 1 / DIAMETER_RANGE or ratio.max() > DIAMETER_RANGE:
-        raise HexdemError(f"packing_file {path}: diameters {beads.diameters_m.min():.4g} to {beads.diameters_m.max():.4g} m "
-                          f"are not within a factor {DIAMETER_RANGE:g} of diameter_m = {diameter_m:g}; set diameter_m "
-                          "to the packing's nominal diameter")
+        raise HexdemError(
+            f"packing_file {path}: diameters {beads.diameters_m.min():.4g} to {beads.diameters_m.max():.4g} m "
+            f"are not within a factor {DIAMETER_RANGE:g} of diameter_m = {diameter_m:g}; set diameter_m "
+            "to the packing's nominal diameter"
+        )
     labels = np.column_stack([np.zeros(len(ratio), dtype=int), np.arange(len(ratio))])
-    packing = placed_packing(labels, beads.positions_m, beads.diameters_m, diameter_m, (),
-                             f"packing of {Path(path).name}, {len(ratio)} beads", (0, struck_bead), FILE_RAYS_DEG)
+    packing = placed_packing(
+        labels,
+        beads.positions_m,
+        beads.diameters_m,
+        diameter_m,
+        (),
+        f"packing of {Path(path).name}, {len(ratio)} beads",
+        (0, struck_bead),
+        FILE_RAYS_DEG,
+    )
     if walls == "none":
         return packing
-    hull = [replace(wall, name=f"wall_hull_{k}")
-            for k, wall in enumerate(touching_walls(packing, hull_normals(beads.positions_m)))]
+    hull = [
+        replace(wall, name=f"wall_hull_{k}")
+        for k, wall in enumerate(touching_walls(packing, hull_normals(beads.positions_m)))
+    ]
     return with_holes(replace(packing, walls=tuple(hull)), [packing.struck], [strike_direction])

@@ -41,9 +41,11 @@ def check_no_overlap(positions_m, diameters_m, what: str) -> None:
     overlap = (diameters[i] + diameters[j]) / 2 - np.linalg.norm(positions[j] - positions[i], axis=1)
     worst = int(np.argmax(overlap / np.minimum(diameters[i], diameters[j])))
     if overlap[worst] > MAX_REST_OVERLAP * min(diameters[i[worst]], diameters[j[worst]]):
-        raise HexdemError(f"{what}: beads {i[worst]} and {j[worst]} overlap by {overlap[worst]:.3g} m at rest; "
-                          f"a packing's beads may touch but not overlap (by {MAX_REST_OVERLAP:g} of the smaller "
-                          "diameter at most: write positions with every digit, as repr or %.17g do)")
+        raise HexdemError(
+            f"{what}: beads {i[worst]} and {j[worst]} overlap by {overlap[worst]:.3g} m at rest; "
+            f"a packing's beads may touch but not overlap (by {MAX_REST_OVERLAP:g} of the smaller "
+            "diameter at most: write positions with every digit, as repr or %.17g do)"
+        )
 
 
 def check_extent(positions_m, diameters_m, what: str) -> None:
@@ -53,13 +55,16 @@ def check_extent(positions_m, diameters_m, what: str) -> None:
     span = float(np.hypot(*np.ptp(positions_m, axis=0)))
     reach = MAX_SPAN_FACTOR * float(np.sum(diameters_m))
     if not span <= reach:
-        raise HexdemError(f"{what}: the beads span {span:.3g} m, more than {MAX_SPAN_FACTOR:g} times all "
-                          f"{len(diameters_m)} of them laid end to end ({reach:.3g} m); positions are in metres, "
-                          "and a pulse crosses only beads that touch")
+        raise HexdemError(
+            f"{what}: the beads span {span:.3g} m, more than {MAX_SPAN_FACTOR:g} times all "
+            f"{len(diameters_m)} of them laid end to end ({reach:.3g} m); positions are in metres, "
+            "and a pulse crosses only beads that touch"
+        )
 
 
-def placed_packing(labels, positions_m, diameters_m, diameter_m: float, wall_angles_deg, shape: str, struck,
-                   rays_deg) -> Packing:
+def placed_packing(
+    labels, positions_m, diameters_m, diameter_m: float, wall_angles_deg, shape: str, struck, rays_deg
+) -> Packing:
     """The packing of beads labelled ``labels`` (N, 2) int at ``positions_m`` (N, 2) [m] with
     ``diameters_m`` (N,) [m] (nominal ``diameter_m``), struck at the bead labelled ``struck``,
     inside flat walls touching it whose inward normals point at ``wall_angles_deg`` (the one at
@@ -72,13 +77,23 @@ def placed_packing(labels, positions_m, diameters_m, diameter_m: float, wall_ang
         raise HexdemError(f"{shape}: every bead needs a finite position and a diameter > 0")
     ratio = diameters / float(diameter_m)
     if not (ratio.min() >= 1 / MAX_DIAMETER_RATIO and ratio.max() <= MAX_DIAMETER_RATIO):
-        raise HexdemError(f"{shape}: diameters {diameters.min():.4g} to {diameters.max():.4g} m are not within a factor "
-                          f"{MAX_DIAMETER_RATIO:g} of diameter_m = {float(diameter_m):g} m")
+        raise HexdemError(
+            f"{shape}: diameters {diameters.min():.4g} to {diameters.max():.4g} m are not within a factor "
+            f"{MAX_DIAMETER_RATIO:g} of diameter_m = {float(diameter_m):g} m"
+        )
     check_extent(positions, diameters, shape)
     check_no_overlap(positions, diameters, shape)
     hit = np.flatnonzero(np.all(labels == np.asarray(struck, dtype=int), axis=1))
     if not len(hit):
         raise HexdemError(f"{shape}: the struck bead {tuple(int(v) for v in struck)} is not in the packing")
-    packing = Packing(labels=labels, positions_m=positions, diameters_m=diameters, diameter_m=float(diameter_m),
-                      struck=int(hit[0]), walls=(), shape=shape, rays_deg=tuple(float(a) for a in rays_deg))
+    packing = Packing(
+        labels=labels,
+        positions_m=positions,
+        diameters_m=diameters,
+        diameter_m=float(diameter_m),
+        struck=int(hit[0]),
+        walls=(),
+        shape=shape,
+        rays_deg=tuple(float(a) for a in rays_deg),
+    )
     return replace(packing, walls=touching_walls(packing, [unit_vector(a) for a in wall_angles_deg]))

@@ -24,7 +24,8 @@ built in three steps:
 Built this way, the packing is in static equilibrium bead by bead, every contact at f0.
 
 **Linear waves.** About f0 a contact is a spring of stiffness
-:math:`k = dF/dδ = \tfrac{3}{2} A δ_0^{1/2} = \tfrac{3}{2} A^{2/3} f_0^{1/3}`. A triangular lattice of beads of mass m joined to their 6 neighbours
+:math:`k = dF/dδ = \tfrac{3}{2} A δ_0^{1/2} = \tfrac{3}{2} A^{2/3} f_0^{1/3}`. A triangular lattice of beads of mass m
+joined to their 6 neighbours
 (spacing a) by such springs stores, under a uniform strain ε, the energy density
 W = (k a²/2A₀) Σ_bonds (n·ε·n)² over its 3 bond directions per bead (A₀ = (√3/2) a² per bead);
 Σ n_i n_j n_k n_l = (3/8)(δ_ij δ_kl + δ_ik δ_jl + δ_il δ_jk) gives Lamé constants λ = μ =
@@ -68,9 +69,11 @@ def checked_static_overlap(force_n: float, coefficient: float, diameter_m: float
     of ``diameter_m`` [m] on."""
     overlap = static_overlap(force_n, coefficient)
     if not overlap < MAX_STATIC_OVERLAP_D * diameter_m:
-        raise HexdemError(f"precompression_n = {force_n:g} N would squeeze each contact by {overlap / diameter_m:.3g} "
-                          f"diameters (from {MAX_STATIC_OVERLAP_D:g} on, Hertz's law no longer holds and the beads "
-                          "pass through one another): lower it")
+        raise HexdemError(
+            f"precompression_n = {force_n:g} N would squeeze each contact by {overlap / diameter_m:.3g} "
+            f"diameters (from {MAX_STATIC_OVERLAP_D:g} on, Hertz's law no longer holds and the beads "
+            "pass through one another): lower it"
+        )
     return overlap
 
 
@@ -110,8 +113,9 @@ def _wall_loads(packing: Packing, needed: np.ndarray) -> dict[tuple[int, int], f
     return loads
 
 
-def precompressed_packing(packing: Packing, force_n: float, pair_coefficient: float,
-                          wall_stiffness_pa: float) -> Packing:
+def precompressed_packing(
+    packing: Packing, force_n: float, pair_coefficient: float, wall_stiffness_pa: float
+) -> Packing:
     r"""The ideal ``packing`` (equal beads) in static equilibrium with every contact at ``force_n``
     [N] (steps 1 and 2): shrunk about the struck bead, each wall split into planes that meet
     their members at the overlap that gives them their missing contacts' force.

@@ -42,11 +42,14 @@ LOOSE_GAP = 0.02
 def check_random_disc(radius_m: float, diameter_m: float, spread: float, seed: int) -> None:
     """Refuse parameters that make no random disc, in one line."""
     if not 0 <= spread < MAX_SPREAD:
-        raise HexdemError(f"diameter_spread must be at least 0 and below {MAX_SPREAD:g} (diameters d (1 ± s)), "
-                          f"got {spread!r}")
+        raise HexdemError(
+            f"diameter_spread must be at least 0 and below {MAX_SPREAD:g} (diameters d (1 ± s)), got {spread!r}"
+        )
     if not radius_m >= MIN_RADIUS_D * diameter_m:
-        raise HexdemError(f"radius_m must be at least {MIN_RADIUS_D:g} diameter_m = {MIN_RADIUS_D * diameter_m:g} m "
-                          f"for a random disc (a middle bead and the ring of six that holds it), got {radius_m!r}")
+        raise HexdemError(
+            f"radius_m must be at least {MIN_RADIUS_D:g} diameter_m = {MIN_RADIUS_D * diameter_m:g} m "
+            f"for a random disc (a middle bead and the ring of six that holds it), got {radius_m!r}"
+        )
     if seed < 0:
         raise HexdemError(f"seed must be an integer >= 0, got {seed!r}")
 

@@ -19,7 +19,6 @@ from hexdem.model.materials import Material
 from hexdem.model.packing import Packing
 
 
-
 class RegionTable(TypedDict, total=False):
     """A region's keys and their types (checked by :class:`~hexdem.model.config.RunConfig`)."""
 
@@ -40,8 +39,11 @@ def _selected(packing: Packing, region: dict, k: int) -> np.ndarray:
     """(N,) bool: the beads region ``k`` selects."""
     unknown = sorted(set(region) - KEYS)
     if unknown or "material" not in region:
-        raise HexdemError(f"region {k}: " + (f"unknown key(s) {', '.join(unknown)}; " if unknown else "")
-                          + f"a region is material = NAME with sites and/or {', '.join(BOUNDS)}")
+        raise HexdemError(
+            f"region {k}: "
+            + (f"unknown key(s) {', '.join(unknown)}; " if unknown else "")
+            + f"a region is material = NAME with sites and/or {', '.join(BOUNDS)}"
+        )
     if not set(region) - {"material"}:
         raise HexdemError(f"region {k} selects nothing: give sites = [[m, n], ...] and/or {', '.join(BOUNDS)}")
     chosen = np.ones(len(packing), dtype=bool)

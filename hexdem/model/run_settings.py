@@ -15,8 +15,15 @@ from hexdem.errors import HexdemError
 from hexdem.model.config import MIN_STEPS_PER_CONTACT
 from hexdem.model.granular import GranularModel, RunSettings
 from hexdem.model.packing_builders import PLACED_SHAPES, ROW_CRYSTAL_SHAPES
-from hexdem.model.timescale import (crossing_time_s, fastest_approach_m_s, impact_contact_time_s, sized_bodies,
-                                    solitary_crossing_time_s, striker_launch_s, wall_contact_time_s)
+from hexdem.model.timescale import (
+    crossing_time_s,
+    fastest_approach_m_s,
+    impact_contact_time_s,
+    sized_bodies,
+    solitary_crossing_time_s,
+    striker_launch_s,
+    wall_contact_time_s,
+)
 
 #: Samples per contact time, whatever the step (every 3.6 µs at 0.4 m/s; its error with the step's
 #: stays inside the targets: ``convergence.sampling_error``); default ``dump_every``:
@@ -33,18 +40,30 @@ def contact_time_s(config, model: GranularModel) -> float:
     time at an impact's V0 or at the initial state's fastest approach (read on ``model``, the
     model built from ``config``), or, if shorter, half the period of two beads on the linearized
     precompressed contact."""
-    strikers = [(spec.v0 * config.unit_system.velocity_m_s,
-                 (config.material(spec.striker_material or config.bead_material),
-                  spec.striker_diameter_m or config.diameter_m)
-                 if spec.striker and (spec.striker_material is not None or spec.striker_diameter_m is not None)
-                 else None) for spec in config.impact_specs()]
+    strikers = [
+        (
+            spec.v0 * config.unit_system.velocity_m_s,
+            (
+                config.material(spec.striker_material or config.bead_material),
+                spec.striker_diameter_m or config.diameter_m,
+            )
+            if spec.striker and (spec.striker_material is not None or spec.striker_diameter_m is not None)
+            else None,
+        )
+        for spec in config.impact_specs()
+    ]
     if config.initial_state_file is not None:
         fastest = fastest_approach_m_s(model)
         strikers += [(fastest, striker) for _, striker in strikers]
     sized = () if config.shape not in PLACED_SHAPES else sized_bodies(model)
-    return impact_contact_time_s(config.material(config.bead_material), config.diameter_m,
-                                 [config.material(r["material"]) for r in config.regions], strikers,
-                                 config.precompression_n, sized)
+    return impact_contact_time_s(
+        config.material(config.bead_material),
+        config.diameter_m,
+        [config.material(r["material"]) for r in config.regions],
+        strikers,
+        config.precompression_n,
+        sized,
+    )
 
 
 def rebound_time_s(model: GranularModel, contact_s: float) -> float:
@@ -75,15 +94,19 @@ def check_sampling(config, settings: RunSettings) -> None:
     contact_s = settings.contact_time_s
     scale = config.unit_system.time_s
     if settings.dt_s > contact_s / MIN_STEPS_PER_CONTACT:
-        raise HexdemError(f"time step {settings.dt_s / scale:.3g} is not small against the Hertz contact time "
-                          f"{contact_s / scale:.3g} at V0 (in {config.units} units): use dt <= "
-                          f"{contact_s / scale / MIN_STEPS_PER_CONTACT:.3g}, or leave dt at its default")
+        raise HexdemError(
+            f"time step {settings.dt_s / scale:.3g} is not small against the Hertz contact time "
+            f"{contact_s / scale:.3g} at V0 (in {config.units} units): use dt <= "
+            f"{contact_s / scale / MIN_STEPS_PER_CONTACT:.3g}, or leave dt at its default"
+        )
     interval_s = settings.dt_s * settings.dump_every
     if settings.n_samples < MIN_SAMPLES or interval_s > contact_s / MIN_SAMPLES_PER_CONTACT:
-        raise HexdemError(f"too few samples to analyse: {settings.n_samples} samples, one every "
-                          f"{interval_s / scale:.3g} (contact time {contact_s / scale:.3g}); need at least "
-                          f"{MIN_SAMPLES} and {MIN_SAMPLES_PER_CONTACT} per contact time: lower dump_every "
-                          "or lengthen duration")
+        raise HexdemError(
+            f"too few samples to analyse: {settings.n_samples} samples, one every "
+            f"{interval_s / scale:.3g} (contact time {contact_s / scale:.3g}); need at least "
+            f"{MIN_SAMPLES} and {MIN_SAMPLES_PER_CONTACT} per contact time: lower dump_every "
+            "or lengthen duration"
+        )
 
 
 def run_settings(config, model: GranularModel) -> RunSettings:
@@ -107,7 +130,13 @@ def run_settings(config, model: GranularModel) -> RunSettings:
         sensor_every = samples * every
         dt_s = 1.0 / config.sensor_rate_hz / sensor_every
     n_steps = max(1, round(duration_s / dt_s))
-    settings = RunSettings(dt_s=dt_s, n_steps=n_steps, dump_every=every, units=config.unit_system,
-                           sensor_every=sensor_every, contact_time_s=contact_s)
+    settings = RunSettings(
+        dt_s=dt_s,
+        n_steps=n_steps,
+        dump_every=every,
+        units=config.unit_system,
+        sensor_every=sensor_every,
+        contact_time_s=contact_s,
+    )
     check_sampling(config, settings)
     return settings

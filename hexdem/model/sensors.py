@@ -22,8 +22,9 @@ def sensor_beads(sensors, packing: Packing) -> dict[str, int]:
             continue
         name, _, n = str(sensor).partition(":")
         if name not in lines or not n.isdigit():
-            raise HexdemError(f"sensor {sensor!r} is neither a bead id nor 'line:n' with line one of "
-                              f"{', '.join(lines)}")
+            raise HexdemError(
+                f"sensor {sensor!r} is neither a bead id nor 'line:n' with line one of {', '.join(lines)}"
+            )
         line = lines[name]
         if int(n) >= len(line):
             raise HexdemError(f"sensor {sensor!r}: line {name} has beads 0 to {len(line) - 1}")

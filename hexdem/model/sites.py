@@ -1,7 +1,8 @@
 """A packing listed site by site: the labels {m, n} of the paper's convention, inline or in a file.
 
 ``sites_file`` is a CSV with columns ``m,n`` (a header line, then one site per line) or a TOML
-file with ``sites = [[m, n], …]``. The struck bead is {0, 0} (or the first impact's site); flat walls touch the packing at
+file with ``sites = [[m, n], …]``. The struck bead is {0, 0} (or the first impact's site); flat walls touch the packing
+at
 the inward-normal angles given (:func:`~hexdem.model.triangular.from_sites`), none by default.
 """
 
@@ -59,6 +60,9 @@ def read_sites(sites, sites_file, diameter_m: float, walls_deg=(), struck=(0, 0)
     except (TypeError, ValueError):
         labels = None  # from_sites words the error
     if labels is not None and len(labels) and diameter_m > 0:
-        check_extent(labels[:, ::-1] * [math.sqrt(3) / 2 * diameter_m, diameter_m / 2],
-                     np.full(len(labels), float(diameter_m)), source)
+        check_extent(
+            labels[:, ::-1] * [math.sqrt(3) / 2 * diameter_m, diameter_m / 2],
+            np.full(len(labels), float(diameter_m)),
+            source,
+        )
     return from_sites(listed, diameter_m, angles, source, struck)

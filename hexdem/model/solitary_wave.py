@@ -34,14 +34,15 @@ from hexdem.model.materials import Material
 SUPPORT_WIDTH_D = 5 * math.pi / math.sqrt(10)
 #: Width at half maximum of its velocity (and strain) profile, cos⁴ = 1/2:
 #: :math:`2 \arccos(2^{−1/4}) \cdot 5/\sqrt{10}` diameters.
-HALF_MAXIMUM_WIDTH_D = 2 * math.acos(2 ** -0.25) * 5 / math.sqrt(10)
+HALF_MAXIMUM_WIDTH_D = 2 * math.acos(2**-0.25) * 5 / math.sqrt(10)
 
 
 def chain_speed_scale_m_s(material: Material) -> float:
     r"""Nesterenko's :math:`c = \sqrt{2E / (πρ(1 − ν^2))}` [m/s] of a chain of equal spheres of ``material``
     (independent of their diameter)."""
-    return math.sqrt(2 * material.youngs_modulus_pa
-                     / (math.pi * material.density_kg_m3 * (1 - material.poisson_ratio**2)))
+    return math.sqrt(
+        2 * material.youngs_modulus_pa / (math.pi * material.density_kg_m3 * (1 - material.poisson_ratio**2))
+    )
 
 
 def solitary_speed_m_s(c_m_s: float, peak_velocity_m_s: float) -> float:

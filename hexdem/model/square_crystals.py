@@ -38,8 +38,9 @@ MIN_GRID = 2
 
 def _grid_size(rows, columns) -> tuple[int, int]:
     if not all(int(value) == value and value >= MIN_GRID for value in (rows, columns)):
-        raise HexdemError(f"a square crystal needs at least {MIN_GRID} rows and {MIN_GRID} columns, "
-                          f"got {rows} x {columns}")
+        raise HexdemError(
+            f"a square crystal needs at least {MIN_GRID} rows and {MIN_GRID} columns, got {rows} x {columns}"
+        )
     return int(rows), int(columns)
 
 
@@ -49,8 +50,16 @@ def square(rows: int, columns: int, diameter_m: float, struck=(0, 0)) -> Packing
     rows, columns = _grid_size(rows, columns)
     m, n = np.meshgrid(np.arange(rows) - (rows - 1) // 2, np.arange(columns), indexing="ij")
     labels = np.column_stack([m.ravel(), n.ravel()])
-    return placed_packing(labels, labels[:, ::-1] * float(diameter_m), np.full(len(labels), float(diameter_m)),
-                          diameter_m, SQUARE_WALLS_DEG, f"square, {rows} x {columns}", struck, SQUARE_RAYS_DEG)
+    return placed_packing(
+        labels,
+        labels[:, ::-1] * float(diameter_m),
+        np.full(len(labels), float(diameter_m)),
+        diameter_m,
+        SQUARE_WALLS_DEG,
+        f"square, {rows} x {columns}",
+        struck,
+        SQUARE_RAYS_DEG,
+    )
 
 
 def interstitial_fit_m(diameter_m: float) -> float:
@@ -59,8 +68,9 @@ def interstitial_fit_m(diameter_m: float) -> float:
     return (math.sqrt(2.0) - 1.0) * float(diameter_m)
 
 
-def centered_square(rows: int, columns: int, diameter_m: float, interstitial_diameter_m: float | None = None,
-                    struck=(0, 0)) -> tuple[Packing, np.ndarray]:
+def centered_square(
+    rows: int, columns: int, diameter_m: float, interstitial_diameter_m: float | None = None, struck=(0, 0)
+) -> tuple[Packing, np.ndarray]:
     """(packing, interstitial bead indices): ``rows`` × ``columns`` corner beads of ``diameter_m``
     and one interstitial of ``interstitial_diameter_m`` (None: :func:`interstitial_fit_m`) in each
     of the (rows − 1)(columns − 1) cells."""
@@ -76,6 +86,14 @@ def centered_square(rows: int, columns: int, diameter_m: float, interstitial_dia
     centres = np.column_stack([2 * ci.ravel() + 1, 2 * cj.ravel() + 1])
     labels = np.vstack([corners, centres])
     diameters = np.concatenate([np.full(len(corners), float(diameter_m)), np.full(len(centres), small)])
-    packing = placed_packing(labels, labels[:, ::-1] * spacing / 2, diameters, diameter_m, SQUARE_WALLS_DEG,
-                             f"centered-square, {rows} x {columns}", struck, SQUARE_RAYS_DEG)
+    packing = placed_packing(
+        labels,
+        labels[:, ::-1] * spacing / 2,
+        diameters,
+        diameter_m,
+        SQUARE_WALLS_DEG,
+        f"centered-square, {rows} x {columns}",
+        struck,
+        SQUARE_RAYS_DEG,
+    )
     return packing, np.arange(len(corners), len(labels))

@@ -48,9 +48,11 @@ def _contact_time_s(reduced_mass: float, coefficient: float, speed_m_s: float, n
     they would overlap by half of ``diameter_m`` (the smaller one's) or more."""
     overlap = float(max_overlap(reduced_mass, coefficient, speed_m_s))
     if overlap >= diameter_m / 2:
-        raise HexdemError(f"at {speed_m_s:.3g} m/s, {names} meeting head on would overlap by {overlap / diameter_m:.3g} "
-                          "diameters (from half a diameter on, Hertz's law no longer holds and they pass through one "
-                          "another): lower the fastest speed of the impacts and the initial state")
+        raise HexdemError(
+            f"at {speed_m_s:.3g} m/s, {names} meeting head on would overlap by {overlap / diameter_m:.3g} "
+            "diameters (from half a diameter on, Hertz's law no longer holds and they pass through one "
+            "another): lower the fastest speed of the impacts and the initial state"
+        )
     return float(contact_time(reduced_mass, coefficient, speed_m_s))
 
 
@@ -65,17 +67,19 @@ def pair_contact_time_s(a: Material, da: float, b: Material, db: float, speed_m_
 def sized_bodies(model) -> tuple[tuple[Material, float], ...]:
     """(material, smallest diameter [m]) of each bead material of the :class:`~hexdem.model.granular.GranularModel`
     ``model``: the smallest beads of a material touch the shortest (t_c ∝ d at a given speed)."""
-    diameters, ids = model.packing.diameters_m, model.material_ids[:len(model.packing)]
+    diameters, ids = model.packing.diameters_m, model.material_ids[: len(model.packing)]
     return tuple((model.materials[k], float(diameters[ids == k].min())) for k in np.unique(ids))
 
 
-def impact_contact_time_s(bead: Material, diameter_m: float, region_materials, impacts,
-                          precompression_n: float = 0.0, sized=()) -> float:
+def impact_contact_time_s(
+    bead: Material, diameter_m: float, region_materials, impacts, precompression_n: float = 0.0, sized=()
+) -> float:
     """The shortest contact time [s] of the pairs the impacts set moving.
 
     ``region_materials``: the other bead materials of the packing; ``impacts``: per impact (and
     per fastest approach of an initial state), (speed [m/s], its striker (material, diameter [m])
-    when of its own material or size, else None). At each impact's speed: two beads (the paper's pair, computed as always), every
+    when of its own material or size, else None). At each impact's speed: two beads (the paper's pair, computed as
+    always), every
     other pair of bead materials, and the striker with each bead material; ``sized`` adds bodies
     (material, diameter [m]) of other sizes (:func:`sized_bodies`). With
     ``precompression_n`` > 0 [N], also half the period of two beads on the linearized
@@ -88,8 +92,10 @@ def impact_contact_time_s(bead: Material, diameter_m: float, region_materials, i
     for speed, striker in impacts:
         pairs = list(itertools.combinations_with_replacement(bodies, 2))[1:]
         pairs += [(striker, body) for body in bodies] if striker is not None else []
-        times += [_contact_time_s(mass / 2, coefficient, speed, f"two {bead.name} beads", diameter_m),
-                  *(pair_contact_time_s(a, da, b, db, speed) for (a, da), (b, db) in pairs)]
+        times += [
+            _contact_time_s(mass / 2, coefficient, speed, f"two {bead.name} beads", diameter_m),
+            *(pair_contact_time_s(a, da, b, db, speed) for (a, da), (b, db) in pairs),
+        ]
     hertz = min(times)
     if precompression_n <= 0:
         return hertz
@@ -104,9 +110,14 @@ def own_contact_times_s(model) -> dict[int, float]:
     """{material id: the Hertz contact time [s] of two beads of that material and the nominal
     diameter meeting at the first impact's speed}, for the packing's bead materials."""
     packing, speed, d = model.packing, model.impacts[0].speed_m_s, model.packing.diameter_m
-    return {int(k): float(contact_time(float(sphere_mass(d, model.materials[k])) / 2,
-                                       float(hertz_coefficient(d, model.materials[k])), speed))
-            for k in np.unique(model.material_ids[:len(packing)])}
+    return {
+        int(k): float(
+            contact_time(
+                float(sphere_mass(d, model.materials[k])) / 2, float(hertz_coefficient(d, model.materials[k])), speed
+            )
+        )
+        for k in np.unique(model.material_ids[: len(packing)])
+    }
 
 
 def crossing_time_s(model, linear_contact_s: float | None = None) -> float:
@@ -124,7 +135,7 @@ def crossing_time_s(model, linear_contact_s: float | None = None) -> float:
     packing = model.packing
     own = own_contact_times_s(model)
     fastest = min(own.values())
-    pace = np.vectorize(own.get, otypes=[float])(model.material_ids[:len(packing)])  # each bead's material's
+    pace = np.vectorize(own.get, otypes=[float])(model.material_ids[: len(packing)])  # each bead's material's
     scale = 1.0 if linear_contact_s is None else linear_contact_s / fastest
     layer_m = math.sqrt(3) / 2 * packing.diameter_m
     times = []
@@ -170,7 +181,7 @@ def solitary_crossing_time_s(model, contact_s: float, wall_contact_s: float) -> 
     peaks 0.53 ms after the strike, its neighbour meets the reflection at 0.74 ms, and this gives
     0.68 ms."""
     packing = model.packing
-    fastest = max(chain_speed_scale_m_s(model.materials[k]) for k in np.unique(model.material_ids[:len(packing)]))
+    fastest = max(chain_speed_scale_m_s(model.materials[k]) for k in np.unique(model.material_ids[: len(packing)]))
     times = []
     for bead, impact in zip(model.struck_beads, model.impacts):
         depth_m = float(np.max((packing.positions_m - packing.positions_m[bead]) @ impact.direction))
@@ -184,8 +195,16 @@ def striker_launch_s(model) -> float:
     material touch (0 for strikers no slower: the pulse a soft striker launches needs that much
     more time to enter the packing)."""
     own, struck, ids = own_contact_times_s(model), model.struck_beads, model.material_ids
-    extra = [pair_contact_time_s(model.materials[ids[struck[k]]], float(model.packing.diameters_m[struck[k]]),
-                                 impact.striker_material or model.bead,
-                                 impact.striker_diameter_m or model.packing.diameter_m, impact.speed_m_s)
-             - own[int(ids[struck[k]])] for k, impact in enumerate(model.impacts) if impact.striker]
+    extra = [
+        pair_contact_time_s(
+            model.materials[ids[struck[k]]],
+            float(model.packing.diameters_m[struck[k]]),
+            impact.striker_material or model.bead,
+            impact.striker_diameter_m or model.packing.diameter_m,
+            impact.speed_m_s,
+        )
+        - own[int(ids[struck[k]])]
+        for k, impact in enumerate(model.impacts)
+        if impact.striker
+    ]
     return max([0.0, *extra])

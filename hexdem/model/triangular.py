@@ -38,8 +38,20 @@ from hexdem.model.walls import WALL_GROUP_GAP, CurvedWall, touching_walls
 #: The step in (m, n) between consecutive sites along each of the lattice's twelve directions, by
 #: angle from +x [deg]: odd multiples of 30° run along touching beads (spacing d), multiples of
 #: 60° between them (spacing √3 d).
-DIRECTION_STEPS = {0: (0, 2), 30: (1, 1), 60: (3, 1), 90: (2, 0), 120: (3, -1), 150: (1, -1), 180: (0, -2),
-                   -150: (-1, -1), -120: (-3, -1), -90: (-2, 0), -60: (-3, 1), -30: (-1, 1)}
+DIRECTION_STEPS = {
+    0: (0, 2),
+    30: (1, 1),
+    60: (3, 1),
+    90: (2, 0),
+    120: (3, -1),
+    150: (1, -1),
+    180: (0, -2),
+    -150: (-1, -1),
+    -120: (-3, -1),
+    -90: (-2, 0),
+    -60: (-3, 1),
+    -30: (-1, 1),
+}
 #: The paper's observation lines and the step in (m, n) between consecutive beads on each.
 LINE_STEPS = {"0": DIRECTION_STEPS[0], "+30": DIRECTION_STEPS[30], "-30": DIRECTION_STEPS[-30]}
 #: Index offsets of the three neighbours counted once per bond (paper's e₁, e₂, e₃).
@@ -48,8 +60,9 @@ BOND_STEPS = ((2, 0), (1, 1), (-1, 1))
 PAPER_LINES = tuple(LabelLine(name, None, step) for name, step in LINE_STEPS.items())
 
 
-def from_sites(labels, diameter_m: float = 1.0, wall_angles_deg=(), shape: str = "listed sites",
-               struck=(0, 0)) -> Packing:
+def from_sites(
+    labels, diameter_m: float = 1.0, wall_angles_deg=(), shape: str = "listed sites", struck=(0, 0)
+) -> Packing:
     """The packing of the listed sites {m, n} (m + n even), with flat walls touching it whose
     inward normals point at ``wall_angles_deg`` (none: a free packing), struck at ``struck``.
 
@@ -63,8 +76,10 @@ def from_sites(labels, diameter_m: float = 1.0, wall_angles_deg=(), shape: str =
         raise HexdemError(f"{shape}: sites must be pairs of integers [m, n]") from None
     odd = labels[(labels.sum(axis=1) % 2) != 0]
     if len(odd):
-        raise HexdemError(f"{shape}: site {{{odd[0, 0]}, {odd[0, 1]}}} has m + n odd: it is not a site of the "
-                          "hexagonal packing (m + n must be even)")
+        raise HexdemError(
+            f"{shape}: site {{{odd[0, 0]}, {odd[0, 1]}}} has m + n odd: it is not a site of the "
+            "hexagonal packing (m + n must be even)"
+        )
     if len(labels) < 1:
         raise HexdemError(f"{shape}: a packing needs at least 1 bead, got none")
     low = labels.min(axis=0)
@@ -77,9 +92,17 @@ def from_sites(labels, diameter_m: float = 1.0, wall_angles_deg=(), shape: str =
     if not len(hit):
         raise HexdemError(f"{shape}: the struck site {{{struck[0]}, {struck[1]}}} is not in the packing")
     positions = np.column_stack([np.sqrt(3) / 2 * labels[:, 1], labels[:, 0] / 2.0]) * diameter_m
-    packing = Packing(labels=labels, positions_m=positions,
-                      diameters_m=np.full(len(labels), float(diameter_m)), diameter_m=float(diameter_m),
-                      struck=int(hit[0]), walls=(), shape=shape, label_lines=PAPER_LINES, bond_steps=BOND_STEPS)
+    packing = Packing(
+        labels=labels,
+        positions_m=positions,
+        diameters_m=np.full(len(labels), float(diameter_m)),
+        diameter_m=float(diameter_m),
+        struck=int(hit[0]),
+        walls=(),
+        shape=shape,
+        label_lines=PAPER_LINES,
+        bond_steps=BOND_STEPS,
+    )
     normals = [unit_vector(a) for a in wall_angles_deg]
     return replace(packing, walls=touching_walls(packing, normals))
 
@@ -92,8 +115,10 @@ def _layer_sites(bounds) -> list[tuple[int, int]]:
 def _circle_sites(radius: int, centre_x: float) -> list[tuple[int, int]]:
     """Sites {m, n} with n >= 0 within ``radius`` of the point (``centre_x``, 0), in bead diameters."""
     layers = int(np.floor(2 * (radius + centre_x) / np.sqrt(3) + 1e-9))
-    heights = [int(np.floor(2 * np.sqrt(max(radius**2 - (np.sqrt(3) / 2 * n - centre_x) ** 2, 0.0)) + 1e-9))
-               for n in range(layers + 1)]
+    heights = [
+        int(np.floor(2 * np.sqrt(max(radius**2 - (np.sqrt(3) / 2 * n - centre_x) ** 2, 0.0)) + 1e-9))
+        for n in range(layers + 1)
+    ]
     return _layer_sites([(-h, h) for h in heights])
 
 
@@ -114,9 +139,16 @@ def without_sites(packing: Packing, vacancies) -> Packing:
     new_index[keep] = np.arange(len(keep))
     walls = tuple(replace(wall, members=new_index[np.setdiff1d(wall.members, removed)]) for wall in packing.walls)
     shape = f"{packing.shape}, {len(removed)} vacanc{'y' if len(removed) == 1 else 'ies'}"
-    return replace(packing, labels=packing.labels[keep], positions_m=packing.positions_m[keep],
-                   diameters_m=packing.diameters_m[keep], struck=int(new_index[packing.struck]), walls=walls,
-                   shape=shape, material_ids=packing.material_ids[keep])
+    return replace(
+        packing,
+        labels=packing.labels[keep],
+        positions_m=packing.positions_m[keep],
+        diameters_m=packing.diameters_m[keep],
+        struck=int(new_index[packing.struck]),
+        walls=walls,
+        shape=shape,
+        material_ids=packing.material_ids[keep],
+    )
 
 
 def hexagon(edge_beads: int, diameter_m: float = 1.0, struck=(0, 0)) -> Packing:
@@ -148,11 +180,17 @@ def half_hexagon(long_edge: int = 91, short_edge: int = 46, diameter_m: float = 
     ``long_edge`` = 2·``short_edge`` − 1 beads (91 and 46 → 3151 beads).
     """
     if int(short_edge) != short_edge or short_edge < 2 or long_edge != 2 * short_edge - 1:
-        raise HexdemError(f"a half-hexagon needs long_edge = 2*short_edge - 1 >= 3, "
-                          f"got long {long_edge}, short {short_edge}")
+        raise HexdemError(
+            f"a half-hexagon needs long_edge = 2*short_edge - 1 >= 3, got long {long_edge}, short {short_edge}"
+        )
     heights = [long_edge - 1 - n for n in range(int(short_edge))]
-    return from_sites(_layer_sites([(-h, h) for h in heights]), diameter_m, (0, 180, 120, -120),
-                      f"half-hexagon, long edge {long_edge}, short edges {short_edge}", struck)
+    return from_sites(
+        _layer_sites([(-h, h) for h in heights]),
+        diameter_m,
+        (0, 180, 120, -120),
+        f"half-hexagon, long edge {long_edge}, short edges {short_edge}",
+        struck,
+    )
 
 
 def disc(radius_beads: int, diameter_m: float = 1.0, struck=(0, 0)) -> Packing:
@@ -189,5 +227,6 @@ def parallelogram(edge_beads: int, depth_beads: int, diameter_m: float = 1.0, st
             raise HexdemError(f"a parallelogram needs {name} >= 2, got {value}")
     k = int(edge_beads) - 1
     sites = _layer_sites([(k % 2 - k + n, k % 2 + k + n) for n in range(int(depth_beads))])
-    return from_sites(sites, diameter_m, (0, 180, 120, -60),
-                      f"parallelogram, {k + 1} per edge, {int(depth_beads)} deep", struck)
+    return from_sites(
+        sites, diameter_m, (0, 180, 120, -60), f"parallelogram, {k + 1} per edge, {int(depth_beads)} deep", struck
+    )

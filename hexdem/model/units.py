@@ -56,8 +56,9 @@ def nondimensional(diameter_m: float, mat: Material = STEEL_316) -> UnitSystem:
     """The paper's system A = d = M = 1 for beads of ``diameter_m`` made of ``mat``."""
     a = float(hertz_coefficient(diameter_m, mat))
     m = float(sphere_mass(diameter_m, mat))
-    return UnitSystem("nondimensional", length_m=diameter_m, mass_kg=m,
-                      time_s=float(np.sqrt(m / (a * np.sqrt(diameter_m)))))
+    return UnitSystem(
+        "nondimensional", length_m=diameter_m, mass_kg=m, time_s=float(np.sqrt(m / (a * np.sqrt(diameter_m))))
+    )
 
 
 def to_nondimensional_velocity(v_m_s, diameter_m: float, mat: Material = STEEL_316):

@@ -31,20 +31,32 @@ def idle_keys(config) -> dict[str, str]:
     :class:`~hexdem.model.config.RunConfig`) that its other keys leave without effect, set or not."""
     idle = {}
     if not any(spec.striker for spec in config.impact_specs()):
-        how = ('no [[impacts]] table is a striker; set kind = "striker" on one' if config.impacts else
-               f'no impact is a striker (impact = "{config.impact}"); set impact = "striker"')
+        how = (
+            'no [[impacts]] table is a striker; set kind = "striker" on one'
+            if config.impacts
+            else f'no impact is a striker (impact = "{config.impact}"); set impact = "striker"'
+        )
         idle.update(dict.fromkeys(STRIKER_KEYS, f"{how} or remove it"))
     if config.engine == "reference":
-        idle.update(dict.fromkeys(LAMMPS_KEYS, 'the reference engine runs in one process and writes no dump '
-                                               '(engine = "reference"); use engine = "lammps" or remove it'))
+        idle.update(
+            dict.fromkeys(
+                LAMMPS_KEYS,
+                "the reference engine runs in one process and writes no dump "
+                '(engine = "reference"); use engine = "lammps" or remove it',
+            )
+        )
     if not config.sensors:
         idle.update(dict.fromkeys(SENSOR_KEYS, "there are no sensors; add sensors or remove it"))
     if config.shape in ("packing", "random") and config.walls == "none":
-        idle.update(dict.fromkeys(WALL_KEYS, 'the packing has no walls (walls = "none"); set walls = "hull" or '
-                                             "remove it"))
+        idle.update(
+            dict.fromkeys(WALL_KEYS, 'the packing has no walls (walls = "none"); set walls = "hull" or remove it')
+        )
     elif config.wall_material == "none":
-        idle.update(dict.fromkeys(WALL_KEYS[1:], 'the packing has no walls (wall_material = "none"); name a wall '
-                                                 "material or remove it"))
+        idle.update(
+            dict.fromkeys(
+                WALL_KEYS[1:], 'the packing has no walls (wall_material = "none"); name a wall material or remove it'
+            )
+        )
     return idle
 
 
@@ -54,8 +66,11 @@ def set_idle_keys(config) -> dict[str, str]:
     value) and a wall material of ``"none"``, which says the same as no walls; in the order of the
     configuration's fields."""
     idle = idle_keys(config)
-    return {key: idle[key] for key in config.set_keys()
-            if key in idle and not (key == "wall_material" and config.wall_material == "none")}
+    return {
+        key: idle[key]
+        for key in config.set_keys()
+        if key in idle and not (key == "wall_material" and config.wall_material == "none")
+    }
 
 
 def check_unused_keys(config) -> None:

@@ -163,9 +163,14 @@ def cut_holes(packing, impacts) -> tuple:
     beads = [impact.bead for impact in impacts]
     for impact, bead in zip(impacts, beads):
         for wall in packing.walls:
-            if bead in wall.members and wall.normals_at(packing.positions_m[[bead]])[0] @ impact.direction < -HOLE_COSINE:
+            if (
+                bead in wall.members
+                and wall.normals_at(packing.positions_m[[bead]])[0] @ impact.direction < -HOLE_COSINE
+            ):
                 m, n = packing.labels[bead]
-                raise HexdemError(f"the impact on bead {{{m}, {n}}} at {impact.angle_deg:g}° points out of the packing "
-                                  f"through {wall.name}: strike it inwards")
+                raise HexdemError(
+                    f"the impact on bead {{{m}, {n}}} at {impact.angle_deg:g}° points out of the packing "
+                    f"through {wall.name}: strike it inwards"
+                )
     holed = with_holes(packing, beads, [impact.direction for impact in impacts])
     return holed, _wall_members(packing) - _wall_members(holed)

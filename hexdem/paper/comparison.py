@@ -25,8 +25,10 @@ def comparison_rows(tca_summary: dict, scaling: dict, protocols: dict) -> list[t
     """Rows of ``published_vs_computed.csv`` from the TCA summary, ``scaling.json`` and
     ``fit_protocols.json``."""
     sweep = scaling["sweep"]
-    sweep_text = (f"{sweep['engine']} engine, hexagon of {sweep['hexagon_edge']} per edge without walls, "
-                  f"V0 {min(sweep['v0']):g}..{max(sweep['v0']):g} ({len(sweep['v0'])} values)")
+    sweep_text = (
+        f"{sweep['engine']} engine, hexagon of {sweep['hexagon_edge']} per edge without walls, "
+        f"V0 {min(sweep['v0']):g}..{max(sweep['v0']):g} ({len(sweep['v0'])} values)"
+    )
     rows = []
     for p in PUBLISHED:
         if not p.combination:
@@ -37,8 +39,7 @@ def comparison_rows(tca_summary: dict, scaling: dict, protocols: dict) -> list[t
             if p.quantity in ("m", "b"):
                 protocol = f"{protocols[p.combination]['stated']['description']}; {sweep_text}"
             else:
-                protocol = (f"least squares of V_{law['start_bead']}/V0 over every V0, law {law['law']}; "
-                            f"{sweep_text}")
+                protocol = f"least squares of V_{law['start_bead']}/V0 over every V0, law {law['law']}; {sweep_text}"
         rows.append((p.item, p.quantity, p.combination, p.value, computed, computed - p.value, protocol))
     return rows
 

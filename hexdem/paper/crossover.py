@@ -39,8 +39,16 @@ from hexdem.model.materials import PAPER_DIAMETER_M, STEEL_316, hertz_coefficien
 from hexdem.paper.disorder_study import LINES, MEASURES, json_number
 
 #: Columns of ``disorder_crossover.csv`` (a contract).
-CROSSOVER_COLUMNS = ("v_striker", "line", "measure", "sigma_tol", "sigma_over_overlap", "transmission", "sem",
-                     "realizations")
+CROSSOVER_COLUMNS = (
+    "v_striker",
+    "line",
+    "measure",
+    "sigma_tol",
+    "sigma_over_overlap",
+    "transmission",
+    "sem",
+    "realizations",
+)
 #: The slope of log σ_c against log V that the overlap hypothesis predicts.
 OVERLAP_EXPONENT = 0.8
 #: A crossover counts as measured when log10 σ_c is known to this many decades (a factor of 3).
@@ -68,8 +76,18 @@ def crossover_rows(summaries: list[dict]) -> list[tuple]:
                     continue
                 v = float(effect["v_striker"])
                 sigma_m = s["sigma_per_tol"] * TOLERANCE_M
-                rows.append((v, effect["line"], measure, s["sigma_per_tol"], sigma_m / impact_overlap_m(v),
-                             json_number(effect["mean_ratio"]), json_number(effect["sem_ratio"]), int(effect["realizations"])))
+                rows.append(
+                    (
+                        v,
+                        effect["line"],
+                        measure,
+                        s["sigma_per_tol"],
+                        sigma_m / impact_overlap_m(v),
+                        json_number(effect["mean_ratio"]),
+                        json_number(effect["sem_ratio"]),
+                        int(effect["realizations"]),
+                    )
+                )
     return sorted(rows, key=lambda r: (r[0], r[1], r[2], r[3]))
 
 
@@ -88,9 +106,18 @@ def fit_crossover(sigma_tol, transmission, sem) -> dict:
     err = np.maximum(np.nan_to_num(np.asarray(sem, float), nan=MIN_SEM), MIN_SEM)
     keep = np.isfinite(t)
     x, t, err = x[keep], t[keep], err[keep]
-    failed = {"sigma_c_tol": float("nan"), "sigma_c_se_tol": float("nan"), "log10_sigma_c": float("nan"),
-              "log10_sigma_c_se": float("nan"), "t0": float("nan"), "t_inf": float("nan"), "drop": float("nan"),
-              "drop_se": float("nan"), "p": float("nan"), "significant": False}
+    failed = {
+        "sigma_c_tol": float("nan"),
+        "sigma_c_se_tol": float("nan"),
+        "log10_sigma_c": float("nan"),
+        "log10_sigma_c_se": float("nan"),
+        "t0": float("nan"),
+        "t_inf": float("nan"),
+        "drop": float("nan"),
+        "drop_se": float("nan"),
+        "p": float("nan"),
+        "significant": False,
+    }
     if len(x) < 5:
         return failed
     start = (t[0], t[-1], float(np.median(x)), 2.0)
@@ -98,8 +125,7 @@ def fit_crossover(sigma_tol, transmission, sem) -> dict:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", OptimizeWarning)
-            params, cov = curve_fit(_step, x, t, p0=start, sigma=err, absolute_sigma=True, bounds=bounds,
-                                    maxfev=20000)
+            params, cov = curve_fit(_step, x, t, p0=start, sigma=err, absolute_sigma=True, bounds=bounds, maxfev=20000)
     except (RuntimeError, ValueError):
         return failed
     t0, t_inf, log_c, p = (float(v) for v in params)
@@ -107,10 +133,18 @@ def fit_crossover(sigma_tol, transmission, sem) -> dict:
     drop_se = float(np.sqrt(max(cov[0, 0] + cov[1, 1] - 2 * cov[0, 1], 0.0)))
     significant = bool(abs(t0 - t_inf) > 2 * drop_se and x.min() <= log_c <= x.max() and se[2] <= MAX_LOG_SIGMA_C_SE)
     sigma_c = 10.0**log_c if significant else float("nan")
-    return {"sigma_c_tol": sigma_c, "sigma_c_se_tol": sigma_c * np.log(10.0) * float(se[2]),
-            "log10_sigma_c": log_c if significant else float("nan"),
-            "log10_sigma_c_se": float(se[2]) if significant else float("nan"),
-            "t0": t0, "t_inf": t_inf, "drop": t0 - t_inf, "drop_se": drop_se, "p": p, "significant": significant}
+    return {
+        "sigma_c_tol": sigma_c,
+        "sigma_c_se_tol": sigma_c * np.log(10.0) * float(se[2]),
+        "log10_sigma_c": log_c if significant else float("nan"),
+        "log10_sigma_c_se": float(se[2]) if significant else float("nan"),
+        "t0": t0,
+        "t_inf": t_inf,
+        "drop": t0 - t_inf,
+        "drop_se": drop_se,
+        "p": p,
+        "significant": significant,
+    }
 
 
 def crossover_fits(rows: list[tuple]) -> list[dict]:
@@ -120,9 +154,17 @@ def crossover_fits(rows: list[tuple]) -> list[dict]:
         chosen = [r for r in rows if (r[0], r[1], r[2]) == (v, line, measure)]
         fit = fit_crossover([r[3] for r in chosen], [r[5] for r in chosen], [r[6] for r in chosen])
         overlap_tol = impact_overlap_m(v) / TOLERANCE_M
-        fits.append({"v_striker": v, "line": line, "measure": measure, "overlap_m": impact_overlap_m(v), **fit,
-                     "sigma_c_over_overlap": fit["sigma_c_tol"] / overlap_tol,
-                     "sigma_c_over_overlap_se": fit["sigma_c_se_tol"] / overlap_tol})
+        fits.append(
+            {
+                "v_striker": v,
+                "line": line,
+                "measure": measure,
+                "overlap_m": impact_overlap_m(v),
+                **fit,
+                "sigma_c_over_overlap": fit["sigma_c_tol"] / overlap_tol,
+                "sigma_c_over_overlap_se": fit["sigma_c_se_tol"] / overlap_tol,
+            }
+        )
     return fits
 
 
@@ -142,16 +184,27 @@ def overlap_test(fits: list[dict]) -> list[dict]:
     for line in LINES:
         for measure in MEASURES:
             chosen = [f for f in fits if f["line"] == line and f["measure"] == measure and f["significant"]]
-            entry = {"line": line, "measure": measure, "speeds": [f["v_striker"] for f in chosen],
-                     "slope": float("nan"), "slope_se": float("nan"), "consistent_with_overlap": None,
-                     "consistent_with_constant": None}
+            entry = {
+                "line": line,
+                "measure": measure,
+                "speeds": [f["v_striker"] for f in chosen],
+                "slope": float("nan"),
+                "slope_se": float("nan"),
+                "consistent_with_overlap": None,
+                "consistent_with_constant": None,
+            }
             if len(chosen) >= 2 and len({f["v_striker"] for f in chosen}) >= 2:
-                slope, se = _slope(np.log10([f["v_striker"] for f in chosen]),
-                                   np.array([f["log10_sigma_c"] for f in chosen]),
-                                   np.array([f["log10_sigma_c_se"] for f in chosen]))
-                entry.update(slope=slope, slope_se=se,
-                             consistent_with_overlap=bool(abs(slope - OVERLAP_EXPONENT) <= 2 * se),
-                             consistent_with_constant=bool(abs(slope) <= 2 * se))
+                slope, se = _slope(
+                    np.log10([f["v_striker"] for f in chosen]),
+                    np.array([f["log10_sigma_c"] for f in chosen]),
+                    np.array([f["log10_sigma_c_se"] for f in chosen]),
+                )
+                entry.update(
+                    slope=slope,
+                    slope_se=se,
+                    consistent_with_overlap=bool(abs(slope - OVERLAP_EXPONENT) <= 2 * se),
+                    consistent_with_constant=bool(abs(slope) <= 2 * se),
+                )
             tests.append(entry)
     return tests
 
@@ -163,19 +216,25 @@ def crossover_verdict(fits: list[dict], tests: list[dict]) -> str:
         name = f"{test['line']}° ({test['measure']})"
         found = [f for f in fits if f["line"] == test["line"] and f["measure"] == test["measure"] and f["significant"]]
         if not found:
-            sentences.append(f"{name}: no crossover measured in the range swept (no drop beyond two standard "
-                             "errors, or none placed within it to half a decade).")
+            sentences.append(
+                f"{name}: no crossover measured in the range swept (no drop beyond two standard "
+                "errors, or none placed within it to half a decade)."
+            )
             continue
-        where = ", ".join(f"σ_c = {f['sigma_c_tol']:.3g} ± {f['sigma_c_se_tol']:.2g} tol "
-                          f"({f['sigma_c_over_overlap']:.3g} δ) at {f['v_striker']:.2f} m/s" for f in found)
+        where = ", ".join(
+            f"σ_c = {f['sigma_c_tol']:.3g} ± {f['sigma_c_se_tol']:.2g} tol "
+            f"({f['sigma_c_over_overlap']:.3g} δ) at {f['v_striker']:.2f} m/s"
+            for f in found
+        )
         if test["consistent_with_overlap"] is None:
             sentences.append(f"{name}: {where}; too few speeds to test σ_c ∝ V to the power 4/5.")
             continue
-        reading = ("consistent with the overlap's 4/5" if test["consistent_with_overlap"] else
-                   "not the overlap's 4/5") + (", and with no dependence on V" if test["consistent_with_constant"]
-                                              else "")
-        sentences.append(f"{name}: {where}; σ_c ∝ V to the power {test['slope']:.2f} ± {test['slope_se']:.2f}, "
-                         f"{reading}.")
+        reading = (
+            "consistent with the overlap's 4/5" if test["consistent_with_overlap"] else "not the overlap's 4/5"
+        ) + (", and with no dependence on V" if test["consistent_with_constant"] else "")
+        sentences.append(
+            f"{name}: {where}; σ_c ∝ V to the power {test['slope']:.2f} ± {test['slope_se']:.2f}, {reading}."
+        )
     return " ".join(sentences)
 
 
@@ -197,19 +256,35 @@ def _shown(value, pattern: str) -> str:
 def fit_table(fits: list[dict]) -> list[tuple[str, ...]]:
     """The rows of :data:`FIT_TABLE_HEADER`: each (V, line, measure)'s σ_c ± its standard error,
     in tol and in δ(V) ("–": no crossover measured), and the step's plateaus."""
-    return [(f"{f['v_striker']:.2f}", f["line"], f["measure"],
-             f"{_shown(f['sigma_c_tol'], '.3g')} ± {_shown(f['sigma_c_se_tol'], '.2g')}"
-             if f["significant"] else "–",
-             f"{_shown(f['sigma_c_over_overlap'], '.3g')} ± {_shown(f['sigma_c_over_overlap_se'], '.2g')}"
-             if f["significant"] else "–", _shown(f["t0"], ".3f"), _shown(f["t_inf"], ".3f")) for f in fits]
+    return [
+        (
+            f"{f['v_striker']:.2f}",
+            f["line"],
+            f["measure"],
+            f"{_shown(f['sigma_c_tol'], '.3g')} ± {_shown(f['sigma_c_se_tol'], '.2g')}" if f["significant"] else "–",
+            f"{_shown(f['sigma_c_over_overlap'], '.3g')} ± {_shown(f['sigma_c_over_overlap_se'], '.2g')}"
+            if f["significant"]
+            else "–",
+            _shown(f["t0"], ".3f"),
+            _shown(f["t_inf"], ".3f"),
+        )
+        for f in fits
+    ]
 
 
 def overlap_table(tests: list[dict]) -> list[tuple[str, ...]]:
     """The rows of :data:`OVERLAP_TABLE_HEADER`: the slope of log σ_c against log V per line and measure."""
     verdicts = {True: "yes", False: "no", None: "–"}
-    return [(t["line"], t["measure"],
-             "–" if _missing(t["slope_se"]) else f"{t['slope']:.2f} ± {t['slope_se']:.2f}",
-             verdicts[t["consistent_with_overlap"]], verdicts[t["consistent_with_constant"]]) for t in tests]
+    return [
+        (
+            t["line"],
+            t["measure"],
+            "–" if _missing(t["slope_se"]) else f"{t['slope']:.2f} ± {t['slope_se']:.2f}",
+            verdicts[t["consistent_with_overlap"]],
+            verdicts[t["consistent_with_constant"]],
+        )
+        for t in tests
+    ]
 
 
 #: The crossover's two figures in ``disorder/``: the transmission against σ/tol, and against
@@ -225,8 +300,9 @@ def crossover_figure(rows: list[tuple], fits: list[dict], path, against: str = "
 
     from hexdem.analysis import plotting as plots
 
-    fig, axes = plots.subplots(len(MEASURES), len(LINES), figsize=(10, 7.6), sharex=True, sharey=True,
-                               layout="constrained")
+    fig, axes = plots.subplots(
+        len(MEASURES), len(LINES), figsize=(10, 7.6), sharex=True, sharey=True, layout="constrained"
+    )
     speeds = sorted({r[0] for r in rows})
     for (i, measure), (j, line) in itertools.product(enumerate(MEASURES), enumerate(LINES)):
         ax = axes[i, j]
@@ -235,12 +311,24 @@ def crossover_figure(rows: list[tuple], fits: list[dict], path, against: str = "
             fit = next(f for f in fits if (f["v_striker"], f["line"], f["measure"]) == (v, line, measure))
             scale = impact_overlap_m(v) / TOLERANCE_M if against == "overlap" else 1.0
             sigma, t, sem = (np.array([r[k] for r in chosen], float) for k in (3, 5, 6))
-            ax.errorbar(sigma / scale, t, yerr=2 * np.nan_to_num(sem), fmt="o", color=colour, capsize=2,
-                        markersize=5, label=f"{v:.2f} m/s")
+            ax.errorbar(
+                sigma / scale,
+                t,
+                yerr=2 * np.nan_to_num(sem),
+                fmt="o",
+                color=colour,
+                capsize=2,
+                markersize=5,
+                label=f"{v:.2f} m/s",
+            )
             grid = np.geomspace(sigma.min(), sigma.max(), 200)
             if fit["significant"]:
-                ax.plot(grid / scale, _step(np.log10(grid), fit["t0"], fit["t_inf"], fit["log10_sigma_c"], fit["p"]),
-                        color=colour, lw=1.2)
+                ax.plot(
+                    grid / scale,
+                    _step(np.log10(grid), fit["t0"], fit["t_inf"], fit["log10_sigma_c"], fit["p"]),
+                    color=colour,
+                    lw=1.2,
+                )
                 ax.axvline(fit["sigma_c_tol"] / scale, color=colour, ls=":", lw=1.2)
         ax.set_xscale("log")
         ax.axhline(1.0, color="k", lw=0.8)
@@ -252,9 +340,12 @@ def crossover_figure(rows: list[tuple], fits: list[dict], path, against: str = "
             ax.set_ylabel("disordered / ideal", fontsize=12)
         ax.tick_params(labelsize=11)
     axes[0, 0].legend(fontsize=10, title="striker", title_fontsize=10)
-    fig.suptitle("Transmission against " + (r"$\sigma / \delta(V)$, $\delta(V)$ the impact's overlap"
-                                            if against == "overlap" else r"$\sigma$")
-                 + " (mean ± 2 SEM; lines: fitted steps, dotted: $\\sigma_c$)", fontsize=12)
+    fig.suptitle(
+        "Transmission against "
+        + (r"$\sigma / \delta(V)$, $\delta(V)$ the impact's overlap" if against == "overlap" else r"$\sigma$")
+        + " (mean ± 2 SEM; lines: fitted steps, dotted: $\\sigma_c$)",
+        fontsize=12,
+    )
     plots.save(fig, path)
 
 
@@ -266,13 +357,22 @@ def pm30_claim(rows: list[tuple]) -> str:
         return "No ±30° transmission was measured."
     rises = [r for r in pm30 if r[5] - 2 * np.nan_to_num(r[6]) > 1.0]
     best = max(pm30, key=lambda r: r[5])
-    span = (f"Across σ = {min(r[3] for r in pm30):g}–{max(r[3] for r in pm30):g} tol "
-            f"(σ/δ(V) = {min(r[4] for r in pm30):.2g}–{max(r[4] for r in pm30):.2g})")
-    largest = (f"the largest ±30° transmission is {best[5]:.3f} ± {best[6]:.3f} ({best[2]}, σ = {best[3]:g} tol, "
-               f"{best[0]:.2f} m/s)")
+    span = (
+        f"Across σ = {min(r[3] for r in pm30):g}–{max(r[3] for r in pm30):g} tol "
+        f"(σ/δ(V) = {min(r[4] for r in pm30):.2g}–{max(r[4] for r in pm30):.2g})"
+    )
+    largest = (
+        f"the largest ±30° transmission is {best[5]:.3f} ± {best[6]:.3f} ({best[2]}, σ = {best[3]:g} tol, "
+        f"{best[0]:.2f} m/s)"
+    )
     if not rises:
-        return (f"{span} the ±30° transmission never exceeds the ideal lattice's by two standard errors; "
-                f"{largest}. The paper's redistribution towards ±30° does not appear at any disorder strength, "
-                "weak on the contact scale or not.")
+        return (
+            f"{span} the ±30° transmission never exceeds the ideal lattice's by two standard errors; "
+            f"{largest}. The paper's redistribution towards ±30° does not appear at any disorder strength, "
+            "weak on the contact scale or not."
+        )
     where = "; ".join(f"{r[2]}, σ = {r[3]:g} tol, {r[0]:.2f} m/s" for r in rises)
-    return f"{span} the ±30° transmission exceeds the ideal lattice's by more than two standard errors at: {where}; {largest}."
+    return (
+        f"{span} the ±30° transmission exceeds the ideal lattice's by more than two standard errors at: "
+        f"{where}; {largest}."
+    )

@@ -40,11 +40,28 @@ from hexdem.paper.settings import (
 )
 
 #: Columns of ``disorder_study.csv``.
-STUDY_COLUMNS = ("sigma_per_tol", "sigma_mm", "preparation", "measure", "line", "ratio_to_ideal", "sem",
-                 "std", "realizations", "ratio_to_equal_beads")
+STUDY_COLUMNS = (
+    "sigma_per_tol",
+    "sigma_mm",
+    "preparation",
+    "measure",
+    "line",
+    "ratio_to_ideal",
+    "sem",
+    "std",
+    "realizations",
+    "ratio_to_equal_beads",
+)
 #: Columns of ``prestress.csv``.
-PRESTRESS_COLUMNS = ("sigma_per_tol", "preparation", "mean_contact_force_n", "mean_contact_force_n_std",
-                     "max_contact_force_n", "wall_force_n", "wall_force_n_std")
+PRESTRESS_COLUMNS = (
+    "sigma_per_tol",
+    "preparation",
+    "mean_contact_force_n",
+    "mean_contact_force_n_std",
+    "max_contact_force_n",
+    "wall_force_n",
+    "wall_force_n_std",
+)
 #: Lines of the study and the two readings of the peak speed.
 LINES = ("0", "±30")
 MEASURES = {"peak": "disorder_effect", "lead": "leading_pulse_effect"}
@@ -71,10 +88,14 @@ class StudyEnsemble:
     def config(self, settings: PaperSettings) -> EnsembleConfig:
         disorder = Disorder(PAPER_DIAMETER_M, sigma_m=self.sigma_per_tol * TOLERANCE_M)
         preparation = Preparation(wall_slack_m=RELAXED_WALL_SLACK_M if self.relaxed else 0.0)
-        return EnsembleConfig(realizations=1 if self.sigma_per_tol == 0 else settings.realizations,
-                              velocities_m_s=self.velocities_m_s, edge_beads=settings.ensemble_edge_beads,
-                              disorder=disorder, preparation=preparation,
-                              steps_per_contact=settings.steps_per_contact)
+        return EnsembleConfig(
+            realizations=1 if self.sigma_per_tol == 0 else settings.realizations,
+            velocities_m_s=self.velocities_m_s,
+            edge_beads=settings.ensemble_edge_beads,
+            disorder=disorder,
+            preparation=preparation,
+            steps_per_contact=settings.steps_per_contact,
+        )
 
 
 def study_ensembles(settings: PaperSettings) -> list[StudyEnsemble]:
@@ -86,8 +107,9 @@ def study_ensembles(settings: PaperSettings) -> list[StudyEnsemble]:
     return ensembles + [StudyEnsemble(s, True, (STUDY_VELOCITY_M_S,)) for s in RELAXED_SIGMA_PER_TOL]
 
 
-def run_study_ensemble(entry: StudyEnsemble, settings: PaperSettings, parsl, out: Path, scaling_json,
-                       others: list[StudyEnsemble] = ()) -> dict:
+def run_study_ensemble(
+    entry: StudyEnsemble, settings: PaperSettings, parsl, out: Path, scaling_json, others: list[StudyEnsemble] = ()
+) -> dict:
     """Run (or resume) one ensemble of the study into ``out / entry.name`` (on ``parsl``, the
     paper's :class:`~hexdem.experiments.executors.ParslSession`, or None); its summary.
 
@@ -95,13 +117,29 @@ def run_study_ensemble(entry: StudyEnsemble, settings: PaperSettings, parsl, out
     the ideal impacts and compactions, is copied rather than run again
     (:mod:`hexdem.disorder.sharing`)."""
     config = entry.config(settings)
-    sources = tuple(Ensemble(other.config(settings), out / other.name) for other in others
-                    if other != entry and (out / other.name).is_dir())
-    summary = run_ensemble(config, out / entry.name, workers=settings.workers, launcher=settings.launcher, parsl=parsl,
-                           scaling_json=scaling_json, log=lambda message: None, share_from=sources)
-    return {"name": entry.name, "sigma_per_tol": entry.sigma_per_tol, "preparation": entry.preparation_name,
-            **{key: summary[key] for key in ("prestress", "this_run", "leading_pulse_defined_fraction",
-                                             *MEASURES.values())}}
+    sources = tuple(
+        Ensemble(other.config(settings), out / other.name)
+        for other in others
+        if other != entry and (out / other.name).is_dir()
+    )
+    summary = run_ensemble(
+        config,
+        out / entry.name,
+        workers=settings.workers,
+        launcher=settings.launcher,
+        parsl=parsl,
+        scaling_json=scaling_json,
+        log=lambda message: None,
+        share_from=sources,
+    )
+    return {
+        "name": entry.name,
+        "sigma_per_tol": entry.sigma_per_tol,
+        "preparation": entry.preparation_name,
+        **{
+            key: summary[key] for key in ("prestress", "this_run", "leading_pulse_defined_fraction", *MEASURES.values())
+        },
+    }
 
 
 def json_number(value) -> float:
@@ -118,24 +156,45 @@ def study_rows(summaries: list[dict]) -> list[tuple]:
             for effect in s[key]:
                 if effect["line"] not in LINES or not np.isclose(effect["v_striker"], STUDY_VELOCITY_M_S):
                     continue
-                control = next(c for c in controls[s["preparation"]][key]
-                               if c["line"] == effect["line"] and np.isclose(c["v_striker"], STUDY_VELOCITY_M_S))
-                rows.append((s["sigma_per_tol"], s["sigma_per_tol"] * TOLERANCE_M * 1e3, s["preparation"], measure,
-                             effect["line"], json_number(effect["mean_ratio"]), json_number(effect["sem_ratio"]),
-                             json_number(effect["std_ratio"]), effect["realizations"],
-                             json_number(effect["mean_ratio"]) / json_number(control["mean_ratio"])))
+                control = next(
+                    c
+                    for c in controls[s["preparation"]][key]
+                    if c["line"] == effect["line"] and np.isclose(c["v_striker"], STUDY_VELOCITY_M_S)
+                )
+                rows.append(
+                    (
+                        s["sigma_per_tol"],
+                        s["sigma_per_tol"] * TOLERANCE_M * 1e3,
+                        s["preparation"],
+                        measure,
+                        effect["line"],
+                        json_number(effect["mean_ratio"]),
+                        json_number(effect["sem_ratio"]),
+                        json_number(effect["std_ratio"]),
+                        effect["realizations"],
+                        json_number(effect["mean_ratio"]) / json_number(control["mean_ratio"]),
+                    )
+                )
     return rows
 
 
 def prestress_rows(summaries: list[dict]) -> list[tuple]:
-    return [(s["sigma_per_tol"], s["preparation"], s["prestress"]["mean_contact_force_n"]["mean"],
-             s["prestress"]["mean_contact_force_n"]["std"], s["prestress"]["max_contact_force_n"]["mean"],
-             s["prestress"]["wall_force_n"]["mean"], s["prestress"]["wall_force_n"]["std"])
-            for s in sorted(summaries, key=lambda s: (s["preparation"], s["sigma_per_tol"]))]
+    return [
+        (
+            s["sigma_per_tol"],
+            s["preparation"],
+            s["prestress"]["mean_contact_force_n"]["mean"],
+            s["prestress"]["mean_contact_force_n"]["std"],
+            s["prestress"]["max_contact_force_n"]["mean"],
+            s["prestress"]["wall_force_n"]["mean"],
+            s["prestress"]["wall_force_n"]["std"],
+        )
+        for s in sorted(summaries, key=lambda s: (s["preparation"], s["sigma_per_tol"]))
+    ]
 
 
 def change(mean: float, sem: float, realizations: int) -> str:
-    """"rises", "falls" or "unchanged": the ratio against 1 at two standard errors. One
+    """ "rises", "falls" or "unchanged": the ratio against 1 at two standard errors. One
     realization is exact (equal beads prepared alike are identical) and has no error;
     "undetermined" where the mean, or the error of several realizations, is missing."""
     if not np.isfinite(mean) or (realizations > 1 and not np.isfinite(sem)):
@@ -162,16 +221,34 @@ def verdict(rows: list[tuple]) -> dict:
         if line != "±30" or sigma == 0:
             continue
         zero = table[(sigma, preparation, measure, "0")]
-        conditions.append({"sigma_per_tol": sigma, "preparation": preparation, "measure": measure,
-                           "pm30": change(row[5], row[6], row[8]), "pm30_ratio": row[5], "pm30_sem": row[6],
-                           "zero": change(zero[5], zero[6], zero[8]), "zero_ratio": zero[5], "zero_sem": zero[6]})
+        conditions.append(
+            {
+                "sigma_per_tol": sigma,
+                "preparation": preparation,
+                "measure": measure,
+                "pm30": change(row[5], row[6], row[8]),
+                "pm30_ratio": row[5],
+                "pm30_sem": row[6],
+                "zero": change(zero[5], zero[6], zero[8]),
+                "zero_ratio": zero[5],
+                "zero_sem": zero[6],
+            }
+        )
     rises = [c for c in conditions if c["pm30"] == "rises"]
     claim = [c for c in rises if c["zero"] == "falls"]
-    paper = next((c for c in conditions if c["sigma_per_tol"] == 6 and c["preparation"] == "prestressed"
-                  and c["measure"] == "peak"), None)
+    paper = next(
+        (
+            c
+            for c in conditions
+            if c["sigma_per_tol"] == 6 and c["preparation"] == "prestressed" and c["measure"] == "peak"
+        ),
+        None,
+    )
     strengths = ", ".join(f"{s:g}" for s in sorted({c["sigma_per_tol"] for c in conditions}))
-    scope = (f"At σ = {strengths} tol (the study's strengths, {STUDY_VELOCITY_M_S:.2f} m/s; weaker disorder: "
-             "the crossover sweep, the report's section 3b): ")
+    scope = (
+        f"At σ = {strengths} tol (the study's strengths, {STUDY_VELOCITY_M_S:.2f} m/s; weaker disorder: "
+        "the crossover sweep, the report's section 3b): "
+    )
     if claim:
         where = "; ".join(f"σ = {c['sigma_per_tol']:g} tol, {c['preparation']}, {c['measure']}" for c in claim)
         summary = f"transmission along ±30° rises while 0° falls, as the paper says, only for: {where}."
@@ -179,11 +256,18 @@ def verdict(rows: list[tuple]) -> dict:
         where = "; ".join(f"σ = {c['sigma_per_tol']:g} tol, {c['preparation']}, {c['measure']}" for c in rises)
         summary = f"transmission along ±30° rises for {where}, but 0° does not fall there as the paper says."
     else:
-        summary = ("under none of the conditions studied does transmission along ±30° rise above the ideal "
-                   "lattice's by more than two standard errors: hexdem does not reproduce the paper's claim "
-                   "at these strengths.")
-    return {"conditions": conditions, "rises_at": claim, "pm30_rises_at": rises, "paper_case": paper,
-            "summary": scope + summary}
+        summary = (
+            "under none of the conditions studied does transmission along ±30° rise above the ideal "
+            "lattice's by more than two standard errors: hexdem does not reproduce the paper's claim "
+            "at these strengths."
+        )
+    return {
+        "conditions": conditions,
+        "rises_at": claim,
+        "pm30_rises_at": rises,
+        "paper_case": paper,
+        "summary": scope + summary,
+    }
 
 
 def study_figure(rows: list[tuple], path) -> None:
@@ -193,13 +277,15 @@ def study_figure(rows: list[tuple], path) -> None:
     from hexdem.analysis import plotting as plots
 
     fig, axes = plots.subplots(2, 2, figsize=(10, 7), sharex=True, sharey=True)
-    styles = {"prestressed": ("o-", "C0", "walls kept prestress (paper's scheme)"),
-              "relaxed": ("s", "C3", "walls stood back (no prestress)")}
+    styles = {
+        "prestressed": ("o-", "C0", "walls kept prestress (paper's scheme)"),
+        "relaxed": ("s", "C3", "walls stood back (no prestress)"),
+    }
     for i, measure in enumerate(MEASURES):
         for j, line in enumerate(LINES):
             ax = axes[i, j]
             for preparation, (style, colour, label) in styles.items():
-                chosen = sorted((r for r in rows if r[2] == preparation and r[3] == measure and r[4] == line))
+                chosen = sorted(r for r in rows if r[2] == preparation and r[3] == measure and r[4] == line)
                 if not chosen:
                     continue
                 sigma, mean, sem = (np.array([r[k] for r in chosen], float) for k in (0, 5, 6))

@@ -38,8 +38,10 @@ def describe(search: ProtocolSearch, i: int) -> str:
     """One protocol in words, as the report and the published-vs-computed table quote it."""
     row = dict(zip(PROTOCOL_COLUMNS, search.row(i)))
     start = f"anchored V_{row['start']}" if row["anchored"] else f"free V_{row['start']}"
-    return (f"{start}, beads {row['start']}..{row['last']}, {row['fit']} fit, "
-            f"V0 {row['v0_min']:.3g}..{row['v0_max']:.3g} ({row['n_v0']} values)")
+    return (
+        f"{start}, beads {row['start']}..{row['last']}, {row['fit']} fit, "
+        f"V0 {row['v0_min']:.3g}..{row['v0_max']:.3g} ({row['n_v0']} values)"
+    )
 
 
 def run_search(scaling_dir, out) -> dict:
@@ -50,17 +52,22 @@ def run_search(scaling_dir, out) -> dict:
     searches, summary, rows = {}, {}, []
     for name in COMBINATIONS:
         max_last = complete_beads(peaks[name]) - 1
-        search = search_protocols(name, v0, peaks[name][:, :max_last + 1], target(name), max_last)
+        search = search_protocols(name, v0, peaks[name][:, : max_last + 1], target(name), max_last)
         searches[name] = search
         stated, closest = stated_protocol(search), search.closest(CLOSEST)
-        rows += [("stated", *search.row(stated))] + [(f"closest_{k + 1}", *search.row(i)) for k, i in enumerate(closest)]
-        summary[name] = {"published": {"m": target(name).m, "b": target(name).b},
-                         "protocols": len(search),
-                         "stated": {**dict(zip(PROTOCOL_COLUMNS, search.row(stated))),
-                                    "description": describe(search, stated)},
-                         "closest": {**dict(zip(PROTOCOL_COLUMNS, search.row(closest[0]))),
-                                     "description": describe(search, closest[0])},
-                         "consistent": search.consistent_shares()}
+        rows += [("stated", *search.row(stated))] + [
+            (f"closest_{k + 1}", *search.row(i)) for k, i in enumerate(closest)
+        ]
+        summary[name] = {
+            "published": {"m": target(name).m, "b": target(name).b},
+            "protocols": len(search),
+            "stated": {**dict(zip(PROTOCOL_COLUMNS, search.row(stated))), "description": describe(search, stated)},
+            "closest": {
+                **dict(zip(PROTOCOL_COLUMNS, search.row(closest[0]))),
+                "description": describe(search, closest[0]),
+            },
+            "consistent": search.consistent_shares(),
+        }
     write_csv(out / "fit_protocols.csv", ("role", *PROTOCOL_COLUMNS), rows)
     write_json(out / "fit_protocols.json", summary)
     protocol_figure(searches, out / "fit_protocols.png")
@@ -77,17 +84,33 @@ def protocol_figure(searches: dict, path) -> None:
     for ax, (name, search) in zip(axes.ravel(), searches.items()):
         for anchored, colour, label in ((True, "C0", "anchored start"), (False, "C1", "free start")):
             chosen = search.anchored == anchored
-            ax.scatter(search.m[chosen], search.b[chosen], s=2, alpha=0.15, color=colour, rasterized=True,
-                       label=label)
+            ax.scatter(search.m[chosen], search.b[chosen], s=2, alpha=0.15, color=colour, rasterized=True, label=label)
         stated, closest, t = stated_protocol(search), search.closest()[0], target(name)
-        ax.errorbar(search.m[stated], search.b[stated], xerr=2 * search.m_stderr[stated],
-                    yerr=2 * search.b_stderr[stated], fmt="D", color="k", capsize=3,
-                    label="paper's stated protocol (± 2 SE)")
+        ax.errorbar(
+            search.m[stated],
+            search.b[stated],
+            xerr=2 * search.m_stderr[stated],
+            yerr=2 * search.b_stderr[stated],
+            fmt="D",
+            color="k",
+            capsize=3,
+            label="paper's stated protocol (± 2 SE)",
+        )
         ax.plot(t.m, t.b, "r*", markersize=12, label="published")
-        ax.plot(search.m[closest], search.b[closest], "^", markersize=9, markerfacecolor="none",
-                markeredgecolor="g", markeredgewidth=1.5, label="closest protocol")
-        for values, mark, axis_limits in ((search.m, (t.m, search.m[stated]), ax.set_xlim),
-                                          (search.b, (t.b, search.b[stated]), ax.set_ylim)):
+        ax.plot(
+            search.m[closest],
+            search.b[closest],
+            "^",
+            markersize=9,
+            markerfacecolor="none",
+            markeredgecolor="g",
+            markeredgewidth=1.5,
+            label="closest protocol",
+        )
+        for values, mark, axis_limits in (
+            (search.m, (t.m, search.m[stated]), ax.set_xlim),
+            (search.b, (t.b, search.b[stated]), ax.set_ylim),
+        ):
             low, high = np.percentile(values, [5, 95])
             low, high = min(low, *mark), max(high, *mark)
             axis_limits(low - 0.05 * (high - low), high + 0.05 * (high - low))

@@ -23,8 +23,16 @@ def _against_mu(ax, rows, column: int, sigma_tol: float, style: str) -> None:
                 continue
             mu, value = np.array([r[0] for r in chosen]), np.array([r[column] for r in chosen])
             sem = np.nan_to_num(np.array([r[5] for r in chosen])) if column == 4 else None
-            ax.errorbar(mu, value, yerr=None if sem is None else 2 * sem, fmt=style, marker=marker,
-                        color=COLOURS[line], capsize=2, label=f"{line}°, {v:.2f} m/s" if sigma_tol == 0 else None)
+            ax.errorbar(
+                mu,
+                value,
+                yerr=None if sem is None else 2 * sem,
+                fmt=style,
+                marker=marker,
+                color=COLOURS[line],
+                capsize=2,
+                label=f"{line}°, {v:.2f} m/s" if sigma_tol == 0 else None,
+            )
 
 
 def friction_figure(rows: list[tuple], decay: list[tuple], conditions: list[dict], edge_beads: int, path) -> None:
@@ -44,22 +52,39 @@ def friction_figure(rows: list[tuple], decay: list[tuple], conditions: list[dict
     arrival.set_ylabel(r"arrival shift $t_n(\mu) - t_n(0)$ [µs]")
     low, high = amplitude.get_ylim()
     amplitude.set_ylim(low - 0.6 * (high - low), high)  # room for the legend below the curves
-    amplitude.legend(fontsize=7, ncol=2, loc="lower left", title="solid: ideal lattice; dashed: σ = 6 tol (± 2 SEM)",
-                     title_fontsize=7)
+    amplitude.legend(
+        fontsize=7,
+        ncol=2,
+        loc="lower left",
+        title="solid: ideal lattice; dashed: σ = 6 tol (± 2 SEM)",
+        title_fontsize=7,
+    )
     for name, _, _ in COMBINATIONS:
         for v, marker in SPEED_MARKERS.items():
             chosen = sorted(r for r in decay if r[2] == name and np.isclose(r[1], v))
-            rates.plot([r[0] for r in chosen], [r[5] for r in chosen], "-", marker=marker, color=COLOURS[name],
-                       label=f"{name}, {v:.2f} m/s")
+            rates.plot(
+                [r[0] for r in chosen],
+                [r[5] for r in chosen],
+                "-",
+                marker=marker,
+                color=COLOURS[name],
+                label=f"{name}, {v:.2f} m/s",
+            )
     rates.set_ylabel(r"decay rate $c(\mu) / c(0)$ (Sec. V, ideal lattice)")
     rates.set_title("the three speeds coincide: Hertz–Mindlin–Coulomb is scale invariant", fontsize=9)
     rates.legend(fontsize=7, ncol=2, loc="lower left")
     for measure, style in (("peak", "o-"), ("lead", "s--")):
         for line, key in (("0", "zero"), ("±30", "pm30")):
             chosen = sorted((c for c in conditions if c["measure"] == measure), key=lambda c: c["friction"])
-            disorder.errorbar([c["friction"] for c in chosen], [c[f"{key}_ratio"] for c in chosen],
-                              yerr=[2 * np.nan_to_num(c[f"{key}_sem"]) for c in chosen], fmt=style,
-                              color=COLOURS[line], capsize=3, label=f"{line}°, {measure}")
+            disorder.errorbar(
+                [c["friction"] for c in chosen],
+                [c[f"{key}_ratio"] for c in chosen],
+                yerr=[2 * np.nan_to_num(c[f"{key}_sem"]) for c in chosen],
+                fmt=style,
+                color=COLOURS[line],
+                capsize=3,
+                label=f"{line}°, {measure}",
+            )
     disorder.axhline(1.0, color="k", lw=0.8)
     disorder.set_ylabel(f"disordered / ideal at σ = 6 tol, {STUDY_VELOCITY_M_S:.2f} m/s")
     disorder.legend(fontsize=7)
@@ -69,5 +94,7 @@ def friction_figure(rows: list[tuple], decay: list[tuple], conditions: list[dict
     for ax in axes.flat:
         ax.set_xlabel(r"Coulomb friction $\mu$")
         ax.grid(True, alpha=0.3)
-    fig.suptitle(f"Mindlin friction and rotation in the hexagon of {edge_beads} per edge, against the frictionless spheres")
+    fig.suptitle(
+        f"Mindlin friction and rotation in the hexagon of {edge_beads} per edge, against the frictionless spheres"
+    )
     plots.save(fig, path)

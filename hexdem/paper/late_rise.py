@@ -36,9 +36,12 @@ from hexdem.experiments.front_study import FrontStudy, study_front_shape
 from hexdem.experiments.run import simulate
 
 #: The four measurements: name → (changes to the run's configuration, front measure).
-VARIANTS = {"baseline": ({}, "half_maximum"), "finer_sampling": ({"dump_every": 3}, "half_maximum"),
-            "finer_step": ({"steps_per_contact": 280, "dump_every": 14}, "half_maximum"),
-            "fixed_speed": ({}, "fixed_speed")}
+VARIANTS = {
+    "baseline": ({}, "half_maximum"),
+    "finer_sampling": ({"dump_every": 3}, "half_maximum"),
+    "finer_step": ({"steps_per_contact": 280, "dump_every": 14}, "half_maximum"),
+    "fixed_speed": ({}, "fixed_speed"),
+}
 #: The fixed speed of the second measure, as a fraction of V0.
 THRESHOLD_FRACTION = 1e-3
 #: Fractions of the largest fitted radius: the plateau and the outer fronts of the late rise.
@@ -53,9 +56,11 @@ COLUMNS = ("variant", "time", "mean_radius_d", "sixfold_cos")
 def late_rise(radius_d, sixfold_cos, largest_d: float) -> float:
     """Mean a6/a0 beyond :data:`OUTER` of ``largest_d`` minus its mean over :data:`PLATEAU`."""
     radius_d, sixfold_cos = np.asarray(radius_d, float), np.asarray(sixfold_cos, float)
+
     def mean_over(low, high):
         chosen = (radius_d >= low * largest_d) & (radius_d <= high * largest_d)
         return float(np.mean(sixfold_cos[chosen])) if chosen.any() else float("nan")
+
     return mean_over(*OUTER) - mean_over(*PLATEAU)
 
 
@@ -73,9 +78,14 @@ def run_late_rise(study: FrontStudy, out: Path, log=None) -> dict:
         shapes[name] = study_front_shape(study, analysis)
         if threshold is not None:
             shapes["fixed_speed"] = study_front_shape(study, analysis, analysis.tracked.threshold_time)
-    return {name: {"shape": shape, "fit": fit_roundness(shape.mean_radius, shape.sixfold_cos, low, high),
-                   "rise": late_rise(shape.mean_radius, shape.sixfold_cos, min(high, float(np.nanmax(shape.mean_radius))))}
-            for name, shape in ((name, shapes[name]) for name in VARIANTS)}
+    return {
+        name: {
+            "shape": shape,
+            "fit": fit_roundness(shape.mean_radius, shape.sixfold_cos, low, high),
+            "rise": late_rise(shape.mean_radius, shape.sixfold_cos, min(high, float(np.nanmax(shape.mean_radius)))),
+        }
+        for name, shape in ((name, shapes[name]) for name in VARIANTS)
+    }
 
 
 def verdict(measured: dict) -> dict:
@@ -84,10 +94,15 @@ def verdict(measured: dict) -> dict:
     "undetermined" where a window holds no front) and one sentence, with A∞ of each."""
     rise = {name: entry["rise"] for name, entry in measured.items()}
     base = rise["baseline"]
+
     def changed(name):
         return abs(rise[name] - base) > RISE_AGREEMENT * abs(base)
-    fits = "; ".join(f"{name.replace('_', ' ')}: A∞ = {entry['fit'].a_inf:+.4f} ± {entry['fit'].a_inf_se:.4f} "
-                     f"(p = {entry['fit'].p:.2f}), late rise {entry['rise']:+.4f}" for name, entry in measured.items())
+
+    fits = "; ".join(
+        f"{name.replace('_', ' ')}: A∞ = {entry['fit'].a_inf:+.4f} ± {entry['fit'].a_inf_se:.4f} "
+        f"(p = {entry['fit'].p:.2f}), late rise {entry['rise']:+.4f}"
+        for name, entry in measured.items()
+    )
     if not all(np.isfinite(list(rise.values()))):
         kind = "undetermined"
     elif not base < -2 * measured["baseline"]["fit"].a_inf_se:
@@ -100,23 +115,40 @@ def verdict(measured: dict) -> dict:
         kind = "of the half-maximum measure"
     else:
         kind = "the front's own"
-    sentences = {"undetermined": "The packing is too small for fronts in both windows of the late rise: undetermined.",
-                 "no late rise": ("The anisotropy does not grow again beyond the plateau by more than twice the "
-                                  "fit's error: there is no late rise here."),
-                 "artefact of the sampling": "The late rise changes when the sampling is refined: it is an artefact of the sampling.",
-                 "artefact of the time step": "The late rise changes with the time step: it is an artefact of the discretization.",
-                 "of the half-maximum measure": ("The late rise stays under finer sampling and a finer time step, but the front "
-                                                 "of a fixed small speed does not show it: it belongs to the half-maximum measure "
-                                                 "(the pulse's shape changing with direction), not to the front's position."),
-                 "the front's own": ("The late rise stays under finer sampling, a finer time step and a second measure of the "
-                                     "front: it is physical, the front's own.")}
-    return {"kind": kind, "rises": rise, "verdict": f"{sentences[kind]} {fits}.",
-            "fits": {name: entry["fit"].as_dict() for name, entry in measured.items()}}
+    sentences = {
+        "undetermined": "The packing is too small for fronts in both windows of the late rise: undetermined.",
+        "no late rise": (
+            "The anisotropy does not grow again beyond the plateau by more than twice the "
+            "fit's error: there is no late rise here."
+        ),
+        "artefact of the sampling": "The late rise changes when the sampling is refined: it is an artefact of "
+        "the sampling.",
+        "artefact of the time step": "The late rise changes with the time step: it is an artefact of the "
+        "discretization.",
+        "of the half-maximum measure": (
+            "The late rise stays under finer sampling and a finer time step, but the front "
+            "of a fixed small speed does not show it: it belongs to the half-maximum measure "
+            "(the pulse's shape changing with direction), not to the front's position."
+        ),
+        "the front's own": (
+            "The late rise stays under finer sampling, a finer time step and a second measure of the "
+            "front: it is physical, the front's own."
+        ),
+    }
+    return {
+        "kind": kind,
+        "rises": rise,
+        "verdict": f"{sentences[kind]} {fits}.",
+        "fits": {name: entry["fit"].as_dict() for name, entry in measured.items()},
+    }
 
 
 def rows(measured: dict) -> list[tuple]:
-    return [(name, float(t), float(r), float(a)) for name, entry in measured.items()
-            for t, r, a in zip(entry["shape"].time, entry["shape"].mean_radius, entry["shape"].sixfold_cos)]
+    return [
+        (name, float(t), float(r), float(a))
+        for name, entry in measured.items()
+        for t, r, a in zip(entry["shape"].time, entry["shape"].mean_radius, entry["shape"].sixfold_cos)
+    ]
 
 
 def late_rise_figure(measured: dict, path) -> None:
@@ -128,18 +160,28 @@ def late_rise_figure(measured: dict, path) -> None:
     for k, (name, entry) in enumerate(measured.items()):
         shape, fit = entry["shape"], entry["fit"]
         keep = shape.mean_radius >= fit.radius_min_d
-        ax.plot(shape.mean_radius[keep], shape.sixfold_cos[keep], "o", color=f"C{k}", markersize=4 - 0.6 * k,
-                label=f"{name.replace('_', ' ')}: A∞ = {fit.a_inf:+.4f} ± {fit.a_inf_se:.4f}, late rise {entry['rise']:+.4f}")
+        ax.plot(
+            shape.mean_radius[keep],
+            shape.sixfold_cos[keep],
+            "o",
+            color=f"C{k}",
+            markersize=4 - 0.6 * k,
+            label=f"{name.replace('_', ' ')}: A∞ = {fit.a_inf:+.4f} ± {fit.a_inf_se:.4f}, late rise "
+            f"{entry['rise']:+.4f}",
+        )
         radius = np.linspace(fit.radius_min_d, fit.radius_max_d, 100)
         ax.plot(radius, fit(radius), color=f"C{k}", lw=1)
         ax.axhline(fit.a_inf, color=f"C{k}", ls=":", lw=1)
     for fraction in (*PLATEAU, OUTER[0]):
-        ax.axvline(fraction * max(float(np.nanmax(e["shape"].mean_radius)) for e in measured.values()),
-                   color="grey", lw=0.6, ls="--")
+        ax.axvline(
+            fraction * max(float(np.nanmax(e["shape"].mean_radius)) for e in measured.values()),
+            color="grey",
+            lw=0.6,
+            ls="--",
+        )
     ax.set_xlabel("mean front radius a₀ [d]")
     ax.set_ylabel("sixfold component a₆/a₀")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7, loc="lower left")
     ax.set_title("The late rise, measured four ways (dashed: the plateau and the outer fronts)", fontsize=10)
     plots.save(fig, path)
-

@@ -22,7 +22,8 @@ then ``report.html``, ``report.md`` and ``published_vs_computed.csv`` (:mod:`hex
 
 **Resuming.** A finished part leaves ``DIR/parts/<name>.json`` (its summary, written
 atomically last); a rerun skips every part that has one, unless a part whose results it
-reads was computed again, and the ensembles resume realization by realization. ``DIR/paper.json`` records the settings: a rerun with others
+reads was computed again, and the ensembles resume realization by realization. ``DIR/paper.json`` records the settings:
+a rerun with others
 (``--quick`` or not) is refused rather than mixed, and ``DIR/.lock`` refuses a second
 ``hexdem paper`` while one runs.
 """
@@ -71,9 +72,15 @@ def _snapshots(settings: PaperSettings, out: Path, shape: str) -> dict:
     long_edge, short_edge = settings.half_hexagon
     half = shape == "half-hexagon"
     edges = {"long_edge": long_edge, "short_edge": short_edge} if half else {}  # (a hexagon refuses them)
-    config = RunConfig(shape=shape, **edges, impact="striker", v0=0.4,
-                       ranks=settings.workers if half else 1, launcher=settings.launcher,
-                       steps_per_contact=settings.steps_per_contact)
+    config = RunConfig(
+        shape=shape,
+        **edges,
+        impact="striker",
+        v0=0.4,
+        ranks=settings.workers if half else 1,
+        launcher=settings.launcher,
+        steps_per_contact=settings.steps_per_contact,
+    )
     times_ms = QUICK_FIG4_TIMES_MS if half and settings.quick else DEFAULT_TIMES_MS[shape]
     folder = out / ("fig4" if half else "fig3")
     run_snapshots(config, [t * 1e-3 for t in times_ms], folder, outline_edge=11 if half else None, log=_quiet)
@@ -84,9 +91,11 @@ def _scaling(settings: PaperSettings, out: Path, parsl) -> dict:
     from hexdem.theory.outputs import write_outputs
     from hexdem.theory.sweep import SweepSettings, run_sweep
 
-    sweep = run_sweep(SweepSettings(n_v0=settings.n_v0, workers=settings.workers, launcher=settings.launcher,
-                                    parsl=settings.parsl),
-                      log=_quiet, parsl=parsl)
+    sweep = run_sweep(
+        SweepSettings(n_v0=settings.n_v0, workers=settings.workers, launcher=settings.launcher, parsl=settings.parsl),
+        log=_quiet,
+        parsl=parsl,
+    )
     return write_outputs(sweep, out / "scaling")
 
 
@@ -105,10 +114,13 @@ def _disorder_summary(summaries: list[dict], out: Path) -> dict:
     write_csv(folder / "disorder_study.csv", STUDY_COLUMNS, rows)
     write_csv(folder / "prestress.csv", PRESTRESS_COLUMNS, loads)
     study_figure(rows, folder / "disorder_study.png")
-    result = {"rows": [dict(zip(STUDY_COLUMNS, row)) for row in rows], "verdict": verdict(rows),
-              "prestress": [dict(zip(PRESTRESS_COLUMNS, row)) for row in loads],
-              "figures_ensemble": FIGURES_ENSEMBLE,
-              "leading_pulse_defined_fraction": {s["name"]: s["leading_pulse_defined_fraction"] for s in summaries}}
+    result = {
+        "rows": [dict(zip(STUDY_COLUMNS, row)) for row in rows],
+        "verdict": verdict(rows),
+        "prestress": [dict(zip(PRESTRESS_COLUMNS, row)) for row in loads],
+        "figures_ensemble": FIGURES_ENSEMBLE,
+        "leading_pulse_defined_fraction": {s["name"]: s["leading_pulse_defined_fraction"] for s in summaries},
+    }
     write_json(folder / "disorder_study.json", result)
     return result
 
@@ -133,9 +145,14 @@ def _crossover(summaries: list[dict], out: Path) -> dict:
     write_csv(folder / "disorder_crossover.csv", CROSSOVER_COLUMNS, rows)
     for against, name in CROSSOVER_FIGURES.items():
         crossover_figure(rows, fits, folder / name, against)
-    result = {"fits": fits, "overlap_test": tests, "verdict": crossover_verdict(fits, tests),
-              "pm30_claim": pm30_claim(rows),
-              "sigma_per_tol": sorted({r[3] for r in rows}), "velocities_m_s": sorted({r[0] for r in rows})}
+    result = {
+        "fits": fits,
+        "overlap_test": tests,
+        "verdict": crossover_verdict(fits, tests),
+        "pm30_claim": pm30_claim(rows),
+        "sigma_per_tol": sorted({r[3] for r in rows}),
+        "velocities_m_s": sorted({r[0] for r in rows}),
+    }
     write_json(folder / "disorder_crossover.json", result)
     return result
 
@@ -156,10 +173,15 @@ def _friction_summary(settings: PaperSettings, summaries: dict, out: Path) -> di
     write_csv(folder / "friction_effect.csv", EFFECT_COLUMNS, rows)
     write_csv(folder / "friction_decay.csv", DECAY_COLUMNS, decay)
     friction_figure(rows, decay, conditions, settings.ensemble_edge_beads, folder / "friction_effect.png")
-    result = {"rows": [dict(zip(EFFECT_COLUMNS, row)) for row in rows],
-              "decay": [dict(zip(DECAY_COLUMNS, row)) for row in decay], "disorder": conditions,
-              "realizations": settings.friction_realizations, "paper_realizations": settings.realizations,
-              "arrival_verdict": arrival_verdict(rows), "disorder_verdict": disorder_verdict(conditions)}
+    result = {
+        "rows": [dict(zip(EFFECT_COLUMNS, row)) for row in rows],
+        "decay": [dict(zip(DECAY_COLUMNS, row)) for row in decay],
+        "disorder": conditions,
+        "realizations": settings.friction_realizations,
+        "paper_realizations": settings.realizations,
+        "arrival_verdict": arrival_verdict(rows),
+        "disorder_verdict": disorder_verdict(conditions),
+    }
     write_json(folder / "friction_study.json", result)
     return result
 
@@ -174,11 +196,14 @@ def _check_settings(out: Path, settings: PaperSettings) -> None:
         try:
             previous = json.loads(path.read_text())["identity"]
         except (OSError, ValueError, KeyError, TypeError):
-            raise HexdemError(f"{path} is unreadable: {out} does not hold a hexdem paper run; "
-                              "choose another --out") from None
+            raise HexdemError(
+                f"{path} is unreadable: {out} does not hold a hexdem paper run; choose another --out"
+            ) from None
         if previous != settings.identity():
-            raise HexdemError(f"{out} holds a hexdem paper run with other settings ({previous}); "
-                              "rerun with the same ones to resume it, or choose another --out")
+            raise HexdemError(
+                f"{out} holds a hexdem paper run with other settings ({previous}); "
+                "rerun with the same ones to resume it, or choose another --out"
+            )
     write_json(path, {"identity": settings.identity(), "settings": settings.as_dict()})
 
 
@@ -204,28 +229,65 @@ def _run_parts(settings: PaperSettings, out: Path, parsl) -> tuple[dict, float]:
     ensembles = study_ensembles(settings)
     ensemble_parts = [f"disorder-{e.name}" for e in ensembles]
     # (name, label, the parts whose results it reads, work)
-    parts = [("tca", "TCA and Fig. 5", (), lambda: _tca(out)),
-             ("fig3", "Fig. 3 snapshots", (), lambda: _snapshots(settings, out, "hexagon")),
-             ("fig4", "Fig. 4 snapshots", (), lambda: _snapshots(settings, out, "half-hexagon")),
-             ("scaling", f"V0 sweep ({settings.n_v0} values) and laws, Figs. 6-7", (),
-              lambda: _scaling(settings, out, parsl)),
-             ("fit_protocols", "fit-protocol search", ("scaling",), lambda: _fit_protocols(out))]
-    parts += [(name, f"ensemble {e.name}", ("scaling",),
-               lambda e=e: run_study_ensemble(e, settings, parsl, out / "disorder", scaling_json, ensembles))
-              for name, e in zip(ensemble_parts, ensembles)]
+    parts = [
+        ("tca", "TCA and Fig. 5", (), lambda: _tca(out)),
+        ("fig3", "Fig. 3 snapshots", (), lambda: _snapshots(settings, out, "hexagon")),
+        ("fig4", "Fig. 4 snapshots", (), lambda: _snapshots(settings, out, "half-hexagon")),
+        (
+            "scaling",
+            f"V0 sweep ({settings.n_v0} values) and laws, Figs. 6-7",
+            (),
+            lambda: _scaling(settings, out, parsl),
+        ),
+        ("fit_protocols", "fit-protocol search", ("scaling",), lambda: _fit_protocols(out)),
+    ]
+    parts += [
+        (
+            name,
+            f"ensemble {e.name}",
+            ("scaling",),
+            lambda e=e: run_study_ensemble(e, settings, parsl, out / "disorder", scaling_json, ensembles),
+        )
+        for name, e in zip(ensemble_parts, ensembles)
+    ]
     study_parts = [name for name, e in zip(ensemble_parts, ensembles) if e.sigma_per_tol in settings.sigma_per_tol]
-    parts.append(("disorder", "disorder study and verdict", tuple(study_parts),
-                  lambda: _disorder_summary([summaries[name] for name in study_parts], out)))
-    parts.append(("crossover", "disorder crossover sweep", tuple(ensemble_parts),
-                  lambda: _crossover([summaries[name] for name in ensemble_parts], out)))
+    parts.append(
+        (
+            "disorder",
+            "disorder study and verdict",
+            tuple(study_parts),
+            lambda: _disorder_summary([summaries[name] for name in study_parts], out),
+        )
+    )
+    parts.append(
+        (
+            "crossover",
+            "disorder crossover sweep",
+            tuple(ensemble_parts),
+            lambda: _crossover([summaries[name] for name in ensemble_parts], out),
+        )
+    )
     paper_part = f"disorder-{FIGURES_ENSEMBLE}"
     friction_parts = [f"friction-{friction_name(mu)}" for mu in settings.frictions]
-    parts += [(name, f"ensemble with friction μ = {mu:g}", (paper_part,),
-               lambda mu=mu: run_friction_ensemble(mu, settings, parsl, out, scaling_json))
-              for name, mu in zip(friction_parts, settings.frictions)]
-    parts.append(("friction", "friction and rotation study", (paper_part, *friction_parts),
-                  lambda: _friction_summary(settings, {mu: summaries[name] for name, mu in
-                                                       zip(friction_parts, settings.frictions)}, out)))
+    parts += [
+        (
+            name,
+            f"ensemble with friction μ = {mu:g}",
+            (paper_part,),
+            lambda mu=mu: run_friction_ensemble(mu, settings, parsl, out, scaling_json),
+        )
+        for name, mu in zip(friction_parts, settings.frictions)
+    ]
+    parts.append(
+        (
+            "friction",
+            "friction and rotation study",
+            (paper_part, *friction_parts),
+            lambda: _friction_summary(
+                settings, {mu: summaries[name] for name, mu in zip(friction_parts, settings.frictions)}, out
+            ),
+        )
+    )
     summaries: dict = {}
     computed: set = set()
     bar = progress_bar(len(parts), "hexdem paper", unit="part")
@@ -244,8 +306,9 @@ def _run_parts(settings: PaperSettings, out: Path, parsl) -> tuple[dict, float]:
                 write_json(marker, {"summary": summary, "wall_time_s": time.perf_counter() - begun})
                 summaries[name] = json.loads(marker.read_text())["summary"]
                 computed.add(name)
-                bar.write(f"hexdem paper: [{k}/{len(parts)}] {label}: {time.perf_counter() - begun:.1f} s",
-                          file=sys.stderr)
+                bar.write(
+                    f"hexdem paper: [{k}/{len(parts)}] {label}: {time.perf_counter() - begun:.1f} s", file=sys.stderr
+                )
             bar.update(1)
         bar.close()
         write_report(out, settings, summaries, time.perf_counter() - start)

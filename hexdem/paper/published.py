@@ -30,12 +30,13 @@ class Published:
     def rounding(self) -> float:
         """Half a unit of the last printed digit."""
         decimals = len(self.text.split(".")[1]) if "." in self.text else 0
-        return 0.5 * 10.0 ** -decimals
+        return 0.5 * 10.0**-decimals
 
 
 def _law(combination: str, equation: str, **values: str) -> list[Published]:
-    return [Published(f"eq. ({equation}), {combination}", quantity, combination, text)
-            for quantity, text in values.items()]
+    return [
+        Published(f"eq. ({equation}), {combination}", quantity, combination, text) for quantity, text in values.items()
+    ]
 
 
 #: The paper's numbers, in the order they appear.

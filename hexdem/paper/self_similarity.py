@@ -59,10 +59,13 @@ class SelfSimilarityStudy:
     fit_range_d: dict = field(default_factory=lambda: {"uncompressed": (10.0, 160.0), "precompressed": (10.0, 90.0)})
 
     @classmethod
-    def quick(cls) -> "SelfSimilarityStudy":
+    def quick(cls) -> SelfSimilarityStudy:
         """The test suite's version: a half-disc of 40 d and a hexagon of 30 per edge."""
-        return cls(FrontStudy(edge_beads=30, radius_beads=40, fit_range_d=(8.0, 35.0)), radius_max_d={"uncompressed": 35.0, "precompressed": 24.0},
-                   fit_range_d={"uncompressed": (8.0, 35.0), "precompressed": (8.0, 24.0)})
+        return cls(
+            FrontStudy(edge_beads=30, radius_beads=40, fit_range_d=(8.0, 35.0)),
+            radius_max_d={"uncompressed": 35.0, "precompressed": 24.0},
+            fit_range_d={"uncompressed": (8.0, 35.0), "precompressed": (8.0, 24.0)},
+        )
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -115,7 +118,9 @@ def local_front_speed(distance_m: np.ndarray, arrival_s: np.ndarray, step: int =
     either end)."""
     speed = np.full(len(distance_m), np.nan)
     with np.errstate(invalid="ignore", divide="ignore"):
-        speed[step:-step] = (distance_m[2 * step:] - distance_m[:-2 * step]) / (arrival_s[2 * step:] - arrival_s[:-2 * step])
+        speed[step:-step] = (distance_m[2 * step :] - distance_m[: -2 * step]) / (
+            arrival_s[2 * step :] - arrival_s[: -2 * step]
+        )
     return speed
 
 
@@ -125,15 +130,27 @@ def measure_ray(times_s, speeds, distance_d, diameter_m: float, fit_range_d: tup
     front = local_front_speed(distance_d * diameter_m, shapes.arrival)
     low, high = fit_range_d
     fitted = (distance_d >= low) & (distance_d <= high)
-    exponents = {name: power_law(distance_d[fitted], values[fitted])
-                 for name, values in (("amplitude", shapes.peak), ("width", shapes.width), ("speed", front))}
+    exponents = {
+        name: power_law(distance_d[fitted], values[fitted])
+        for name, values in (("amplitude", shapes.peak), ("width", shapes.width), ("speed", front))
+    }
     shape_rows = profiles(times_s, speeds, shapes)
     third = (high - low) / 3
     outer = fitted & (distance_d >= high - third)
     middle = fitted & (distance_d >= low + third) & (distance_d < high - third)
     residual = collapse_residuals(shape_rows, reference_profile(shape_rows[outer]))
-    return Ray(distance_d, shapes.peak, shapes.width, shapes.arrival, front, residual, shape_rows, exponents,
-               float(np.nanmedian(residual[middle])), fit_range_d)
+    return Ray(
+        distance_d,
+        shapes.peak,
+        shapes.width,
+        shapes.arrival,
+        front,
+        residual,
+        shape_rows,
+        exponents,
+        float(np.nanmedian(residual[middle])),
+        fit_range_d,
+    )
 
 
 def run_study_packing(study: SelfSimilarityStudy, name: str, workdir, log=None) -> dict[str, Ray]:
@@ -150,7 +167,9 @@ def run_study_packing(study: SelfSimilarityStudy, name: str, workdir, log=None) 
     origin = lattice.positions_m[lattice.struck]
     measured = {}
     for ray, beads in rays.items():
-        speeds = analysis.tracked.trace_speeds[:, [column[int(b)] for b in beads]] * analysis.settings.units.velocity_m_s
+        speeds = (
+            analysis.tracked.trace_speeds[:, [column[int(b)] for b in beads]] * analysis.settings.units.velocity_m_s
+        )
         distance_d = np.hypot(*(lattice.positions_m[beads] - origin).T) / lattice.diameter_m
         measured[ray] = measure_ray(times_s, speeds, distance_d, lattice.diameter_m, study.fit_range_d[name])
     return measured

@@ -113,11 +113,19 @@ class PaperSettings:
         return {"quick": self.quick, "steps_per_contact": self.steps_per_contact}
 
     def as_dict(self) -> dict:
-        return {**asdict(self), "n_v0": self.n_v0, "realizations": self.realizations,
-                "half_hexagon": list(self.half_hexagon), "sigma_per_tol": list(self.sigma_per_tol),
-                "study_velocity_m_s": STUDY_VELOCITY_M_S, "fig9_velocities_m_s": list(FIG9_VELOCITIES_M_S),
-                "relaxed_sigma_per_tol": list(RELAXED_SIGMA_PER_TOL), "relaxed_wall_slack_m": RELAXED_WALL_SLACK_M,
-                "crossover_sigma_per_tol": list(self.crossover_sigma_per_tol),
-                "crossover_velocities_m_s": list(CROSSOVER_VELOCITIES_M_S),
-                "friction_realizations": self.friction_realizations, "frictions": list(self.frictions),
-                "ensemble_edge_beads": self.ensemble_edge_beads}
+        return {
+            **asdict(self),
+            "n_v0": self.n_v0,
+            "realizations": self.realizations,
+            "half_hexagon": list(self.half_hexagon),
+            "sigma_per_tol": list(self.sigma_per_tol),
+            "study_velocity_m_s": STUDY_VELOCITY_M_S,
+            "fig9_velocities_m_s": list(FIG9_VELOCITIES_M_S),
+            "relaxed_sigma_per_tol": list(RELAXED_SIGMA_PER_TOL),
+            "relaxed_wall_slack_m": RELAXED_WALL_SLACK_M,
+            "crossover_sigma_per_tol": list(self.crossover_sigma_per_tol),
+            "crossover_velocities_m_s": list(CROSSOVER_VELOCITIES_M_S),
+            "friction_realizations": self.friction_realizations,
+            "frictions": list(self.frictions),
+            "ensemble_edge_beads": self.ensemble_edge_beads,
+        }

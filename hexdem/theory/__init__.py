@@ -1,1 +1,2 @@
-"""Theory of Secs. IV-V: the ternary collision approximation, the V0 sweep and the velocity-decay scaling laws, their tables and figures."""
+"""Theory of Secs. IV-V: the ternary collision approximation, the V0 sweep and the velocity-decay scaling laws, their
+tables and figures."""

@@ -27,13 +27,13 @@ import numpy as np
 from hexdem.analysis.pulse_shape import pulse_shapes
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
+from hexdem.model.model_builder import build_model
 from hexdem.model.solitary_wave import (
     HALF_MAXIMUM_WIDTH_D,
     SUPPORT_WIDTH_D,
     chain_speed_scale_m_s,
     solitary_speed_m_s,
 )
-from hexdem.model.model_builder import build_model
 
 #: Beads of the chain.
 CHAIN_BEADS = 80
@@ -47,8 +47,9 @@ CHAIN_LINE = "+30"
 def chain_config(v0_m_s: float = 0.4, n_beads: int = CHAIN_BEADS) -> RunConfig:
     """The chain struck at ``v0_m_s``, run until a pulse as slow as that of V_m = V0/2 (slower
     than any the impact makes) has crossed it."""
-    config = RunConfig(shape="sites", sites=[[k, k] for k in range(n_beads)], site_walls_deg=[],
-                       strike_angle_deg=30.0, v0=v0_m_s)
+    config = RunConfig(
+        shape="sites", sites=[[k, k] for k in range(n_beads)], site_walls_deg=[], strike_angle_deg=30.0, v0=v0_m_s
+    )
     slowest = solitary_speed_m_s(chain_speed_scale_m_s(build_model(config).bead), v0_m_s / 2)
     return config.replace(duration=n_beads * config.diameter_m / slowest)
 
@@ -75,7 +76,7 @@ def measure_chain(analysis, window: tuple[int, int] = WINDOW) -> ChainWave:
     """The chain's pulse (see the module docstring) from a run of :func:`chain_config` that
     traced :data:`CHAIN_LINE`, in SI units."""
     if analysis.settings.units.name != "si":
-        raise HexdemError("the chain's pulse is measured in SI units; run the chain with units = \"si\"")
+        raise HexdemError('the chain\'s pulse is measured in SI units; run the chain with units = "si"')
     r = analysis.results
     beads = r.lines[CHAIN_LINE]
     first, last = window

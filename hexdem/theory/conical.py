@@ -47,8 +47,15 @@ def dirac_matrix(lattice: Lattice2D, angle_rad: float) -> np.ndarray:
     return odd / (4 * omega_k * cone_slope(lattice) * np.linalg.norm(step))
 
 
-def cone_ring_radius(lattice: Lattice2D, width_m: float, times_s, polarization=CIRCULAR, speed_m_s=None,
-                     radial_points: int = 1500, angles: int = 96) -> np.ndarray:
+def cone_ring_radius(
+    lattice: Lattice2D,
+    width_m: float,
+    times_s,
+    polarization=CIRCULAR,
+    speed_m_s=None,
+    radial_points: int = 1500,
+    angles: int = 96,
+) -> np.ndarray:
     """R(t) [m] (see the module docstring) of a packet of envelope width ``width_m`` (σ) and
     ``polarization`` χ at ``times_s``, the cone's slope ``speed_m_s`` (None: v_D of ``lattice``),
     integrated on ``radial_points`` × ``angles`` points out to |q| = 6/σ."""
@@ -61,15 +68,16 @@ def cone_ring_radius(lattice: Lattice2D, width_m: float, times_s, polarization=C
     m_chi = np.array([dirac_matrix(lattice, angle) @ chi for angle in theta])  # (A, 2)
     # M is linear in (cos θ, sin θ), so dM/dθ = M(θ + π/2) exactly
     dm_chi = np.array([dirac_matrix(lattice, angle + np.pi / 2) @ chi for angle in theta])
-    g = np.exp(-(width_m * q) ** 2 / 2)
-    dg = -width_m**2 * q * g
+    g = np.exp(-((width_m * q) ** 2) / 2)
+    dg = -(width_m**2) * q * g
     weight = q[:, None] * dq * dtheta
     norm = np.sum(g**2 * q) * dq * 2 * np.pi
     second_moment = []
     for t in np.atleast_1d(np.asarray(times_s, float)):
         c, s = np.cos(speed * q * t)[:, None, None], np.sin(speed * q * t)[:, None, None]
-        along = (-speed * t * s * chi - 1j * speed * t * c * m_chi) * g[:, None, None] \
-            + (c * chi - 1j * s * m_chi) * dg[:, None, None]
+        along = (-speed * t * s * chi - 1j * speed * t * c * m_chi) * g[:, None, None] + (
+            c * chi - 1j * s * m_chi
+        ) * dg[:, None, None]
         around = -1j * s * dm_chi * (g / q)[:, None, None]
         density = np.sum(np.abs(along) ** 2 + np.abs(around) ** 2, axis=2)
         second_moment.append(np.sum(density * weight) / norm)

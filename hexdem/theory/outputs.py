@@ -13,8 +13,17 @@ from hexdem.theory.scaling import COMBINATIONS, Combination, decay_form_summary,
 from hexdem.theory.sweep import Sweep
 
 #: Files ``write_outputs`` publishes.
-OUTPUT_FILES = ("scaling.json", "peaks.csv", "decay_fits.csv", "sensitivity.csv", "decay_form.csv",
-                "fig6_vodecay30.png", "fig7_vodecay0.png", "decay_rates.png", "decay_form.png")
+OUTPUT_FILES = (
+    "scaling.json",
+    "peaks.csv",
+    "decay_fits.csv",
+    "sensitivity.csv",
+    "decay_form.csv",
+    "fig6_vodecay30.png",
+    "fig7_vodecay0.png",
+    "decay_rates.png",
+    "decay_form.png",
+)
 #: V₀ of the example traces in Figs. 6a and 7a (the paper's Fig. 6a uses 0.05).
 TRACE_V0 = 0.05
 
@@ -43,8 +52,10 @@ def read_sweep_peaks(out) -> tuple[np.ndarray, dict]:
     path = Path(out) / "peaks.csv"
     try:
         with open(path, newline="") as fh:
-            rows = [(float(r["strike_deg"]), r["line"], float(r["v0"]), int(r["n"]), float(r["peak_speed"]))
-                    for r in csv.DictReader(fh)]
+            rows = [
+                (float(r["strike_deg"]), r["line"], float(r["v0"]), int(r["n"]), float(r["peak_speed"]))
+                for r in csv.DictReader(fh)
+            ]
     except (OSError, KeyError, ValueError):
         raise HexdemError(f"{path} is missing or is not the peaks.csv of hexdem scaling") from None
     v0 = np.array(sorted({r[2] for r in rows}))
@@ -66,44 +77,99 @@ def write_outputs(sweep: Sweep, out, last: int | None = None, kind: str = "logli
     last = sweep.settings.last if last is None else last
     unit = RunConfig(units="nondimensional").unit_system.velocity_m_s
     fits = {name: sweep.fit(combination, last, kind) for name, combination in COMBINATIONS.items()}
-    forms = {name: [decay_form_test(row, c.start, last) for row in sweep.peaks(c)]
-             for name, c in COMBINATIONS.items()}
+    forms = {name: [decay_form_test(row, c.start, last) for row in sweep.peaks(c)] for name, c in COMBINATIONS.items()}
     summary = {name: fit.summary(unit) for name, fit in fits.items()}
     for name, tests in forms.items():
         summary[name]["decay_form"] = decay_form_summary(tests, sweep.v0)
-    summary["sweep"] = {**sweep.settings.as_dict(), "v0": sweep.v0.tolist(), "wall_time_s": sweep.wall_time_s,
-                        "max_energy_drift": max(run.energy_drift for run in sweep.runs.values()),
-                        "velocity_unit_m_s": unit,
-                        "runs_that_warned": [{"strike_deg": run.strike_deg, "v0": run.v0, "warnings": list(run.warnings)}
-                                             for run in sweep.runs.values() if run.warnings]}
+    summary["sweep"] = {
+        **sweep.settings.as_dict(),
+        "v0": sweep.v0.tolist(),
+        "wall_time_s": sweep.wall_time_s,
+        "max_energy_drift": max(run.energy_drift for run in sweep.runs.values()),
+        "velocity_unit_m_s": unit,
+        "runs_that_warned": [
+            {"strike_deg": run.strike_deg, "v0": run.v0, "warnings": list(run.warnings)}
+            for run in sweep.runs.values()
+            if run.warnings
+        ],
+    }
     write_json(out / "scaling.json", summary)
 
-    peak_rows = [(run.strike_deg, line, run.v0, n, float(v), float(t), " ".join(run.warnings))
-                 for run in sorted(sweep.runs.values(), key=lambda r: (r.strike_deg, r.v0))
-                 for line in ("0", "+30") for n, (v, t) in enumerate(zip(run.peaks[line], run.t_peak[line]))]
+    peak_rows = [
+        (run.strike_deg, line, run.v0, n, float(v), float(t), " ".join(run.warnings))
+        for run in sorted(sweep.runs.values(), key=lambda r: (r.strike_deg, r.v0))
+        for line in ("0", "+30")
+        for n, (v, t) in enumerate(zip(run.peaks[line], run.t_peak[line]))
+    ]
     write_csv(out / "peaks.csv", ("strike_deg", "line", "v0", "n", "peak_speed", "t_peak", "warnings"), peak_rows)
 
-    write_csv(out / "decay_fits.csv",
-              ("combination", "v0", "c", "c_stderr", "v_start", "v_start_over_v0", "c_law", "v_start_over_v0_law"),
-              [(name, v, c, e, vs, vs / v, float(f.law.decay_rate(v)), float(f.law.start_ratio(v)))
-               for name, f in fits.items() for v, c, e, vs in zip(f.v0, f.c, f.c_stderr, f.v_start)])
-    sensitivity_rows = [row for c in COMBINATIONS.values()
-                        for row in sensitivity(c, sweep.v0, sweep.peaks(c), range(c.start + 2, complete_beads(sweep.peaks(c))))]
+    write_csv(
+        out / "decay_fits.csv",
+        ("combination", "v0", "c", "c_stderr", "v_start", "v_start_over_v0", "c_law", "v_start_over_v0_law"),
+        [
+            (name, v, c, e, vs, vs / v, float(f.law.decay_rate(v)), float(f.law.start_ratio(v)))
+            for name, f in fits.items()
+            for v, c, e, vs in zip(f.v0, f.c, f.c_stderr, f.v_start)
+        ],
+    )
+    sensitivity_rows = [
+        row
+        for c in COMBINATIONS.values()
+        for row in sensitivity(c, sweep.v0, sweep.peaks(c), range(c.start + 2, complete_beads(sweep.peaks(c))))
+    ]
     write_csv(out / "sensitivity.csv", tuple(sensitivity_rows[0]), [tuple(r.values()) for r in sensitivity_rows])
-    write_csv(out / "decay_form.csv",
-              ("combination", "v0", "rss_geometric", "rss_power", "q", "p", "ratio_slope", "ratio_slope_stderr",
-               "power_ratio_slope", "drift_fraction", "verdict"),
-              [(name, v, t.rss_geometric, t.rss_power, t.q, t.p, t.ratio_slope, t.ratio_slope_stderr,
-                t.power_ratio_slope, t.drift_fraction, t.verdict)
-               for name, tests in forms.items() for v, t in zip(sweep.v0, tests)])
+    write_csv(
+        out / "decay_form.csv",
+        (
+            "combination",
+            "v0",
+            "rss_geometric",
+            "rss_power",
+            "q",
+            "p",
+            "ratio_slope",
+            "ratio_slope_stderr",
+            "power_ratio_slope",
+            "drift_fraction",
+            "verdict",
+        ),
+        [
+            (
+                name,
+                v,
+                t.rss_geometric,
+                t.rss_power,
+                t.q,
+                t.p,
+                t.ratio_slope,
+                t.ratio_slope_stderr,
+                t.power_ratio_slope,
+                t.drift_fraction,
+                t.verdict,
+            )
+            for name, tests in forms.items()
+            for v, t in zip(sweep.v0, tests)
+        ],
+    )
 
-    theory_plots.vodecay30(_trace(sweep, COMBINATIONS["30/30"]), fits["30/30"], fits["30/0"],
-                           out / "fig6_vodecay30.png")
+    theory_plots.vodecay30(
+        _trace(sweep, COMBINATIONS["30/30"]), fits["30/30"], fits["30/0"], out / "fig6_vodecay30.png"
+    )
     theory_plots.vodecay0(_trace(sweep, COMBINATIONS["0/0"]), fits["0/0"], fits["0/30"], out / "fig7_vodecay0.png")
     theory_plots.decay_rates(list(fits.values()), out / "decay_rates.png")
     picks = sorted({0, len(sweep.v0) // 2, len(sweep.v0) - 1})
     theory_plots.decay_form(
-        {name: [(sweep.v0[i], np.arange(c.start, last), sweep.peaks(c)[i, c.start + 1:last + 1]
-                 / sweep.peaks(c)[i, c.start:last]) for i in picks] for name, c in COMBINATIONS.items()},
-        out / "decay_form.png")
+        {
+            name: [
+                (
+                    sweep.v0[i],
+                    np.arange(c.start, last),
+                    sweep.peaks(c)[i, c.start + 1 : last + 1] / sweep.peaks(c)[i, c.start : last],
+                )
+                for i in picks
+            ]
+            for name, c in COMBINATIONS.items()
+        },
+        out / "decay_form.png",
+    )
     return summary

@@ -42,7 +42,9 @@ from hexdem.model.precompression import spring_stiffness, static_overlap
 #: The band structure's path through the Brillouin zone.
 PATH = ("Γ", "K", "M", "Γ")
 #: Unit vectors of the three bond directions (their opposites are the other three neighbours).
-BOND_DIRECTIONS = np.array([[math.cos(math.radians(angle)), math.sin(math.radians(angle))] for angle in (30.0, 90.0, 150.0)])
+BOND_DIRECTIONS = np.array(
+    [[math.cos(math.radians(angle)), math.sin(math.radians(angle))] for angle in (30.0, 90.0, 150.0)]
+)
 
 
 @dataclass(frozen=True)
@@ -54,17 +56,20 @@ class Lattice2D:
     mass_kg: float
 
     @classmethod
-    def precompressed(cls, force_n: float, diameter_m: float, material: Material = STEEL_316) -> "Lattice2D":
+    def precompressed(cls, force_n: float, diameter_m: float, material: Material = STEEL_316) -> Lattice2D:
         """The packing of ``material`` spheres of ``diameter_m`` with every contact at ``force_n`` > 0
         (an uncompressed packing has no linear waves)."""
         if not force_n > 0:
             raise HexdemError(f"linear waves need a precompression > 0 N per contact, got {force_n!r}")
         coefficient = float(hertz_coefficient(diameter_m, material))
-        return cls(diameter_m - static_overlap(force_n, coefficient), spring_stiffness(force_n, coefficient),
-                   float(sphere_mass(diameter_m, material)))
+        return cls(
+            diameter_m - static_overlap(force_n, coefficient),
+            spring_stiffness(force_n, coefficient),
+            float(sphere_mass(diameter_m, material)),
+        )
 
     @classmethod
-    def of(cls, config) -> "Lattice2D":
+    def of(cls, config) -> Lattice2D:
         """The packing of a :class:`~hexdem.model.config.RunConfig` (its beads' material and size,
         its ``precompression_n``)."""
         return cls.precompressed(config.precompression_n, config.diameter_m, config.material(config.bead_material))
@@ -80,8 +85,11 @@ class Lattice2D:
         edge next to K (|K − M| = 2π/(3a)): half the reciprocal vector perpendicular to the
         150° bonds."""
         a = self.spacing_m
-        return {"Γ": np.zeros(2), "K": np.array([0.0, 4 * math.pi / (3 * a)]),
-                "M": np.array([math.pi / (math.sqrt(3) * a), math.pi / a])}
+        return {
+            "Γ": np.zeros(2),
+            "K": np.array([0.0, 4 * math.pi / (3 * a)]),
+            "M": np.array([math.pi / (math.sqrt(3) * a), math.pi / a]),
+        }
 
     def dirac_frequency(self) -> float:
         """ω_K = sqrt(9/2) sqrt(k/m) [rad/s], where the two bands meet (module docstring)."""

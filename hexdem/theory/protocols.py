@@ -33,8 +33,22 @@ STARTS = (1, 2, 3)
 #: A protocol is consistent when |Δ| ≤ this many standard errors + the published rounding.
 CONSISTENT_SIGMAS = 2.0
 #: Columns of a protocol table (``fit_protocols.csv``).
-PROTOCOL_COLUMNS = ("combination", "start", "last", "anchored", "fit", "v0_min", "v0_max", "n_v0",
-                    "m", "m_stderr", "b", "b_stderr", "distance", "consistent")
+PROTOCOL_COLUMNS = (
+    "combination",
+    "start",
+    "last",
+    "anchored",
+    "fit",
+    "v0_min",
+    "v0_max",
+    "n_v0",
+    "m",
+    "m_stderr",
+    "b",
+    "b_stderr",
+    "distance",
+    "consistent",
+)
 
 
 @dataclass(frozen=True)
@@ -74,10 +88,22 @@ class ProtocolSearch:
 
     def row(self, i: int) -> tuple:
         """Protocol ``i`` as a row of :data:`PROTOCOL_COLUMNS`."""
-        return (self.combination, int(self.start[i]), int(self.last[i]), bool(self.anchored[i]),
-                FIT_KINDS[self.kind[i]], float(self.v0[self.first[i]]), float(self.v0[self.final[i]]),
-                int(self.final[i] - self.first[i] + 1), float(self.m[i]), float(self.m_stderr[i]),
-                float(self.b[i]), float(self.b_stderr[i]), float(self.distance[i]), bool(self.consistent[i]))
+        return (
+            self.combination,
+            int(self.start[i]),
+            int(self.last[i]),
+            bool(self.anchored[i]),
+            FIT_KINDS[self.kind[i]],
+            float(self.v0[self.first[i]]),
+            float(self.v0[self.final[i]]),
+            int(self.final[i] - self.first[i] + 1),
+            float(self.m[i]),
+            float(self.m_stderr[i]),
+            float(self.b[i]),
+            float(self.b_stderr[i]),
+            float(self.distance[i]),
+            bool(self.consistent[i]),
+        )
 
     def closest(self, count: int = 1) -> list[int]:
         """Indices of the ``count`` protocols nearest the target."""
@@ -85,11 +111,19 @@ class ProtocolSearch:
 
     def find(self, start: int, last: int, anchored: bool, kind: str, first: int, final: int) -> int:
         """Index of one protocol (e.g. the paper's stated one)."""
-        match = np.flatnonzero((self.start == start) & (self.last == last) & (self.anchored == anchored)
-                               & (self.kind == FIT_KINDS.index(kind)) & (self.first == first) & (self.final == final))
+        match = np.flatnonzero(
+            (self.start == start)
+            & (self.last == last)
+            & (self.anchored == anchored)
+            & (self.kind == FIT_KINDS.index(kind))
+            & (self.first == first)
+            & (self.final == final)
+        )
         if len(match) == 0:
-            raise HexdemError(f"{self.combination}: no protocol with window {start}..{last}, "
-                              f"{'anchored' if anchored else 'free'} {kind}, V0 indices {first}..{final} was searched")
+            raise HexdemError(
+                f"{self.combination}: no protocol with window {start}..{last}, "
+                f"{'anchored' if anchored else 'free'} {kind}, V0 indices {first}..{final} was searched"
+            )
         return int(match[0])
 
     def consistent_shares(self) -> dict:
@@ -102,13 +136,15 @@ class ProtocolSearch:
         def share(mask) -> float:
             return round(float(np.count_nonzero(mask & chosen)) / total, 3)
 
-        return {"count": total,
-                "anchored": share(self.anchored),
-                **{f"fit_{name}": share(self.kind == k) for k, name in enumerate(FIT_KINDS)},
-                **{f"start_{s}": share(self.start == s) for s in np.unique(self.start)},
-                "last_range": [int(self.last[chosen].min()), int(self.last[chosen].max())],
-                "v0_min_range": [float(self.v0[self.first[chosen]].min()), float(self.v0[self.first[chosen]].max())],
-                "v0_max_range": [float(self.v0[self.final[chosen]].min()), float(self.v0[self.final[chosen]].max())]}
+        return {
+            "count": total,
+            "anchored": share(self.anchored),
+            **{f"fit_{name}": share(self.kind == k) for k, name in enumerate(FIT_KINDS)},
+            **{f"start_{s}": share(self.start == s) for s in np.unique(self.start)},
+            "last_range": [int(self.last[chosen].min()), int(self.last[chosen].max())],
+            "v0_min_range": [float(self.v0[self.first[chosen]].min()), float(self.v0[self.first[chosen]].max())],
+            "v0_max_range": [float(self.v0[self.final[chosen]].min()), float(self.v0[self.final[chosen]].max())],
+        }
 
 
 def line_fits_over_ranges(x, y, min_points: int = MIN_V0):
@@ -119,8 +155,17 @@ def line_fits_over_ranges(x, y, min_points: int = MIN_V0):
     """
     x, y = np.asarray(x, float), np.asarray(y, float)
     xc, yc = x - x.mean(), y - y.mean()
-    prefix = {name: np.concatenate([[0.0], np.cumsum(values)]) for name, values in
-              (("1", np.ones_like(x)), ("x", xc), ("y", yc), ("xx", xc * xc), ("xy", xc * yc), ("yy", yc * yc))}
+    prefix = {
+        name: np.concatenate([[0.0], np.cumsum(values)])
+        for name, values in (
+            ("1", np.ones_like(x)),
+            ("x", xc),
+            ("y", yc),
+            ("xx", xc * xc),
+            ("xy", xc * yc),
+            ("yy", yc * yc),
+        )
+    }
     first, final = (a.ravel() for a in np.meshgrid(np.arange(len(x)), np.arange(len(x)), indexing="ij"))
     keep = final - first + 1 >= min_points
     first, final = first[keep], final[keep]
@@ -152,12 +197,23 @@ def search_protocols(name: str, v0, peaks, target: Target, max_last: int, starts
                     c = np.array([fit_decay(n, row, start, last, kind, anchored)[0] for row in peaks])
                     first, final, m, m_err, b, b_err = line_fits_over_ranges(v0, c)
                     size = len(m)
-                    parts.append({"start": np.full(size, start), "last": np.full(size, last),
-                                  "anchored": np.full(size, anchored), "kind": np.full(size, kind_index),
-                                  "first": first, "final": final, "m": m, "m_stderr": m_err, "b": b,
-                                  "b_stderr": b_err})
+                    parts.append(
+                        {
+                            "start": np.full(size, start),
+                            "last": np.full(size, last),
+                            "anchored": np.full(size, anchored),
+                            "kind": np.full(size, kind_index),
+                            "first": first,
+                            "final": final,
+                            "m": m,
+                            "m_stderr": m_err,
+                            "b": b,
+                            "b_stderr": b_err,
+                        }
+                    )
     columns = {key: np.concatenate([part[key] for part in parts]) for key in parts[0]}
     distance = np.hypot((columns["m"] - target.m) / target.m, (columns["b"] - target.b) / target.b)
-    consistent = ((abs(columns["m"] - target.m) <= CONSISTENT_SIGMAS * columns["m_stderr"] + target.m_rounding)
-                  & (abs(columns["b"] - target.b) <= CONSISTENT_SIGMAS * columns["b_stderr"] + target.b_rounding))
+    consistent = (abs(columns["m"] - target.m) <= CONSISTENT_SIGMAS * columns["m_stderr"] + target.m_rounding) & (
+        abs(columns["b"] - target.b) <= CONSISTENT_SIGMAS * columns["b_stderr"] + target.b_rounding
+    )
     return ProtocolSearch(name, v0, distance=distance, consistent=consistent, **columns)

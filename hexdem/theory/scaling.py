@@ -64,12 +64,15 @@ class Combination:
     degree: int
 
 
-COMBINATIONS = {c.name: c for c in (
-    Combination("30/30", 30.0, "+30", 1, "v30", 1),
-    Combination("30/0", 30.0, "0", 2, "v0", 2),
-    Combination("0/0", 0.0, "0", 2, "v0", 2),
-    Combination("0/30", 0.0, "+30", 1, "veq0", 2),
-)}
+COMBINATIONS = {
+    c.name: c
+    for c in (
+        Combination("30/30", 30.0, "+30", 1, "v30", 1),
+        Combination("30/0", 30.0, "0", 2, "v0", 2),
+        Combination("0/0", 0.0, "0", 2, "v0", 2),
+        Combination("0/30", 0.0, "+30", 1, "veq0", 2),
+    )
+}
 FIT_KINDS = ("loglinear", "nonlinear")
 #: Default last bead of the fit windows (the paper's Figs. 6a and 7a show beads 0–12).
 DEFAULT_LAST = 12
@@ -148,8 +151,9 @@ def fit_decay(n, v, start: int, last: int, kind: str = "loglinear", anchored: bo
         if anchored:
             popt, pcov = curve_fit(lambda kk, cc: anchor * cc**kk, k.astype(float), vk, p0=[c])
         else:
-            popt, pcov = curve_fit(lambda kk, cc, amplitude: amplitude * cc**kk, k.astype(float), vk,
-                                   p0=[c, math.exp(coefficients[1])])
+            popt, pcov = curve_fit(
+                lambda kk, cc, amplitude: amplitude * cc**kk, k.astype(float), vk, p0=[c, math.exp(coefficients[1])]
+            )
         c, c_err = float(popt[0]), float(np.sqrt(pcov[0, 0]))
     return c, c_err
 
@@ -181,7 +185,7 @@ class ScalingLaw:
         v0 = np.asarray(v0, float)
         return v0 * self.start_ratio(v0) * self.decay_rate(v0) ** (np.asarray(n) - self.start)
 
-    def physical(self, velocity_unit_m_s: float) -> "ScalingLaw":
+    def physical(self, velocity_unit_m_s: float) -> ScalingLaw:
         r"""The same law for V₀ and V_n in m/s: every V becomes V/U, :math:`U = d^{5/4} \sqrt{A/M}`
         (``velocity_unit_m_s``, end of Sec. V), so m and the V₀-powers of the polynomial pick up
         powers of 1/U."""
@@ -212,8 +216,9 @@ class CombinationFit:
 
     @property
     def law(self) -> ScalingLaw:
-        return ScalingLaw(self.combination.name, self.combination.start, self.rate["m"], self.rate["b"],
-                          tuple(self.ratio.values))
+        return ScalingLaw(
+            self.combination.name, self.combination.start, self.rate["m"], self.rate["b"], tuple(self.ratio.values)
+        )
 
     def summary(self, velocity_unit_m_s: float) -> dict:
         """The ``scaling.json`` entry: coefficients, standard errors, window, V₀ range."""
@@ -238,12 +243,13 @@ class CombinationFit:
             "observation_line": self.combination.line,
             "equation": self.combination.equation,
             "law": f"V_n = V0 ({_polynomial_text(degree)}) (m V0 + b)^(n - {self.combination.start}), "
-                   f"n >= {self.combination.start}",
+            f"n >= {self.combination.start}",
             "rms_relative_residual_c": float(np.sqrt(self.rate.rss / len(self.v0)) / np.mean(self.c)),
             "physical": {
-                "units": "V0, V_n in m/s; m in s/m; alpha in (s/m)^%d; beta in (s/m)^%d" % (degree, degree - 1),
+                "units": f"V0, V_n in m/s; m in s/m; alpha in (s/m)^{degree}; beta in (s/m)^{degree - 1}",
                 "velocity_unit_m_s": velocity_unit_m_s,
-                "m": physical.m, "b": physical.b,
+                "m": physical.m,
+                "b": physical.b,
                 **dict(zip(names, list(physical.amplitude) + [None] * (3 - len(physical.amplitude)))),
             },
         }
@@ -253,19 +259,21 @@ def _polynomial_text(degree: int) -> str:
     return "alpha V0 + beta" if degree == 1 else "alpha V0^2 + beta V0 + gamma"
 
 
-def fit_combination(combination: Combination, v0, peaks, last: int = DEFAULT_LAST,
-                    kind: str = "loglinear") -> CombinationFit:
+def fit_combination(
+    combination: Combination, v0, peaks, last: int = DEFAULT_LAST, kind: str = "loglinear"
+) -> CombinationFit:
     """Fit one combination: ``peaks`` (K, L) peak speeds V_n of its line for each V₀ of ``v0``."""
     v0, peaks = np.asarray(v0, float), np.asarray(peaks, float)
     start = combination.start
     if not start + 2 <= last < peaks.shape[1]:
-        raise HexdemError(f"{combination.name}: the window's last bead must lie in {start + 2}..{peaks.shape[1] - 1}, "
-                          f"got {last}")
+        raise HexdemError(
+            f"{combination.name}: the window's last bead must lie in {start + 2}..{peaks.shape[1] - 1}, got {last}"
+        )
     n = np.arange(peaks.shape[1])
     decay = np.array([fit_decay(n, row, start, last, kind) for row in peaks])
     v_start = peaks[:, start]
     rate = polynomial_fit(v0, decay[:, 0], 1, ("m", "b"))
-    ratio = polynomial_fit(v0, v_start / v0, combination.degree, ("alpha", "beta", "gamma")[:combination.degree + 1])
+    ratio = polynomial_fit(v0, v_start / v0, combination.degree, ("alpha", "beta", "gamma")[: combination.degree + 1])
     return CombinationFit(combination, last, kind, v0, decay[:, 0], decay[:, 1], v_start, rate, ratio)
 
 
@@ -278,9 +286,17 @@ def sensitivity(combination: Combination, v0, peaks, lasts=None) -> list[dict]:
     for last in lasts:
         for kind in FIT_KINDS:
             fit = fit_combination(combination, v0, peaks, last, kind)
-            rows.append({"combination": combination.name, "last": last, "fit": kind,
-                         "m": fit.rate["m"], "m_stderr": fit.rate.error("m"),
-                         "b": fit.rate["b"], "b_stderr": fit.rate.error("b")})
+            rows.append(
+                {
+                    "combination": combination.name,
+                    "last": last,
+                    "fit": kind,
+                    "m": fit.rate["m"],
+                    "m_stderr": fit.rate.error("m"),
+                    "b": fit.rate["b"],
+                    "b_stderr": fit.rate.error("b"),
+                }
+            )
     return rows
 
 
@@ -318,7 +334,7 @@ class DecayFormTest:
 
     @property
     def verdict(self) -> str:
-        """"geometric" or "power" when the residuals and the ratio drift agree, else "neither"."""
+        """ "geometric" or "power" when the residuals and the ratio drift agree, else "neither"."""
         if self.rss_geometric < self.rss_power and self.drift_fraction < GEOMETRIC_BELOW:
             return "geometric"
         if self.rss_power < self.rss_geometric and self.drift_fraction > POWER_ABOVE:
@@ -338,14 +354,21 @@ def decay_form_test(v, start: int, last: int) -> DecayFormTest:
         raise HexdemError(f"the form test needs 1 <= start and at least 4 beads, got {start}..{last}")
     v = np.asarray(v, float)
     n = np.arange(start, last + 1).astype(float)
-    log_v = np.log(v[start:last + 1])
+    log_v = np.log(v[start : last + 1])
     geometric = polynomial_fit(n, log_v, 1, ("slope", "intercept"))
     power = polynomial_fit(np.log(n), log_v, 1, ("slope", "intercept"))
     p = -power["slope"]
-    drift = polynomial_fit(n[:-1], v[start + 1:last + 1] / v[start:last], 1, ("slope", "intercept"))
+    drift = polynomial_fit(n[:-1], v[start + 1 : last + 1] / v[start:last], 1, ("slope", "intercept"))
     power_drift = polynomial_fit(n[:-1], (n[:-1] / n[1:]) ** p, 1, ("slope", "intercept"))
-    return DecayFormTest(geometric.rss, power.rss, math.exp(geometric["slope"]), p,
-                         drift["slope"], drift.error("slope"), power_drift["slope"])
+    return DecayFormTest(
+        geometric.rss,
+        power.rss,
+        math.exp(geometric["slope"]),
+        p,
+        drift["slope"],
+        drift.error("slope"),
+        power_drift["slope"],
+    )
 
 
 def decay_form_summary(tests, v0) -> dict:
@@ -358,10 +381,16 @@ def decay_form_summary(tests, v0) -> dict:
     return {
         "verdict": winner if counts[winner] > len(tests) / 2 else "mixed",
         "verdict_counts": counts,
-        "smaller_rss_counts": {"geometric": sum(t.rss_geometric < t.rss_power for t in tests),
-                               "power": sum(t.rss_power <= t.rss_geometric for t in tests)},
+        "smaller_rss_counts": {
+            "geometric": sum(t.rss_geometric < t.rss_power for t in tests),
+            "power": sum(t.rss_power <= t.rss_geometric for t in tests),
+        },
         "median_drift_fraction": float(np.median([t.drift_fraction for t in tests])),
-        "ratio_slope_per_bead": {"at_v0_min": tests[0].ratio_slope, "at_v0_max": tests[-1].ratio_slope,
-                                 "v0_min": float(v0[0]), "v0_max": float(v0[-1])},
+        "ratio_slope_per_bead": {
+            "at_v0_min": tests[0].ratio_slope,
+            "at_v0_max": tests[-1].ratio_slope,
+            "v0_min": float(v0[0]),
+            "v0_max": float(v0[-1]),
+        },
         "median_rss_power_over_geometric": float(np.median([t.rss_power / t.rss_geometric for t in tests])),
     }

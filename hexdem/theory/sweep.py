@@ -24,11 +24,10 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from hexdem.errors import HexdemError, one_line
-from hexdem.experiments.executors import (holding, parsl_session, run_tasks, study_executor, study_retries,
-                                          tasks_failed)
-from hexdem.theory.scaling import DEFAULT_LAST, Combination, CombinationFit, fit_combination
+from hexdem.experiments.executors import holding, parsl_session, run_tasks, study_executor, study_retries, tasks_failed
 from hexdem.model.model_builder import build_model
 from hexdem.model.run_settings import contact_time_s
+from hexdem.theory.scaling import DEFAULT_LAST, Combination, CombinationFit, fit_combination
 
 #: Strike angles of the sweep [deg]: each one serves two combinations.
 STRIKES_DEG = (0.0, 30.0)
@@ -62,8 +61,10 @@ class SweepSettings:
 
     def __post_init__(self):
         if not (0 < self.v0_min < self.v0_max and self.n_v0 >= 4):
-            raise HexdemError(f"need 0 < v0_min < v0_max and at least 4 values of V0 (the quadratic laws have "
-                              f"3 parameters), got {self.v0_min}..{self.v0_max} with {self.n_v0} values")
+            raise HexdemError(
+                f"need 0 < v0_min < v0_max and at least 4 values of V0 (the quadratic laws have "
+                f"3 parameters), got {self.v0_min}..{self.v0_max} with {self.n_v0} values"
+            )
         if self.steps_per_contact < self.samples_per_contact or self.samples_per_contact < 5:
             raise HexdemError("need steps_per_contact >= samples_per_contact >= 5")
         if self.workers < 1:
@@ -87,10 +88,17 @@ class SweepSettings:
         """The :class:`~hexdem.model.config.RunConfig` of one run of the sweep."""
         from hexdem.model.config import RunConfig
 
-        base = RunConfig(shape="hexagon", edge_beads=self.hexagon_edge, wall_material="none",
-                         units="nondimensional", v0=float(v0), strike_angle_deg=float(strike_deg),
-                         engine=self.engine, dump_every=self.steps_per_contact // self.samples_per_contact,
-                         launcher=self.launcher)
+        base = RunConfig(
+            shape="hexagon",
+            edge_beads=self.hexagon_edge,
+            wall_material="none",
+            units="nondimensional",
+            v0=float(v0),
+            strike_angle_deg=float(strike_deg),
+            engine=self.engine,
+            dump_every=self.steps_per_contact // self.samples_per_contact,
+            launcher=self.launcher,
+        )
         tau = contact_time_s(base, build_model(base)) / base.unit_system.time_s
         return base.replace(dt=tau / self.steps_per_contact, duration=self.duration_contacts * tau)
 
@@ -119,23 +127,31 @@ def run_one(settings: SweepSettings, v0: float, strike_deg: float) -> RunPeaks:
     with tempfile.TemporaryDirectory(prefix="hexdem-scaling-") as scratch:
         analysis = simulate(config, scratch, trace_lines=("0", "+30"))
     r = analysis.results
-    lines = {name: r.lines[name][:settings.last + 2] for name in ("0", "+30")}
+    lines = {name: r.lines[name][: settings.last + 2] for name in ("0", "+30")}
     traces = {}
     for name, beads in lines.items():
         times, speeds = analysis.line_trace(name)
-        traces[name] = (times, speeds[:, :len(beads)])
+        traces[name] = (times, speeds[:, : len(beads)])
     t_peak = {name: r.t_peak[beads] for name, beads in lines.items()}
     end = analysis.settings.duration_s / analysis.settings.units.time_s
     tau = config.duration / settings.duration_contacts
-    return RunPeaks(float(v0), float(strike_deg),
-                    {name: r.peak_speed[beads] for name, beads in lines.items()}, t_peak, traces,
-                    float(r.energy_drift), time.perf_counter() - start,
-                    window_warnings({name: times[:settings.last + 1] for name, times in t_peak.items()}, end, tau))
+    return RunPeaks(
+        float(v0),
+        float(strike_deg),
+        {name: r.peak_speed[beads] for name, beads in lines.items()},
+        t_peak,
+        traces,
+        float(r.energy_drift),
+        time.perf_counter() - start,
+        window_warnings({name: times[: settings.last + 1] for name, times in t_peak.items()}, end, tau),
+    )
 
 
 #: Warnings of a run of the V₀ sweep, by name: what its fits should not be trusted for.
-SCALING_WARNINGS = {"window_peak_near_end": "a bead of the fit window peaked within one contact time of the run's end "
-                                            "(or not at all): its peak may be cut short; raise duration_contacts"}
+SCALING_WARNINGS = {
+    "window_peak_near_end": "a bead of the fit window peaked within one contact time of the run's end "
+    "(or not at all): its peak may be cut short; raise duration_contacts"
+}
 
 
 def window_warnings(t_peak: dict, end: float, contact_time: float) -> tuple[str, ...]:
@@ -166,12 +182,14 @@ class Sweep:
     def fit(self, combination: Combination, last: int | None = None, kind: str = "loglinear") -> CombinationFit:
         peaks = self.peaks(combination)
         last = self.settings.last if last is None else last
-        missing = ~np.isfinite(peaks[:, :last + 1])
+        missing = ~np.isfinite(peaks[:, : last + 1])
         if missing.any():
             i, n = np.argwhere(missing)[0]
-            raise HexdemError(f"{combination.name}: bead {n} had not peaked at V0 = {self.v0[i]:.4g} within "
-                              f"{self.settings.duration_contacts} contact times; raise duration_contacts or "
-                              "lower the window's last bead")
+            raise HexdemError(
+                f"{combination.name}: bead {n} had not peaked at V0 = {self.v0[i]:.4g} within "
+                f"{self.settings.duration_contacts} contact times; raise duration_contacts or "
+                "lower the window's last bead"
+            )
         return fit_combination(combination, self.v0, peaks, last, kind)
 
 
@@ -189,8 +207,10 @@ def run_sweep(settings: SweepSettings, log=None, parsl=None) -> Sweep:
     with holding(parsl, settings.workers):
         for done, (key, result) in enumerate(_results(settings, jobs, parsl), 1):
             sweep.runs[key] = result
-            log(f"[{done}/{len(jobs)}] strike {result.strike_deg:g} deg, V0 = {result.v0:.4g}: "
-                f"{result.wall_time_s:.1f} s, energy drift {result.energy_drift:.1e}")
+            log(
+                f"[{done}/{len(jobs)}] strike {result.strike_deg:g} deg, V0 = {result.v0:.4g}: "
+                f"{result.wall_time_s:.1f} s, energy drift {result.energy_drift:.1e}"
+            )
     sweep.wall_time_s = time.perf_counter() - start
     return sweep
 

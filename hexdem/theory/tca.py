@@ -38,7 +38,8 @@ invariant under :math:`x → λx,\ t → λ^{−1/4} t,\ v → λ^{5/4} v`.
     \frac{z}{\sqrt{2E}}, \qquad E = V^2/2.
 
 The paper prints :math:`\sqrt{k}` in the argument; k is what energy conservation
-:math:`\tfrac{1}{2}\dot z^2 + \tfrac{2k}{5} z^{5/2} = E` gives, and what :func:`hypergeometric_time` uses (the tests check
+:math:`\tfrac{1}{2}\dot z^2 + \tfrac{2k}{5} z^{5/2} = E` gives, and what :func:`hypergeometric_time` uses (the tests
+check
 it against direct integration).
 
 **Full lattice.** T_n as the paper defines it: t = 0 when the velocities of beads n − 1 and
@@ -134,13 +135,23 @@ def solve_omega() -> float:
 def _until_rate_vanishes(rhs, state0, rate, theta: float, v: float):
     """Integrate ``rhs`` from ``state0`` until ``rate(state)`` falls through zero:
     (time, state, dense solution)."""
+
     def stops(t, s, theta):
         return rate(s)
 
     stops.terminal, stops.direction = True, -1
     horizon = 50.0 * v**-0.2  # many Hertz contact times at speed v (A = M = 1)
-    sol = solve_ivp(rhs, (0.0, horizon), state0, args=(theta,), method="DOP853",
-                    rtol=RTOL, atol=ATOL, events=stops, dense_output=True)
+    sol = solve_ivp(
+        rhs,
+        (0.0, horizon),
+        state0,
+        args=(theta,),
+        method="DOP853",
+        rtol=RTOL,
+        atol=ATOL,
+        events=stops,
+        dense_output=True,
+    )
     if not sol.t_events[0].size:
         raise HexdemError("the TCA never reached equal velocities of beads 0 and 1")
     return float(sol.t_events[0][0]), sol.y_events[0][0], sol
@@ -253,8 +264,12 @@ def predict_pulses(v_first: float, n_first: int, n_last: int, theta: float = THE
     c, omega = decay_factor(theta), solve_omega()
     n = np.arange(n_first, n_last + 1)
     velocity = v_first * c ** (n - n_first)
-    return PulsePrediction(n, velocity, np.array([residence_time(v, theta) for v in velocity]),
-                           np.array([hypergeometric_residence_time(v, omega) for v in velocity]))
+    return PulsePrediction(
+        n,
+        velocity,
+        np.array([residence_time(v, theta) for v in velocity]),
+        np.array([hypergeometric_residence_time(v, omega) for v in velocity]),
+    )
 
 
 @dataclass(frozen=True)
@@ -338,22 +353,29 @@ def arrival_time_table(analysis, line: str = "+30") -> dict:
     units = _nondimensional_units(analysis)
     scale = analysis.settings.units.time_s / units.time_s
     lattice = lattice_pulses(analysis, line).crossing_time
-    lattice = lattice[:np.flatnonzero(np.isfinite(lattice))[-1] + 1]
+    lattice = lattice[: np.flatnonzero(np.isfinite(lattice))[-1] + 1]
     v1 = 0.5 * v0_m_s / units.velocity_m_s
     prediction = predict_pulses(v1, 1, len(lattice) - 1)
     tca, hyperg = prediction.arrival_times(t_first=lattice[0] * scale)
-    return {"n": np.arange(1, len(lattice) + 1), "lattice": lattice,
-            "tca": np.concatenate([[lattice[0]], tca / scale]),
-            "hyperg": np.concatenate([[lattice[0]], hyperg / scale])}
+    return {
+        "n": np.arange(1, len(lattice) + 1),
+        "lattice": lattice,
+        "tca": np.concatenate([[lattice[0]], tca / scale]),
+        "hyperg": np.concatenate([[lattice[0]], hyperg / scale]),
+    }
 
 
 def summary() -> dict:
     """ω, c and the TCA's timing at V₀ = 1 (T scales as :math:`V_0^{-1/5}`), nondimensional (``hexdem tca``)."""
     event = equal_velocity(1.0)
     omega = solve_omega()
-    return {"omega": omega, "c": event.decay_factor,
-            "compatibility_residual": float(compatibility_residual(omega)),
-            "equal_velocity_fraction": event.velocity, "bca_equal_velocity_fraction": BCA_EQUAL_VELOCITY_FRACTION,
-            "residence_time_at_v0_1": event.time,
-            "residence_time_hyperg_at_v0_1": hypergeometric_residence_time(1.0, omega),
-            "units": "nondimensional, A = d = M = 1"}
+    return {
+        "omega": omega,
+        "c": event.decay_factor,
+        "compatibility_residual": float(compatibility_residual(omega)),
+        "equal_velocity_fraction": event.velocity,
+        "bca_equal_velocity_fraction": BCA_EQUAL_VELOCITY_FRACTION,
+        "residence_time_at_v0_1": event.time,
+        "residence_time_hyperg_at_v0_1": hypergeometric_residence_time(1.0, omega),
+        "units": "nondimensional, A = d = M = 1",
+    }

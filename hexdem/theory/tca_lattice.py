@@ -14,8 +14,8 @@ import numpy as np
 from hexdem.common.io import write_csv
 from hexdem.experiments.run import simulate
 from hexdem.model.config import RunConfig
-from hexdem.theory import theory_figures as theory_plots
 from hexdem.theory import tca
+from hexdem.theory import theory_figures as theory_plots
 from hexdem.theory.sweep import SweepSettings
 
 #: Fig. 5a: V₀ (nondimensional) and the last bead shown.
@@ -26,8 +26,9 @@ FIG5B_V0_M_S = 0.4
 
 def _rows(table):
     keys = list(table)
-    return keys, [tuple(int(table[k][i]) if k == "n" else float(table[k][i]) for k in keys)
-                  for i in range(len(table["n"]))]
+    return keys, [
+        tuple(int(table[k][i]) if k == "n" else float(table[k][i]) for k in keys) for i in range(len(table["n"]))
+    ]
 
 
 def write_fig5(out, engine: str, log) -> dict:
@@ -44,18 +45,37 @@ def write_fig5(out, engine: str, log) -> dict:
     write_csv(out / "fig5a_pulse_speed.csv", header, rows)
     header, rows = _rows(arrivals)
     write_csv(out / "fig5b_arrival_time.csv", [h if h == "n" else f"{h}_s" for h in header], rows)
-    theory_plots.tca_pulse_speeds(speeds["n"], speeds["lattice"], speeds["n"], speeds["tca"], speeds["hyperg"],
-                                  FIG5A_V0, out / "fig5a_pulse_speed.png")
-    theory_plots.tca_arrival_times(arrivals["n"], *(arrivals[k] * 1e3 for k in ("lattice", "tca", "hyperg")),
-                                   FIG5B_V0_M_S, out / "fig5b_arrival_time.png")
+    theory_plots.tca_pulse_speeds(
+        speeds["n"],
+        speeds["lattice"],
+        speeds["n"],
+        speeds["tca"],
+        speeds["hyperg"],
+        FIG5A_V0,
+        out / "fig5a_pulse_speed.png",
+    )
+    theory_plots.tca_arrival_times(
+        arrivals["n"],
+        *(arrivals[k] * 1e3 for k in ("lattice", "tca", "hyperg")),
+        FIG5B_V0_M_S,
+        out / "fig5b_arrival_time.png",
+    )
 
     def deviation(table, key):
         return float(np.max(np.abs(table[key] / table["lattice"] - 1)))
 
-    return {"engine": engine,
-            "fig5a": {"v0": FIG5A_V0, "beads": [int(speeds["n"][0]), int(speeds["n"][-1])],
-                      "max_relative_deviation_tca": deviation(speeds, "tca"),
-                      "max_relative_deviation_hyperg": deviation(speeds, "hyperg")},
-            "fig5b": {"v0_m_s": FIG5B_V0_M_S, "beads": [int(arrivals["n"][0]), int(arrivals["n"][-1])],
-                      "max_relative_deviation_tca": deviation(arrivals, "tca"),
-                      "max_relative_deviation_hyperg": deviation(arrivals, "hyperg")}}
+    return {
+        "engine": engine,
+        "fig5a": {
+            "v0": FIG5A_V0,
+            "beads": [int(speeds["n"][0]), int(speeds["n"][-1])],
+            "max_relative_deviation_tca": deviation(speeds, "tca"),
+            "max_relative_deviation_hyperg": deviation(speeds, "hyperg"),
+        },
+        "fig5b": {
+            "v0_m_s": FIG5B_V0_M_S,
+            "beads": [int(arrivals["n"][0]), int(arrivals["n"][-1])],
+            "max_relative_deviation_tca": deviation(arrivals, "tca"),
+            "max_relative_deviation_hyperg": deviation(arrivals, "hyperg"),
+        },
+    }

@@ -28,14 +28,30 @@ def _lattice_against_tca(n_lattice, lattice, n_tca, tca, hyperg, ylabel, title, 
 
 def tca_pulse_speeds(n_lattice, lattice, n_tca, tca, hyperg, v0, path) -> None:
     """Fig. 5a: pulse speed c_n = 1/T_n against n, lattice vs TCA vs eq. (6)."""
-    _lattice_against_tca(n_lattice, lattice, n_tca, tca, hyperg, "pulse speed $c_n = 1/T_n$  [d per time unit]",
-                         f"30° strike, 30° observation, $V_0$ = {v0:g} (nondimensional)", path)
+    _lattice_against_tca(
+        n_lattice,
+        lattice,
+        n_tca,
+        tca,
+        hyperg,
+        "pulse speed $c_n = 1/T_n$  [d per time unit]",
+        f"30° strike, 30° observation, $V_0$ = {v0:g} (nondimensional)",
+        path,
+    )
 
 
 def tca_arrival_times(n, lattice_ms, tca_ms, hyperg_ms, v0_m_s, path) -> None:
     """Fig. 5b: arrival time of the pulse against n (physical units, 0° strike, 30° line)."""
-    _lattice_against_tca(n, lattice_ms, n, tca_ms, hyperg_ms, "arrival time [ms]",
-                         f"0° strike, 30° observation, $V_0$ = {v0_m_s:g} m/s, steel d = 19.05 mm", path)
+    _lattice_against_tca(
+        n,
+        lattice_ms,
+        n,
+        tca_ms,
+        hyperg_ms,
+        "arrival time [ms]",
+        f"0° strike, 30° observation, $V_0$ = {v0_m_s:g} m/s, steel d = 19.05 mm",
+        path,
+    )
 
 
 def _traces(ax, trace, fit, title):
@@ -49,8 +65,8 @@ def _traces(ax, trace, fit, title):
     fit_values = peaks[start] * c ** np.arange(last - start + 1)
     for n in range(last + 1):
         ax.plot(times, speeds[:, n], linewidth=0.8)
-    ax.plot(t_peak[:last + 1], peaks[:last + 1], "k.", label="maxima $V_n$")
-    ax.plot(t_peak[start:last + 1], fit_values, "r--", label=f"$V_{start}\\,c^{{n-{start}}}$")
+    ax.plot(t_peak[: last + 1], peaks[: last + 1], "k.", label="maxima $V_n$")
+    ax.plot(t_peak[start : last + 1], fit_values, "r--", label=f"$V_{start}\\,c^{{n-{start}}}$")
     ax.annotate(f"$V_{start}$", (t_peak[start], peaks[start]), textcoords="offset points", xytext=(4, 4))
     ax.set_xlabel("time [nondimensional]")
     ax.set_ylabel(f"|v|  [{ND_SPEED}]")
@@ -85,8 +101,9 @@ def vodecay30(trace, fit_30_30, fit_30_0, path) -> None:
     axes[0, 1].legend()
     axes[0, 1].grid(alpha=0.3)
     _start_speed_panel(axes[1, 0], fit_30_30, "$V_1$", "(c) $V_1 = \\alpha V_0^2 + \\beta V_0$, 30/30")
-    _start_speed_panel(axes[1, 1], fit_30_0, "$V_2$",
-                       "(d) $V_2 = V_0(\\alpha V_0^2 + \\beta V_0 + \\gamma)$, 30° strike, 0° line")
+    _start_speed_panel(
+        axes[1, 1], fit_30_0, "$V_2$", "(d) $V_2 = V_0(\\alpha V_0^2 + \\beta V_0 + \\gamma)$, 30° strike, 0° line"
+    )
     fig.tight_layout()
     save(fig, path)
 
@@ -95,8 +112,9 @@ def vodecay0(trace, fit_0_0, fit_0_30, path) -> None:
     """Fig. 7: (a) 0/0 traces with the fit from bead 2; (b) V₁ against V₀ for 0/30 with V₀/2."""
     fig, axes = subplots(1, 2, figsize=(12, 4.5))
     _traces(axes[0], trace, fit_0_0, "(a) 0° strike, 0° line")
-    _start_speed_panel(axes[1], fit_0_30, "$V_1$", "(b) $V_1$ against $V_0$, 0° strike, 30° line",
-                       extra=("$V_0/2$", lambda v: v / 2))
+    _start_speed_panel(
+        axes[1], fit_0_30, "$V_1$", "(b) $V_1$ against $V_0$, 0° strike, 30° line", extra=("$V_0/2$", lambda v: v / 2)
+    )
     fig.tight_layout()
     save(fig, path)
 
@@ -118,8 +136,7 @@ def decay_form(ratios_by_combination, path) -> None:
 
     ``ratios_by_combination``: {name: [(v0, n, ratio), ...]}.
     """
-    fig, axes = subplots(1, len(ratios_by_combination), figsize=(4 * len(ratios_by_combination), 4),
-                         sharey=True)
+    fig, axes = subplots(1, len(ratios_by_combination), figsize=(4 * len(ratios_by_combination), 4), sharey=True)
     for ax, (name, curves) in zip(np.atleast_1d(axes), ratios_by_combination.items()):
         for v0, n, ratio in curves:
             ax.plot(n, ratio, "o-", markersize=3, label=f"$V_0$ = {v0:.3g}")

@@ -41,11 +41,11 @@ from hexdem.experiments.wave_run import record_waves, steps_per_sample
 from hexdem.model.config import RunConfig
 from hexdem.model.granular import GranularModel
 from hexdem.model.initial_state import write_initial_state
+from hexdem.model.model_builder import build_model
+from hexdem.model.run_settings import run_settings
 from hexdem.theory.conical import CIRCULAR, cone_ring_radius
 from hexdem.theory.phonons import Lattice2D, cone_slope, dynamical_matrix, frequencies
 from hexdem.waves.states import bloch_packet
-from hexdem.model.model_builder import build_model
-from hexdem.model.run_settings import run_settings
 
 #: conical.csv's columns.
 COLUMNS = ("time_s", "ring_radius_d", "theory_radius_d")
@@ -91,11 +91,19 @@ class ConicalSettings:
         if not (is_number(self.control_fraction) and 0 < self.control_fraction < 1):
             raise HexdemError(f"control_fraction must lie between 0 and 1 (of K), got {self.control_fraction!r}")
         theory = self.theory()
-        blocks = self.reach * self.width_d * theory.spacing_m / cone_slope(theory) * theory.dirac_frequency() / (
-            2 * math.pi * self.block_periods)
+        blocks = (
+            self.reach
+            * self.width_d
+            * theory.spacing_m
+            / cone_slope(theory)
+            * theory.dirac_frequency()
+            / (2 * math.pi * self.block_periods)
+        )
         if blocks < 4:
-            raise HexdemError(f"a reach of {self.reach:g} widths lasts {blocks:.1f} energy blocks of {self.block_periods} "
-                              "periods; the ring needs at least 4: widen the packet or reach farther")
+            raise HexdemError(
+                f"a reach of {self.reach:g} widths lasts {blocks:.1f} energy blocks of {self.block_periods} "
+                "periods; the ring needs at least 4: widen the packet or reach farther"
+            )
         self.config()  # its own checks, worded there
 
     def control_wave_vector(self) -> np.ndarray:
@@ -112,8 +120,14 @@ class ConicalSettings:
         return math.ceil((farthest + CLEARANCE_WIDTHS) * self.width_d / (math.sqrt(3) / 2)) + 1
 
     def config(self) -> RunConfig:
-        return RunConfig(edge_beads=self.edge_beads(), precompression_n=self.precompression_n, v0=1e-6,
-                         steps_per_contact=self.steps_per_contact, engine=self.engine, ranks=self.ranks)
+        return RunConfig(
+            edge_beads=self.edge_beads(),
+            precompression_n=self.precompression_n,
+            v0=1e-6,
+            steps_per_contact=self.steps_per_contact,
+            engine=self.engine,
+            ranks=self.ranks,
+        )
 
     def theory(self) -> Lattice2D:
         """The linear lattice (its size does not matter)."""
@@ -163,8 +177,9 @@ class Conical:
     @property
     def drift_deviation(self) -> float:
         """The control's drift velocity's relative deviation from its group velocity (vector norms)."""
-        return float(np.linalg.norm(self.drift_velocity_m_s - self.group_velocity_m_s)
-                     / np.linalg.norm(self.group_velocity_m_s))
+        return float(
+            np.linalg.norm(self.drift_velocity_m_s - self.group_velocity_m_s) / np.linalg.norm(self.group_velocity_m_s)
+        )
 
     @property
     def control_widening(self) -> float:
@@ -179,8 +194,10 @@ class Conical:
     def rows(self) -> list[list]:
         """conical.csv's rows (:data:`COLUMNS`)."""
         d = self.diameter_m
-        return [[repr(float(t)), repr(float(r / d)), repr(float(theory / d))]
-                for t, r, theory in zip(self.dirac.times_s, self.dirac.ring_radius_m(), self.theory_radius_m)]
+        return [
+            [repr(float(t)), repr(float(r / d)), repr(float(theory / d))]
+            for t, r, theory in zip(self.dirac.times_s, self.dirac.ring_radius_m(), self.theory_radius_m)
+        ]
 
     def control_path_m(self) -> np.ndarray:
         """(F,) the control's centroid's distance from its start along its group velocity."""
@@ -191,33 +208,62 @@ class Conical:
     def control_rows(self) -> list[list]:
         """control.csv's rows (:data:`CONTROL_COLUMNS`)."""
         d, speed = self.diameter_m, np.linalg.norm(self.group_velocity_m_s)
-        return [[repr(float(t)), repr(float(along / d)), repr(float(speed * t / d)), repr(float(width / d))]
-                for t, along, width in zip(self.control.times_s, self.control_path_m(), self.control_width_m)]
+        return [
+            [repr(float(t)), repr(float(along / d)), repr(float(speed * t / d)), repr(float(width / d))]
+            for t, along, width in zip(self.control.times_s, self.control_path_m(), self.control_width_m)
+        ]
 
 
 def group_velocity(theory: Lattice2D, wave_vector, branch: int) -> np.ndarray:
     """∇ω of ``branch`` (0 lower) at ``wave_vector`` [m/s], by central differences."""
     step = 1e-6 / theory.spacing_m
-    return np.array([(frequencies(theory, wave_vector + step * unit)[branch]
-                      - frequencies(theory, wave_vector - step * unit)[branch]) / (2 * step) for unit in np.eye(2)])
+    return np.array(
+        [
+            (
+                frequencies(theory, wave_vector + step * unit)[branch]
+                - frequencies(theory, wave_vector - step * unit)[branch]
+            )
+            / (2 * step)
+            for unit in np.eye(2)
+        ]
+    )
 
 
-def _run_packet(settings: ConicalSettings, config: RunConfig, model: GranularModel, workdir: Path, wave_vector, polarization,
-                omega: float, centre, log, show_progress) -> PacketRun:
+def _run_packet(
+    settings: ConicalSettings,
+    config: RunConfig,
+    model: GranularModel,
+    workdir: Path,
+    wave_vector,
+    polarization,
+    omega: float,
+    centre,
+    log,
+    show_progress,
+) -> PacketRun:
     """Write the packet's state on ``model``'s (precompressed) positions, run ``config`` from it
     and record its energy blocks."""
     lattice, theory = model.packing, settings.theory()
     width = settings.width_d * config.diameter_m
-    velocities, displacements = bloch_packet(lattice.positions_m, centre, width, wave_vector, polarization,
-                                             omega, settings.speed_m_s)
+    velocities, displacements = bloch_packet(
+        lattice.positions_m, centre, width, wave_vector, polarization, omega, settings.speed_m_s
+    )
     workdir.mkdir(parents=True, exist_ok=True)
     write_initial_state(workdir / "initial_state.csv", lattice, velocities, displacements)
     period, dt_s = 2 * math.pi / theory.dirac_frequency(), run_settings(config, model).dt_s
     every = steps_per_sample(dt_s, period, settings.samples_per_period)
-    config = config.replace(initial_state_file=str(workdir / "initial_state.csv"),
-                            duration=settings.reach * width / cone_slope(theory), dump_every=every)
-    recorded = record_waves(config, workdir / "run", block=max(1, round(settings.block_periods * period / (every * dt_s))),
-                            log=log, show_progress=show_progress)
+    config = config.replace(
+        initial_state_file=str(workdir / "initial_state.csv"),
+        duration=settings.reach * width / cone_slope(theory),
+        dump_every=every,
+    )
+    recorded = record_waves(
+        config,
+        workdir / "run",
+        block=max(1, round(settings.block_periods * period / (every * dt_s))),
+        log=log,
+        show_progress=show_progress,
+    )
     return PacketRun(np.asarray(centre, float), width, recorded)
 
 
@@ -243,21 +289,44 @@ def measure_conical(settings: ConicalSettings, workdir, log=None, show_progress:
     model = build_model(config)
     centre = model.packing.positions_m.mean(axis=0)
     k_point = theory.high_symmetry_points()["K"]
-    dirac = _run_packet(settings, config, model, workdir / "dirac", k_point, CIRCULAR, theory.dirac_frequency(), centre,
-                        log, show_progress)
+    dirac = _run_packet(
+        settings,
+        config,
+        model,
+        workdir / "dirac",
+        k_point,
+        CIRCULAR,
+        theory.dirac_frequency(),
+        centre,
+        log,
+        show_progress,
+    )
     measured = dirac.ring_radius_m()
     v_d = cone_slope(theory)
     cone = _block_cone(theory, dirac)
-    fitted = minimize_scalar(lambda speed: float(np.sum((cone(speed) - measured) ** 2)), bounds=(0.5 * v_d, 1.5 * v_d),
-                             method="bounded", options={"xatol": 1e-6 * v_d}).x
+    fitted = minimize_scalar(
+        lambda speed: float(np.sum((cone(speed) - measured) ** 2)),
+        bounds=(0.5 * v_d, 1.5 * v_d),
+        method="bounded",
+        options={"xatol": 1e-6 * v_d},
+    ).x
     q = settings.control_wave_vector()
     omega2, vectors = np.linalg.eigh(dynamical_matrix(theory, q))
     velocity = group_velocity(theory, q, 0)
     duration = settings.reach * dirac.width_m / v_d
-    control = _run_packet(settings, config, model, workdir / "control", q, vectors[:, 0], math.sqrt(omega2[0]),
-                          centre - velocity * duration / 2, log, show_progress)
+    control = _run_packet(
+        settings,
+        config,
+        model,
+        workdir / "control",
+        q,
+        vectors[:, 0],
+        math.sqrt(omega2[0]),
+        centre - velocity * duration / 2,
+        log,
+        show_progress,
+    )
     centroids = energy_centroid(control.recorded.positions_m, control.recorded.block_kinetic_j)
     drift = np.polyfit(control.times_s, centroids, 1)[0]
     spread = energy_spread(control.recorded.positions_m, control.recorded.block_kinetic_j, centroids)
-    return Conical(dirac, control, cone(v_d), v_d, float(fitted),
-                   velocity, drift, spread, config.diameter_m, settings)
+    return Conical(dirac, control, cone(v_d), v_d, float(fitted), velocity, drift, spread, config.diameter_m, settings)

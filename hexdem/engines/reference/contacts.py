@@ -48,12 +48,20 @@ class PairLaws:
     units: UnitSystem
 
     @classmethod
-    def of(cls, model: GranularModel, units: UnitSystem) -> "PairLaws":
+    def of(cls, model: GranularModel, units: UnitSystem) -> PairLaws:
         laws, radii_m = model.laws, model.diameters_m / 2
-        return cls(model.initial_positions_m() / units.length_m, radii_m / units.length_m, radii_m,
-                   model.masses_kg / units.mass_kg, model.material_ids, laws.pair_table("normal_stiffness_pa"),
-                   laws.pair_table("damping"), laws.pair_table("tangential_stiffness_pa"), laws.pair_table("friction"),
-                   units)
+        return cls(
+            model.initial_positions_m() / units.length_m,
+            radii_m / units.length_m,
+            radii_m,
+            model.masses_kg / units.mass_kg,
+            model.material_ids,
+            laws.pair_table("normal_stiffness_pa"),
+            laws.pair_table("damping"),
+            laws.pair_table("tangential_stiffness_pa"),
+            laws.pair_table("friction"),
+            units,
+        )
 
     def normal(self, i, j):
         """(rest_x, rest_y, c, A, η) of the pairs (i → j): rest vector of their positions at t = 0,
@@ -62,8 +70,7 @@ class PairLaws:
         rest = self.start[j] - self.start[i]
         stiffness = coefficient(self.normal_pa[ids[i], ids[j]], reduced(radii[i], radii[j]), self.units)
         damping = self.damping[ids[i], ids[j]] * np.sqrt(reduced(self.masses[i], self.masses[j]) * stiffness)
-        return (rest[:, 0].copy(), rest[:, 1].copy(), (radii[i] + radii[j]) / self.units.length_m, stiffness,
-                damping)
+        return (rest[:, 0].copy(), rest[:, 1].copy(), (radii[i] + radii[j]) / self.units.length_m, stiffness, damping)
 
     def tangential(self, i, j):
         """(K, μ, R_i, R_j) of the pairs (i → j): Mindlin's K = k_t sqrt(R_eff), Coulomb's μ, the radii."""
@@ -78,7 +85,7 @@ def wall_geometry(model: GranularModel):
     with ρ the distance from there to a curved wall's centre (0 for a plane), R_eff the Hertz
     contact radius."""
     lattice, walls = model.packing, model.walls
-    positions, radii = model.initial_positions_m()[:len(lattice)], lattice.radii_m
+    positions, radii = model.initial_positions_m()[: len(lattice)], lattice.radii_m
     beads, normals = wall_normals(walls, positions)
     gaps = np.concatenate([np.zeros(0)] + [wall.gaps_m(positions[wall.members], radii[wall.members]) for wall in walls])
     curvature = np.concatenate([np.zeros(0)] + [wall.curvatures_at(positions[wall.members]) for wall in walls])
@@ -107,7 +114,7 @@ class ListedPairs:
     carried: dict = field(default_factory=dict)
 
     @classmethod
-    def at_rest(cls, laws: PairLaws, fields, make_kernel) -> "ListedPairs":
+    def at_rest(cls, laws: PairLaws, fields, make_kernel) -> ListedPairs:
         """The list of the bodies at t = 0, in the kernel that ``make_kernel(**list_fields)`` makes."""
         listed = cls(None, laws, fields, skin_of(2.0 * laws.radii))
         at_rest = np.zeros(len(laws.radii))
@@ -125,8 +132,14 @@ class ListedPairs:
         pairs = candidate_pairs(self.laws.start + np.column_stack([x, y]), self.laws.radii, self.skin)
         i, j = pairs[:, 0].copy(), pairs[:, 1].copy()
         self.builds += 1
-        return dict(pair_i=i, pair_j=j, **self.fields(i, j), built_x=np.array(x, float), built_y=np.array(y, float),
-                    reach=REBUILD_SHARE * self.skin)
+        return dict(
+            pair_i=i,
+            pair_j=j,
+            **self.fields(i, j),
+            built_x=np.array(x, float),
+            built_y=np.array(y, float),
+            reach=REBUILD_SHARE * self.skin,
+        )
 
     def rebuild(self, x, y) -> None:
         """Rebuild the list at the displacements (x, y), carrying the ``carried`` arrays over."""

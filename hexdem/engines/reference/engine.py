@@ -57,9 +57,15 @@ def _wall_contacts(model: GranularModel, units: UnitSystem) -> dict:
     beads, normals, gaps, curvature, r_eff = wall_geometry(model)
     stiffness = coefficient(model.wall_stiffness_pa(beads) if model.walls else np.zeros(0), r_eff, units)
     damping = model.wall_damping * np.sqrt(model.masses_kg[beads] / units.mass_kg * stiffness)
-    return dict(wall_cell=beads.astype(np.int64), wall_nx=normals[:, 0].copy(), wall_ny=normals[:, 1].copy(),
-                wall_gap=gaps / units.length_m, wall_curvature=curvature * units.length_m, wall_stiffness=stiffness,
-                wall_damping=damping)
+    return dict(
+        wall_cell=beads.astype(np.int64),
+        wall_nx=normals[:, 0].copy(),
+        wall_ny=normals[:, 1].copy(),
+        wall_gap=gaps / units.length_m,
+        wall_curvature=curvature * units.length_m,
+        wall_stiffness=stiffness,
+        wall_damping=damping,
+    )
 
 
 @dataclass
@@ -71,17 +77,27 @@ class ReferenceSystem:
     units: UnitSystem
 
     @classmethod
-    def from_model(cls, model: GranularModel, units: UnitSystem) -> "ReferenceSystem":
+    def from_model(cls, model: GranularModel, units: UnitSystem) -> ReferenceSystem:
         laws = PairLaws.of(model, units)
 
         def fields(i, j) -> dict:
             rest_x, rest_y, contact, stiffness, damping = laws.normal(i, j)
-            return dict(pair_rest_x=rest_x, pair_rest_y=rest_y, pair_contact=contact, pair_stiffness=stiffness,
-                        pair_damping=damping)
+            return dict(
+                pair_rest_x=rest_x,
+                pair_rest_y=rest_y,
+                pair_contact=contact,
+                pair_stiffness=stiffness,
+                pair_damping=damping,
+            )
 
         external = model.external_forces_n() / units.force_n
-        body = dict(**_wall_contacts(model, units), damped=model.dissipative, inv_mass=units.mass_kg / model.masses_kg,
-                    external_x=external[:, 0].copy(), external_y=external[:, 1].copy())
+        body = dict(
+            **_wall_contacts(model, units),
+            damped=model.dissipative,
+            inv_mass=units.mass_kg / model.masses_kg,
+            external_x=external[:, 0].copy(),
+            external_y=external[:, 1].copy(),
+        )
         return cls(ListedPairs.at_rest(laws, fields, lambda **listed: KernelArrays(**listed, **body)), units)
 
     @property
@@ -138,8 +154,15 @@ class ReferenceEngine:
 
     name = "reference"
 
-    def run(self, model: GranularModel, settings: RunSettings, directory, on_sample: Observer, comm=None,
-            show_progress: bool = True) -> dict:
+    def run(
+        self,
+        model: GranularModel,
+        settings: RunSettings,
+        directory,
+        on_sample: Observer,
+        comm=None,
+        show_progress: bool = True,
+    ) -> dict:
         """Integrate ``model`` with ``settings``, calling ``on_sample`` with every sample; write
         ``reference.json`` into ``directory``. Returns a description of the run."""
         _check_settings(settings)
@@ -159,10 +182,22 @@ class ReferenceEngine:
             sensed = settings.sensor_every and step % settings.sensor_every == 0
             accelerations = system.accelerations(x, y, u, w) if sensed else None
             if not (np.isfinite(velocities).all() and np.isfinite(x).all() and np.isfinite(y).all()):
-                raise HexdemError(f"reference integration diverged (non-finite state at t = "
-                                  f"{step * settings.dt_s:.4g} s): reduce the time step")
-            on_sample(Sample(index, step, step * dt, ids, start_positions + np.column_stack([x, y]),
-                             velocities, accelerations, system.angular_velocities()))
+                raise HexdemError(
+                    f"reference integration diverged (non-finite state at t = "
+                    f"{step * settings.dt_s:.4g} s): reduce the time step"
+                )
+            on_sample(
+                Sample(
+                    index,
+                    step,
+                    step * dt,
+                    ids,
+                    start_positions + np.column_stack([x, y]),
+                    velocities,
+                    accelerations,
+                    system.angular_velocities(),
+                )
+            )
             if bar is not None:
                 bar.update(step - bar.n)
 
@@ -173,15 +208,29 @@ class ReferenceEngine:
         finally:
             if bar is not None:
                 bar.close()
-        engine = {"name": self.name, "version": version("hexdem"), "ranks": 1, "integrator": "classical RK4",
-                  "friction": model.laws.tangential,
-                  "units": units.name, "wall_time_s": time.perf_counter() - begin, "n_pairs": n_pairs,
-                  "n_list_builds": system.pairs.builds, "skin": system.pairs.skin,
-                  "n_wall_contacts": system.n_wall_contacts}
-        write_json(directory / PARAMETERS_NAME, {**engine, "model": model.packing.shape, "n_bodies": model.n_bodies,
-                                                 "time_step": dt, "n_steps": settings.n_steps,
-                                                 "dump_every": settings.dump_every,
-                                                 "unit_scales_si": {"length_m": units.length_m,
-                                                                    "mass_kg": units.mass_kg,
-                                                                    "time_s": units.time_s}})
+        engine = {
+            "name": self.name,
+            "version": version("hexdem"),
+            "ranks": 1,
+            "integrator": "classical RK4",
+            "friction": model.laws.tangential,
+            "units": units.name,
+            "wall_time_s": time.perf_counter() - begin,
+            "n_pairs": n_pairs,
+            "n_list_builds": system.pairs.builds,
+            "skin": system.pairs.skin,
+            "n_wall_contacts": system.n_wall_contacts,
+        }
+        write_json(
+            directory / PARAMETERS_NAME,
+            {
+                **engine,
+                "model": model.packing.shape,
+                "n_bodies": model.n_bodies,
+                "time_step": dt,
+                "n_steps": settings.n_steps,
+                "dump_every": settings.dump_every,
+                "unit_scales_si": {"length_m": units.length_m, "mass_kg": units.mass_kg, "time_s": units.time_s},
+            },
+        )
         return engine

@@ -29,9 +29,17 @@ def _pair_fields(laws: PairLaws):
     def fields(i, j) -> dict:
         rest_x, rest_y, contact, stiffness, damping = laws.normal(i, j)
         tangential, mu, radius_i, radius_j = laws.tangential(i, j)
-        return dict(pair_rest_x=rest_x, pair_rest_y=rest_y, pair_contact=contact, pair_stiffness=stiffness,
-                    pair_damping=damping, pair_tangential=tangential, pair_mu=mu, pair_radius_i=radius_i,
-                    pair_radius_j=radius_j)
+        return dict(
+            pair_rest_x=rest_x,
+            pair_rest_y=rest_y,
+            pair_contact=contact,
+            pair_stiffness=stiffness,
+            pair_damping=damping,
+            pair_tangential=tangential,
+            pair_mu=mu,
+            pair_radius_i=radius_i,
+            pair_radius_j=radius_j,
+        )
 
     return fields
 
@@ -46,10 +54,18 @@ def _wall_fields(model: GranularModel, units: UnitSystem) -> dict:
 
     stiffness = coefficient(table("normal_stiffness_pa"), r_eff, units)
     damping = table("damping") * np.sqrt(model.masses_kg[beads] / units.mass_kg * stiffness)
-    return dict(wall_cell=beads.astype(np.int64), wall_nx=normals[:, 0].copy(), wall_ny=normals[:, 1].copy(),
-                wall_gap=gaps / units.length_m, wall_curvature=curvature * units.length_m, wall_stiffness=stiffness,
-                wall_damping=damping, wall_tangential=coefficient(table("tangential_stiffness_pa"), r_eff, units),
-                wall_mu=table("friction"), wall_radius=model.packing.radii_m[beads] / units.length_m)
+    return dict(
+        wall_cell=beads.astype(np.int64),
+        wall_nx=normals[:, 0].copy(),
+        wall_ny=normals[:, 1].copy(),
+        wall_gap=gaps / units.length_m,
+        wall_curvature=curvature * units.length_m,
+        wall_stiffness=stiffness,
+        wall_damping=damping,
+        wall_tangential=coefficient(table("tangential_stiffness_pa"), r_eff, units),
+        wall_mu=table("friction"),
+        wall_radius=model.packing.radii_m[beads] / units.length_m,
+    )
 
 
 @dataclass
@@ -64,15 +80,20 @@ class FrictionalSystem:
     state: dict = field(default_factory=dict, compare=False)
 
     @classmethod
-    def from_model(cls, model: GranularModel, units: UnitSystem) -> "FrictionalSystem":
+    def from_model(cls, model: GranularModel, units: UnitSystem) -> FrictionalSystem:
         laws = PairLaws.of(model, units)
         masses, radii = laws.masses, laws.radii
         external = model.external_forces_n() / units.force_n
-        body = dict(**_wall_fields(model, units), inv_mass=1.0 / masses,
-                    inv_inertia=1.0 / (INERTIA * masses * radii**2), external_x=external[:, 0].copy(),
-                    external_y=external[:, 1].copy())
-        return cls(ListedPairs.at_rest(laws, _pair_fields(laws), lambda **listed: FrictionArrays(**listed, **body)),
-                   units)
+        body = dict(
+            **_wall_fields(model, units),
+            inv_mass=1.0 / masses,
+            inv_inertia=1.0 / (INERTIA * masses * radii**2),
+            external_x=external[:, 0].copy(),
+            external_y=external[:, 1].copy(),
+        )
+        return cls(
+            ListedPairs.at_rest(laws, _pair_fields(laws), lambda **listed: FrictionArrays(**listed, **body)), units
+        )
 
     @property
     def kernel(self) -> FrictionArrays:
@@ -92,8 +113,22 @@ class FrictionalSystem:
         k, n = self.kernel, len(x)
         fx, fy, torque = np.zeros(n), np.zeros(n), np.zeros(n)
         pair_xi, wall_xi = self.pairs.carried["pair_xi"].copy(), self.state["wall_xi"].copy()
-        frictional_forces(k, x, y, u, w, self.state["spins"], pair_xi, wall_xi, False, fx, fy, torque,
-                          np.zeros(len(pair_xi)), np.zeros(len(wall_xi)))
+        frictional_forces(
+            k,
+            x,
+            y,
+            u,
+            w,
+            self.state["spins"],
+            pair_xi,
+            wall_xi,
+            False,
+            fx,
+            fy,
+            torque,
+            np.zeros(len(pair_xi)),
+            np.zeros(len(wall_xi)),
+        )
         return np.column_stack([fx * k.inv_mass, fy * k.inv_mass])
 
     def integrate(self, velocities, dt: float, settings: RunSettings, emit):
@@ -109,8 +144,18 @@ class FrictionalSystem:
         emit(0, 0, x, y, u, w)
 
         def steps(kernel, n_steps):
-            return integrate_frictional(kernel, x, y, u, w, self.state["spins"], self.pairs.carried["pair_xi"],
-                                        self.state["wall_xi"], float(dt), n_steps)
+            return integrate_frictional(
+                kernel,
+                x,
+                y,
+                u,
+                w,
+                self.state["spins"],
+                self.pairs.carried["pair_xi"],
+                self.state["wall_xi"],
+                float(dt),
+                n_steps,
+            )
 
         for index in range(1, settings.n_samples):
             self.pairs.advance(every, steps, x, y)

@@ -19,7 +19,8 @@ as LAMMPS's history created by the step that finds the contact), and the tangent
 f = K sqrt(δ) ξ, −f t on j and +f t on i (−f t on a body on a wall), capped at μ F_n (F_n with its
 damping, clipped at zero as LAMMPS's ``limit_damping`` clips it: it never pulls, and where the damping
 would make it pull the cap is 0): on slip ξ is set back to the capped force's displacement.
-Torques: +(R_i − δ/2) f on i and +(R_j − δ/2) f on j (LAMMPS's levers, which add up to the distance of the centres, so that
+Torques: +(R_i − δ/2) f on i and +(R_j − δ/2) f on j (LAMMPS's levers, which add up to the distance of the centres, so
+that
 angular momentum is kept), +R f on a body on a wall. Moment of inertia of a solid sphere,
 I = (2/5) m R².
 
@@ -108,7 +109,9 @@ def _pairs(k, x, y, u, w, spin, xi, cap, fx, fy, torque, slip):
                 xi[b] = 0.0
             continue
         root = np.sqrt(overlap)
-        normal = max(k.pair_stiffness[b] * overlap * root - k.pair_damping[b] * np.sqrt(root) * (nx * du + ny * dw), 0.0)
+        normal = max(
+            k.pair_stiffness[b] * overlap * root - k.pair_damping[b] * np.sqrt(root) * (nx * du + ny * dw), 0.0
+        )
         f, xi[b] = _capped(k.pair_tangential[b], root, normal, k.pair_mu[b], xi[b], cap)
         gx, gy = normal * nx + f * ny, normal * ny - f * nx  # on j: F_n n − f t, t = (−n_y, n_x)
         fx[i] -= gx
@@ -149,8 +152,9 @@ def _walls(k, x, y, u, v, spin, xi, cap, fx, fy, torque, slip):
                 xi[c] = 0.0
             continue
         root = np.sqrt(depth)
-        normal = max(k.wall_stiffness[c] * depth * root - k.wall_damping[c] * np.sqrt(root) * (u[cell] * nx + v[cell] * ny),
-                     0.0)
+        normal = max(
+            k.wall_stiffness[c] * depth * root - k.wall_damping[c] * np.sqrt(root) * (u[cell] * nx + v[cell] * ny), 0.0
+        )
         f, xi[c] = _capped(k.wall_tangential[c], root, normal, k.wall_mu[c], xi[c], cap)
         fx[cell] += normal * nx + f * ny  # F_n n − f t
         fy[cell] += normal * ny - f * nx
