@@ -29,8 +29,21 @@ __all__ = ["RunConfig", "ImpactResult", "LineResult", "simulate_impact", "tca", 
 
 @dataclass(frozen=True)
 class LineResult:
-    """One observation line, bead n = 0 (the struck bead) first, in the run's units:
-    ``bead_id`` (1-based, as in the decks), ``peak_speed``, ``t_peak``, ``arrival_time``."""
+    """One observation line of an impact, bead n = 0 (the struck bead) first.
+
+    Every array has one entry per bead of the line (L,), in the run's units (:attr:`ImpactResult.units`).
+
+    Attributes
+    ----------
+    bead_id : numpy.ndarray of int, shape (L,)
+        The beads' ids, 1-based as in the LAMMPS decks.
+    peak_speed : numpy.ndarray of float, shape (L,)
+        Each bead's largest speed |v| during the run [m/s, or V₀'s unit when nondimensional].
+    t_peak : numpy.ndarray of float, shape (L,)
+        When each bead reached it [s, or the nondimensional time].
+    arrival_time : numpy.ndarray of float, shape (L,)
+        When the leading wave reached each bead (half its peak speed; NaN where it never came).
+    """
 
     bead_id: np.ndarray
     peak_speed: np.ndarray
@@ -40,11 +53,27 @@ class LineResult:
 
 @dataclass(frozen=True)
 class ImpactResult:
-    """What :func:`simulate_impact` returns, in the run's ``units`` ("si" or "nondimensional").
+    """What :func:`simulate_impact` returns: the pulse's peaks and arrivals at every bead.
 
-    ``lines``: {"0", "+30", "-30"} → :class:`LineResult`; per bead (N,): ``positions`` (N, 2),
-    ``peak_speed``, ``t_peak``, ``arrival_time``; ``energy_drift`` max |E − E0|/E0;
-    ``far_wall_reached``: the leading wave passed the wall facing the strike.
+    Attributes
+    ----------
+    units : str
+        ``"si"`` (m, s, m/s) or ``"nondimensional"`` (d = 1, the bead's mass 1, Hertz's A = 1; Sec. II).
+    lines : dict of str to LineResult
+        The observation lines ``"0"``, ``"+30"`` and ``"-30"`` (degrees from the strike; Fig. 1).
+    positions : numpy.ndarray of float, shape (N, 2)
+        The N beads' positions as packed [m, or d].
+    peak_speed : numpy.ndarray of float, shape (N,)
+        Each bead's largest speed during the run.
+    t_peak : numpy.ndarray of float, shape (N,)
+        When each bead reached it.
+    arrival_time : numpy.ndarray of float, shape (N,)
+        When the leading wave reached each bead (NaN where it never came).
+    energy_drift : float
+        The largest relative change of the total energy, max |E − E₀| / E₀ (0 for an exact
+        conservative integration; Tsuji's damping or friction make it the energy lost).
+    far_wall_reached : bool
+        Whether the leading wave reached the wall facing the strike.
     """
 
     units: str
@@ -69,13 +98,33 @@ class ImpactResult:
 
 
 def simulate_impact(config: RunConfig | None = None, out=None, verbose: bool = False, **changes) -> ImpactResult:
-    """Simulate one impact of ``config`` (default: the paper's experiment) with ``changes``
-    applied (RunConfig field names, e.g. ``edge_beads=7, v0=0.7``).
+    """Simulate one impact of ``config`` with ``changes`` applied, on the engine it names.
 
-    Nothing is written unless ``out`` is given; then ``out`` receives the files of ``hexdem
-    run`` (deck, ``peaks.csv``, ``summary.json``, figures). ``verbose`` prints progress. A key that
-    the others leave without effect is refused, as ``hexdem run`` refuses it
-    (:func:`~hexdem.model.unused_keys.check_unused_keys`).
+    Parameters
+    ----------
+    config : RunConfig, optional
+        The simulation (default: the paper's experiment, an 11-per-edge steel hexagon struck at
+        V₀ = 0.42 m/s along 0°).
+    out : str or pathlib.Path, optional
+        A folder to receive the files of ``hexdem run`` (deck, ``peaks.csv``, ``summary.json``,
+        figures); nothing is written without it.
+    verbose : bool, default False
+        Print progress to standard error.
+    **changes
+        :class:`RunConfig` keys and their values, e.g. ``edge_beads=7, v0=0.7`` (V₀ in ``units``).
+
+    Returns
+    -------
+    ImpactResult
+        Peaks and arrivals at every bead and along the observation lines.
+
+    Raises
+    ------
+    hexdem.errors.HexdemError
+        A configuration that is refused, or a key that the others leave without effect, as
+        ``hexdem run`` refuses it (:func:`~hexdem.model.unused_keys.check_unused_keys`).
+    hexdem.errors.RunFailed
+        An engine that failed, or a run whose energy drifted.
     """
     config = (config or RunConfig()).override(**changes)
     check_unused_keys(config)
@@ -87,19 +136,40 @@ def simulate_impact(config: RunConfig | None = None, out=None, verbose: bool = F
 
 
 def tca() -> dict:
-    """ω, c and the TCA's residence time at V₀ = 1 (nondimensional; Sec. IV, eq. (6))."""
+    """The ternary collision approximation's numbers (Sec. IV, eq. (6)).
+
+    Returns
+    -------
+    dict
+        ``omega`` (ω, the compatibility condition's root), ``c`` (the decay factor per layer),
+        ``residence_time_at_v0_1`` (nondimensional; it scales as :math:`V_0^{-1/5}`), and the
+        rest of :func:`hexdem.theory.tca.summary`; nondimensional, A = d = M = 1.
+    """
     return _tca.summary()
 
 
 def scaling_laws(
     settings: SweepSettings | None = None, last: int | None = None, kind: str = "loglinear"
 ) -> dict[str, CombinationFit]:
-    """Run the V₀ sweep of ``settings`` (default: Sec. V's, on the reference integrator) and fit
-    the laws of the four combinations "30/30", "30/0", "0/0", "0/30" (window up to ``last``).
+    """Run the V₀ sweep of Sec. V and fit the scaling laws (9), (10), (11).
 
-    Each :class:`~hexdem.theory.scaling.CombinationFit` has ``rate["m"]``, ``rate["b"]`` (c = m V₀
-    + b), ``ratio`` (α, β[, γ]) with standard errors (``rate.error("m")``) and ``law``.
     Spawns worker processes: call it under ``if __name__ == "__main__":`` in scripts.
+
+    Parameters
+    ----------
+    settings : SweepSettings, optional
+        The sweep (default: Sec. V's, nondimensional V₀ from 0.01 to 0.30, on the reference integrator).
+    last : int, optional
+        The last bead any fit may use (default: ``settings.last``).
+    kind : {"loglinear", "nonlinear"}, default "loglinear"
+        How each V₀'s decay V_n = V_s cⁿ is fitted.
+
+    Returns
+    -------
+    dict of str to CombinationFit
+        The combinations ``"30/30"``, ``"30/0"``, ``"0/0"``, ``"0/30"`` (strike/observation lines),
+        each with ``rate["m"]``, ``rate["b"]`` (c = m V₀ + b), ``ratio`` (α, β[, γ]), their
+        standard errors (``rate.error("m")``) and the fitted ``law``.
     """
     sweep = run_sweep(settings or SweepSettings(), log=lambda message: None)
     return {name: sweep.fit(combination, last, kind) for name, combination in COMBINATIONS.items()}

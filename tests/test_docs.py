@@ -428,3 +428,14 @@ def test_the_crossover_page_shows_its_runs_numbers():
         *(f"{impact_overlap_m(v) / TOLERANCE_M:.2f}" for v in speeds),
         *(f"{v:.2f}" for v in speeds),
     )
+
+
+def test_the_api_reference_renders_numpydoc_sections(built):
+    """The Python API's functions and the classes they return show their numpydoc sections as
+    sections (Napoleon), not as raw underlined headings."""
+    page = (built / "reference" / "_generated" / "api_api.html").read_text()
+    for section in ("Parameters", "Returns", "Raises"):
+        assert re.search(rf"<dt[^>]*>{section}<span class=\"colon\">", page), section
+    assert "----------" not in page
+    for attribute in ("peak_speed", "arrival_time", "energy_drift", "far_wall_reached", "bead_id"):
+        assert f'id="hexdem.api.ImpactResult.{attribute}"' in page or f'id="hexdem.api.LineResult.{attribute}"' in page

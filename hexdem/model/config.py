@@ -69,16 +69,16 @@ def read_config_table(path) -> dict:
 @dataclass(frozen=True)
 class RunConfig:
     """One simulation: every key a configuration file may set, each checked against its declared
-        type (:mod:`hexdem.common.typecheck`) and its meaning in
-        :data:`~hexdem.model.config_keys.KEY_DESCRIPTIONS`. Lengths in m; ``v0``, ``dt``, ``duration``
-        in ``units``. ``given``: the keys the user wrote (:meth:`from_dict`, :meth:`override`), each
-        set whatever its value (:meth:`set_keys`). ``dt = None`` takes the contact time
+    type (:mod:`hexdem.common.typecheck`) and its meaning in
+    :data:`~hexdem.model.config_keys.KEY_DESCRIPTIONS`. Lengths in m; ``v0``, ``dt``, ``duration``
+    in ``units``. ``given``: the keys the user wrote (:meth:`from_dict`, :meth:`override`), each
+    set whatever its value (:meth:`set_keys`). ``dt = None`` takes the contact time
     (:func:`~hexdem.model.run_settings.contact_time_s`) over
-        ``steps_per_contact``, shortened so that the default sampling interval, 1/20 of the contact
-        time, is whole steps; ``duration = None`` follows the pulse layer by layer from the struck
-        bead to the far wall, each layer for the contact time of its quickest material, and a soft
-        striker's longer contact (:func:`~hexdem.model.timescale.crossing_time_s`; the pulse resides
-        less than that on each layer: 0.82 ms are needed, 1.43 ms are run for the default experiment).
+    ``steps_per_contact``, shortened so that the default sampling interval, 1/20 of the contact
+    time, is whole steps; ``duration = None`` follows the pulse layer by layer from the struck
+    bead to the far wall, each layer for the contact time of its quickest material, and a soft
+    striker's longer contact (:func:`~hexdem.model.timescale.crossing_time_s`; the pulse resides
+    less than that on each layer: 0.82 ms are needed, 1.43 ms are run for the default experiment).
     """
 
     shape: str = "hexagon"

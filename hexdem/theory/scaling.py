@@ -197,11 +197,26 @@ class ScalingLaw:
 
 @dataclass(frozen=True)
 class CombinationFit:
-    """Scaling-law fit of one combination over a V₀ sweep.
+    """The scaling laws of one strike/observation combination, fitted over a V₀ sweep (Sec. V).
 
-    ``v0`` (K,); per V₀: ``c``, ``c_stderr``, ``v_start`` (measured V_s); ``rate`` the fit of
-    c = m V₀ + b; ``ratio`` the fit of V_s/V₀ (α, β[, γ]); ``last`` and ``kind`` the window's
-    last bead and the per-V₀ fit type.
+    Attributes
+    ----------
+    combination : Combination
+        The strike and observation lines, and the laws' form (eqs. (9)–(11)).
+    last : int
+        The fit window's last bead.
+    kind : {"loglinear", "nonlinear"}
+        How each V₀'s decay V_n = V_s cⁿ was fitted.
+    v0 : numpy.ndarray of float, shape (K,)
+        The sweep's striking speeds (nondimensional).
+    c, c_stderr : numpy.ndarray of float, shape (K,)
+        The decay factor per layer at each V₀, and its standard error.
+    v_start : numpy.ndarray of float, shape (K,)
+        The measured V_s at each V₀ (the law's starting speed, eqs. (9)–(11)).
+    rate : Fit
+        The fit of c = m V₀ + b (``rate["m"]``, ``rate["b"]``, ``rate.error("m")``).
+    ratio : Fit
+        The fit of V_s / V₀ (α, β[, γ]).
     """
 
     combination: Combination

@@ -35,15 +35,34 @@ STRIKES_DEG = (0.0, 30.0)
 
 @dataclass(frozen=True)
 class SweepSettings:
-    """How the V₀ sweep is simulated (nondimensional V₀).
+    """How the V₀ sweep of Sec. V is simulated (nondimensional, A = d = M = 1).
 
-    ``v0_min``, ``v0_max``, ``n_v0``: evenly spaced V₀; ``last``: the last bead any fit may
-    use; ``edge_beads``: hexagon size (None: ``last`` + 4); ``steps_per_contact``: time step
-    τ(V₀)/this; ``samples_per_contact``: output samples per τ(V₀); ``duration_contacts``: run
-    length in τ(V₀); ``engine``: "reference" or "lammps"; ``workers``: runs at once in local
-    processes; ``parsl``: a Parsl configuration file that takes the runs instead
-    (:mod:`hexdem.experiments.executors`; :func:`run_sweep` runs it); ``launcher``: the MPI
-    launcher command that starts each run's rank (e.g. ``"srun"``; None: in the worker's process).
+    Attributes
+    ----------
+    v0_min, v0_max : float
+        The smallest and largest striking speed V₀ (nondimensional).
+    n_v0 : int
+        How many V₀, evenly spaced (at least 4: the quadratic laws have 3 parameters).
+    last : int
+        The last bead any fit may use.
+    edge_beads : int or None
+        The hexagon's beads per edge (None: ``last`` + 4).
+    steps_per_contact : int
+        The time step, τ(V₀) over this, τ the contact time at V₀.
+    samples_per_contact : int
+        Samples of the beads' speeds per τ(V₀).
+    duration_contacts : float
+        Each run's length, in τ(V₀).
+    engine : {"reference", "lammps"}
+        The engine of every run.
+    workers : int
+        Runs at once, in local processes.
+    launcher : str or None
+        The MPI launcher command that starts each run's rank (e.g. ``"srun"``; None: in the
+        worker's process).
+    parsl : str or None
+        A Parsl configuration file that takes the runs instead of local processes
+        (:mod:`hexdem.experiments.executors`; :func:`run_sweep` runs it).
     """
 
     v0_min: float = 0.01
