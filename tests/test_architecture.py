@@ -22,6 +22,7 @@ LAYERS = (
     "waves",
     "disorder",
     "calibration",
+    "design",
     "paper",
     "api",
     "cli",

@@ -8,8 +8,8 @@ The paper's protocol (Sec. II): 4 sensors at a time, in three configurations tha
 sensor nearest the impact (along 0°; across the 0° line near the impact; across it further
 away), 20 packings for each, struck at 0.40 m/s, and configuration 1 also at 0.25 and 0.70 m/s;
 accelerometers sampled at 500 kS/s, records and runs of 3 ms (:data:`RECORD_DURATION_S`). The sensors' beads are the
-text's positions on the
-11-per-edge lattice (Fig. 1's exact beads are not in the text):
+text's positions on the 11-per-edge lattice (Fig. 1's exact beads are not in the text;
+:data:`hexdem.design.candidates.PAPER_CONFIGURATIONS`):
 
 * configuration 1: ``0:1, 0:3, 0:5, 0:7``;
 * configuration 2: ``0:1, +30:2, -30:2, +30:3`` (the row through 0:1 and its neighbours);
@@ -44,14 +44,11 @@ from hexdem.calibration.study import calibrate, prepare
 from hexdem.calibration.synthetic import synthetic_rows, write_measured
 from hexdem.cli.main import exit_status
 from hexdem.common.io import ensure_writable_dir, write_csv, write_json
+from hexdem.design.candidates import PAPER_CONFIGURATIONS
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
 
-CONFIGURATIONS = {
-    1: ("0:1", "0:3", "0:5", "0:7"),
-    2: ("0:1", "+30:2", "-30:2", "+30:3"),
-    3: ("0:1", "0:4", "+30:8", "-30:8"),
-}
+CONFIGURATIONS = {int(name): sensors for name, sensors in PAPER_CONFIGURATIONS.items()}
 DATA_SETS = ((1, 0.40), (2, 0.40), (3, 0.40), (1, 0.25), (1, 0.70))
 QUICK_DATA_SETS = ((1, 0.40), (2, 0.40))
 QUICK_BUDGET = 90

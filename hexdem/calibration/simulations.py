@@ -178,7 +178,7 @@ def disordered_impact(config: RunConfig, sigma_m: float, seed: int, realization:
     return analysis
 
 
-def _impact(problem: Problem, values, realization: int, workdir: Path, packings: Path):
+def analysed_impact(problem: Problem, values, realization: int, workdir: Path, packings: Path):
     """The analysed impact of the parameter set ``values``: on the ideal lattice, or on its
     packing ``realization``."""
     from hexdem.experiments.run import simulate
@@ -200,7 +200,7 @@ def simulate_point(problem: Problem, values, folder, realization: int = 0) -> li
         partial.mkdir(parents=True)
         write_json(partial / "parameters.json", {"keys": problem.keys, "values": [float(v) for v in values]})
         with silenced():
-            analysis = _impact(problem, values, realization, partial / "deck", folder.parent.parent / PACKINGS)
+            analysis = analysed_impact(problem, values, realization, partial / "deck", folder.parent.parent / PACKINGS)
         units, tracked = analysis.settings.units, analysis.tracked
         times = tracked.sensor_times * units.time_s
         accelerations = np.moveaxis(tracked.sensor_states[:, :, 2:4], 1, 0) * (units.length_m / units.time_s**2)

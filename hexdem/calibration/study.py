@@ -88,7 +88,7 @@ class Calibration:
     discrepancy: nuisance.Discrepancy | None = None
 
 
-def _realizations(priors, realizations: int | None) -> int:
+def realizations_of(priors, realizations: int | None) -> int:
     """Packings per parameter set: as asked, else 1 on the ideal lattice and
     :data:`~hexdem.calibration.packings.DISORDER_REALIZATIONS` when σ is calibrated, whose
     spread between packings one packing cannot measure."""
@@ -131,7 +131,7 @@ def prepare(
     the configuration's ``sensor_rate_hz``, becomes the simulations'; their measured axes, those
     with which the simulations' records are reduced."""
     priors = parse_priors(prior_texts)
-    realizations = _realizations(priors, realizations)
+    realizations = realizations_of(priors, realizations)
     gain_sd, speed_scatter = instrument_sd("--sensor-gain-sd", gain_sd), instrument_sd("--speed-scatter", speed_scatter)
     problem = Problem(base, tuple(priors), realizations, seed)
     check_problem(problem)

@@ -53,6 +53,7 @@ COMMANDS = {
     "snapshots": ("hexdem.cli.snapshots", "wavefront speed maps at chosen times (Figs. 3 and 4)"),
     "sweep": ("hexdem.cli.sweep", "a study of any run-config keys, each run a full result directory"),
     "calibrate": ("hexdem.cli.calibrate", "the model's parameters from measured sensor records, with uncertainties"),
+    "design": ("hexdem.cli.design", "which beads to instrument, and at which striker speed, for a calibration"),
     "paper": ("hexdem.cli.paper", "the whole paper: every published number beside hexdem's, in one report"),
 }
 
