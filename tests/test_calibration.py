@@ -462,6 +462,23 @@ BAD_INPUT = [
         ),
         "pulse",
     ),
+    (
+        ["--prior", "v0=uniform(0.2, 0.7)"],
+        lambda lines: (
+            [lines[0]]
+            + [
+                ",".join(
+                    l.split(",")[:2]
+                    + [f"{0.3 * ((i * 37) % 11 - 5)}", f"{0.3 * ((i * 53) % 7 - 3)}"]
+                    + l.split(",")[4:]
+                )
+                if l.startswith("0:1,")
+                else l
+                for i, l in enumerate(lines[1:])
+            ]
+        ),
+        "sensor 0:1 shows no pulse above the accelerometer's noise",
+    ),
     (["--prior", "diameter_sigma_m=uniform(-1e-5, 1e-4)"], None, "diameter_sigma_m: the standard deviation"),
     (["--prior", "diameter_sigma_m=normal(5e-5, 2e-5)"], None, "reaches -3e-05 m"),
     (["--prior", "diameter_sigma_m=uniform(0, 0.01)"], None, "would hold a bead of diameter"),

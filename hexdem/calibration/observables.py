@@ -123,6 +123,20 @@ def lead_in(record: Record) -> int:
     return int(np.argmax(magnitude >= FOOT_LEVEL * magnitude.max())) - FOOT_SAMPLES
 
 
+def _check_first_pulse(record: Record, sensor: str) -> None:
+    """Refuse a record whose first sensor holds no pulse above its noise, measured on the whole
+    record (the median absolute deviation, blind to a short pulse): without it, no lead-in is found."""
+    channel = record.accelerations[0][:, np.asarray(record.axes[0], bool)]
+    centred = channel - np.median(channel, axis=0)
+    level = float(MAD_TO_SD * np.max(np.median(np.abs(centred), axis=0)))
+    peak = float(np.max(np.sqrt(np.sum(centred**2, axis=1))))
+    if peak < MIN_SIGNAL_TO_NOISE * level:
+        raise HexdemError(
+            f"sensor {sensor} shows no pulse above the accelerometer's noise (largest {peak:.3g} m/s² above "
+            f"its median, noise {level:.3g} m/s² rms over the record): is the record long enough to hold its pulse?"
+        )
+
+
 def noise_covariance(record: Record, sensors, seed: int) -> tuple[np.ndarray, np.ndarray]:
     """(covariance of the record's observables under its own accelerometer noise, each channel's
     noise standard deviation [m/s²] (n_sensors, 2), NaN where the axis was not measured), by the
@@ -130,6 +144,7 @@ def noise_covariance(record: Record, sensors, seed: int) -> tuple[np.ndarray, np
     lead-in is exactly constant (its noise cannot be measured), and a sensor (of ``sensors``, the
     record's) whose largest acceleration is not :data:`MIN_SIGNAL_TO_NOISE` times its noise (it
     holds no pulse) are refused."""
+    _check_first_pulse(record, sensors[0])
     quiet = lead_in(record)
     if quiet < BASELINE_SAMPLES:
         raise HexdemError(
