@@ -5,7 +5,10 @@ A parameter set (on one packing, when disordered) is run once with every recorde
 reduces a sensor's (:mod:`hexdem.calibration.observables`): its log peak speed, and its arrival
 [µs] from the impact (a design's relative arrivals are differences of these). The accelerometers'
 noise is carried by a parametric bootstrap per bead: :data:`NOISE_DRAWS` copies of its record with
-white noise of ``noise_m_s2`` rms on each axis, their observables' variances and covariance.
+white noise of ``noise_m_s2`` rms on each axis, their observables' variances and covariance. The
+bootstrap reduces each bead's record NOISE_DRAWS times, many times the simulation's own cost, so it
+runs on one simulation a speed (the design's first parameter set, on its first packing); the
+others' moments are scaled from it (:class:`~hexdem.design.criterion.Moments`).
 
 **Sensor mass.** Every recorded bead is simulated as a plain bead (``sensor_mass_factor`` 1): one
 run cannot give each of hundreds of candidates a sensor's mass without every other candidate's.
@@ -79,11 +82,13 @@ def finished_moments(folder: Path, values) -> dict | None:
     return arrays
 
 
-def simulate_beads(problem: Problem, values, folder, noise_m_s2: float, seed: int, realization: int = 0) -> None:
+def simulate_beads(
+    problem: Problem, values, folder, noise_m_s2: float, seed: int, realization: int = 0, bootstrap: bool = False
+) -> None:
     """Run the parameter set ``values`` (on packing ``realization`` when disordered) with every
     bead of ``problem``'s sensors recorded, into ``folder`` (made whole or not at all): ``observables``
-    (n, 2) and ``noise`` (n, 3) of :func:`bead_observables` and :func:`noise_moments`; a task of the
-    study executor."""
+    (n, 2) of :func:`bead_observables` and, with ``bootstrap``, ``noise`` (n, 3) of
+    :func:`noise_moments` (else NaN); a task of the study executor."""
     folder = Path(folder)
     if finished_moments(folder, values) is not None:
         return
@@ -101,5 +106,7 @@ def simulate_beads(problem: Problem, values, folder, noise_m_s2: float, seed: in
             partial / MOMENTS_NAME,
             values=np.asarray(values, float),
             observables=bead_observables(times, accelerations),
-            noise=noise_moments(times, accelerations, noise_m_s2, rng),
+            noise=noise_moments(times, accelerations, noise_m_s2, rng)
+            if bootstrap
+            else np.full((len(accelerations), 3), np.nan),
         )
