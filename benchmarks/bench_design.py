@@ -34,7 +34,7 @@ from machine import describe
 
 from hexdem.calibration.priors import Prior
 from hexdem.calibration.study import calibrate, prepare
-from hexdem.design.candidates import PAPER_CONFIGURATIONS
+from hexdem.design.candidates import PAPER_CONFIGURATIONS, sensor_value
 from hexdem.design.study import prepare_design, run_design
 
 
@@ -72,7 +72,7 @@ def main() -> None:
     rng = np.random.default_rng(args.seed)
     measured = {}
     for name, (sensors, _) in designs.items():
-        base = {"sensors": sensors}
+        base = {"sensors": [sensor_value(sensor) for sensor in sensors]}
         widths = []
         for t in range(truths):
             folder = root / name.replace(" ", "-") / f"truth-{t}"
