@@ -216,6 +216,19 @@ def _row(moments: Moments, recorded, beads, v: float, study: DesignStudy) -> dic
     }
 
 
+def _configuration(name: str, row: dict | None, priors) -> dict | None:
+    """A paper configuration's entry of ``design.json`` from its scored ``row`` (None: a bead of it
+    saw no pulse)."""
+    if row is None:
+        return None
+    return {
+        "sensors": list(PAPER_CONFIGURATIONS[name]),
+        "v_striker": row["v_striker"],
+        "criterion": row["criterion"],
+        "widths": {prior.key: row[f"width_{prior.key}"] for prior in priors},
+    }
+
+
 def run_design(study: DesignStudy, out, workers: int = 1, parsl=None, log=print) -> dict:
     """Run ``study`` into ``out``; the summary written to ``design.json``."""
     from hexdem.design.figure import design_figure
@@ -300,18 +313,12 @@ def run_design(study: DesignStudy, out, workers: int = 1, parsl=None, log=print)
             "priors": [prior.describe() for prior in study.priors],
         }
         if study.paper:
-            at_best = paper_rows[best["v_striker"]]
-            summary["paper_configurations"] = {
-                name: None
-                if row is None
-                else {
-                    "sensors": list(PAPER_CONFIGURATIONS[name]),
-                    "v_striker": row["v_striker"],
-                    "criterion": row["criterion"],
-                    "widths": {prior.key: row[f"width_{prior.key}"] for prior in study.priors},
-                }
-                for name, row in at_best.items()
+            scored = {
+                v: {name: _configuration(name, row, study.priors) for name, row in rows_at.items()}
+                for v, rows_at in paper_rows.items()
             }
+            summary["paper_configurations"] = scored[best["v_striker"]]
+            summary["paper_configurations_by_speed"] = {f"{v:g}": entry for v, entry in scored.items()}
         write_json(out / "design.json", summary)
         design_figure(
             next(iter(study.problems.values())),
