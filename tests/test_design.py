@@ -14,6 +14,9 @@ from hexdem.design.search import search
 
 SMALL = "edge_beads = 5\n"
 COLUMNS = ["rank", "sensors", "v_striker", "criterion", "width_v0"]
+#: 2 sensors among the lines' beads, V0 ~ uniform(0.2, 0.7), 4 records, 8 simulations.
+SMALL_DESIGN = ["--prior", "v0=uniform(0.2, 0.7)", "--sensors", "2", "--candidates", "lines", "--noise", "5"]
+SMALL_DESIGN += ["--records", "4", "--budget", "8"]
 
 
 def one_key_moments(slopes, noise_var, points: int = 5) -> Moments:
@@ -70,27 +73,7 @@ def designed(tmp_path_factory):
     root = tmp_path_factory.mktemp("design")
     (root / "base.toml").write_text(SMALL)
     out = root / "out"
-    code = main(
-        [
-            "design",
-            "--config",
-            str(root / "base.toml"),
-            "--prior",
-            "v0=uniform(0.2, 0.7)",
-            "--sensors",
-            "2",
-            "--candidates",
-            "lines",
-            "--noise",
-            "5",
-            "--records",
-            "4",
-            "--budget",
-            "8",
-            "--out",
-            str(out),
-        ]
-    )
+    code = main(["design", "--config", str(root / "base.toml"), *SMALL_DESIGN, "--out", str(out)])
     assert code == 0
     return out
 
@@ -115,27 +98,7 @@ def test_a_design_writes_its_ranked_table_summary_and_figure(designed):
 @pytest.mark.xdist_group("design")
 def test_a_design_run_again_resumes_from_its_simulations(designed, capsys):
     stamps = {p: p.stat().st_mtime_ns for p in (designed / "simulations").glob("*/moments.npz")}
-    code = main(
-        [
-            "design",
-            "--config",
-            str(designed.parent / "base.toml"),
-            "--prior",
-            "v0=uniform(0.2, 0.7)",
-            "--sensors",
-            "2",
-            "--candidates",
-            "lines",
-            "--noise",
-            "5",
-            "--records",
-            "4",
-            "--budget",
-            "8",
-            "--out",
-            str(designed),
-        ]
-    )
+    code = main(["design", "--config", str(designed.parent / "base.toml"), *SMALL_DESIGN, "--out", str(designed)])
     assert code == 0 and len(stamps) == 8
     assert {p: p.stat().st_mtime_ns for p in (designed / "simulations").glob("*/moments.npz")} == stamps
 
