@@ -3,7 +3,8 @@ r"""The design criterion: the expected information a design's records carry abou
 **Model.** A design is N sensors (beads) struck at one speed, R records (on R packings where the
 packings are disordered). Its observables are those of ``hexdem calibrate``: the N log peak
 speeds and the N − 1 arrivals relative to the sensor the pulse reaches first. Their mean μ(θ) over
-packings is a quadratic in the keys θ, fitted by least squares to the simulations; a record's
+packings is emulated in the keys θ by the calibration's Gaussian process (a linear trend and a
+Matérn 5/2 process per observable, :mod:`hexdem.calibration.emulator`), whose slopes give J; a record's
 covariance is the calibration's likelihood's (:mod:`hexdem.calibration.nuisance`): the
 accelerometers' noise (a bootstrap per bead, :mod:`~hexdem.design.records`), the striker's speed
 scatter, the packings' spread (their pooled residual covariance, scaled as σ² where σ is a key),
@@ -12,29 +13,30 @@ and each sensor's gain, common to all R records:
 .. math:: Σ(θ) = (V_\text{noise} + V_\text{speed} + V_\text{spread}) / R + G.
 
 **Criterion.** In the keys standardised by their priors (z = (θ − mean)/sd, prior covariance I),
-linearised at θ, the posterior covariance is :math:`P(θ) = (I + J^T Σ^{-1} J)^{-1}` with
-J = ∂μ/∂z, and the information gain is :math:`-\tfrac12 \log\det P(θ)` nats (Lindley's, for a
-Gaussian prior of the priors' variances). The criterion is its mean over the simulated parameter
-sets: the expected information gain, larger for a better design. Each key's expected 90 % width
-is the mean of 2 × 1.645 √P_kk × sd, at most the prior's own central 90 % width. The information
-gain rewards designs that measure every key; the widths say which key a design leaves at its
-prior. It is the Laplace (local Gaussian) approximation: a posterior that is far from Gaussian,
-or a model discrepancy that the calibration would find, is not foreseen.
-"""
+linearised at θ, the posterior covariance is :math:`P(θ) = (I + J^T Σ^{-1} J)^{-1}` with J = ∂μ/∂z
+(central differences of the emulator), and the information gain is :math:`-\tfrac12 \log\det P(θ)`
+nats (Lindley's, for a Gaussian prior of the priors' variances). The criterion is its mean over the
+simulated parameter sets: the expected information gain, larger for a better design. Each key's
+expected 90 % width is the mean of 2 × 1.645 √P_kk × sd, at most the prior's own central 90 % width.
+The information gain rewards designs that measure every key; the widths say which key a design
+leaves at its prior. It is the Laplace (local Gaussian) approximation: a posterior that is far from
+Gaussian, or a model discrepancy that the calibration would find, is not foreseen."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from itertools import combinations_with_replacement
 
 import numpy as np
 
+from hexdem.calibration.emulator import Emulator
 from hexdem.calibration.packings import SIGMA_KEY
 
 #: z of the central 90 % interval of a normal distribution.
 Z90 = 1.6448536269514722
 #: Points on the unit interval at which a prior's mean, standard deviation and 90 % width are taken.
 PRIOR_GRID = 4001
+#: The step in the standardised keys of the emulator's central differences.
+SLOPE_STEP = 1e-3
 
 
 def prior_moments(prior) -> tuple[float, float, float]:
@@ -44,17 +46,17 @@ def prior_moments(prior) -> tuple[float, float, float]:
     return float(np.mean(values)), float(np.std(values)), float(high - low)
 
 
-def quadratic_features(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(features (M, F), their derivatives (M, F, p)) of the full quadratic in ``z`` (M, p)."""
-    m, p = z.shape
-    pairs = list(combinations_with_replacement(range(p), 2))
-    features = np.column_stack([np.ones(m), z, *[z[:, i] * z[:, j] for i, j in pairs]])
-    slopes = np.zeros((m, features.shape[1], p))
-    slopes[:, 1 : 1 + p, :] = np.eye(p)
-    for f, (i, j) in enumerate(pairs, start=1 + p):
-        slopes[:, f, i] += z[:, j]
-        slopes[:, f, j] += z[:, i]
-    return features, slopes
+def slopes(z: np.ndarray, mean: np.ndarray) -> np.ndarray:
+    """(M, o, p): the derivatives of the o observables ``mean`` (M, o) in ``z`` (M, p) at every
+    point, from a Gaussian-process emulator of each (:class:`~hexdem.calibration.emulator.Emulator`,
+    the calibration's own) by central differences of :data:`SLOPE_STEP`."""
+    emulator = Emulator(z, mean)
+    out = np.empty((len(z), mean.shape[1], z.shape[1]))
+    for j in range(z.shape[1]):
+        step = np.zeros(z.shape[1])
+        step[j] = SLOPE_STEP
+        out[:, :, j] = (emulator.predict(z + step)[0] - emulator.predict(z - step)[0]) / (2 * SLOPE_STEP)
+    return out
 
 
 @dataclass
@@ -86,10 +88,7 @@ class Moments:
         centre, sd = np.array([m[0] for m in moments]), np.array([m[1] for m in moments])
         z = (values - centre) / np.where(sd > 0, sd, 1.0)
         mean = observables.mean(axis=1)
-        features, derivatives = quadratic_features(z)
-        flat = mean.reshape(len(mean), -1)
-        coefficients, *_ = np.linalg.lstsq(features, flat, rcond=None)
-        slope = np.einsum("mfp,fo->mop", derivatives, coefficients).reshape(*mean.shape, z.shape[1])
+        slope = slopes(z, mean.reshape(len(mean), -1)).reshape(*mean.shape, z.shape[1])
         scale = np.ones(len(values))
         if SIGMA_KEY in keys:
             sigma = values[:, list(keys).index(SIGMA_KEY)]

@@ -125,7 +125,7 @@ def prepare_design(
         if sets < smallest:
             raise HexdemError(
                 f"--budget {budget}: at least {smallest * len(problems) * realizations} simulations "
-                f"({smallest} parameter sets a speed, for a quadratic in {len(priors)} key(s), x "
+                f"({smallest} parameter sets a speed, for an emulator of {len(priors)} key(s), x "
                 f"{len(problems)} speed(s) x {realizations} packing(s))"
             )
     return DesignStudy(
