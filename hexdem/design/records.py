@@ -69,13 +69,16 @@ def _bootstrap(times, accelerations, noise_m_s2: float, rng) -> np.ndarray:
 
 def noise_moments(times, accelerations, noise_m_s2: float, rng) -> np.ndarray:
     """(n, 3): each bead's variance of its log peak and of its arrival [µs²], and their covariance,
-    under white noise of ``noise_m_s2`` rms per axis (a parametric bootstrap). A lab's channels are
+    under white noise of ``noise_m_s2`` rms per axis (a parametric bootstrap), as ``hexdem
+    calibrate`` measures them: its bootstrap adds fresh noise to a record that holds its own, so its
+    copies carry √2 times the channel's level, and so do these. A lab's channels are
     not all at the stated level: where a bead's observables degrade faster than its noise grows (a
     small pulse whose half-maximum crossing jumps from one hump to another), its moments at
     :data:`NOISE_MARGIN` times the level, scaled back by the square of the margin, are taken
     instead, so that a design does not rest on a bead that a noisier channel would lose."""
-    nominal = _bootstrap(times, accelerations, noise_m_s2, rng)
-    noisier = _bootstrap(times, accelerations, NOISE_MARGIN * noise_m_s2, rng) / NOISE_MARGIN**2
+    level = np.sqrt(2.0) * noise_m_s2  # a record's own noise, and the calibration's bootstrap's on top of it
+    nominal = _bootstrap(times, accelerations, level, rng)
+    noisier = _bootstrap(times, accelerations, NOISE_MARGIN * level, rng) / NOISE_MARGIN**2
     worse = (noisier[:, 0] > nominal[:, 0]) | (noisier[:, 1] > nominal[:, 1])
     return np.where(worse[:, None], noisier, nominal)
 
