@@ -79,11 +79,8 @@ class Moments:
     @classmethod
     def of(cls, keys, values: np.ndarray, observables: np.ndarray, noise: np.ndarray, priors) -> Moments:
         """From the parameter sets ``values`` (M, p) in key units, each packing's ``observables``
-        (M, K, n, 2), and the bootstrap's ``noise`` (n, 3) of the first set's first packing. At
-        the other sets it is scaled by (its peak / their mean peak)², bead by bead: white noise
-        integrated to velocity has the same spread whatever the pulse, so the log peak's variance
-        goes as 1/peak², and so does the arrival's, the half-maximum crossing's slope being in
-        proportion to the peak."""
+        (M, K, n, 2), and the bootstrap's ``noise`` (M, n, 3) of each set's first packing, NaN at
+        the sets not bootstrapped, which take the nearest bootstrapped set's (in the standardised keys)."""
         moments = [prior_moments(prior) for prior in priors]
         centre, sd = np.array([m[0] for m in moments]), np.array([m[1] for m in moments])
         z = (values - centre) / np.where(sd > 0, sd, 1.0)
@@ -94,8 +91,9 @@ class Moments:
             sigma = values[:, list(keys).index(SIGMA_KEY)]
             scale = sigma**2 / max(float(np.mean(sigma**2)), 1e-300)
         width = np.array([m[2] for m in moments])
-        ratio = np.exp(2 * (observables[0, 0, :, 0][None, :] - mean[:, :, 0]))
-        return cls(mean, slope, noise[None, :, :] * ratio[:, :, None], observables - mean[:, None], scale, sd, width)
+        measured = np.flatnonzero(np.all(np.isfinite(noise), axis=(1, 2)))
+        nearest = measured[np.argmin(np.sum((z[:, None, :] - z[None, measured, :]) ** 2, axis=-1), axis=1)]
+        return cls(mean, slope, noise[nearest], observables - mean[:, None], scale, sd, width)
 
     def design_map(self, beads) -> tuple[np.ndarray, np.ndarray]:
         """(the beads ordered by their mean arrival, the map A (2N − 1, 2N) from their (log peak,

@@ -5,10 +5,10 @@ A parameter set (on one packing, when disordered) is run once with every recorde
 reduces a sensor's (:mod:`hexdem.calibration.observables`): its log peak speed, and its arrival
 [µs] from the impact (a design's relative arrivals are differences of these). The accelerometers'
 noise is carried by a parametric bootstrap per bead: :data:`NOISE_DRAWS` copies of its record with
-white noise of ``noise_m_s2`` rms on each axis, their observables' variances and covariance. The
-bootstrap reduces each bead's record NOISE_DRAWS times, many times the simulation's own cost, so it
-runs on one simulation a speed (the design's first parameter set, on its first packing); the
-others' moments are scaled from it (:class:`~hexdem.design.criterion.Moments`).
+white noise of ``noise_m_s2`` rms on each axis, their observables' variances and covariance, on
+every third parameter set (:data:`~hexdem.design.study.NOISE_EVERY`, on its first packing), the
+others taking the nearest's: the noise of a small pulse's arrival depends on the pulse's shape,
+which changes with the parameters.
 
 **Sensor mass.** Every recorded bead is simulated as a plain bead (``sensor_mass_factor`` 1): one
 run cannot give each of hundreds of candidates a sensor's mass without every other candidate's.
@@ -32,7 +32,7 @@ from hexdem.errors import HexdemError
 from hexdem.experiments.signals import integrate_velocity, pulse
 
 #: Noisy copies of each bead's record whose observables give its noise moments.
-NOISE_DRAWS = 64
+NOISE_DRAWS = 24
 #: How many times the stated noise a channel may carry (:func:`noise_moments`).
 NOISE_MARGIN = 2.0
 MOMENTS_NAME = "moments.npz"

@@ -38,6 +38,8 @@ SIMULATIONS = "simulations"
 RANKED = 20
 #: Parameter sets per striker speed by default: this many per key, plus as many again.
 SETS_PER_KEY = 10
+#: The noise is bootstrapped on every this many parameter sets (on their first packing).
+NOISE_EVERY = 3
 
 
 @dataclass(frozen=True)
@@ -159,8 +161,8 @@ def _plan(study: DesignStudy) -> dict:
 
 def _simulate(study: DesignStudy, out: Path, workers: int, parsl) -> tuple[dict, int]:
     """Run every simulation not finished before; {speed: (values (M, p), observables (M, K, n, 2),
-    noise (n, 3) of the first parameter set's first packing)} of the parameter sets whose every
-    packing ran, and the failed count."""
+    noise (M, n, 3) of each set's first packing, NaN where not bootstrapped)} of the parameter sets
+    whose every packing ran, and the failed count."""
     unit = inference.design(len(study.priors), study.sets, study.seed)
     keys = [prior.key for prior in study.priors]
     if SIGMA_KEY in keys:  # parameter sets share their packings, as a calibration's do
@@ -181,7 +183,7 @@ def _simulate(study: DesignStudy, out: Path, workers: int, parsl) -> tuple[dict,
             study.noise_m_s2,
             study.seed,
             key[2],
-            key[1:] == (0, 0),
+            key[2] == 0 and key[1] % NOISE_EVERY == 0,
         )
         for key, folder in folders.items()
         if finished_moments(folder, values[key[1]]) is None
@@ -193,14 +195,12 @@ def _simulate(study: DesignStudy, out: Path, workers: int, parsl) -> tuple[dict,
     }
     results = {}
     for v in study.problems:
-        if any((v, 0, k) in failed for k in range(study.realizations)):
-            raise HexdemError(f"the first simulation at {v:g}, whose records measure the noise's effect, failed")
         kept = [i for i in range(study.sets) if not any((v, i, k) in failed for k in range(study.realizations))]
         arrays = [[finished_moments(folders[(v, i, k)], values[i]) for k in range(study.realizations)] for i in kept]
         results[v] = (
             values[kept],
             np.array([[a["observables"] for a in row] for row in arrays]),
-            arrays[0][0]["noise"],
+            np.array([row[0]["noise"] for row in arrays]),
         )
     return results, len(failed)
 
@@ -249,7 +249,9 @@ def run_design(study: DesignStudy, out, workers: int = 1, parsl=None, log=print)
         for v, (values, observables, noise) in results.items():
             if len(values) < (len(study.priors) + 1) * (len(study.priors) + 2) // 2:
                 raise HexdemError(f"{failed} simulations failed (see {out / SIMULATIONS}); too few are left")
-            usable = np.all(np.isfinite(observables), axis=(0, 1, 3)) & np.all(np.isfinite(noise), axis=1)
+            usable = np.all(np.isfinite(observables), axis=(0, 1, 3)) & np.all(
+                np.isfinite(noise[::NOISE_EVERY]), axis=(0, 2)
+            )
             dropped |= {study.recorded[b] for b in np.flatnonzero(~usable) if study.recorded[b] in study.candidates}
             pool = [b for b, label in enumerate(study.recorded) if label in study.candidates and usable[b]]
             if len(pool) < study.sensors:
