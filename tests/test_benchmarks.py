@@ -46,6 +46,14 @@ EXPECTED = {
         "reference",
         "target at 140 steps per contact",
     ),
+    "bench_design.py": (
+        "design:",
+        "simulations",
+        "predicted 90 % width",
+        "measured median 90 % width",
+        "predicted ratio best",
+        "within 30 %",
+    ),
     "bench_results.py": (
         "beads",
         "never moved",
