@@ -59,6 +59,12 @@ def slopes(z: np.ndarray, mean: np.ndarray) -> np.ndarray:
     return out
 
 
+def bootstrapped(noise: np.ndarray) -> np.ndarray:
+    """(M,) whether each parameter set's ``noise`` (M, n, 3) was bootstrapped: a set that was not
+    holds NaN only; one that was may hold NaN at a bead without a pulse."""
+    return np.any(np.isfinite(noise), axis=(1, 2))
+
+
 @dataclass
 class Moments:
     """What the simulations of one striker speed say about every candidate bead (n of them):
@@ -91,7 +97,7 @@ class Moments:
             sigma = values[:, list(keys).index(SIGMA_KEY)]
             scale = sigma**2 / max(float(np.mean(sigma**2)), 1e-300)
         width = np.array([m[2] for m in moments])
-        measured = np.flatnonzero(np.all(np.isfinite(noise), axis=(1, 2)))
+        measured = np.flatnonzero(bootstrapped(noise))
         nearest = measured[np.argmin(np.sum((z[:, None, :] - z[None, measured, :]) ** 2, axis=-1), axis=1)]
         return cls(mean, slope, noise[nearest], observables - mean[:, None], scale, sd, width)
 

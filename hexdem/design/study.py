@@ -25,7 +25,7 @@ from hexdem.calibration.study import instrument_sd, realizations_of
 from hexdem.common.checks import positive_int
 from hexdem.common.io import ensure_writable_dir, keep_plan, locked_directory, write_csv, write_json
 from hexdem.design.candidates import PAPER_CONFIGURATIONS, candidate_labels, is_paper_lattice, sensor_value
-from hexdem.design.criterion import Moments
+from hexdem.design.criterion import Moments, bootstrapped
 from hexdem.design.records import finished_moments, simulate_beads
 from hexdem.design.search import search
 from hexdem.errors import HexdemError
@@ -250,7 +250,7 @@ def run_design(study: DesignStudy, out, workers: int = 1, parsl=None, log=print)
             if len(values) < (len(study.priors) + 1) * (len(study.priors) + 2) // 2:
                 raise HexdemError(f"{failed} simulations failed (see {out / SIMULATIONS}); too few are left")
             usable = np.all(np.isfinite(observables), axis=(0, 1, 3)) & np.all(
-                np.isfinite(noise[::NOISE_EVERY]), axis=(0, 2)
+                np.isfinite(noise[bootstrapped(noise)]), axis=(0, 2)
             )
             dropped |= {study.recorded[b] for b in np.flatnonzero(~usable) if study.recorded[b] in study.candidates}
             pool = [b for b, label in enumerate(study.recorded) if label in study.candidates and usable[b]]
