@@ -3,7 +3,8 @@ from the prior, the records made as a lab's instruments make them.
 
 Usage: python benchmarks/bench_calibration.py [--case tiny|quick|disordered] [--truths 50] [--records 1]
                                               [--workers 2] [--noise 5] [--seed 2026] [--out DIR] [--quick]
-                                              [--no-model-discrepancy] [--cost N]
+                                              [--no-model-discrepancy] [--cost N] [--toy K,R]
+                                              [--spread-in-sigma S1,S2,...]
 
 **Simulation-based calibration** (Talts, Betancourt, Simpson, Vehtari & Gelman 2018): draw a truth θ
 from the prior, make a record of it, calibrate, and take the rank of θ among L = 99 draws of the
@@ -39,6 +40,9 @@ each on the same K packings (shared deviates, as the calibration's own), and R r
 independent packings with a little noise; the coverage of σ's 90 % interval over ``--truths``
 truths, through the calibration's own likelihood and sampler.
 
+``--spread-in-sigma S1,S2,...``: the observables of the disordered case's 8 packings (the calibration's
+own, seed 0) at each σ [m], restitution 0.95: whether they vary smoothly with σ on shared deviates.
+
 ``--quick``: one truth of the tiny case on one worker. ``--cost N``: N simulations of the quick case,
 one after another in this process after one to warm up (as a worker runs them), each timed whole
 (configuration, LAMMPS, the sensors' reduction, its folder written) beside its LAMMPS loop (the
@@ -57,7 +61,7 @@ from pathlib import Path
 import numpy as np
 from machine import describe
 
-from hexdem.calibration.packings import SIGMA_KEY
+from hexdem.calibration.packings import DISORDER_REALIZATIONS, SIGMA_KEY
 from hexdem.calibration.priors import Prior, to_parameters
 from hexdem.calibration.simulations import Problem, simulate_point
 from hexdem.calibration.study import DEFAULT_GAIN_SD, DEFAULT_SPEED_SCATTER, calibrate, prepare
@@ -170,6 +174,26 @@ def disorder_toy(packings: int, records: int, truths: int, seed: int) -> None:
     )
 
 
+def spread_in_sigma(sigmas, root: Path) -> None:
+    """The table of ``--spread-in-sigma``: each packing's observables at each σ."""
+    from hexdem.calibration.observables import at_rest_before, reduce_record
+    from hexdem.calibration.simulations import analysed_impact
+    from hexdem.common.progress import silenced
+
+    base, prior_texts, _ = CASES["disordered"]
+    problem = Problem(base, tuple(Prior.parse(text) for text in prior_texts), DISORDER_REALIZATIONS)
+    print("| σ µm | packing | " + " | ".join(problem.names) + " |")
+    print("|---" * (2 + len(problem.names)) + "|")
+    for sigma in sigmas:
+        for k in range(problem.realizations):
+            with silenced():
+                analysis = analysed_impact(problem, [sigma, 0.95], k, root / f"s{sigma:g}-k{k}", root / "packings")
+            units, tracked = analysis.settings.units, analysis.tracked
+            accelerations = np.moveaxis(tracked.sensor_states[:, :, 2:4], 1, 0) * (units.length_m / units.time_s**2)
+            observed = reduce_record(*at_rest_before(tracked.sensor_times * units.time_s, accelerations))
+            print(f"| {sigma * 1e6:.0f} | {k} | " + " | ".join(f"{v:.3g}" for v in observed) + " |", flush=True)
+
+
 def simulation_cost(count: int, root: Path) -> None:
     """The table of ``--cost``: each simulation's whole time beside its LAMMPS loop."""
     base, prior_texts, _ = CASES["quick"]
@@ -204,6 +228,7 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--cost", type=int, metavar="N", help="time N simulations against their LAMMPS loop, only")
     parser.add_argument("--toy", metavar="K,R", help="the disorder toy on K packings a set and R records, only")
+    parser.add_argument("--spread-in-sigma", metavar="S1,S2", help="the disordered case's packings at σ [m], only")
     args = parser.parse_args()
     print(f"machine: {describe()}; load average {os.getloadavg()[0]:.2f}", flush=True)
     if args.toy:
@@ -213,6 +238,9 @@ def main() -> None:
     root = Path(args.out or tempfile.mkdtemp(prefix="hexdem-bench-calibration-"))
     if args.cost:
         simulation_cost(args.cost, root)
+        return
+    if args.spread_in_sigma:
+        spread_in_sigma([float(value) for value in args.spread_in_sigma.split(",")], root)
         return
     case = "tiny" if args.quick else args.case
     base, prior_texts, budget = CASES[case]
@@ -227,9 +255,9 @@ def main() -> None:
     print(
         "| truth | "
         + " | ".join(f"{p.key} true | {p.key} 90 % interval | {p.key} rank" for p in priors)
-        + " | simulations | fit p | wall s |"
+        + " | records kept | simulations | fit p | wall s |"
     )
-    print("|---" * (1 + 3 * len(priors) + 3) + "|")
+    print("|---" * (1 + 3 * len(priors) + 4) + "|")
     ranks, inside = {p.key: [] for p in priors}, {(p.key, level): 0 for p in priors for level in (0.5, 0.9)}
     refused = []
     for t in range(truths):
@@ -265,7 +293,8 @@ def main() -> None:
             held = "" if q05 <= truth[j] <= q95 else " MISSED"
             cells.append(f"{truth[j]:.6g} | [{q05:.6g}, {q95:.6g}]{held} | {rank}")
         print(
-            f"| {t} | " + " | ".join(cells) + f" | {summary['simulations']['runs']} | "
+            f"| {t} | " + " | ".join(cells) + f" | {len(calibration.data.records)} of {args.records} | "
+            f"{summary['simulations']['runs']} | "
             f"{summary['fit']['p_value']:.2f} | {seconds:.0f} |",
             flush=True,
         )

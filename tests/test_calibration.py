@@ -7,6 +7,7 @@ import signal
 import subprocess
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +17,7 @@ from scipy.stats import qmc
 
 from hexdem.calibration import inference, nuisance
 from hexdem.calibration.emulator import Emulator
-from hexdem.calibration.observables import Record, noise_covariance, reduce_record
+from hexdem.calibration.observables import FOOT_SAMPLES, Record, lead_in, noise_covariance, reduce_record
 from hexdem.calibration.packings import SIGMA_LEVELS, preparation_of, settled_packing
 from hexdem.calibration.priors import NORMAL_TAIL, Prior
 from hexdem.calibration.report import summarize
@@ -238,6 +239,46 @@ def test_the_spread_between_packings_follows_the_parameters():
     assert Spread(points, observables[:, :1])(test) == pytest.approx(0.0)
 
 
+def test_packings_without_a_detected_pulse_are_left_out_of_the_spread():
+    """The observables of the test above, with a fifth of the packings turned into outliers 30
+    standard deviations off (a sensor the pulse did not reach: a log peak of −26) and marked as
+    undetected (NaN), as a simulation below the records' detection level is: the spread holds
+    s = 0.1 + u within the same 25 % (its sets have fewer packings) and counts the median set's
+    packings less one as its degrees of freedom; kept, the outliers inflate s more than five-fold."""
+    rng = np.random.default_rng(1)
+    n, k, rho = 80, 8, 0.8
+    points = inference.design(1, n, seed=6)
+    chol = np.linalg.cholesky(np.array([[1.0, rho], [rho, 1.0]]))
+    scale = 0.1 + points
+    observables = scale[:, None, :] * (rng.standard_normal((n, k, 2)) @ chol.T) + points[:, None, :]
+    lost = rng.random((n, k)) < 0.2
+    observables[lost] -= 30 * scale[np.nonzero(lost)[0]]
+    test = np.array([[0.1], [0.5], [0.9]])
+    kept = Spread(points, observables)
+    assert np.all(np.sqrt(np.diagonal(kept(test), axis1=1, axis2=2)) > 5 * (0.1 + test))
+    observables[lost] = np.nan
+    spread = Spread(points, observables)
+    sd = np.sqrt(np.diagonal(spread(test), axis1=1, axis2=2))
+    assert sd == pytest.approx(np.repeat(0.1 + test, 2, axis=1), rel=0.25)
+    assert spread.dof == int(np.median(k - lost.sum(axis=1))) - 1
+
+
+def test_a_simulated_packing_is_detected_as_the_records_sensors_would_detect_it():
+    """A packing whose pulse reaches 100 m/s² at sensor 0:1 and 5 m/s² at 0:3 (on y alone): with
+    detection levels of 10 m/s² it holds no pulse the records' sensors would see; with 4 m/s² at
+    0:3 it does, unless 0:3 measures x alone; without levels every packing is detected."""
+    from hexdem.calibration.simulations import detected
+
+    accelerations = np.zeros((2, 50, 2))
+    accelerations[0, 10, 0], accelerations[1, 30, 1] = 100.0, 5.0
+    problem = Problem(TINY, (Prior("v0", "uniform", 0.2, 0.7),))
+    assert detected(problem, accelerations)
+    assert not detected(replace(problem, detection_m_s2=(10.0, 10.0)), accelerations)
+    assert detected(replace(problem, detection_m_s2=(10.0, 4.0)), accelerations)
+    single_axis = replace(problem, detection_m_s2=(10.0, 4.0), axes=((True, True), (True, False)))
+    assert not detected(single_axis, accelerations)
+
+
 def test_a_record_from_a_packing_the_runs_never_took_stays_possible():
     """Every parameter set runs on the same K packings, so K = 2 packings of m = 4 observables
     deviate in one direction only, whatever the number of sets: pooled as it is, their correlation
@@ -411,6 +452,24 @@ def test_a_lead_in_that_is_not_at_rest_is_refused():
         noise_covariance(Record("0", record.times, record.accelerations + ramp, record.axes), ["a", "b"], seed=0)
 
 
+def test_the_lead_in_of_a_weak_first_pulse_ends_at_its_foot_above_the_noise():
+    """A first sensor whose pulse is 12 times its noise (a packing whose pulse took another path
+    past it), on a DC offset of 20 m/s²: 10 % of its peak is 1.2 noise standard deviations, which
+    the noise crosses at once; the foot is where it first reaches 5 of them, within the pulse's
+    rise (from 300 µs, 150 samples in, to its peak 10 samples later), and the noise is measured on
+    the lead-in before it."""
+    record, _, _ = pulse_record(0.0, np.random.default_rng(0))
+    rng = np.random.default_rng(8)
+    noise = 0.1 * np.pi / 80e-6 / 12
+    weak = record.accelerations.copy()
+    weak[0] = weak[0] + noise * rng.standard_normal(weak[0].shape) + 20.0
+    weak[1] = 50 * weak[1] + noise * rng.standard_normal(weak[1].shape)
+    quiet = lead_in(Record("0", record.times, weak, record.axes))
+    assert 150 - FOOT_SAMPLES <= quiet <= 160 - FOOT_SAMPLES  # the rise takes 10 samples
+    _, levels = noise_covariance(Record("0", record.times, weak, record.axes), ["a", "b"], seed=0)
+    assert levels == pytest.approx(noise, rel=0.3)
+
+
 @pytest.fixture(scope="module")
 def measured(tmp_path_factory):
     """A synthetic record of the tiny case at v0 = TRUE_V0: twice finer step, noise, clock offset."""
@@ -430,6 +489,33 @@ def damaged(measured, tmp_path, change) -> str:
     path = tmp_path / "damaged.csv"
     path.write_text("\n".join(change(lines)) + "\n")
     return str(path)
+
+
+def test_a_record_whose_sensor_shows_no_pulse_is_left_out_of_several(measured, tmp_path):
+    """Two records, the second's sensor 0:3 holding noise alone (its pulse did not reach it): the
+    second is left out with a note, the first is calibrated, and the simulations' detection level
+    is ten times each sensor's noise measured on the record kept (its noisier axis); a file of the
+    second record alone is refused."""
+    from hexdem.calibration.study import prepare
+
+    lines = lines_of(measured / "data.csv")
+    rng = np.random.default_rng(3)
+    second = [
+        ",".join(l.split(",")[:2] + [f"{5 * rng.standard_normal():.6g}", f"{5 * rng.standard_normal():.6g}", "1"])
+        if l.startswith("0:3,")
+        else l.rsplit(",", 1)[0] + ",1"
+        for l in lines[1:]
+    ]
+    (tmp_path / "two.csv").write_text("\n".join(lines + second) + "\n")
+    calibration = prepare(TINY, tmp_path / "two.csv", ["v0=uniform(0.2, 0.7)"], 30, seed=0)
+    assert calibration.data.record_names == ("0",) and calibration.left_out == ("1",)
+    assert "record 1 left out: sensor 0:3 shows no pulse above the accelerometer's noise" in calibration.notes
+    noise = np.nanmax(calibration.channel_noise_m_s2[0], axis=1)
+    assert calibration.problem.detection_m_s2 == pytest.approx(10 * noise)
+    assert noise == pytest.approx(5.0, rel=0.5)  # 56 quiet samples: the seed's draw reads 0:1 at 3.45
+    (tmp_path / "bad.csv").write_text("\n".join(lines[:1] + second) + "\n")
+    with pytest.raises(HexdemError, match="record 1: sensor 0:3 shows no pulse"):
+        prepare(TINY, tmp_path / "bad.csv", ["v0=uniform(0.2, 0.7)"], 30, seed=0)
 
 
 BAD_INPUT = [

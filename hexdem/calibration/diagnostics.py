@@ -53,7 +53,7 @@ def in_g_hint(records, simulated, sensors: int) -> str:
     gravity's factor (records in g read as m/s²), else an empty one: ``records`` (R, m) and the
     simulations' ``simulated`` (n, K, m) observables, the first ``sensors`` of them log peaks."""
     measured = float(np.mean(records[:, :sensors]))
-    lowest, highest = float(np.min(simulated[..., :sensors])), float(np.max(simulated[..., :sensors]))
+    lowest, highest = float(np.nanmin(simulated[..., :sensors])), float(np.nanmax(simulated[..., :sensors]))
     scaled = measured + np.log(STANDARD_GRAVITY_M_S2)
     if measured < lowest - np.log(2.0) and lowest - 1.0 <= scaled <= highest + 1.0:
         return (

@@ -331,11 +331,21 @@ def fit_stage(
     instruments: Instruments | None = None,
     discrepancy: Discrepancy | None = None,
 ) -> Fit:
-    """Fit the emulator to the simulations and sample the posterior it implies (``model_error``:
+    """Fit the emulator to the simulations and sample the posterior it implies: the emulator to each
+    parameter set's mean over its packings whose pulse the sensors detect (the others' observables are
+    NaN, :func:`~hexdem.calibration.simulations.detected`), the spread to their deviations (``model_error``:
     the covariance of the model's own integration error, :func:`step_error`; ``instruments``: the
     records' gains and speed scatter; ``discrepancy``: what the model cannot represent)."""
     points, observables = np.asarray(points, float), np.asarray(observables, float)
-    emulator = Emulator(points, observables.mean(axis=1))
+    detected = np.isfinite(observables[..., 0]).sum(axis=1)
+    seen = detected >= min(2, observables.shape[1])
+    if seen.sum() < initial_points(points.shape[1]) // 2:
+        raise HexdemError(
+            f"the sensors would detect a pulse on {'enough packings of ' if observables.shape[1] > 1 else ''}only "
+            f"{seen.sum()} of {len(points)} simulated parameter sets: too few to calibrate (a sensor the pulse "
+            "seldom reaches, or records noisier than its pulse)"
+        )
+    emulator = Emulator(points[detected > 0], np.nanmean(observables[detected > 0], axis=1))
     spread = Spread(points, observables, *records_scatter(data, instruments))
     likelihood = Likelihood(data, emulator, spread, model_error, instruments, discrepancy)
     states, chain = sample_posterior(likelihood, likelihood.dimension, seed)
@@ -361,8 +371,9 @@ def step_error(coarse, fine) -> np.ndarray:
     converges at first order in the step (the sensors' samples fall on whole steps), so the runs
     miss the limit of a vanishing step by about b = 2 (coarse − fine). The likelihood treats b as
     unknown within its size, the rank-one covariance b bᵀ: a record, measured without any time
-    step, may then sit off the runs by b in either direction."""
-    bias = 2.0 * (np.asarray(coarse, float) - np.asarray(fine, float))
+    step, may then sit off the runs by b in either direction. A packing whose pulse the sensors do not
+    detect (NaN observables) measures no error: none is added."""
+    bias = np.nan_to_num(2.0 * (np.asarray(coarse, float) - np.asarray(fine, float)))
     return np.outer(bias, bias)
 
 

@@ -58,6 +58,9 @@ BOOTSTRAP_DRAWS = 400
 FOOT_LEVEL = 0.1
 #: Samples before the foot kept out of the quiet lead-in.
 FOOT_SAMPLES = 10
+#: Noise standard deviations that the foot of a weak pulse must reach (white noise passes 5 of them
+#: in fewer than one sample in a million).
+FOOT_NOISE = 5.0
 #: A sensor's largest acceleration over the noise below which its record holds no pulse.
 MIN_SIGNAL_TO_NOISE = 10.0
 #: The median absolute deviation of white Gaussian noise times this is its standard deviation.
@@ -117,21 +120,41 @@ def at_rest_before(times, accelerations) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate([lead, times]), np.concatenate([rest, accelerations], axis=1)
 
 
+class NoPulse(HexdemError):
+    """A record with a sensor that shows no pulse above its accelerometer's noise: on a disordered
+    packing, one whose pulse took another path or waits at a gap (:func:`noise_covariance`)."""
+
+
+def _centred(record: Record, sensor: int) -> np.ndarray:
+    """Sensor ``sensor``'s measured axes of ``record`` less each channel's median over the record."""
+    channel = record.accelerations[sensor][:, np.asarray(record.axes[sensor], bool)]
+    return channel - np.median(channel, axis=0)
+
+
+def _record_noise(centred) -> float:
+    """The noise [m/s² rms] of a ``centred`` channel group, measured on the whole record (the median
+    absolute deviation of its noisier axis, blind to a short pulse)."""
+    return float(MAD_TO_SD * np.max(np.median(np.abs(centred), axis=0)))
+
+
 def lead_in(record: Record) -> int:
-    """Samples of ``record`` before the pulse's foot at its first sensor (its quiet lead-in)."""
-    magnitude = np.hypot(*record.accelerations[0].T)
-    return int(np.argmax(magnitude >= FOOT_LEVEL * magnitude.max())) - FOOT_SAMPLES
+    """Samples of ``record`` before the pulse's foot at its first sensor (its quiet lead-in): where
+    the first sensor's acceleration, its offset removed, first reaches :data:`FOOT_LEVEL` of its
+    peak, or :data:`FOOT_NOISE` times its noise where the pulse is so weak that the noise reaches that share."""
+    centred = _centred(record, 0)
+    magnitude = np.sqrt(np.sum(centred**2, axis=1))
+    level = max(FOOT_LEVEL * magnitude.max(), FOOT_NOISE * _record_noise(centred))
+    return int(np.argmax(magnitude >= level)) - FOOT_SAMPLES
 
 
 def _check_first_pulse(record: Record, sensor: str) -> None:
     """Refuse a record whose first sensor holds no pulse above its noise, measured on the whole
-    record (the median absolute deviation, blind to a short pulse): without it, no lead-in is found."""
-    channel = record.accelerations[0][:, np.asarray(record.axes[0], bool)]
-    centred = channel - np.median(channel, axis=0)
-    level = float(MAD_TO_SD * np.max(np.median(np.abs(centred), axis=0)))
+    record: without it, no lead-in is found."""
+    centred = _centred(record, 0)
+    level = _record_noise(centred)
     peak = float(np.max(np.sqrt(np.sum(centred**2, axis=1))))
     if peak < MIN_SIGNAL_TO_NOISE * level:
-        raise HexdemError(
+        raise NoPulse(
             f"sensor {sensor} shows no pulse above the accelerometer's noise (largest {peak:.3g} m/s² above "
             f"its median, noise {level:.3g} m/s² rms over the record): is the record long enough to hold its pulse?"
         )
@@ -160,7 +183,7 @@ def noise_covariance(record: Record, sensors, seed: int) -> tuple[np.ndarray, np
         peak = float(np.max(np.hypot(channel[:, 0], channel[:, 1])))
         level = float(np.nanmax(levels))
         if peak < MIN_SIGNAL_TO_NOISE * level:
-            raise HexdemError(
+            raise NoPulse(
                 f"sensor {sensor} shows no pulse above the accelerometer's noise "
                 f"(largest {peak:.3g} m/s², noise {level:.3g} m/s² rms): is the record long enough to "
                 "hold its pulse?"

@@ -4,7 +4,8 @@ parameters drawn, reduced to the observables of its sensors.
 Every simulation is one task of the study executor (:mod:`~hexdem.experiments.executors`) and
 has a folder of its own, ``DIR/simulations/NNNN`` (``-kK`` for the K-th packing), that holds
 ``parameters.json`` (the values set), ``observables.json`` (the reduced record,
-:func:`~hexdem.calibration.observables.reduce_record`) and the run's LAMMPS deck. It is made in
+:func:`~hexdem.calibration.observables.reduce_record`; null where a sensor's pulse stays below what
+the records' sensors detect, :func:`detected`) and the run's LAMMPS deck. It is made in
 ``.NNNN.part`` and renamed into place once complete, so that a folder that exists is a finished
 simulation: a calibration run again (after ``kill -9``, say) finds it, checks that its
 parameters are the planned ones, and does not repeat it. No figures are drawn and no result
@@ -52,14 +53,17 @@ CHECKED_QUANTILES = (0.0, 0.5, 1.0)
 class Problem:
     """What a calibration simulates: the base configuration table ``base``, the ``priors`` of
     the parameters it draws, the ``realizations`` (packings) per parameter set, the
-    ``seed`` of the packings' diameters, and the ``axes`` each sensor measured (x, y), with which
-    a simulation's record is reduced as the measured ones are (None: both)."""
+    ``seed`` of the packings' diameters, the ``axes`` each sensor measured (x, y), with which
+    a simulation's record is reduced as the measured ones are (None: both), and each sensor's
+    smallest detectable peak acceleration ``detection_m_s2`` [m/s²] (None: every pulse is detected),
+    below which a simulation's packing holds no pulse that the records' sensors would detect."""
 
     base: dict
     priors: tuple[Prior, ...]
     realizations: int = 1
     seed: int = 0
     axes: tuple[tuple[bool, bool], ...] | None = None
+    detection_m_s2: tuple[float, ...] | None = None
 
     @property
     def keys(self) -> list[str]:
@@ -152,7 +156,18 @@ def finished(folder: Path, values) -> np.ndarray | None:
             f"{folder} holds a simulation of other parameters: {folder.parent.parent} holds another "
             "calibration; rerun the same command to resume it, or choose another --out"
         )
-    return np.array(json.loads(path.read_text())["observables"])
+    return np.array(json.loads(path.read_text())["observables"], dtype=float)
+
+
+def detected(problem: Problem, accelerations) -> bool:
+    """Whether every sensor's peak acceleration (``accelerations`` (n_sensors, K, 2) [m/s²], over the
+    axes measured) reaches its :attr:`Problem.detection_m_s2`: a packing that does not is a record
+    the lab would have left out (no pulse at a sensor), and its observables are NaN."""
+    if problem.detection_m_s2 is None:
+        return True
+    axes = np.ones((len(accelerations), 2), bool) if problem.axes is None else np.asarray(problem.axes, bool)
+    peaks = np.max(np.sqrt(np.sum((accelerations * axes[:, None, :]) ** 2, axis=2)), axis=1)
+    return bool(np.all(peaks >= np.asarray(problem.detection_m_s2)))
 
 
 def disordered_impact(config: RunConfig, sigma_m: float, seed: int, realization: int, workdir, packings):
@@ -204,7 +219,11 @@ def simulate_point(problem: Problem, values, folder, realization: int = 0) -> li
         units, tracked = analysis.settings.units, analysis.tracked
         times = tracked.sensor_times * units.time_s
         accelerations = np.moveaxis(tracked.sensor_states[:, :, 2:4], 1, 0) * (units.length_m / units.time_s**2)
-        observables = reduce_record(*at_rest_before(times, accelerations), problem.axes)
+        observables = (
+            reduce_record(*at_rest_before(times, accelerations), problem.axes)
+            if detected(problem, accelerations)
+            else np.full(len(problem.names), np.nan)
+        )
         write_json(
             partial / "observables.json",
             {

@@ -3,16 +3,18 @@
 On disordered packings the observables of one parameter set differ from packing to packing,
 and a measured record is one packing: its likelihood holds that spread Σ_K(u) besides its
 noise (:mod:`~hexdem.calibration.inference`). Σ_K depends on the parameters: it vanishes with
-the disorder, grows with σ (as σ² while the disorder is weak, the observables' deviations then
-being linear in the diameters' deviations σ z), and changes with the striker speed or the
-dissipation. It is modelled as
+the disorder, grows with σ, and changes with the striker speed or the dissipation. On packings
+prepared as the paper's (:mod:`~hexdem.disorder.preparation`) it grows within the compaction's
+overlaps (a few 0.1 µm) and is as large at 5 µm as at 140 µm: which neighbours touch is then set
+by the signs of the diameters' deviations. It is modelled as
 
     Σ_K(u) = diag s(u) · R · diag s(u),
 
 with s_j(u) the standard deviation of observable j between packings, emulated
-(:class:`~hexdem.calibration.emulator.Emulator`, a linear trend: on shared deviates s grows in
-proportion to σ while the disorder is weak) from each parameter set's sample standard deviation
-over its K packings, less its bias (:func:`sd_bias`), and R the correlation between the
+(:class:`~hexdem.calibration.emulator.Emulator`, a linear trend and a process that may be nearly
+all nugget: the sets share their packings, so what varies between them is small) from each
+parameter set's sample standard deviation over its K packings whose pulse the sensors detect, less
+its bias (:func:`sd_bias`), and R the correlation between the
 observables (a slow packing's arrivals are late at every later sensor together), pooled over the
 parameter sets from the deviations scaled by the emulated s (each set's own sample standard
 deviation would bias the correlation towards zero: with K = 8, 0.77 for 0.8), with the records'
@@ -82,7 +84,9 @@ def records_correlation(scatter) -> np.ndarray:
 
 
 class Spread:
-    """Σ_K(u) fitted to simulations at unit-cube ``points`` (n, p) with ``observables`` (n, K, m);
+    """Σ_K(u) fitted to simulations at unit-cube ``points`` (n, p) with ``observables`` (n, K, m), NaN
+    for a packing whose pulse the sensors do not detect (left out; a set with fewer than two
+    detected packings tells no spread);
     with ``scatter``, the records' own covariance between packings (:func:`records_correlation`)
     from ``scatter_dof`` independent records' deviations, pooled into the correlation: records of
     independent packings are more independent directions than the K packings' K − 1."""
@@ -92,13 +96,20 @@ class Spread:
         n, self.realizations, self.size = observables.shape
         if self.realizations < 2:
             return
-        centred = observables - observables.mean(axis=1, keepdims=True)
-        sd = np.sqrt(np.sum(centred**2, axis=1) / (self.realizations - 1))
-        self.sd = Emulator(points, sd / sd_bias(self.realizations), nugget_max=NOISY_NUGGET)
+        valid = np.isfinite(observables[..., 0])
+        counts = valid.sum(axis=1)
+        usable = counts >= 2
+        points, observables, valid, counts = points[usable], observables[usable], valid[usable], counts[usable]
+        mean = np.nanmean(observables, axis=1, keepdims=True)
+        centred = np.where(valid[..., None], observables - mean, 0.0)
+        sd = np.sqrt(np.sum(centred**2, axis=1) / (counts - 1)[:, None])
+        bias = np.array([sd_bias(count) for count in counts])
+        self.sd = Emulator(points, sd / bias[:, None], nugget_max=NOISY_NUGGET)
+        self.dof = int(np.median(counts)) - 1
         scaled = centred / self._sd(points)[:, None, :]
         pooled = np.einsum("nki,nkj->ij", scaled, scaled)
         norm = np.sqrt(np.diag(pooled))
-        simulated, dof = pooled / np.outer(norm, norm), self.realizations - 1
+        simulated, dof = pooled / np.outer(norm, norm), self.dof
         if scatter is not None and scatter_dof > 0:
             simulated = (dof * simulated + scatter_dof * records_correlation(scatter)) / (dof + scatter_dof)
             dof += scatter_dof
@@ -114,12 +125,12 @@ class Spread:
 
     def scale(self, unit) -> np.ndarray:
         """The spread's scale λ (Σ_K,true = λ Σ_K) at unit coordinates ``unit`` (k,): the K packings'
-        sample variances, shared by every parameter set, carry K − 1 degrees of freedom, so the true
-        variance over theirs is (K − 1)/X, X of the χ² law of K − 1 degrees of freedom: inverse-gamma
-        with shape and scale (K − 1)/2."""
+        sample variances, shared by every parameter set, carry K − 1 degrees of freedom (the median
+        set's detected packings less one), so the true variance over theirs is (K − 1)/X, X of the χ²
+        law of K − 1 degrees of freedom: inverse-gamma with shape and scale (K − 1)/2."""
         from scipy.stats import invgamma
 
-        half = (self.realizations - 1) / 2
+        half = self.dof / 2
         return invgamma.ppf(np.clip(np.asarray(unit, float), 1e-12, 1 - 1e-12), half, scale=half)
 
     def _sd(self, unit) -> np.ndarray:

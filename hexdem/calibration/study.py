@@ -20,7 +20,13 @@ from pathlib import Path
 import numpy as np
 
 from hexdem.calibration import diagnostics, inference, nuisance, plots
-from hexdem.calibration.observables import noise_covariance, read_measured, reduce_record
+from hexdem.calibration.observables import (
+    MIN_SIGNAL_TO_NOISE,
+    NoPulse,
+    noise_covariance,
+    read_measured,
+    reduce_record,
+)
 from hexdem.calibration.packings import DISORDER_REALIZATIONS, SIGMA_KEY, on_sigma_levels
 from hexdem.calibration.priors import parse_priors, to_parameters
 from hexdem.calibration.report import summarize, write_posterior
@@ -73,8 +79,8 @@ class Calibration:
     """A checked calibration: the ``problem``, the measured ``data``, each record's noise per channel
     ``channel_noise_m_s2`` (R, n_sensors, 2; NaN for an axis not measured), the stage sizes, ``seed``,
     the records' ``instruments``, the ``acceleration_unit`` they were read in, their
-    ``rate_hz``, ``notes`` on how they were read, and the model's ``discrepancy`` (None: the model
-    taken as exact)."""
+    ``rate_hz``, ``notes`` on how they were read, the model's ``discrepancy`` (None: the model
+    taken as exact), and the records ``left_out`` (a sensor without a pulse)."""
 
     problem: Problem
     data: inference.Data
@@ -86,6 +92,7 @@ class Calibration:
     rate_hz: float = 0.0
     notes: tuple[str, ...] = ()
     discrepancy: nuisance.Discrepancy | None = None
+    left_out: tuple[str, ...] = ()
 
 
 def realizations_of(priors, realizations: int | None) -> int:
@@ -140,17 +147,25 @@ def prepare(
     dimension = len(priors)
     budget = inference.default_budget(dimension) * realizations if budget is None else positive_int("--budget", budget)
     stages = inference.stage_sizes(dimension, budget // realizations, realizations)
-    observed, covariances, noise = [], [], []
+    kept, left_out, observed, covariances, noise = [], [], [], [], []
     for k, record in enumerate(records):
         try:
             covariance, levels = noise_covariance(record, problem.sensors, seed + k)
             observed.append(reduce_record(record.times, record.accelerations, record.axes))
+        except NoPulse as exc:
+            if len(records) == 1 or (not kept and k == len(records) - 1):
+                raise HexdemError(f"{measured}, record {record.name}: {exc}") from None
+            notes.append(f"record {record.name} left out: {str(exc).split(' (')[0]}")
+            left_out.append(record.name)
+            continue
         except HexdemError as exc:
             raise HexdemError(f"{measured}, record {record.name}: {exc}") from None
+        kept.append(record)
         covariances.append(covariance)
         noise.append(levels)
+    problem = replace(problem, detection_m_s2=detection_levels(np.array(noise)))
     data = inference.Data(
-        np.array(observed), np.array(covariances), tuple(problem.names), tuple(record.name for record in records)
+        np.array(observed), np.array(covariances), tuple(problem.names), tuple(record.name for record in kept)
     )
     instruments = nuisance.Instruments(len(problem.sensors), gain_sd, speed_scatter)
     discrepancy = nuisance.Discrepancy(len(problem.sensors)) if model_discrepancy else None
@@ -162,10 +177,19 @@ def prepare(
         seed,
         instruments,
         acceleration_unit,
-        records[0].rate_hz,
+        kept[0].rate_hz,
         tuple(notes),
         discrepancy,
+        tuple(left_out),
     )
+
+
+def detection_levels(noise) -> tuple[float, ...]:
+    """Each sensor's smallest detectable peak acceleration [m/s²]: :data:`MIN_SIGNAL_TO_NOISE` times
+    the median over the records of its noisier measured axis's noise (``noise`` (R, n_sensors, 2)).
+    A simulated packing whose pulse stays below it at a sensor is left out of the fit, as a record
+    without a pulse is: both are then of the packings whose pulse the sensors detect."""
+    return tuple(float(MIN_SIGNAL_TO_NOISE * level) for level in np.median(np.nanmax(noise, axis=2), axis=0))
 
 
 def _as_measured(problem: Problem, records) -> tuple[Problem, list[str]]:
@@ -347,6 +371,7 @@ def _write_results(
         "realizations": problem.realizations,
         "runs": int(sum(calibration.stages)) * problem.realizations,
         "failed": failed,
+        "undetected": int(np.sum(~np.isfinite(fit.observables[..., 0]))),
         "wall_time_s": seconds,
     }
     summary["time_step_check"] = step_check | {
@@ -354,6 +379,8 @@ def _write_results(
     }
     summary["data"] = {
         "records": len(data.records),
+        "records_left_out": list(calibration.left_out),
+        "detection_m_s2": dict(zip(problem.sensors, problem.detection_m_s2 or ())),
         "sensors": problem.sensors,
         "observables": list(data.names),
         "accelerometer_noise_m_s2": [
