@@ -470,6 +470,17 @@ def test_the_lead_in_of_a_weak_first_pulse_ends_at_its_foot_above_the_noise():
     assert levels == pytest.approx(noise, rel=0.3)
 
 
+def test_the_lead_in_ends_where_the_pulse_first_reaches_any_sensor():
+    """The pulse reaches the second sensor (at 300 µs) before the first (at 700 µs), as on a
+    packing whose pulse went around the first by another path: the lead-in ends at the second's
+    foot, and the record is calibrated rather than refused as not at rest before the first's."""
+    record, _, _ = pulse_record(1.0, np.random.default_rng(6))
+    swapped = Record("0", record.times, record.accelerations[::-1].copy(), record.axes)
+    assert 150 - FOOT_SAMPLES <= lead_in(swapped) <= 160 - FOOT_SAMPLES
+    _, levels = noise_covariance(swapped, ["a", "b"], seed=0)
+    assert levels == pytest.approx(1.0, rel=0.35)
+
+
 @pytest.fixture(scope="module")
 def measured(tmp_path_factory):
     """A synthetic record of the tiny case at v0 = TRUE_V0: twice finer step, noise, clock offset."""

@@ -17,8 +17,9 @@ Every record must be sampled at one steady rate (the simulations then sample at 
 
 **Noise.** A measured record's observables are uncertain through its accelerometer noise. That
 noise is measured channel by channel on the record itself, on the samples before the pulse
-reaches its first sensor (the quiet lead-in that a triggered acquisition keeps: up to
-:data:`FOOT_SAMPLES` before its acceleration first reaches :data:`FOOT_LEVEL` of its peak), as the
+reaches any sensor (the quiet lead-in that a triggered acquisition keeps: up to
+:data:`FOOT_SAMPLES` before a sensor's acceleration first reaches :data:`FOOT_LEVEL` of its peak,
+:func:`lead_in`), as the
 median absolute deviation of the channel about its own median × 1.4826 (the standard deviation of
 white noise, blind to each channel's own offset and to the pulse's foot if a few of its samples
 are in the window). A lead-in that is not at rest, whose second half departs from its first by
@@ -54,7 +55,7 @@ REST_TOLERANCE = 6.0
 #: estimate's own scatter does not make the likelihood overconfident (docs/validation/benchmarks.md,
 #: *Calibration from measurements*).
 BOOTSTRAP_DRAWS = 400
-#: The pulse's foot: where the first sensor's acceleration first reaches this share of its peak.
+#: The pulse's foot: where a sensor's acceleration first reaches this share of its peak.
 FOOT_LEVEL = 0.1
 #: Samples before the foot kept out of the quiet lead-in.
 FOOT_SAMPLES = 10
@@ -138,13 +139,19 @@ def _record_noise(centred) -> float:
 
 
 def lead_in(record: Record) -> int:
-    """Samples of ``record`` before the pulse's foot at its first sensor (its quiet lead-in): where
-    the first sensor's acceleration, its offset removed, first reaches :data:`FOOT_LEVEL` of its
-    peak, or :data:`FOOT_NOISE` times its noise where the pulse is so weak that the noise reaches that share."""
-    centred = _centred(record, 0)
-    magnitude = np.sqrt(np.sum(centred**2, axis=1))
-    level = max(FOOT_LEVEL * magnitude.max(), FOOT_NOISE * _record_noise(centred))
-    return int(np.argmax(magnitude >= level)) - FOOT_SAMPLES
+    """Samples of ``record`` before the pulse's foot at the first sensor it reaches (its quiet
+    lead-in; on a disordered packing the pulse may reach a later sensor first, by another path): a
+    sensor's foot is where its acceleration, its offset removed, first reaches :data:`FOOT_LEVEL` of
+    its peak, or :data:`FOOT_NOISE` times its noise where its pulse is so weak that the noise reaches
+    that share (a sensor whose pulse never does has no foot)."""
+    feet = []
+    for sensor in range(len(record.accelerations)):
+        centred = _centred(record, sensor)
+        magnitude = np.sqrt(np.sum(centred**2, axis=1))
+        above = magnitude >= max(FOOT_LEVEL * magnitude.max(), FOOT_NOISE * _record_noise(centred))
+        if above.any():
+            feet.append(int(np.argmax(above)))
+    return min(feet) - FOOT_SAMPLES
 
 
 def _check_first_pulse(record: Record, sensor: str) -> None:
@@ -171,8 +178,8 @@ def noise_covariance(record: Record, sensors, seed: int) -> tuple[np.ndarray, np
     quiet = lead_in(record)
     if quiet < BASELINE_SAMPLES:
         raise HexdemError(
-            f"it starts {max(quiet, 0)} samples before the pulse's foot at its first "
-            f"sensor; a calibration needs at least {BASELINE_SAMPLES} quiet samples to measure the "
+            f"it starts {max(quiet, 0)} samples before the pulse's foot at the first sensor it "
+            f"reaches; a calibration needs at least {BASELINE_SAMPLES} quiet samples to measure the "
             "accelerometer's noise and offset (record with a pre-trigger lead-in)"
         )
     noise = np.full(record.axes.shape, np.nan)
