@@ -455,7 +455,7 @@ def test_a_lead_in_that_is_not_at_rest_is_refused():
 def test_the_lead_in_of_a_weak_first_pulse_ends_at_its_foot_above_the_noise():
     """A first sensor whose pulse is 12 times its noise (a packing whose pulse took another path
     past it), on a DC offset of 20 m/s²: 10 % of its peak is 1.2 noise standard deviations, which
-    the noise crosses at once; the foot is where it first reaches 5 of them, within the pulse's
+    the noise crosses at once; the foot is where it first reaches 6 of them, within the pulse's
     rise (from 300 µs, 150 samples in, to its peak 10 samples later), and the noise is measured on
     the lead-in before it."""
     record, _, _ = pulse_record(0.0, np.random.default_rng(0))

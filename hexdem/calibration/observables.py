@@ -59,9 +59,10 @@ BOOTSTRAP_DRAWS = 400
 FOOT_LEVEL = 0.1
 #: Samples before the foot kept out of the quiet lead-in.
 FOOT_SAMPLES = 10
-#: Noise standard deviations that the foot of a weak pulse must reach (white noise passes 5 of them
-#: in fewer than one sample in a million).
-FOOT_NOISE = 5.0
+#: Noise standard deviations that the foot of a weak pulse must reach (the magnitude of two axes of
+#: white noise passes k of them with probability exp(−k²/2): 6 in one sample in 7 × 10⁷, and 4.8,
+#: where 20 samples read the noise 20 % low, in one in 10⁵).
+FOOT_NOISE = 6.0
 #: A sensor's largest acceleration over the noise below which its record holds no pulse.
 MIN_SIGNAL_TO_NOISE = 10.0
 #: The median absolute deviation of white Gaussian noise times this is its standard deviation.
@@ -143,12 +144,16 @@ def lead_in(record: Record) -> int:
     lead-in; on a disordered packing the pulse may reach a later sensor first, by another path): a
     sensor's foot is where its acceleration, its offset removed, first reaches :data:`FOOT_LEVEL` of
     its peak, or :data:`FOOT_NOISE` times its noise where its pulse is so weak that the noise reaches
-    that share (a sensor whose pulse never does has no foot)."""
+    that share (a sensor whose pulse never does has no foot). That noise is the standard deviation of
+    the record's first 2 × :data:`~hexdem.experiments.signals.BASELINE_SAMPLES` samples, quiet in any
+    record with the lead-in a calibration needs (a pulse that lasts, on a short record, would swell
+    a median absolute deviation over the whole record past the pulse itself)."""
     feet = []
     for sensor in range(len(record.accelerations)):
         centred = _centred(record, sensor)
         magnitude = np.sqrt(np.sum(centred**2, axis=1))
-        above = magnitude >= max(FOOT_LEVEL * magnitude.max(), FOOT_NOISE * _record_noise(centred))
+        noise = float(np.max(np.std(centred[: 2 * BASELINE_SAMPLES], axis=0)))
+        above = magnitude >= max(FOOT_LEVEL * magnitude.max(), FOOT_NOISE * noise)
         if above.any():
             feet.append(int(np.argmax(above)))
     return min(feet) - FOOT_SAMPLES
