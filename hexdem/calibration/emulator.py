@@ -28,6 +28,10 @@ LOG_BOUNDS = {
 }
 
 
+#: The shortest length (in the unit cube) of a dimension along which the response is smooth.
+SMOOTH_LENGTH = 1.0
+
+
 def matern52_of_distance(r) -> np.ndarray:
     """The Matérn 5/2 correlation at scaled distance ``r``."""
     return (1.0 + np.sqrt(5.0) * r + 5.0 / 3.0 * r * r) * np.exp(-np.sqrt(5.0) * r)
@@ -44,10 +48,11 @@ def _design(x) -> np.ndarray:
 
 
 class _Process:
-    """One observable's trend and residual process, fitted to (x, y)."""
+    """One observable's trend and residual process, fitted to (x, y), its length along each
+    dimension at least ``shortest`` (p,)."""
 
-    def __init__(self, x, y, nugget_max: float):
-        self.x, self.nugget_max = x, nugget_max
+    def __init__(self, x, y, nugget_max: float, shortest):
+        self.x, self.nugget_max, self.shortest = x, nugget_max, shortest
         self.beta = np.linalg.lstsq(_design(x), y, rcond=None)[0]
         residual = y - _design(x) @ self.beta
         self.scale = float(np.std(residual)) or 1.0
@@ -75,9 +80,12 @@ class _Process:
         return float(0.5 * self.z @ alpha + np.sum(np.log(np.diag(factor[0]))))
 
     def _optimize(self) -> np.ndarray:
-        p = self.x.shape[1]
-        bounds = [LOG_BOUNDS["length"]] * p + [LOG_BOUNDS["signal"], (LOG_BOUNDS["nugget"][0], np.log(self.nugget_max))]
-        starts = [np.r_[np.full(p, np.log(length)), 0.0, np.log(1e-4)] for length in (0.3, 1.0)]
+        low = np.log(self.shortest)
+        bounds = [(a, LOG_BOUNDS["length"][1]) for a in low] + [
+            LOG_BOUNDS["signal"],
+            (LOG_BOUNDS["nugget"][0], np.log(self.nugget_max)),
+        ]
+        starts = [np.r_[np.maximum(np.log(length), low), 0.0, np.log(1e-4)] for length in (0.3, 1.0)]
         fits = [minimize(self._negative_log_likelihood, start, method="L-BFGS-B", bounds=bounds) for start in starts]
         return min(fits, key=lambda fit: fit.fun).x
 
@@ -86,11 +94,15 @@ class Emulator:
     """Gaussian processes of every observable, fitted to simulations at unit-cube points ``x``
     (n, p) with observables ``y`` (n, m); ``nugget_max`` bounds the nugget τ² (a share of the
     residuals' variance): small for simulations that are smooth in the parameters, larger for
-    noisy outputs."""
+    noisy outputs; ``smooth`` the dimensions along which the response is taken as smooth over the
+    whole prior (lengths of at least :data:`SMOOTH_LENGTH`), its wiggles from one simulated value
+    to the next left to the nugget."""
 
-    def __init__(self, x, y, nugget_max: float = 0.1):
+    def __init__(self, x, y, nugget_max: float = 0.1, smooth=()):
         x, y = np.asarray(x, float), np.asarray(y, float)
-        processes = [_Process(x, y[:, j], nugget_max) for j in range(y.shape[1])]
+        shortest = np.full(x.shape[1], np.exp(LOG_BOUNDS["length"][0]))
+        shortest[list(smooth)] = SMOOTH_LENGTH
+        processes = [_Process(x, y[:, j], nugget_max, shortest) for j in range(y.shape[1])]
         self.x = x
         self.inverse_squared_lengths = np.array([1.0 / p.lengths**2 for p in processes])  # (m, p)
         self.beta = np.column_stack([p.beta for p in processes])  # (p + 1, m)

@@ -46,7 +46,7 @@ from scipy.stats import qmc
 
 from hexdem.calibration.emulator import Emulator
 from hexdem.calibration.nuisance import Discrepancy, Instruments
-from hexdem.calibration.spread import Spread
+from hexdem.calibration.spread import NOISY_NUGGET, Spread
 from hexdem.errors import HexdemError
 
 WALKERS = 64
@@ -330,10 +330,15 @@ def fit_stage(
     model_error=None,
     instruments: Instruments | None = None,
     discrepancy: Discrepancy | None = None,
+    smooth=(),
 ) -> Fit:
     """Fit the emulator to the simulations and sample the posterior it implies: the emulator to each
     parameter set's mean over its packings whose pulse the sensors detect (the others' observables are
-    NaN, :func:`~hexdem.calibration.simulations.detected`), the spread to their deviations (``model_error``:
+    NaN, :func:`~hexdem.calibration.simulations.detected`), the spread to their deviations; both
+    smooth over the whole prior along the dimensions ``smooth`` (σ's: every set at one σ strikes the same
+    K packings, whose contact networks change at a few σ, so that the K packings' mean and spread
+    jump from one σ to the next by their sampling error; the nugget takes the jumps, and the
+    likelihood's Σ_K/K their size) (``model_error``:
     the covariance of the model's own integration error, :func:`step_error`; ``instruments``: the
     records' gains and speed scatter; ``discrepancy``: what the model cannot represent)."""
     points, observables = np.asarray(points, float), np.asarray(observables, float)
@@ -345,8 +350,13 @@ def fit_stage(
             f"{seen.sum()} of {len(points)} simulated parameter sets: too few to calibrate (a sensor the pulse "
             "seldom reaches, or records noisier than its pulse)"
         )
-    emulator = Emulator(points[detected > 0], np.nanmean(observables[detected > 0], axis=1))
-    spread = Spread(points, observables, *records_scatter(data, instruments))
+    emulator = Emulator(
+        points[detected > 0],
+        np.nanmean(observables[detected > 0], axis=1),
+        nugget_max=NOISY_NUGGET if smooth else 0.1,
+        smooth=smooth,
+    )
+    spread = Spread(points, observables, *records_scatter(data, instruments), smooth=smooth)
     likelihood = Likelihood(data, emulator, spread, model_error, instruments, discrepancy)
     states, chain = sample_posterior(likelihood, likelihood.dimension, seed)
     return Fit(points, observables, emulator, spread, states, likelihood, chain)

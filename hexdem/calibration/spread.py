@@ -38,8 +38,9 @@ from scipy.special import gammaln
 
 from hexdem.calibration.emulator import Emulator
 
-#: The emulator's nugget bound for s: on shared deviates its sampling error is common to every
-#: parameter set (the scale λ takes it), and what is left between sets is small.
+#: The emulator's nugget bound for what the K shared packings' sampling error makes jump from one
+#: parameter set to another: s's (its error common to every set the scale λ takes), and along σ the
+#: mean's too (:func:`~hexdem.calibration.inference.fit_stage`).
 NOISY_NUGGET = 10.0
 #: Standard deviations between packings are floored here (observables are of order one): a
 #: parameter set whose packings agree exactly (σ = 0) keeps a spread of full rank.
@@ -89,9 +90,11 @@ class Spread:
     detected packings tells no spread);
     with ``scatter``, the records' own covariance between packings (:func:`records_correlation`)
     from ``scatter_dof`` independent records' deviations, pooled into the correlation: records of
-    independent packings are more independent directions than the K packings' K − 1."""
+    independent packings are more independent directions than the K packings' K − 1; ``smooth``,
+    the dimensions along which s is smooth over the whole prior
+    (:class:`~hexdem.calibration.emulator.Emulator`)."""
 
-    def __init__(self, points, observables, scatter=None, scatter_dof: int = 0):
+    def __init__(self, points, observables, scatter=None, scatter_dof: int = 0, smooth=()):
         observables = np.asarray(observables, float)
         n, self.realizations, self.size = observables.shape
         if self.realizations < 2:
@@ -104,7 +107,7 @@ class Spread:
         centred = np.where(valid[..., None], observables - mean, 0.0)
         sd = np.sqrt(np.sum(centred**2, axis=1) / (counts - 1)[:, None])
         bias = np.array([sd_bias(count) for count in counts])
-        self.sd = Emulator(points, sd / bias[:, None], nugget_max=NOISY_NUGGET)
+        self.sd = Emulator(points, sd / bias[:, None], nugget_max=NOISY_NUGGET, smooth=smooth)
         self.dof = int(np.median(counts)) - 1
         scaled = centred / self._sd(points)[:, None, :]
         pooled = np.einsum("nki,nkj->ij", scaled, scaled)

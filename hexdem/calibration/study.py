@@ -273,6 +273,7 @@ def calibrate(calibration: Calibration, measured, out, workers: int = 1, parsl=N
         keep_plan(out / PLAN_NAME, _plan(calibration, measured), "calibration")
         points, observables, failed, index, fit = np.empty((0, dimension)), None, 0, 0, None
         step_check, model_error = None, None
+        smooth = (problem.keys.index(SIGMA_KEY),) if SIGMA_KEY in problem.keys else ()
         for stage, size in enumerate(calibration.stages):
             new = (
                 inference.design(dimension, size, seed)
@@ -302,6 +303,7 @@ def calibrate(calibration: Calibration, measured, out, workers: int = 1, parsl=N
                 model_error,
                 calibration.instruments,
                 calibration.discrepancy,
+                smooth,
             )
             if step_check is None:
                 step_check = _check_time_step(calibration, fit, out, workers, parsl)
@@ -314,6 +316,7 @@ def calibrate(calibration: Calibration, measured, out, workers: int = 1, parsl=N
                     model_error,
                     calibration.instruments,
                     calibration.discrepancy,
+                    smooth,
                 )
         summary = _write_results(calibration, fit, out, failed, time.perf_counter() - started, step_check)
     for note in summary["identifiability"]:
