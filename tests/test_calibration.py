@@ -22,7 +22,7 @@ from hexdem.calibration.packings import SIGMA_LEVELS, preparation_of, settled_pa
 from hexdem.calibration.priors import NORMAL_TAIL, Prior
 from hexdem.calibration.report import summarize
 from hexdem.calibration.simulations import Problem, simulate_point
-from hexdem.calibration.spread import Spread
+from hexdem.calibration.spread import RECORD_TAIL_DOF, Spread
 from hexdem.calibration.synthetic import synthetic_rows, write_measured
 from hexdem.cli.main import main
 from hexdem.errors import HexdemError
@@ -129,11 +129,16 @@ class _Fixed:
         """The spread's scale, 1 at every coordinate (the spread as given)."""
         return np.ones(len(unit))
 
+    def record_scale(self, unit):
+        """Each record's packing scale: 1 + 4 u at its coordinate u."""
+        return 1 + 4 * np.asarray(unit)
+
 
 def test_the_likelihood_is_the_joint_gaussian_of_records_that_share_the_emulators_error():
-    """Records y_r = μ + e + δ_r + ε_r with e ~ N(0, diag s² + Σ_K/K) common to all: the stacked
-    records are N(1 ⊗ μ, blockdiag(Σ_r + Σ_K) + 11ᵀ ⊗ C), whose density the likelihood must be
-    (up to the constant −(R m / 2) log 2π that it leaves out)."""
+    """Records y_r = μ + e + δ_r + ε_r with e ~ N(0, diag s² + Σ_K/K) common to all and
+    δ_r ~ N(0, λ_r Σ_K): the stacked records are N(1 ⊗ μ, blockdiag(Σ_r + λ_r Σ_K) + 11ᵀ ⊗ C),
+    whose density the likelihood must be (up to the constant −(R m / 2) log 2π that it leaves out),
+    each record's λ_r at its own coordinate after the spread's scale."""
     rng = np.random.default_rng(2)
     m, r, k = 3, 4, 8
     mean, variance = rng.normal(size=m), rng.uniform(0.01, 0.05, m)
@@ -147,17 +152,21 @@ def test_the_likelihood_is_the_joint_gaussian_of_records_that_share_the_emulator
         _Fixed(mean, variance, spread, k),
     )
     common = np.diag(variance) + spread / k
+    coordinates = np.array([0.0, 0.25, 0.5, 1.0])
+    scales = 1 + 4 * coordinates
     joint = np.kron(np.ones((r, r)), common)
     for i in range(r):
-        joint[i * m : (i + 1) * m, i * m : (i + 1) * m] += covariances[i] + spread
+        joint[i * m : (i + 1) * m, i * m : (i + 1) * m] += covariances[i] + scales[i] * spread
     residual = (records - mean).ravel()
     expected = -0.5 * (residual @ np.linalg.solve(joint, residual) + np.linalg.slogdet(joint)[1])
-    assert likelihood.dimension == 2  # the spread's scale after the parameter
-    assert likelihood(np.array([[0.5, 0.5]]))[0] == pytest.approx(expected, rel=1e-10)
-    together, alone = likelihood.misfit(np.array([0.5, 0.5]))
+    assert likelihood.dimension == 2 + r  # the spread's scale and the records' after the parameter
+    point = np.r_[0.5, 0.5, coordinates]
+    assert likelihood(point[None])[0] == pytest.approx(expected, rel=1e-10)
+    together, alone = likelihood.misfit(point)
     assert together == pytest.approx(residual @ np.linalg.solve(joint, residual), rel=1e-10)
     assert alone[1] == pytest.approx(
-        (records[1] - mean) @ np.linalg.solve(covariances[1] + spread + common, records[1] - mean), rel=1e-10
+        (records[1] - mean) @ np.linalg.solve(covariances[1] + scales[1] * spread + common, records[1] - mean),
+        rel=1e-10,
     )
 
 
@@ -215,6 +224,26 @@ def test_the_instruments_enter_as_gains_common_to_all_records_and_a_speed_per_re
     assert estimate[0] == pytest.approx(centre[:2], rel=1e-8)
     assert variance_given[0] == pytest.approx(np.diag(spread)[:2], rel=1e-8)
     assert estimate[0, 1] - estimate[0, 0] == pytest.approx(0.05, abs=0.01)  # the second sensor reads 5 % high
+
+
+def test_an_emulator_smooth_along_sigma_leaves_the_shared_packings_jumps_to_its_nugget():
+    """A response linear in σ's coordinate u plus a jump of 0.3 rms at each of σ's 10 levels, the
+    same for every set on a level (the K packings that all its sets share), the sets' second
+    coordinate random: the ordinary emulator interpolates the jumps as if they were the response;
+    the one smooth along u recovers the line, off it by about what a line fitted through 10 jumps
+    errs, √(2/10) ≈ 0.45 of their rms, a little more as a process of length 1 still bends (0.51 to
+    0.96 over six seeds; 0.51 at this one)."""
+    rng = np.random.default_rng(2)
+    levels = (np.arange(10) + 0.5) / 10
+    jumps = 0.3 * rng.standard_normal(10)
+    level = rng.integers(0, 10, 80)
+    points = np.column_stack([levels[level], rng.random(80)])
+    y = (points[:, 0] + jumps[level])[:, None]
+    test = np.column_stack([levels, np.full(10, 0.5)])
+    ordinary = Emulator(points, y).predict(test)[0][:, 0]
+    smooth = Emulator(points, y, nugget_max=10.0, smooth=(0,)).predict(test)[0][:, 0]
+    assert np.sqrt(np.mean((ordinary - levels - jumps) ** 2)) < 0.1 * np.sqrt(np.mean(jumps**2))
+    assert np.sqrt(np.mean((smooth - levels) ** 2)) < 0.6 * np.sqrt(np.mean(jumps**2))
 
 
 def test_the_spread_between_packings_follows_the_parameters():
@@ -843,7 +872,8 @@ def test_the_guides_measured_example_passes_every_input_check():
 def test_the_spread_between_packings_is_known_to_a_scale_that_k_packings_leave_open():
     """K packings give the spread's sample variances K − 1 degrees of freedom: the true over the
     estimated is (K − 1)/χ²_{K−1}, whose quantile u is (K − 1)/χ²_{K−1} at 1 − u; the sampler
-    takes that scale as a coordinate after the parameters (and before the discrepancy's)."""
+    takes that scale as a coordinate after the parameters, then each record's packing scale λ_r,
+    inverse-gamma (ν/2, ν/2) (ν/χ²_ν at 1 − u), and the discrepancy's last."""
     from scipy.stats import chi2
 
     points = inference.design(1, 20, seed=1)
@@ -851,8 +881,11 @@ def test_the_spread_between_packings_is_known_to_a_scale_that_k_packings_leave_o
     spread = Spread(points, observables)
     for u in (0.05, 0.5, 0.95):
         assert spread.scale(np.array([u]))[0] == pytest.approx(7 / chi2.ppf(1 - u, 7), rel=1e-9)
+        assert spread.record_scale(np.array([u]))[0] == pytest.approx(
+            RECORD_TAIL_DOF / chi2.ppf(1 - u, RECORD_TAIL_DOF), rel=1e-9
+        )
     data = inference.Data(observables[:2, 0], np.array([np.eye(3) * 1e-4] * 2), ("a", "b", "c"))
     emulator = Emulator(points, observables.mean(axis=1))
-    assert inference.Likelihood(data, emulator, spread).dimension == 2
-    assert inference.Likelihood(data, emulator, spread, discrepancy=nuisance.Discrepancy(2)).dimension == 3
+    assert inference.Likelihood(data, emulator, spread).dimension == 4
+    assert inference.Likelihood(data, emulator, spread, discrepancy=nuisance.Discrepancy(2)).dimension == 5
     assert inference.Likelihood(data, emulator, Spread(points, observables[:, :1])).dimension == 1

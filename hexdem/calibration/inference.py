@@ -4,7 +4,7 @@ The posterior of the unit-cube coordinates u of the priors (:mod:`~hexdem.calibr
 is p(u | data) ∝ p(y_1, …, y_R | u) on [0, 1]^p, the records y_r
 (:mod:`~hexdem.calibration.observables`) modelled as
 
-    y_r = μ(u) + e + δ_r + ε_r,   e ~ N(0, C(u)),  δ_r ~ N(0, Σ_K(u) + V(u)),  ε_r ~ N(0, Σ_r):
+    y_r = μ(u) + e + δ_r + ε_r,   e ~ N(0, C(u)),  δ_r ~ N(0, λ_r Σ_K(u) + V(u)),  ε_r ~ N(0, Σ_r):
 
 μ(u) the emulated mean of the model's observables over the K packings simulated at u
 (:mod:`~hexdem.calibration.emulator`); ε_r record r's accelerometer noise; δ_r its packing's
@@ -19,8 +19,14 @@ the model cannot represent, a discrepancy of relative size τ
 with u). Σ_K is known only to a scale λ, as K packings tell it
 (:meth:`~hexdem.calibration.spread.Spread.scale`): λ is sampled with u too, so that the records,
 independent packings, tell it further, and integrated out it gives them a joint Student-t rather
-than a Gaussian of a spread taken as known. With
-D_r = Σ_r + Σ_K + V, P = Σ_r D_r⁻¹ and b = Σ_r D_r⁻¹ (y_r − μ), integrating e out gives
+than a Gaussian of a spread taken as known. And each record's packing deviates with a scale λ_r
+of its own, δ_r ~ N(0, λ_r Σ_K + V), λ_r inverse-gamma with shape and scale ν/2
+(:meth:`~hexdem.calibration.spread.Spread.record_scale`), sampled with u: integrated out, each
+packing's deviation is a Student-t of ν degrees of freedom. A packing's observables are not
+Gaussian: where its pulse finds a weak path past a sensor, the sensor's peak falls 50-fold, and
+one such record among Gaussian ones would count as impossible at every parameter but where the
+emulated spread happens to be widest. With
+D_r = Σ_r + λ_r Σ_K + V, P = Σ_r D_r⁻¹ and b = Σ_r D_r⁻¹ (y_r − μ), integrating e out gives
 
     log p = Σ_r log N(y_r; μ, D_r) − ½ log det(I + C P) + ½ bᵀ (I + C P)⁻¹ C b,
 
@@ -126,16 +132,20 @@ class Likelihood:
         return self.spread.realizations >= 2
 
     @property
-    def dimension(self) -> int:
-        """The sampler's coordinates: the parameters', the spread's scale λ's on disordered packings,
-        and τ's with a :class:`~hexdem.calibration.nuisance.Discrepancy`."""
-        return self.emulator.x.shape[1] + self.scaled_spread + (self.discrepancy is not None)
+    def record_scales(self) -> int:
+        """How many records carry a scale λ_r of their own packing's deviation
+        (:meth:`Spread.record_scale`), the sampler's coordinates after λ's: every record on K ≥ 2
+        packings a parameter set, none on the ideal lattice."""
+        return len(self.data.records) if self.scaled_spread else 0
 
-    def moments(self, unit) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """At the sampler's unit-cube points ``unit`` (k, :attr:`dimension`): the emulated mean μ
-        (k, m), the common error's covariance C (k, m, m) and what each record adds to its own
-        noise, Σ_K + V (k, m, m)."""
-        unit = np.atleast_2d(unit)
+    @property
+    def dimension(self) -> int:
+        """The sampler's coordinates: the parameters', the spread's scale λ's and each record's λ_r's
+        on disordered packings, and τ's with a :class:`~hexdem.calibration.nuisance.Discrepancy`."""
+        return self.emulator.x.shape[1] + self.scaled_spread + self.record_scales + (self.discrepancy is not None)
+
+    def _parts(self, unit) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(μ (k, m), C (k, m, m), λ Σ_K (k, m, m), V (k, m, m)) at the sampler's points ``unit``."""
         count = self.emulator.x.shape[1]
         parameters = unit[:, :count]
         mean, variance = self.emulator.predict(parameters)
@@ -150,12 +160,29 @@ class Likelihood:
         )
         if self.discrepancy is not None:
             common = common + self.discrepancy.covariance(mean, unit[:, -1])
-        return mean, common, spread + self.instruments.per_record(mean)
+        return mean, common, spread, self.instruments.per_record(mean)
 
-    def _pooled(self, mean, own):
+    def moments(self, unit) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """At the sampler's unit-cube points ``unit`` (k, :attr:`dimension`): the emulated mean μ
+        (k, m), the common error's covariance C (k, m, m) and what a new record adds to its own
+        noise, Σ_K + V (k, m, m), its packing's scale λ_r taken as 1."""
+        mean, common, spread, speed = self._parts(np.atleast_2d(unit))
+        return mean, common, spread + speed
+
+    def _records(self, unit) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
+        """(μ, C, [what record r adds to its own noise, λ_r Σ_K + V, for each record]) at ``unit``."""
+        unit = np.atleast_2d(unit)
+        mean, common, spread, speed = self._parts(unit)
+        if not self.record_scales:
+            return mean, common, [spread + speed] * len(self.data.records)
+        first = self.emulator.x.shape[1] + 1
+        scales = self.spread.record_scale(unit[:, first : first + self.record_scales])
+        return mean, common, [spread * scales[:, r, None, None] + speed for r in range(self.record_scales)]
+
+    def _pooled(self, mean, owns):
         """(Σ_r log N(y_r; μ, D_r), P, b) at each point (see the module docstring)."""
         total, precision, pulled = 0.0, 0.0, 0.0
-        for record, covariance in zip(self.data.records, self.data.covariances):
+        for record, covariance, own in zip(self.data.records, self.data.covariances, owns):
             scatter = covariance + own
             solved = np.linalg.solve(scatter, (record - mean)[:, :, None])[:, :, 0]
             total = total - 0.5 * (np.einsum("ki,ki->k", record - mean, solved) + np.linalg.slogdet(scatter)[1])
@@ -169,8 +196,8 @@ class Likelihood:
         result = np.full(len(unit), -np.inf)
         if not inside.any():
             return result
-        mean, common, own = self.moments(unit[inside])
-        total, precision, pulled = self._pooled(mean, own)
+        mean, common, owns = self._records(unit[inside])
+        total, precision, pulled = self._pooled(mean, owns)
         shrink = np.eye(mean.shape[1]) + common @ precision
         gain = np.linalg.solve(shrink, (common @ pulled[:, :, None]))[:, :, 0]
         result[inside] = total - 0.5 * np.linalg.slogdet(shrink)[1] + 0.5 * np.einsum("ki,ki->k", pulled, gain)
@@ -180,8 +207,8 @@ class Likelihood:
         """(mean (k, n), variance (k, n)) of each sensor's log gain given the records, at the
         sampler's points ``unit`` (:meth:`moments`): g is part of the common error e, so with G its covariance,
         E[g | y] = G (I + P C)⁻¹ b and Cov[g | y] = G − G (I + P C)⁻¹ P G."""
-        mean, common, own = self.moments(np.atleast_2d(unit))
-        _, precision, pulled = self._pooled(mean, own)
+        mean, common, owns = self._records(unit)
+        _, precision, pulled = self._pooled(mean, owns)
         gains = self.instruments.common()
         shrink = np.eye(mean.shape[1]) + precision @ common
         centre = (gains @ np.linalg.solve(shrink, pulled[:, :, None]))[:, :, 0]
@@ -191,13 +218,15 @@ class Likelihood:
 
     def misfit(self, unit) -> tuple[float, list[float]]:
         """(χ² of all the records together, [χ² of each record]) at the sampler's point ``unit``
-        (:meth:`moments`), each with the full covariance that the likelihood gives it: the stacked records
-        N(1 ⊗ μ, blockdiag(Σ_r + Σ_K + V) + 11ᵀ ⊗ C), and record r alone N(μ, Σ_r + Σ_K + V + C)."""
-        mean, common, own = (value[0] for value in self.moments(np.atleast_2d(unit)))
+        (:meth:`moments`), each with the full covariance that the likelihood gives it there: the stacked
+        records N(1 ⊗ μ, blockdiag(Σ_r + λ_r Σ_K + V) + 11ᵀ ⊗ C), and record r alone
+        N(μ, Σ_r + λ_r Σ_K + V + C), each record's packing scale λ_r at ``unit``'s."""
+        mean, common, owns = self._records(unit)
+        mean, common, owns = mean[0], common[0], [own[0] for own in owns]
         records, m = self.data.records, len(mean)
         joint = np.kron(np.ones((len(records), len(records))), common)
         alone = []
-        for r, covariance in enumerate(self.data.covariances):
+        for r, (covariance, own) in enumerate(zip(self.data.covariances, owns)):
             block = slice(r * m, (r + 1) * m)
             joint[block, block] += covariance + own
             residual = records[r] - mean
@@ -314,6 +343,16 @@ class Fit:
         """The posterior's samples of the spread's scale λ (:meth:`Spread.scale`), or None on one packing."""
         count = self.points.shape[1]
         return self.spread.scale(self.states[:, count]) if self.likelihood.scaled_spread else None
+
+    @property
+    def record_scales(self) -> np.ndarray | None:
+        """The posterior's samples (n, R) of each record's packing scale λ_r
+        (:meth:`Spread.record_scale`), or None on one packing."""
+        count = self.likelihood.record_scales
+        if not count:
+            return None
+        first = self.points.shape[1] + 1
+        return self.spread.record_scale(self.states[:, first : first + count])
 
     @property
     def discrepancy_sizes(self) -> np.ndarray | None:

@@ -42,6 +42,10 @@ from hexdem.calibration.emulator import Emulator
 #: parameter set to another: s's (its error common to every set the scale λ takes), and along σ the
 #: mean's too (:func:`~hexdem.calibration.inference.fit_stage`).
 NOISY_NUGGET = 10.0
+#: The degrees of freedom of a record's deviation between packings (:meth:`Spread.record_scale`): a
+#: tail heavy enough for a packing whose pulse takes a weak path (a deviation of 15 standard deviations
+#: costs 10 in log density where a Gaussian's costs 112), with a finite variance.
+RECORD_TAIL_DOF = 4
 #: Standard deviations between packings are floored here (observables are of order one): a
 #: parameter set whose packings agree exactly (σ = 0) keeps a spread of full rank.
 SD_FLOOR = 1e-9
@@ -134,6 +138,15 @@ class Spread:
         from scipy.stats import invgamma
 
         half = self.dof / 2
+        return invgamma.ppf(np.clip(np.asarray(unit, float), 1e-12, 1 - 1e-12), half, scale=half)
+
+    def record_scale(self, unit) -> np.ndarray:
+        """Each record's packing scale λ_r (its deviation ~ N(0, λ_r Σ_K)) at unit coordinates ``unit``:
+        inverse-gamma with shape and scale ν/2, ν = :data:`RECORD_TAIL_DOF`, so that a record's
+        deviation is a Student-t of ν degrees of freedom."""
+        from scipy.stats import invgamma
+
+        half = RECORD_TAIL_DOF / 2
         return invgamma.ppf(np.clip(np.asarray(unit, float), 1e-12, 1 - 1e-12), half, scale=half)
 
     def _sd(self, unit) -> np.ndarray:

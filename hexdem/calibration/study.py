@@ -450,6 +450,10 @@ def _diagnose(calibration: Calibration, fit: inference.Fit, summary: dict) -> No
     summary["instruments"] = {"sensor_gain_sd": instruments.gain_sd, "speed_scatter": instruments.speed_scatter}
     if fit.spread_scales is not None:
         summary["spread_scale"] = diagnostics.quantile_summary(fit.spread_scales)
+        summary["record_spread_scales"] = [
+            {"record": name} | diagnostics.quantile_summary(scales)
+            for name, scales in zip(data.record_names, fit.record_scales.T)
+        ]
     if fit.discrepancy_sizes is not None:
         summary["model_discrepancy"] = calibration.discrepancy.as_dict() | diagnostics.quantile_summary(
             fit.discrepancy_sizes
