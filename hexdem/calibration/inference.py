@@ -65,6 +65,16 @@ STRAGGLER_DROP = 10.0
 START_CANDIDATES = 4096
 
 
+def chain_steps(dimension: int) -> tuple[int, int]:
+    """(burn-in, kept) steps of the walkers on a posterior of ``dimension`` coordinates: the
+    autocorrelation time of emcee's stretch move grows about in proportion to the dimension (some
+    45 steps at 7 coordinates: two parameters, the spread's scale, three records' and the
+    discrepancy's), so the walkers take 50 steps a coordinate to burn in and keep 150, for
+    :data:`EFFECTIVE_SAMPLES` independent samples and :data:`AUTOCORRELATION_LENGTHS` τ a walker;
+    at least :data:`BURN_IN_STEPS` and :data:`KEPT_STEPS`."""
+    return max(BURN_IN_STEPS, 50 * dimension), max(KEPT_STEPS, 150 * dimension)
+
+
 def initial_points(dimension: int) -> int:
     """Simulations of stage 0 (a space-filling design over the prior)."""
     return 10 * dimension + 10
@@ -277,7 +287,7 @@ EFFECTIVE_SAMPLES = 1000
 
 
 def sample_posterior(likelihood: Likelihood, dimension: int, seed: int) -> tuple[np.ndarray, Chain]:
-    """Unit-cube samples (WALKERS · KEPT_STEPS / THIN, p) of the posterior of ``likelihood``, and
+    """Unit-cube samples (WALKERS · kept steps / THIN, p; :func:`chain_steps`) of the posterior of ``likelihood``, and
     how the chain mixed: the walkers start at the best of START_CANDIDATES prior points, and after
     the burn-in every straggler (:func:`stragglers`) restarts beside a walker in the posterior and
     the burn-in runs again."""
@@ -287,10 +297,11 @@ def sample_posterior(likelihood: Likelihood, dimension: int, seed: int) -> tuple
     candidates = qmc.LatinHypercube(dimension, seed=rng).random(START_CANDIDATES)
     best = candidates[np.argsort(likelihood(candidates))[-WALKERS:]]
     start = np.clip(best + rng.normal(0.0, 1e-3, best.shape), 1e-6, 1 - 1e-6)
+    burn_in, kept = chain_steps(dimension)
     sampler = emcee.EnsembleSampler(WALKERS, dimension, likelihood, vectorize=True)
     sampler.random_state = np.random.RandomState(int(rng.integers(2**31))).get_state()
-    state = sampler.run_mcmc(start, BURN_IN_STEPS)
-    lost = stragglers(sampler.get_log_prob(discard=BURN_IN_STEPS // 2), dimension)
+    state = sampler.run_mcmc(start, burn_in)
+    lost = stragglers(sampler.get_log_prob(discard=burn_in // 2), dimension)
     if lost.any():
         coords = state.coords.copy()
         kept = np.flatnonzero(~lost)
@@ -298,11 +309,11 @@ def sample_posterior(likelihood: Likelihood, dimension: int, seed: int) -> tuple
             coords[rng.choice(kept, lost.sum())] + rng.normal(0.0, 1e-6, (lost.sum(), dimension)), 0.0, 1.0
         )
         sampler.reset()
-        state = sampler.run_mcmc(coords, BURN_IN_STEPS)
+        state = sampler.run_mcmc(coords, burn_in)
     sampler.reset()
-    sampler.run_mcmc(state, KEPT_STEPS)
+    sampler.run_mcmc(state, kept)
     tau = sampler.get_autocorr_time(quiet=True, tol=0)
-    chain = Chain(tuple(float(t) for t in tau), float(np.mean(sampler.acceptance_fraction)), KEPT_STEPS, WALKERS)
+    chain = Chain(tuple(float(t) for t in tau), float(np.mean(sampler.acceptance_fraction)), kept, WALKERS)
     return sampler.get_chain(thin=THIN, flat=True), chain
 
 

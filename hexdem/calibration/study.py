@@ -364,8 +364,8 @@ def _write_results(
         "name": "Gaussian-process emulator refined on the posterior, sampled by emcee",
         "stages": list(calibration.stages),
         "walkers": inference.WALKERS,
-        "burn_in_steps": inference.BURN_IN_STEPS,
-        "kept_steps": inference.KEPT_STEPS,
+        "burn_in_steps": inference.chain_steps(fit.likelihood.dimension)[0],
+        "kept_steps": fit.chain.steps,
         "thin": inference.THIN,
         "seed": calibration.seed,
     }
