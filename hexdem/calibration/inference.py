@@ -67,12 +67,12 @@ START_CANDIDATES = 4096
 
 def chain_steps(dimension: int) -> tuple[int, int]:
     """(burn-in, kept) steps of the walkers on a posterior of ``dimension`` coordinates: the
-    autocorrelation time of emcee's stretch move grows about in proportion to the dimension (some
-    45 steps at 7 coordinates: two parameters, the spread's scale, three records' and the
-    discrepancy's), so the walkers take 50 steps a coordinate to burn in and keep 150, for
+    autocorrelation time τ of emcee's stretch move grows about in proportion to the dimension (some
+    13 steps a coordinate at 7: two parameters, the spread's scale, three records' and the
+    discrepancy's), so the walkers take 100 steps a coordinate to burn in (7 τ) and keep 250, for
     :data:`EFFECTIVE_SAMPLES` independent samples and :data:`AUTOCORRELATION_LENGTHS` τ a walker;
     at least :data:`BURN_IN_STEPS` and :data:`KEPT_STEPS`."""
-    return max(BURN_IN_STEPS, 50 * dimension), max(KEPT_STEPS, 150 * dimension)
+    return max(BURN_IN_STEPS, 100 * dimension), max(KEPT_STEPS, 250 * dimension)
 
 
 def initial_points(dimension: int) -> int:
