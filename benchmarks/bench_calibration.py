@@ -40,8 +40,9 @@ each on the same K packings (shared deviates, as the calibration's own), and R r
 independent packings with a little noise; the coverage of σ's 90 % interval over ``--truths``
 truths, through the calibration's own likelihood and sampler.
 
-``--spread-in-sigma S1,S2,...``: the observables of the disordered case's 8 packings (the calibration's
-own, seed 0) at each σ [m], restitution 0.95: whether they vary smoothly with σ on shared deviates.
+``--spread-in-sigma S1,S2,...``: the observables of 8 packings (the calibration's own, seed 0) of the
+``--case``'s lattice and sensors at each σ [m], restitution 0.95: whether they vary smoothly with σ
+on shared deviates.
 
 ``--quick``: one truth of the tiny case on one worker. ``--cost N``: N simulations of the quick case,
 one after another in this process after one to warm up (as a worker runs them), each timed whole
@@ -174,14 +175,14 @@ def disorder_toy(packings: int, records: int, truths: int, seed: int) -> None:
     )
 
 
-def spread_in_sigma(sigmas, root: Path) -> None:
-    """The table of ``--spread-in-sigma``: each packing's observables at each σ."""
+def spread_in_sigma(sigmas, root: Path, case: str) -> None:
+    """The table of ``--spread-in-sigma``: each packing's observables at each σ, on ``case``'s lattice."""
     from hexdem.calibration.observables import at_rest_before, reduce_record
     from hexdem.calibration.simulations import analysed_impact
     from hexdem.common.progress import silenced
 
-    base, prior_texts, _ = CASES["disordered"]
-    problem = Problem(base, tuple(Prior.parse(text) for text in prior_texts), DISORDER_REALIZATIONS)
+    prior_texts = CASES["disordered"][1]
+    problem = Problem(CASES[case][0], tuple(Prior.parse(text) for text in prior_texts), DISORDER_REALIZATIONS)
     print("| σ µm | packing | " + " | ".join(problem.names) + " |")
     print("|---" * (2 + len(problem.names)) + "|")
     for sigma in sigmas:
@@ -240,7 +241,7 @@ def main() -> None:
         simulation_cost(args.cost, root)
         return
     if args.spread_in_sigma:
-        spread_in_sigma([float(value) for value in args.spread_in_sigma.split(",")], root)
+        spread_in_sigma([float(value) for value in args.spread_in_sigma.split(",")], root, args.case)
         return
     case = "tiny" if args.quick else args.case
     base, prior_texts, budget = CASES[case]
