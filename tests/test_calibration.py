@@ -246,6 +246,14 @@ def test_an_emulator_smooth_along_sigma_leaves_the_shared_packings_jumps_to_its_
     assert np.sqrt(np.mean((smooth - levels) ** 2)) < 0.6 * np.sqrt(np.mean(jumps**2))
 
 
+def correlated_packings(rng, n: int, k: int, rho: float) -> tuple[np.ndarray, np.ndarray]:
+    """(points (n, 1), observables (n, k, 2)): μ(u) + s(u) L z over k packings, s = 0.1 + u, μ = u,
+    L the Cholesky factor of two observables correlated ``rho``."""
+    points = inference.design(1, n, seed=6)
+    chol = np.linalg.cholesky(np.array([[1.0, rho], [rho, 1.0]]))
+    return points, (0.1 + points)[:, None, :] * (rng.standard_normal((n, k, 2)) @ chol.T) + points[:, None, :]
+
+
 def test_the_spread_between_packings_follows_the_parameters():
     """Observables μ(u) + s(u) L z over K = 8 packings, s = 0.1 + u: the emulated standard
     deviations hold s within the sampling error of 80 sets of 8 (one set's log sample sd is off by
@@ -253,12 +261,8 @@ def test_the_spread_between_packings_follows_the_parameters():
     are 25 %), and the pooled correlation holds L Lᵀ's ρ = 0.8 within 4 (1 − ρ²)/√(n (K − 1)),
     four of its standard errors, before it is shrunk as for K − 1 = ν deviations of m = 2
     observables: ν ρ / (ν + w), w = max(m + 1 − ν, 1) = 1."""
-    rng = np.random.default_rng(5)
     n, k, rho = 80, 8, 0.8
-    points = inference.design(1, n, seed=6)
-    chol = np.linalg.cholesky(np.array([[1.0, rho], [rho, 1.0]]))
-    scale = 0.1 + points
-    observables = scale[:, None, :] * (rng.standard_normal((n, k, 2)) @ chol.T) + points[:, None, :]
+    points, observables = correlated_packings(np.random.default_rng(5), n, k, rho)
     spread = Spread(points, observables)
     test = np.array([[0.1], [0.5], [0.9]])
     sd = np.sqrt(np.diagonal(spread(test), axis1=1, axis2=2))
@@ -275,11 +279,9 @@ def test_packings_without_a_detected_pulse_are_left_out_of_the_spread():
     s = 0.1 + u within the same 25 % (its sets have fewer packings) and counts the median set's
     packings less one as its degrees of freedom; kept, the outliers inflate s more than five-fold."""
     rng = np.random.default_rng(1)
-    n, k, rho = 80, 8, 0.8
-    points = inference.design(1, n, seed=6)
-    chol = np.linalg.cholesky(np.array([[1.0, rho], [rho, 1.0]]))
+    n, k = 80, 8
+    points, observables = correlated_packings(rng, n, k, 0.8)
     scale = 0.1 + points
-    observables = scale[:, None, :] * (rng.standard_normal((n, k, 2)) @ chol.T) + points[:, None, :]
     lost = rng.random((n, k)) < 0.2
     observables[lost] -= 30 * scale[np.nonzero(lost)[0]]
     test = np.array([[0.1], [0.5], [0.9]])
