@@ -189,9 +189,14 @@ class Likelihood:
         mean, common, spread, speed = self._parts(unit)
         if not self.record_scales:
             return mean, common, [spread + speed] * len(self.data.records)
-        first = self.emulator.x.shape[1] + 1
-        scales = self.spread.record_scale(unit[:, first : first + self.record_scales])
+        scales = self.packing_scales(unit)
         return mean, common, [spread * scales[:, r, None, None] + speed for r in range(self.record_scales)]
+
+    def packing_scales(self, unit) -> np.ndarray:
+        """Each record's packing scale λ_r (k, R) at the sampler's points ``unit`` (k, :attr:`dimension`),
+        from its coordinates after the spread's scale (:meth:`Spread.record_scale`)."""
+        first = self.emulator.x.shape[1] + 1
+        return self.spread.record_scale(np.atleast_2d(unit)[:, first : first + self.record_scales])
 
     def _pooled(self, mean, owns):
         """(Σ_r log N(y_r; μ, D_r), P, b) at each point (see the module docstring)."""
@@ -367,11 +372,7 @@ class Fit:
     def record_scales(self) -> np.ndarray | None:
         """The posterior's samples (n, R) of each record's packing scale λ_r
         (:meth:`Spread.record_scale`), or None on one packing."""
-        count = self.likelihood.record_scales
-        if not count:
-            return None
-        first = self.points.shape[1] + 1
-        return self.spread.record_scale(self.states[:, first : first + count])
+        return self.likelihood.packing_scales(self.states) if self.likelihood.record_scales else None
 
     @property
     def discrepancy_sizes(self) -> np.ndarray | None:

@@ -133,12 +133,6 @@ def _centred(record: Record, sensor: int) -> np.ndarray:
     return channel - np.median(channel, axis=0)
 
 
-def _record_noise(centred) -> float:
-    """The noise [m/s² rms] of a ``centred`` channel group, measured on the whole record (the median
-    absolute deviation of its noisier axis, blind to a short pulse)."""
-    return float(MAD_TO_SD * np.max(np.median(np.abs(centred), axis=0)))
-
-
 def lead_in(record: Record) -> int:
     """Samples of ``record`` before the pulse's foot at the first sensor it reaches (its quiet
     lead-in; on a disordered packing the pulse may reach a later sensor first, by another path): a
@@ -161,9 +155,10 @@ def lead_in(record: Record) -> int:
 
 def _check_first_pulse(record: Record, sensor: str) -> None:
     """Refuse a record whose first sensor holds no pulse above its noise, measured on the whole
-    record: without it, no lead-in is found."""
+    record (the median absolute deviation of its noisier axis, blind to a short pulse): without it,
+    no lead-in is found."""
     centred = _centred(record, 0)
-    level = _record_noise(centred)
+    level = float(MAD_TO_SD * np.max(np.median(np.abs(centred), axis=0)))
     peak = float(np.max(np.sqrt(np.sum(centred**2, axis=1))))
     if peak < MIN_SIGNAL_TO_NOISE * level:
         raise NoPulse(

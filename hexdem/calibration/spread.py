@@ -59,6 +59,15 @@ def sd_bias(realizations: int) -> float:
     )
 
 
+def variance_ratio(unit, dof: float) -> np.ndarray:
+    """The quantiles ``unit`` of ν/X, X of the χ² law of ν = ``dof`` degrees of freedom: inverse-gamma
+    with shape and scale ν/2, the true variance over one estimated from ν degrees of freedom."""
+    from scipy.stats import invgamma
+
+    half = dof / 2
+    return invgamma.ppf(np.clip(np.asarray(unit, float), 1e-12, 1 - 1e-12), half, scale=half)
+
+
 def shrunk_correlation(sample, dof: int) -> np.ndarray:
     """The correlation between observables from ``sample``, the correlation of ``dof`` = ν
     independent deviations, shrunk towards the identity: (ν R̂ + w I) / (ν + w), w = max(m + 1 − ν, 1).
@@ -135,19 +144,13 @@ class Spread:
         sample variances, shared by every parameter set, carry K − 1 degrees of freedom (the median
         set's detected packings less one), so the true variance over theirs is (K − 1)/X, X of the χ²
         law of K − 1 degrees of freedom: inverse-gamma with shape and scale (K − 1)/2."""
-        from scipy.stats import invgamma
-
-        half = self.dof / 2
-        return invgamma.ppf(np.clip(np.asarray(unit, float), 1e-12, 1 - 1e-12), half, scale=half)
+        return variance_ratio(unit, self.dof)
 
     def record_scale(self, unit) -> np.ndarray:
         """Each record's packing scale λ_r (its deviation ~ N(0, λ_r Σ_K)) at unit coordinates ``unit``:
         inverse-gamma with shape and scale ν/2, ν = :data:`RECORD_TAIL_DOF`, so that a record's
         deviation is a Student-t of ν degrees of freedom."""
-        from scipy.stats import invgamma
-
-        half = RECORD_TAIL_DOF / 2
-        return invgamma.ppf(np.clip(np.asarray(unit, float), 1e-12, 1 - 1e-12), half, scale=half)
+        return variance_ratio(unit, RECORD_TAIL_DOF)
 
     def _sd(self, unit) -> np.ndarray:
         return np.maximum(self.sd.predict(unit)[0], SD_FLOOR)
