@@ -3,6 +3,8 @@ both sides where the machine has a core to spare, and an error on either side re
 
 import os
 import signal
+import subprocess
+import sys
 
 import pytest
 
@@ -56,3 +58,43 @@ def test_an_error_here_stops_the_child_and_is_raised(tmp_path):
 
     with pytest.raises(ValueError, match="this side failed"):
         forked.run_shared([fails, lambda: __import__("time").sleep(30)])
+
+
+#: A command stopped (SIGTERM from another process, hexdem's handlers in place) while it waits for
+#: the child, which still draws; it prints what the jobs' folder holds as the stop is raised and a
+#: second later.
+STOPPED_WHILE_THE_CHILD_DRAWS = """
+import os, subprocess, sys, time
+from pathlib import Path
+from hexdem.common.forked import run_shared
+from hexdem.common.interrupt import Interrupted, stop_on_signals
+
+stop_on_signals()
+out = Path(sys.argv[1])
+
+def slow_figure():
+    time.sleep(1)
+    (out / "figure.png").write_text("drawn")
+
+try:
+    run_shared([lambda: subprocess.Popen(["sh", "-c", f"sleep 0.3; kill -TERM {os.getpid()}"]), slow_figure])
+except Interrupted:
+    print(sorted(path.name for path in out.iterdir()))
+    time.sleep(1.5)
+    print(sorted(path.name for path in out.iterdir()))
+"""
+
+
+@pytest.mark.skipif(not forked.spare_cores(), reason="one core: no child is forked")
+def test_a_stop_while_the_child_draws_is_raised_once_the_child_has_ended(tmp_path):
+    """A run's staging folder is removed as the stop is raised: a child still drawing into it then
+    would leave it behind, so nothing may be written once run_shared has raised."""
+    done = subprocess.run(
+        [sys.executable, "-c", STOPPED_WHILE_THE_CHILD_DRAWS, str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
+    assert done.returncode == 0, done.stderr
+    at_the_stop, a_second_later = done.stdout.splitlines()
+    assert at_the_stop == a_second_later

@@ -16,6 +16,7 @@ import sys
 import threading
 from collections.abc import Callable, Sequence
 
+from hexdem.common.interrupt import deferred_signals
 from hexdem.common.preload import finish_background_loading
 from hexdem.errors import HexdemError
 
@@ -37,7 +38,9 @@ def run_shared(jobs: Sequence[Callable[[], None]]) -> None:
     in a child process forked from this one when :func:`spare_cores`, the others here; else all
     here, in order. An exception of either side is raised here once both have stopped, this side's
     first (the child's is sent back through a pipe; a child that dies of a signal is a
-    :class:`~hexdem.errors.HexdemError`)."""
+    :class:`~hexdem.errors.HexdemError`). The child is waited for however this side ends, a stop
+    (:mod:`hexdem.common.interrupt`) included, which stops it first: no file of the jobs is written
+    once this returns or raises."""
     if len(jobs) < 2 or not spare_cores():
         for job in jobs:
             job()
@@ -52,15 +55,16 @@ def run_shared(jobs: Sequence[Callable[[], None]]) -> None:
         _run_child(jobs[1::2], writer)
     os.close(writer)
     try:
-        for job in jobs[0::2]:
-            job()
-    except BaseException:
+        with os.fdopen(reader, "rb") as pipe:
+            for job in jobs[0::2]:
+                job()
+            report = pipe.read()
+    except BaseException:  # an error here, or a stop while the child draws: it is stopped too
         os.kill(child, signal.SIGTERM)
         raise
     finally:
-        with os.fdopen(reader, "rb") as pipe:
-            report = pipe.read()
-        _, status = os.waitpid(child, 0)
+        with deferred_signals():  # the child has ended, and written its last file, before anything goes on
+            _, status = os.waitpid(child, 0)
     if report:
         raise pickle.loads(report)
     if status != 0:
