@@ -3,7 +3,8 @@ from the prior, the records made as a lab's instruments make them.
 
 Usage: python benchmarks/bench_calibration.py [--case tiny|quick|disordered] [--truths 50] [--records 1]
                                               [--workers 2] [--noise 5] [--seed 2026] [--out DIR] [--quick]
-                                              [--no-model-discrepancy] [--cost N] [--toy K,R]
+                                              [--no-model-discrepancy | --draw-discrepancy]
+                                              [--cost N] [--toy K,R]
                                               [--spread-in-sigma S1,S2,...]
 
 **Simulation-based calibration** (Talts, Betancourt, Simpson, Vehtari & Gelman 2018): draw a truth θ
@@ -19,6 +20,14 @@ drawn in [0, 5] ms (:mod:`hexdem.calibration.synthetic`); and with the instrumen
 the calibration's defaults assume them: each sensor's gain ~ N(1, 0.02), the record's striker
 speed v0 (1 + 0.01 z), each channel's noise level uniform in [0.5, 2] × ``--noise`` m/s² rms and
 a DC offset uniform in ±20 m/s². Nothing of the truth reaches the calibration but the record.
+
+``--draw-discrepancy``: each truth's records also differ from the model as the calibration's
+discrepancy term says they may (:class:`~hexdem.calibration.nuisance.Discrepancy`): its relative size
+τ drawn from that term's log-uniform prior, and each sensor's log peak and relative arrival off by
+τ z (z ~ N(0, 1)), the same in every record of the truth (:func:`~hexdem.calibration.synthetic.model_error_applied`).
+Talts et al.'s check then draws every unknown of the calibration's model from its prior. Without it the
+records hold no model error (τ = 0), a truth at the discrepancy prior's lower end, where its
+intervals are conservative.
 
 **Cases.**
 
@@ -62,6 +71,7 @@ from pathlib import Path
 import numpy as np
 from machine import describe
 
+from hexdem.calibration.nuisance import Discrepancy
 from hexdem.calibration.packings import DISORDER_REALIZATIONS, SIGMA_KEY
 from hexdem.calibration.priors import Prior, to_parameters
 from hexdem.calibration.simulations import Problem, simulate_point
@@ -93,17 +103,24 @@ NOISE_FACTORS, OFFSET_M_S2 = (0.5, 2.0), 20.0
 TRUTH_PACKING_SEED = 100_000
 
 
-def truth_record(base: dict, priors, rng, noise: float, path: Path, index: int, records: int = 1) -> np.ndarray:
+def truth_record(
+    base: dict, priors, rng, noise: float, path: Path, index: int, records: int = 1, discrepancy: bool = False
+) -> tuple[np.ndarray, float]:
     """A truth drawn from ``priors`` and ``records`` records of it, as a lab's instruments make them,
     written to ``path``: each sensor's gain the same in every record, the striker's speed, the
     channels' noise and offsets and the clock drawn anew for each, and on disordered packings each
-    record struck on a packing of its own."""
+    record struck on a packing of its own; with ``discrepancy``, a model error drawn from the
+    discrepancy term's prior, the same in every record. Returns the truth and the model error's τ."""
     truth = to_parameters(priors, rng.random((1, len(priors))))[0]
     values = {prior.key: float(v) for prior, v in zip(priors, truth)}
     sigma = values.pop(SIGMA_KEY, None)
     config = RunConfig.from_dict(base | values)
     sensors = len(config.sensors)
     gains = 1 + DEFAULT_GAIN_SD * rng.standard_normal(sensors)
+    tau, model_error = 0.0, None  # (drawn only where asked: the other tables' truths stay as they were)
+    if discrepancy:
+        tau = float(Discrepancy(sensors).size(rng.random()))
+        model_error = tau * rng.standard_normal((sensors, 2))
     rows = []
     for r in range(records):
         striker = config.replace(v0=config.v0 * (1 + DEFAULT_SPEED_SCATTER * rng.standard_normal()))
@@ -120,10 +137,13 @@ def truth_record(base: dict, priors, rng, noise: float, path: Path, index: int, 
             packings=path.parent / "truth-packing",
             gains=gains,
             offsets_m_s2=offsets,
+            model_error=model_error,
         )
     write_measured(path, rows)
-    (path.parent / "truth.json").write_text(json.dumps({prior.key: float(v) for prior, v in zip(priors, truth)}))
-    return truth
+    (path.parent / "truth.json").write_text(
+        json.dumps({prior.key: float(v) for prior, v in zip(priors, truth)} | {"model_error_tau": tau})
+    )
+    return truth, tau
 
 
 def binomial_band(level: float, count: int) -> tuple[float, float]:
@@ -223,7 +243,13 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--noise", type=float, default=5.0, help="accelerometer noise [m/s² rms]")
     parser.add_argument("--records", type=int, default=1, help="records a truth, each on a packing of its own")
-    parser.add_argument("--no-model-discrepancy", action="store_true", help="calibrate with the model taken as exact")
+    discrepancy = parser.add_mutually_exclusive_group()
+    discrepancy.add_argument(
+        "--no-model-discrepancy", action="store_true", help="calibrate with the model taken as exact"
+    )
+    discrepancy.add_argument(
+        "--draw-discrepancy", action="store_true", help="records off the model by an error drawn from its prior"
+    )
     parser.add_argument("--seed", type=int, default=2026)
     parser.add_argument("--out", help="keep the calibrations here (default: a temporary folder)")
     parser.add_argument("--quick", action="store_true")
@@ -252,19 +278,22 @@ def main() -> None:
         f"case {case}: {', '.join(prior_texts)}; noise {args.noise:g} m/s^2 rms; {truths} truth(s) of "
         f"{args.records} record(s); workers {workers}"
         + ("; the model taken as exact" if args.no_model_discrepancy else "")
+        + ("; the records' model error drawn from the discrepancy's prior" if args.draw_discrepancy else "")
     )
     print(
         "| truth | "
         + " | ".join(f"{p.key} true | {p.key} 90 % interval | {p.key} rank" for p in priors)
-        + " | records kept | simulations | fit p | wall s |"
+        + " | model error τ | records kept | simulations | fit p | wall s |"
     )
-    print("|---" * (1 + 3 * len(priors) + 4) + "|")
+    print("|---" * (1 + 3 * len(priors) + 5) + "|")
     ranks, inside = {p.key: [] for p in priors}, {(p.key, level): 0 for p in priors for level in (0.5, 0.9)}
     refused = []
     for t in range(truths):
         folder = root / f"truth-{t}"
         folder.mkdir(parents=True, exist_ok=True)
-        truth = truth_record(base, priors, rng, args.noise, folder / "data.csv", t, args.records)
+        truth, tau = truth_record(
+            base, priors, rng, args.noise, folder / "data.csv", t, args.records, args.draw_discrepancy
+        )
         start = time.perf_counter()
         try:
             calibration = prepare(
@@ -294,7 +323,7 @@ def main() -> None:
             held = "" if q05 <= truth[j] <= q95 else " MISSED"
             cells.append(f"{truth[j]:.6g} | [{q05:.6g}, {q95:.6g}]{held} | {rank}")
         print(
-            f"| {t} | " + " | ".join(cells) + f" | {len(calibration.data.records)} of {args.records} | "
+            f"| {t} | " + " | ".join(cells) + f" | {tau:.2g} | {len(calibration.data.records)} of {args.records} | "
             f"{summary['simulations']['runs']} | "
             f"{summary['fit']['p_value']:.2f} | {seconds:.0f} |",
             flush=True,

@@ -23,7 +23,7 @@ from hexdem.calibration.priors import NORMAL_TAIL, Prior
 from hexdem.calibration.report import summarize
 from hexdem.calibration.simulations import Problem, simulate_point
 from hexdem.calibration.spread import RECORD_TAIL_DOF, Spread
-from hexdem.calibration.synthetic import synthetic_rows, write_measured
+from hexdem.calibration.synthetic import model_error_applied, synthetic_rows, write_measured
 from hexdem.cli.main import main
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
@@ -451,6 +451,18 @@ def test_a_record_reduces_to_its_pulses_peaks_and_relative_arrival():
     shortfall = (2 * np.pi * 2e-6 / 80e-6) ** 2 / 12
     assert observed[1] == pytest.approx(log_peak - shortfall, abs=0.1 * shortfall)
     assert observed[2] == pytest.approx(arrival, abs=0.05)  # µs, against a 2 µs sampling interval
+
+
+def test_a_records_model_error_moves_its_observables_as_the_discrepancy_term_says():
+    """A record made to differ from the model by the relative errors of the discrepancy term
+    (:class:`~hexdem.calibration.nuisance.Discrepancy`): the second sensor's log peak 0.03 higher and its
+    arrival 5 % of its 400 µs later; the first sensor, the arrivals' reference, unmoved."""
+    record, _, _ = pulse_record(0.0, np.random.default_rng(0))
+    before = reduce_record(record.times, record.accelerations)
+    moved = model_error_applied(record.times, record.accelerations.transpose(1, 0, 2), [[0.0, 0.0], [0.03, 0.05]])
+    after = reduce_record(record.times, moved.transpose(1, 0, 2))
+    assert after[:2] - before[:2] == pytest.approx([0.0, 0.03], abs=1e-4)
+    assert after[2] - before[2] == pytest.approx(0.05 * 400.0, abs=0.05)  # µs
 
 
 def test_the_accelerometer_noise_is_measured_channel_by_channel_on_the_quiet_lead_in():

@@ -6,7 +6,10 @@ acquisition), after a quiet pre-trigger lead-in, with white accelerometer noise 
 clock offset. A calibration given such records does not fit a model to its own output: its runs
 integrate at another step and sample at other instants. A record of a disordered packing is
 struck on a packing prepared as a calibration prepares its own
-(:mod:`~hexdem.calibration.packings`), from a seed of its own.
+(:mod:`~hexdem.calibration.packings`), from a seed of its own. A record may also differ from the
+model as the calibration's discrepancy term says a real one may
+(:class:`~hexdem.calibration.nuisance.Discrepancy`): each sensor's peak and arrival off by a
+relative error of its own.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from hexdem.calibration.observables import ACCELERATION_UNITS, MEASURED_COLUMNS
 from hexdem.calibration.simulations import disordered_impact
 from hexdem.common.io import write_csv
 from hexdem.common.progress import silenced
+from hexdem.experiments.signals import integrate_velocity, pulse
 from hexdem.model.config import RunConfig
 
 #: The pre-trigger lead-in a record keeps before the impact [s].
@@ -38,13 +42,15 @@ def synthetic_rows(
     gains=None,
     offsets_m_s2=None,
     lead_in_s: float = LEAD_IN_S,
+    model_error=None,
 ) -> list:
     """Rows ``sensor,time,ax,ay,record`` of one synthetic record of ``config``: on the ideal
     lattice, or with ``disorder`` = (σ [m], seed, k) on that packing, settled in (or read from)
     the folder ``packings``. As a lab's instruments record it: ``noise_m_s2``, white noise of one
     level or of one per channel (n_sensors, 2); ``gains`` (n_sensors,), each sensor's sensitivity
     over its nominal one; ``offsets_m_s2`` (n_sensors, 2), each channel's DC offset; a pre-trigger
-    lead-in of ``lead_in_s``."""
+    lead-in of ``lead_in_s``. ``model_error`` (n_sensors, 2): the relative errors of the model's
+    observables that the record holds (:func:`model_error_applied`)."""
     from hexdem.experiments.run import simulate
 
     fine = config.replace(steps_per_contact=config.steps_per_contact * finer)
@@ -59,6 +65,8 @@ def synthetic_rows(
     units, tracked = analysis.settings.units, analysis.tracked
     times = tracked.sensor_times * units.time_s
     accelerations = tracked.sensor_states[:, :, 2:4] * (units.length_m / units.time_s**2)
+    if model_error is not None:
+        accelerations = model_error_applied(times, accelerations, model_error)
     interval = 1.0 / config.sensor_rate_hz
     lead = np.arange(-round(lead_in_s / interval), 0) * interval
     times = np.concatenate([lead, times]) + offset_s
@@ -74,6 +82,28 @@ def synthetic_rows(
         for s, sensor in enumerate(config.sensors)
         for t, a in zip(times, accelerations)
     ]
+
+
+def model_error_applied(times, accelerations, model_error) -> np.ndarray:
+    """The noise-free ``accelerations`` (K, n_sensors, 2), sampled at ``times`` (K,) [s], as they
+    would be if the model erred by the relative ``model_error`` (n_sensors, 2) of the discrepancy
+    term: sensor i's peak speed times exp(``model_error[i, 0]``), its arrival after the first
+    sensor's, t_i, later by ``model_error[i, 1]`` t_i (the first sensor's arrival is the reference:
+    its column is unused). The delayed signal is the cubic spline through its samples, zero before
+    the first."""
+    from scipy.interpolate import CubicSpline
+
+    model_error = np.asarray(model_error, float)
+    arrivals = np.array(
+        [pulse(times, *integrate_velocity(times, *channel.T))[1] for channel in accelerations.transpose(1, 0, 2)]
+    )
+    delays = np.nan_to_num(model_error[:, 1] * (arrivals - arrivals[0]))  # a sensor without a pulse: none
+    shifted = np.empty_like(accelerations)
+    for sensor, delay in enumerate(delays):
+        later = times - delay
+        values = CubicSpline(times, accelerations[:, sensor], axis=0, extrapolate=False)(later)
+        shifted[:, sensor] = np.nan_to_num(values)
+    return shifted * np.exp(model_error[:, 0])[None, :, None]
 
 
 def write_measured(path, rows, unit: str = "m/s2", single_axis: bool = False) -> None:
