@@ -48,6 +48,27 @@ def misfit_records(fit: dict, threshold: float) -> list[str]:
     return [entry["record"] for entry in fit["records"] if entry["p_value"] < threshold]
 
 
+def predictive_residuals(likelihood, draws, rng) -> np.ndarray:
+    """Each record's observables less the median of its own posterior predictive distribution, in
+    units of that distribution's standard deviation (R, m): at the posterior's ``draws`` (k, d) of
+    the sampler's unit cube, N(μ, Σ_r + C + λ_r Σ_K + V) with the record's own noise Σ_r and
+    packing scale λ_r (:meth:`~hexdem.calibration.inference.Likelihood.record_moments`), so that a
+    record whose packing took a weak path stands as far off as its χ² says, and no farther."""
+    data = likelihood.data
+    mean, common, owns = likelihood.record_moments(draws)
+    residuals = []
+    for record, noise, own in zip(data.records, data.covariances, owns):
+        predicted = gaussian_draws(rng, mean, noise + common + own)
+        residuals.append((record - np.median(predicted, axis=0)) / np.std(predicted, axis=0))
+    return np.array(residuals)
+
+
+def gaussian_draws(rng, mean, covariance) -> np.ndarray:
+    """One draw (k, m) of each N(``mean[i]``, ``covariance[i]``), ``mean`` (k, m) and ``covariance`` (k, m, m)."""
+    lower = np.linalg.cholesky(covariance)
+    return mean + np.einsum("kij,kj->ki", lower, rng.standard_normal(mean.shape))
+
+
 def in_g_hint(records, simulated, sensors: int) -> str:
     """A sentence for records whose peak speeds lie below every simulation's by about standard
     gravity's factor (records in g read as m/s²), else an empty one: ``records`` (R, m) and the

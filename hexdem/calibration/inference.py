@@ -183,8 +183,9 @@ class Likelihood:
         mean, common, spread, speed = self._parts(np.atleast_2d(unit))
         return mean, common, spread + speed
 
-    def _records(self, unit) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
-        """(μ, C, [what record r adds to its own noise, λ_r Σ_K + V, for each record]) at ``unit``."""
+    def record_moments(self, unit) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
+        """At the sampler's unit-cube points ``unit``: μ (k, m), C (k, m, m) and, for each record,
+        what it adds to its own noise, λ_r Σ_K + V (k, m, m), with its packing's scale λ_r at ``unit``."""
         unit = np.atleast_2d(unit)
         mean, common, spread, speed = self._parts(unit)
         if not self.record_scales:
@@ -215,7 +216,7 @@ class Likelihood:
         result = np.full(len(unit), -np.inf)
         if not inside.any():
             return result
-        mean, common, owns = self._records(unit[inside])
+        mean, common, owns = self.record_moments(unit[inside])
         total, precision, pulled = self._pooled(mean, owns)
         shrink = np.eye(mean.shape[1]) + common @ precision
         gain = np.linalg.solve(shrink, (common @ pulled[:, :, None]))[:, :, 0]
@@ -226,7 +227,7 @@ class Likelihood:
         """(mean (k, n), variance (k, n)) of each sensor's log gain given the records, at the
         sampler's points ``unit`` (:meth:`moments`): g is part of the common error e, so with G its covariance,
         E[g | y] = G (I + P C)⁻¹ b and Cov[g | y] = G − G (I + P C)⁻¹ P G."""
-        mean, common, owns = self._records(unit)
+        mean, common, owns = self.record_moments(unit)
         _, precision, pulled = self._pooled(mean, owns)
         gains = self.instruments.common()
         shrink = np.eye(mean.shape[1]) + precision @ common
@@ -240,7 +241,7 @@ class Likelihood:
         (:meth:`moments`), each with the full covariance that the likelihood gives it there: the stacked
         records N(1 ⊗ μ, blockdiag(Σ_r + λ_r Σ_K + V) + 11ᵀ ⊗ C), and record r alone
         N(μ, Σ_r + λ_r Σ_K + V + C), each record's packing scale λ_r at ``unit``'s."""
-        mean, common, owns = self._records(unit)
+        mean, common, owns = self.record_moments(unit)
         mean, common, owns = mean[0], common[0], [own[0] for own in owns]
         records, m = self.data.records, len(mean)
         joint = np.kron(np.ones((len(records), len(records))), common)

@@ -88,13 +88,15 @@ def corner(priors, samples, path) -> None:
     save(fig, path)
 
 
-def predictive(sensors, distances, records, covariances, predicted, path, misfit=None) -> None:
+def predictive(sensors, distances, records, covariances, predicted, residuals, path, misfit=None) -> None:
     """Measured observables per sensor beside the posterior predictive band, and their residuals.
 
     ``distances`` (n,): each sensor's distance from the struck bead [bead diameters]; ``records``
     (R, m) and ``covariances`` (R, m, m): the measured records' observables and noise;
-    ``predicted`` (S, m): draws of the posterior predictive distribution; ``misfit`` (R,): the
-    records that do not fit the model, marked."""
+    ``predicted`` (S, m): draws of the posterior predictive distribution of a typical record (the
+    band); ``residuals`` (R, m): each record's observables less the median of its own posterior
+    predictive distribution (its noise, its packing's scale λ_r), in units of its standard deviation;
+    ``misfit`` (R,): the records that do not fit the model, marked."""
     misfit = np.zeros(len(records), bool) if misfit is None else np.asarray(misfit, bool)
     n = len(sensors)
     x = np.asarray(distances, float)
@@ -135,13 +137,11 @@ def predictive(sensors, distances, records, covariances, predicted, path, misfit
     ax_peak.set_title("Peak speed at each sensor")
     ax_arrival.set_ylabel(f"arrival after sensor {sensors[0]} [ms]")
     ax_arrival.set_title("Relative arrival time")
-    centre, spread = np.median(predicted, axis=0), np.std(predicted, axis=0)
-    z = (records - centre) / np.where(spread > 0, spread, 1.0)
     for ax, columns, shown in ((z_peak, slice(0, n), x), (z_arrival, slice(n, None), x[1:])):
         ax.axhspan(-2, 2, color="0.92")
         ax.axhspan(-1, 1, color="0.82")
         ax.axhline(0, color="0.4", lw=0.8)
-        for r, row in enumerate(z[:, columns]):
+        for r, row in enumerate(residuals[:, columns]):
             ax.plot(
                 shown,
                 row,

@@ -409,8 +409,7 @@ def _write_results(
     rng = np.random.default_rng(calibration.seed)
     draws = fit.states[rng.choice(len(fit.states), PREDICTIVE_DRAWS)]
     mean, common, own = fit.likelihood.moments(draws)
-    noise = np.mean(data.covariances, axis=0)
-    predicted = np.array([rng.multivariate_normal(m, noise + c + o) for m, c, o in zip(mean, common, own)])
+    predicted = diagnostics.gaussian_draws(rng, mean, np.mean(data.covariances, axis=0) + common + own)
     misfit = diagnostics.misfit_records(summary["fit"], MISFIT_P)
     plots.predictive(
         problem.sensors,
@@ -418,6 +417,7 @@ def _write_results(
         data.records,
         data.covariances,
         predicted,
+        diagnostics.predictive_residuals(fit.likelihood, draws, rng),
         out / "predictive.png",
         [name in misfit for name in data.record_names],
     )
