@@ -767,6 +767,21 @@ def test_a_calibration_finds_the_truth_and_resumes_after_kill_9_to_the_same_post
     assert (killed / "posterior.csv").read_bytes() == (whole / "posterior.csv").read_bytes()
 
 
+def test_stragglers_restart_beside_the_others_and_the_chain_keeps_its_length(monkeypatch):
+    """Walkers flagged as stuck (here the first five, whatever their place) restart beside the others,
+    and the kept chain has its full length: a standard normal's samples, :data:`~inference.THIN` apart."""
+    monkeypatch.setattr(inference, "stragglers", lambda log_probability, dimension: np.arange(inference.WALKERS) < 5)
+
+    def likelihood(unit):
+        return -0.5 * np.sum(((unit - 0.5) / 0.05) ** 2, axis=1)
+
+    samples, chain = inference.sample_posterior(likelihood, 2, seed=1)
+    burn_in, kept = inference.chain_steps(2)
+    assert samples.shape == (inference.WALKERS * kept // inference.THIN, 2) and chain.steps == kept
+    assert np.mean(samples, axis=0) == pytest.approx([0.5, 0.5], abs=0.01)
+    assert np.std(samples, axis=0) == pytest.approx([0.05, 0.05], rel=0.1)
+
+
 def test_walkers_stuck_where_the_posterior_has_no_mass_are_found():
     """A two-dimensional Gaussian's walkers have log probabilities within a few units of each other
     (−χ²₂/2: 99.99 % above −9.2); two walkers at −7,000, as stuck walkers sat on a curved ridge, are

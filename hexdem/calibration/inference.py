@@ -318,9 +318,9 @@ def sample_posterior(likelihood: Likelihood, dimension: int, seed: int) -> tuple
     lost = stragglers(sampler.get_log_prob(discard=burn_in // 2), dimension)
     if lost.any():
         coords = state.coords.copy()
-        kept = np.flatnonzero(~lost)
+        found = np.flatnonzero(~lost)
         coords[lost] = np.clip(
-            coords[rng.choice(kept, lost.sum())] + rng.normal(0.0, 1e-6, (lost.sum(), dimension)), 0.0, 1.0
+            coords[rng.choice(found, lost.sum())] + rng.normal(0.0, 1e-6, (lost.sum(), dimension)), 0.0, 1.0
         )
         sampler.reset()
         state = sampler.run_mcmc(coords, burn_in)
