@@ -528,7 +528,7 @@ def test_the_lead_in_of_a_weak_first_pulse_ends_at_its_foot_above_the_noise():
     weak = record.accelerations.copy()
     weak[0] = weak[0] + noise * rng.standard_normal(weak[0].shape) + 20.0
     weak[1] = 50 * weak[1] + noise * rng.standard_normal(weak[1].shape)
-    quiet = lead_in(Record("0", record.times, weak, record.axes))
+    quiet = lead_in(Record("0", record.times, weak, record.axes), ["a", "b"])
     assert 150 - FOOT_SAMPLES <= quiet <= 160 - FOOT_SAMPLES  # the rise takes 10 samples
     _, levels = noise_covariance(Record("0", record.times, weak, record.axes), ["a", "b"], seed=0)
     assert levels == pytest.approx(noise, rel=0.3)
@@ -540,9 +540,32 @@ def test_the_lead_in_ends_where_the_pulse_first_reaches_any_sensor():
     foot, and the record is calibrated rather than refused as not at rest before the first's."""
     record, _, _ = pulse_record(1.0, np.random.default_rng(6))
     swapped = Record("0", record.times, record.accelerations[::-1].copy(), record.axes)
-    assert 150 - FOOT_SAMPLES <= lead_in(swapped) <= 160 - FOOT_SAMPLES
+    assert 150 - FOOT_SAMPLES <= lead_in(swapped, ["a", "b"]) <= 160 - FOOT_SAMPLES
     _, levels = noise_covariance(swapped, ["a", "b"], seed=0)
     assert levels == pytest.approx(1.0, rel=0.35)
+
+
+def test_a_pulse_that_rings_through_the_record_is_a_pulse():
+    """The sensor next to the impact on a small packing: its pulse rings on to the record's end (a
+    fifth of its peak acceleration at 50 kHz), so a median absolute deviation over the whole record
+    reads 0.2 of the peak as noise. Its noise is read on the quiet lead-in, 1 m/s², and the record is
+    calibrated, not refused as a sensor without a pulse."""
+    record, _, _ = pulse_record(1.0, np.random.default_rng(9))
+    ringing = record.accelerations.copy()
+    peak = 0.1 * np.pi / 80e-6
+    after = record.times >= 300e-6
+    ringing[0, after, 0] += 0.2 * peak * np.sin(2 * np.pi * 50e3 * (record.times[after] - 300e-6))
+    whole = 1.4826 * np.median(np.abs(ringing[0, :, 0] - np.median(ringing[0, :, 0])))
+    assert 10 * whole > peak  # what the whole record's deviation would call noise
+    _, levels = noise_covariance(Record("0", record.times, ringing, record.axes), ["a", "b"], seed=0)
+    assert levels == pytest.approx(1.0, rel=0.35)
+
+
+def test_a_record_of_noise_alone_is_refused_as_holding_no_pulse():
+    rng = np.random.default_rng(10)
+    noise = Record("0", np.arange(600) * 2e-6, rng.standard_normal((2, 600, 2)), np.ones((2, 2), bool))
+    with pytest.raises(HexdemError, match="no sensor of a, b shows a pulse above the accelerometer's noise"):
+        noise_covariance(noise, ["a", "b"], seed=0)
 
 
 @pytest.fixture(scope="module")

@@ -133,38 +133,31 @@ def _centred(record: Record, sensor: int) -> np.ndarray:
     return channel - np.median(channel, axis=0)
 
 
-def lead_in(record: Record) -> int:
-    """Samples of ``record`` before the pulse's foot at the first sensor it reaches (its quiet
-    lead-in; on a disordered packing the pulse may reach a later sensor first, by another path): a
-    sensor's foot is where its acceleration, its offset removed, first reaches :data:`FOOT_LEVEL` of
-    its peak, or :data:`FOOT_NOISE` times its noise where its pulse is so weak that the noise reaches
-    that share (a sensor whose pulse never does has no foot). That noise is the standard deviation of
-    the record's first 2 × :data:`~hexdem.experiments.signals.BASELINE_SAMPLES` samples, quiet in any
-    record with the lead-in a calibration needs (a pulse that lasts, on a short record, would swell
-    a median absolute deviation over the whole record past the pulse itself)."""
+def lead_in(record: Record, sensors) -> int:
+    """Samples of ``record`` (of ``sensors``) before the pulse's foot at the first sensor it reaches
+    (its quiet lead-in; on a disordered packing the pulse may reach a later sensor first, by another
+    path): a sensor's foot is where its acceleration, its offset removed, first reaches
+    :data:`FOOT_LEVEL` of its peak, or :data:`FOOT_NOISE` times its noise where its pulse is so weak
+    that the noise reaches that share. That noise is the standard deviation of the record's first
+    2 × :data:`~hexdem.experiments.signals.BASELINE_SAMPLES` samples, quiet in any record with the
+    lead-in a calibration needs: a median absolute deviation over the whole record would take a pulse
+    that rings through a small packing's record for noise, and a sensor next to the impact for one
+    without a pulse. A sensor whose peak is not :data:`MIN_SIGNAL_TO_NOISE` times that noise holds no
+    pulse and has no foot (noise alone would give it one anywhere); a record in which no sensor has
+    one is refused."""
     feet = []
     for sensor in range(len(record.accelerations)):
         centred = _centred(record, sensor)
         magnitude = np.sqrt(np.sum(centred**2, axis=1))
         noise = float(np.max(np.std(centred[: 2 * BASELINE_SAMPLES], axis=0)))
-        above = magnitude >= max(FOOT_LEVEL * magnitude.max(), FOOT_NOISE * noise)
-        if above.any():
-            feet.append(int(np.argmax(above)))
-    return min(feet) - FOOT_SAMPLES
-
-
-def _check_first_pulse(record: Record, sensor: str) -> None:
-    """Refuse a record whose first sensor holds no pulse above its noise, measured on the whole
-    record (the median absolute deviation of its noisier axis, blind to a short pulse): without it,
-    no lead-in is found."""
-    centred = _centred(record, 0)
-    level = float(MAD_TO_SD * np.max(np.median(np.abs(centred), axis=0)))
-    peak = float(np.max(np.sqrt(np.sum(centred**2, axis=1))))
-    if peak < MIN_SIGNAL_TO_NOISE * level:
+        if magnitude.max() >= MIN_SIGNAL_TO_NOISE * noise:
+            feet.append(int(np.argmax(magnitude >= max(FOOT_LEVEL * magnitude.max(), FOOT_NOISE * noise))))
+    if not feet:
         raise NoPulse(
-            f"sensor {sensor} shows no pulse above the accelerometer's noise (largest {peak:.3g} m/s² above "
-            f"its median, noise {level:.3g} m/s² rms over the record): is the record long enough to hold its pulse?"
+            f"no sensor of {', '.join(sensors)} shows a pulse above the accelerometer's noise: is the "
+            "record long enough to hold its pulse?"
         )
+    return min(feet) - FOOT_SAMPLES
 
 
 def noise_covariance(record: Record, sensors, seed: int) -> tuple[np.ndarray, np.ndarray]:
@@ -174,8 +167,7 @@ def noise_covariance(record: Record, sensors, seed: int) -> tuple[np.ndarray, np
     lead-in is exactly constant (its noise cannot be measured), and a sensor (of ``sensors``, the
     record's) whose largest acceleration is not :data:`MIN_SIGNAL_TO_NOISE` times its noise (it
     holds no pulse) are refused."""
-    _check_first_pulse(record, sensors[0])
-    quiet = lead_in(record)
+    quiet = lead_in(record, sensors)
     if quiet < BASELINE_SAMPLES:
         raise HexdemError(
             f"it starts {max(quiet, 0)} samples before the pulse's foot at the first sensor it "
