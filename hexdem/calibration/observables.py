@@ -93,21 +93,25 @@ def observation_names(sensors) -> list[str]:
     return [f"log_peak:{s}" for s in sensors] + [f"arrival:{s}" for s in sensors[1:]]
 
 
+def pulses(times, accelerations) -> tuple[np.ndarray, np.ndarray]:
+    """(peak speed [m/s], half-maximum arrival [s]) of each sensor's pulse (n,), its ``accelerations``
+    (n, K, 2) at ``times`` (K,) [s] integrated to velocity (:mod:`hexdem.experiments.signals`); NaN
+    arrival where a sensor holds no rising pulse."""
+    found = [pulse(times, *integrate_velocity(times, channel[:, 0], channel[:, 1])) for channel in accelerations]
+    peaks, arrivals = zip(*found)
+    return np.asarray(peaks, float), np.asarray(arrivals, float)
+
+
 def reduce_record(times, accelerations, axes=None) -> np.ndarray:
     """The observables of one record: log peak speeds [ln(m/s)], then arrivals relative to the
     first sensor's [µs]; with ``axes`` (n_sensors, 2), each sensor's speed from its measured axes
     alone."""
     if axes is not None:
         accelerations = np.asarray(accelerations) * np.asarray(axes, bool)[:, None, :]
-    peaks, arrivals = [], []
-    for channel in accelerations:
-        vx, vy = integrate_velocity(times, channel[:, 0], channel[:, 1])
-        peak, arrival = pulse(times, vx, vy)
-        peaks.append(peak)
-        arrivals.append(arrival)
-    if not (np.all(np.isfinite(arrivals)) and np.all(np.asarray(peaks) > 0)):
+    peaks, arrivals = pulses(times, accelerations)
+    if not (np.all(np.isfinite(arrivals)) and np.all(peaks > 0)):
         raise HexdemError("no rising pulse at every sensor: is the record long enough?")
-    relative = (np.asarray(arrivals[1:]) - arrivals[0]) / ARRIVAL_UNIT_S
+    relative = (arrivals[1:] - arrivals[0]) / ARRIVAL_UNIT_S
     return np.concatenate([np.log(peaks), relative])
 
 

@@ -19,11 +19,10 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem.calibration.observables import ACCELERATION_UNITS, MEASURED_COLUMNS
+from hexdem.calibration.observables import ACCELERATION_UNITS, MEASURED_COLUMNS, pulses
 from hexdem.calibration.simulations import disordered_impact
 from hexdem.common.io import write_csv
 from hexdem.common.progress import silenced
-from hexdem.experiments.signals import integrate_velocity, pulse
 from hexdem.model.config import RunConfig
 
 #: The pre-trigger lead-in a record keeps before the impact [s].
@@ -94,9 +93,7 @@ def model_error_applied(times, accelerations, model_error) -> np.ndarray:
     from scipy.interpolate import CubicSpline
 
     model_error = np.asarray(model_error, float)
-    arrivals = np.array(
-        [pulse(times, *integrate_velocity(times, *channel.T))[1] for channel in accelerations.transpose(1, 0, 2)]
-    )
+    arrivals = pulses(times, accelerations.transpose(1, 0, 2))[1]
     delays = np.nan_to_num(model_error[:, 1] * (arrivals - arrivals[0]))  # a sensor without a pulse: none
     shifted = np.empty_like(accelerations)
     for sensor, delay in enumerate(delays):
