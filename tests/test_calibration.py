@@ -792,7 +792,8 @@ def test_a_calibration_finds_the_truth_and_resumes_after_kill_9_to_the_same_post
 
 def test_stragglers_restart_beside_the_others_and_the_chain_keeps_its_length(monkeypatch):
     """Walkers flagged as stuck (here the first five, whatever their place) restart beside the others,
-    and the kept chain has its full length: a standard normal's samples, :data:`~inference.THIN` apart."""
+    and the kept chain has its full length, :data:`~inference.THIN` steps apart, with the moments of the
+    normal N(0.5, 0.05²) it samples."""
     monkeypatch.setattr(inference, "stragglers", lambda log_probability, dimension: np.arange(inference.WALKERS) < 5)
 
     def likelihood(unit):
