@@ -714,6 +714,29 @@ def test_bad_input_is_one_line_before_any_simulation(measured, tmp_path, capsys,
     assert not out.exists()
 
 
+@pytest.mark.parametrize(
+    "content, message",
+    [
+        (bytes(range(256)) * 8, "is a binary file, not a CSV of measured samples"),
+        ("sensor,time,ax\n0:1,0.0,1.5\n".encode("utf-16"), "is a binary file"),
+        ("sensor,time,ax\n0:1,0.0,1.5 m/s\xb2\n".encode("latin-1"), "is not UTF-8 text: a binary file, or a CSV saved in another encoding"),
+    ],
+    ids=["binary", "utf-16", "latin-1"],
+)
+def test_a_measured_file_that_is_not_utf8_text_is_one_line(measured, tmp_path, capsys, content, message):
+    """A binary file, or a CSV saved as UTF-16 (NUL in every other byte) or Latin-1, given as
+    ``--measured``: one line naming the file and what it is, exit 3, nothing written."""
+    data, out = tmp_path / "data.bin", tmp_path / "out"
+    data.write_bytes(content)
+    code = main(
+        ["calibrate", "--config", str(measured / "base.toml"), "--measured", str(data), "--out", str(out)]
+        + ["--prior", "v0=uniform(0.2, 0.7)"]
+    )
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 3 and len(err) == 1 and message in err[0] and str(data) in err[0], err
+    assert not out.exists()
+
+
 def test_workers_and_parsl_together_are_a_usage_error(measured, tmp_path, capsys):
     with pytest.raises(SystemExit) as stop:
         main(

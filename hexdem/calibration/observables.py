@@ -230,6 +230,10 @@ def _channel_noise(lead, name: str) -> float:
     return noise
 
 
+#: Bytes read at the start of a measured file to tell a binary file (one holding NUL) from a CSV.
+BINARY_PROBE_BYTES = 8192
+
+
 def read_measured(path, sensors, unit: str = "m/s2") -> list[Record]:
     """The records of the measured file ``path`` (columns ``sensor,time,ax``, optionally ``ay`` and
     ``record``; accelerations in ``unit``, one of :data:`ACCELERATION_UNITS`), each holding exactly
@@ -238,7 +242,10 @@ def read_measured(path, sensors, unit: str = "m/s2") -> list[Record]:
     if unit not in ACCELERATION_UNITS:
         raise HexdemError(f"--acceleration-unit {unit!r}: use one of {', '.join(ACCELERATION_UNITS)}")
     try:
-        with open(path, newline="") as fh:
+        with open(path, "rb") as fh:
+            if b"\0" in fh.read(BINARY_PROBE_BYTES):
+                raise HexdemError(f"{path} is a binary file, not a CSV of measured samples")
+        with open(path, newline="", encoding="utf-8") as fh:
             reader = csv.DictReader(fh)
             columns = reader.fieldnames or ()
             missing = [c for c in REQUIRED_COLUMNS if c not in columns]
@@ -262,6 +269,8 @@ def read_measured(path, sensors, unit: str = "m/s2") -> list[Record]:
                 )
     except OSError as exc:
         raise HexdemError(f"cannot read {path}: {exc.strerror}") from None
+    except UnicodeDecodeError:
+        raise HexdemError(f"{path} is not UTF-8 text: a binary file, or a CSV saved in another encoding") from None
     if not grouped:
         raise HexdemError(f"{path} holds no measured samples")
     scale = ACCELERATION_UNITS[unit]
