@@ -52,31 +52,9 @@ from scipy.stats import qmc
 
 from hexdem.calibration.emulator import Emulator
 from hexdem.calibration.nuisance import Discrepancy, Instruments
+from hexdem.calibration.sampler import Chain, sample_posterior
 from hexdem.calibration.spread import NOISY_NUGGET, Spread
 from hexdem.errors import HexdemError
-
-WALKERS = 64
-BURN_IN_STEPS = 300
-KEPT_STEPS = 500
-#: The most coordinates on which the walkers take BURN_IN_STEPS and KEPT_STEPS (:func:`chain_steps`).
-FEW_COORDINATES = 3
-THIN = 10
-#: How far below the median walker's log probability a walker is a straggler (plus the dimension).
-STRAGGLER_DROP = 10.0
-#: Prior points at which the emulated posterior is evaluated to start the walkers.
-START_CANDIDATES = 4096
-
-
-def chain_steps(dimension: int) -> tuple[int, int]:
-    """(burn-in, kept) steps of the walkers on a posterior of ``dimension`` coordinates: the
-    autocorrelation time τ grows with the dimension (with :func:`sample_posterior`'s moves past
-    :data:`FEW_COORDINATES`, some 10 steps a coordinate at 7: two parameters, the spread's scale,
-    three records' and the discrepancy's), so past it the walkers take 100 steps a coordinate to burn
-    in and keep 250, for :data:`EFFECTIVE_SAMPLES` independent samples and
-    :data:`AUTOCORRELATION_LENGTHS` τ a walker; :data:`BURN_IN_STEPS` and :data:`KEPT_STEPS` up to it."""
-    if dimension <= FEW_COORDINATES:
-        return BURN_IN_STEPS, KEPT_STEPS
-    return 100 * dimension, 250 * dimension
 
 
 def initial_points(dimension: int) -> int:
@@ -236,6 +214,11 @@ class Likelihood:
         n = self.instruments.sensors
         return centre[:, :n], np.diagonal(covariance, axis1=1, axis2=2)[:, :n]
 
+    def without_discrepancy(self) -> Likelihood:
+        """This likelihood with the model taken as exact: no :class:`~hexdem.calibration.nuisance.Discrepancy`,
+        its coordinates those of this one less τ's (the last), the others' the same."""
+        return Likelihood(self.data, self.emulator, self.spread, self.model_error, self.instruments)
+
     def misfit(self, unit) -> tuple[float, list[float]]:
         """(χ² of all the records together, [χ² of each record]) at the sampler's point ``unit``
         (:meth:`moments`), each with the full covariance that the likelihood gives it there: the stacked
@@ -253,93 +236,6 @@ class Likelihood:
             alone.append(float(residual @ np.linalg.solve(covariance + own + common, residual)))
         stacked = (records - mean).ravel()
         return float(stacked @ np.linalg.solve(joint, stacked)), alone
-
-
-@dataclass(frozen=True)
-class Chain:
-    """How emcee's kept chain mixed: the integrated ``autocorrelation_steps`` τ of each coordinate
-    (emcee's estimate, averaged over the walkers), the walkers' mean ``acceptance_fraction``, the
-    ``steps`` kept and the ``walkers``. The chain is long enough (:attr:`long_enough`) when it
-    holds :data:`AUTOCORRELATION_LENGTHS` τ per walker and :data:`EFFECTIVE_SAMPLES` independent
-    samples, walkers × steps / τ: enough to place a 90 % interval's ends to a few per cent of its width."""
-
-    autocorrelation_steps: tuple[float, ...]
-    acceptance_fraction: float
-    steps: int
-    walkers: int
-
-    @property
-    def effective_samples(self) -> float:
-        return self.walkers * self.steps / max(self.autocorrelation_steps)
-
-    @property
-    def long_enough(self) -> bool:
-        return (
-            self.steps >= AUTOCORRELATION_LENGTHS * max(self.autocorrelation_steps)
-            and self.effective_samples >= EFFECTIVE_SAMPLES
-        )
-
-    def as_dict(self) -> dict:
-        return {
-            "autocorrelation_steps": list(self.autocorrelation_steps),
-            "acceptance_fraction": self.acceptance_fraction,
-            "kept_steps": self.steps,
-            "walkers": self.walkers,
-            "effective_samples": self.effective_samples,
-            "long_enough": self.long_enough,
-        }
-
-
-#: Autocorrelation times that each walker's kept chain must hold.
-AUTOCORRELATION_LENGTHS = 10
-#: Independent samples that the kept chain must hold.
-EFFECTIVE_SAMPLES = 1000
-
-
-def sample_posterior(likelihood: Likelihood, dimension: int, seed: int) -> tuple[np.ndarray, Chain]:
-    """Unit-cube samples (WALKERS · kept steps / THIN, p; :func:`chain_steps`) of the posterior of ``likelihood``, and
-    how the chain mixed: the walkers start at the best of START_CANDIDATES prior points (past
-    :data:`FEW_COORDINATES`, they move by differential evolution, 80 %, and its snooker update,
-    20 %, in place of the stretch move, which mixed three times slower over the records' packing
-    scales, whose posteriors are skewed), and after
-    the burn-in every straggler (:func:`stragglers`) restarts beside a walker in the posterior and
-    the burn-in runs again."""
-    import emcee
-
-    rng = np.random.default_rng(seed)
-    candidates = qmc.LatinHypercube(dimension, seed=rng).random(START_CANDIDATES)
-    best = candidates[np.argsort(likelihood(candidates))[-WALKERS:]]
-    start = np.clip(best + rng.normal(0.0, 1e-3, best.shape), 1e-6, 1 - 1e-6)
-    burn_in, kept = chain_steps(dimension)
-    moves = None if dimension <= FEW_COORDINATES else [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
-    sampler = emcee.EnsembleSampler(WALKERS, dimension, likelihood, vectorize=True, moves=moves)
-    sampler.random_state = np.random.RandomState(int(rng.integers(2**31))).get_state()
-    state = sampler.run_mcmc(start, burn_in)
-    lost = stragglers(sampler.get_log_prob(discard=burn_in // 2), dimension)
-    if lost.any():
-        coords = state.coords.copy()
-        found = np.flatnonzero(~lost)
-        coords[lost] = np.clip(
-            coords[rng.choice(found, lost.sum())] + rng.normal(0.0, 1e-6, (lost.sum(), dimension)), 0.0, 1.0
-        )
-        sampler.reset()
-        state = sampler.run_mcmc(coords, burn_in)
-    sampler.reset()
-    sampler.run_mcmc(state, kept)
-    tau = sampler.get_autocorr_time(quiet=True, tol=0)
-    chain = Chain(tuple(float(t) for t in tau), float(np.mean(sampler.acceptance_fraction)), kept, WALKERS)
-    return sampler.get_chain(thin=THIN, flat=True), chain
-
-
-def stragglers(log_probability, dimension: int) -> np.ndarray:
-    """Walkers stuck where the posterior has no mass: their median log probability over the
-    burn-in's second half (``log_probability`` (steps, walkers)) is more than STRAGGLER_DROP +
-    ``dimension`` below the median walker's, a density e^-(10 + p) of the typical one, where the
-    typical set of a p-dimensional posterior lies within about p/2 of its median. An affine-invariant
-    stretch move brings such a walker back only along straight lines through the others, which a
-    curved ridge of the posterior can cross only where it has no mass."""
-    typical = np.median(log_probability, axis=0)
-    return typical < np.median(typical) - (STRAGGLER_DROP + dimension)
 
 
 @dataclass(frozen=True)
@@ -391,6 +287,7 @@ def fit_stage(
     instruments: Instruments | None = None,
     discrepancy: Discrepancy | None = None,
     smooth=(),
+    chains: int = 1,
 ) -> Fit:
     """Fit the emulator to the simulations and sample the posterior it implies: the emulator to each
     parameter set's mean over its packings whose pulse the sensors detect (the others' observables are
@@ -400,7 +297,9 @@ def fit_stage(
     jump from one σ to the next by their sampling error; the nugget takes the jumps, and the
     likelihood's Σ_K/K their size) (``model_error``:
     the covariance of the model's own integration error, :func:`step_error`; ``instruments``: the
-    records' gains and speed scatter; ``discrepancy``: what the model cannot represent)."""
+    records' gains and speed scatter; ``discrepancy``: what the model cannot represent; ``chains``:
+    the sampler's independent ensembles, several for the posterior reported, whose convergence they
+    check, one for a stage that only picks the next points)."""
     points, observables = np.asarray(points, float), np.asarray(observables, float)
     detected = np.isfinite(observables[..., 0]).sum(axis=1)
     seen = detected >= min(2, observables.shape[1])
@@ -418,7 +317,7 @@ def fit_stage(
     )
     spread = Spread(points, observables, *records_scatter(data, instruments), smooth=smooth)
     likelihood = Likelihood(data, emulator, spread, model_error, instruments, discrepancy)
-    states, chain = sample_posterior(likelihood, likelihood.dimension, seed)
+    states, chain = sample_posterior(likelihood, likelihood.dimension, seed, chains)
     return Fit(points, observables, emulator, spread, states, likelihood, chain)
 
 

@@ -67,11 +67,15 @@ class Discrepancy:
         """τ (k,) of the unit-cube coordinates ``unit`` (k,)."""
         return self.low * (self.high / self.low) ** np.asarray(unit, float)
 
+    def weights(self, mean) -> np.ndarray:
+        """W's diagonal (k, m) at the emulated means ``mean`` (k, m): 1 for a log peak, t_j² for an arrival."""
+        mean = np.atleast_2d(mean)
+        return np.column_stack([np.ones((len(mean), self.sensors)), mean[:, self.sensors :] ** 2])
+
     def covariance(self, mean, unit) -> np.ndarray:
         """τ² W (k, m, m) at the emulated means ``mean`` (k, m) and τ's coordinates ``unit`` (k,)."""
-        mean = np.atleast_2d(mean)
-        weights = np.column_stack([np.ones((len(mean), self.sensors)), mean[:, self.sensors :] ** 2])
-        return (self.size(unit) ** 2)[:, None, None] * weights[:, :, None] * np.eye(mean.shape[1])
+        weights = self.weights(mean)
+        return (self.size(unit) ** 2)[:, None, None] * weights[:, :, None] * np.eye(weights.shape[1])
 
     def as_dict(self) -> dict:
         return {"prior": f"loguniform({self.low:g}, {self.high:g})", "meaning": "relative size of the model's error"}
