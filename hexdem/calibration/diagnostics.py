@@ -7,13 +7,15 @@ whatever misfit it is asked about (sensors' gains off by 6 % passed a check that
 measures, each with the full covariance that the likelihood gives the records
 (:meth:`~hexdem.calibration.inference.Likelihood.misfit`: the noise of each record, the packings'
 spread, the striker's speed scatter, and the errors common to every record, the emulator's, the
-time step's and the sensors' gains): the records' χ² at the posterior median u*, with R m − p
-degrees of freedom together (R records of m observables, p parameters) and m for each record
-alone, exact for a model linear in the parameters near u*; and the posterior predictive p-value
+time step's and the sensors' gains): the records' χ² at u*, the posterior draw where the exact
+model's likelihood is highest (not the coordinates' medians, which on a posterior of several
+modes or a curved ridge lie where it has no mass), with R m − p degrees of freedom together (R
+records of m observables, p parameters) and m for each record alone, exact for a model linear in
+the parameters near u*; and the posterior predictive p-value
 of the χ² discrepancy (Gelman, Meng & Stern 1996), P(T(y_rep, θ) ≥ T(y, θ) | y) over the
 posterior's draws θ, where a replicated record set y_rep of the exact model at θ makes T(y_rep, θ)
 a χ² of R m degrees of freedom, so that the p-value is the mean of its survival function at
-T(y, θ). Either p-value below :data:`~hexdem.calibration.study.MISFIT_P` is a warning naming the
+T(y, θ). Either p-value below :data:`~hexdem.calibration.assessment.MISFIT_P` is a warning naming the
 records that do not fit: the model, the instruments or the configuration differ from what the
 records measured, and the intervals then say too little.
 """
@@ -33,7 +35,7 @@ DISAGREEMENT_WIDTH_RATIO = 2.0
 def goodness_of_fit(likelihood, states, parameters: int, rng, draws: int = PREDICTIVE_CHECK_DRAWS) -> dict:
     """``fit`` of ``calibration.json`` (see the module docstring): with the model taken as exact
     (:meth:`~hexdem.calibration.inference.Likelihood.without_discrepancy`), ``chi2``, ``dof`` and
-    ``p_value`` of the records together at the posterior median of the sampler's ``states``, and
+    ``p_value`` of the records together at the most likely of the sampler's ``states``, and
     ``predictive_p_value``, the posterior predictive p-value over ``draws`` of them; ``records``,
     each record's ``record``, ``chi2``, ``p_value`` and ``predictive_p_value``."""
     from scipy.stats import chi2 as chi_squared
@@ -41,7 +43,7 @@ def goodness_of_fit(likelihood, states, parameters: int, rng, draws: int = PREDI
     exact = likelihood.without_discrepancy()
     states = np.asarray(states, float)[:, : exact.dimension]
     data = likelihood.data
-    together, alone = exact.misfit(np.median(states, axis=0))
+    together, alone = exact.misfit(states[int(np.argmax(exact(states)))])
     chosen = states[rng.choice(len(states), min(draws, len(states)), replace=False)]
     realized = [exact.misfit(unit) for unit in chosen]
     count, size = data.records.shape
@@ -50,8 +52,8 @@ def goodness_of_fit(likelihood, states, parameters: int, rng, draws: int = PREDI
     each = np.array([record for _, record in realized])
     return {
         "method": (
-            "the model taken as exact (no discrepancy term): chi-square at the posterior median with the "
-            "likelihood's covariance, and the posterior predictive p-value of the chi-square discrepancy"
+            "the model taken as exact (no discrepancy term): chi-square with the likelihood's covariance at "
+            "the most likely posterior draw, and the posterior predictive p-value of the chi-square discrepancy"
         ),
         "chi2": together,
         "dof": dof,

@@ -20,7 +20,7 @@ with u). Σ_K is known only to a scale λ, as K packings tell it
 (:meth:`~hexdem.calibration.spread.Spread.scale`): λ is sampled with u too, so that the records,
 independent packings, tell it further, and integrated out it gives them a joint Student-t rather
 than a Gaussian of a spread taken as known. And each record's packing deviates with a scale λ_r
-of its own, δ_r ~ N(0, λ_r Σ_K + V), λ_r inverse-gamma with shape and scale ν/2
+of its own, δ_r ~ N(0, λ_r Σ_K + V), λ_r inverse-gamma of shape ν/2 and mean 1
 (:meth:`~hexdem.calibration.spread.Spread.record_scale`), sampled with u: integrated out, each
 packing's deviation is a Student-t of ν degrees of freedom. A packing's observables are not
 Gaussian: where its pulse finds a weak path past a sensor, the sensor's peak falls 50-fold, and
@@ -30,7 +30,9 @@ D_r = Σ_r + λ_r Σ_K + V, P = Σ_r D_r⁻¹ and b = Σ_r D_r⁻¹ (y_r − μ)
 
     log p = Σ_r log N(y_r; μ, D_r) − ½ log det(I + C P) + ½ bᵀ (I + C P)⁻¹ C b,
 
-which for one record is log N(y_1; μ, Σ_1 + Σ_K + C).
+which for one record is log N(y_1; μ, Σ_1 + Σ_K + C). On disordered packings the records kept
+are those whose pulse the sensors detect, a selection: R_d log P(u) + R_u log(1 − P(u)) adds what
+the count of records detected and left out tells (:mod:`~hexdem.calibration.detection`).
 
 **Stages.** Stage 0 simulates :func:`initial_points` points of a Latin hypercube over the
 whole prior. Every later stage fits the emulator to all simulations so far, samples its posterior
@@ -50,6 +52,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import qmc
 
+from hexdem.calibration.detection import Detection
 from hexdem.calibration.emulator import Emulator
 from hexdem.calibration.nuisance import Discrepancy, Instruments
 from hexdem.calibration.sampler import Chain, sample_posterior
@@ -90,13 +93,15 @@ def stage_sizes(dimension: int, budget: int, realizations: int = 1) -> list[int]
 @dataclass(frozen=True)
 class Data:
     """The measured records' observables ``records`` (R, m), their noise covariances
-    ``covariances`` (R, m, m), the observables' ``names``, and the records' own names
-    ``record_names`` (their ``record`` column)."""
+    ``covariances`` (R, m, m), the observables' ``names``, the records' own names
+    ``record_names`` (their ``record`` column), and how many records were ``undetected`` (a sensor
+    without a pulse: left out, :mod:`~hexdem.calibration.detection`)."""
 
     records: np.ndarray
     covariances: np.ndarray
     names: tuple[str, ...]
     record_names: tuple[str, ...] = ()
+    undetected: int = 0
 
 
 class Likelihood:
@@ -111,11 +116,13 @@ class Likelihood:
         model_error=None,
         instruments: Instruments | None = None,
         discrepancy: Discrepancy | None = None,
+        detection: Detection | None = None,
     ):
         self.data, self.emulator, self.spread = data, emulator, spread
         self.model_error = 0.0 if model_error is None else np.asarray(model_error, float)
         self.instruments = instruments or Instruments(1 + data.records.shape[1] // 2)
         self.discrepancy = discrepancy
+        self.detection = detection
 
     @property
     def scaled_spread(self) -> bool:
@@ -199,6 +206,9 @@ class Likelihood:
         shrink = np.eye(mean.shape[1]) + common @ precision
         gain = np.linalg.solve(shrink, (common @ pulled[:, :, None]))[:, :, 0]
         result[inside] = total - 0.5 * np.linalg.slogdet(shrink)[1] + 0.5 * np.einsum("ki,ki->k", pulled, gain)
+        if self.detection is not None:
+            parameters = unit[inside, : self.emulator.x.shape[1]]
+            result[inside] += self.detection.log_likelihood(parameters, len(self.data.records), self.data.undetected)
         return result
 
     def log_gains(self, unit) -> tuple[np.ndarray, np.ndarray]:
@@ -217,7 +227,9 @@ class Likelihood:
     def without_discrepancy(self) -> Likelihood:
         """This likelihood with the model taken as exact: no :class:`~hexdem.calibration.nuisance.Discrepancy`,
         its coordinates those of this one less τ's (the last), the others' the same."""
-        return Likelihood(self.data, self.emulator, self.spread, self.model_error, self.instruments)
+        return Likelihood(
+            self.data, self.emulator, self.spread, self.model_error, self.instruments, detection=self.detection
+        )
 
     def misfit(self, unit) -> tuple[float, list[float]]:
         """(χ² of all the records together, [χ² of each record]) at the sampler's point ``unit``
@@ -316,7 +328,8 @@ def fit_stage(
         smooth=smooth,
     )
     spread = Spread(points, observables, *records_scatter(data, instruments), smooth=smooth)
-    likelihood = Likelihood(data, emulator, spread, model_error, instruments, discrepancy)
+    detection = Detection(points, observables, smooth) if observables.shape[1] >= 2 else None
+    likelihood = Likelihood(data, emulator, spread, model_error, instruments, discrepancy, detection)
     states, chain = sample_posterior(likelihood, likelihood.dimension, seed, chains)
     return Fit(points, observables, emulator, spread, states, likelihood, chain)
 

@@ -17,10 +17,12 @@ the K packings, change smoothly with σ, which is what the emulator interpolates
 draws at every σ would add the spread between packings as noise between neighbouring parameter
 sets.
 
-**σ levels.** The σ of every simulated parameter set is one of :data:`SIGMA_LEVELS` values, the
-centres of equal-probability bins of its prior (:func:`on_sigma_levels`): the inference's
-design and posterior draws are moved to the nearest, so that parameter sets share their
-packings. The emulator is fitted at the values simulated, and interpolates between the levels.
+**σ levels.** The σ of every simulated parameter set is one of :data:`SIGMA_LEVELS` values, evenly
+spaced in its prior's probability from its lower end to its upper end (:func:`on_sigma_levels`):
+the inference's design and posterior draws are moved to the nearest, so that parameter sets share
+their packings. The prior's ends are levels, so that the emulators interpolate between simulated
+σ and never extrapolate past them; a prior from 0 simulates the ideal lattice, where every packing
+is alike.
 
 **Cache.** A preparation depends on the lattice (its shape and size, its nominal diameters),
 the beads' and walls' materials, the sensor beads' masses, the diameters (σ, k, the seed), the
@@ -82,11 +84,11 @@ def deviates(seed: int, realization: int, n_beads: int) -> np.ndarray:
 
 
 def on_sigma_levels(unit_points, column: int) -> np.ndarray:
-    """``unit_points`` with their σ coordinate (``column``) moved to the centre of its bin of
-    :data:`SIGMA_LEVELS` equal-probability bins."""
+    """``unit_points`` with their σ coordinate (``column``) moved to the nearest of
+    :data:`SIGMA_LEVELS` levels evenly spaced in probability from the prior's lower end to its upper
+    end (unit coordinates i / (SIGMA_LEVELS − 1))."""
     points = np.array(unit_points, float)
-    bins = np.minimum(np.floor(points[:, column] * SIGMA_LEVELS), SIGMA_LEVELS - 1)
-    points[:, column] = (bins + 0.5) / SIGMA_LEVELS
+    points[:, column] = np.round(points[:, column] * (SIGMA_LEVELS - 1)) / (SIGMA_LEVELS - 1)
     return points
 
 

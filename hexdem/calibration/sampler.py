@@ -139,7 +139,9 @@ def sample_posterior(log_probability, dimension: int, seed: int, chains: int = C
     tau = _largest_tau(ensembles)
     for _ in range(EXTENSIONS):
         done = ensembles[0][0].iteration
-        wanted = min(int(np.ceil(EXTENSION_MARGIN * AUTOCORRELATION_LENGTHS * np.max(tau))), MOST_KEPT * kept)
+        wanted = min(
+            THIN * int(np.ceil(EXTENSION_MARGIN * AUTOCORRELATION_LENGTHS * np.max(tau) / THIN)), MOST_KEPT * kept
+        )
         if done >= AUTOCORRELATION_LENGTHS * np.max(tau) or wanted <= done:
             break
         states = [sampler.run_mcmc(state, wanted - done) for (sampler, _), state in zip(ensembles, states)]
