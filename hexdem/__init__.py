@@ -11,7 +11,8 @@ Hexagonal Granular Crystal Lattices". The subpackages follow the data flow:
 
 The Python API (:mod:`hexdem.api`) is available here and imported on first use, so that
 ``import hexdem`` stays light: ``hexdem.RunConfig``, ``hexdem.simulate_impact``,
-``hexdem.tca``, ``hexdem.SweepSettings``, ``hexdem.scaling_laws``.
+``hexdem.tca``, ``hexdem.SweepSettings``, ``hexdem.scaling_laws``, ``hexdem.calibrate`` and its
+``hexdem.Posterior``.
 """
 
 import os
@@ -25,7 +26,17 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 from hexdem.errors import HexdemError  # noqa: E402
 
-_API = ("RunConfig", "ImpactResult", "LineResult", "simulate_impact", "tca", "SweepSettings", "scaling_laws")
+_API = (
+    "RunConfig",
+    "ImpactResult",
+    "LineResult",
+    "simulate_impact",
+    "tca",
+    "SweepSettings",
+    "scaling_laws",
+    "Posterior",
+    "calibrate",
+)
 __all__ = ["HexdemError", *_API]
 
 

@@ -5,14 +5,19 @@
   time along each observation line, energy drift), writing files only if asked;
 * :func:`tca` — ω and c of the ternary collision approximation (Sec. IV);
 * :class:`SweepSettings` and :func:`scaling_laws` — the V₀ sweep of Sec. V and the fitted
-  laws (9), (10), (11) of the four strike/observation combinations.
+  laws (9), (10), (11) of the four strike/observation combinations;
+* :func:`calibrate` and :class:`Posterior` — the model's parameters from a lab's sensor records
+  (``hexdem calibrate``), the posterior's draws, intervals, fit and diagnostics, and the posterior
+  as an ArviZ ``DataTree`` (:meth:`Posterior.to_inference_data`).
 """
 
 from __future__ import annotations
 
+import json
 import sys
 import tempfile
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -24,7 +29,17 @@ from hexdem.theory import tca as _tca
 from hexdem.theory.scaling import COMBINATIONS, CombinationFit
 from hexdem.theory.sweep import SweepSettings, run_sweep
 
-__all__ = ["RunConfig", "ImpactResult", "LineResult", "simulate_impact", "tca", "SweepSettings", "scaling_laws"]
+__all__ = [
+    "RunConfig",
+    "ImpactResult",
+    "LineResult",
+    "simulate_impact",
+    "tca",
+    "SweepSettings",
+    "scaling_laws",
+    "Posterior",
+    "calibrate",
+]
 
 
 @dataclass(frozen=True)
@@ -173,3 +188,178 @@ def scaling_laws(
     """
     sweep = run_sweep(settings or SweepSettings(), log=lambda message: None)
     return {name: sweep.fit(combination, last, kind) for name, combination in COMBINATIONS.items()}
+
+
+@dataclass(frozen=True)
+class Posterior:
+    """What :func:`calibrate` returns: the posterior of the calibrated keys, as ``hexdem calibrate``
+    writes it into its folder (``posterior.csv`` and ``calibration.json``).
+
+    Attributes
+    ----------
+    keys : tuple of str
+        The calibrated keys, in the order of the priors.
+    samples : numpy.ndarray of float, shape (n, p)
+        The posterior's draws of the keys, in their units (σ in m, V₀ in m/s), ``chains`` blocks of
+        equal length one after the other.
+    chains : int
+        The sampler's independent chains.
+    summary : dict
+        ``calibration.json``: per key its prior, median and 90 % interval, ``fit``, ``convergence``,
+        ``model_discrepancy``, ``warnings`` and the rest (the calibration guide lists them).
+    folder : pathlib.Path
+        The calibration's folder.
+    """
+
+    keys: tuple[str, ...]
+    samples: np.ndarray
+    chains: int
+    summary: dict
+    folder: Path
+
+    @classmethod
+    def read(cls, folder) -> Posterior:
+        """The posterior of the finished calibration in ``folder``.
+
+        Parameters
+        ----------
+        folder : str or pathlib.Path
+            The ``--out`` of ``hexdem calibrate``.
+
+        Returns
+        -------
+        Posterior
+        """
+        folder = Path(folder)
+        summary = json.loads((folder / "calibration.json").read_text())
+        samples = np.loadtxt(folder / "posterior.csv", delimiter=",", skiprows=1, ndmin=2)
+        return cls(tuple(summary["parameters"]), samples, int(summary["method"]["chains"]), summary, folder)
+
+    @property
+    def intervals(self) -> dict[str, tuple[float, float]]:
+        """Each key's 90 % central interval (5 % and 95 % quantiles), in its unit."""
+        return {key: (entry["q05"], entry["q95"]) for key, entry in self.summary["parameters"].items()}
+
+    @property
+    def medians(self) -> dict[str, float]:
+        """Each key's posterior median, in its unit."""
+        return {key: entry["median"] for key, entry in self.summary["parameters"].items()}
+
+    @property
+    def fit(self) -> dict:
+        """Whether the model fits the records: ``chi2``, ``dof``, ``p_value``, ``predictive_p_value``, per record."""
+        return self.summary["fit"]
+
+    @property
+    def convergence(self) -> dict:
+        """How the chains mixed: ``rhat``, ``ess_bulk``, ``ess_tail``, ``autocorrelation_lengths``, ``converged``."""
+        return self.summary["convergence"]
+
+    @property
+    def warnings(self) -> list[str]:
+        """What the calibration says not to trust, one sentence each (empty when all checks pass)."""
+        return self.summary["warnings"]
+
+    def to_inference_data(self):
+        """The posterior as ArviZ's ``DataTree`` (the successor of ``InferenceData``).
+
+        Returns
+        -------
+        xarray.DataTree
+            A ``posterior`` group with one variable per key, of dimensions (chain, draw), so that
+            ArviZ's diagnostics and plots (and ``.to_netcdf(PATH)``) work on it.
+
+        Raises
+        ------
+        ImportError
+            Without ArviZ's base package: ``pip install 'hexdem[arviz]'``.
+        """
+        import arviz_base
+
+        draws = self.samples.reshape(self.chains, -1, len(self.keys))
+        posterior = {key: draws[:, :, j] for j, key in enumerate(self.keys)}
+        return arviz_base.from_dict(
+            {"posterior": posterior}, attrs={"posterior": {"hexdem_calibration": str(self.folder)}}
+        )
+
+
+def calibrate(
+    measured,
+    priors,
+    out,
+    config=None,
+    *,
+    budget: int | None = None,
+    seed: int = 0,
+    realizations: int | None = None,
+    sensor_gain_sd: float | None = None,
+    speed_scatter: float | None = None,
+    acceleration_unit: str = "m/s2",
+    model_discrepancy: bool = True,
+    workers: int = 1,
+    verbose: bool = False,
+) -> Posterior:
+    """Calibrate the model's parameters from measured sensor records, as ``hexdem calibrate`` does.
+
+    Spawns worker processes with ``workers`` > 1: call it under ``if __name__ == "__main__":`` in scripts.
+
+    Parameters
+    ----------
+    measured : str or pathlib.Path
+        The records: a CSV of columns ``sensor,time,ax[,ay][,record]`` (times in s).
+    priors : list of str
+        One ``KEY=DIST`` per calibrated key, e.g. ``"restitution=uniform(0.8, 1.0)"``,
+        ``"diameter_sigma_m=uniform(0, 1.5e-4)"`` (σ of the diameters [m]: disordered packings).
+    out : str or pathlib.Path
+        The calibration's folder; calling again with the same arguments resumes it.
+    config : str, pathlib.Path or dict, optional
+        The base configuration: a TOML file, or its keys (default: the paper's experiment); its
+        ``sensors`` are the measured ones.
+    budget : int, optional
+        Simulations in all (default: (30 per key + 30) × the packings per parameter set).
+    seed : int, default 0
+        Every random choice: the same seed, records and simulations give the same posterior.
+    realizations : int, optional
+        Packings per parameter set (default: 8 with a prior on ``diameter_sigma_m``, else 1).
+    sensor_gain_sd, speed_scatter : float, optional
+        The sensors' gains' and the striker's speed's relative standard deviations (defaults 0.02
+        and 0.01, as the command's).
+    acceleration_unit : {"m/s2", "g"}, default "m/s2"
+        The records' unit.
+    model_discrepancy : bool, default True
+        Sample a relative model error τ with the parameters (Kennedy & O'Hagan's discrepancy).
+    workers : int, default 1
+        Simulations at once.
+    verbose : bool, default False
+        Print progress to standard error.
+
+    Returns
+    -------
+    Posterior
+        Its draws, intervals, fit, convergence and warnings.
+
+    Raises
+    ------
+    hexdem.errors.HexdemError
+        Input the command refuses (a prior, a record, a budget), before any simulation.
+    """
+    from hexdem.calibration.study import DEFAULT_GAIN_SD, DEFAULT_SPEED_SCATTER, prepare
+    from hexdem.calibration.study import calibrate as run_calibration
+    from hexdem.experiments.sweep_plan import read_base
+
+    base = dict(config) if isinstance(config, dict) else read_base(None if config is None else str(config))
+    calibration = prepare(
+        base,
+        measured,
+        list(priors),
+        budget,
+        seed,
+        realizations,
+        DEFAULT_GAIN_SD if sensor_gain_sd is None else sensor_gain_sd,
+        DEFAULT_SPEED_SCATTER if speed_scatter is None else speed_scatter,
+        acceleration_unit,
+        model_discrepancy,
+    )
+    log = (lambda message: sys.stderr.write(f"hexdem: {message}\n")) if verbose else (lambda message: None)
+    run_calibration(calibration, measured, out, workers, None, log)
+    return Posterior.read(out)
