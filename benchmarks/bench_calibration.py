@@ -12,7 +12,11 @@ from the prior, make a record of it, calibrate, and take the rank of θ among L 
 posterior. A calibration whose posteriors are right gives ranks uniform on 0..L, whatever the
 truth, and central intervals that hold θ as often as they claim. The table gives, per key, the
 coverage of the 50 % and 90 % central intervals with the binomial 95 % band of the number of
-truths, and the rank histogram with the χ² test of its uniformity.
+truths, and the rank histogram with the χ² test of its uniformity; then each key's rank ECDF against
+its simultaneous 95 % band (Säilynoja, Bürkner & Vehtari 2022), the expected coverage of the joint
+posterior over every credibility level (TARP, Lemos et al. 2023) against the same band, the band's
+power at this many truths (the under-coverage it would see), and how many intervals missed their
+truth with no warning from the calibration (:mod:`hexdem.calibration.coverage`).
 
 **The records differ from the calibration's runs as a lab's do.** Each record is made at twice the
 calibration's time resolution, sampled at 500 kS/s after a 100 µs lead-in, with a clock offset
@@ -71,6 +75,7 @@ from pathlib import Path
 import numpy as np
 from machine import describe
 
+from hexdem.calibration import coverage
 from hexdem.calibration.nuisance import Discrepancy
 from hexdem.calibration.packings import DISORDER_REALIZATIONS, SIGMA_KEY
 from hexdem.calibration.priors import Prior, to_parameters
@@ -287,7 +292,7 @@ def main() -> None:
     )
     print("|---" * (1 + 3 * len(priors) + 5) + "|")
     ranks, inside = {p.key: [] for p in priors}, {(p.key, level): 0 for p in priors for level in (0.5, 0.9)}
-    refused = []
+    refused, unit_draws, unit_truths, silent = [], [], [], []
     for t in range(truths):
         folder = root / f"truth-{t}"
         folder.mkdir(parents=True, exist_ok=True)
@@ -312,6 +317,8 @@ def main() -> None:
         seconds = time.perf_counter() - start
         samples = np.loadtxt(folder / "calibration" / "posterior.csv", delimiter=",", skiprows=1, ndmin=2)
         draws = samples[np.random.default_rng(t).choice(len(samples), RANK_DRAWS, replace=False)]
+        unit_draws.append(np.column_stack([prior.to_unit(draws[:, j]) for j, prior in enumerate(priors)]))
+        unit_truths.append([prior.to_unit(truth[j]) for j, prior in enumerate(priors)])
         cells = []
         for j, prior in enumerate(priors):
             rank = int(np.sum(draws[:, j] < truth[j]))
@@ -321,6 +328,8 @@ def main() -> None:
                 inside[(prior.key, level)] += bool(low <= truth[j] <= high)
             q05, q95 = np.quantile(samples[:, j], [0.05, 0.95])
             held = "" if q05 <= truth[j] <= q95 else " MISSED"
+            if held and not summary["warnings"]:
+                silent.append((t, prior.key))
             cells.append(f"{truth[j]:.6g} | [{q05:.6g}, {q95:.6g}]{held} | {rank}")
         print(
             f"| {t} | " + " | ".join(cells) + f" | {tau:.2g} | {len(calibration.data.records)} of {args.records} | "
@@ -346,6 +355,36 @@ def main() -> None:
             cells.append(f"{inside[(prior.key, level)] / truths:.2f} | [{low:.2f}, {high:.2f}]")
         counts, p_value = rank_histogram(ranks[prior.key], bins)
         print(f"| {prior.key} | " + " | ".join(cells) + f" | {' '.join(map(str, counts))} | {p_value:.2f} |")
+    coverage_checks(priors, ranks, np.array(unit_draws), np.array(unit_truths), args.seed)
+    print(
+        f"\nmissed in silence (a 90 % interval missing its truth, no warning): {len(silent)} of "
+        f"{truths * len(priors)} intervals ({', '.join(f'truth {t} {key}' for t, key in silent) or 'none'})"
+    )
+
+
+def coverage_checks(priors, ranks: dict, unit_draws, unit_truths, seed: int) -> None:
+    """Each key's rank ECDF against its simultaneous 95 % band, TARP's expected coverage of the joint
+    posterior against the same band, and the band's power at this many truths
+    (:mod:`hexdem.calibration.coverage`)."""
+    count = len(unit_truths)
+    band = coverage.ecdf_band(count, seed=seed)
+    jitter = np.random.default_rng(seed).random(count)
+    print("\n| check | statistic | inside its simultaneous 95 % band |")
+    print("|---|---|---|")
+    for prior in priors:
+        fractions = (np.array(ranks[prior.key]) + jitter) / (RANK_DRAWS + 1)
+        inside = not coverage.outside_band(fractions, band)
+        print(f"| rank ECDF of {prior.key} | {count} truths | {'yes' if inside else 'NO'} |")
+    references = np.random.default_rng(seed + 1).random(unit_truths.shape)
+    _, _, area, shares = coverage.tarp(unit_draws, unit_truths, references)
+    inside = not coverage.outside_band(shares, band)
+    print(f"| TARP, every key at once | area to the diagonal {area:+.3f} | {'yes' if inside else 'NO'} |")
+    for scale in (0.7, 0.8):
+        print(
+            f"power at {count} truths: a posterior {scale} times too narrow (its 90 % intervals covering "
+            f"{coverage.central_coverage(scale):.2f}) leaves the band with probability "
+            f"{coverage.ecdf_power(count, scale, seed=seed):.2f}"
+        )
 
 
 if __name__ == "__main__":

@@ -26,6 +26,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 from hexdem.errors import HexdemError  # noqa: E402
 
+#: The names of :mod:`hexdem.api`, imported on first use (its ``__all__``).
 _API = (
     "RunConfig",
     "ImpactResult",

@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from hexdem import _API
 from hexdem.analysis.impact import ImpactAnalysis
 from hexdem.experiments.run import run_experiment, simulate
 from hexdem.model.config import RunConfig
@@ -29,17 +30,7 @@ from hexdem.theory import tca as _tca
 from hexdem.theory.scaling import COMBINATIONS, CombinationFit
 from hexdem.theory.sweep import SweepSettings, run_sweep
 
-__all__ = [
-    "RunConfig",
-    "ImpactResult",
-    "LineResult",
-    "simulate_impact",
-    "tca",
-    "SweepSettings",
-    "scaling_laws",
-    "Posterior",
-    "calibrate",
-]
+__all__ = list(_API)
 
 
 @dataclass(frozen=True)

@@ -18,7 +18,7 @@ from scipy.stats import qmc
 from hexdem.calibration import diagnostics, inference, nuisance, sampler
 from hexdem.calibration.emulator import Emulator
 from hexdem.calibration.observables import FOOT_SAMPLES, Record, lead_in, noise_covariance, reduce_record
-from hexdem.calibration.packings import SIGMA_LEVELS, preparation_of, settled_packing
+from hexdem.calibration.packings import SIGMA_LEVELS, on_sigma_levels, preparation_of, settled_packing
 from hexdem.calibration.priors import NORMAL_TAIL, Prior
 from hexdem.calibration.report import summarize
 from hexdem.calibration.simulations import Problem, simulate_point
@@ -135,8 +135,9 @@ class _Fixed:
 
 
 def test_the_likelihood_is_the_joint_gaussian_of_records_that_share_the_emulators_error():
-    """Records y_r = μ + e + δ_r + ε_r with e ~ N(0, diag s² + Σ_K/K) common to all and
-    δ_r ~ N(0, λ_r Σ_K): the stacked records are N(1 ⊗ μ, blockdiag(Σ_r + λ_r Σ_K) + 11ᵀ ⊗ C),
+    """Records y_r = μ + e + δ_r + ε_r with e ~ N(0, diag s² + (π/2) Σ_K/K) common to all (the
+    error of the median of K packings) and δ_r ~ N(0, λ_r Σ_K): the stacked records are
+    N(1 ⊗ μ, blockdiag(Σ_r + λ_r Σ_K) + 11ᵀ ⊗ C),
     whose density the likelihood must be (up to the constant −(R m / 2) log 2π that it leaves out),
     each record's λ_r at its own coordinate after the spread's scale."""
     rng = np.random.default_rng(2)
@@ -151,7 +152,7 @@ def test_the_likelihood_is_the_joint_gaussian_of_records_that_share_the_emulator
         _Fixed(mean, variance, spread, k),
         _Fixed(mean, variance, spread, k),
     )
-    common = np.diag(variance) + spread / k
+    common = np.diag(variance) + np.pi / 2 * spread / k
     coordinates = np.array([0.0, 0.25, 0.5, 1.0])
     scales = 1 + 4 * coordinates
     joint = np.kron(np.ones((r, r)), common)
@@ -172,7 +173,8 @@ def test_the_likelihood_is_the_joint_gaussian_of_records_that_share_the_emulator
 
 def test_each_records_predictive_residual_is_in_units_of_its_own_spread():
     """predictive.png's residuals: record r's observables against N(μ, Σ_r + C + λ_r Σ_K), its packing's
-    scale λ_r = 1 + 4 u_r at its coordinate; the draws all at one point, so (y_r − μ) / √diag of that
+    scale λ_r = 1 + 4 u_r at its coordinate (C with the error (π/2) Σ_K/K of the median of K
+    packings); the draws all at one point, so (y_r − μ) / √diag of that
     covariance, to the sampling error of 4000 draws (about 1 % of the standard deviation, 2 % of the
     median)."""
     rng = np.random.default_rng(3)
@@ -187,7 +189,7 @@ def test_each_records_predictive_residual_is_in_units_of_its_own_spread():
     draws = np.tile(np.r_[0.5, 0.5, coordinates], (4000, 1))
     residuals = diagnostics.predictive_residuals(likelihood, draws, np.random.default_rng(4))
     for i, scale in enumerate(1 + 4 * coordinates):
-        sd = np.sqrt(np.diag(covariances[i] + np.diag(variance) + spread / k + scale * spread))
+        sd = np.sqrt(np.diag(covariances[i] + np.diag(variance) + np.pi / 2 * spread / k + scale * spread))
         assert residuals[i] == pytest.approx((records[i] - mean) / sd, abs=0.05)
 
 
@@ -292,6 +294,33 @@ def test_the_spread_between_packings_follows_the_parameters():
     shrink = (k - 1) / (k - 1 + max(3 - (k - 1), 1))
     assert spread.correlation[0, 1] == pytest.approx(shrink * rho, abs=shrink * 4 * (1 - rho**2) / np.sqrt(n * (k - 1)))
     assert Spread(points, observables[:, :1])(test) == pytest.approx(0.0)
+
+
+def test_the_ideal_lattice_tells_neither_centre_nor_spread_and_sigma_is_never_extrapolated():
+    """Sets on σ's 10 levels from 0: at σ = 0 every packing is the ideal lattice (observables all 0),
+    above it the packings differ about a centre 1 that does not move with σ (the paper's hexagon).
+    The ideal lattice's sets enter neither emulator, and below the lowest disordered level (1/9 of
+    the prior) the centre and the spread are that level's, 1 and 0.3 within the sampling error of
+    the sets' medians and robust scales, not a trend run down to the ideal lattice's 0."""
+    from hexdem.calibration.spread import disordered_range, packing_centres, robust_sd
+
+    rng = np.random.default_rng(9)
+    points = on_sigma_levels(inference.design(1, 60, seed=2), 0)
+    observables = 1.0 + 0.3 * rng.standard_normal((60, 8, 2))
+    observables[points[:, 0] == 0] = 0.0
+    sd = robust_sd(observables, np.ones((60, 8), bool))
+    held = disordered_range(points, sd, (0,))
+    assert held[0][0] == pytest.approx(1 / 9) and held[1][0] == pytest.approx(1.0)
+    differ = np.any(sd > 0, axis=1)
+    assert (~differ).sum() == np.sum(points[:, 0] == 0) > 0
+    centre = Emulator(points[differ], packing_centres(observables[differ]), smooth=(0,), held=held)
+    spread = Spread(points, observables, smooth=(0,))
+    for emulated, truth in (
+        (centre.predict([[0.0], [0.05]])[0], 1.0),
+        (np.sqrt(np.diagonal(spread([[0.0]]), axis1=1, axis2=2)), 0.3),
+    ):
+        assert emulated == pytest.approx(truth, rel=0.25)
+    assert centre.predict([[0.0]])[0] == pytest.approx(centre.predict([[1 / 9]])[0], rel=1e-12)
 
 
 def test_packings_without_a_detected_pulse_are_left_out_of_the_spread():
@@ -1091,3 +1120,33 @@ def test_the_spread_between_packings_is_known_to_a_scale_that_k_packings_leave_o
     assert inference.Likelihood(data, emulator, spread).dimension == 4
     assert inference.Likelihood(data, emulator, spread, discrepancy=nuisance.Discrepancy(2)).dimension == 5
     assert inference.Likelihood(data, emulator, Spread(points, observables[:, :1])).dimension == 1
+
+
+def test_the_rank_ecdf_band_holds_calibrated_posteriors_and_sees_narrow_ones():
+    """The simultaneous 95 % band of 100 truths' rank ECDF: a conjugate normal posterior (prior
+    N(0.5, 0.1²), a measurement of sd 0.03) stays inside it in about 95 of 100 studies (binomial 95 %
+    band [89, 99]); one 0.7 times too narrow (its 90 % intervals covering 0.75) leaves it in most, as
+    the band's stated power says (0.93, Monte Carlo); TARP's shares, uniform for the calibrated
+    posterior, sit inside the same band as often, and the narrow posterior's leave it."""
+    from hexdem.calibration import coverage
+
+    assert coverage.central_coverage(1.0) == pytest.approx(0.9)
+    assert coverage.central_coverage(0.7) == pytest.approx(0.75, abs=0.005)
+    count, draws_each = 100, 200
+    band = coverage.ecdf_band(count)
+    rng = np.random.default_rng(8)
+    variance = 1 / (1 / 0.1**2 + 1 / 0.03**2)
+    outside = {1.0: [0, 0], 0.7: [0, 0]}
+    for _ in range(100):
+        truths = 0.5 + 0.1 * rng.standard_normal((count, 2))
+        measured = truths + 0.03 * rng.standard_normal((count, 2))
+        centre = variance * (0.5 / 0.1**2 + measured / 0.03**2)
+        for scale in outside:
+            draws = centre[:, None, :] + scale * np.sqrt(variance) * rng.standard_normal((count, draws_each, 2))
+            ranks = coverage.fractional_ranks(draws[:, :, 0], truths[:, 0])
+            shares = coverage.tarp(draws, truths, 0.5 + 0.1 * rng.standard_normal((count, 2)))[3]
+            outside[scale][0] += coverage.outside_band(ranks, band)
+            outside[scale][1] += coverage.outside_band(shares, band)
+    assert all(1 <= count_ <= 11 for count_ in outside[1.0]), outside
+    assert all(count_ >= 80 for count_ in outside[0.7]), outside
+    assert coverage.ecdf_power(count, 0.7) == pytest.approx(0.93, abs=0.05)

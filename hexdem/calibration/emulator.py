@@ -96,10 +96,12 @@ class Emulator:
     residuals' variance): small for simulations that are smooth in the parameters, larger for
     noisy outputs; ``smooth`` the dimensions along which the response is taken as smooth over the
     whole prior (lengths of at least :data:`SMOOTH_LENGTH`), its wiggles from one simulated value
-    to the next left to the nugget."""
+    to the next left to the nugget; ``held``, (lowest (p,), highest (p,)): each predicted point is
+    moved inside them first, so that the response is held at its ends rather than extrapolated."""
 
-    def __init__(self, x, y, nugget_max: float = 0.1, smooth=()):
+    def __init__(self, x, y, nugget_max: float = 0.1, smooth=(), held=None):
         x, y = np.asarray(x, float), np.asarray(y, float)
+        self.held = held
         shortest = np.full(x.shape[1], np.exp(LOG_BOUNDS["length"][0]))
         shortest[list(smooth)] = SMOOTH_LENGTH
         processes = [_Process(x, y[:, j], nugget_max, shortest) for j in range(y.shape[1])]
@@ -122,6 +124,8 @@ class Emulator:
         """(mean (k, m), variance (k, m)) of the observables at unit-cube points ``xs`` (k, p): every
         observable's correlations from one table of squared distances."""
         xs = np.atleast_2d(np.asarray(xs, float))
+        if self.held is not None:
+            xs = np.clip(xs, *self.held)
         squared = (xs[:, None, :] - self.x[None, :, :]) ** 2  # (k, n, p)
         correlation = matern52_of_distance(np.sqrt(squared @ self.inverse_squared_lengths.T))  # (k, n, m)
         mean = _design(xs) @ self.beta + self.scale * np.einsum("knm,nm->km", correlation, self.weights)

@@ -6,13 +6,13 @@ is p(u | data) ∝ p(y_1, …, y_R | u) on [0, 1]^p, the records y_r
 
     y_r = μ(u) + e + δ_r + ε_r,   e ~ N(0, C(u)),  δ_r ~ N(0, λ_r Σ_K(u) + V(u)),  ε_r ~ N(0, Σ_r):
 
-μ(u) the emulated mean of the model's observables over the K packings simulated at u
+μ(u) the emulated centre (median) of the model's observables over the K packings simulated at u
 (:mod:`~hexdem.calibration.emulator`); ε_r record r's accelerometer noise; δ_r its packing's
 deviation from the mean, Σ_K(u) the spread between packings (:mod:`~hexdem.calibration.spread`;
 zero on the ideal lattice), and its striker's speed off the calibrated one, V(u)
 (:class:`~hexdem.calibration.nuisance.Instruments`), independent between records, each record
 being one packing and one strike; and e the error common to every record: the emulator's
-variance s²(u), Σ_K(u)/K, for a mean over K packings is not the mean over all, each sensor's
+variance s²(u), Σ_K(u) (π/2)/K, for a median over K packings is not the centre of all, each sensor's
 gain, the same in all its records (:class:`~hexdem.calibration.nuisance.Instruments`), and what
 the model cannot represent, a discrepancy of relative size τ
 (:class:`~hexdem.calibration.nuisance.Discrepancy`, Kennedy & O'Hagan's δ, whose τ is sampled
@@ -56,7 +56,14 @@ from hexdem.calibration.detection import Detection
 from hexdem.calibration.emulator import Emulator
 from hexdem.calibration.nuisance import Discrepancy, Instruments
 from hexdem.calibration.sampler import Chain, sample_posterior
-from hexdem.calibration.spread import NOISY_NUGGET, Spread
+from hexdem.calibration.spread import (
+    MEDIAN_VARIANCE,
+    NOISY_NUGGET,
+    Spread,
+    disordered_range,
+    packing_centres,
+    robust_sd,
+)
 from hexdem.errors import HexdemError
 
 
@@ -153,7 +160,7 @@ class Likelihood:
             spread = spread * self.spread.scale(unit[:, count])[:, None, None]
         common = (
             variance[:, :, None] * np.eye(mean.shape[1])
-            + spread / self.spread.realizations
+            + spread * MEDIAN_VARIANCE / self.spread.realizations
             + self.model_error
             + self.instruments.common()
         )
@@ -302,12 +309,15 @@ def fit_stage(
     chains: int = 1,
 ) -> Fit:
     """Fit the emulator to the simulations and sample the posterior it implies: the emulator to each
-    parameter set's mean over its packings whose pulse the sensors detect (the others' observables are
-    NaN, :func:`~hexdem.calibration.simulations.detected`), the spread to their deviations; both
+    parameter set's centre over its packings whose pulse the sensors detect (their median,
+    :func:`~hexdem.calibration.spread.packing_centres`; the others' observables are NaN,
+    :func:`~hexdem.calibration.simulations.detected`), the spread to their deviations; both
     smooth over the whole prior along the dimensions ``smooth`` (σ's: every set at one σ strikes the same
-    K packings, whose contact networks change at a few σ, so that the K packings' mean and spread
+    K packings, whose contact networks change at a few σ, so that the K packings' centre and spread
     jump from one σ to the next by their sampling error; the nugget takes the jumps, and the
-    likelihood's Σ_K/K their size) (``model_error``:
+    likelihood's Σ_K/K their size), and held at the σ simulated with packings that differ
+    (:func:`~hexdem.calibration.spread.disordered_range`: the ideal lattice's sets, σ = 0, enter
+    neither) (``model_error``:
     the covariance of the model's own integration error, :func:`step_error`; ``instruments``: the
     records' gains and speed scatter; ``discrepancy``: what the model cannot represent; ``chains``:
     the sampler's independent ensembles, several for the posterior reported, whose convergence they
@@ -321,13 +331,20 @@ def fit_stage(
             f"{seen.sum()} of {len(points)} simulated parameter sets: too few to calibrate (a sensor the pulse "
             "seldom reaches, or records noisier than its pulse)"
         )
+    spread = Spread(points, observables, *records_scatter(data, instruments), smooth=smooth)
+    told = detected > 0
+    held = None
+    if observables.shape[1] >= 2:
+        sd = robust_sd(observables, np.isfinite(observables[..., 0]))
+        held = disordered_range(points, sd, smooth)
+        told &= np.any(sd > 0, axis=1) if held is not None else True
     emulator = Emulator(
-        points[detected > 0],
-        np.nanmean(observables[detected > 0], axis=1),
+        points[told],
+        packing_centres(observables[told]),
         nugget_max=NOISY_NUGGET if smooth else 0.1,
         smooth=smooth,
+        held=held,
     )
-    spread = Spread(points, observables, *records_scatter(data, instruments), smooth=smooth)
     detection = Detection(points, observables, smooth) if observables.shape[1] >= 2 else None
     likelihood = Likelihood(data, emulator, spread, model_error, instruments, discrepancy, detection)
     states, chain = sample_posterior(likelihood, likelihood.dimension, seed, chains)

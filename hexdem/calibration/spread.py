@@ -29,10 +29,16 @@ a record whose pulse took another path costs the same few nats at every paramete
 pulling the parameters to where an emulated spread swollen by the other path is widest.
 
 **σ levels from the prior's lower bound.** At σ = 0 every packing is the ideal lattice, and the
-spread is zero; past a few 0.1 µm it is set by the deviates' signs and no longer grows. Sets whose
-packings all agree tell no spread and are left out of s's emulator, and along σ s is never
-extrapolated (:meth:`Spread._sd`): below the lowest σ simulated with a spread it is that σ's, not
-a trend run down to zero, which the records' own scatter would make impossible.
+spread is zero; past a few 0.1 µm (the compaction's overlaps) which neighbours touch is set by the
+deviates' signs, and neither the packings' centre nor their spread moves with σ beyond the
+sampling error of K packings (on the paper's hexagon: the relative arrivals 144, 298, 459 µs at
+σ = 0, then 169-174, 373-463, 562-604 µs at every level from 13 to 120 µm, without a trend). A
+jump that sits within a few 0.1 µm of 0 cannot be emulated by a response smooth in σ, which would
+spread it over the whole prior and read an offset of the records' own packings as σ. So sets whose
+packings all agree (σ = 0) tell neither centre nor spread, and along σ both emulators are held at
+the lowest and highest σ simulated with packings that differ (:func:`disordered_range`), never
+extrapolated: below the lowest disordered level the model is that level's, not a trend run down
+to the ideal lattice.
 
 **What K packings cannot tell.** Every parameter set is simulated on the same K packings, so the
 robust scales share one error: their scale is known from K − 1 degrees of freedom only, to some
@@ -56,6 +62,9 @@ NOISY_NUGGET = 10.0
 #: tail heavy enough for a packing whose pulse takes a weak path (a deviation of 15 standard deviations
 #: costs 10 in log density where a Gaussian's costs 112), with a finite variance.
 RECORD_TAIL_DOF = 4
+#: The variance of the median of K normal values over that of one, times K (2/π is its efficiency):
+#: the error of the K packings' centre, common to every record, Σ_K · MEDIAN_VARIANCE / K.
+MEDIAN_VARIANCE = np.pi / 2
 #: Standard deviations between packings are floored here (observables are of order one): a
 #: parameter set whose packings agree exactly (σ = 0) keeps a spread of full rank.
 SD_FLOOR = 1e-9
@@ -79,6 +88,28 @@ def robust_sd(values, valid) -> np.ndarray:
     counts = valid.sum(axis=1)
     factors = np.array([MAD_SMALL_SAMPLE.get(int(k), k / (k - 0.8)) for k in counts])
     return MAD_NORMAL * factors[:, None] * np.nanmedian(deviation, axis=1)
+
+
+def packing_centres(observables) -> np.ndarray:
+    """Each parameter set's centre (n, m) over its packings whose pulse the sensors detect
+    (``observables`` (n, K, m), NaN where not): the median, the main path's, which one packing that
+    took another path moves by at most one rank where it moves the mean by 1/K of the paths'
+    difference (40 µs between two σ levels of the paper's hexagon); one packing's own observables."""
+    return np.nanmedian(observables, axis=1)
+
+
+def disordered_range(points, sd, smooth) -> tuple[np.ndarray, np.ndarray] | None:
+    """(lowest (p,), highest (p,)) of the unit-cube ``points`` (n, p) whose packings differ (robust
+    ``sd`` (n, m) above 0 somewhere) along the ``smooth`` dimensions (σ's), unbounded along the
+    others: where the emulators of the packings' centre and spread are held (see the module
+    docstring); None where no dimension is smooth or no set's packings differ."""
+    differ = np.any(np.asarray(sd) > 0, axis=1)
+    if not smooth or not differ.any():
+        return None
+    lowest, highest = np.full(points.shape[1], -np.inf), np.full(points.shape[1], np.inf)
+    for j in smooth:
+        lowest[j], highest[j] = points[differ, j].min(), points[differ, j].max()
+    return lowest, highest
 
 
 def variance_ratio(unit, dof: float) -> np.ndarray:
@@ -146,10 +177,8 @@ class Spread:
         centred = np.where(valid[..., None], observables - mean, 0.0)
         sd = robust_sd(observables, valid)
         spread = np.any(sd > 0, axis=1)
-        self.sd = Emulator(points[spread], sd[spread], nugget_max=NOISY_NUGGET, smooth=smooth)
-        self.smooth = tuple(smooth)
-        self.lowest = points[spread].min(axis=0)
-        self.highest = points[spread].max(axis=0)
+        held = disordered_range(points, sd, smooth)
+        self.sd = Emulator(points[spread], sd[spread], nugget_max=NOISY_NUGGET, smooth=smooth, held=held)
         self.dof = int(np.median(counts)) - 1
         scaled = centred / self._sd(points)[:, None, :]
         pooled = np.einsum("nki,nkj->ij", scaled, scaled)
@@ -181,9 +210,4 @@ class Spread:
         return variance_ratio(unit, RECORD_TAIL_DOF)
 
     def _sd(self, unit) -> np.ndarray:
-        """s (k, m) at ``unit`` (k, p), along the ``smooth`` dimensions (σ's) never extrapolated: held
-        at the simulated sets' lowest and highest σ with a spread beyond them."""
-        unit = np.array(unit, float)
-        for j in self.smooth:
-            unit[:, j] = np.clip(unit[:, j], self.lowest[j], self.highest[j])
         return np.maximum(self.sd.predict(unit)[0], SD_FLOOR)
