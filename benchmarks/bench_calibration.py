@@ -3,7 +3,7 @@ from the prior, the records made as a lab's instruments make them.
 
 Usage: python benchmarks/bench_calibration.py [--case tiny|quick|disordered] [--truths 50] [--records 1]
                                               [--workers 2] [--noise 5] [--seed 2026] [--out DIR] [--quick]
-                                              [--no-model-discrepancy | --draw-discrepancy]
+                                              [--no-model-discrepancy | --draw-discrepancy | --misspecified]
                                               [--cost N] [--toy K,R]
                                               [--spread-in-sigma S1,S2,...]
 
@@ -32,6 +32,13 @@ discrepancy term says they may (:class:`~hexdem.calibration.nuisance.Discrepancy
 Talts et al.'s check then draws every unknown of the calibration's model from its prior. Without it the
 records hold no model error (τ = 0), a truth at the discrepancy prior's lower end, where its
 intervals are conservative.
+
+``--misspecified``: the misspecified arm. The records differ from the model in ways the calibration
+does not model (:class:`~hexdem.calibration.synthetic.LabFaults`): sampled off the runs' instants,
+each sensor's channels skewed by up to 1 µs, a gain per axis, coloured noise, a slow drift, and a
+model error structured along the line (each later sensor's peak lower and arrival later by a share
+that grows with its place). Here the intervals must hold or the calibration must warn: the table's
+last line counts the intervals that missed in silence.
 
 **Cases.**
 
@@ -81,7 +88,7 @@ from hexdem.calibration.packings import DISORDER_REALIZATIONS, SIGMA_KEY
 from hexdem.calibration.priors import Prior, to_parameters
 from hexdem.calibration.simulations import Problem, simulate_point
 from hexdem.calibration.study import DEFAULT_GAIN_SD, DEFAULT_SPEED_SCATTER, calibrate, prepare
-from hexdem.calibration.synthetic import synthetic_rows, write_measured
+from hexdem.calibration.synthetic import LabFaults, synthetic_rows, write_measured
 from hexdem.engines.lammps.standalone import loop_time_s
 from hexdem.errors import HexdemError
 from hexdem.model.config import RunConfig
@@ -109,13 +116,26 @@ TRUTH_PACKING_SEED = 100_000
 
 
 def truth_record(
-    base: dict, priors, rng, noise: float, path: Path, index: int, records: int = 1, discrepancy: bool = False
+    base: dict,
+    priors,
+    rng,
+    noise: float,
+    path: Path,
+    index: int,
+    records: int = 1,
+    discrepancy: bool = False,
+    misspecified: bool = False,
 ) -> tuple[np.ndarray, float]:
     """A truth drawn from ``priors`` and ``records`` records of it, as a lab's instruments make them,
     written to ``path``: each sensor's gain the same in every record, the striker's speed, the
     channels' noise and offsets and the clock drawn anew for each, and on disordered packings each
     record struck on a packing of its own; with ``discrepancy``, a model error drawn from the
-    discrepancy term's prior, the same in every record. Returns the truth and the model error's τ."""
+    discrepancy term's prior, the same in every record; ``misspecified``, the records as the
+    calibration does not model them: each record's :class:`~hexdem.calibration.synthetic.LabFaults`
+    (off the runs' instants, skewed channels, a gain per axis, coloured noise, drift) and a model error
+    structured along the line, the same in every record: sensor i of n (0 the first) reads its peak
+    exp(−κ i) lower and its arrival (1 + ε i/(n − 1)) later, κ uniform in [0, 0.05] and ε in
+    [−0.02, 0.02]. Returns the truth and the model error's τ (κ for the misspecified arm)."""
     truth = to_parameters(priors, rng.random((1, len(priors))))[0]
     values = {prior.key: float(v) for prior, v in zip(priors, truth)}
     sigma = values.pop(SIGMA_KEY, None)
@@ -126,6 +146,10 @@ def truth_record(
     if discrepancy:
         tau = float(Discrepancy(sensors).size(rng.random()))
         model_error = tau * rng.standard_normal((sensors, 2))
+    if misspecified:
+        tau, stretch = float(rng.uniform(0.0, 0.05)), float(rng.uniform(-0.02, 0.02))
+        along = np.arange(sensors) / max(sensors - 1, 1)
+        model_error = np.column_stack([-tau * np.arange(sensors), stretch * along])
     rows = []
     for r in range(records):
         striker = config.replace(v0=config.v0 * (1 + DEFAULT_SPEED_SCATTER * rng.standard_normal()))
@@ -143,6 +167,7 @@ def truth_record(
             gains=gains,
             offsets_m_s2=offsets,
             model_error=model_error,
+            faults=LabFaults.drawn(sensors, rng) if misspecified else None,
         )
     write_measured(path, rows)
     (path.parent / "truth.json").write_text(
@@ -255,6 +280,11 @@ def main() -> None:
     discrepancy.add_argument(
         "--draw-discrepancy", action="store_true", help="records off the model by an error drawn from its prior"
     )
+    discrepancy.add_argument(
+        "--misspecified",
+        action="store_true",
+        help="records as the calibration does not model them: lab faults and a model error along the line",
+    )
     parser.add_argument("--seed", type=int, default=2026)
     parser.add_argument("--out", help="keep the calibrations here (default: a temporary folder)")
     parser.add_argument("--quick", action="store_true")
@@ -284,6 +314,7 @@ def main() -> None:
         f"{args.records} record(s); workers {workers}"
         + ("; the model taken as exact" if args.no_model_discrepancy else "")
         + ("; the records' model error drawn from the discrepancy's prior" if args.draw_discrepancy else "")
+        + ("; the records misspecified: lab faults and a model error along the line" if args.misspecified else "")
     )
     print(
         "| truth | "
@@ -297,7 +328,15 @@ def main() -> None:
         folder = root / f"truth-{t}"
         folder.mkdir(parents=True, exist_ok=True)
         truth, tau = truth_record(
-            base, priors, rng, args.noise, folder / "data.csv", t, args.records, args.draw_discrepancy
+            base,
+            priors,
+            rng,
+            args.noise,
+            folder / "data.csv",
+            t,
+            args.records,
+            args.draw_discrepancy,
+            args.misspecified,
         )
         start = time.perf_counter()
         try:

@@ -1150,3 +1150,25 @@ def test_the_rank_ecdf_band_holds_calibrated_posteriors_and_sees_narrow_ones():
     assert all(1 <= count_ <= 11 for count_ in outside[1.0]), outside
     assert all(count_ >= 80 for count_ in outside[0.7]), outside
     assert coverage.ecdf_power(count, 0.7) == pytest.approx(0.93, abs=0.05)
+
+
+def test_lab_faults_shift_the_samples_and_colour_the_noise_as_drawn():
+    """The misspecified arm's faults: with no phase, skew or gain the samples are the signal's own;
+    half an interval off, a sine sampled 10 times a period reads the sine half an interval later (to
+    the cubic spline's error inside its two end samples, 1e-3 of its amplitude); the noise keeps
+    each channel's level and its lag-one correlation is the memory drawn (20,000 samples: ±0.02);
+    the drift is a ramp."""
+    from hexdem.calibration.synthetic import LabFaults
+
+    times = np.arange(400) * 1e-6
+    signal = np.sin(2 * np.pi * times / 10e-6)[:, None, None] * np.ones((1, 2, 2))
+    none = LabFaults(0.0, np.zeros(2), np.ones((2, 2)), 0.0, np.zeros((2, 2)))
+    assert none.resampled(times, signal, 1e-6) == pytest.approx(signal)
+    half = LabFaults(0.5, np.zeros(2), np.full((2, 2), 1.1), 0.7, np.full((2, 2), 3.0))
+    later = np.sin(2 * np.pi * (times + 0.5e-6) / 10e-6)[2:-2, None, None] * 1.1
+    assert half.resampled(times, signal, 1e-6)[2:-2] == pytest.approx(np.broadcast_to(later, (396, 2, 2)), abs=2e-3)
+    recorded = half.recorded(np.zeros((20_000, 2, 2)), np.full((2, 2), 2.0), np.random.default_rng(5))
+    noise = recorded - np.linspace(0, 1, 20_000)[:, None, None] * 3.0
+    assert np.std(noise, axis=0) == pytest.approx(2.0, rel=0.1)
+    lag = np.mean(noise[1:] * noise[:-1], axis=0) / np.var(noise, axis=0)
+    assert lag == pytest.approx(0.7, abs=0.02)

@@ -15,6 +15,7 @@ relative error of its own.
 from __future__ import annotations
 
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -27,6 +28,61 @@ from hexdem.model.config import RunConfig
 
 #: The pre-trigger lead-in a record keeps before the impact [s].
 LEAD_IN_S = 100e-6
+
+
+@dataclass(frozen=True)
+class LabFaults:
+    """What a lab's acquisition does to a record that the calibration does not model, for the
+    coverage study's misspecified arm: the samples taken ``sample_phase`` (0 to 1) of a sampling
+    interval off the simulation's instants (the runs are sampled on their own clock); each sensor's
+    channels ``skew_s`` (n_sensors,) late (a multiplexed card's trigger); each axis's own gain
+    ``axis_gains`` (n_sensors, 2), where the calibration models one gain a sensor; noise coloured
+    as a first-order autoregression of coefficient ``noise_memory`` at the channel's level; and a
+    slow drift of each channel, ``drift_m_s2`` (n_sensors, 2) over the record."""
+
+    sample_phase: float
+    skew_s: np.ndarray
+    axis_gains: np.ndarray
+    noise_memory: float
+    drift_m_s2: np.ndarray
+
+    @classmethod
+    def drawn(cls, sensors: int, rng) -> LabFaults:
+        """Faults of the sizes a lab's acquisition has: a phase uniform in [0, 1), skews uniform in
+        ±1 µs, axis gains N(1, 0.02), noise memory uniform in [0.5, 0.9], drifts uniform in ±2 m/s²."""
+        return cls(
+            float(rng.random()),
+            rng.uniform(-1e-6, 1e-6, sensors),
+            1 + 0.02 * rng.standard_normal((sensors, 2)),
+            float(rng.uniform(0.5, 0.9)),
+            rng.uniform(-2.0, 2.0, (sensors, 2)),
+        )
+
+    def resampled(self, times, accelerations, interval: float) -> np.ndarray:
+        """``accelerations`` (K, n_sensors, 2) sampled at ``times`` (K,), as the lab samples them: each
+        sensor at times + (phase × ``interval``) + its skew, the cubic spline through the samples
+        (zero before the first), times each axis's gain."""
+        from scipy.interpolate import CubicSpline
+
+        shifted = np.empty_like(accelerations)
+        for sensor, skew in enumerate(self.skew_s):
+            at = times + self.sample_phase * interval + skew
+            shifted[:, sensor] = np.nan_to_num(
+                CubicSpline(times, accelerations[:, sensor], axis=0, extrapolate=False)(at)
+            )
+        return shifted * self.axis_gains[None]
+
+    def recorded(self, accelerations, level, rng) -> np.ndarray:
+        """``accelerations`` (K, n_sensors, 2) with noise of each channel's ``level`` (n_sensors, 2),
+        coloured (unit variance per sample, each sample ``noise_memory`` of the one before), and the drift."""
+        white = rng.standard_normal(accelerations.shape)
+        coloured = np.empty_like(white)
+        coloured[0] = white[0]
+        memory = self.noise_memory
+        for k in range(1, len(white)):
+            coloured[k] = memory * coloured[k - 1] + np.sqrt(1 - memory**2) * white[k]
+        ramp = np.linspace(0.0, 1.0, len(accelerations))[:, None, None]
+        return accelerations + level * coloured + ramp * self.drift_m_s2
 
 
 def synthetic_rows(
@@ -42,6 +98,7 @@ def synthetic_rows(
     offsets_m_s2=None,
     lead_in_s: float = LEAD_IN_S,
     model_error=None,
+    faults: LabFaults | None = None,
 ) -> list:
     """Rows ``sensor,time,ax,ay,record`` of one synthetic record of ``config``: on the ideal
     lattice, or with ``disorder`` = (σ [m], seed, k) on that packing, settled in (or read from)
@@ -49,7 +106,8 @@ def synthetic_rows(
     level or of one per channel (n_sensors, 2); ``gains`` (n_sensors,), each sensor's sensitivity
     over its nominal one; ``offsets_m_s2`` (n_sensors, 2), each channel's DC offset; a pre-trigger
     lead-in of ``lead_in_s``. ``model_error`` (n_sensors, 2): the relative errors of the model's
-    observables that the record holds (:func:`model_error_applied`)."""
+    observables that the record holds (:func:`model_error_applied`). ``faults``: what a lab's
+    acquisition does that the calibration does not model (:class:`LabFaults`)."""
     from hexdem.experiments.run import simulate
 
     fine = config.replace(steps_per_contact=config.steps_per_contact * finer)
@@ -67,13 +125,18 @@ def synthetic_rows(
     if model_error is not None:
         accelerations = model_error_applied(times, accelerations, model_error)
     interval = 1.0 / config.sensor_rate_hz
+    if faults is not None:
+        accelerations = faults.resampled(times, accelerations, interval)
     lead = np.arange(-round(lead_in_s / interval), 0) * interval
     times = np.concatenate([lead, times]) + offset_s
     accelerations = np.concatenate([np.zeros((len(lead), *accelerations.shape[1:])), accelerations])
     if gains is not None:
         accelerations = accelerations * np.asarray(gains, float)[None, :, None]
     level = np.broadcast_to(np.asarray(noise_m_s2, float), accelerations.shape[1:])
-    accelerations = accelerations + level * rng.standard_normal(accelerations.shape)
+    if faults is None:
+        accelerations = accelerations + level * rng.standard_normal(accelerations.shape)
+    else:
+        accelerations = faults.recorded(accelerations, level, rng)
     if offsets_m_s2 is not None:
         accelerations = accelerations + np.asarray(offsets_m_s2, float)
     return [
