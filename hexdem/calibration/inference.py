@@ -36,7 +36,8 @@ the count of records detected and left out tells (:mod:`~hexdem.calibration.dete
 
 **Stages.** Stage 0 simulates :func:`initial_points` points of a Latin hypercube over the
 whole prior. Every later stage fits the emulator to all simulations so far, samples its posterior
-with emcee's affine-invariant ensemble (Goodman & Weare 2010) and simulates
+with emcee's ensembles (:mod:`~hexdem.calibration.sampler`: one for a stage that only picks the
+next points, four independent ones for the last, whose agreement is checked) and simulates
 :func:`round_points` new points drawn from that posterior, so that the emulator is refined where
 the posterior puts its mass. The last fit's posterior is the result. After stage 0, the
 posterior's most likely sample is also run at half the time step (:func:`step_error`): the runs'
