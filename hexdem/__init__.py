@@ -24,20 +24,9 @@ import os
 #: Set here, before NumPy loads its BLAS; a value the user set is kept.
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
+from hexdem.api_names import API_NAMES as _API  # noqa: E402
 from hexdem.errors import HexdemError  # noqa: E402
 
-#: The names of :mod:`hexdem.api`, imported on first use (its ``__all__``).
-_API = (
-    "RunConfig",
-    "ImpactResult",
-    "LineResult",
-    "simulate_impact",
-    "tca",
-    "SweepSettings",
-    "scaling_laws",
-    "Posterior",
-    "calibrate",
-)
 __all__ = ["HexdemError", *_API]
 
 

@@ -21,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from hexdem import _API
 from hexdem.analysis.impact import ImpactAnalysis
+from hexdem.api_names import API_NAMES
 from hexdem.experiments.run import run_experiment, simulate
 from hexdem.model.config import RunConfig
 from hexdem.model.unused_keys import check_unused_keys
@@ -30,7 +30,7 @@ from hexdem.theory import tca as _tca
 from hexdem.theory.scaling import COMBINATIONS, CombinationFit
 from hexdem.theory.sweep import SweepSettings, run_sweep
 
-__all__ = list(_API)
+__all__ = list(API_NAMES)
 
 
 @dataclass(frozen=True)

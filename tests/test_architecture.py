@@ -13,6 +13,7 @@ PACKAGE = Path(hexdem.__file__).parent
 #: Layers in the direction data flows; a module may import only from its own layer or lower ones.
 LAYERS = (
     "errors",
+    "api_names",
     "common",
     "model",
     "engines",
