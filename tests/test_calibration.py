@@ -277,6 +277,26 @@ def correlated_packings(rng, n: int, k: int, rho: float) -> tuple[np.ndarray, np
     return points, (0.1 + points)[:, None, :] * (rng.standard_normal((n, k, 2)) @ chol.T) + points[:, None, :]
 
 
+def test_sets_that_strike_one_levels_packings_count_as_one_draw_of_them():
+    """60 sets on σ's 10 levels, 40 of them at one level, each observing a flat response plus the
+    error its level's packings share (sd 0.1) and a little of its own (sd 0.01): the emulator told
+    the levels (``groups``) keeps the response's uncertainty at the crowded level at the size that 10
+    levels' errors allow (0.1/√10 ≈ 0.03, within a factor of 2), and holds the flat response there
+    to it; untold, it takes the 40 sets for 40 independent draws and claims a quarter of that."""
+    rng = np.random.default_rng(12)
+    sigma = np.r_[np.repeat(5 / 9, 40), np.repeat(np.arange(10) / 9, 2)]
+    points = np.column_stack([sigma, rng.random(60)])
+    groups = np.unique(sigma, return_inverse=True)[1]
+    shared = 0.1 * rng.standard_normal(10)
+    values = (shared[groups] + 0.01 * rng.standard_normal(60))[:, None]
+    crowded = np.array([[5 / 9, 0.5]])
+    told = Emulator(points, values, nugget_max=10.0, smooth=(0,), groups=groups).predict(crowded)
+    untold = Emulator(points, values, nugget_max=10.0, smooth=(0,)).predict(crowded)
+    assert np.sqrt(told[1][0, 0]) == pytest.approx(0.1 / np.sqrt(10), rel=1.0)
+    assert abs(told[0][0, 0] - np.mean(shared)) < 3 * np.sqrt(told[1][0, 0])
+    assert np.sqrt(untold[1][0, 0]) < 0.3 * np.sqrt(told[1][0, 0])
+
+
 def test_the_spread_between_packings_follows_the_parameters():
     """Observables μ(u) + s(u) L z over K = 8 packings, s = 0.1 + u: the emulated standard
     deviations hold s within the sampling error of 80 sets of 8 (one set's log sample sd is off by

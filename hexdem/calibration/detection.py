@@ -23,7 +23,7 @@ import numpy as np
 from scipy.special import expit, logit
 
 from hexdem.calibration.emulator import Emulator
-from hexdem.calibration.spread import NOISY_NUGGET
+from hexdem.calibration.spread import NOISY_NUGGET, level_groups
 
 
 class Detection:
@@ -37,7 +37,10 @@ class Detection:
         self.always = bool(detected.all())
         if not self.always:
             share = (detected.sum(axis=1) + 0.5) / (realizations + 1)
-            self.emulator = Emulator(points, logit(share)[:, None], nugget_max=NOISY_NUGGET, smooth=smooth)
+            groups = level_groups(points, smooth)
+            self.emulator = Emulator(
+                points, logit(share)[:, None], nugget_max=NOISY_NUGGET, smooth=smooth, groups=groups
+            )
 
     def probability(self, unit) -> np.ndarray:
         """P (k,) at unit-cube points ``unit`` (k, p): 1 where every simulated packing was detected."""

@@ -49,31 +49,36 @@ def _design(x) -> np.ndarray:
 
 class _Process:
     """One observable's trend and residual process, fitted to (x, y), its length along each
-    dimension at least ``shortest`` (p,)."""
+    dimension at least ``shortest`` (p,); with ``same`` (n, n), 1 where two points share a group
+    (their σ level), an effect η² common to each group's points, fitted with the rest and left out
+    of predictions."""
 
-    def __init__(self, x, y, nugget_max: float, shortest):
-        self.x, self.nugget_max, self.shortest = x, nugget_max, shortest
+    def __init__(self, x, y, nugget_max: float, shortest, same=None):
+        self.x, self.nugget_max, self.shortest, self.same = x, nugget_max, shortest, same
         self.beta = np.linalg.lstsq(_design(x), y, rcond=None)[0]
         residual = y - _design(x) @ self.beta
         self.scale = float(np.std(residual)) or 1.0
         self.z = residual / self.scale
         self.theta = self._optimize()
-        lengths, signal, nugget = self._unpack(self.theta)
-        k = signal * matern52(x, x, lengths) + nugget * np.eye(len(x))
+        k = self._covariance(self.theta)
         factor = cho_factor(k, lower=True)
         self.alpha = cho_solve(factor, self.z)
         self.whitener = solve_triangular(factor[0], np.eye(len(x)), lower=True)
-        self.lengths, self.signal = lengths, signal
+        self.lengths, self.signal = self._unpack(self.theta)[:2]
 
     def _unpack(self, theta):
         p = self.x.shape[1]
-        return np.exp(theta[:p]), np.exp(theta[p]), np.exp(theta[p + 1])
+        group = np.exp(theta[p + 2]) if self.same is not None else 0.0
+        return np.exp(theta[:p]), np.exp(theta[p]), np.exp(theta[p + 1]), group
+
+    def _covariance(self, theta) -> np.ndarray:
+        lengths, signal, nugget, group = self._unpack(theta)
+        k = signal * matern52(self.x, self.x, lengths) + (nugget + 1e-12) * np.eye(len(self.x))
+        return k if self.same is None else k + group * self.same
 
     def _negative_log_likelihood(self, theta) -> float:
-        lengths, signal, nugget = self._unpack(theta)
-        k = signal * matern52(self.x, self.x, lengths) + (nugget + 1e-12) * np.eye(len(self.x))
         try:
-            factor = cho_factor(k, lower=True)
+            factor = cho_factor(self._covariance(theta), lower=True)
         except np.linalg.LinAlgError:
             return 1e25
         alpha = cho_solve(factor, self.z)
@@ -81,11 +86,11 @@ class _Process:
 
     def _optimize(self) -> np.ndarray:
         low = np.log(self.shortest)
-        bounds = [(a, LOG_BOUNDS["length"][1]) for a in low] + [
-            LOG_BOUNDS["signal"],
-            (LOG_BOUNDS["nugget"][0], np.log(self.nugget_max)),
-        ]
-        starts = [np.r_[np.maximum(np.log(length), low), 0.0, np.log(1e-4)] for length in (0.3, 1.0)]
+        noise = (LOG_BOUNDS["nugget"][0], np.log(self.nugget_max))
+        bounds = [(a, LOG_BOUNDS["length"][1]) for a in low] + [LOG_BOUNDS["signal"], noise]
+        bounds += [noise] if self.same is not None else []
+        extra = [np.log(1e-4)] if self.same is not None else []
+        starts = [np.r_[np.maximum(np.log(length), low), 0.0, np.log(1e-4), extra] for length in (0.3, 1.0)]
         fits = [minimize(self._negative_log_likelihood, start, method="L-BFGS-B", bounds=bounds) for start in starts]
         return min(fits, key=lambda fit: fit.fun).x
 
@@ -97,14 +102,19 @@ class Emulator:
     noisy outputs; ``smooth`` the dimensions along which the response is taken as smooth over the
     whole prior (lengths of at least :data:`SMOOTH_LENGTH`), its wiggles from one simulated value
     to the next left to the nugget; ``held``, (lowest (p,), highest (p,)): each predicted point is
-    moved inside them first, so that the response is held at its ends rather than extrapolated."""
+    moved inside them first, so that the response is held at its ends rather than extrapolated;
+    ``groups`` (n,), labels of points that share an error (the K packings of one σ level, which
+    every parameter set at that level strikes): an effect common to each group, fitted as the
+    nugget is and left out of the prediction, so that many sets at one level count as one draw of
+    its packings, not as many independent ones."""
 
-    def __init__(self, x, y, nugget_max: float = 0.1, smooth=(), held=None):
+    def __init__(self, x, y, nugget_max: float = 0.1, smooth=(), held=None, groups=None):
         x, y = np.asarray(x, float), np.asarray(y, float)
         self.held = held
         shortest = np.full(x.shape[1], np.exp(LOG_BOUNDS["length"][0]))
         shortest[list(smooth)] = SMOOTH_LENGTH
-        processes = [_Process(x, y[:, j], nugget_max, shortest) for j in range(y.shape[1])]
+        same = None if groups is None else (np.asarray(groups)[:, None] == np.asarray(groups)[None, :]).astype(float)
+        processes = [_Process(x, y[:, j], nugget_max, shortest, same) for j in range(y.shape[1])]
         self.x = x
         self.inverse_squared_lengths = np.array([1.0 / p.lengths**2 for p in processes])  # (m, p)
         self.beta = np.column_stack([p.beta for p in processes])  # (p + 1, m)

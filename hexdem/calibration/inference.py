@@ -62,6 +62,7 @@ from hexdem.calibration.spread import (
     NOISY_NUGGET,
     Spread,
     disordered_range,
+    level_groups,
     packing_centres,
     robust_sd,
 )
@@ -345,6 +346,7 @@ def fit_stage(
         nugget_max=NOISY_NUGGET if smooth else 0.1,
         smooth=smooth,
         held=held,
+        groups=level_groups(points[told], smooth),
     )
     detection = Detection(points, observables, smooth) if observables.shape[1] >= 2 else None
     likelihood = Likelihood(data, emulator, spread, model_error, instruments, discrepancy, detection)

@@ -38,7 +38,10 @@ spread it over the whole prior and read an offset of the records' own packings a
 packings all agree (σ = 0) tell neither centre nor spread, and along σ both emulators are held at
 the lowest and highest σ simulated with packings that differ (:func:`disordered_range`), never
 extrapolated: below the lowest disordered level the model is that level's, not a trend run down
-to the ideal lattice.
+to the ideal lattice. And every set at one level strikes the same K packings: the emulators take
+what those packings share as an effect common to the level (:func:`level_groups`), so that the
+32 sets a refinement puts at one level count as one draw of its packings, not 32 (which had the
+centre's emulator claim 0.5 µs where the K packings know it to 10).
 
 **What K packings cannot tell.** Every parameter set is simulated on the same K packings, so the
 robust scales share one error: their scale is known from K − 1 degrees of freedom only, to some
@@ -112,6 +115,15 @@ def disordered_range(points, sd, smooth) -> tuple[np.ndarray, np.ndarray] | None
     return lowest, highest
 
 
+def level_groups(points, smooth) -> np.ndarray | None:
+    """Labels (n,) of the unit-cube ``points`` (n, p) that share their values along the ``smooth``
+    dimensions (σ's: a σ level, whose K packings every set at it strikes), for the emulators' group
+    effect (:class:`~hexdem.calibration.emulator.Emulator`); None without such dimensions."""
+    if not smooth:
+        return None
+    return np.unique(np.asarray(points)[:, list(smooth)], axis=0, return_inverse=True)[1].ravel()
+
+
 def variance_ratio(unit, dof: float) -> np.ndarray:
     """The quantiles ``unit`` of the true variance over one estimated from ν = ``dof`` degrees of
     freedom: ν/X, X of the χ² law of ν degrees of freedom, is inverse-gamma with shape ν/2; its scale
@@ -177,8 +189,8 @@ class Spread:
         centred = np.where(valid[..., None], observables - mean, 0.0)
         sd = robust_sd(observables, valid)
         spread = np.any(sd > 0, axis=1)
-        held = disordered_range(points, sd, smooth)
-        self.sd = Emulator(points[spread], sd[spread], nugget_max=NOISY_NUGGET, smooth=smooth, held=held)
+        held, groups = disordered_range(points, sd, smooth), level_groups(points[spread], smooth)
+        self.sd = Emulator(points[spread], sd[spread], nugget_max=NOISY_NUGGET, smooth=smooth, held=held, groups=groups)
         self.dof = int(np.median(counts)) - 1
         scaled = centred / self._sd(points)[:, None, :]
         pooled = np.einsum("nki,nkj->ij", scaled, scaled)
