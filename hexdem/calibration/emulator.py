@@ -43,8 +43,9 @@ def matern52(a, b, lengths) -> np.ndarray:
     return matern52_of_distance(np.sqrt(np.sum(d * d, axis=-1)))
 
 
-def _design(x) -> np.ndarray:
-    return np.column_stack([np.ones(len(x)), x])
+def _design(x, trend) -> np.ndarray:
+    """The trend's regressors at ``x`` (n, p): a constant and the dimensions ``trend`` (a mask (p,))."""
+    return np.column_stack([np.ones(len(x)), x[:, trend]])
 
 
 class _Process:
@@ -53,10 +54,11 @@ class _Process:
     (their σ level), an effect η² common to each group's points, fitted with the rest and left out
     of predictions."""
 
-    def __init__(self, x, y, nugget_max: float, shortest, same=None):
+    def __init__(self, x, y, nugget_max: float, shortest, same=None, trend=None):
         self.x, self.nugget_max, self.shortest, self.same = x, nugget_max, shortest, same
-        self.beta = np.linalg.lstsq(_design(x), y, rcond=None)[0]
-        residual = y - _design(x) @ self.beta
+        trend = np.ones(x.shape[1], bool) if trend is None else trend
+        self.beta = np.linalg.lstsq(_design(x, trend), y, rcond=None)[0]
+        residual = y - _design(x, trend) @ self.beta
         self.scale = float(np.std(residual)) or 1.0
         self.z = residual / self.scale
         self.theta = self._optimize()
@@ -106,7 +108,9 @@ class Emulator:
     ``groups`` (n,), labels of points that share an error (the K packings of one σ level, which
     every parameter set at that level strikes): an effect common to each group, fitted as the
     nugget is and left out of the prediction, so that many sets at one level count as one draw of
-    its packings, not as many independent ones."""
+    its packings, not as many independent ones; and no linear trend along the ``smooth``
+    dimensions, whose slope a few levels' draws would set by chance (the process alone, of lengths
+    of at least the prior's, carries what changes along them)."""
 
     def __init__(self, x, y, nugget_max: float = 0.1, smooth=(), held=None, groups=None):
         x, y = np.asarray(x, float), np.asarray(y, float)
@@ -114,7 +118,10 @@ class Emulator:
         shortest = np.full(x.shape[1], np.exp(LOG_BOUNDS["length"][0]))
         shortest[list(smooth)] = SMOOTH_LENGTH
         same = None if groups is None else (np.asarray(groups)[:, None] == np.asarray(groups)[None, :]).astype(float)
-        processes = [_Process(x, y[:, j], nugget_max, shortest, same) for j in range(y.shape[1])]
+        self.trend = np.ones(x.shape[1], bool)
+        if groups is not None:
+            self.trend[list(smooth)] = False
+        processes = [_Process(x, y[:, j], nugget_max, shortest, same, self.trend) for j in range(y.shape[1])]
         self.x = x
         self.inverse_squared_lengths = np.array([1.0 / p.lengths**2 for p in processes])  # (m, p)
         self.beta = np.column_stack([p.beta for p in processes])  # (p + 1, m)
@@ -138,7 +145,7 @@ class Emulator:
             xs = np.clip(xs, *self.held)
         squared = (xs[:, None, :] - self.x[None, :, :]) ** 2  # (k, n, p)
         correlation = matern52_of_distance(np.sqrt(squared @ self.inverse_squared_lengths.T))  # (k, n, m)
-        mean = _design(xs) @ self.beta + self.scale * np.einsum("knm,nm->km", correlation, self.weights)
+        mean = _design(xs, self.trend) @ self.beta + self.scale * np.einsum("knm,nm->km", correlation, self.weights)
         whitened = np.moveaxis(correlation, 2, 0) @ np.transpose(self.whiteners, (0, 2, 1))  # (m, k, n)
         variance = np.maximum(self.signal - np.sum(whitened * whitened, axis=-1).T, 0.0)
         return mean, self.scale**2 * variance

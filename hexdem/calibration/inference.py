@@ -339,7 +339,7 @@ def fit_stage(
     if observables.shape[1] >= 2:
         sd = robust_sd(observables, np.isfinite(observables[..., 0]))
         held = disordered_range(points, sd, smooth)
-        told &= np.any(sd > 0, axis=1) if held is not None else True
+        told &= np.any(sd > 0, axis=1) | (detected < 2) if held is not None else True
     emulator = Emulator(
         points[told],
         packing_centres(observables[told]),

@@ -10,7 +10,7 @@ by the signs of the diameters' deviations. It is modelled as
 
     Σ_K(u) = diag s(u) · R · diag s(u),
 
-with s_j(u) the standard deviation of observable j between packings, emulated
+with s_j(u) the standard deviation of observable j between packings, emulated on its logarithm
 (:class:`~hexdem.calibration.emulator.Emulator`, a linear trend and a process that may be nearly
 all nugget: the sets share their packings, so what varies between them is small) from each
 parameter set's robust standard deviation over its K packings whose pulse the sensors detect
@@ -68,6 +68,10 @@ RECORD_TAIL_DOF = 4
 #: The variance of the median of K normal values over that of one, times K (2/π is its efficiency):
 #: the error of the K packings' centre, common to every record, Σ_K · MEDIAN_VARIANCE / K.
 MEDIAN_VARIANCE = np.pi / 2
+#: An observable's spread is emulated on its logarithm, each set's floored at this share of the sets'
+#: median: a set of two or three detected packings that share an observable exactly would otherwise
+#: stand 7 below the others' logarithm and drag the emulator with it.
+LOG_SD_FLOOR = 0.1
 #: Standard deviations between packings are floored here (observables are of order one): a
 #: parameter set whose packings agree exactly (σ = 0) keeps a spread of full rank.
 SD_FLOOR = 1e-9
@@ -85,12 +89,24 @@ def robust_sd(values, valid) -> np.ndarray:
     ``valid`` (n, K): 1.4826 b_k × the median absolute deviation from the median of each set's k
     valid packings (:data:`MAD_SMALL_SAMPLE`), unbiased at the normal law for any k ≥ 2. A packing
     whose pulse took another path moves it by at most one rank, where it swells a sample standard
-    deviation past the spread of all the others (132-193 µs against 12-36 µs on the paper's hexagon)."""
-    values = np.where(valid[..., None], values, np.nan)
-    deviation = np.abs(values - np.nanmedian(values, axis=1, keepdims=True))
+    deviation past the spread of all the others (132-193 µs against 12-36 µs on the paper's hexagon).
+    Where more than half the packings agree exactly (on the paper's hexagon at σ ≤ 24 µm, the pulse
+    reaches the second sensor of the 0° line by the same contacts in 5 of 8), the median absolute
+    deviation is 0 though the others differ: there it is √(π k / (2 (k − 1))) × the mean absolute
+    deviation from the median (a spread of 0 made every record that differs impossible: a log
+    likelihood of −72,000). Zero for a set with fewer than two valid packings, or whose packings
+    all agree (σ = 0)."""
     counts = valid.sum(axis=1)
-    factors = np.array([MAD_SMALL_SAMPLE.get(int(k), k / (k - 0.8)) for k in counts])
-    return MAD_NORMAL * factors[:, None] * np.nanmedian(deviation, axis=1)
+    scale = np.zeros((len(counts), np.shape(values)[-1]))
+    some = counts >= 2
+    values = np.where(valid[some][..., None], np.asarray(values, float)[some], np.nan)
+    deviation = np.abs(values - np.nanmedian(values, axis=1, keepdims=True))
+    k = counts[some][:, None]
+    factors = np.array([MAD_SMALL_SAMPLE.get(int(count), count / (count - 0.8)) for count in counts[some]])
+    median_absolute = MAD_NORMAL * factors[:, None] * np.nanmedian(deviation, axis=1)
+    mean_absolute = np.sqrt(np.pi / 2 * k / (k - 1)) * np.nanmean(deviation, axis=1)
+    scale[some] = np.where(median_absolute > 0, median_absolute, mean_absolute)
+    return scale
 
 
 def packing_centres(observables) -> np.ndarray:
@@ -190,7 +206,15 @@ class Spread:
         sd = robust_sd(observables, valid)
         spread = np.any(sd > 0, axis=1)
         held, groups = disordered_range(points, sd, smooth), level_groups(points[spread], smooth)
-        self.sd = Emulator(points[spread], sd[spread], nugget_max=NOISY_NUGGET, smooth=smooth, held=held, groups=groups)
+        floor = np.maximum(LOG_SD_FLOOR * np.median(sd[spread], axis=0), SD_FLOOR)
+        self.sd = Emulator(
+            points[spread],
+            np.log(np.maximum(sd[spread], floor)),
+            nugget_max=NOISY_NUGGET,
+            smooth=smooth,
+            held=held,
+            groups=groups,
+        )
         self.dof = int(np.median(counts)) - 1
         scaled = centred / self._sd(points)[:, None, :]
         pooled = np.einsum("nki,nkj->ij", scaled, scaled)
@@ -222,4 +246,6 @@ class Spread:
         return variance_ratio(unit, RECORD_TAIL_DOF)
 
     def _sd(self, unit) -> np.ndarray:
-        return np.maximum(self.sd.predict(unit)[0], SD_FLOOR)
+        """s (k, m) at ``unit`` (k, p): the exponential of its logarithm's emulator, which stays positive
+        where an emulator of s itself ran below zero between sets of small and large spread."""
+        return np.maximum(np.exp(self.sd.predict(unit)[0]), SD_FLOOR)
