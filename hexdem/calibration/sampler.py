@@ -128,7 +128,9 @@ def sample_posterior(log_probability, dimension: int, seed: int, chains: int = C
     whose log density (vectorised over rows) is ``log_probability``, and how the ``chains``
     independent ensembles mixed (see the module docstring). The ensembles keep the same number of
     steps: their first length, grown until every one holds AUTOCORRELATION_LENGTHS of the largest
-    τ (at most EXTENSIONS times, to at most MOST_KEPT times the first length)."""
+    τ (at most EXTENSIONS times, to at most MOST_KEPT times the first length); one ensemble alone,
+    for a stage that only picks the next points or a second look at the posterior, keeps its first
+    length."""
     rng = np.random.default_rng(seed)
     burn_in, kept = chain_steps(dimension)
     ensembles = [
@@ -137,7 +139,7 @@ def sample_posterior(log_probability, dimension: int, seed: int, chains: int = C
     ]
     states = [sampler.run_mcmc(state, kept) for sampler, state in ensembles]
     tau = _largest_tau(ensembles)
-    for _ in range(EXTENSIONS):
+    for _ in range(EXTENSIONS if chains > 1 else 0):
         done = ensembles[0][0].iteration
         wanted = min(
             THIN * int(np.ceil(EXTENSION_MARGIN * AUTOCORRELATION_LENGTHS * np.max(tau) / THIN)), MOST_KEPT * kept
