@@ -485,7 +485,7 @@ def test_a_calibration_of_the_disorder_runs_on_disordered_records(tmp_path):
     σ and V0 calibrated on K = 2 packings per parameter set: 45 sets, 90 simulations, at most 2
     packings per σ level. One record's sensor 0:3 shows no pulse and is left out, and the count
     enters the likelihood (``detection``). The two kept tell V0 and σ (their intervals 0.57 and 0.61
-    of the priors' when this test was written, where a flat likelihood leaves 0.90), hold the truths
+    of the priors' when this test was written, where a flat likelihood leaves 1), hold the truths
     to four of their standard deviations, and the fit is stated."""
     config = RunConfig.from_dict(DISORDERED | {"v0": TRUE_V0})
     rows = []
@@ -908,7 +908,7 @@ def test_a_calibration_finds_the_truth_and_resumes_after_kill_9_to_the_same_post
 
 def assert_informed(summary: dict, widest: dict, records: int, observables: int) -> None:
     """The data informed the posterior and the fit is stated: each key's 90 % interval at most
-    ``widest[key]`` of its prior's (a flat likelihood leaves it at 0.9), the ``records`` kept, the fit's
+    ``widest[key]`` of its prior's (a flat likelihood leaves it at 1), the ``records`` kept, the fit's
     ``dof`` R m − p, its
     ``chi2`` finite and within its χ² law's 99.9 % quantile (at a flat posterior's median, far off
     the truth, a record's χ² runs to hundreds), and the chains converged."""
