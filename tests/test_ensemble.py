@@ -173,17 +173,19 @@ def wait_for_unlock(out, timeout_s=60):
 #: the other realizations' impacts still running in its workers: kill -9 at a known point, which
 #: a test polling for the first result from outside can miss on a busy machine (the small
 #: ensemble's last impacts end within a tenth of a second of its first result).
-KILLED_AFTER_REALIZATION_1 = """
+KILLED_AFTER_TWO_REALIZATIONS = """
 import os, signal, sys
 from hexdem.cli.main import command
 from hexdem.disorder import runner
 
 publish = runner.publish_result
+published = []
 
 
 def publish_then_die(ensemble, k):
     publish(ensemble, k)
-    if k == 1:
+    published.append(k)
+    if len(published) == 2:
         os.kill(os.getpid(), signal.SIGKILL)
 
 
@@ -197,11 +199,12 @@ def test_an_ensemble_killed_midway_resumes_with_every_realization_intact(referen
     out = tmp_path / "killed"
     args = ["ensemble", "--out", str(out), *CLI_SMALL, "--realizations", "5", "--workers", "2"]
     process = subprocess.run(
-        [sys.executable, "-c", KILLED_AFTER_REALIZATION_1, *args], stderr=subprocess.DEVNULL, timeout=120, check=False
+        [sys.executable, "-c", KILLED_AFTER_TWO_REALIZATIONS, *args], stderr=subprocess.DEVNULL, timeout=120, check=False
     )
     assert process.returncode == -signal.SIGKILL
     finished = {path: path.stat().st_mtime_ns for path in out.glob("realizations/*/result.npz")}
-    assert sorted(path.parent.name for path in finished) == ["r0000", "r0001"]
+    # two workers: the second realization published may be any of the first three, whichever finished
+    assert len(finished) == 2 and {path.parent.name for path in finished} <= {"r0000", "r0001", "r0002"}
     wait_for_unlock(out)
     assert main(args) == 0
     for path, mtime in finished.items():
