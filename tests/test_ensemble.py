@@ -199,7 +199,10 @@ def test_an_ensemble_killed_midway_resumes_with_every_realization_intact(referen
     out = tmp_path / "killed"
     args = ["ensemble", "--out", str(out), *CLI_SMALL, "--realizations", "5", "--workers", "2"]
     process = subprocess.run(
-        [sys.executable, "-c", KILLED_AFTER_TWO_REALIZATIONS, *args], stderr=subprocess.DEVNULL, timeout=120, check=False
+        [sys.executable, "-c", KILLED_AFTER_TWO_REALIZATIONS, *args],
+        stderr=subprocess.DEVNULL,
+        timeout=120,
+        check=False,
     )
     assert process.returncode == -signal.SIGKILL
     finished = {path: path.stat().st_mtime_ns for path in out.glob("realizations/*/result.npz")}
