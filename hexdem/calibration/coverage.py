@@ -55,11 +55,14 @@ def ecdf_band(count: int, alpha: float = 0.05, seed: int = 0) -> tuple[np.ndarra
     return points, binom.ppf(gamma / 2, count, points) / count, binom.isf(gamma / 2, count, points) / count
 
 
-def outside_band(fractions, band) -> bool:
-    """Whether the ECDF of ``fractions`` (N,) leaves ``band`` (:func:`ecdf_band`) anywhere."""
+def outside_band(fractions, band):
+    """Whether the ECDF of ``fractions`` (N,) leaves ``band`` (:func:`ecdf_band`) anywhere; for
+    ``fractions`` (S, N), whether each row's does (S,)."""
     points, lower, upper = band
-    ecdf = _ecdf(np.asarray(fractions)[None], points)[0]
-    return bool(np.any((ecdf < lower) | (ecdf > upper)))
+    fractions = np.asarray(fractions)
+    ecdf = _ecdf(np.atleast_2d(fractions), points)
+    outside = np.any((ecdf < lower) | (ecdf > upper), axis=1)
+    return bool(outside[0]) if fractions.ndim == 1 else outside
 
 
 def ecdf_power(count: int, scale: float, alpha: float = 0.05, trials: int = 2000, seed: int = 0) -> float:
@@ -68,9 +71,7 @@ def ecdf_power(count: int, scale: float, alpha: float = 0.05, trials: int = 2000
     band = ecdf_band(count, alpha, seed)
     rng = np.random.default_rng(seed + 1)
     fractions = norm.cdf(rng.standard_normal((trials, count)) / scale)
-    points, lower, upper = band
-    ecdf = _ecdf(fractions, points)
-    return float(np.mean(np.any((ecdf < lower) | (ecdf > upper), axis=1)))
+    return float(np.mean(outside_band(fractions, band)))
 
 
 def central_coverage(scale: float, level: float = 0.9) -> float:

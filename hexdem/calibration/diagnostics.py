@@ -74,13 +74,12 @@ def goodness_of_fit(likelihood, states, parameters: int, rng, draws: int = PREDI
 def misfit_records(fit: dict, threshold: float) -> list[str]:
     """The records of ``fit`` (:func:`goodness_of_fit`) whose p-value, at the median or predictive,
     lies below ``threshold``."""
-    return [
-        entry["record"] for entry in fit["records"] if min(entry["p_value"], entry["predictive_p_value"]) < threshold
-    ]
+    return [entry["record"] for entry in fit["records"] if misfit_together(entry, threshold)]
 
 
 def misfit_together(fit: dict, threshold: float) -> bool:
-    """Whether the records together do not fit (:func:`goodness_of_fit`): either p-value below ``threshold``."""
+    """Whether ``fit`` (:func:`goodness_of_fit`'s records together, or one record's entry) does not fit:
+    either p-value below ``threshold``."""
     return min(fit["p_value"], fit["predictive_p_value"]) < threshold
 
 

@@ -61,10 +61,9 @@ from hexdem.calibration.spread import (
     MEDIAN_VARIANCE,
     NOISY_NUGGET,
     Spread,
-    disordered_range,
+    ideal_sets,
     level_groups,
     packing_centres,
-    robust_sd,
 )
 from hexdem.errors import HexdemError
 
@@ -335,17 +334,14 @@ def fit_stage(
         )
     spread = Spread(points, observables, *records_scatter(data, instruments), smooth=smooth)
     told = detected > 0
-    held = None
-    if observables.shape[1] >= 2:
-        sd = robust_sd(observables, np.isfinite(observables[..., 0]))
-        held = disordered_range(points, sd, smooth)
-        told &= np.any(sd > 0, axis=1) | (detected < 2) if held is not None else True
+    if spread.held is not None:
+        told &= ~ideal_sets(observables)
     emulator = Emulator(
         points[told],
         packing_centres(observables[told]),
         nugget_max=NOISY_NUGGET if smooth else 0.1,
         smooth=smooth,
-        held=held,
+        held=spread.held,
         groups=level_groups(points[told], smooth),
     )
     detection = Detection(points, observables, smooth) if observables.shape[1] >= 2 else None

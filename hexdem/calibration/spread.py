@@ -121,7 +121,7 @@ def disordered_range(points, sd, smooth) -> tuple[np.ndarray, np.ndarray] | None
     """(lowest (p,), highest (p,)) of the unit-cube ``points`` (n, p) whose packings differ (robust
     ``sd`` (n, m) above 0 somewhere) along the ``smooth`` dimensions (σ's), unbounded along the
     others: where the emulators of the packings' centre and spread are held (see the module
-    docstring); None where no dimension is smooth or no set's packings differ."""
+    docstring; :attr:`Spread.held`); None where no dimension is smooth or no set's packings differ."""
     differ = np.any(np.asarray(sd) > 0, axis=1)
     if not smooth or not differ.any():
         return None
@@ -129,6 +129,14 @@ def disordered_range(points, sd, smooth) -> tuple[np.ndarray, np.ndarray] | None
     for j in smooth:
         lowest[j], highest[j] = points[differ, j].min(), points[differ, j].max()
     return lowest, highest
+
+
+def ideal_sets(observables) -> np.ndarray:
+    """Which parameter sets (n,) of ``observables`` (n, K, m) (NaN where a packing's pulse was not
+    detected) have two or more detected packings that all agree exactly: the ideal lattice, σ = 0,
+    which tells neither the packings' centre nor their spread along σ (see the module docstring)."""
+    valid = np.isfinite(np.asarray(observables, float)[..., 0])
+    return (valid.sum(axis=1) >= 2) & ~np.any(robust_sd(observables, valid) > 0, axis=1)
 
 
 def level_groups(points, smooth) -> np.ndarray | None:
@@ -195,25 +203,26 @@ class Spread:
     def __init__(self, points, observables, scatter=None, scatter_dof: int = 0, smooth=()):
         observables = np.asarray(observables, float)
         n, self.realizations, self.size = observables.shape
+        self.held = None
         if self.realizations < 2:
             return
         valid = np.isfinite(observables[..., 0])
         counts = valid.sum(axis=1)
         usable = counts >= 2
         points, observables, valid, counts = points[usable], observables[usable], valid[usable], counts[usable]
-        mean = np.nanmean(np.where(valid[..., None], observables, np.nan), axis=1, keepdims=True)
+        mean = np.nanmean(observables, axis=1, keepdims=True)
         centred = np.where(valid[..., None], observables - mean, 0.0)
         sd = robust_sd(observables, valid)
         spread = np.any(sd > 0, axis=1)
-        held, groups = disordered_range(points, sd, smooth), level_groups(points[spread], smooth)
+        self.held = disordered_range(points, sd, smooth)
         floor = np.maximum(LOG_SD_FLOOR * np.median(sd[spread], axis=0), SD_FLOOR)
         self.sd = Emulator(
             points[spread],
             np.log(np.maximum(sd[spread], floor)),
             nugget_max=NOISY_NUGGET,
             smooth=smooth,
-            held=held,
-            groups=groups,
+            held=self.held,
+            groups=level_groups(points[spread], smooth),
         )
         self.dof = int(np.median(counts)) - 1
         scaled = centred / self._sd(points)[:, None, :]

@@ -62,15 +62,7 @@ class LabFaults:
         """``accelerations`` (K, n_sensors, 2) sampled at ``times`` (K,), as the lab samples them: each
         sensor at times + (phase × ``interval``) + its skew, the cubic spline through the samples
         (zero before the first), times each axis's gain."""
-        from scipy.interpolate import CubicSpline
-
-        shifted = np.empty_like(accelerations)
-        for sensor, skew in enumerate(self.skew_s):
-            at = times + self.sample_phase * interval + skew
-            shifted[:, sensor] = np.nan_to_num(
-                CubicSpline(times, accelerations[:, sensor], axis=0, extrapolate=False)(at)
-            )
-        return shifted * self.axis_gains[None]
+        return sampled_at(times, accelerations, self.sample_phase * interval + self.skew_s) * self.axis_gains[None]
 
     def recorded(self, accelerations, level, rng) -> np.ndarray:
         """``accelerations`` (K, n_sensors, 2) with noise of each channel's ``level`` (n_sensors, 2),
@@ -153,17 +145,22 @@ def model_error_applied(times, accelerations, model_error) -> np.ndarray:
     sensor's, t_i, later by ``model_error[i, 1]`` t_i (the first sensor's arrival is the reference:
     its column is unused). The delayed signal is the cubic spline through its samples, zero before
     the first."""
-    from scipy.interpolate import CubicSpline
-
     model_error = np.asarray(model_error, float)
     arrivals = pulses(times, accelerations.transpose(1, 0, 2))[1]
     delays = np.nan_to_num(model_error[:, 1] * (arrivals - arrivals[0]))  # a sensor without a pulse: none
+    return sampled_at(times, accelerations, -delays) * np.exp(model_error[:, 0])[None, :, None]
+
+
+def sampled_at(times, accelerations, offsets_s) -> np.ndarray:
+    """``accelerations`` (K, n_sensors, 2), sampled at ``times`` (K,) [s], at times + ``offsets_s[i]``
+    for each sensor i: the cubic spline through its samples, zero outside them."""
+    from scipy.interpolate import CubicSpline
+
     shifted = np.empty_like(accelerations)
-    for sensor, delay in enumerate(delays):
-        later = times - delay
-        values = CubicSpline(times, accelerations[:, sensor], axis=0, extrapolate=False)(later)
-        shifted[:, sensor] = np.nan_to_num(values)
-    return shifted * np.exp(model_error[:, 0])[None, :, None]
+    for sensor, offset in enumerate(offsets_s):
+        spline = CubicSpline(times, accelerations[:, sensor], axis=0, extrapolate=False)
+        shifted[:, sensor] = np.nan_to_num(spline(times + offset))
+    return shifted
 
 
 def write_measured(path, rows, unit: str = "m/s2", single_axis: bool = False) -> None:
